@@ -1,0 +1,112 @@
+#include "fovea/core/display.hpp"
+
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+
+#include <nlohmann/json.hpp>
+
+#include "fovea/core/error.hpp"
+
+namespace fovea::core {
+
+namespace embedded_displays {
+std::span<const std::uint8_t> find(std::string_view name);
+std::vector<std::string_view> names();
+}  // namespace embedded_displays
+
+namespace {
+
+using nlohmann::json;
+
+[[noreturn]] void fail(std::string_view origin, const std::string& what) {
+  throw InputError(std::string(origin) + ": " + what);
+}
+
+double number(const json& j, const char* key, std::string_view origin, const std::string& path) {
+  if (!j.contains(key) || !j[key].is_number()) fail(origin, "missing or non-numeric \"" + path + key + "\"");
+  const double v = j[key].get<double>();
+  if (!std::isfinite(v)) fail(origin, "non-finite \"" + path + key + "\"");
+  return v;
+}
+
+Fov read_fov(const json& j, std::string_view origin, const std::string& path) {
+  if (!j.is_object()) fail(origin, "\"" + path + "\" must be an object");
+  const std::string p = path + ".";
+  return Fov::from_degrees(number(j, "left", origin, p), number(j, "right", origin, p),
+                           number(j, "up", origin, p), number(j, "down", origin, p));
+}
+
+}  // namespace
+
+DisplayPreset parse_display(std::string_view text, std::string_view origin) {
+  json j;
+  try {
+    j = json::parse(text);
+  } catch (const json::parse_error& e) {
+    fail(origin, std::string("invalid JSON: ") + e.what());
+  }
+  if (!j.is_object()) fail(origin, "top level must be an object");
+  DisplayPreset d;
+  d.json = std::string(text);
+  d.name = j.value("name", std::string());
+  if (d.name.empty()) fail(origin, "missing \"name\"");
+  d.description = j.value("description", std::string());
+  const double w = number(j, "width", origin, ""), h = number(j, "height", origin, "");
+  if (w < 1 || h < 1 || w > 65536 || h > 65536 || w != std::floor(w) || h != std::floor(h))
+    fail(origin, "\"width\"/\"height\" must be whole numbers in 1..65536");
+  d.width = static_cast<int>(w);
+  d.height = static_cast<int>(h);
+  if (!j.contains("fov_deg")) fail(origin, "missing \"fov_deg\"");
+  d.fov_left = read_fov(j["fov_deg"], origin, "fov_deg");
+  d.fov_right = j.contains("fov_deg_right") ? read_fov(j["fov_deg_right"], origin, "fov_deg_right")
+                                            : d.fov_left.mirrored();
+  if (j.contains("refresh_hz")) d.refresh_hz = number(j, "refresh_hz", origin, "");
+  if (j.contains("ipd_m")) d.ipd_m = number(j, "ipd_m", origin, "");
+  if (!(d.refresh_hz > 0 && d.refresh_hz <= 1000)) fail(origin, "\"refresh_hz\" must be in (0, 1000]");
+  try {  // validates the FOV and raster
+    (void)d.view(Eye::Left);
+    (void)d.view(Eye::Right);
+  } catch (const InputError& e) {
+    fail(origin, e.what());
+  }
+  return d;
+}
+
+DisplayPreset load_display(std::string_view name_or_path) {
+  const auto bytes = embedded_displays::find(std::string(name_or_path) + ".json");
+  if (!bytes.empty())
+    return parse_display(std::string_view(reinterpret_cast<const char*>(bytes.data()), bytes.size()),
+                         name_or_path);
+  const std::filesystem::path path(name_or_path);
+  std::ifstream in(path, std::ios::binary);
+  if (!in) {
+    std::string names;
+    for (const auto& n : display_preset_names()) names += (names.empty() ? "" : ", ") + n;
+    throw InputError("display \"" + std::string(name_or_path) +
+                     "\": neither a preset name (" + names + ") nor a readable file");
+  }
+  std::ostringstream ss;
+  ss << in.rdbuf();
+  return parse_display(ss.str(), path.string());
+}
+
+std::vector<std::string> display_preset_names() {
+  std::vector<std::string> out;
+  for (auto n : embedded_displays::names()) {
+    std::string s(n);
+    if (s.size() > 5 && s.ends_with(".json")) out.push_back(s.substr(0, s.size() - 5));
+  }
+  return out;
+}
+
+Eye parse_eye(std::string_view s) {
+  if (s == "left") return Eye::Left;
+  if (s == "right") return Eye::Right;
+  throw InputError("eye: expected left or right, got \"" + std::string(s) + "\"");
+}
+
+const char* eye_name(Eye e) { return e == Eye::Left ? "left" : "right"; }
+
+}  // namespace fovea::core

@@ -1,0 +1,104 @@
+#include "fovea/core/image.hpp"
+
+#include <unistd.h>
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <cstdio>
+#include <filesystem>
+#include <stdexcept>
+
+#include <stb/stb_image.h>
+#include <stb/stb_image_write.h>
+
+#include "fovea/core/error.hpp"
+
+namespace fovea::core {
+
+float srgb_encode(float x) {
+  if (!(x > 0)) return 0;  // also NaN
+  if (x >= 1) return 1;
+  return x <= 0.0031308f ? 12.92f * x : 1.055f * std::pow(x, 1 / 2.4f) - 0.055f;
+}
+
+float srgb_decode(float x) {
+  return x <= 0.04045f ? x / 12.92f : std::pow((x + 0.055f) / 1.055f, 2.4f);
+}
+
+void write_file_atomic(const std::string& path, std::span<const std::uint8_t> bytes) {
+  const std::string tmp = path + ".tmp." + std::to_string(::getpid());
+  std::FILE* f = std::fopen(tmp.c_str(), "wb");
+  if (!f) throw std::runtime_error(path + ": cannot open for writing");
+  const bool ok = std::fwrite(bytes.data(), 1, bytes.size(), f) == bytes.size();
+  if (std::fclose(f) != 0 || !ok) {
+    std::remove(tmp.c_str());
+    throw std::runtime_error(path + ": write failed");
+  }
+  std::error_code ec;
+  std::filesystem::rename(tmp, path, ec);
+  if (ec) {
+    std::remove(tmp.c_str());
+    throw std::runtime_error(path + ": rename failed: " + ec.message());
+  }
+}
+
+void write_file_atomic(const std::string& path, const std::string& text) {
+  write_file_atomic(path, std::span(reinterpret_cast<const std::uint8_t*>(text.data()), text.size()));
+}
+
+void write_png(const std::string& path, const Image& img, Encoding enc) {
+  if (img.width < 1 || img.height < 1) throw std::runtime_error(path + ": empty image");
+  std::vector<std::uint8_t> rgba(size_t(img.width) * img.height * 4);
+  for (size_t i = 0; i < img.pixels.size(); ++i)
+    for (int c = 0; c < 4; ++c) {
+      float v = img.pixels[i][c];
+      if (c < 3 && enc == Encoding::Srgb) v = srgb_encode(v);
+      v = std::isfinite(v) ? std::clamp(v, 0.0f, 1.0f) : 0.0f;
+      rgba[i * 4 + c] = static_cast<std::uint8_t>(std::lround(v * 255.0f));
+    }
+  std::vector<std::uint8_t> png;
+  auto sink = [](void* ctx, void* data, int size) {
+    auto* v = static_cast<std::vector<std::uint8_t>*>(ctx);
+    v->insert(v->end(), static_cast<std::uint8_t*>(data), static_cast<std::uint8_t*>(data) + size);
+  };
+  if (!stbi_write_png_to_func(sink, &png, img.width, img.height, 4, rgba.data(), img.width * 4))
+    throw std::runtime_error(path + ": PNG encoding failed");
+  write_file_atomic(path, png);
+}
+
+Image read_png(const std::string& path, Encoding enc) {
+  int w = 0, h = 0, n = 0;
+  std::uint8_t* data = stbi_load(path.c_str(), &w, &h, &n, 4);
+  if (!data) throw InputError(path + ": cannot read PNG (" + std::string(stbi_failure_reason()) + ")");
+  Image img(w, h);
+  for (size_t i = 0; i < img.pixels.size(); ++i)
+    for (int c = 0; c < 4; ++c) {
+      float v = data[i * 4 + c] / 255.0f;
+      img.pixels[i][c] = (c < 3 && enc == Encoding::Srgb) ? srgb_decode(v) : v;
+    }
+  stbi_image_free(data);
+  return img;
+}
+
+glm::vec4 colormap_inferno(float t) {
+  // Piecewise-linear through samples of matplotlib's "inferno" (sRGB-encoded values).
+  static constexpr std::array<std::array<float, 3>, 9> k = {{{0.001f, 0.000f, 0.014f},
+                                                             {0.088f, 0.042f, 0.227f},
+                                                             {0.258f, 0.039f, 0.406f},
+                                                             {0.416f, 0.090f, 0.433f},
+                                                             {0.578f, 0.148f, 0.404f},
+                                                             {0.735f, 0.216f, 0.330f},
+                                                             {0.865f, 0.317f, 0.226f},
+                                                             {0.955f, 0.475f, 0.094f},
+                                                             {0.988f, 0.998f, 0.645f}}};
+  if (!std::isfinite(t)) t = 0;
+  t = std::clamp(t, 0.0f, 1.0f) * (k.size() - 1);
+  const int i = std::min(static_cast<int>(t), static_cast<int>(k.size()) - 2);
+  const float f = t - i;
+  glm::vec4 c{0, 0, 0, 1};
+  for (int j = 0; j < 3; ++j) c[j] = srgb_decode(k[i][j] + f * (k[i + 1][j] - k[i][j]));
+  return c;
+}
+
+}  // namespace fovea::core
