@@ -1,0 +1,30 @@
+// One sample of a sample grid (any distribution), as produced by the grid-generation
+// shader and consumed by the path tracer and the reconstruction. Shared C++/GLSL.
+#ifndef FOVEA_SHADERS_GRID_H
+#define FOVEA_SHADERS_GRID_H
+#include "fovea/shaders/common.h"
+
+#ifdef __cplusplus
+namespace fovea::shaders {
+#endif
+
+// flags: 0 means "trace this cell"; any bit set means the thread skips it.
+FOVEA_CONST FOVEA_UINT kCellClipped = FOVEA_U(1);    // beyond the column's row count (VP clip)
+FOVEA_CONST FOVEA_UINT kCellOffscreen = FOVEA_U(2);  // direction outside the view frustum
+FOVEA_CONST FOVEA_UINT kCellHidden = FOVEA_U(4);     // inside the lens' hidden area
+FOVEA_CONST FOVEA_UINT kCellKilled = FOVEA_U(8);     // randomly killed (linear fall-off)
+FOVEA_CONST FOVEA_UINT kCellPadding = FOVEA_U(16);   // padding to whole 32x32 blocks
+
+struct GridSample {
+  float dir_x, dir_y, dir_z;  // unit view-space direction (OpenXR: -Z forward, +Y up)
+  FOVEA_UINT flags;
+  float screen_x, screen_y;   // continuous display pixel position, origin top-left, y down
+  float ecc_deg;              // eccentricity from the gaze, degrees
+  float footprint;            // sample spacing in display pixels (sqrt of pixels per sample)
+};
+
+#ifdef __cplusplus
+static_assert(sizeof(GridSample) == 32);
+}  // namespace fovea::shaders
+#endif
+#endif
