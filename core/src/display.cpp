@@ -64,6 +64,7 @@ DisplayPreset parse_display(std::string_view text, std::string_view origin) {
                                             : d.fov_left.mirrored();
   if (j.contains("refresh_hz")) d.refresh_hz = number(j, "refresh_hz", origin, "");
   if (j.contains("ipd_m")) d.ipd_m = number(j, "ipd_m", origin, "");
+  d.lens = parse_lens_params(text, origin);
   if (!(d.refresh_hz > 0 && d.refresh_hz <= 1000)) fail(origin, "\"refresh_hz\" must be in (0, 1000]");
   try {  // validates the FOV and raster
     (void)d.view(Eye::Left);

@@ -6,6 +6,7 @@
 #include <string_view>
 #include <vector>
 
+#include "fovea/core/lens_params.hpp"
 #include "fovea/core/view.hpp"
 
 namespace fovea::core {
@@ -20,6 +21,7 @@ struct DisplayPreset {
   Fov fov_right;
   double refresh_hz = 90;
   double ipd_m = 0.063;
+  LensParams lens;   // the "lens" section (left eye; the right eye mirrors it), lens.hpp
   std::string json;  // the preset's source text, for modules that read their own sections
 
   const Fov& fov(Eye e) const { return e == Eye::Left ? fov_left : fov_right; }
