@@ -1,0 +1,412 @@
+// glTF 2.0 through tinygltf (the Debian library). tinygltf parses the JSON and decodes
+// images; everything it hands back is treated as untrusted: every index, offset, stride
+// and count is checked here before use.
+#include <algorithm>
+#include <cmath>
+#include <cstring>
+#include <filesystem>
+#include <set>
+
+#include <glm/geometric.hpp>
+#include <glm/gtc/matrix_transform.hpp>
+#include <glm/gtc/quaternion.hpp>
+#include <glm/gtc/type_ptr.hpp>
+#include <glm/mat3x3.hpp>
+#include <glm/mat4x4.hpp>
+#include <tiny_gltf.h>
+
+#include "fovea/core/error.hpp"
+#include "fovea/renderer/scene_io.hpp"
+
+namespace fovea::renderer {
+
+namespace {
+
+using tinygltf::Model;
+
+struct Ctx {
+  const Model& m;
+  Scene& s;
+  std::string origin;
+  const SceneLimits& limits;
+  std::vector<std::uint32_t> material_map;  // glTF material index -> scene material
+  std::uint32_t default_material = 0;
+  bool have_camera = false;
+  std::size_t triangles_seen = 0;  // triangles instantiated so far (DAGs can explode)
+
+  void warn(const std::string& w) {
+    if (std::find(s.warnings.begin(), s.warnings.end(), origin + ": " + w) == s.warnings.end())
+      s.warnings.push_back(origin + ": " + w);
+  }
+};
+
+int component_count(int type) {
+  switch (type) {
+    case TINYGLTF_TYPE_SCALAR: return 1;
+    case TINYGLTF_TYPE_VEC2: return 2;
+    case TINYGLTF_TYPE_VEC3: return 3;
+    case TINYGLTF_TYPE_VEC4: return 4;
+    default: return 0;
+  }
+}
+
+int component_size(int ct) {
+  switch (ct) {
+    case TINYGLTF_COMPONENT_TYPE_BYTE:
+    case TINYGLTF_COMPONENT_TYPE_UNSIGNED_BYTE: return 1;
+    case TINYGLTF_COMPONENT_TYPE_SHORT:
+    case TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT: return 2;
+    case TINYGLTF_COMPONENT_TYPE_UNSIGNED_INT:
+    case TINYGLTF_COMPONENT_TYPE_FLOAT: return 4;
+    default: return 0;
+  }
+}
+
+// One component as a double; normalised integers map to [0,1] / [-1,1] (glTF §3.11).
+double read_component(const unsigned char* p, int ct, bool normalized) {
+  switch (ct) {
+    case TINYGLTF_COMPONENT_TYPE_FLOAT: { float f; std::memcpy(&f, p, 4); return f; }
+    case TINYGLTF_COMPONENT_TYPE_UNSIGNED_INT: { std::uint32_t v; std::memcpy(&v, p, 4); return v; }
+    case TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT: {
+      std::uint16_t v; std::memcpy(&v, p, 2); return normalized ? v / 65535.0 : v;
+    }
+    case TINYGLTF_COMPONENT_TYPE_SHORT: {
+      std::int16_t v; std::memcpy(&v, p, 2); return normalized ? std::max(v / 32767.0, -1.0) : v;
+    }
+    case TINYGLTF_COMPONENT_TYPE_UNSIGNED_BYTE: return normalized ? *p / 255.0 : *p;
+    case TINYGLTF_COMPONENT_TYPE_BYTE: {
+      const auto v = static_cast<std::int8_t>(*p); return normalized ? std::max(v / 127.0, -1.0) : v;
+    }
+    default: return 0;
+  }
+}
+
+// Reads accessor `index` as `comps` doubles per element. Returns false (with `why`) for
+// anything out of range: indices, offsets, strides, counts, types, sparse storage.
+bool read_accessor(const Model& m, int index, int comps, std::vector<double>& out, std::string& why) {
+  if (index < 0 || std::size_t(index) >= m.accessors.size()) {
+    why = "accessor index " + std::to_string(index) + " out of range";
+    return false;
+  }
+  const auto& a = m.accessors[std::size_t(index)];
+  if (a.sparse.isSparse) { why = "sparse accessors are not supported"; return false; }
+  const int nc = component_count(a.type), cs = component_size(a.componentType);
+  if (nc != comps || cs == 0) { why = "accessor " + std::to_string(index) + " has an unexpected type"; return false; }
+  if (a.bufferView < 0 || std::size_t(a.bufferView) >= m.bufferViews.size()) {
+    why = "accessor " + std::to_string(index) + " references a missing bufferView";
+    return false;
+  }
+  const auto& bv = m.bufferViews[std::size_t(a.bufferView)];
+  if (bv.buffer < 0 || std::size_t(bv.buffer) >= m.buffers.size()) {
+    why = "bufferView " + std::to_string(a.bufferView) + " references a missing buffer";
+    return false;
+  }
+  const auto& buf = m.buffers[std::size_t(bv.buffer)].data;
+  const std::size_t elem = std::size_t(nc) * std::size_t(cs);
+  const std::size_t stride = bv.byteStride ? bv.byteStride : elem;
+  const std::size_t count = a.count;
+  // All arithmetic checked against the buffer size without overflow.
+  const std::size_t view_off = bv.byteOffset, view_len = bv.byteLength, acc_off = a.byteOffset;
+  if (stride < elem || stride > 252 || view_off > buf.size() || view_len > buf.size() - view_off ||
+      acc_off > view_len || count > (std::size_t(1) << 31)) {
+    why = "accessor " + std::to_string(index) + " lies outside its buffer";
+    return false;
+  }
+  if (count > 0 && (count - 1) > (view_len - acc_off) / stride) {
+    why = "accessor " + std::to_string(index) + " lies outside its buffer";
+    return false;
+  }
+  if (count > 0 && (count - 1) * stride + elem > view_len - acc_off) {
+    why = "accessor " + std::to_string(index) + " lies outside its buffer";
+    return false;
+  }
+  out.resize(count * std::size_t(nc));
+  const unsigned char* base = buf.data() + view_off + acc_off;
+  for (std::size_t i = 0; i < count; ++i)
+    for (int c = 0; c < nc; ++c)
+      out[i * nc + c] = read_component(base + i * stride + std::size_t(c) * cs, a.componentType, a.normalized);
+  return true;
+}
+
+int find_attribute(const tinygltf::Primitive& p, const char* name) {
+  const auto it = p.attributes.find(name);
+  return it == p.attributes.end() ? -1 : it->second;
+}
+
+void load_textures(Ctx& c) {
+  for (const auto& tex : c.m.textures) {
+    Texture t;
+    t.name = tex.name;
+    const int src = tex.source;
+    if (src < 0 || std::size_t(src) >= c.m.images.size()) {
+      c.warn("texture without a valid image, replaced by white");
+    } else {
+      const auto& img = c.m.images[std::size_t(src)];
+      const int comp = img.component;
+      const std::size_t bpc = img.bits == 16 ? 2 : img.bits == 8 ? 1 : 0;
+      const bool ok = img.width > 0 && img.height > 0 && img.width <= c.limits.max_texture_size &&
+                      img.height <= c.limits.max_texture_size && comp >= 1 && comp <= 4 && bpc != 0 &&
+                      img.image.size() == std::size_t(img.width) * img.height * comp * bpc;
+      if (!ok) {
+        c.warn("image \"" + img.uri.substr(0, 64) + "\" missing or undecodable, replaced by white");
+      } else {
+        t.width = img.width;
+        t.height = img.height;
+        t.rgba.resize(std::size_t(t.width) * t.height * 4);
+        for (std::size_t i = 0; i < std::size_t(t.width) * t.height; ++i) {
+          std::uint8_t px[4] = {0, 0, 0, 255};
+          for (int k = 0; k < comp; ++k)  // 16-bit: keep the high byte (little endian)
+            px[k] = img.image[(i * comp + k) * bpc + (bpc - 1)];
+          if (comp <= 2) px[2] = px[1] = px[0], px[3] = comp == 2 ? img.image[(i * comp + 1) * bpc + bpc - 1] : 255;
+          std::memcpy(&t.rgba[i * 4], px, 4);
+        }
+      }
+    }
+    if (t.width == 0) {
+      t.width = t.height = 1;
+      t.rgba = {255, 255, 255, 255};
+    }
+    c.s.textures.push_back(std::move(t));
+  }
+}
+
+void load_materials(Ctx& c) {
+  Material def;
+  def.name = "gltf-default";  // glTF §3.9.6: the default material
+  def.base_color = glm::vec3(1.0f);
+  def.metallic = 1.0f;
+  def.roughness = 1.0f;
+  c.default_material = c.s.add_material(def);
+  for (const auto& gm : c.m.materials) {
+    Material m;
+    m.name = gm.name;
+    const auto& pbr = gm.pbrMetallicRoughness;
+    if (pbr.baseColorFactor.size() >= 3)
+      m.base_color = glm::vec3(float(pbr.baseColorFactor[0]), float(pbr.baseColorFactor[1]), float(pbr.baseColorFactor[2]));
+    m.metallic = float(pbr.metallicFactor);
+    m.roughness = float(pbr.roughnessFactor);
+    const int ti = pbr.baseColorTexture.index;
+    if (ti >= 0 && std::size_t(ti) < c.s.textures.size()) m.base_color_texture = ti;
+    else if (ti >= 0) c.warn("material \"" + gm.name + "\" references a missing texture, ignored");
+    if (gm.emissiveFactor.size() >= 3)
+      m.emission = glm::vec3(float(gm.emissiveFactor[0]), float(gm.emissiveFactor[1]), float(gm.emissiveFactor[2]));
+    const auto ext = gm.extensions.find("KHR_materials_emissive_strength");
+    if (ext != gm.extensions.end() && ext->second.IsObject() && ext->second.Has("emissiveStrength") &&
+        ext->second.Get("emissiveStrength").IsNumber())
+      m.emission *= float(ext->second.Get("emissiveStrength").GetNumberAsDouble());
+    c.material_map.push_back(c.s.add_material(m));
+  }
+}
+
+bool finite_matrix(const glm::dmat4& t) {
+  for (int i = 0; i < 4; ++i)
+    for (int j = 0; j < 4; ++j)
+      if (!std::isfinite(t[i][j])) return false;
+  return true;
+}
+
+glm::dmat4 local_transform(const tinygltf::Node& n) {
+  if (n.matrix.size() == 16) return glm::make_mat4(n.matrix.data());
+  glm::dmat4 t(1.0);
+  if (n.translation.size() == 3) t = glm::translate(t, glm::dvec3(n.translation[0], n.translation[1], n.translation[2]));
+  if (n.rotation.size() == 4) {
+    glm::dquat q(n.rotation[3], n.rotation[0], n.rotation[1], n.rotation[2]);
+    const double len = glm::length(q);
+    if (len > 0 && std::isfinite(len)) t = t * glm::mat4_cast(q / len);
+  }
+  if (n.scale.size() == 3) t = glm::scale(t, glm::dvec3(n.scale[0], n.scale[1], n.scale[2]));
+  return t;
+}
+
+void add_primitive(Ctx& c, const tinygltf::Primitive& p, const glm::dmat4& world, const std::string& mesh_name) {
+  const std::string where = "mesh \"" + mesh_name + "\"";
+  if (p.mode != TINYGLTF_MODE_TRIANGLES && p.mode != -1) {
+    c.warn(where + ": non-triangle primitive skipped");
+    return;
+  }
+  std::string why;
+  std::vector<double> pos, nrm, uv, idx;
+  if (!read_accessor(c.m, find_attribute(p, "POSITION"), 3, pos, why)) {
+    c.warn(where + ": primitive skipped, POSITION: " + why);
+    return;
+  }
+  const std::size_t nv = pos.size() / 3;
+  const int ni = find_attribute(p, "NORMAL"), nt = find_attribute(p, "TEXCOORD_0");
+  if (ni >= 0 && (!read_accessor(c.m, ni, 3, nrm, why) || nrm.size() != pos.size())) {
+    c.warn(where + ": normals ignored (" + (why.empty() ? "count mismatch" : why) + ")");
+    nrm.clear();
+  }
+  why.clear();
+  if (nt >= 0 && (!read_accessor(c.m, nt, 2, uv, why) || uv.size() != 2 * nv)) {
+    c.warn(where + ": texture coordinates ignored (" + (why.empty() ? "count mismatch" : why) + ")");
+    uv.clear();
+  }
+  if (p.indices >= 0) {
+    if (!read_accessor(c.m, p.indices, 1, idx, why)) {
+      c.warn(where + ": primitive skipped, indices: " + why);
+      return;
+    }
+  } else {
+    idx.resize(nv);
+    for (std::size_t i = 0; i < nv; ++i) idx[i] = double(i);
+  }
+  std::uint32_t mat = c.default_material;
+  if (p.material >= 0 && std::size_t(p.material) < c.material_map.size()) mat = c.material_map[std::size_t(p.material)];
+  else if (p.material >= 0) c.warn(where + ": invalid material index, default material used");
+  const std::size_t ntri = idx.size() / 3;
+  c.triangles_seen += ntri;
+  if (c.triangles_seen > c.limits.max_triangles)
+    throw core::InputError(c.origin + ": more than " + std::to_string(c.limits.max_triangles) +
+                           " triangles after instancing the node graph");
+  const glm::dmat3 nmat = glm::transpose(glm::inverse(glm::dmat3(world)));
+  // Mirroring transforms reverse the winding; swapping two vertices keeps front faces.
+  const bool flip = glm::determinant(glm::dmat3(world)) < 0;
+  std::size_t bad = 0;
+  for (std::size_t t = 0; t < ntri; ++t) {
+    glm::vec3 P[3], N[3];
+    glm::vec2 T[3];
+    bool ok = true;
+    for (int k = 0; k < 3; ++k) {
+      const double iv = idx[3 * t + k];
+      if (!(iv >= 0 && iv < double(nv))) { ok = false; break; }
+      const std::size_t v = std::size_t(iv);
+      P[k] = glm::vec3(world * glm::dvec4(pos[3 * v], pos[3 * v + 1], pos[3 * v + 2], 1.0));
+      N[k] = nrm.empty() ? glm::vec3(0) : glm::vec3(nmat * glm::dvec3(nrm[3 * v], nrm[3 * v + 1], nrm[3 * v + 2]));
+      T[k] = uv.empty() ? glm::vec2(0) : glm::vec2(float(uv[2 * v]), float(uv[2 * v + 1]));
+    }
+    if (!ok) { ++bad; continue; }
+    if (flip) {
+      std::swap(P[1], P[2]);
+      std::swap(N[1], N[2]);
+      std::swap(T[1], T[2]);
+    }
+    c.s.add_triangle(P[0], P[1], P[2], mat, N[0], N[1], N[2], T[0], T[1], T[2]);
+  }
+  if (bad) c.warn(where + ": " + std::to_string(bad) + " triangles with out-of-range indices dropped");
+  if (idx.size() % 3) c.warn(where + ": index count not a multiple of 3, remainder ignored");
+}
+
+void visit(Ctx& c, int node, const glm::dmat4& parent, std::vector<int>& path) {
+  if (node < 0 || std::size_t(node) >= c.m.nodes.size()) {
+    c.warn("node index " + std::to_string(node) + " out of range, skipped");
+    return;
+  }
+  if (std::find(path.begin(), path.end(), node) != path.end()) {
+    c.warn("node graph contains a cycle through node " + std::to_string(node) + ", edge dropped");
+    return;
+  }
+  if (path.size() >= 256) {
+    c.warn("node hierarchy deeper than 256 levels, truncated");
+    return;
+  }
+  const auto& n = c.m.nodes[std::size_t(node)];
+  const glm::dmat4 world = parent * local_transform(n);
+  if (!finite_matrix(world)) {
+    c.warn("node " + std::to_string(node) + " has a non-finite transform, subtree skipped");
+    return;
+  }
+  if (n.mesh >= 0) {
+    if (std::size_t(n.mesh) >= c.m.meshes.size()) {
+      c.warn("node " + std::to_string(node) + " references a missing mesh");
+    } else {
+      const auto& mesh = c.m.meshes[std::size_t(n.mesh)];
+      for (const auto& p : mesh.primitives) add_primitive(c, p, world, mesh.name);
+    }
+  }
+  if (n.camera >= 0 && !c.have_camera && std::size_t(n.camera) < c.m.cameras.size()) {
+    // glTF cameras look down -Z with +Y up, as OpenXR views do.
+    glm::dmat3 r(world);
+    for (int i = 0; i < 3; ++i) r[i] = glm::length(r[i]) > 0 ? glm::normalize(r[i]) : r[i];
+    const glm::dquat q = glm::quat_cast(r);
+    if (std::isfinite(q.w) && std::abs(glm::length(q) - 1.0) < 1e-3) {
+      c.s.camera.orientation = glm::normalize(q);
+      c.s.camera.position = glm::dvec3(world[3]);
+      c.have_camera = true;
+    }
+  }
+  path.push_back(node);
+  for (int child : n.children) visit(c, child, world, path);
+  path.pop_back();
+}
+
+Scene from_model(const Model& m, const std::string& origin, const SceneLimits& limits) {
+  Scene s;
+  s.name = std::filesystem::path(origin).stem().string();
+  Ctx c{m, s, origin, limits};
+  load_textures(c);
+  load_materials(c);
+  std::vector<int> roots;
+  if (!m.scenes.empty()) {
+    const int si = m.defaultScene >= 0 && std::size_t(m.defaultScene) < m.scenes.size() ? m.defaultScene : 0;
+    roots = m.scenes[std::size_t(si)].nodes;
+  } else {
+    // No scene: every node that is nobody's child is a root.
+    std::set<int> children;
+    for (const auto& n : m.nodes) children.insert(n.children.begin(), n.children.end());
+    for (int i = 0; i < int(m.nodes.size()); ++i)
+      if (!children.count(i)) roots.push_back(i);
+  }
+  std::vector<int> path;
+  for (int r : roots) visit(c, r, glm::dmat4(1.0), path);
+  sanitize(s, origin, limits);
+  return s;
+}
+
+// tinygltf reports problems as newline-separated text; one line is enough for a message.
+std::string first_line(const std::string& s) {
+  const auto nl = s.find('\n');
+  return s.substr(0, nl);
+}
+
+void collect_warnings(Scene& s, const std::string& origin, const std::string& warn) {
+  std::size_t start = 0;
+  while (start < warn.size()) {
+    const auto nl = warn.find('\n', start);
+    const std::string line = warn.substr(start, nl == std::string::npos ? std::string::npos : nl - start);
+    if (!line.empty()) s.warnings.push_back(origin + ": " + line);
+    if (nl == std::string::npos) break;
+    start = nl + 1;
+  }
+}
+
+}  // namespace
+
+Scene load_gltf(const std::string& path, const SceneLimits& limits) {
+  std::error_code ec;
+  if (!std::filesystem::is_regular_file(path, ec))
+    throw core::InputError(path + ": not a readable file");
+  tinygltf::TinyGLTF loader;
+  Model m;
+  std::string err, warn;
+  const bool binary = path.ends_with(".glb") || path.ends_with(".GLB");
+  bool ok = false;
+  try {
+    ok = binary ? loader.LoadBinaryFromFile(&m, &err, &warn, path)
+                : loader.LoadASCIIFromFile(&m, &err, &warn, path);
+  } catch (const std::exception& e) {  // e.g. JSON type errors thrown from inside the parser
+    err = e.what();
+  }
+  if (!ok) throw core::InputError(path + ": not a valid glTF 2.0 file: " + first_line(err.empty() ? warn : err));
+  Scene s = from_model(m, path, limits);
+  collect_warnings(s, path, warn);
+  return s;
+}
+
+Scene load_gltf_text(std::string_view text, const std::string& origin, const std::string& base_dir,
+                     const SceneLimits& limits) {
+  tinygltf::TinyGLTF loader;
+  Model m;
+  std::string err, warn;
+  bool ok = false;
+  try {
+    ok = loader.LoadASCIIFromString(&m, &err, &warn, text.data(), static_cast<unsigned>(text.size()), base_dir);
+  } catch (const std::exception& e) {
+    err = e.what();
+  }
+  if (!ok) throw core::InputError(origin + ": not a valid glTF 2.0 file: " + first_line(err.empty() ? warn : err));
+  Scene s = from_model(m, origin, limits);
+  collect_warnings(s, origin, warn);
+  return s;
+}
+
+}  // namespace fovea::renderer

@@ -1,0 +1,216 @@
+// Bad and hostile scene files: each is loaded with the offending part dropped (and a
+// warning) or refused with core::InputError; never a crash.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <cstring>
+#include <filesystem>
+#include <fstream>
+#include <limits>
+
+#include <unistd.h>
+
+#include <nlohmann/json.hpp>
+
+#include "fovea/core/error.hpp"
+#include "fovea/renderer/scene_io.hpp"
+
+namespace fr = fovea::renderer;
+namespace fs = std::filesystem;
+using nlohmann::json;
+
+namespace {
+
+std::string base64(const std::vector<std::uint8_t>& d) {
+  static const char* t = "ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz0123456789+/";
+  std::string out;
+  for (std::size_t i = 0; i < d.size(); i += 3) {
+    const std::uint32_t v = (std::uint32_t(d[i]) << 16) | (i + 1 < d.size() ? d[i + 1] << 8 : 0) |
+                            (i + 2 < d.size() ? d[i + 2] : 0);
+    out += t[(v >> 18) & 63];
+    out += t[(v >> 12) & 63];
+    out += i + 1 < d.size() ? t[(v >> 6) & 63] : '=';
+    out += i + 2 < d.size() ? t[v & 63] : '=';
+  }
+  return out;
+}
+
+// A one-mesh glTF: `pos` (xyz triples) and uint32 `idx` in one data-URI buffer.
+json make_gltf(const std::vector<float>& pos, const std::vector<std::uint32_t>& idx) {
+  std::vector<std::uint8_t> bytes(pos.size() * 4 + idx.size() * 4);
+  std::memcpy(bytes.data(), pos.data(), pos.size() * 4);
+  std::memcpy(bytes.data() + pos.size() * 4, idx.data(), idx.size() * 4);
+  json j;
+  j["asset"] = {{"version", "2.0"}};
+  j["buffers"] = json::array({{{"byteLength", bytes.size()}, {"uri", "data:application/octet-stream;base64," + base64(bytes)}}});
+  j["bufferViews"] = json::array({{{"buffer", 0}, {"byteOffset", 0}, {"byteLength", pos.size() * 4}},
+                                  {{"buffer", 0}, {"byteOffset", pos.size() * 4}, {"byteLength", idx.size() * 4}}});
+  j["accessors"] = json::array({{{"bufferView", 0}, {"componentType", 5126}, {"count", pos.size() / 3}, {"type", "VEC3"}},
+                                {{"bufferView", 1}, {"componentType", 5125}, {"count", idx.size()}, {"type", "SCALAR"}}});
+  j["meshes"] = json::array({{{"primitives", json::array({{{"attributes", {{"POSITION", 0}}}, {"indices", 1}}})}}});
+  j["nodes"] = json::array({{{"mesh", 0}}});
+  j["scenes"] = json::array({{{"nodes", json::array({0})}}});
+  j["scene"] = 0;
+  return j;
+}
+
+const std::vector<float> kTwoTris = {0, 0, 0, 1, 0, 0, 0, 1, 0, 1, 1, 0};
+const std::vector<std::uint32_t> kTwoIdx = {0, 1, 2, 1, 3, 2};
+
+class Hostile : public ::testing::Test {
+ protected:
+  fs::path dir = fs::temp_directory_path() / ("fovea_hostile_" + std::to_string(::getpid()));
+  void SetUp() override { fs::create_directories(dir); }
+  void TearDown() override { fs::remove_all(dir); }
+  std::string write(const std::string& name, const std::string& text) {
+    std::ofstream(dir / name, std::ios::binary) << text;
+    return (dir / name).string();
+  }
+  std::string write(const std::string& name, const json& j) { return write(name, j.dump()); }
+};
+
+bool has_warning(const fr::Scene& s, const std::string& what) {
+  for (const auto& w : s.warnings)
+    if (w.find(what) != std::string::npos) return true;
+  return false;
+}
+
+}  // namespace
+
+TEST_F(Hostile, OutOfRangeIndicesDropTheirTriangles) {
+  const fr::Scene s = fr::load_scene(write("a.gltf", make_gltf(kTwoTris, {0, 1, 2, 1, 99, 2})));
+  EXPECT_EQ(s.triangle_count(), 1u);
+  EXPECT_TRUE(has_warning(s, "out-of-range indices")) << s.warnings.size();
+}
+
+TEST_F(Hostile, NanAndInfPositionsDropTheirTriangles) {
+  std::vector<float> p = kTwoTris;
+  p[9] = std::numeric_limits<float>::quiet_NaN();
+  p[10] = std::numeric_limits<float>::infinity();
+  const fr::Scene s = fr::load_scene(write("a.gltf", make_gltf(p, kTwoIdx)));
+  EXPECT_EQ(s.triangle_count(), 1u);
+  EXPECT_TRUE(has_warning(s, "NaN/Inf"));
+}
+
+TEST_F(Hostile, AllTrianglesBadIsRefused) {
+  const std::string f = write("a.gltf", make_gltf(kTwoTris, {5, 6, 7}));
+  EXPECT_THROW(fr::load_scene(f), fovea::core::InputError);
+}
+
+TEST_F(Hostile, ZeroAreaTrianglesAreDropped) {
+  const fr::Scene s = fr::load_scene(write("a.gltf", make_gltf(kTwoTris, {0, 1, 2, 0, 0, 1, 1, 1, 1})));
+  EXPECT_EQ(s.triangle_count(), 1u);
+  EXPECT_TRUE(has_warning(s, "zero-area"));
+}
+
+TEST_F(Hostile, HugeCoordinatesLoadAndAbsurdOnesAreDropped) {
+  std::vector<float> p = kTwoTris;
+  for (float& v : p) v = v * 1e7f + 3e7f;
+  fr::Scene s = fr::load_scene(write("a.gltf", make_gltf(p, kTwoIdx)));
+  EXPECT_EQ(s.triangle_count(), 2u);
+  p[9] = 1e30f;
+  s = fr::load_scene(write("b.gltf", make_gltf(p, kTwoIdx)));
+  EXPECT_EQ(s.triangle_count(), 1u);
+  EXPECT_TRUE(has_warning(s, "coordinate limit"));
+}
+
+TEST_F(Hostile, MissingBufferIsRefused) {
+  json j = make_gltf(kTwoTris, kTwoIdx);
+  j["buffers"][0]["uri"] = "missing.bin";
+  EXPECT_THROW(fr::load_scene(write("a.gltf", j)), fovea::core::InputError);
+}
+
+TEST_F(Hostile, AccessorBeyondItsBufferSkipsThePrimitive) {
+  json j = make_gltf(kTwoTris, kTwoIdx);
+  j["accessors"][0]["byteOffset"] = 1u << 30;
+  EXPECT_THROW(fr::load_scene(write("a.gltf", j)), fovea::core::InputError);
+  j = make_gltf(kTwoTris, kTwoIdx);
+  j["accessors"][1]["count"] = 4000000000u;
+  EXPECT_THROW(fr::load_scene(write("b.gltf", j)), fovea::core::InputError);
+  j = make_gltf(kTwoTris, kTwoIdx);
+  j["bufferViews"][0]["buffer"] = 7;
+  EXPECT_THROW(fr::load_scene(write("c.gltf", j)), fovea::core::InputError);
+}
+
+TEST_F(Hostile, MissingTextureBecomesWhiteWithAWarning) {
+  json j = make_gltf(kTwoTris, kTwoIdx);
+  j["images"] = json::array({{{"uri", "nope.png"}}});
+  j["textures"] = json::array({{{"source", 0}}, {{"source", 5}}});
+  j["materials"] = json::array({{{"pbrMetallicRoughness", {{"baseColorTexture", {{"index", 1}}}}}}});
+  j["meshes"][0]["primitives"][0]["material"] = 0;
+  const fr::Scene s = fr::load_scene(write("a.gltf", j));
+  EXPECT_EQ(s.triangle_count(), 2u);
+  ASSERT_EQ(s.textures.size(), 2u);
+  EXPECT_EQ(s.textures[0].width, 1);
+  EXPECT_FALSE(s.warnings.empty());
+}
+
+TEST_F(Hostile, RecursiveNodeGraphIsCut) {
+  json j = make_gltf(kTwoTris, kTwoIdx);
+  j["nodes"] = json::array({{{"mesh", 0}, {"children", {1}}}, {{"children", {0, 1, 42}}}});
+  const fr::Scene s = fr::load_scene(write("a.gltf", j));
+  EXPECT_EQ(s.triangle_count(), 2u);
+  EXPECT_TRUE(has_warning(s, "cycle"));
+}
+
+TEST_F(Hostile, ExponentialInstancingIsRefused) {
+  json j = make_gltf(kTwoTris, kTwoIdx);
+  json nodes = json::array();
+  for (int i = 0; i < 40; ++i) nodes.push_back({{"children", {i + 1, i + 1}}});
+  nodes.push_back({{"mesh", 0}});
+  j["nodes"] = nodes;
+  fr::SceneLimits lim;
+  lim.max_triangles = 100000;
+  EXPECT_THROW(fr::load_scene(write("a.gltf", j), lim), fovea::core::InputError);
+}
+
+TEST_F(Hostile, NonFiniteTransformSkipsTheSubtree) {
+  json j = make_gltf(kTwoTris, kTwoIdx);
+  j["nodes"] = json::array({{{"mesh", 0}}, {{"mesh", 0}, {"scale", {1e308, 1e308, 1e308}}, {"children", {0}}}});
+  j["scenes"][0]["nodes"] = {0, 1};
+  const fr::Scene s = fr::load_scene(write("a.gltf", j));
+  EXPECT_EQ(s.triangle_count(), 2u);
+}
+
+TEST_F(Hostile, GarbageFilesAreRefused) {
+  EXPECT_THROW(fr::load_scene(write("empty.gltf", std::string())), fovea::core::InputError);
+  EXPECT_THROW(fr::load_scene(write("junk.gltf", std::string("{\"asset\": [1, 2"))), fovea::core::InputError);
+  EXPECT_THROW(fr::load_scene(write("junk.glb", std::string("glTF\x02\0\0\0\xff\xff\xff\x7f", 12))),
+               fovea::core::InputError);
+  EXPECT_THROW(fr::load_scene(write("empty.obj", std::string())), fovea::core::InputError);
+  EXPECT_THROW(fr::load_scene(write("wrong.gltf", json{{"asset", {{"version", 7}}}, {"meshes", 3}})),
+               fovea::core::InputError);
+}
+
+TEST_F(Hostile, ObjWithBadIndicesAndNansLoadsTheRest) {
+  const std::string f = write("a.obj",
+                              std::string("mtllib missing.mtl\nv 0 0 0\nv 1 0 0\nv 0 1 0\nv nan 0 0\nvn 0 0 1\n"
+                              "f 1 2 3\nf 1 2 99\nf 1 2 4\nf -1 -2 -3\nf 1//7 2//1 3//1\nusemtl nothing\nf 3 2 1\n"));
+  const fr::Scene s = fr::load_scene(f);
+  EXPECT_GE(s.triangle_count(), 2u);
+  EXPECT_FALSE(s.warnings.empty());
+}
+
+// Every glTF and OBJ model of Debian's assimp-testmodels, including its deliberately
+// malformed ones (IndexOutOfRange, MissingBin, RecursiveNodes, BoxWithInfinites, ...).
+TEST(HostileCorpus, AssimpTestModelsLoadOrAreRefused) {
+  const fs::path root = "/usr/share/assimp/models";
+  ASSERT_TRUE(fs::is_directory(root)) << "install Debian's assimp-testmodels (./x deps)";
+  int loaded = 0, refused = 0;
+  for (const char* sub : {"glTF2", "OBJ", "invalid"})
+    for (const auto& e : fs::recursive_directory_iterator(root / sub)) {
+      const std::string ext = e.path().extension().string();
+      if (ext != ".gltf" && ext != ".glb" && ext != ".obj") continue;
+      try {
+        const fr::Scene s = fr::load_scene(e.path().string());
+        EXPECT_GT(s.triangle_count(), 0u);
+        ++loaded;
+      } catch (const fovea::core::InputError& err) {
+        EXPECT_NE(std::string(err.what()).find(e.path().string()), std::string::npos) << err.what();
+        ++refused;
+      }
+    }
+  EXPECT_GT(loaded, 20);
+  EXPECT_GT(refused, 3);
+  std::printf("assimp-testmodels: %d loaded, %d refused\n", loaded, refused);
+}

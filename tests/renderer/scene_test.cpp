@@ -1,0 +1,124 @@
+// Procedural scenes, the embedded default scene, and the loaders on well-formed input.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+
+#include <glm/geometric.hpp>
+
+#include "fovea/core/error.hpp"
+#include "fovea/renderer/procedural.hpp"
+#include "fovea/renderer/scene_io.hpp"
+
+namespace fr = fovea::renderer;
+
+namespace {
+
+glm::vec3 face_normal(const fr::Scene& s, std::size_t t) {
+  const glm::vec3* p = &s.positions[3 * t];
+  return glm::normalize(glm::cross(p[1] - p[0], p[2] - p[0]));
+}
+
+std::size_t emissive_triangles(const fr::Scene& s) {
+  std::size_t n = 0;
+  for (std::size_t t = 0; t < s.triangle_count(); ++t) n += fr::triangle_power(s, t) > 0;
+  return n;
+}
+
+}  // namespace
+
+TEST(Scene, CornellLightFacesDownAndBoxIsClosed) {
+  const fr::Scene s = fr::load_scene("cornell");
+  EXPECT_EQ(s.triangle_count(), 2u * (6 + 5 + 5));
+  EXPECT_TRUE(s.warnings.empty());
+  ASSERT_EQ(emissive_triangles(s), 2u);
+  for (std::size_t t = 0; t < s.triangle_count(); ++t)
+    if (fr::triangle_power(s, t) > 0) {
+      EXPECT_NEAR(face_normal(s, t).y, -1.0f, 1e-5f);
+    }
+  const auto [lo, hi] = fr::scene_bounds(s);
+  EXPECT_NEAR(lo.x, 0.0f, 1e-6f);
+  EXPECT_NEAR(hi.x, 0.556f, 1e-6f);
+  EXPECT_NEAR(hi.y, 0.5488f, 1e-6f);
+  EXPECT_NEAR(hi.z, 0.5592f, 1e-6f);
+}
+
+TEST(Scene, MirroredCornellReflectsGeometryAndKeepsFacing) {
+  const fr::Scene a = fr::make_cornell(false), b = fr::make_cornell(true);
+  ASSERT_EQ(a.triangle_count(), b.triangle_count());
+  for (std::size_t t = 0; t < a.triangle_count(); ++t) {
+    EXPECT_NEAR(a.positions[3 * t].x, 0.556f - b.positions[3 * t].x, 1e-6f);
+    const glm::vec3 na = face_normal(a, t), nb = face_normal(b, t);
+    EXPECT_NEAR(na.x, -nb.x, 1e-5f);
+    EXPECT_NEAR(na.y, nb.y, 1e-5f);
+  }
+}
+
+TEST(Scene, FurnaceIsAClosedInwardFacingEmitter) {
+  const fr::Scene s = fr::load_scene("furnace");
+  EXPECT_EQ(emissive_triangles(s), s.triangle_count());
+  for (std::size_t t = 0; t < s.triangle_count(); ++t) {
+    const glm::vec3* p = &s.positions[3 * t];
+    const glm::vec3 centroid = (p[0] + p[1] + p[2]) / 3.0f;
+    EXPECT_LT(glm::dot(face_normal(s, t), centroid), 0.0f) << t;  // front faces the centre
+  }
+  EXPECT_EQ(s.materials[0].specular, 0.0f);
+  EXPECT_EQ(s.materials[0].base_color, glm::vec3(0.5f));
+}
+
+TEST(Scene, GlossySpheresAndOccludersHaveTheirFeatures) {
+  const fr::Scene g = fr::load_scene("glossy-spheres");
+  int ggx = 0;
+  for (const auto& m : g.materials) ggx += m.metallic == 1.0f;
+  EXPECT_EQ(ggx, 5);
+  EXPECT_EQ(emissive_triangles(g), 4u);
+  const fr::Scene o = fr::load_scene("stereo-occluders");
+  EXPECT_EQ(o.textures.size(), 1u);
+  EXPECT_GT(emissive_triangles(o), 0u);
+}
+
+TEST(Scene, DefaultGltfSceneIsSmallTexturedAndLit) {
+  const fr::Scene s = fr::load_scene("default");
+  EXPECT_GE(s.triangle_count(), 1000u);
+  EXPECT_LE(s.triangle_count(), 10000u);
+  EXPECT_TRUE(s.warnings.empty()) << s.warnings.front();
+  ASSERT_EQ(s.textures.size(), 1u);
+  EXPECT_EQ(s.textures[0].width, 64);
+  bool strength = false;
+  for (const auto& m : s.materials) strength = strength || std::abs(m.emission.x - 12.0f) < 1e-4f;
+  EXPECT_TRUE(strength) << "KHR_materials_emissive_strength not applied";
+  EXPECT_NEAR(s.camera.position.y, 1.5, 1e-6);
+  EXPECT_NEAR(s.camera.position.z, 2.2, 1e-6);
+  // Transforms: the props group is offset by z = -1.2 and the sphere by x = -0.9.
+  const auto [lo, hi] = fr::scene_bounds(s);
+  EXPECT_NEAR(lo.x, -3.0f, 1e-4f);
+  EXPECT_NEAR(hi.y, 3.0f, 1e-4f);
+  const char* src = std::getenv("FOVEA_SOURCE_DIR");
+  ASSERT_NE(src, nullptr) << "FOVEA_SOURCE_DIR not set";
+  const auto file = std::filesystem::path(src) / "data/scenes/default.gltf";
+  EXPECT_LT(std::filesystem::file_size(file), 500u * 1024u);
+  const fr::Scene f = fr::load_scene(file.string());
+  EXPECT_EQ(f.triangle_count(), s.triangle_count());
+}
+
+TEST(Scene, ObjWithMtlReadsMaterials) {
+  const auto dir = std::filesystem::temp_directory_path() / "fovea_obj_test";
+  std::filesystem::create_directories(dir);
+  std::ofstream(dir / "m.mtl") << "newmtl lamp\nKd 0.2 0.3 0.4\nKs 0.5 0.5 0.5\nNs 100\nKe 5 4 3\n";
+  std::ofstream(dir / "m.obj") << "mtllib m.mtl\nv 0 0 0\nv 1 0 0\nv 0 1 0\nv 1 1 0\nusemtl lamp\nf 1 2 3\nf 2 4 3\n";
+  const fr::Scene s = fr::load_scene((dir / "m.obj").string());
+  ASSERT_EQ(s.triangle_count(), 2u);
+  const auto& m = s.materials[s.material[0]];
+  EXPECT_EQ(m.base_color, glm::vec3(0.2f, 0.3f, 0.4f));
+  EXPECT_FLOAT_EQ(m.specular, 0.5f);
+  EXPECT_NEAR(m.roughness, std::sqrt(std::sqrt(2.0f / 102.0f)), 1e-6f);
+  EXPECT_EQ(m.emission, glm::vec3(5, 4, 3));
+  std::filesystem::remove_all(dir);
+}
+
+TEST(Scene, UnknownNameIsAnInputError) {
+  EXPECT_THROW(fr::load_scene("no-such-scene"), fovea::core::InputError);
+  EXPECT_THROW(fr::load_scene("/nonexistent/x.gltf"), fovea::core::InputError);
+}
