@@ -1,0 +1,92 @@
+#pragma once
+// Buffers: one VkBuffer with its own memory allocation (no sub-allocation; fine for
+// the few hundred buffers Fovea uses). HostVisible buffers are persistently mapped and
+// coherent; DeviceLocal buffers move data through a temporary staging buffer.
+#include <cstddef>
+#include <cstdint>
+#include <cstring>
+#include <ranges>
+#include <span>
+#include <string>
+#include <type_traits>
+#include <vector>
+
+#include "fovea/gpu/handle.hpp"
+
+namespace fovea::gpu {
+
+class Context;
+
+enum class BufferUsage : std::uint32_t {
+  Storage = VK_BUFFER_USAGE_STORAGE_BUFFER_BIT,
+  Uniform = VK_BUFFER_USAGE_UNIFORM_BUFFER_BIT,
+  TransferSrc = VK_BUFFER_USAGE_TRANSFER_SRC_BIT,
+  TransferDst = VK_BUFFER_USAGE_TRANSFER_DST_BIT,
+};
+constexpr BufferUsage operator|(BufferUsage a, BufferUsage b) {
+  return static_cast<BufferUsage>(static_cast<std::uint32_t>(a) | static_cast<std::uint32_t>(b));
+}
+
+enum class Memory {
+  DeviceLocal,  // fastest for shaders; host access goes through staging copies
+  HostVisible,  // mapped and coherent; for readback, uniforms and per-frame uploads
+};
+
+struct BufferDesc {
+  VkDeviceSize size = 0;  // bytes, > 0
+  BufferUsage usage = BufferUsage::Storage;
+  Memory memory = Memory::DeviceLocal;
+  std::string name;  // shown in validation messages
+};
+
+class Buffer {
+ public:
+  Buffer() = default;
+  // Transfer usages are always added so upload/download and copies work on any buffer.
+  Buffer(Context& ctx, const BufferDesc& desc);
+
+  VkBuffer handle() const { return buffer_.get(); }
+  VkDeviceSize size() const { return size_; }
+  bool host_visible() const { return mapped_ != nullptr; }
+  // The mapped bytes of a HostVisible buffer (empty for DeviceLocal). The GPU must be
+  // done with them (submit_and_wait returned) before the host reads.
+  std::span<std::byte> mapped() const { return {mapped_, mapped_ ? size_ : 0}; }
+
+  // Synchronous transfers (a submit_and_wait each for DeviceLocal); throw
+  // std::out_of_range when [offset, offset + bytes) exceeds the buffer.
+  void upload_bytes(std::span<const std::byte> data, VkDeviceSize offset = 0);
+  void download_bytes(std::span<std::byte> out, VkDeviceSize offset = 0) const;
+
+  template <std::ranges::contiguous_range R>
+  void upload(const R& data, VkDeviceSize offset = 0) {
+    static_assert(std::is_trivially_copyable_v<std::ranges::range_value_t<R>>);
+    upload_bytes(std::as_bytes(std::span(std::ranges::data(data), std::ranges::size(data))), offset);
+  }
+  template <class T>
+  void download(std::span<T> out, VkDeviceSize offset = 0) const {
+    static_assert(std::is_trivially_copyable_v<T>);
+    download_bytes(std::as_writable_bytes(out), offset);
+  }
+  // The whole buffer as size() / sizeof(T) elements.
+  template <class T>
+  std::vector<T> download() const {
+    std::vector<T> v(size_ / sizeof(T));
+    download(std::span<T>(v));
+    return v;
+  }
+
+ private:
+  Context* ctx_ = nullptr;
+  VkDeviceSize size_ = 0;
+  std::byte* mapped_ = nullptr;
+  DeviceHandle<VkDeviceMemory, vkFreeMemory> memory_;  // declared first: destroyed after the buffer
+  DeviceHandle<VkBuffer, vkDestroyBuffer> buffer_;
+};
+
+// Records a copy of `bytes` bytes between buffers (whole `src` when bytes == VK_WHOLE_SIZE).
+void copy_buffer(VkCommandBuffer cmd, const Buffer& src, const Buffer& dst, VkDeviceSize bytes = VK_WHOLE_SIZE,
+                 VkDeviceSize src_offset = 0, VkDeviceSize dst_offset = 0);
+// Records a fill of the whole buffer with a repeated 32-bit word.
+void fill_buffer(VkCommandBuffer cmd, const Buffer& buffer, std::uint32_t word);
+
+}  // namespace fovea::gpu

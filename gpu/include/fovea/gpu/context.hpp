@@ -1,0 +1,142 @@
+#pragma once
+// Headless Vulkan 1.2 compute context: instance, one physical device, one
+// compute-capable queue, a transient command pool. No window system.
+//
+// Device choice: env FOVEA_VK_DEVICE (case-insensitive substring of the device name)
+// or ContextOptions::device; otherwise discrete > integrated > virtual > CPU.
+// Validation: env FOVEA_VK_VALIDATION=1 or ContextOptions::validation enables
+// VK_LAYER_KHRONOS_validation (with synchronization validation) and a messenger that
+// counts errors and warnings and logs them to stderr with their message id.
+//
+// A Context is neither copyable nor movable: resources keep a pointer to it and must
+// be destroyed before it. It is meant to be used from one thread at a time.
+#include <atomic>
+#include <cstdint>
+#include <functional>
+#include <memory>
+#include <optional>
+#include <span>
+#include <string>
+#include <string_view>
+#include <vector>
+
+#include <vulkan/vulkan_core.h>
+
+namespace fovea::gpu {
+
+struct ContextOptions {
+  // Unset: read env FOVEA_VK_VALIDATION ("1"/"0"). True and the layer absent -> error.
+  std::optional<bool> validation;
+  // Unset: read env FOVEA_VK_DEVICE. Empty: automatic choice.
+  std::optional<std::string> device;
+};
+
+// Counters of validation messages, shared so they can be read after the context
+// (and its device) is gone: errors at vkDestroyDevice are counted too.
+struct ValidationCounters {
+  std::atomic<std::int64_t> errors{0};
+  std::atomic<std::int64_t> warnings{0};
+};
+
+// What the device-choice logic needs to know about one physical device.
+struct DeviceCandidate {
+  std::string name;
+  VkPhysicalDeviceType type = VK_PHYSICAL_DEVICE_TYPE_OTHER;
+  std::uint32_t api_version = 0;
+  bool has_compute_queue = false;
+};
+
+// Index of the device to use: the first candidate whose name contains `override`
+// (case-insensitive) when it is non-empty, else the best type. Throws core::InputError
+// listing every device when nothing matches, the match lacks Vulkan 1.2 or a compute
+// queue, or the list is empty.
+std::size_t choose_device(std::span<const DeviceCandidate> candidates, std::string_view override);
+
+// Properties of the chosen device that shader authors and reports care about.
+struct DeviceInfo {
+  std::string name;
+  std::string driver;  // driver name and info, e.g. "llvmpipe Mesa 22.3.6 (LLVM 15.0.6)"
+  VkPhysicalDeviceType type = VK_PHYSICAL_DEVICE_TYPE_OTHER;
+  std::uint32_t api_version = 0;
+  std::uint32_t subgroup_size = 0;
+  std::uint32_t max_shared_memory_bytes = 0;
+  std::uint32_t max_workgroup_invocations = 0;
+  std::uint32_t max_workgroup_size[3] = {0, 0, 0};
+  std::uint32_t max_push_constant_bytes = 0;
+  std::uint32_t timestamp_valid_bits = 0;  // on the chosen queue; 0 = no timestamps
+  double timestamp_period_ns = 0;          // ns per timestamp tick
+};
+
+// Optional features, enabled only when the device supports them.
+struct EnabledFeatures {
+  bool shader_int64 = false;
+  bool shader_int16 = false;
+  bool shader_int8 = false;
+  bool shader_float16 = false;
+  bool storage_buffer_8bit = false;
+  bool storage_buffer_16bit = false;
+  bool scalar_block_layout = false;
+  bool storage_image_read_without_format = false;
+  bool storage_image_write_without_format = false;
+  bool timeline_semaphore = false;
+};
+
+class Context {
+ public:
+  explicit Context(const ContextOptions& options = {});
+  ~Context();
+  Context(const Context&) = delete;
+  Context& operator=(const Context&) = delete;
+
+  VkInstance instance() const { return instance_; }
+  VkPhysicalDevice physical_device() const { return physical_device_; }
+  VkDevice device() const { return device_; }
+  VkQueue queue() const { return queue_; }
+  std::uint32_t queue_family() const { return queue_family_; }
+  const DeviceInfo& info() const { return info_; }
+  const VkPhysicalDeviceLimits& limits() const { return limits_; }
+  const EnabledFeatures& features() const { return features_; }
+  bool timestamps_supported() const { return info_.timestamp_valid_bits > 0; }
+
+  bool validation_enabled() const { return validation_; }
+  std::int64_t validation_errors() const { return counters_->errors.load(); }
+  std::int64_t validation_warnings() const { return counters_->warnings.load(); }
+  std::shared_ptr<const ValidationCounters> validation_counters() const { return counters_; }
+
+  // Records `record` into a fresh primary command buffer, submits it and waits for it.
+  // Calls may nest (an upload inside `record` completes before the outer submission).
+  void submit_and_wait(const std::function<void(VkCommandBuffer)>& record);
+
+  // Index of a memory type allowed by `type_bits` having all of `required`, preferring
+  // one that also has `preferred`; throws VulkanError when there is none.
+  std::uint32_t memory_type(std::uint32_t type_bits, VkMemoryPropertyFlags required,
+                            VkMemoryPropertyFlags preferred = 0) const;
+  VkMemoryPropertyFlags memory_type_flags(std::uint32_t index) const;
+
+  // Names an object for validation messages (no-op without VK_EXT_debug_utils).
+  void set_name(VkObjectType type, std::uint64_t handle, const std::string& name) const;
+
+ private:
+  void create_instance(bool validation);
+  void pick_device(const std::string& override);
+  void create_device();
+  void release();
+
+  std::shared_ptr<ValidationCounters> counters_ = std::make_shared<ValidationCounters>();
+  bool validation_ = false;
+  bool debug_utils_ = false;
+  VkInstance instance_ = VK_NULL_HANDLE;
+  VkDebugUtilsMessengerEXT messenger_ = VK_NULL_HANDLE;
+  VkPhysicalDevice physical_device_ = VK_NULL_HANDLE;
+  VkDevice device_ = VK_NULL_HANDLE;
+  VkQueue queue_ = VK_NULL_HANDLE;
+  std::uint32_t queue_family_ = 0;
+  VkCommandPool command_pool_ = VK_NULL_HANDLE;
+  DeviceInfo info_;
+  VkPhysicalDeviceLimits limits_{};
+  VkPhysicalDeviceMemoryProperties memory_{};
+  EnabledFeatures features_;
+  PFN_vkSetDebugUtilsObjectNameEXT set_object_name_ = nullptr;
+};
+
+}  // namespace fovea::gpu

@@ -1,0 +1,60 @@
+#pragma once
+// Descriptor set layouts from a binding list (binding number = position in the list,
+// one descriptor each) and descriptor sets, each with its own small pool. Sets are
+// created at setup time, updated with bind(), and bound by ComputePipeline.
+#include <cstdint>
+#include <vector>
+
+#include "fovea/gpu/handle.hpp"
+
+namespace fovea::gpu {
+
+class Context;
+class Buffer;
+class Image2D;
+class Sampler;
+
+enum class Binding {
+  StorageBuffer,  // buffer { ... }
+  UniformBuffer,  // uniform { ... }
+  StorageImage,   // image2D / uimage2D with a format qualifier
+  SampledImage,   // sampler2D (combined image sampler)
+};
+
+class DescriptorSetLayout {
+ public:
+  DescriptorSetLayout() = default;
+  DescriptorSetLayout(Context& ctx, std::vector<Binding> bindings);
+  VkDescriptorSetLayout handle() const { return layout_.get(); }
+  const std::vector<Binding>& bindings() const { return bindings_; }
+
+ private:
+  std::vector<Binding> bindings_;
+  DeviceHandle<VkDescriptorSetLayout, vkDestroyDescriptorSetLayout> layout_;
+};
+
+class DescriptorSet {
+ public:
+  DescriptorSet() = default;
+  // Vulkan requires `layout` to stay alive while the set is updated with bind().
+  DescriptorSet(Context& ctx, const DescriptorSetLayout& layout);
+
+  VkDescriptorSet handle() const { return set_; }
+
+  // Point a binding at a resource. Throws core::InputError when the binding does not
+  // exist or has another type. Resources must outlive every use of the set.
+  DescriptorSet& bind(std::uint32_t binding, const Buffer& buffer, VkDeviceSize offset = 0,
+                      VkDeviceSize range = VK_WHOLE_SIZE);
+  DescriptorSet& bind(std::uint32_t binding, const Image2D& image);
+  DescriptorSet& bind(std::uint32_t binding, const Image2D& image, const Sampler& sampler);
+
+ private:
+  void expect(std::uint32_t binding, Binding type) const;
+  void write(std::uint32_t binding, const VkDescriptorBufferInfo* buffer, const VkDescriptorImageInfo* image);
+
+  std::vector<Binding> bindings_;
+  DeviceHandle<VkDescriptorPool, vkDestroyDescriptorPool> pool_;
+  VkDescriptorSet set_ = VK_NULL_HANDLE;  // freed with the pool
+};
+
+}  // namespace fovea::gpu

@@ -1,0 +1,28 @@
+#pragma once
+// Vulkan failures. Bad input (a device override matching nothing, an unknown shader, a
+// zero-sized buffer) is core::InputError; a failing Vulkan call is VulkanError.
+#include <stdexcept>
+#include <string>
+
+#include <vulkan/vulkan_core.h>
+
+namespace fovea::gpu {
+
+class VulkanError : public std::runtime_error {
+ public:
+  VulkanError(VkResult result, const std::string& what);
+  VkResult result() const { return result_; }
+
+ private:
+  VkResult result_;
+};
+
+// "VK_ERROR_OUT_OF_DEVICE_MEMORY" etc.
+const char* result_name(VkResult result);
+
+// Throws VulkanError naming `call` unless result is VK_SUCCESS.
+inline void check(VkResult result, const char* call) {
+  if (result != VK_SUCCESS) throw VulkanError(result, call);
+}
+
+}  // namespace fovea::gpu

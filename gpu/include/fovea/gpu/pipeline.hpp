@@ -1,0 +1,79 @@
+#pragma once
+// Compute pipelines from the embedded SPIR-V (fovea::shaders::find), with their own
+// pipeline layout: descriptor set layouts, one push-constant range, optional 32-bit
+// specialization constants. The workgroup size is read from the SPIR-V (including
+// local_size_*_id specialization), so dispatches can be given in threads.
+#include <array>
+#include <bit>
+#include <cstdint>
+#include <initializer_list>
+#include <span>
+#include <string>
+#include <vector>
+
+#include "fovea/gpu/descriptors.hpp"
+#include "fovea/gpu/handle.hpp"
+
+namespace fovea::gpu {
+
+// Value of `layout(constant_id = id) const ...` (int, uint, float or bool).
+struct SpecConstant {
+  std::uint32_t id = 0;
+  std::uint32_t bits = 0;
+  static SpecConstant u32(std::uint32_t id, std::uint32_t v) { return {id, v}; }
+  static SpecConstant i32(std::uint32_t id, std::int32_t v) { return {id, std::bit_cast<std::uint32_t>(v)}; }
+  static SpecConstant f32(std::uint32_t id, float v) { return {id, std::bit_cast<std::uint32_t>(v)}; }
+  static SpecConstant boolean(std::uint32_t id, bool v) { return {id, v ? 1u : 0u}; }
+};
+
+struct ComputePipelineDesc {
+  std::string shader;                      // embedded name, e.g. "pt_trace.comp.spv"
+  std::vector<std::vector<Binding>> sets;  // sets[s][b]: type of `layout(set = s, binding = b)`
+  std::uint32_t push_constant_bytes = 0;   // size of the push_constant block, multiple of 4
+  std::vector<SpecConstant> specialization;
+};
+
+class ComputePipeline {
+ public:
+  ComputePipeline() = default;
+  // Throws core::InputError for an unknown shader name or an invalid description.
+  ComputePipeline(Context& ctx, const ComputePipelineDesc& desc);
+
+  VkPipeline handle() const { return pipeline_.get(); }
+  VkPipelineLayout layout() const { return layout_.get(); }
+  const DescriptorSetLayout& set_layout(std::size_t set) const { return set_layouts_.at(set); }
+  std::array<std::uint32_t, 3> workgroup_size() const { return local_size_; }
+  const std::string& shader() const { return shader_; }
+
+  // Records: bind the pipeline and sets[i] as set i.
+  void bind(VkCommandBuffer cmd, std::initializer_list<const DescriptorSet*> sets = {}) const;
+  // Records: push constants; `bytes` must be push_constant_bytes long.
+  void push_bytes(VkCommandBuffer cmd, std::span<const std::byte> bytes) const;
+  template <class T>
+  void push(VkCommandBuffer cmd, const T& constants) const {
+    push_bytes(cmd, std::as_bytes(std::span(&constants, 1)));
+  }
+  // Records: vkCmdDispatch with enough workgroups to cover x * y * z threads (rounded up;
+  // shaders must bounds-check). Throws core::InputError beyond the device's group limits.
+  void dispatch(VkCommandBuffer cmd, std::uint32_t x, std::uint32_t y = 1, std::uint32_t z = 1) const;
+
+  // Bind, push and dispatch in one go.
+  template <class T>
+  void run(VkCommandBuffer cmd, std::initializer_list<const DescriptorSet*> sets, const T& constants,
+           std::uint32_t x, std::uint32_t y = 1, std::uint32_t z = 1) const {
+    bind(cmd, sets);
+    push(cmd, constants);
+    dispatch(cmd, x, y, z);
+  }
+
+ private:
+  std::string shader_;
+  std::uint32_t push_bytes_ = 0;
+  std::array<std::uint32_t, 3> local_size_{1, 1, 1};
+  std::array<std::uint32_t, 3> max_groups_{0, 0, 0};
+  std::vector<DescriptorSetLayout> set_layouts_;
+  DeviceHandle<VkPipelineLayout, vkDestroyPipelineLayout> layout_;
+  DeviceHandle<VkPipeline, vkDestroyPipeline> pipeline_;
+};
+
+}  // namespace fovea::gpu

@@ -1,0 +1,90 @@
+#include "fovea/gpu/buffer.hpp"
+
+#include <stdexcept>
+#include <utility>
+
+#include "fovea/core/error.hpp"
+#include "fovea/gpu/context.hpp"
+#include "fovea/gpu/error.hpp"
+
+namespace fovea::gpu {
+namespace {
+
+void check_range(const Buffer& b, VkDeviceSize offset, std::size_t bytes, const char* what) {
+  if (offset > b.size() || bytes > b.size() - offset)
+    throw std::out_of_range(std::string(what) + ": " + std::to_string(bytes) + " bytes at offset " +
+                            std::to_string(offset) + " exceed the buffer's " + std::to_string(b.size()) + " bytes");
+}
+
+}  // namespace
+
+Buffer::Buffer(Context& ctx, const BufferDesc& desc) : ctx_(&ctx), size_(desc.size) {
+  if (desc.size == 0) throw core::InputError("gpu::Buffer '" + desc.name + "': size must be > 0");
+  const VkDevice dev = ctx.device();
+  VkBufferCreateInfo ci{VK_STRUCTURE_TYPE_BUFFER_CREATE_INFO};
+  ci.size = desc.size;
+  ci.usage = static_cast<VkBufferUsageFlags>(desc.usage | BufferUsage::TransferSrc | BufferUsage::TransferDst);
+  ci.sharingMode = VK_SHARING_MODE_EXCLUSIVE;
+  VkBuffer buffer = VK_NULL_HANDLE;
+  check(vkCreateBuffer(dev, &ci, nullptr, &buffer), "vkCreateBuffer");
+  buffer_ = {dev, buffer};
+
+  VkMemoryRequirements req;
+  vkGetBufferMemoryRequirements(dev, buffer, &req);
+  const bool host = desc.memory == Memory::HostVisible;
+  // Host-visible memory is also asked to be coherent so no flushes are needed; cached
+  // memory is preferred because readback is its main use.
+  const std::uint32_t type =
+      host ? ctx.memory_type(req.memoryTypeBits, VK_MEMORY_PROPERTY_HOST_VISIBLE_BIT | VK_MEMORY_PROPERTY_HOST_COHERENT_BIT,
+                             VK_MEMORY_PROPERTY_HOST_CACHED_BIT)
+           : ctx.memory_type(req.memoryTypeBits, 0, VK_MEMORY_PROPERTY_DEVICE_LOCAL_BIT);
+  VkMemoryAllocateInfo ai{VK_STRUCTURE_TYPE_MEMORY_ALLOCATE_INFO};
+  ai.allocationSize = req.size;
+  ai.memoryTypeIndex = type;
+  VkDeviceMemory memory = VK_NULL_HANDLE;
+  check(vkAllocateMemory(dev, &ai, nullptr, &memory), "vkAllocateMemory");
+  memory_ = {dev, memory};
+  check(vkBindBufferMemory(dev, buffer, memory, 0), "vkBindBufferMemory");
+  if (host) {
+    void* p = nullptr;
+    check(vkMapMemory(dev, memory, 0, VK_WHOLE_SIZE, 0, &p), "vkMapMemory");
+    mapped_ = static_cast<std::byte*>(p);
+  }
+  if (!desc.name.empty()) ctx.set_name(VK_OBJECT_TYPE_BUFFER, reinterpret_cast<std::uint64_t>(buffer), desc.name);
+}
+
+void Buffer::upload_bytes(std::span<const std::byte> data, VkDeviceSize offset) {
+  check_range(*this, offset, data.size(), "gpu::Buffer::upload");
+  if (data.empty()) return;
+  if (mapped_ != nullptr) {
+    std::memcpy(mapped_ + offset, data.data(), data.size());
+    return;
+  }
+  Buffer staging(*ctx_, {data.size(), BufferUsage::TransferSrc, Memory::HostVisible, "staging upload"});
+  std::memcpy(staging.mapped_, data.data(), data.size());
+  ctx_->submit_and_wait([&](VkCommandBuffer cmd) { copy_buffer(cmd, staging, *this, data.size(), 0, offset); });
+}
+
+void Buffer::download_bytes(std::span<std::byte> out, VkDeviceSize offset) const {
+  check_range(*this, offset, out.size(), "gpu::Buffer::download");
+  if (out.empty()) return;
+  if (mapped_ != nullptr) {
+    std::memcpy(out.data(), mapped_ + offset, out.size());
+    return;
+  }
+  Buffer staging(*ctx_, {out.size(), BufferUsage::TransferDst, Memory::HostVisible, "staging download"});
+  ctx_->submit_and_wait([&](VkCommandBuffer cmd) { copy_buffer(cmd, *this, staging, out.size(), offset, 0); });
+  std::memcpy(out.data(), staging.mapped_, out.size());
+}
+
+void copy_buffer(VkCommandBuffer cmd, const Buffer& src, const Buffer& dst, VkDeviceSize bytes,
+                 VkDeviceSize src_offset, VkDeviceSize dst_offset) {
+  VkBufferCopy region{src_offset, dst_offset, bytes == VK_WHOLE_SIZE ? src.size() - src_offset : bytes};
+  vkCmdCopyBuffer(cmd, src.handle(), dst.handle(), 1, &region);
+}
+
+void fill_buffer(VkCommandBuffer cmd, const Buffer& buffer, std::uint32_t word) {
+  vkCmdFillBuffer(cmd, buffer.handle(), 0, VK_WHOLE_SIZE, word);
+}
+
+}  // namespace fovea::gpu

@@ -1,0 +1,119 @@
+#include "fovea/gpu/pipeline.hpp"
+
+#include <cstring>
+#include <string>
+
+#include "fovea/core/error.hpp"
+#include "fovea/gpu/context.hpp"
+#include "fovea/gpu/error.hpp"
+#include "fovea/shaders/embedded.hpp"
+#include "spirv.hpp"
+
+namespace fovea::gpu {
+namespace {
+
+std::string known_shaders() {
+  std::string s;
+  for (std::string_view n : shaders::names()) s += (s.empty() ? "" : ", ") + std::string(n);
+  return s;
+}
+
+}  // namespace
+
+ComputePipeline::ComputePipeline(Context& ctx, const ComputePipelineDesc& desc)
+    : shader_(desc.shader), push_bytes_(desc.push_constant_bytes) {
+  const std::string what = "gpu::ComputePipeline '" + desc.shader + "'";
+  const std::span<const std::uint8_t> bytes = shaders::find(desc.shader);
+  if (bytes.empty()) throw core::InputError(what + ": no such embedded shader; known: " + known_shaders());
+  if (bytes.size() % 4 != 0) throw core::InputError(what + ": SPIR-V size is not a multiple of 4");
+  if (desc.push_constant_bytes % 4 != 0 || desc.push_constant_bytes > ctx.limits().maxPushConstantsSize)
+    throw core::InputError(what + ": push_constant_bytes " + std::to_string(desc.push_constant_bytes) +
+                           " must be a multiple of 4 and at most " + std::to_string(ctx.limits().maxPushConstantsSize));
+  // The embedded arrays are 4-byte aligned (embed_files.cmake), but copy to be independent of that.
+  std::vector<std::uint32_t> words(bytes.size() / 4);
+  std::memcpy(words.data(), bytes.data(), bytes.size());
+  local_size_ = spirv::workgroup_size(words, desc.specialization);
+  for (int i = 0; i < 3; ++i) {
+    max_groups_[i] = ctx.limits().maxComputeWorkGroupCount[i];
+    if (local_size_[i] == 0 || local_size_[i] > ctx.limits().maxComputeWorkGroupSize[i])
+      throw core::InputError(what + ": workgroup size " + std::to_string(local_size_[i]) + " in dimension " +
+                             std::to_string(i) + " is outside the device limit " +
+                             std::to_string(ctx.limits().maxComputeWorkGroupSize[i]));
+  }
+  if (std::uint64_t(local_size_[0]) * local_size_[1] * local_size_[2] > ctx.limits().maxComputeWorkGroupInvocations)
+    throw core::InputError(what + ": workgroup has more invocations than the device's " +
+                           std::to_string(ctx.limits().maxComputeWorkGroupInvocations));
+
+  const VkDevice dev = ctx.device();
+  VkShaderModuleCreateInfo mci{VK_STRUCTURE_TYPE_SHADER_MODULE_CREATE_INFO};
+  mci.codeSize = bytes.size();
+  mci.pCode = words.data();
+  VkShaderModule module_handle = VK_NULL_HANDLE;
+  check(vkCreateShaderModule(dev, &mci, nullptr, &module_handle), "vkCreateShaderModule");
+  const DeviceHandle<VkShaderModule, vkDestroyShaderModule> module(dev, module_handle);
+
+  std::vector<VkDescriptorSetLayout> set_handles;
+  for (const auto& bindings : desc.sets) {
+    set_layouts_.emplace_back(ctx, bindings);
+    set_handles.push_back(set_layouts_.back().handle());
+  }
+  const VkPushConstantRange range{VK_SHADER_STAGE_COMPUTE_BIT, 0, desc.push_constant_bytes};
+  VkPipelineLayoutCreateInfo lci{VK_STRUCTURE_TYPE_PIPELINE_LAYOUT_CREATE_INFO};
+  lci.setLayoutCount = static_cast<std::uint32_t>(set_handles.size());
+  lci.pSetLayouts = set_handles.data();
+  lci.pushConstantRangeCount = desc.push_constant_bytes > 0 ? 1 : 0;
+  lci.pPushConstantRanges = &range;
+  VkPipelineLayout layout = VK_NULL_HANDLE;
+  check(vkCreatePipelineLayout(dev, &lci, nullptr, &layout), "vkCreatePipelineLayout");
+  layout_ = {dev, layout};
+
+  std::vector<VkSpecializationMapEntry> entries;
+  for (std::size_t i = 0; i < desc.specialization.size(); ++i)
+    entries.push_back({desc.specialization[i].id, static_cast<std::uint32_t>(i * sizeof(std::uint32_t)), 4});
+  std::vector<std::uint32_t> data;
+  for (const SpecConstant& c : desc.specialization) data.push_back(c.bits);
+  VkSpecializationInfo spec{static_cast<std::uint32_t>(entries.size()), entries.data(), data.size() * 4, data.data()};
+
+  VkComputePipelineCreateInfo pci{VK_STRUCTURE_TYPE_COMPUTE_PIPELINE_CREATE_INFO};
+  pci.stage = {VK_STRUCTURE_TYPE_PIPELINE_SHADER_STAGE_CREATE_INFO};
+  pci.stage.stage = VK_SHADER_STAGE_COMPUTE_BIT;
+  pci.stage.module = module.get();
+  pci.stage.pName = "main";
+  pci.stage.pSpecializationInfo = entries.empty() ? nullptr : &spec;
+  pci.layout = layout;
+  VkPipeline pipeline = VK_NULL_HANDLE;
+  check(vkCreateComputePipelines(dev, VK_NULL_HANDLE, 1, &pci, nullptr, &pipeline), "vkCreateComputePipelines");
+  pipeline_ = {dev, pipeline};
+  ctx.set_name(VK_OBJECT_TYPE_PIPELINE, reinterpret_cast<std::uint64_t>(pipeline), desc.shader);
+}
+
+void ComputePipeline::bind(VkCommandBuffer cmd, std::initializer_list<const DescriptorSet*> sets) const {
+  vkCmdBindPipeline(cmd, VK_PIPELINE_BIND_POINT_COMPUTE, pipeline_.get());
+  if (sets.size() == 0) return;
+  std::vector<VkDescriptorSet> handles;
+  for (const DescriptorSet* s : sets) handles.push_back(s->handle());
+  vkCmdBindDescriptorSets(cmd, VK_PIPELINE_BIND_POINT_COMPUTE, layout_.get(), 0,
+                          static_cast<std::uint32_t>(handles.size()), handles.data(), 0, nullptr);
+}
+
+void ComputePipeline::push_bytes(VkCommandBuffer cmd, std::span<const std::byte> bytes) const {
+  if (bytes.size() != push_bytes_)
+    throw core::InputError("gpu::ComputePipeline '" + shader_ + "': " + std::to_string(bytes.size()) +
+                           " push-constant bytes given, the layout has " + std::to_string(push_bytes_));
+  vkCmdPushConstants(cmd, layout_.get(), VK_SHADER_STAGE_COMPUTE_BIT, 0, push_bytes_, bytes.data());
+}
+
+void ComputePipeline::dispatch(VkCommandBuffer cmd, std::uint32_t x, std::uint32_t y, std::uint32_t z) const {
+  const std::uint32_t threads[3] = {x, y, z};
+  std::uint32_t groups[3];
+  for (int i = 0; i < 3; ++i) {
+    groups[i] = static_cast<std::uint32_t>((std::uint64_t(threads[i]) + local_size_[i] - 1) / local_size_[i]);
+    if (groups[i] > max_groups_[i])
+      throw core::InputError("gpu::ComputePipeline '" + shader_ + "': " + std::to_string(groups[i]) +
+                             " workgroups in dimension " + std::to_string(i) + " exceed the device limit " +
+                             std::to_string(max_groups_[i]));
+  }
+  vkCmdDispatch(cmd, groups[0], groups[1], groups[2]);
+}
+
+}  // namespace fovea::gpu
