@@ -112,3 +112,20 @@ TEST_F(Compute, MisuseIsReportedBeforeVulkanSeesIt) {
     EXPECT_THROW(pipe.dispatch(cmd, 0xffffffffu, 0xffffffffu), fovea::core::InputError);
   });
 }
+
+// Synchronization validation is on: a dispatch writing a buffer right after a transfer
+// wrote it, without a barrier, is reported. (This layer version does not flag
+// dispatch-after-dispatch write hazards, so compute_to_compute must not be forgotten.)
+TEST_F(Compute, MissingBarrierIsReported) {
+  gpu::ComputePipeline pipe(ctx(), fill_desc({}));
+  gpu::Buffer out(ctx(), {.size = 64 * 4});
+  gpu::Buffer params(ctx(), {.size = 4, .usage = gpu::BufferUsage::Uniform, .memory = gpu::Memory::HostVisible});
+  gpu::DescriptorSet set(ctx(), pipe.set_layout(0));
+  set.bind(0, out).bind(1, params);
+  expect_validation_errors(1, [&] {
+    ctx().submit_and_wait([&](VkCommandBuffer cmd) {
+      gpu::fill_buffer(cmd, out, 0);
+      pipe.run(cmd, {&set}, FillPush{64, 2}, 64);
+    });
+  });
+}
