@@ -1,0 +1,272 @@
+// Common parts of the sample distributions and the raster-based ones (Cartesian full,
+// Cartesian uniform at equal budget, Weier's linear fall-off).
+#include "fovea/core/distribution.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <numbers>
+
+#include <glm/geometric.hpp>
+
+#include "distribution_impl.hpp"
+#include "fovea/core/error.hpp"
+#include "fovea/shaders/hash.h"
+
+namespace fovea::core {
+
+namespace {
+struct Name {
+  DistributionKind kind;
+  const char* name;
+};
+constexpr Name kNames[] = {{DistributionKind::VisualPolar, "visual-polar"},
+                           {DistributionKind::PaperVisualPolar, "paper-visual-polar"},
+                           {DistributionKind::Cartesian, "cartesian"},
+                           {DistributionKind::CartesianUniform, "cartesian-uniform"},
+                           {DistributionKind::LinearFalloff, "linear-falloff"},
+                           {DistributionKind::LogPolar, "log-polar"}};
+}  // namespace
+
+DistributionKind parse_distribution(std::string_view s) {
+  std::string all;
+  for (const auto& n : kNames) {
+    if (s == n.name) return n.kind;
+    all += std::string(all.empty() ? "" : "|") + n.name;
+  }
+  throw InputError("distribution: unknown \"" + std::string(s) + "\" (expected " + all + ")");
+}
+
+const char* distribution_name(DistributionKind k) {
+  for (const auto& n : kNames)
+    if (n.kind == k) return n.name;
+  return "?";
+}
+
+void DistributionParams::validate() const {
+  auto need = [](bool ok, const std::string& what) {
+    if (!ok) throw InputError(what);
+  };
+  need(std::isfinite(budget) && budget >= 0.01 && budget <= 1.0, "budget: must be in [0.01, 1] (fraction of display pixels)");
+  need(std::isfinite(margin_deg) && margin_deg >= 0 && margin_deg <= 30, "margin: must be in [0, 30] degrees");
+  need(gamma == 1.0 || gamma == 2.0, "gamma: must be 1 or 2");
+  need(std::isfinite(cap) && cap > 0 && cap <= 16, "cap: must be in (0, 16] samples per display pixel");
+  need(std::isfinite(aniso) && aniso >= 1 && aniso <= 64, "aniso: must be in [1, 64]");
+  need(std::isfinite(falloff_fovea_deg) && std::isfinite(falloff_periphery_deg) && falloff_fovea_deg >= 0 &&
+           falloff_periphery_deg > falloff_fovea_deg,
+       "linear fall-off: need 0 <= fl < pl");
+  need(std::isfinite(falloff_min_p) && falloff_min_p > 0 && falloff_min_p <= 1, "linear fall-off: Pp must be in (0, 1]");
+  need(std::isfinite(logpolar_sigma) && logpolar_sigma >= 1 && logpolar_sigma <= 8, "log-polar: sigma must be in [1, 8]");
+  need(std::isfinite(logpolar_alpha) && logpolar_alpha >= 1 && logpolar_alpha <= 8, "log-polar: alpha must be in [1, 8]");
+}
+
+void orthonormal_basis(glm::dvec3 n, glm::dvec3& b1, glm::dvec3& b2) {
+  const double sign = std::copysign(1.0, n.z);
+  const double a = -1.0 / (sign + n.z);
+  const double b = n.x * n.y * a;
+  b1 = {1.0 + sign * n.x * n.x * a, sign * b, -sign * n.x};
+  b2 = {b, sign + n.y * n.y * a, -n.y};
+}
+
+double halton(std::uint32_t i, std::uint32_t base) {
+  double f = 1, r = 0;
+  while (i > 0) {
+    f /= base;
+    r += f * (i % base);
+    i /= base;
+  }
+  return r;
+}
+
+GazeStatus SampleDistribution::set_frame(glm::dvec3 g, std::uint32_t frame) {
+  GazeStatus st;
+  const double len = glm::length(g);
+  glm::dvec3 d = (std::isfinite(len) && len > 1e-12) ? g / len : glm::dvec3(0);
+  const bool usable = d != glm::dvec3(0) && d.z < 0;
+  if (usable) {
+    const glm::dvec3 before = d;
+    view_.clamp_to_frustum(d);
+    st.clamped = glm::length(d - before) > 1e-12;
+    last_valid_gaze_ = d;
+    has_valid_gaze_ = true;
+  } else {
+    st.fallback = true;
+    d = has_valid_gaze_ ? last_valid_gaze_ : view_.centre_dir();
+  }
+  gaze_ = d;
+  st.used = d;
+  frame_ = frame;
+  on_frame();
+  return st;
+}
+
+glm::dvec2 SampleDistribution::jitter() const {
+  if (!jitter_) return {0, 0};
+  // Halton (2, 3) over frames, the usual TAA sequence; index 0 is skipped (it is 0, 0).
+  const std::uint32_t i = (frame_ % 1024u) + 1u;
+  return {halton(i, 2) - 0.5, halton(i, 3) - 0.5};
+}
+
+shaders::GridSample SampleDistribution::sample_at(int column, int row, glm::dvec2 j) const {
+  shaders::GridSample s{};
+  if (column >= columns_ || row >= rows_) {
+    s.flags = shaders::kCellPadding;
+    s.dir_z = -1;
+    return s;
+  }
+  glm::dvec3 dir;
+  glm::dvec2 px;
+  map({column + 0.5 + j.x, row + 0.5 + j.y}, column, dir, px);
+  std::uint32_t flags = cell_flags(column, row, dir);
+  if (!view_.contains_pixel(px)) flags |= shaders::kCellOffscreen;
+  else if (visible_ && !visible_(px)) flags |= shaders::kCellHidden;
+  s.dir_x = float(dir.x);
+  s.dir_y = float(dir.y);
+  s.dir_z = float(dir.z);
+  s.flags = flags;
+  // Positions far outside the display are irrelevant (the cell is skipped); keep them finite.
+  s.screen_x = float(std::clamp(px.x, -1e6, 1e6));
+  s.screen_y = float(std::clamp(px.y, -1e6, 1e6));
+  s.ecc_deg = float(angle_deg(dir, gaze_));
+  const double ppc = pixels_per_cell(column, dir);
+  s.footprint = float(std::isfinite(ppc) ? std::clamp(std::sqrt(std::max(ppc, 0.0)), 1e-6, 1e6) : 1e6);
+  return s;
+}
+
+std::uint32_t SampleDistribution::cell_flags(int, int, glm::dvec3) const { return 0; }
+
+double SampleDistribution::samples_per_pixel(glm::dvec2 px) const {
+  // |det J| of display -> grid: cells per display pixel.
+  const auto c = screen_to_grid(px);
+  const double h = 0.25;
+  const auto dx = screen_to_grid(px + glm::dvec2(h, 0));
+  const auto dy = screen_to_grid(px + glm::dvec2(0, h));
+  if (!c || !dx || !dy) return 0;
+  glm::dvec2 a = (*dx - *c) / h, b = (*dy - *c) / h;
+  // Rows wrap around φ = 2π; unwrap the difference.
+  auto unwrap = [&](glm::dvec2& v, glm::dvec2 base) {
+    const int col = std::clamp(int(base.x), 0, columns_ - 1);
+    const double period = row_period(col);
+    if (period > 0) v.y -= period / h * std::round(v.y * h / period);
+  };
+  unwrap(a, *c);
+  unwrap(b, *c);
+  const double det = std::abs(a.x * b.y - a.y * b.x);
+  return std::isfinite(det) ? det : 0;
+}
+
+double SampleDistribution::row_period(int) const { return 0; }
+
+shaders::GridParams SampleDistribution::gpu_params() const {
+  shaders::GridParams g{};
+  g.columns = std::uint32_t(columns_);
+  g.rows = std::uint32_t(rows_);
+  g.padded_columns = std::uint32_t(padded_columns());
+  g.padded_rows = std::uint32_t(padded_rows());
+  g.frame = frame_;
+  g.seed = params_.seed;
+  g.gaze_x = float(gaze_.x);
+  g.gaze_y = float(gaze_.y);
+  g.gaze_z = float(gaze_.z);
+  glm::dvec3 b1, b2;
+  orthonormal_basis(gaze_, b1, b2);
+  g.b1_x = float(b1.x), g.b1_y = float(b1.y), g.b1_z = float(b1.z);
+  g.b2_x = float(b2.x), g.b2_y = float(b2.y), g.b2_z = float(b2.z);
+  g.width = float(view_.width());
+  g.height = float(view_.height());
+  g.tan_left = float(view_.tan_left());
+  g.tan_right = float(view_.tan_right());
+  g.tan_up = float(view_.tan_up());
+  g.tan_down = float(view_.tan_down());
+  const glm::dvec2 gp = view_.dir_to_pixel(gaze_).value_or(glm::dvec2(0));
+  g.gaze_px_x = float(gp.x);
+  g.gaze_px_y = float(gp.y);
+  const glm::dvec2 j = jitter();
+  g.jitter_u = float(j.x);
+  g.jitter_v = float(j.y);
+  fill_gpu(g);
+  return g;
+}
+
+// ---- Cartesian raster family --------------------------------------------------------
+
+namespace {
+
+class RasterDistribution final : public SampleDistribution {
+ public:
+  RasterDistribution(const View& v, const DistributionParams& p) : SampleDistribution(v, p) {
+    if (p.kind == DistributionKind::CartesianUniform) {
+      const double k = std::sqrt(p.budget);
+      columns_ = std::max(1, int(std::lround(v.width() * k)));
+      rows_ = std::max(1, int(std::lround(v.height() * k)));
+    } else {
+      columns_ = v.width();
+      rows_ = v.height();
+    }
+    set_frame(v.centre_dir());
+  }
+
+  bool invertible() const override { return params_.kind != DistributionKind::LinearFalloff; }
+
+  std::optional<glm::dvec2> screen_to_grid(glm::dvec2 px) const override {
+    if (!invertible() || !std::isfinite(px.x) || !std::isfinite(px.y)) return std::nullopt;
+    return glm::dvec2(px.x * columns_ / view_.width(), px.y * rows_ / view_.height());
+  }
+
+  double keep_probability(double e) const {
+    // Dissertation Eq. 4.1: 1 inside fl, linear to Pp at pl, Pp beyond.
+    const auto& p = params_;
+    if (e <= p.falloff_fovea_deg) return 1.0;
+    if (e >= p.falloff_periphery_deg) return p.falloff_min_p;
+    return 1.0 + (e - p.falloff_fovea_deg) * (p.falloff_min_p - 1.0) / (p.falloff_periphery_deg - p.falloff_fovea_deg);
+  }
+
+  double target_density(glm::dvec3 dir) const override {
+    const double per_pixel = double(columns_) * rows_ / (double(view_.width()) * view_.height());
+    const double k = params_.kind == DistributionKind::LinearFalloff ? keep_probability(angle_deg(dir, gaze_)) : 1.0;
+    return k * per_pixel * view_.pixels_per_deg2(dir);
+  }
+
+  double pixels_per_cell(int, glm::dvec3) const override {
+    return double(view_.width()) * view_.height() / (double(columns_) * rows_);
+  }
+
+  double samples_per_pixel(glm::dvec2 px) const override {
+    if (params_.kind == DistributionKind::LinearFalloff)
+      return keep_probability(angle_deg(view_.pixel_to_dir(px), gaze_));
+    return double(columns_) * rows_ / (double(view_.width()) * view_.height());
+  }
+
+ protected:
+  void map(glm::dvec2 grid, int, glm::dvec3& dir, glm::dvec2& px) const override {
+    px = {grid.x * view_.width() / columns_, grid.y * view_.height() / rows_};
+    dir = view_.pixel_to_dir(px);
+  }
+  void on_frame() override {}
+  std::uint32_t cell_flags(int column, int row, glm::dvec3 dir) const override {
+    if (params_.kind != DistributionKind::LinearFalloff) return 0;
+    const double u = shaders::hash_to_unit(shaders::hash3(std::uint32_t(column), std::uint32_t(row),
+                                                          frame_ * 0x9E3779B9u + params_.seed));
+    return u < keep_probability(angle_deg(dir, gaze_)) ? 0 : shaders::kCellKilled;
+  }
+  void fill_gpu(shaders::GridParams& g) const override {
+    g.family = shaders::kFamilyCartesian;
+    g.kill = params_.kind == DistributionKind::LinearFalloff ? 1u : 0u;
+    g.fl_deg = float(params_.falloff_fovea_deg);
+    g.pl_deg = float(params_.falloff_periphery_deg);
+    g.pp = float(params_.falloff_min_p);
+  }
+};
+
+}  // namespace
+
+std::unique_ptr<SampleDistribution> make_distribution(const View& view, const DistributionParams& p) {
+  p.validate();
+  switch (p.kind) {
+    case DistributionKind::VisualPolar: return make_visual_polar(view, p);
+    case DistributionKind::PaperVisualPolar:
+    case DistributionKind::LogPolar: return make_screen_polar(view, p);
+    default: return std::make_unique<RasterDistribution>(view, p);
+  }
+}
+
+}  // namespace fovea::core

@@ -1,0 +1,40 @@
+#pragma once
+// Private: polar grids (angular Visual-Polar, paper-compatible VP, log-polar) share one
+// representation — a column table of radius ranges [r_i, r_i+1) (linear within a column)
+// and rows per column H_i, with φ = 2π·v / H_i — and differ only in what "radius" and
+// "angle" mean: eccentricity on the sphere around the gaze, or pixels on the display.
+#include <memory>
+#include <vector>
+
+#include "fovea/core/distribution.hpp"
+
+namespace fovea::core {
+
+std::unique_ptr<SampleDistribution> make_visual_polar(const View& view, const DistributionParams& p);
+std::unique_ptr<SampleDistribution> make_screen_polar(const View& view, const DistributionParams& p);
+
+class PolarDistribution : public SampleDistribution {
+ public:
+  std::optional<glm::dvec2> screen_to_grid(glm::dvec2 px) const override;
+  // Current column table: boundaries (columns + 1) and rows per column.
+  const std::vector<double>& radii() const { return r_; }
+  const std::vector<int>& rows_per_column() const { return h_; }
+
+ protected:
+  using SampleDistribution::SampleDistribution;
+  // (radius, φ) <-> direction and display position.
+  virtual void from_polar(double r, double phi, glm::dvec3& dir, glm::dvec2& px) const = 0;
+  virtual bool to_polar(glm::dvec2 px, double& r, double& phi) const = 0;
+
+  void map(glm::dvec2 grid, int column, glm::dvec3& dir, glm::dvec2& px) const override;
+  std::uint32_t cell_flags(int column, int row, glm::dvec3 dir) const override;
+  double row_period(int column) const override { return h_[column]; }
+  void fill_gpu(shaders::GridParams& g) const override;
+  // Copies r_/h_ into the GPU table; call at the end of on_frame().
+  void publish_table();
+
+  std::vector<double> r_;  // columns_ + 1 radii
+  std::vector<int> h_;     // columns_ rows, each in [1, rows_]
+};
+
+}  // namespace fovea::core
