@@ -1,0 +1,37 @@
+#pragma once
+// A GazeSource over any SampleStream: keeps a bounded window of recent samples and answers
+// sample_at() by interpolation. Recorded streams (replay, synthetic) are played on a
+// timeline starting at their first sample (t = 0), scaled by `speed`, optionally looped;
+// seeking backwards before the window re-reads the stream from its start.
+#include <deque>
+#include <memory>
+#include <mutex>
+
+#include "fovea/devices/gaze.hpp"
+
+namespace fovea::devices {
+
+class TimelineSource final : public GazeSource {
+ public:
+  TimelineSource(std::unique_ptr<SampleStream> stream, const SourceOptions& opt);
+  GazeSample latest() override;
+  GazeSample sample_at(core::TimeNs t) override;
+  std::string describe() const override { return stream_->describe(); }
+  // Samples currently held (bounded by window_ns); for tests of the memory bound.
+  std::size_t window_size() const { return win_.size(); }
+
+ private:
+  void pull_until(core::TimeNs t);
+  void restart();
+  GazeSample at_recording_time(core::TimeNs tt);
+
+  std::unique_ptr<SampleStream> stream_;
+  SourceOptions opt_;
+  std::deque<GazeSample> win_;
+  bool ended_ = false, trimmed_ = false;
+  core::TimeNs period_ = -1;  // loop period once the end is known
+  core::TimeNs opened_ns_ = 0;
+  std::mutex mutex_;
+};
+
+}  // namespace fovea::devices

@@ -1,0 +1,186 @@
+#include "fovea/devices/gaze.hpp"
+
+#include <algorithm>
+#include <charconv>
+#include <cmath>
+#include <map>
+#include <stdexcept>
+
+#include <glm/geometric.hpp>
+
+#include "fovea/core/error.hpp"
+#include "fovea/devices/readers.hpp"
+#include "fovea/devices/synthetic.hpp"
+#include "fovea/devices/timeline.hpp"
+#include "source_uri.hpp"
+
+namespace fovea::devices {
+
+void SampleStream::rewind() { throw std::logic_error(describe() + ": not rewindable"); }
+
+EyeGaze combine_eyes(const EyeGaze& l, const EyeGaze& r) {
+  EyeGaze c;
+  if (l.tracked() && r.tracked()) {
+    c.dir = glm::normalize(l.dir + r.dir);
+    c.confidence = std::min(l.confidence, r.confidence);
+    c.flags = kTracked;
+  } else if (l.tracked() || r.tracked()) {
+    c = l.tracked() ? l : r;
+  } else {
+    c.dir = l.dir;
+    c.flags = ((l.flags | r.flags) & kBlink) ? kBlink : kLost;
+  }
+  return c;
+}
+
+namespace {
+EyeGaze lerp_eye(const EyeGaze& a, const EyeGaze& b, double u) {
+  if (a.tracked() && b.tracked()) {
+    EyeGaze g;
+    const glm::dvec3 d = a.dir + u * (b.dir - a.dir);
+    const double n = glm::length(d);
+    g.dir = n > 1e-12 ? d / n : (u < 0.5 ? a.dir : b.dir);
+    g.confidence = a.confidence + u * (b.confidence - a.confidence);
+    g.flags = kTracked;
+    return g;
+  }
+  return u < 0.5 ? a : b;
+}
+}  // namespace
+
+GazeSample interpolate(const GazeSample& a, const GazeSample& b, core::TimeNs t) {
+  const double span = static_cast<double>(b.t_ns - a.t_ns);
+  const double u = span > 0 ? std::clamp(static_cast<double>(t - a.t_ns) / span, 0.0, 1.0) : 0.0;
+  GazeSample s;
+  s.t_ns = t;
+  s.device_time_ns = a.device_time_ns + std::llround(u * static_cast<double>(b.device_time_ns - a.device_time_ns));
+  s.host_time_ns = a.host_time_ns + std::llround(u * static_cast<double>(b.host_time_ns - a.host_time_ns));
+  s.combined = lerp_eye(a.combined, b.combined, u);
+  s.left = lerp_eye(a.left, b.left, u);
+  s.right = lerp_eye(a.right, b.right, u);
+  return s;
+}
+
+// ---- URI parsing ---------------------------------------------------------------------
+SourceUri parse_source_uri(std::string_view uri) {
+  SourceUri u;
+  const std::string s(uri);
+  const auto colon = s.find(':');
+  static const char* schemes[] = {"replay", "synthetic", "hid", "usb", "hid-capture", "mouse", "openxr"};
+  std::string rest = s;
+  u.scheme = "replay";
+  if (colon != std::string::npos) {
+    const std::string sch = s.substr(0, colon);
+    if (std::find_if(std::begin(schemes), std::end(schemes), [&](const char* x) { return sch == x; }) != std::end(schemes)) {
+      u.scheme = sch;
+      rest = s.substr(colon + 1);
+    }
+  } else if (s == "mouse" || s == "openxr") {
+    u.scheme = s;
+    rest.clear();
+  }
+  const auto q = rest.find('?');
+  u.body = rest.substr(0, q);
+  if (q != std::string::npos) {
+    std::string query = rest.substr(q + 1);
+    std::size_t start = 0;
+    while (start <= query.size()) {
+      const auto amp = query.find('&', start);
+      const std::string kv = query.substr(start, amp == std::string::npos ? std::string::npos : amp - start);
+      if (!kv.empty()) {
+        const auto eq = kv.find('=');
+        if (eq == std::string::npos || eq == 0)
+          throw core::InputError("gaze source \"" + s + "\": query item \"" + kv + "\" is not key=value");
+        u.query[kv.substr(0, eq)] = kv.substr(eq + 1);
+      }
+      if (amp == std::string::npos) break;
+      start = amp + 1;
+    }
+  }
+  u.text = s;
+  return u;
+}
+
+std::string SourceUri::take(const std::string& key) {
+  auto it = query.find(key);
+  if (it == query.end()) return {};
+  std::string v = it->second;
+  query.erase(it);
+  return v;
+}
+
+double SourceUri::take_number(const std::string& key, double fallback, double lo, double hi) {
+  const std::string v = take(key);
+  if (v.empty()) return fallback;
+  double d = 0;
+  const auto r = std::from_chars(v.data(), v.data() + v.size(), d);
+  if (r.ec != std::errc() || r.ptr != v.data() + v.size() || !std::isfinite(d) || d < lo || d > hi)
+    throw core::InputError("gaze source \"" + text + "\": " + key + "=" + v + " must be a number in [" +
+                           std::to_string(lo) + ", " + std::to_string(hi) + "]");
+  return d;
+}
+
+void SourceUri::finish() const {
+  if (!query.empty())
+    throw core::InputError("gaze source \"" + text + "\": unknown option \"" + query.begin()->first + "\"");
+}
+
+void apply_common_options(SourceUri& u, SourceOptions& opt) {
+  opt.horizon_ns = std::llround(u.take_number("horizon_ms", static_cast<double>(opt.horizon_ns) * 1e-6, 0, 1000) * 1e6);
+  opt.min_confidence = u.take_number("min_confidence", opt.min_confidence, 0, 1);
+}
+
+std::unique_ptr<SampleStream> open_sample_stream(std::string_view uri, const SourceOptions& base) {
+  SourceUri u = parse_source_uri(uri);
+  SourceOptions opt = base;
+  apply_common_options(u, opt);
+  if (u.scheme == "replay") {
+    if (u.body.empty()) throw core::InputError("gaze source \"" + u.text + "\": missing file name");
+    if (auto f = u.take("format"); !f.empty()) opt.format = f;
+    u.take("speed");
+    u.take("loop");
+    u.finish();
+    return open_reader(u.body, opt);
+  }
+  if (u.scheme == "synthetic") {
+    SynthParams p;
+    std::uint64_t seed = 0;
+    const auto r = std::from_chars(u.body.data(), u.body.data() + u.body.size(), seed);
+    if (u.body.empty() || r.ec != std::errc() || r.ptr != u.body.data() + u.body.size())
+      throw core::InputError("gaze source \"" + u.text + "\": synthetic:SEED needs a non-negative integer seed");
+    p.seed = seed;
+    if (auto t = u.take("task"); !t.empty()) p.task = parse_synth_task(t);
+    p.rate_hz = u.take_number("rate", p.rate_hz, 60, 1000);
+    p.seconds = u.take_number("seconds", 0, 0, 1e6);
+    p.noise_deg = u.take_number("noise", p.noise_deg, 0, 10);
+    p.noise_color = u.take_number("color", p.noise_color, 0, 0.98);
+    p.dropout_per_s = u.take_number("dropouts", p.dropout_per_s, 0, 10);
+    p.ipd_m = base.display.ipd_m;
+    u.finish();
+    return std::make_unique<SyntheticStream>(p);
+  }
+  return open_device_stream(u, opt);
+}
+
+std::unique_ptr<GazeSource> open_gaze_source(std::string_view uri, const SourceOptions& base) {
+  SourceUri u = parse_source_uri(uri);
+  SourceOptions opt = base;
+  apply_common_options(u, opt);
+  if (u.scheme == "replay") {
+    opt.speed = u.take_number("speed", 1.0, 1e-3, 1e3);
+    const std::string loop = u.take("loop");
+    if (!loop.empty() && loop != "0" && loop != "1")
+      throw core::InputError("gaze source \"" + u.text + "\": loop must be 0 or 1");
+    opt.loop = loop == "1";
+  }
+  // The remaining options are validated by the stream itself.
+  std::string rebuilt = u.scheme + ":" + u.body;
+  char sep = '?';
+  for (const auto& [k, v] : u.query) {
+    rebuilt += sep + k + "=" + v;
+    sep = '&';
+  }
+  return std::make_unique<TimelineSource>(open_sample_stream(rebuilt, opt), opt);
+}
+
+}  // namespace fovea::devices

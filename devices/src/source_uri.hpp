@@ -1,0 +1,24 @@
+#pragma once
+// Parsing of gaze-source URIs ("scheme:body?key=value&...") shared by the factories.
+#include <map>
+#include <memory>
+#include <string>
+#include <string_view>
+
+#include "fovea/devices/gaze.hpp"
+
+namespace fovea::devices {
+
+struct SourceUri {
+  std::string text, scheme, body;
+  std::map<std::string, std::string> query;
+  std::string take(const std::string& key);  // "" if absent; removes the key
+  double take_number(const std::string& key, double fallback, double lo, double hi);
+  void finish() const;  // throws for any key nobody took
+};
+
+SourceUri parse_source_uri(std::string_view uri);
+// hid:, usb:, hid-capture:, mouse, openxr (devices' own translation units).
+std::unique_ptr<SampleStream> open_device_stream(SourceUri& u, const SourceOptions& opt);
+
+}  // namespace fovea::devices

@@ -1,0 +1,171 @@
+// fovea gaze info|synth|convert|plot|record: recorded, synthetic and live gaze.
+#include <cmath>
+#include <cstdio>
+#include <iostream>
+#include <sstream>
+
+#include <nlohmann/json.hpp>
+
+#include "command.hpp"
+#include "fovea/core/error.hpp"
+#include "fovea/devices/analysis.hpp"
+#include "fovea/devices/readers.hpp"
+#include "fovea/devices/synthetic.hpp"
+
+namespace fovea::tools {
+
+namespace dv = fovea::devices;
+
+namespace {
+
+const char* kHelp =
+    "usage: fovea gaze <subcommand> ...\n"
+    "  info FILE [--format F]          JSON summary: samples, validity, rate, events, dropped rows\n"
+    "  convert IN OUT [--format F]     any supported format -> the project's CSV (+ OUT.json)\n"
+    "  synth --task T --seconds S OUT  synthetic gaze (--seed N --rate HZ --noise DEG --color C\n"
+    "                                  --dropouts PER_S); tasks: reading search pursuit fixation-grid\n"
+    "  plot FILE OUT.png               gaze over time and on the display, saccades marked\n"
+    "  record --source URI --seconds S OUT [--raw CAPTURE]   record a live source\n"
+    "geometry for 2D formats: --display NAME|FILE (default small), --screen WxH@HFOVxVFOV\n"
+    "  (e.g. 1920x1080@95x63: the raster and symmetric field of view the gaze coordinates refer to)\n"
+    "--min-confidence C (default 0.6): samples below are marked lost\n"
+    "formats: fovea pupil-core neon tobii-g3 eyelink-asc (auto-detected; see docs/gaze.md)\n";
+
+const std::vector<std::string> kGeometryOpts = {"format", "display", "screen", "min-confidence"};
+
+// "WxH@HFOVxVFOV" -> a View with a symmetric field of view.
+core::View parse_screen(const std::string& s) {
+  int w = 0, h = 0;
+  double hf = 0, vf = 0;
+  char tail = 0;
+  if (std::sscanf(s.c_str(), "%dx%d@%lfx%lf%c", &w, &h, &hf, &vf, &tail) != 4 || w < 1 || h < 1 || w > 65536 ||
+      h > 65536 || !(hf > 0 && hf < 179) || !(vf > 0 && vf < 179))
+    throw core::InputError("--screen: expected WxH@HFOVxVFOV (pixels, degrees), e.g. 1920x1080@95x63; got \"" + s + "\"");
+  return core::View(core::Fov::from_degrees(-hf / 2, hf / 2, vf / 2, -vf / 2), w, h);
+}
+
+dv::SourceOptions gaze_source_options(const Args& a) {
+  dv::SourceOptions opt;
+  opt.display = core::load_display(a.str("display", "small"));
+  if (auto s = a.opt("screen")) opt.screen = parse_screen(*s);
+  opt.format = a.str("format", "");
+  opt.min_confidence = a.num("min-confidence", opt.min_confidence);
+  if (!(opt.min_confidence >= 0 && opt.min_confidence <= 1)) throw core::InputError("--min-confidence must be in [0, 1]");
+  return opt;
+}
+
+int cmd_info(const std::vector<std::string>& argv) {
+  Args a(argv, kGeometryOpts, {}, 1);
+  if (a.positional().size() != 1) throw core::InputError("gaze info needs FILE (see --help)");
+  const dv::SourceOptions opt = gaze_source_options(a);
+  auto reader = dv::open_reader(a.positional()[0], opt);
+  dv::SummaryParams sp;
+  sp.infer_blinks = !reader->reports_blinks();
+  const dv::GazeSummary s = dv::summarize(*reader, sp);
+  const dv::ReadStats& st = reader->stats();
+  if (s.tracked == 0)
+    throw core::InputError(a.positional()[0] + ": no usable sample (" + std::to_string(st.samples) + " kept, " +
+                           std::to_string(st.dropped_total()) + " dropped)");
+  nlohmann::json j;
+  j["format"] = dv::format_name(reader->format());
+  j["samples"] = s.samples;
+  j["valid_fraction"] = std::round(s.valid_fraction() * 1e6) / 1e6;
+  j["rate_hz"] = std::round(s.rate_hz * 1e3) / 1e3;
+  j["duration_s"] = std::round(s.duration_s * 1e6) / 1e6;
+  j["dropped"] = nlohmann::json::object();
+  for (const auto& [k, v] : st.dropped) j["dropped"][k] = v;
+  j["fixations"] = s.fixations;
+  j["saccades"] = s.saccades;
+  j["blinks"] = s.blinks;
+  std::cout << j.dump(2) << "\n";
+  return 0;
+}
+
+int cmd_convert(const std::vector<std::string>& argv) {
+  Args a(argv, kGeometryOpts, {}, 2);
+  if (a.positional().size() != 2) throw core::InputError("gaze convert needs IN and OUT (see --help)");
+  const dv::SourceOptions opt = gaze_source_options(a);
+  const std::string& in = a.positional()[0];
+  auto reader = dv::open_reader(in, opt);
+  nlohmann::json meta = {{"source", in},
+                         {"source_format", dv::format_name(reader->format())},
+                         {"display", opt.display.name}};
+  const core::View sv = opt.screen_view();
+  meta["screen"] = {{"width", sv.width()}, {"height", sv.height()}};
+  dv::FoveaCsvWriter w(a.positional()[1], meta.dump());
+  dv::GazeSample s;
+  std::uint64_t tracked = 0;
+  while (reader->next(s)) {
+    w.write(s);
+    tracked += s.tracked();
+  }
+  const dv::ReadStats& st = reader->stats();
+  if (tracked == 0) throw core::InputError(in + ": no usable sample; nothing written");
+  w.finish();
+  std::cerr << "converted " << st.samples << " samples (" << st.dropped_total() << " rows dropped";
+  for (const auto& [k, v] : st.dropped) std::cerr << ", " << k << ": " << v;
+  std::cerr << ") -> " << a.positional()[1] << "\n";
+  return 0;
+}
+
+int cmd_synth(const std::vector<std::string>& argv) {
+  Args a(argv, {"task", "seconds", "seed", "rate", "noise", "color", "dropouts", "display"}, {}, 1);
+  if (a.positional().size() != 1) throw core::InputError("gaze synth needs OUT (see --help)");
+  dv::SynthParams p;
+  p.task = dv::parse_synth_task(a.str("task", "search"));
+  p.seconds = a.num("seconds", 5);
+  if (!(p.seconds > 0)) throw core::InputError("--seconds must be positive");
+  const long seed = a.integer("seed", 1);
+  if (seed < 0) throw core::InputError("--seed must be non-negative");
+  p.seed = static_cast<std::uint64_t>(seed);
+  p.rate_hz = a.num("rate", p.rate_hz);
+  p.noise_deg = a.num("noise", p.noise_deg);
+  p.noise_color = a.num("color", p.noise_color);
+  p.dropout_per_s = a.num("dropouts", p.dropout_per_s);
+  const core::DisplayPreset display = core::load_display(a.str("display", "small"));
+  p.ipd_m = display.ipd_m;
+  dv::SyntheticStream stream(p);
+  std::ostringstream cmd;
+  cmd << "fovea gaze synth --task " << dv::synth_task_name(p.task) << " --seconds " << p.seconds << " --seed " << p.seed
+      << " --rate " << p.rate_hz << " --noise " << p.noise_deg << " --color " << p.noise_color << " --dropouts "
+      << p.dropout_per_s << " --display " << display.name;
+  const nlohmann::json meta = {{"display", display.name},
+                               {"generator", cmd.str()},
+                               {"synthetic", {{"seed", p.seed},
+                                              {"task", dv::synth_task_name(p.task)},
+                                              {"rate_hz", p.rate_hz},
+                                              {"seconds", p.seconds},
+                                              {"noise_deg_rms", p.noise_deg},
+                                              {"noise_color", p.noise_color},
+                                              {"dropouts_per_s", p.dropout_per_s}}}};
+  dv::FoveaCsvWriter w(a.positional()[0], meta.dump());
+  dv::GazeSample s;
+  while (stream.next(s)) w.write(s);
+  w.finish();
+  std::cerr << "wrote " << w.samples() << " samples -> " << a.positional()[0] << "\n";
+  return 0;
+}
+
+int run(std::vector<std::string> args) {
+  if (args.empty() || args[0] == "--help" || args[0] == "-h") {
+    std::cout << kHelp;
+    return args.empty() ? 2 : 0;
+  }
+  const std::string sub = args[0];
+  args.erase(args.begin());
+  for (const auto& s : args)
+    if (s == "--help" || s == "-h") {
+      std::cout << kHelp;
+      return 0;
+    }
+  if (sub == "info") return cmd_info(args);
+  if (sub == "convert") return cmd_convert(args);
+  if (sub == "synth") return cmd_synth(args);
+  throw core::InputError("unknown gaze subcommand \"" + sub + "\" (info, convert, synth, plot, record)");
+}
+
+}  // namespace
+
+FOVEA_COMMAND(gaze_cmd, "gaze", "recorded, synthetic and live gaze: info, convert, synth, plot, record", run);
+
+}  // namespace fovea::tools
