@@ -4,7 +4,6 @@
 // relative to begin(). Queues without timestamps (timestampValidBits == 0) are
 // reported by supported() == false; recording is then a no-op and read() is empty.
 #include <cstdint>
-#include <optional>
 #include <string>
 #include <vector>
 
@@ -37,8 +36,8 @@ class GpuTimer {
   // Records: a timestamp once all earlier commands finished, closing stage `name`.
   // Throws std::length_error beyond max_stages.
   void stage(VkCommandBuffer cmd, std::string name);
-  // After the submission completed: the stages in order, or nullopt when unsupported.
-  std::optional<std::vector<StageTime>> read() const;
+  // After the submission completed: the stages in order; empty when unsupported.
+  std::vector<StageTime> read() const;
 
  private:
   std::uint32_t valid_bits_ = 0;
