@@ -33,7 +33,10 @@ bool LineReader::fill() {
     end_ -= begin_;
     begin_ = 0;
   }
-  if (buf_.size() - end_ < kChunk) buf_.resize(end_ + kChunk);
+  if (buf_.size() - end_ < kChunk) {  // grow by exactly one chunk (no doubling): the bound stays tight
+    buf_.reserve(end_ + kChunk);
+    buf_.resize(end_ + kChunk);
+  }
   peak_ = std::max(peak_, buf_.capacity());
   const int n = gzread(static_cast<gzFile>(gz_), buf_.data() + end_, static_cast<unsigned>(kChunk));
   if (n < 0) {
