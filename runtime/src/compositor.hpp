@@ -1,0 +1,63 @@
+#pragma once
+// What the simulated panel shows: the submitted projection layers, read back from the
+// application's swapchain images and resampled into each eye's panel raster (a plain copy
+// when the layer matches the panel's field of view and size), with the hidden area blacked
+// out. Every k-th frame the two panel images are written as PNG files.
+#include <array>
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include "fovea/core/display.hpp"
+#include "fovea/core/image.hpp"
+#include "vk_util.hpp"
+#include "xr.hpp"
+
+namespace fovea::runtime {
+
+struct LayerView {
+  VkImage image = VK_NULL_HANDLE;
+  VkFormat format = VK_FORMAT_UNDEFINED;
+  std::uint32_t array_layer = 0;
+  XrRect2Di rect{};
+  core::Fov fov;
+};
+
+struct ProjectionLayer {
+  std::array<LayerView, 2> views;
+  bool alpha_blend = false;  // XR_COMPOSITION_LAYER_BLEND_TEXTURE_SOURCE_ALPHA_BIT
+};
+
+class Compositor {
+ public:
+  Compositor(VkPhysicalDevice physical, VkDevice device, OneShotQueue& queue, const core::DisplayPreset& display,
+             std::string out_dir, std::int64_t png_every);
+  ~Compositor();
+  Compositor(const Compositor&) = delete;
+  Compositor& operator=(const Compositor&) = delete;
+
+  // Whether frame `index` is one whose panel images are produced.
+  bool wants(std::int64_t index) const { return !out_dir_.empty() && index % png_every_ == 0; }
+  // Composes and writes <out>/panel_<index>_{left,right}.png. The images must be in
+  // COLOR_ATTACHMENT_OPTIMAL layout and owned by the session queue (as after release);
+  // they are left that way. Throws std::runtime_error on Vulkan or I/O failure.
+  void compose(std::int64_t index, const std::vector<ProjectionLayer>& layers);
+
+  static bool readable_format(VkFormat f);
+
+ private:
+  core::Image read_back(const LayerView& v);
+  void ensure_staging(VkDeviceSize bytes);
+
+  VkPhysicalDevice physical_;
+  VkDevice device_;
+  OneShotQueue& queue_;
+  core::DisplayPreset display_;
+  std::string out_dir_;
+  std::int64_t png_every_;
+  VkBuffer staging_ = VK_NULL_HANDLE;
+  VkDeviceMemory staging_memory_ = VK_NULL_HANDLE;
+  VkDeviceSize staging_size_ = 0;
+};
+
+}  // namespace fovea::runtime

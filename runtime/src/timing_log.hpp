@@ -1,0 +1,40 @@
+#pragma once
+// Per-frame timing log: one JSON object per line in <out>/timing.jsonl. All times are int64
+// ns of CLOCK_MONOTONIC (the XrTime base).
+#include <cstdint>
+#include <cstdio>
+#include <string>
+
+#include "fovea/core/clock.hpp"
+
+namespace fovea::runtime {
+
+struct FrameRecord {
+  std::int64_t frame = 0;
+  core::TimeNs predicted_display_ns = 0;
+  core::TimeNs wait_call_ns = 0, wait_return_ns = 0;  // xrWaitFrame entry and return
+  core::TimeNs late_ns = 0;                            // wait return past the frame's wake time
+  core::TimeNs begin_ns = 0;                           // xrBeginFrame
+  core::TimeNs end_call_ns = 0, end_return_ns = 0;     // xrEndFrame entry and return
+  double compositor_ms = 0;                            // read-back, resampling, mask, PNG
+  bool composited = false;                             // panel images produced for this frame
+  std::uint32_t layers = 0;
+  core::TimeNs gaze_sample_ns = 0;  // the eye tracker sample for the predicted display time
+  bool gaze_valid = false;
+};
+
+class TimingLog {
+ public:
+  TimingLog() = default;
+  ~TimingLog();
+  TimingLog(const TimingLog&) = delete;
+  TimingLog& operator=(const TimingLog&) = delete;
+  // Starts <dir>/timing.jsonl (truncating); an empty dir disables the log.
+  void open(const std::string& dir);
+  void write(const FrameRecord& r);
+
+ private:
+  std::FILE* file_ = nullptr;
+};
+
+}  // namespace fovea::runtime
