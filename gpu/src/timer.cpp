@@ -42,8 +42,8 @@ void GpuTimer::stage(VkCommandBuffer cmd, std::string name) {
   vkCmdWriteTimestamp(cmd, VK_PIPELINE_STAGE_BOTTOM_OF_PIPE_BIT, pool_.get(), static_cast<std::uint32_t>(names_.size()));
 }
 
-std::vector<StageTime> GpuTimer::read() const {
-  if (!pool_) return {};
+std::optional<std::vector<StageTime>> GpuTimer::read() const {
+  if (!pool_) return std::nullopt;
   if (!begun_) throw std::logic_error("gpu::GpuTimer::read before begin");
   std::vector<std::uint64_t> ticks(names_.size() + 1);
   check(vkGetQueryPoolResults(pool_.device(), pool_.get(), 0, static_cast<std::uint32_t>(ticks.size()),

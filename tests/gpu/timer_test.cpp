@@ -25,7 +25,7 @@ TEST_F(Timer, StagesAreOrderedAndNonNegative) {
   gpu::GpuTimer timer(ctx());
   if (!ctx().timestamps_supported()) {
     EXPECT_FALSE(timer.supported());
-    EXPECT_TRUE(timer.read().empty());
+    EXPECT_FALSE(timer.read().has_value());
     GTEST_SKIP() << "the queue has no timestamps (timestampValidBits == 0)";
   }
   ASSERT_TRUE(timer.supported());
@@ -51,11 +51,12 @@ TEST_F(Timer, StagesAreOrderedAndNonNegative) {
     timer.stage(cmd, "fill again");
   });
   const auto stages = timer.read();
-  ASSERT_EQ(stages.size(), 3u);
-  EXPECT_EQ(stages[0].name, "clear");
-  EXPECT_EQ(stages[2].name, "fill again");
+  ASSERT_TRUE(stages.has_value());
+  ASSERT_EQ(stages->size(), 3u);
+  EXPECT_EQ((*stages)[0].name, "clear");
+  EXPECT_EQ((*stages)[2].name, "fill again");
   std::int64_t previous_end = 0;
-  for (const gpu::StageTime& s : stages) {
+  for (const gpu::StageTime& s : *stages) {
     EXPECT_GE(s.start_ns, 0) << s.name;
     EXPECT_EQ(s.start_ns, previous_end) << s.name << " starts where the previous stage ended";
     EXPECT_GE(s.end_ns, s.start_ns) << s.name;
@@ -73,5 +74,5 @@ TEST_F(Timer, MisuseThrows) {
     timer.stage(cmd, "one");
     EXPECT_THROW(timer.stage(cmd, "two"), std::length_error);
   });
-  EXPECT_EQ(timer.read().size(), 1u);
+  EXPECT_EQ(timer.read()->size(), 1u);
 }

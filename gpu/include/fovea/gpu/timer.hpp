@@ -2,8 +2,9 @@
 // GPU timestamps for one submission: begin(), then stage("name") after each stage's
 // commands; after submit_and_wait, read() gives each stage's start and end in ns
 // relative to begin(). Queues without timestamps (timestampValidBits == 0) are
-// reported by supported() == false; recording is then a no-op and read() is empty.
+// reported by supported() == false; recording is then a no-op and read() is nullopt.
 #include <cstdint>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -36,8 +37,9 @@ class GpuTimer {
   // Records: a timestamp once all earlier commands finished, closing stage `name`.
   // Throws std::length_error beyond max_stages.
   void stage(VkCommandBuffer cmd, std::string name);
-  // After the submission completed: the stages in order; empty when unsupported.
-  std::vector<StageTime> read() const;
+  // After the submission completed: the stages in order, or nullopt when unsupported.
+  // Keep the result in a variable: `for (auto& s : *timer.read())` would dangle.
+  std::optional<std::vector<StageTime>> read() const;
 
  private:
   std::uint32_t valid_bits_ = 0;
