@@ -45,8 +45,10 @@ class VisualPolar final : public PolarDistribution {
   double target_density(glm::dvec3 dir) const override { return sigma(angle_deg(dir, gaze_), sigma0_); }
 
   double pixels_per_cell(int column, glm::dvec3 dir) const override {
-    // Ring solid angle 2π(cos e_i − cos e_i+1) sr, shared by the column's rows.
-    const double sr = 2 * kPi * (std::cos(r_[column] * kDeg) - std::cos(r_[column + 1] * kDeg));
+    // Ring solid angle 2π(cos e_i − cos e_i+1) = 4π sin(mid)·sin(half-width) sr (no
+    // cancellation for thin rings), shared by the column's rows.
+    const double sr = 4 * kPi * std::sin(0.5 * (r_[column] + r_[column + 1]) * kDeg) *
+                      std::sin(0.5 * (r_[column + 1] - r_[column]) * kDeg);
     return sr / (kDeg * kDeg) / h_[column] * view_.pixels_per_deg2(dir);
   }
 

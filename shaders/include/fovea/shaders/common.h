@@ -7,11 +7,9 @@
 #define FOVEA_UINT std::uint32_t
 #define FOVEA_INT std::int32_t
 #define FOVEA_CONST constexpr
-#define FOVEA_U(x) x##u
 #else
 #define FOVEA_UINT uint
 #define FOVEA_INT int
 #define FOVEA_CONST const
-#define FOVEA_U(x) x##u
 #endif
 #endif

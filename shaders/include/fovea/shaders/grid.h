@@ -9,11 +9,11 @@ namespace fovea::shaders {
 #endif
 
 // flags: 0 means "trace this cell"; any bit set means the thread skips it.
-FOVEA_CONST FOVEA_UINT kCellClipped = FOVEA_U(1);    // beyond the column's row count (VP clip)
-FOVEA_CONST FOVEA_UINT kCellOffscreen = FOVEA_U(2);  // direction outside the view frustum
-FOVEA_CONST FOVEA_UINT kCellHidden = FOVEA_U(4);     // inside the lens' hidden area
-FOVEA_CONST FOVEA_UINT kCellKilled = FOVEA_U(8);     // randomly killed (linear fall-off)
-FOVEA_CONST FOVEA_UINT kCellPadding = FOVEA_U(16);   // padding to whole 32x32 blocks
+FOVEA_CONST FOVEA_UINT kCellClipped = 1u;    // beyond the column's row count (VP clip)
+FOVEA_CONST FOVEA_UINT kCellOffscreen = 2u;  // direction outside the view frustum
+FOVEA_CONST FOVEA_UINT kCellHidden = 4u;     // inside the lens' hidden area
+FOVEA_CONST FOVEA_UINT kCellKilled = 8u;     // randomly killed (linear fall-off)
+FOVEA_CONST FOVEA_UINT kCellPadding = 16u;   // padding to whole 32x32 blocks
 
 struct GridSample {
   float dir_x, dir_y, dir_z;  // unit view-space direction (OpenXR: -Z forward, +Y up)

@@ -9,9 +9,9 @@ namespace fovea::shaders {
 #endif
 
 // GridParams.family
-FOVEA_CONST FOVEA_UINT kFamilyAngularPolar = FOVEA_U(0);  // VP: radius = eccentricity (deg) around the gaze
-FOVEA_CONST FOVEA_UINT kFamilyScreenPolar = FOVEA_U(1);   // paper VP, log-polar: radius in pixels
-FOVEA_CONST FOVEA_UINT kFamilyCartesian = FOVEA_U(2);     // raster scaled to the display
+FOVEA_CONST FOVEA_UINT kFamilyAngularPolar = 0u;  // VP: radius = eccentricity (deg) around the gaze
+FOVEA_CONST FOVEA_UINT kFamilyScreenPolar = 1u;   // paper VP, log-polar: radius in pixels
+FOVEA_CONST FOVEA_UINT kFamilyCartesian = 2u;     // raster scaled to the display
 
 // One column of a polar grid: radius range [r0, r1) (linear within the column) and rows.
 struct GridColumn {

@@ -14,9 +14,9 @@ namespace fovea::shaders {
 // A 32-bit avalanche mix (xor-shift / multiply rounds).
 FOVEA_FN FOVEA_UINT hash1(FOVEA_UINT x) {
   x ^= x >> 16;
-  x *= FOVEA_U(0x7feb352d);
+  x *= 0x7feb352du;
   x ^= x >> 15;
-  x *= FOVEA_U(0x846ca68b);
+  x *= 0x846ca68bu;
   x ^= x >> 16;
   return x;
 }

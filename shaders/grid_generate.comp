@@ -1,0 +1,30 @@
+#version 460
+// Grid generation: one GridSample (view direction, display position, flags) per cell of
+// any sample distribution, from the per-frame GridParams and column table built by
+// core::SampleDistribution on the CPU. Mirrors the CPU double-precision reference.
+#extension GL_GOOGLE_include_directive : require
+
+layout(local_size_x = 8, local_size_y = 8) in;
+
+#include "fovea/shaders/grid.h"
+#include "fovea/shaders/grid_params.h"
+#include "fovea/shaders/hash.h"
+
+layout(std140, set = 0, binding = 0) uniform Params { GridParams P; };
+layout(std430, set = 0, binding = 1) readonly buffer Columns { GridColumn cols[]; };
+layout(std430, set = 0, binding = 2) readonly buffer Mask { uint hidden_mask[]; };  // 1 bit per display pixel
+layout(std430, set = 0, binding = 3) writeonly buffer Samples { GridSample samples[]; };
+
+#include "fovea/shaders/grid_map.glsl"
+
+void main() {
+  uvec2 cell = gl_GlobalInvocationID.xy;
+  if (cell.x >= P.padded_columns || cell.y >= P.padded_rows) return;
+  GridSample s = gm_sample(cell.x, cell.y, vec2(P.jitter_u, P.jitter_v));
+  if (s.flags == 0u && P.has_mask > 0.5) {
+    uvec2 p = uvec2(min(vec2(s.screen_x, s.screen_y), vec2(P.width - 1.0, P.height - 1.0)));
+    uint bit = p.y * uint(P.width) + p.x;
+    if ((hidden_mask[bit >> 5] & (1u << (bit & 31u))) != 0u) s.flags |= kCellHidden;
+  }
+  samples[cell.y * P.padded_columns + cell.x] = s;
+}

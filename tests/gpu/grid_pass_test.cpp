@@ -1,0 +1,92 @@
+// GPU grid generation (shaders/grid_generate.comp) = the CPU double-precision reference
+// (core::SampleDistribution::sample) for every distribution, on lavapipe.
+#include <cmath>
+#include <numeric>
+#include <vector>
+
+#include "fovea/core/display.hpp"
+#include "fovea/core/distribution.hpp"
+#include "fovea/gpu/buffer.hpp"
+#include "fovea/gpu/grid_pass.hpp"
+#include "gpu_fixture.hpp"
+
+using namespace fovea;
+using fovea::test::GpuTest;
+
+namespace {
+
+struct Case {
+  const char* display;
+  core::DistributionKind kind;
+};
+
+class GridPassTest : public GpuTest, public ::testing::WithParamInterface<Case> {};
+
+TEST_P(GridPassTest, MatchesCpuReference) {
+  const Case c = GetParam();
+  const core::View view = core::load_display(c.display).view(core::Eye::Left);
+  core::DistributionParams p;
+  p.kind = c.kind;
+  auto d = core::make_distribution(view, p);
+  d->set_jitter(true);
+  gpu::GridPass pass(ctx());
+  const glm::dvec2 gazes[] = {{0.5, 0.5}, {0.2, 0.7}, {0, 0}, {1, 0.5}, {0.5 + 0.5 / view.width(), 0.5}};
+  double worst_px = 0, worst_dir = 0;
+  for (std::uint32_t f = 0; f < std::size(gazes); ++f) {
+    d->set_frame(view.pixel_to_dir({gazes[f].x * view.width(), gazes[f].y * view.height()}), f);
+    gpu::Buffer out(ctx(), {.size = gpu::GridPass::samples_bytes(*d), .memory = gpu::Memory::HostVisible,
+                            .name = "grid samples"});
+    pass.generate(*d, out);
+    const auto got = out.download<shaders::GridSample>();
+    int flag_mismatch = 0;
+    for (int row = 0; row < d->padded_rows(); ++row)
+      for (int col = 0; col < d->padded_columns(); ++col) {
+        const auto& g = got[size_t(row) * d->padded_columns() + col];
+        const auto r = d->sample(col, row);
+        ASSERT_TRUE(std::isfinite(g.dir_x) && std::isfinite(g.dir_y) && std::isfinite(g.dir_z) &&
+                    std::isfinite(g.screen_x) && std::isfinite(g.screen_y) && std::isfinite(g.ecc_deg) &&
+                    std::isfinite(g.footprint));
+        if (g.flags != r.flags) {
+          // Only cells within float rounding of a decision boundary may differ: the display
+          // edge, or a linear fall-off threshold.
+          const bool near_edge = std::min({std::abs(r.screen_x), std::abs(r.screen_y),
+                                           std::abs(r.screen_x - view.width()),
+                                           std::abs(r.screen_y - view.height())}) < 1e-3;
+          const bool kill_only = ((g.flags ^ r.flags) == shaders::kCellKilled);
+          EXPECT_TRUE(near_edge || kill_only) << "cell " << col << "," << row << " gpu " << g.flags << " cpu " << r.flags;
+          ++flag_mismatch;
+          continue;
+        }
+        if (r.flags & (shaders::kCellPadding | shaders::kCellOffscreen)) continue;
+        worst_px = std::max({worst_px, std::abs(double(g.screen_x) - r.screen_x), std::abs(double(g.screen_y) - r.screen_y)});
+        worst_dir = std::max({worst_dir, std::abs(double(g.dir_x) - r.dir_x), std::abs(double(g.dir_y) - r.dir_y),
+                              std::abs(double(g.dir_z) - r.dir_z)});
+        EXPECT_NEAR(g.ecc_deg, r.ecc_deg, 2e-3) << col << "," << row;
+        // Footprints of sub-pixel cells (log-polar centre) are limited by the float table.
+        EXPECT_NEAR(g.footprint, r.footprint, 1e-3 * (1 + r.footprint)) << col << "," << row;
+      }
+    EXPECT_LE(flag_mismatch, d->columns() * d->rows() / 1000 + 2);
+  }
+  EXPECT_LT(worst_px, 0.01) << "worst display-position difference, pixels";
+  EXPECT_LT(worst_dir, 1e-5);
+  RecordProperty("worst_px", std::to_string(worst_px));
+  std::printf("%s %s: worst |gpu - cpu| = %.2e px, %.2e in direction\n", c.display,
+              core::distribution_name(c.kind), worst_px, worst_dir);
+}
+
+const Case kCases[] = {
+    {"tiny", core::DistributionKind::VisualPolar},       {"small", core::DistributionKind::VisualPolar},
+    {"fove0", core::DistributionKind::VisualPolar},      {"small", core::DistributionKind::PaperVisualPolar},
+    {"small", core::DistributionKind::Cartesian},        {"small", core::DistributionKind::CartesianUniform},
+    {"small", core::DistributionKind::LinearFalloff},    {"small", core::DistributionKind::LogPolar},
+};
+
+INSTANTIATE_TEST_SUITE_P(Distributions, GridPassTest, ::testing::ValuesIn(kCases),
+                         [](const auto& info) {
+                           std::string n = std::string(info.param.display) + "_" + core::distribution_name(info.param.kind);
+                           for (char& ch : n)
+                             if (ch == '-') ch = '_';
+                           return n;
+                         });
+
+}  // namespace
