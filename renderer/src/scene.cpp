@@ -5,6 +5,7 @@
 #include <limits>
 #include <map>
 
+#include <glm/common.hpp>
 #include <glm/geometric.hpp>
 
 #include "fovea/core/error.hpp"

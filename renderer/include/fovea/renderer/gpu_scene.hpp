@@ -1,0 +1,42 @@
+#pragma once
+// A scene on the GPU: BVH nodes, triangles in BVH order, shading attributes, materials,
+// the emissive-triangle table for next-event estimation and the textures, uploaded once.
+#include <cstdint>
+
+#include "fovea/gpu/buffer.hpp"
+#include "fovea/gpu/context.hpp"
+#include "fovea/renderer/bvh.hpp"
+#include "fovea/renderer/scene.hpp"
+
+namespace fovea::renderer {
+
+struct GpuSceneStats {
+  std::uint32_t triangles = 0, nodes = 0, lights = 0, textures = 0;
+  int bvh_depth = 0;
+  double bvh_sah_cost = 0;
+  double build_ms = 0;  // CPU BVH build
+};
+
+class GpuScene {
+ public:
+  // `scene` must be sanitised (every loader does that).
+  GpuScene(gpu::Context& ctx, const Scene& scene, const BvhOptions& bvh = {});
+
+  const gpu::Buffer& nodes() const { return nodes_; }
+  const gpu::Buffer& triangles() const { return triangles_; }
+  const gpu::Buffer& shading() const { return shading_; }
+  const gpu::Buffer& materials() const { return materials_; }
+  const gpu::Buffer& lights() const { return lights_; }          // >= 1 entry (a dummy when none)
+  const gpu::Buffer& texture_table() const { return texture_table_; }
+  const gpu::Buffer& texels() const { return texels_; }
+  std::uint32_t light_count() const { return stats_.lights; }     // real emissive triangles
+  glm::vec3 environment() const { return environment_; }
+  const GpuSceneStats& stats() const { return stats_; }
+
+ private:
+  gpu::Buffer nodes_, triangles_, shading_, materials_, lights_, texture_table_, texels_;
+  glm::vec3 environment_{0};
+  GpuSceneStats stats_;
+};
+
+}  // namespace fovea::renderer

@@ -1,0 +1,42 @@
+#pragma once
+// Batches of rays against a GpuScene (pt_raycast.comp): closest-hit or any-hit, through
+// the BVH or by brute force. For BVH tests and the ray-throughput benchmark.
+#include <span>
+#include <vector>
+
+#include "fovea/gpu/descriptors.hpp"
+#include "fovea/gpu/pipeline.hpp"
+#include "fovea/renderer/gpu_scene.hpp"
+#include "fovea/shaders/pt_raycast.h"
+
+namespace fovea::renderer {
+
+enum class RayQuery : std::uint32_t {
+  Closest = shaders::kPtRaycastClosest,
+  Any = shaders::kPtRaycastAny,
+  BruteClosest = shaders::kPtRaycastBruteClosest,
+  BruteAny = shaders::kPtRaycastBruteAny,
+};
+
+class Raycaster {
+ public:
+  Raycaster(gpu::Context& ctx, const GpuScene& scene);
+
+  // Uploads `rays` (replacing earlier ones); trace() then runs on them.
+  void set_rays(std::span<const shaders::PtRay> rays);
+  // Traces the current rays `repeat` times in one submission; returns the hits.
+  std::vector<shaders::PtHitRecord> trace(RayQuery query, int repeat = 1);
+  // GPU time of the last trace() in ns (0 without timestamp support).
+  std::int64_t last_gpu_ns() const { return last_gpu_ns_; }
+
+ private:
+  gpu::Context& ctx_;
+  const GpuScene& scene_;
+  gpu::ComputePipeline pipeline_;
+  gpu::Buffer rays_, hits_;
+  gpu::DescriptorSet set_;
+  std::uint32_t count_ = 0;
+  std::int64_t last_gpu_ns_ = 0;
+};
+
+}  // namespace fovea::renderer

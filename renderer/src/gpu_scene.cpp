@@ -1,0 +1,95 @@
+#include "fovea/renderer/gpu_scene.hpp"
+
+#include <chrono>
+#include <cstring>
+
+#include <glm/geometric.hpp>
+
+namespace fovea::renderer {
+
+namespace {
+
+template <class T>
+gpu::Buffer upload(gpu::Context& ctx, const std::vector<T>& data, const char* name) {
+  gpu::Buffer b(ctx, {data.size() * sizeof(T), gpu::BufferUsage::Storage, gpu::Memory::DeviceLocal, name});
+  b.upload(data);
+  return b;
+}
+
+}  // namespace
+
+GpuScene::GpuScene(gpu::Context& ctx, const Scene& s, const BvhOptions& bvh_options) {
+  using namespace shaders;
+  const auto t0 = std::chrono::steady_clock::now();
+  const Bvh bvh = build_bvh(s.positions, bvh_options);
+  stats_.build_ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
+  const std::size_t n = bvh.order.size();
+
+  // Lights: emissive triangles, chosen with probability proportional to their power.
+  std::vector<std::uint32_t> slot_of(n);
+  for (std::size_t i = 0; i < n; ++i) slot_of[bvh.order[i]] = std::uint32_t(i);
+  std::vector<PtLight> lights;
+  double total = 0;
+  for (std::size_t t = 0; t < n; ++t) total += triangle_power(s, t);
+  std::vector<float> light_pdf(n, 0.0f);
+  if (total > 0) {
+    double acc = 0;
+    for (std::size_t t = 0; t < n; ++t) {
+      const float p = triangle_power(s, t);
+      if (!(p > 0)) continue;
+      const glm::vec3* v = &s.positions[3 * t];
+      const float area = 0.5f * glm::length(glm::cross(v[1] - v[0], v[2] - v[0]));
+      acc += p;
+      const float pmf = float(p / total);
+      lights.push_back({slot_of[t], float(acc / total), pmf, area});
+      light_pdf[t] = pmf / area;
+    }
+    lights.back().cdf = 1.0f;  // no rounding gap at the top of the CDF
+  }
+  stats_.lights = std::uint32_t(lights.size());
+  if (lights.empty()) lights.push_back({0, 1.0f, 0.0f, 0.0f});
+
+  std::vector<PtTriangle> tris(n);
+  std::vector<PtShading> shading(n);
+  for (std::size_t i = 0; i < n; ++i) {
+    const std::uint32_t t = bvh.order[i];
+    const glm::vec3* p = &s.positions[3 * t];
+    const glm::vec3* nn = &s.normals[3 * t];
+    const glm::vec2* uv = &s.uvs[3 * t];
+    tris[i] = {p[0].x, p[0].y, p[0].z, s.material[t], p[1].x, p[1].y, p[1].z, t, p[2].x, p[2].y, p[2].z, light_pdf[t]};
+    shading[i] = {nn[0].x, nn[0].y, nn[0].z, nn[1].x, nn[1].y, nn[1].z, nn[2].x, nn[2].y, nn[2].z,
+                  uv[0].x, uv[0].y, uv[1].x, uv[1].y, uv[2].x, uv[2].y, 0.0f};
+  }
+
+  std::vector<PtMaterial> mats;
+  for (const Material& m : s.materials)
+    mats.push_back({m.base_color.x, m.base_color.y, m.base_color.z, m.base_color_texture, m.emission.x, m.emission.y,
+                    m.emission.z, m.metallic, m.roughness, m.specular, 0.0f, 0.0f});
+
+  std::vector<PtTextureInfo> table;
+  std::vector<std::uint32_t> texels;
+  for (const Texture& t : s.textures) {
+    table.push_back({std::uint32_t(texels.size()), std::uint32_t(t.width), std::uint32_t(t.height), 0});
+    const std::size_t first = texels.size();
+    texels.resize(first + std::size_t(t.width) * t.height);
+    std::memcpy(texels.data() + first, t.rgba.data(), t.rgba.size());  // RGBA8 -> unpackUnorm4x8 order
+  }
+  stats_.textures = std::uint32_t(table.size());
+  if (table.empty()) table.push_back({0, 1, 1, 0});
+  if (texels.empty()) texels.push_back(0xFFFFFFFFu);
+
+  nodes_ = upload(ctx, bvh.nodes, "pt.bvh_nodes");
+  triangles_ = upload(ctx, tris, "pt.triangles");
+  shading_ = upload(ctx, shading, "pt.shading");
+  materials_ = upload(ctx, mats, "pt.materials");
+  lights_ = upload(ctx, lights, "pt.lights");
+  texture_table_ = upload(ctx, table, "pt.texture_table");
+  texels_ = upload(ctx, texels, "pt.texels");
+  environment_ = s.environment;
+  stats_.triangles = std::uint32_t(n);
+  stats_.nodes = std::uint32_t(bvh.nodes.size());
+  stats_.bvh_depth = bvh.depth;
+  stats_.bvh_sah_cost = bvh.sah_cost;
+}
+
+}  // namespace fovea::renderer

@@ -1,0 +1,46 @@
+#include "fovea/renderer/raycaster.hpp"
+
+#include <stdexcept>
+
+#include "fovea/gpu/barriers.hpp"
+#include "fovea/gpu/timer.hpp"
+
+namespace fovea::renderer {
+
+Raycaster::Raycaster(gpu::Context& ctx, const GpuScene& scene)
+    : ctx_(ctx),
+      scene_(scene),
+      pipeline_(ctx, {"pt_raycast.comp.spv",
+                      {{gpu::Binding::StorageBuffer, gpu::Binding::StorageBuffer, gpu::Binding::StorageBuffer,
+                        gpu::Binding::StorageBuffer}},
+                      sizeof(shaders::PtRaycastParams)}) {}
+
+void Raycaster::set_rays(std::span<const shaders::PtRay> rays) {
+  if (rays.empty()) throw std::invalid_argument("Raycaster::set_rays: no rays");
+  count_ = std::uint32_t(rays.size());
+  rays_ = gpu::Buffer(ctx_, {rays.size_bytes(), gpu::BufferUsage::Storage, gpu::Memory::DeviceLocal, "pt.rays"});
+  rays_.upload(rays);
+  hits_ = gpu::Buffer(ctx_, {rays.size() * sizeof(shaders::PtHitRecord), gpu::BufferUsage::Storage,
+                             gpu::Memory::DeviceLocal, "pt.hits"});
+  set_ = gpu::DescriptorSet(ctx_, pipeline_.set_layout(0));
+  set_.bind(0, scene_.nodes()).bind(1, scene_.triangles()).bind(2, rays_).bind(3, hits_);
+}
+
+std::vector<shaders::PtHitRecord> Raycaster::trace(RayQuery query, int repeat) {
+  if (count_ == 0) throw std::logic_error("Raycaster::trace before set_rays");
+  gpu::GpuTimer timer(ctx_, 2);
+  ctx_.submit_and_wait([&](VkCommandBuffer cmd) {
+    timer.begin(cmd);
+    const shaders::PtRaycastParams p{count_, static_cast<std::uint32_t>(query), 0, 0};
+    for (int r = 0; r < repeat; ++r) {
+      if (r) gpu::barrier(cmd, gpu::access::compute_write, gpu::access::compute_write);
+      pipeline_.run(cmd, {&set_}, p, count_);
+    }
+    timer.stage(cmd, "raycast");
+  });
+  const auto t = timer.read();
+  last_gpu_ns_ = t && !t->empty() ? t->back().duration_ns() : 0;
+  return hits_.download<shaders::PtHitRecord>();
+}
+
+}  // namespace fovea::renderer

@@ -1,0 +1,68 @@
+// Scene data of the path tracer on the GPU (shared C++/GLSL, std430 = C++ layout).
+#ifndef FOVEA_SHADERS_PT_SCENE_H
+#define FOVEA_SHADERS_PT_SCENE_H
+#include "fovea/shaders/common.h"
+
+#ifdef __cplusplus
+namespace fovea::shaders {
+#endif
+
+// Traversal stack size; the builder keeps the tree shallower than this.
+FOVEA_CONST FOVEA_UINT kPtBvhMaxDepth = 60;
+FOVEA_CONST FOVEA_UINT kPtNoHit = 0xFFFFFFFF;
+
+// BVH node, 32 bytes. Interior nodes (count == 0) have their children at `first` and
+// `first + 1`; leaves hold triangles [first, first + count) of the reordered triangles.
+struct PtBvhNode {
+  float lo_x, lo_y, lo_z;
+  FOVEA_UINT first;
+  float hi_x, hi_y, hi_z;
+  FOVEA_UINT count;
+};
+
+// Triangle vertices in BVH order, what traversal reads (48 bytes).
+struct PtTriangle {
+  float v0_x, v0_y, v0_z;
+  FOVEA_UINT material;
+  float v1_x, v1_y, v1_z;
+  FOVEA_UINT source;  // index of the triangle in the scene (for debugging and tests)
+  float v2_x, v2_y, v2_z;
+  float light_pdf;  // emissive: P(choose this triangle) / area, for MIS; else 0
+};
+
+// Shading attributes of a triangle, same order (64 bytes).
+struct PtShading {
+  float n0_x, n0_y, n0_z;
+  float n1_x, n1_y, n1_z;
+  float n2_x, n2_y, n2_z;
+  float uv0_x, uv0_y, uv1_x, uv1_y, uv2_x, uv2_y;
+  float pad;
+};
+
+struct PtMaterial {
+  float base_r, base_g, base_b;
+  FOVEA_INT texture;  // index into the texture table, -1 for none
+  float emit_r, emit_g, emit_b;
+  float metallic;
+  float roughness, specular, pad0, pad1;
+};
+
+// A texture in the shared texel buffer (RGBA8 sRGB words).
+struct PtTextureInfo {
+  FOVEA_UINT offset, width, height, pad;
+};
+
+// Emissive triangle for next-event estimation, chosen by power with a CDF.
+struct PtLight {
+  FOVEA_UINT triangle;  // index into the BVH-ordered triangles
+  float cdf;            // inclusive prefix sum of the selection probabilities
+  float pmf;
+  float area;
+};
+
+#ifdef __cplusplus
+static_assert(sizeof(PtBvhNode) == 32 && sizeof(PtTriangle) == 48 && sizeof(PtShading) == 64);
+static_assert(sizeof(PtMaterial) == 48 && sizeof(PtTextureInfo) == 16 && sizeof(PtLight) == 16);
+}  // namespace fovea::shaders
+#endif
+#endif

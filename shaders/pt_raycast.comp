@@ -1,0 +1,33 @@
+#version 460
+// Traces a batch of rays against the scene BVH (or by brute force): BVH tests and the
+// ray-throughput benchmark.
+#extension GL_GOOGLE_include_directive : require
+#include "fovea/shaders/pt_scene.h"
+#include "fovea/shaders/pt_raycast.h"
+
+layout(local_size_x = 64) in;
+layout(std430, set = 0, binding = 0) readonly buffer Nodes { PtBvhNode nodes[]; };
+layout(std430, set = 0, binding = 1) readonly buffer Tris { PtTriangle tris[]; };
+layout(std430, set = 0, binding = 2) readonly buffer Rays { PtRay rays[]; };
+layout(std430, set = 0, binding = 3) writeonly buffer Hits { PtHitRecord hits[]; };
+layout(push_constant) uniform Params { PtRaycastParams pc; };
+
+#include "fovea/shaders/pt_traverse.h"
+
+void main() {
+  const uint i = gl_GlobalInvocationID.x;
+  if (i >= pc.count) return;
+  const PtRay ray = rays[i];
+  const vec3 org = vec3(ray.org_x, ray.org_y, ray.org_z), dir = vec3(ray.dir_x, ray.dir_y, ray.dir_z);
+  const bool any_hit = pc.mode == kPtRaycastAny || pc.mode == kPtRaycastBruteAny;
+  PtHit h;
+  bool found;
+  if (pc.mode == kPtRaycastClosest || pc.mode == kPtRaycastAny) found = pt_traverse(org, dir, ray.tmin, ray.tmax, any_hit, h);
+  else found = pt_brute_force(org, dir, ray.tmin, ray.tmax, any_hit, h);
+  PtHitRecord rec;
+  rec.t = found ? h.t : ray.tmax;
+  rec.triangle = found ? (any_hit ? 0u : tris[h.tri].source) : kPtNoHit;
+  rec.u = found && !any_hit ? h.bary.x : 0.0;
+  rec.v = found && !any_hit ? h.bary.y : 0.0;
+  hits[i] = rec;
+}

@@ -1,0 +1,214 @@
+// BVH: structure on the CPU, and GPU traversal (closest and any hit) identical to brute
+// force on random and adversarial geometry; watertightness of the triangle test.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <random>
+#include <set>
+
+#include <glm/geometric.hpp>
+
+#include "fovea/renderer/bvh.hpp"
+#include "fovea/renderer/procedural.hpp"
+#include "fovea/renderer/raycaster.hpp"
+#include "gpu_fixture.hpp"
+
+namespace fr = fovea::renderer;
+using fovea::shaders::PtRay;
+
+namespace {
+
+std::vector<glm::vec3> random_soup(int n, float extent, float size, std::uint32_t seed) {
+  std::mt19937 rng(seed);
+  std::uniform_real_distribution<float> u(-1, 1);
+  std::vector<glm::vec3> p;
+  for (int i = 0; i < n; ++i) {
+    const glm::vec3 c(u(rng) * extent, u(rng) * extent, u(rng) * extent);
+    for (int k = 0; k < 3; ++k) p.push_back(c + size * glm::vec3(u(rng), u(rng), u(rng)));
+  }
+  return p;
+}
+
+// A coplanar grid of quads in z = 0 (shared edges and vertices everywhere).
+std::vector<glm::vec3> coplanar_grid(int n, float cell) {
+  std::vector<glm::vec3> p;
+  for (int i = 0; i < n; ++i)
+    for (int j = 0; j < n; ++j) {
+      const glm::vec3 a(i * cell, j * cell, 0), b((i + 1) * cell, j * cell, 0), c((i + 1) * cell, (j + 1) * cell, 0),
+          d(i * cell, (j + 1) * cell, 0);
+      p.insert(p.end(), {a, b, c, a, c, d});
+    }
+  return p;
+}
+
+// sah_gain: the geometry is spread out, so the tree must beat a flat list clearly.
+void check_structure(const std::vector<glm::vec3>& p, bool sah_gain = true) {
+  const fr::Bvh b = fr::build_bvh(p);
+  const std::size_t n = p.size() / 3;
+  ASSERT_EQ(b.order.size(), n);
+  std::vector<int> seen(n, 0);
+  EXPECT_LE(b.depth, int(fovea::shaders::kPtBvhMaxDepth));
+  // Walk the tree: children inside parents, leaves contain their triangles.
+  std::vector<std::size_t> stack{0};
+  std::size_t visited = 0;
+  auto inside = [](const fovea::shaders::PtBvhNode& outer, glm::vec3 q) {
+    return q.x >= outer.lo_x && q.y >= outer.lo_y && q.z >= outer.lo_z && q.x <= outer.hi_x && q.y <= outer.hi_y &&
+           q.z <= outer.hi_z;
+  };
+  while (!stack.empty()) {
+    const auto& node = b.nodes[stack.back()];
+    stack.pop_back();
+    ++visited;
+    if (node.count > 0) {
+      EXPECT_LE(node.first + node.count, n);
+      for (std::uint32_t i = node.first; i < node.first + node.count; ++i) {
+        ++seen[b.order[i]];
+        for (int k = 0; k < 3; ++k) EXPECT_TRUE(inside(node, p[3 * b.order[i] + k]));
+      }
+    } else {
+      ASSERT_LT(node.first + 1, b.nodes.size());
+      for (std::uint32_t c = node.first; c <= node.first + 1; ++c) {
+        const auto& ch = b.nodes[c];
+        EXPECT_TRUE(inside(node, {ch.lo_x, ch.lo_y, ch.lo_z}) || ch.count > 0);
+        stack.push_back(c);
+      }
+    }
+  }
+  EXPECT_EQ(visited, b.nodes.size());
+  for (std::size_t t = 0; t < n; ++t) ASSERT_EQ(seen[t], 1) << "triangle " << t;
+  if (sah_gain) {
+    EXPECT_LT(b.sah_cost, 0.5 * double(n)) << "SAH cost no better than a flat list";
+  }
+}
+
+}  // namespace
+
+TEST(Bvh, RandomSoupIsAValidPartition) { check_structure(random_soup(5000, 10, 0.5f, 1)); }
+TEST(Bvh, ParallelAndSerialBuildsAgree) {
+  const auto p = random_soup(20000, 10, 0.3f, 2);
+  fr::BvhOptions one, two;
+  one.threads = 1;
+  two.threads = 2;
+  const fr::Bvh a = fr::build_bvh(p, one), b = fr::build_bvh(p, two);
+  EXPECT_EQ(a.order, b.order);
+  EXPECT_EQ(a.nodes.size(), b.nodes.size());
+  EXPECT_DOUBLE_EQ(a.sah_cost, b.sah_cost);
+}
+TEST(Bvh, CoincidentTrianglesStillSplit) {
+  std::vector<glm::vec3> p;
+  for (int i = 0; i < 1000; ++i) p.insert(p.end(), {{0, 0, 0}, {1, 0, 0}, {0, 1, 0}});
+  check_structure(p, false);  // identical boxes: no split can reduce the SAH cost
+  EXPECT_LE(fr::build_bvh(p).depth, 12);
+}
+TEST(Bvh, CoplanarHugeAndTinyGeometry) {
+  check_structure(coplanar_grid(40, 1.0f));
+  check_structure(random_soup(2000, 1e7f, 1e3f, 3));
+  check_structure(random_soup(2000, 1e-3f, 1e-5f, 4));
+  // Deep chain: triangles at exponentially shrinking scales force the depth limit.
+  std::vector<glm::vec3> chain;
+  for (int i = 0; i < 200; ++i) {
+    const float s = std::ldexp(1.0f, -i / 2);
+    chain.insert(chain.end(), {{s, 0, 0}, {s, s * 0.5f, 0}, {s, 0, s * 0.5f}});
+  }
+  check_structure(chain, false);
+}
+
+class BvhGpu : public fovea::test::GpuTest {
+ protected:
+  // Closest and any hit through the BVH equal brute force for every ray.
+  void expect_equal_to_brute_force(const std::vector<glm::vec3>& p, const std::vector<PtRay>& rays) {
+    fr::Scene s;
+    s.materials.push_back({});
+    for (std::size_t t = 0; t < p.size() / 3; ++t) s.add_triangle(p[3 * t], p[3 * t + 1], p[3 * t + 2], 0);
+    fr::sanitize(s, "test");
+    fr::GpuScene g(ctx(), s);
+    fr::Raycaster rc(ctx(), g);
+    rc.set_rays(rays);
+    const auto bvh = rc.trace(fr::RayQuery::Closest), brute = rc.trace(fr::RayQuery::BruteClosest);
+    const auto any = rc.trace(fr::RayQuery::Any), brute_any = rc.trace(fr::RayQuery::BruteAny);
+    int hits = 0, ties = 0;
+    for (std::size_t i = 0; i < rays.size(); ++i) {
+      ASSERT_EQ(bvh[i].triangle == fovea::shaders::kPtNoHit, brute[i].triangle == fovea::shaders::kPtNoHit) << "ray " << i;
+      ASSERT_EQ(bvh[i].t, brute[i].t) << "ray " << i;
+      ties += bvh[i].triangle != brute[i].triangle;  // equal distance, e.g. on a shared edge
+      hits += bvh[i].triangle != fovea::shaders::kPtNoHit;
+      ASSERT_EQ(any[i].triangle, brute_any[i].triangle) << "ray " << i;
+      ASSERT_EQ(any[i].triangle == 0, bvh[i].triangle != fovea::shaders::kPtNoHit) << "ray " << i;
+    }
+    EXPECT_GT(hits, int(rays.size() / 20)) << "too few hits to test anything";
+    EXPECT_LT(ties, int(rays.size() / 20));
+  }
+};
+
+namespace {
+
+PtRay ray(glm::vec3 o, glm::vec3 d, float tmax = 1e30f) {
+  d = glm::normalize(d);
+  return {o.x, o.y, o.z, 0.0f, d.x, d.y, d.z, tmax};
+}
+
+// Random rays through the scene's bounds plus rays aimed exactly at vertices and edge
+// midpoints and axis-parallel rays (zero direction components).
+std::vector<PtRay> adversarial_rays(const std::vector<glm::vec3>& p, float extent, std::uint32_t seed) {
+  std::mt19937 rng(seed);
+  std::uniform_real_distribution<float> u(-1, 1);
+  std::vector<PtRay> r;
+  for (int i = 0; i < 3000; ++i) {
+    const glm::vec3 o(u(rng) * 2 * extent, u(rng) * 2 * extent, u(rng) * 2 * extent);
+    const glm::vec3 target = p[std::size_t(rng() % p.size())];
+    r.push_back(ray(o, glm::vec3(u(rng), u(rng), u(rng))));
+    r.push_back(ray(o, target - o));
+    const std::size_t t = 3 * (rng() % (p.size() / 3));
+    r.push_back(ray(o, 0.5f * (p[t] + p[t + 1]) - o));
+    const int axis = int(rng() % 3);
+    glm::vec3 d(0);
+    d[axis] = u(rng) < 0 ? -1.0f : 1.0f;
+    r.push_back(ray(o, d, extent * (1 + u(rng))));
+  }
+  return r;
+}
+
+}  // namespace
+
+TEST_F(BvhGpu, RandomSoupEqualsBruteForce) {
+  const auto p = random_soup(3000, 10, 1.0f, 5);
+  expect_equal_to_brute_force(p, adversarial_rays(p, 10, 6));
+}
+
+TEST_F(BvhGpu, CoplanarGridEqualsBruteForceIncludingGrazingRays) {
+  const auto p = coplanar_grid(24, 1.0f);
+  auto rays = adversarial_rays(p, 12, 7);
+  for (int i = 0; i < 500; ++i) rays.push_back(ray({-1.0f, 0.37f * float(i % 60), 0.0f}, {1, 0.01f * float(i % 7), 0}));
+  for (int i = 0; i < 500; ++i) rays.push_back(ray({float(i % 25), float(i / 25), 5.0f}, {0, 0, -1}));  // through vertices
+  expect_equal_to_brute_force(p, rays);
+}
+
+TEST_F(BvhGpu, HugeAndTinyCoordinatesEqualBruteForce) {
+  auto big = random_soup(1500, 1e7f, 2e5f, 8);
+  expect_equal_to_brute_force(big, adversarial_rays(big, 1e7f, 9));
+  auto tiny = random_soup(1500, 1e-3f, 1e-4f, 10);
+  expect_equal_to_brute_force(tiny, adversarial_rays(tiny, 1e-3f, 11));
+}
+
+TEST_F(BvhGpu, ClosedMeshIsWatertight) {
+  // Rays from the centre of a closed sphere at its vertices and edge midpoints, where
+  // non-watertight tests let rays slip between triangles, must all hit.
+  fr::Scene s;
+  s.materials.push_back({});
+  fr::add_sphere(s, {0.1f, -0.2f, 0.3f}, 1.0f, 0, 40, 80);
+  fr::sanitize(s, "sphere");
+  std::vector<PtRay> rays;
+  const glm::vec3 c(0.1f, -0.2f, 0.3f);
+  for (std::size_t t = 0; t < s.triangle_count(); ++t)
+    for (int k = 0; k < 3; ++k) {
+      rays.push_back(ray(c, s.positions[3 * t + k] - c));
+      rays.push_back(ray(c, 0.5f * (s.positions[3 * t + k] + s.positions[3 * t + (k + 1) % 3]) - c));
+    }
+  fr::GpuScene g(ctx(), s);
+  fr::Raycaster rc(ctx(), g);
+  rc.set_rays(rays);
+  const auto hits = rc.trace(fr::RayQuery::Closest);
+  int misses = 0;
+  for (const auto& h : hits) misses += h.triangle == fovea::shaders::kPtNoHit;
+  EXPECT_EQ(misses, 0) << "of " << hits.size();
+}
