@@ -100,3 +100,14 @@ TEST_F(Images, RejectsBadSizesAndFormats) {
   const std::vector<glm::vec4> too_few(3);
   EXPECT_THROW(img.upload(too_few), std::invalid_argument);
 }
+
+TEST_F(Buffers, SubmissionsNest) {
+  gpu::Buffer a(ctx(), {.size = 16});
+  gpu::Buffer b(ctx(), {.size = 16, .memory = gpu::Memory::HostVisible});
+  const auto data = iota_words(4, 9);
+  ctx().submit_and_wait([&](VkCommandBuffer cmd) {
+    a.upload(data);  // its own submission, complete before the outer one is submitted
+    gpu::copy_buffer(cmd, a, b);
+  });
+  EXPECT_EQ(b.download<std::uint32_t>(), data);
+}
