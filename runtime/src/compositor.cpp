@@ -6,7 +6,8 @@
 #include <cstring>
 #include <stdexcept>
 
-#include "visibility_mask.hpp"
+#include "fovea/compositor/distortion.hpp"
+#include "log.hpp"
 
 namespace fovea::runtime {
 namespace {
@@ -32,29 +33,11 @@ glm::vec4 bilinear(const core::Image& img, glm::dvec2 px) {
   return glm::mix(top, bottom, fy);
 }
 
-// Sign of the 2D cross product (b - a) x (p - a).
-double edge(const XrVector2f& a, const XrVector2f& b, glm::dvec2 p) {
-  return (double(b.x) - a.x) * (p.y - a.y) - (double(b.y) - a.y) * (p.x - a.x);
-}
-
-// Blacks out panel pixels whose centre falls inside a hidden-area triangle.
-void apply_hidden_area(core::Image& panel, const core::View& view, const VisibilityMask& hidden) {
-  if (hidden.indices.empty()) return;
-  for (int y = 0; y < panel.height; ++y)
-    for (int x = 0; x < panel.width; ++x) {
-      const glm::dvec3 d = view.pixel_to_dir({x + 0.5, y + 0.5});
-      const glm::dvec2 t(d.x / -d.z, d.y / -d.z);  // tangent plane z = -1, as the mask
-      for (size_t i = 0; i + 2 < hidden.indices.size(); i += 3) {
-        const XrVector2f& a = hidden.vertices[hidden.indices[i]];
-        const XrVector2f& b = hidden.vertices[hidden.indices[i + 1]];
-        const XrVector2f& c = hidden.vertices[hidden.indices[i + 2]];
-        const double e0 = edge(a, b, t), e1 = edge(b, c, t), e2 = edge(c, a, t);
-        if ((e0 >= 0 && e1 >= 0 && e2 >= 0) || (e0 <= 0 && e1 <= 0 && e2 <= 0)) {
-          panel.at(x, y) = {0, 0, 0, 1};
-          break;
-        }
-      }
-    }
+// Blacks out the view pixels whose direction no one can see through the lens.
+void apply_hidden_area(core::Image& img, const core::View& view, const core::HiddenAreaMask& hidden) {
+  for (int y = 0; y < img.height; ++y)
+    for (int x = 0; x < img.width; ++x)
+      if (!hidden.visible(view.pixel_to_dir({x + 0.5, y + 0.5}))) img.at(x, y) = {0, 0, 0, 1};
 }
 
 }  // namespace
@@ -65,13 +48,20 @@ bool Compositor::readable_format(VkFormat f) {
 }
 
 Compositor::Compositor(VkPhysicalDevice physical, VkDevice device, OneShotQueue& queue,
-                       const core::DisplayPreset& display, std::string out_dir, std::int64_t png_every)
+                       const core::DisplayPreset& display, std::array<const core::HiddenAreaMask*, 2> hidden,
+                       bool lens, std::string out_dir, std::int64_t png_every)
     : physical_(physical),
       device_(device),
       queue_(queue),
       display_(display),
+      hidden_(hidden),
+      lens_(lens),
       out_dir_(std::move(out_dir)),
-      png_every_(png_every) {}
+      png_every_(png_every) {
+  FOVEA_LOG_INFO("compositor: %s, lens model %s, hidden area %.1f%% of the left panel", 
+                 lens_ ? "lens distortion + hidden area" : "undistorted view + hidden area",
+                 core::lens_model_name(hidden_[0]->lens().kind()), 100.0 * hidden_[0]->hidden_fraction());
+}
 
 Compositor::~Compositor() {
   if (staging_) vkDestroyBuffer(device_, staging_, nullptr);
@@ -144,29 +134,35 @@ core::Image Compositor::read_back(const LayerView& v) {
 void Compositor::compose(std::int64_t index, const std::vector<ProjectionLayer>& layers) {
   for (int e = 0; e < 2; ++e) {
     const core::Eye eye = e == 0 ? core::Eye::Left : core::Eye::Right;
-    const core::View panel_view = display_.view(eye);
-    core::Image panel(display_.width, display_.height, {0, 0, 0, 1});
+    const core::View view = display_.view(eye);
+    core::Image rendered(display_.width, display_.height, {0, 0, 0, 1});
     for (const ProjectionLayer& layer : layers) {
       const LayerView& lv = layer.views[size_t(e)];
       const core::Image src = read_back(lv);
-      const bool copy = same_fov(lv.fov, display_.fov(eye)) && src.width == panel.width && src.height == panel.height;
+      const bool copy = same_fov(lv.fov, display_.fov(eye)) && src.width == rendered.width && src.height == rendered.height;
       const core::View layer_view(lv.fov, src.width, src.height);
-      for (int y = 0; y < panel.height; ++y)
-        for (int x = 0; x < panel.width; ++x) {
+      for (int y = 0; y < rendered.height; ++y)
+        for (int x = 0; x < rendered.width; ++x) {
           glm::vec4 c;
           if (copy) {
             c = src.at(x, y);
           } else {
-            const auto p = layer_view.dir_to_pixel(panel_view.pixel_to_dir({x + 0.5, y + 0.5}));
+            const auto p = layer_view.dir_to_pixel(view.pixel_to_dir({x + 0.5, y + 0.5}));
             if (!p || !layer_view.contains_pixel(*p)) continue;  // outside the layer: unchanged
             c = bilinear(src, *p);
           }
-          glm::vec4& dst = panel.at(x, y);
+          glm::vec4& dst = rendered.at(x, y);
           dst = layer.alpha_blend ? glm::vec4(glm::vec3(c) * c.w + glm::vec3(dst) * (1 - c.w), 1) : glm::vec4(glm::vec3(c), 1);
         }
     }
-    apply_hidden_area(panel, panel_view,
-                      visibility_mask(display_, eye, XR_VISIBILITY_MASK_TYPE_HIDDEN_TRIANGLE_MESH_KHR));
+    const core::HiddenAreaMask& hidden = *hidden_[size_t(e)];
+    core::Image panel;
+    if (lens_) {
+      panel = compositor::distort_reference(hidden, rendered);
+    } else {
+      apply_hidden_area(rendered, view, hidden);
+      panel = std::move(rendered);
+    }
     char name[64];
     std::snprintf(name, sizeof name, "/panel_%06lld_%s.png", static_cast<long long>(index), core::eye_name(eye));
     core::write_png(out_dir_ + name, panel);

@@ -1,14 +1,18 @@
 #pragma once
-// What the simulated panel shows: the submitted projection layers, read back from the
-// application's swapchain images and resampled into each eye's panel raster (a plain copy
-// when the layer matches the panel's field of view and size), with the hidden area blacked
-// out. Every k-th frame the two panel images are written as PNG files.
+// What the simulated panel shows. The submitted projection layers are read back from the
+// application's swapchain images into each eye's rendered view (the display preset's FOV and
+// raster; a plain copy when the layer matches it, else resampled by direction). Then either
+// the lens: compositor::distort_reference (per-channel distortion, hidden area black, the
+// CPU reference of the distortion pass), or (env FOVEA_RUNTIME_LENS=0) the undistorted view
+// with the directions the lens hides blacked out. Every k-th frame the two panel images
+// are written as PNG files.
 #include <array>
 #include <cstdint>
 #include <string>
 #include <vector>
 
 #include "fovea/core/display.hpp"
+#include "fovea/core/hidden_area.hpp"
 #include "fovea/core/image.hpp"
 #include "vk_util.hpp"
 #include "xr.hpp"
@@ -30,8 +34,9 @@ struct ProjectionLayer {
 
 class Compositor {
  public:
+  // `hidden` (one per eye) must outlive the compositor.
   Compositor(VkPhysicalDevice physical, VkDevice device, OneShotQueue& queue, const core::DisplayPreset& display,
-             std::string out_dir, std::int64_t png_every);
+             std::array<const core::HiddenAreaMask*, 2> hidden, bool lens, std::string out_dir, std::int64_t png_every);
   ~Compositor();
   Compositor(const Compositor&) = delete;
   Compositor& operator=(const Compositor&) = delete;
@@ -53,6 +58,8 @@ class Compositor {
   VkDevice device_;
   OneShotQueue& queue_;
   core::DisplayPreset display_;
+  std::array<const core::HiddenAreaMask*, 2> hidden_;
+  bool lens_;
   std::string out_dir_;
   std::int64_t png_every_;
   VkBuffer staging_ = VK_NULL_HANDLE;

@@ -1,32 +1,44 @@
 #pragma once
-// The eye tracker behind XR_EXT_eye_gaze_interaction: a combined-eye gaze direction in VIEW
-// space, with the time the sample was taken and whether it is valid (blinks are invalid).
+// The eye tracker behind XR_EXT_eye_gaze_interaction: a devices::GazeSource (env FOVEA_GAZE,
+// default "synthetic:1"; e.g. "replay:FILE", "synthetic:SEED?task=reading", "hid:") adapted
+// to the runtime's clock. Recorded and synthetic sources count time from their first
+// sample; the runtime starts them at the display epoch, so a run sees the same gaze at the
+// same frame index every time. Live sources already use the host monotonic clock.
 #include <memory>
 #include <string>
 
 #include <glm/vec3.hpp>
 
 #include "fovea/core/clock.hpp"
+#include "fovea/core/display.hpp"
+
+namespace fovea::devices {
+class GazeSource;
+}
 
 namespace fovea::runtime {
 
 struct GazeSample {
-  glm::dvec3 dir{0, 0, -1};   // unit, view space (-Z forward)
-  bool valid = false;
-  core::TimeNs sample_ns = 0;  // when the tracker took the sample (CLOCK_MONOTONIC)
+  glm::dvec3 dir{0, 0, -1};    // combined gaze, unit, view space (-Z forward)
+  bool valid = false;          // tracked (not a blink, dropout or low confidence)
+  core::TimeNs sample_ns = 0;  // the sample's time (CLOCK_MONOTONIC)
 };
 
 class GazeTracker {
  public:
-  virtual ~GazeTracker() = default;
-  // The tracker's latest sample at or before `t_ns`; `epoch_ns` is the display epoch, the
-  // origin of scripted models.
-  virtual GazeSample sample_at(core::TimeNs t_ns, core::TimeNs epoch_ns) = 0;
-  virtual std::string describe() const = 0;
-};
+  // Throws core::InputError for a URI the devices module cannot open.
+  GazeTracker(const std::string& uri, const core::DisplayPreset& display);
+  ~GazeTracker();
+  GazeTracker(const GazeTracker&) = delete;
+  GazeTracker& operator=(const GazeTracker&) = delete;
 
-// env FOVEA_GAZE: "synthetic" (default) or "synthetic:<seed>": a built-in deterministic model.
-// Throws core::InputError for a spec it cannot serve.
-std::unique_ptr<GazeTracker> open_gaze_tracker(const std::string& spec);
+  // The gaze at time t_ns; `epoch_ns` is where recorded/synthetic sources start.
+  GazeSample sample_at(core::TimeNs t_ns, core::TimeNs epoch_ns);
+  std::string describe() const;
+
+ private:
+  std::unique_ptr<devices::GazeSource> source_;
+  bool live_ = false;
+};
 
 }  // namespace fovea::runtime

@@ -102,7 +102,10 @@ XrResult api::xrCreateInstance(const XrInstanceCreateInfo* info, XrInstance* ins
       inst->config = read_config();
       inst->display = core::load_display(inst->config.display);
       inst->head = HeadMotion::from_spec(inst->config.head);
-      inst->gaze = open_gaze_tracker(inst->config.gaze);
+      inst->gaze = std::make_unique<GazeTracker>(inst->config.gaze, inst->display);
+      for (int e = 0; e < 2; ++e)
+        inst->hidden[size_t(e)] = std::make_unique<core::HiddenAreaMask>(
+            core::Lens::for_eye(inst->display, e == 0 ? core::Eye::Left : core::Eye::Right));
     } catch (const core::InputError& e) {
       FOVEA_LOG_ERROR("xrCreateInstance: %s", e.what());
       return XR_ERROR_INITIALIZATION_FAILED;

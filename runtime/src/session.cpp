@@ -64,8 +64,10 @@ XrResult api::xrCreateSession(XrInstance instance, const XrSessionCreateInfo* in
     s->queue_index = binding->queueIndex;
     vkGetDeviceQueue(s->vk_device, s->queue_family, s->queue_index, &s->queue);
     s->gpu = std::make_unique<OneShotQueue>(s->vk_device, s->queue_family, s->queue);
-    s->compositor = std::make_unique<Compositor>(s->vk_physical, s->vk_device, *s->gpu, inst->display,
-                                                 inst->config.out_dir, inst->config.png_every);
+    s->compositor = std::make_unique<Compositor>(
+        s->vk_physical, s->vk_device, *s->gpu, inst->display,
+        std::array<const core::HiddenAreaMask*, 2>{inst->hidden[0].get(), inst->hidden[1].get()}, inst->config.lens,
+        inst->config.out_dir, inst->config.png_every);
     s->clock = DisplayClock(inst->display.refresh_hz);
     s->timing.open(inst->config.out_dir);
     Session* raw = s.get();

@@ -2,6 +2,7 @@
 // The runtime's objects and the handle table. Handles given to the application are opaque
 // ids looked up in one table (never dereferenced), so a stale or garbage handle is reported
 // as XR_ERROR_HANDLE_INVALID instead of crashing. One mutex serialises all commands.
+#include <array>
 #include <cstdint>
 #include <deque>
 #include <map>
@@ -15,6 +16,7 @@
 #include "compositor.hpp"
 #include "display_clock.hpp"
 #include "fovea/core/display.hpp"
+#include "fovea/core/hidden_area.hpp"
 #include "gaze.hpp"
 #include "head_motion.hpp"
 #include "timing_log.hpp"
@@ -39,9 +41,10 @@ struct Config {
   std::int64_t exit_after_frames = 0;  // FOVEA_EXIT_AFTER_FRAMES (0: never)
   std::string out_dir;                 // FOVEA_RUNTIME_OUT
   std::int64_t png_every = 1;          // FOVEA_RUNTIME_PNG_EVERY
-  std::string gaze = "synthetic";      // FOVEA_GAZE
+  std::string gaze = "synthetic:1";    // FOVEA_GAZE (a devices::GazeSource URI)
   std::string head = "scripted";       // FOVEA_HEAD_POSE
   bool vk_validation = false;          // FOVEA_VK_VALIDATION=1
+  bool lens = true;                    // FOVEA_RUNTIME_LENS (0: panel shows the undistorted view)
 };
 // Throws core::InputError naming the variable.
 Config read_config();
@@ -67,6 +70,8 @@ struct Instance final : Object {
   std::map<XrPath, std::vector<XrActionSuggestedBinding>> suggested;
   HeadMotion head;
   std::unique_ptr<GazeTracker> gaze;
+  // The lens-derived hidden area of each eye (visibility masks, compositor).
+  std::array<std::unique_ptr<core::HiddenAreaMask>, 2> hidden;
   // Vulkan objects the runtime created on the application's behalf (enable2); reported only.
   VkInstance vk_instance = VK_NULL_HANDLE;
 

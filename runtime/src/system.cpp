@@ -142,12 +142,12 @@ XrResult api::xrGetVisibilityMaskKHR(XrSession session, XrViewConfigurationType 
     if (!has_type(mask, XR_TYPE_VISIBILITY_MASK_KHR)) return XR_ERROR_VALIDATION_FAILURE;
     if ((mask->vertexCapacityInput && !mask->vertices) || (mask->indexCapacityInput && !mask->indices))
       return XR_ERROR_VALIDATION_FAILURE;
-    const VisibilityMask m = visibility_mask(s->instance->display, viewIndex == 0 ? core::Eye::Left : core::Eye::Right,
-                                             maskType);
+    const VisibilityMask m = visibility_mask(*s->instance->hidden[viewIndex], maskType);
     mask->vertexCountOutput = uint32_t(m.vertices.size());
     mask->indexCountOutput = uint32_t(m.indices.size());
-    FOVEA_LOG_INFO("visibility mask: view %u type %d: %zu vertices, %zu indices (%s)", viewIndex, int(maskType),
-                   m.vertices.size(), m.indices.size(), visibility_mask_source());
+    FOVEA_LOG_INFO("visibility mask: view %u type %d: %zu vertices, %zu indices (lens: %s)", viewIndex, int(maskType),
+                   m.vertices.size(), m.indices.size(),
+                   core::lens_model_name(s->instance->hidden[viewIndex]->lens().kind()));
     if (mask->vertexCapacityInput == 0 && mask->indexCapacityInput == 0) return XR_SUCCESS;
     if (mask->vertexCapacityInput < m.vertices.size() || mask->indexCapacityInput < m.indices.size())
       return XR_ERROR_SIZE_INSUFFICIENT;
