@@ -135,26 +135,13 @@ shaders::GridSample SampleDistribution::sample_at(int column, int row, glm::dvec
 std::uint32_t SampleDistribution::cell_flags(int, int, glm::dvec3) const { return 0; }
 
 double SampleDistribution::samples_per_pixel(glm::dvec2 px) const {
-  // |det J| of display -> grid: cells per display pixel.
-  const auto c = screen_to_grid(px);
-  const double h = 0.25;
-  const auto dx = screen_to_grid(px + glm::dvec2(h, 0));
-  const auto dy = screen_to_grid(px + glm::dvec2(0, h));
-  if (!c || !dx || !dy) return 0;
-  glm::dvec2 a = (*dx - *c) / h, b = (*dy - *c) / h;
-  // Rows wrap around φ = 2π; unwrap the difference.
-  auto unwrap = [&](glm::dvec2& v, glm::dvec2 base) {
-    const int col = std::clamp(int(base.x), 0, columns_ - 1);
-    const double period = row_period(col);
-    if (period > 0) v.y -= period / h * std::round(v.y * h / period);
-  };
-  unwrap(a, *c);
-  unwrap(b, *c);
-  const double det = std::abs(a.x * b.y - a.y * b.x);
-  return std::isfinite(det) ? det : 0;
+  // One sample per cell: the inverse of the cell's area on the display where px falls.
+  const auto g = screen_to_grid(px);
+  if (!g) return 0;
+  const int column = std::clamp(int(g->x), 0, columns_ - 1);
+  const double ppc = pixels_per_cell(column, view_.pixel_to_dir(px));
+  return ppc > 0 && std::isfinite(ppc) ? 1.0 / ppc : 0;
 }
-
-double SampleDistribution::row_period(int) const { return 0; }
 
 shaders::GridParams SampleDistribution::gpu_params() const {
   shaders::GridParams g{};

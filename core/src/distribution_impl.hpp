@@ -28,7 +28,6 @@ class PolarDistribution : public SampleDistribution {
 
   void map(glm::dvec2 grid, int column, glm::dvec3& dir, glm::dvec2& px) const override;
   std::uint32_t cell_flags(int column, int row, glm::dvec3 dir) const override;
-  double row_period(int column) const override { return h_[column]; }
   void fill_gpu(shaders::GridParams& g) const override;
   // Copies r_/h_ into the GPU table; call at the end of on_frame().
   void publish_table();

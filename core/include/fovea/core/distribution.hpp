@@ -90,8 +90,8 @@ class SampleDistribution {
   virtual bool invertible() const { return true; }
   // Intended samples per square degree at a view direction.
   virtual double target_density(glm::dvec3 dir) const = 0;
-  // Expected samples per display pixel around a display position (from the mapping's
-  // Jacobian where invertible).
+  // Expected samples per display pixel around a display position (the inverse area of
+  // the cell covering it; the keep probability for linear fall-off).
   virtual double samples_per_pixel(glm::dvec2 px) const;
 
   // GPU description of the current frame (uniforms + column table; see grid_params.h).
@@ -105,8 +105,6 @@ class SampleDistribution {
   virtual void on_frame() = 0;                    // rebuild per-frame state after the gaze moved
   virtual std::uint32_t cell_flags(int column, int row, glm::dvec3 dir) const;  // clip/kill
   virtual void fill_gpu(shaders::GridParams& g) const = 0;
-  // Rows per φ period of a column (polar kinds), 0 where rows do not wrap.
-  virtual double row_period(int column) const;
   // Display pixels covered by one cell of `column` around direction `dir`.
   virtual double pixels_per_cell(int column, glm::dvec3 dir) const = 0;
 
