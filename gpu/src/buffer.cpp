@@ -53,6 +53,24 @@ Buffer::Buffer(Context& ctx, const BufferDesc& desc) : ctx_(&ctx), size_(desc.si
   if (!desc.name.empty()) ctx.set_name(VK_OBJECT_TYPE_BUFFER, reinterpret_cast<std::uint64_t>(buffer), desc.name);
 }
 
+Buffer::Buffer(Buffer&& o) noexcept
+    : ctx_(std::exchange(o.ctx_, nullptr)),
+      size_(std::exchange(o.size_, 0)),
+      mapped_(std::exchange(o.mapped_, nullptr)),
+      memory_(std::move(o.memory_)),
+      buffer_(std::move(o.buffer_)) {}
+
+Buffer& Buffer::operator=(Buffer&& o) noexcept {
+  if (this != &o) {
+    buffer_ = std::move(o.buffer_);  // the buffer goes before the memory it is bound to
+    memory_ = std::move(o.memory_);
+    ctx_ = std::exchange(o.ctx_, nullptr);
+    size_ = std::exchange(o.size_, 0);
+    mapped_ = std::exchange(o.mapped_, nullptr);
+  }
+  return *this;
+}
+
 void Buffer::upload_bytes(std::span<const std::byte> data, VkDeviceSize offset) {
   check_range(*this, offset, data.size(), "gpu::Buffer::upload");
   if (data.empty()) return;

@@ -156,6 +156,20 @@ TEST(Context, ValidationEnvironmentIsParsed) {
   }
 }
 
+TEST(Context, MissingValidationLayerIsClearError) {
+  // The loader looks for explicit layers only in VK_LAYER_PATH when it is set.
+  ScopedEnv env("VK_LAYER_PATH", "/nonexistent-fovea-layer-dir");
+  try {
+    gpu::Context ctx({.validation = true});
+    FAIL() << "expected InputError";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("VK_LAYER_KHRONOS_validation is not installed"), std::string::npos)
+        << e.what();
+  }
+  gpu::Context without({.validation = false});  // validation off does not need the layer
+  EXPECT_FALSE(without.validation_enabled());
+}
+
 // Logs the figures docs/gpu.md quotes; checks only what the Vulkan spec guarantees.
 TEST(Context, ReportsDeviceInfo) {
   gpu::Context ctx({.validation = true});

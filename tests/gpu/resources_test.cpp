@@ -68,8 +68,13 @@ TEST_F(Buffers, MoveTransfersOwnership) {
   gpu::Buffer b = std::move(a);
   EXPECT_EQ(b.handle(), handle);
   EXPECT_EQ(a.handle(), VK_NULL_HANDLE);  // NOLINT(bugprone-use-after-move): checking the moved-from state
+  EXPECT_FALSE(a.host_visible());
+  EXPECT_EQ(a.size(), 0u);
   a = std::move(b);
   EXPECT_EQ(a.handle(), handle);
+  EXPECT_TRUE(a.host_visible());
+  a = gpu::Buffer(ctx(), {.size = 32});  // releases the first buffer
+  EXPECT_EQ(a.size(), 32u);
 }
 
 using Images = GpuTest;

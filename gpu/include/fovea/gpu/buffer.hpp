@@ -44,6 +44,9 @@ class Buffer {
   Buffer() = default;
   // Transfer usages are always added so upload/download and copies work on any buffer.
   Buffer(Context& ctx, const BufferDesc& desc);
+  // Moves leave the source empty (no handle, size 0, not mapped).
+  Buffer(Buffer&& o) noexcept;
+  Buffer& operator=(Buffer&& o) noexcept;
 
   VkBuffer handle() const { return buffer_.get(); }
   VkDeviceSize size() const { return size_; }
