@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <numbers>
 
 #include "fovea/core/error.hpp"
 #include "fovea/gpu/barriers.hpp"
@@ -83,6 +84,27 @@ core::Image distort_reference(const core::HiddenAreaMask& mask, const core::Imag
       }
     }
   return out;
+}
+
+core::Image direction_grid(const core::View& v, double step_deg) {
+  core::Image img(v.width(), v.height(), {0.02f, 0.02f, 0.03f, 1});
+  const double step = std::clamp(step_deg, 0.1, 90.0) * std::numbers::pi / 180;
+  const double px_per_tan_x = v.width() / (v.tan_right() - v.tan_left());
+  const double px_per_tan_y = v.height() / (v.tan_up() - v.tan_down());
+  const double width_px = std::max(0.6, v.width() / 500.0);
+  for (int y = 0; y < v.height(); ++y)
+    for (int x = 0; x < v.width(); ++x) {
+      const double tx = v.tan_left() + (x + 0.5) / px_per_tan_x, ty = v.tan_up() - (y + 0.5) / px_per_tan_y;
+      // Distance in pixels to the nearest line of constant angle, per axis (dθ = dt/(1+t²)).
+      const double ax = std::atan(tx) / step, ay = std::atan(ty) / step;
+      const double dx = std::abs(ax - std::round(ax)) * step * (1 + tx * tx) * px_per_tan_x;
+      const double dy = std::abs(ay - std::round(ay)) * step * (1 + ty * ty) * px_per_tan_y;
+      const double d = std::min(dx, dy);
+      const bool axis = (std::round(ax) == 0 && dx <= d) || (std::round(ay) == 0 && dy <= d);
+      const float a = float(std::exp(-0.5 * (d / width_px) * (d / width_px)));
+      if (a > 0.01f) img.at(x, y) = axis ? glm::vec4(a, a, 0.2f * a, 1) : glm::vec4(a, a, a, 1);
+    }
+  return img;
 }
 
 DistortionPass::DistortionPass(gpu::Context& ctx, const core::HiddenAreaMask& mask, ChannelSelect select)

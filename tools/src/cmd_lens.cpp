@@ -6,7 +6,6 @@
 #include <atomic>
 #include <cmath>
 #include <iostream>
-#include <numbers>
 #include <thread>
 #include <vector>
 
@@ -47,30 +46,8 @@ ahead), the fraction the path tracer skips because the lens hides them.
 Exit status: 0 on success, 2 on invalid arguments.
 )";
 
-// The view-space grid: lines every 5° of angle along both axes, as a smooth linear image.
-core::Image direction_grid(const core::View& v) {
-  core::Image img(v.width(), v.height(), {0.02f, 0.02f, 0.03f, 1});
-  const double step = 5 * std::numbers::pi / 180;
-  const double px_per_tan_x = v.width() / (v.tan_right() - v.tan_left());
-  const double px_per_tan_y = v.height() / (v.tan_up() - v.tan_down());
-  const double width_px = std::max(0.6, v.width() / 500.0);
-  for (int y = 0; y < v.height(); ++y)
-    for (int x = 0; x < v.width(); ++x) {
-      const double tx = v.tan_left() + (x + 0.5) / px_per_tan_x, ty = v.tan_up() - (y + 0.5) / px_per_tan_y;
-      // Distance in pixels to the nearest line of constant angle, per axis.
-      const double ax = std::atan(tx) / step, ay = std::atan(ty) / step;
-      const double dx = std::abs(ax - std::round(ax)) * step * (1 + tx * tx) * px_per_tan_x;
-      const double dy = std::abs(ay - std::round(ay)) * step * (1 + ty * ty) * px_per_tan_y;
-      const double d = std::min(dx, dy);
-      const bool axis = (std::round(ax) == 0 && dx <= d) || (std::round(ay) == 0 && dy <= d);
-      const float v01 = float(std::exp(-0.5 * (d / width_px) * (d / width_px)));
-      if (v01 > 0.01f) img.at(x, y) = axis ? glm::vec4(v01, v01, 0.2f * v01, 1) : glm::vec4(v01, v01, v01, 1);
-    }
-  return img;
-}
-
 core::Image eye_picture(const core::HiddenAreaMask& mask, compositor::ChannelSelect select, bool panel_grid) {
-  core::Image img = compositor::distort_reference(mask, direction_grid(mask.lens().view()), select);
+  core::Image img = compositor::distort_reference(mask, compositor::direction_grid(mask.lens().view()), select);
   const int W = img.width, H = img.height;
   for (int y = 0; y < H; ++y)
     for (int x = 0; x < W; ++x) {

@@ -38,6 +38,11 @@ struct PanelImage {
 core::Image distort_reference(const core::HiddenAreaMask& mask, const core::Image& view_image,
                               ChannelSelect select = ChannelSelect::All);
 
+// A linear view-space reference image: lines every `step_deg` of angle along both axes
+// (the two through the view axis yellow) on a dark background, i.e. a grid of directions
+// as a straight-ahead scene would show it; for pictures of the distortion and the mirror.
+core::Image direction_grid(const core::View& view, double step_deg = 5);
+
 class DistortionPass {
  public:
   DistortionPass(gpu::Context& ctx, const core::HiddenAreaMask& mask, ChannelSelect select = ChannelSelect::All);
