@@ -206,7 +206,7 @@ XrResult api::xrSuggestInteractionProfileBindings(XrInstance instance,
       const std::string* bp = inst->path_string(b.binding);
       if (!bp) return XR_ERROR_PATH_INVALID;
       if (!bindable(*profile, *bp)) {
-        FOVEA_LOG_WARN("%s: binding %s is not in %s", __func__, bp->c_str(), profile->path);
+        FOVEA_LOG_WARN("xrSuggestInteractionProfileBindings: binding %s is not in %s", bp->c_str(), profile->path);
         return XR_ERROR_PATH_UNSUPPORTED;
       }
       bindings.push_back(b);

@@ -1,0 +1,121 @@
+// End to end: Debian's hello_xr (OpenXR 1.0.20 sample) rendering with Vulkan on lavapipe
+// against the Fovea runtime, headless, ended by FOVEA_EXIT_AFTER_FRAMES.
+#include <filesystem>
+#include <fstream>
+#include <map>
+
+#include <gtest/gtest.h>
+#include <nlohmann/json.hpp>
+
+#include "fovea/core/image.hpp"
+#include "xr_process.hpp"
+
+namespace fovea::test {
+namespace {
+
+constexpr int kFrames = 12;
+constexpr int kPngEvery = 4;
+
+std::vector<nlohmann::json> timing(const std::string& out) {
+  std::vector<nlohmann::json> v;
+  std::ifstream in(out + "/timing.jsonl");
+  for (std::string line; std::getline(in, line);) v.push_back(nlohmann::json::parse(line));
+  return v;
+}
+
+// Fraction of pixels that differ from the most common colour (hello_xr's background).
+double foreground_fraction(const core::Image& img) {
+  std::map<std::tuple<int, int, int>, int> hist;
+  auto key = [](const glm::vec4& c) {
+    return std::tuple<int, int, int>(int(c.x * 255 + 0.5f), int(c.y * 255 + 0.5f), int(c.z * 255 + 0.5f));
+  };
+  for (const auto& p : img.pixels) ++hist[key(p)];
+  int mode = 0;
+  for (const auto& [k, n] : hist) mode = std::max(mode, n);
+  return 1.0 - double(mode) / double(img.pixels.size());
+}
+
+void expect_clean_output(const ProcessResult& r) {
+  EXPECT_EQ(r.output.find("VUID-"), std::string::npos) << r.output;
+  EXPECT_EQ(r.output.find("Validation Error"), std::string::npos) << r.output;
+  EXPECT_EQ(r.output.find("[fovea-runtime] error"), std::string::npos) << r.output;
+}
+
+ProcessResult run_and_check(const std::string& graphics, std::map<std::string, std::string> extra_env = {}) {
+  TempDir dir("hello_xr");
+  auto env = runtime_env(dir.path(), kFrames, kPngEvery);
+  for (auto& [k, v] : extra_env) env[k] = v;
+  const ProcessResult r = run_process({FOVEA_HELLO_XR, "-g", graphics}, env, 120);
+  EXPECT_FALSE(r.timed_out) << r.output;
+  EXPECT_EQ(r.exit_code, 0) << r.output;
+  if (r.exit_code != 0) return r;
+  expect_clean_output(r);
+
+  // Every frame logged, on the display clock: predicted display times one period apart.
+  const auto frames = timing(dir.path());
+  EXPECT_EQ(frames.size(), size_t(kFrames));
+  if (frames.size() != size_t(kFrames)) return r;
+  const std::int64_t period = 1'000'000'000 / 70;  // the "small" preset runs at 70 Hz
+  for (size_t i = 0; i < frames.size(); ++i) {
+    const auto& f = frames[i];
+    EXPECT_EQ(f["frame"].get<std::int64_t>(), std::int64_t(i));
+    if (i > 0) {
+      const std::int64_t dt =
+          f["predicted_display_ns"].get<std::int64_t>() - frames[i - 1]["predicted_display_ns"].get<std::int64_t>();
+      EXPECT_NEAR(double(dt), double(period), 2.0);
+    }
+    EXPECT_LE(f["wait_call_ns"].get<std::int64_t>(), f["wait_return_ns"].get<std::int64_t>());
+    EXPECT_LE(f["begin_ns"].get<std::int64_t>(), f["end_call_ns"].get<std::int64_t>());
+    EXPECT_LE(f["end_call_ns"].get<std::int64_t>(), f["end_return_ns"].get<std::int64_t>());
+    // The eye tracker was sampled for the frame: a sample at or before the display time.
+    const std::int64_t gaze_t = f["gaze_sample_ns"].get<std::int64_t>();
+    EXPECT_GT(gaze_t, 0);
+    EXPECT_LE(gaze_t, f["predicted_display_ns"].get<std::int64_t>());
+    EXPECT_EQ(f["composited"].get<bool>(), i % kPngEvery == 0);
+  }
+  // hello_xr renders from its second frame on (the first one is not yet visible).
+  EXPECT_EQ(frames[0]["layers"].get<int>(), 0);
+  EXPECT_EQ(frames[kFrames - 1]["layers"].get<int>(), 1);
+
+  // Panel images: hello_xr's cubes visible (not a constant image), the eyes differ (stereo).
+  for (int f = 0; f < kFrames; ++f)
+    for (const char* eye : {"left", "right"}) {
+      char name[64];
+      std::snprintf(name, sizeof name, "/panel_%06d_%s.png", f, eye);
+      EXPECT_EQ(std::filesystem::exists(dir.path() + name), f % kPngEvery == 0) << name;
+    }
+  const core::Image left = core::read_png(dir.path() + "/panel_000008_left.png");
+  const core::Image right = core::read_png(dir.path() + "/panel_000008_right.png");
+  EXPECT_EQ(left.width, 320);
+  EXPECT_EQ(left.height, 360);
+  EXPECT_GT(foreground_fraction(left), 0.005);
+  EXPECT_LT(foreground_fraction(left), 0.9);
+  EXPECT_NE(left.pixels, right.pixels);
+
+  // The runtime's log shows the session's path and the hidden area the compositor applied.
+  const std::string log = read_text(dir.path() + "/runtime.log");
+  EXPECT_NE(log.find("FOVEA_EXIT_AFTER_FRAMES=12 reached"), std::string::npos) << log;
+  EXPECT_NE(log.find("hidden area"), std::string::npos) << log;
+  EXPECT_NE(log.find("gaze"), std::string::npos) << log;
+  return r;
+}
+
+TEST(HelloXr, Vulkan2) { run_and_check("Vulkan2"); }
+
+TEST(HelloXr, Vulkan) { run_and_check("Vulkan"); }
+
+// The Khronos core validation layer between hello_xr and the runtime reports nothing.
+TEST(HelloXr, CoreValidationClean) {
+  TempDir report("xr_cv");
+  const std::string file = report.path() + "/core_validation.txt";
+  const ProcessResult r = run_and_check("Vulkan2", {{"XR_ENABLE_API_LAYERS", "XR_APILAYER_LUNARG_core_validation"},
+                            {"XR_CORE_VALIDATION_EXPORT_TYPE", "text"},
+                            {"XR_CORE_VALIDATION_FILE_NAME", file}});
+  EXPECT_NE(r.output.find("Core Validation output type: text"), std::string::npos) << "layer not active:\n" << r.output;
+  const std::string text = read_text(file);
+  EXPECT_EQ(text.find("VUID-"), std::string::npos) << text;
+  EXPECT_EQ(text.find("VALID_ERROR"), std::string::npos) << text;
+}
+
+}  // namespace
+}  // namespace fovea::test

@@ -1,0 +1,595 @@
+// The runtime through the real OpenXR loader: error codes of the specification for invalid
+// handles, wrong structure types, calls in the wrong state and bad arguments; the session
+// state machine; spaces, swapchains, frames, eye gaze and visibility masks.
+#include <cmath>
+#include <cstring>
+
+#include "xr_fixture.hpp"
+
+namespace fovea::test {
+namespace {
+
+template <class H>
+H bogus(std::uint64_t v) {
+  return reinterpret_cast<H>(v);
+}
+
+TEST_F(XrTest, InstanceBasics) {
+  create_instance();
+  XrInstanceProperties props{XR_TYPE_INSTANCE_PROPERTIES};
+  ASSERT_EQ(xrGetInstanceProperties(instance_, &props), XR_SUCCESS);
+  EXPECT_STREQ(props.runtimeName, "Fovea simulated HMD");
+  XrSystemProperties sp{XR_TYPE_SYSTEM_PROPERTIES};
+  ASSERT_EQ(xrGetSystemProperties(instance_, system_, &sp), XR_SUCCESS);
+  EXPECT_TRUE(sp.trackingProperties.orientationTracking);
+  char buf[XR_MAX_RESULT_STRING_SIZE];
+  ASSERT_EQ(xrResultToString(instance_, XR_ERROR_SESSION_NOT_READY, buf), XR_SUCCESS);
+  EXPECT_STREQ(buf, "XR_ERROR_SESSION_NOT_READY");
+  char sbuf[XR_MAX_STRUCTURE_NAME_SIZE];
+  ASSERT_EQ(xrStructureTypeToString(instance_, XR_TYPE_FRAME_STATE, sbuf), XR_SUCCESS);
+  EXPECT_STREQ(sbuf, "XR_TYPE_FRAME_STATE");
+}
+
+TEST_F(XrTest, WrongStructureTypes) {
+  create_instance();
+  XrInstanceProperties props{XR_TYPE_SYSTEM_PROPERTIES};
+  EXPECT_EQ(xrGetInstanceProperties(instance_, &props), XR_ERROR_VALIDATION_FAILURE);
+  XrSystemGetInfo gi{XR_TYPE_SESSION_CREATE_INFO};
+  gi.formFactor = XR_FORM_FACTOR_HEAD_MOUNTED_DISPLAY;
+  XrSystemId id = 0;
+  EXPECT_EQ(xrGetSystem(instance_, &gi, &id), XR_ERROR_VALIDATION_FAILURE);
+  XrSystemProperties sp{XR_TYPE_INSTANCE_PROPERTIES};
+  EXPECT_EQ(xrGetSystemProperties(instance_, system_, &sp), XR_ERROR_VALIDATION_FAILURE);
+  XrEventDataBuffer ev{XR_TYPE_FRAME_STATE};
+  EXPECT_EQ(xrPollEvent(instance_, &ev), XR_ERROR_VALIDATION_FAILURE);
+  create_session();
+  XrReferenceSpaceCreateInfo rci{XR_TYPE_ACTION_SPACE_CREATE_INFO};
+  rci.referenceSpaceType = XR_REFERENCE_SPACE_TYPE_LOCAL;
+  rci.poseInReferenceSpace.orientation.w = 1;
+  XrSpace space = XR_NULL_HANDLE;
+  EXPECT_EQ(xrCreateReferenceSpace(session_, &rci, &space), XR_ERROR_VALIDATION_FAILURE);
+  XrSessionBeginInfo bi{XR_TYPE_SESSION_CREATE_INFO};
+  bi.primaryViewConfigurationType = XR_VIEW_CONFIGURATION_TYPE_PRIMARY_STEREO;
+  EXPECT_EQ(xrBeginSession(session_, &bi), XR_ERROR_VALIDATION_FAILURE);
+  XrSessionCreateInfo sci{XR_TYPE_SESSION_BEGIN_INFO};
+  XrSession other = XR_NULL_HANDLE;
+  EXPECT_EQ(xrCreateSession(instance_, &sci, &other), XR_ERROR_VALIDATION_FAILURE);
+}
+
+TEST_F(XrTest, InvalidHandles) {
+  create_instance();
+  create_session();
+  const XrSpace local = reference_space(XR_REFERENCE_SPACE_TYPE_LOCAL);
+  // Garbage, a handle of another type, and a destroyed handle.
+  EXPECT_EQ(xrBeginSession(bogus<XrSession>(0xdeadbeef), nullptr), XR_ERROR_HANDLE_INVALID);
+  EXPECT_EQ(xrBeginSession(bogus<XrSession>(reinterpret_cast<std::uint64_t>(local)), nullptr), XR_ERROR_HANDLE_INVALID);
+  XrSpaceLocation loc{XR_TYPE_SPACE_LOCATION};
+  EXPECT_EQ(xrLocateSpace(local, bogus<XrSpace>(0x12345), 1, &loc), XR_ERROR_HANDLE_INVALID);
+  uint32_t n = 0;
+  EXPECT_EQ(xrEnumerateSwapchainImages(bogus<XrSwapchain>(0x777), 0, &n, nullptr), XR_ERROR_HANDLE_INVALID);
+  ASSERT_EQ(xrDestroySpace(local), XR_SUCCESS);
+  EXPECT_EQ(xrDestroySpace(local), XR_ERROR_HANDLE_INVALID);
+  XrActionSetCreateInfo asci{XR_TYPE_ACTION_SET_CREATE_INFO};
+  std::strcpy(asci.actionSetName, "set");
+  std::strcpy(asci.localizedActionSetName, "Set");
+  XrActionSet set = XR_NULL_HANDLE;
+  ASSERT_EQ(xrCreateActionSet(instance_, &asci, &set), XR_SUCCESS);
+  ASSERT_EQ(xrDestroyActionSet(set), XR_SUCCESS);
+  XrActionCreateInfo aci{XR_TYPE_ACTION_CREATE_INFO};
+  std::strcpy(aci.actionName, "a");
+  std::strcpy(aci.localizedActionName, "A");
+  aci.actionType = XR_ACTION_TYPE_BOOLEAN_INPUT;
+  XrAction action = XR_NULL_HANDLE;
+  EXPECT_EQ(xrCreateAction(set, &aci, &action), XR_ERROR_HANDLE_INVALID);
+  // Extension functions: only with the extension enabled; no instance -> handle invalid.
+  PFN_xrVoidFunction fn = nullptr;
+  EXPECT_EQ(xrGetInstanceProcAddr(instance_, "xrGetVisibilityMaskKHR", &fn), XR_ERROR_FUNCTION_UNSUPPORTED);
+  EXPECT_EQ(fn, nullptr);
+  EXPECT_EQ(xrGetInstanceProcAddr(instance_, "xrNoSuchFunction", &fn), XR_ERROR_FUNCTION_UNSUPPORTED);
+}
+
+TEST_F(XrTest, BadArguments) {
+  create_instance();
+  XrSystemGetInfo gi{XR_TYPE_SYSTEM_GET_INFO};
+  gi.formFactor = XR_FORM_FACTOR_HANDHELD_DISPLAY;
+  XrSystemId id = 0;
+  EXPECT_EQ(xrGetSystem(instance_, &gi, &id), XR_ERROR_FORM_FACTOR_UNSUPPORTED);
+  XrSystemProperties sp{XR_TYPE_SYSTEM_PROPERTIES};
+  EXPECT_EQ(xrGetSystemProperties(instance_, system_ + 7, &sp), XR_ERROR_SYSTEM_INVALID);
+  uint32_t n = 0;
+  EXPECT_EQ(xrEnumerateViewConfigurationViews(instance_, system_, XR_VIEW_CONFIGURATION_TYPE_PRIMARY_MONO, 0, &n, nullptr),
+            XR_ERROR_VIEW_CONFIGURATION_TYPE_UNSUPPORTED);
+  ASSERT_EQ(xrEnumerateViewConfigurationViews(instance_, system_, XR_VIEW_CONFIGURATION_TYPE_PRIMARY_STEREO, 0, &n, nullptr),
+            XR_SUCCESS);
+  ASSERT_EQ(n, 2u);
+  XrViewConfigurationView views[2]{{XR_TYPE_VIEW_CONFIGURATION_VIEW}, {XR_TYPE_VIEW_CONFIGURATION_VIEW}};
+  EXPECT_EQ(xrEnumerateViewConfigurationViews(instance_, system_, XR_VIEW_CONFIGURATION_TYPE_PRIMARY_STEREO, 1, &n, views),
+            XR_ERROR_SIZE_INSUFFICIENT);
+  ASSERT_EQ(xrEnumerateViewConfigurationViews(instance_, system_, XR_VIEW_CONFIGURATION_TYPE_PRIMARY_STEREO, 2, &n, views),
+            XR_SUCCESS);
+  EXPECT_EQ(views[0].recommendedImageRectWidth, 64u);  // the "tiny" preset
+  EXPECT_EQ(views[0].recommendedImageRectHeight, 72u);
+  // Paths.
+  XrPath p = XR_NULL_PATH;
+  EXPECT_EQ(xrStringToPath(instance_, "no/leading/slash", &p), XR_ERROR_PATH_FORMAT_INVALID);
+  EXPECT_EQ(xrStringToPath(instance_, "/Upper/case", &p), XR_ERROR_PATH_FORMAT_INVALID);
+  EXPECT_EQ(xrStringToPath(instance_, "/double//slash", &p), XR_ERROR_PATH_FORMAT_INVALID);
+  EXPECT_EQ(xrStringToPath(instance_, "/trailing/", &p), XR_ERROR_PATH_FORMAT_INVALID);
+  char buf[64];
+  EXPECT_EQ(xrPathToString(instance_, 987654, sizeof buf, &n, buf), XR_ERROR_PATH_INVALID);
+  const XrPath left = path("/user/hand/left");
+  EXPECT_EQ(path("/user/hand/left"), left);
+  ASSERT_EQ(xrPathToString(instance_, left, sizeof buf, &n, buf), XR_SUCCESS);
+  EXPECT_STREQ(buf, "/user/hand/left");
+  EXPECT_EQ(n, 16u);
+  EXPECT_EQ(xrPathToString(instance_, left, 4, &n, buf), XR_ERROR_SIZE_INSUFFICIENT);
+
+  // Session creation needs the graphics requirements call and a graphics binding.
+  XrSessionCreateInfo sci{XR_TYPE_SESSION_CREATE_INFO};
+  sci.systemId = system_;
+  XrSession s = XR_NULL_HANDLE;
+  EXPECT_EQ(xrCreateSession(instance_, &sci, &s), XR_ERROR_GRAPHICS_DEVICE_INVALID);
+  create_session();
+  XrSession second = XR_NULL_HANDLE;
+  XrGraphicsBindingVulkan2KHR binding{XR_TYPE_GRAPHICS_BINDING_VULKAN2_KHR};
+  binding.instance = vk_instance_;
+  binding.physicalDevice = vk_physical_;
+  binding.device = vk_device_;
+  binding.queueFamilyIndex = 99;
+  sci.next = &binding;
+  EXPECT_EQ(xrCreateSession(instance_, &sci, &second), XR_ERROR_GRAPHICS_DEVICE_INVALID);
+
+  // Spaces.
+  XrReferenceSpaceCreateInfo rci{XR_TYPE_REFERENCE_SPACE_CREATE_INFO};
+  rci.referenceSpaceType = XR_REFERENCE_SPACE_TYPE_LOCAL;
+  rci.poseInReferenceSpace = {{0, 0, 0, 2}, {0, 0, 0}};
+  XrSpace space = XR_NULL_HANDLE;
+  EXPECT_EQ(xrCreateReferenceSpace(session_, &rci, &space), XR_ERROR_POSE_INVALID);
+  rci.poseInReferenceSpace = {{0, 0, 0, 1}, {0, 0, 0}};
+  rci.referenceSpaceType = XR_REFERENCE_SPACE_TYPE_UNBOUNDED_MSFT;
+  EXPECT_EQ(xrCreateReferenceSpace(session_, &rci, &space), XR_ERROR_REFERENCE_SPACE_UNSUPPORTED);
+  const XrSpace local = reference_space(XR_REFERENCE_SPACE_TYPE_LOCAL);
+  XrSpaceLocation loc{XR_TYPE_SPACE_LOCATION};
+  EXPECT_EQ(xrLocateSpace(local, local, 0, &loc), XR_ERROR_TIME_INVALID);
+
+  // Swapchains.
+  XrSwapchainCreateInfo ci{XR_TYPE_SWAPCHAIN_CREATE_INFO};
+  ci.usageFlags = XR_SWAPCHAIN_USAGE_COLOR_ATTACHMENT_BIT;
+  ci.format = 12345;
+  ci.sampleCount = ci.faceCount = ci.arraySize = ci.mipCount = 1;
+  ci.width = ci.height = 16;
+  XrSwapchain sc = XR_NULL_HANDLE;
+  EXPECT_EQ(xrCreateSwapchain(session_, &ci, &sc), XR_ERROR_SWAPCHAIN_FORMAT_UNSUPPORTED);
+  ci.format = VK_FORMAT_R8G8B8A8_SRGB;
+  ci.width = 0;
+  EXPECT_EQ(xrCreateSwapchain(session_, &ci, &sc), XR_ERROR_VALIDATION_FAILURE);
+}
+
+TEST_F(XrTest, SessionStateMachine) {
+  create_instance();
+  create_session();
+  XrSessionBeginInfo bi{XR_TYPE_SESSION_BEGIN_INFO};
+  bi.primaryViewConfigurationType = XR_VIEW_CONFIGURATION_TYPE_PRIMARY_STEREO;
+  // READY is queued but not yet observed by the application.
+  EXPECT_EQ(xrBeginSession(session_, &bi), XR_ERROR_SESSION_NOT_READY);
+  XrFrameState fs{XR_TYPE_FRAME_STATE};
+  EXPECT_EQ(xrWaitFrame(session_, nullptr, &fs), XR_ERROR_SESSION_NOT_RUNNING);
+  EXPECT_EQ(xrRequestExitSession(session_), XR_ERROR_SESSION_NOT_RUNNING);
+  EXPECT_EQ(poll_states(), (std::vector<XrSessionState>{XR_SESSION_STATE_IDLE, XR_SESSION_STATE_READY}));
+  bi.primaryViewConfigurationType = XR_VIEW_CONFIGURATION_TYPE_PRIMARY_MONO;
+  EXPECT_EQ(xrBeginSession(session_, &bi), XR_ERROR_VIEW_CONFIGURATION_TYPE_UNSUPPORTED);
+  bi.primaryViewConfigurationType = XR_VIEW_CONFIGURATION_TYPE_PRIMARY_STEREO;
+  ASSERT_EQ(xrBeginSession(session_, &bi), XR_SUCCESS);
+  EXPECT_EQ(xrBeginSession(session_, &bi), XR_ERROR_SESSION_RUNNING);
+  EXPECT_EQ(xrEndSession(session_), XR_ERROR_SESSION_NOT_STOPPING);
+  // Frame call order.
+  EXPECT_EQ(xrBeginFrame(session_, nullptr), XR_ERROR_CALL_ORDER_INVALID);
+  XrFrameEndInfo ei{XR_TYPE_FRAME_END_INFO};
+  ei.displayTime = 1;
+  ei.environmentBlendMode = XR_ENVIRONMENT_BLEND_MODE_OPAQUE;
+  EXPECT_EQ(xrEndFrame(session_, &ei), XR_ERROR_CALL_ORDER_INVALID);
+  ASSERT_EQ(xrWaitFrame(session_, nullptr, &fs), XR_SUCCESS);
+  EXPECT_FALSE(fs.shouldRender);  // not yet VISIBLE
+  ASSERT_EQ(xrBeginFrame(session_, nullptr), XR_SUCCESS);
+  ei.environmentBlendMode = XR_ENVIRONMENT_BLEND_MODE_ADDITIVE;
+  EXPECT_EQ(xrEndFrame(session_, &ei), XR_ERROR_ENVIRONMENT_BLEND_MODE_UNSUPPORTED);
+  ei.environmentBlendMode = XR_ENVIRONMENT_BLEND_MODE_OPAQUE;
+  ei.displayTime = 0;
+  EXPECT_EQ(xrEndFrame(session_, &ei), XR_ERROR_TIME_INVALID);
+  ei.displayTime = fs.predictedDisplayTime;
+  ASSERT_EQ(xrEndFrame(session_, &ei), XR_SUCCESS);
+  EXPECT_EQ(poll_states(), (std::vector<XrSessionState>{XR_SESSION_STATE_SYNCHRONIZED, XR_SESSION_STATE_VISIBLE,
+                                                        XR_SESSION_STATE_FOCUSED}));
+  // A begun frame that is begun again is discarded.
+  ASSERT_EQ(xrWaitFrame(session_, nullptr, &fs), XR_SUCCESS);
+  EXPECT_TRUE(fs.shouldRender);
+  ASSERT_EQ(xrBeginFrame(session_, nullptr), XR_SUCCESS);
+  ASSERT_EQ(xrWaitFrame(session_, nullptr, &fs), XR_SUCCESS);
+  EXPECT_EQ(xrBeginFrame(session_, nullptr), XR_FRAME_DISCARDED);
+  ei.displayTime = fs.predictedDisplayTime;
+  ASSERT_EQ(xrEndFrame(session_, &ei), XR_SUCCESS);
+  // Exit: FOCUSED -> VISIBLE -> SYNCHRONIZED -> STOPPING, then IDLE -> EXITING.
+  ASSERT_EQ(xrRequestExitSession(session_), XR_SUCCESS);
+  EXPECT_EQ(poll_states(), (std::vector<XrSessionState>{XR_SESSION_STATE_VISIBLE, XR_SESSION_STATE_SYNCHRONIZED,
+                                                        XR_SESSION_STATE_STOPPING}));
+  ASSERT_EQ(xrEndSession(session_), XR_SUCCESS);
+  EXPECT_EQ(xrEndSession(session_), XR_ERROR_SESSION_NOT_RUNNING);
+  EXPECT_EQ(poll_states(), (std::vector<XrSessionState>{XR_SESSION_STATE_IDLE, XR_SESSION_STATE_EXITING}));
+}
+
+TEST_F(XrTest, ExitAfterFrames) {
+  setenv("FOVEA_EXIT_AFTER_FRAMES", "3", 1);
+  create_instance();
+  run_to_focused();
+  ASSERT_EQ(frame(), XR_SUCCESS);
+  EXPECT_TRUE(poll_states().empty());
+  ASSERT_EQ(frame(), XR_SUCCESS);  // the third frame
+  EXPECT_EQ(poll_states(), (std::vector<XrSessionState>{XR_SESSION_STATE_VISIBLE, XR_SESSION_STATE_SYNCHRONIZED,
+                                                        XR_SESSION_STATE_STOPPING}));
+  ASSERT_EQ(xrEndSession(session_), XR_SUCCESS);
+  EXPECT_EQ(poll_states(), (std::vector<XrSessionState>{XR_SESSION_STATE_IDLE, XR_SESSION_STATE_EXITING}));
+}
+
+TEST_F(XrTest, DisplayClock) {
+  create_instance();
+  run_to_focused();
+  XrFrameState a{XR_TYPE_FRAME_STATE}, b{XR_TYPE_FRAME_STATE};
+  ASSERT_EQ(frame({}, &a), XR_SUCCESS);
+  ASSERT_EQ(frame({}, &b), XR_SUCCESS);
+  EXPECT_EQ(a.predictedDisplayPeriod, 14285714);  // 70 Hz
+  EXPECT_EQ(b.predictedDisplayTime - a.predictedDisplayTime, a.predictedDisplayPeriod);
+  timespec now{};
+  clock_gettime(CLOCK_MONOTONIC, &now);
+  const XrTime t_now = XrTime(now.tv_sec) * 1'000'000'000 + now.tv_nsec;
+  EXPECT_GT(b.predictedDisplayTime, t_now - 1'000'000'000);
+  EXPECT_LT(b.predictedDisplayTime, t_now + 1'000'000'000);
+}
+
+TEST_F(XrTest, SpacesAndViews) {
+  create_instance();
+  run_to_focused();
+  const XrSpace local = reference_space(XR_REFERENCE_SPACE_TYPE_LOCAL);
+  const XrSpace stage = reference_space(XR_REFERENCE_SPACE_TYPE_STAGE);
+  const XrSpace view = reference_space(XR_REFERENCE_SPACE_TYPE_VIEW);
+  XrFrameState fs{XR_TYPE_FRAME_STATE};
+  ASSERT_EQ(frame({}, &fs), XR_SUCCESS);
+  XrSpaceLocation loc{XR_TYPE_SPACE_LOCATION};
+  ASSERT_EQ(xrLocateSpace(local, stage, fs.predictedDisplayTime, &loc), XR_SUCCESS);
+  EXPECT_NEAR(loc.pose.position.y, 1.6, 1e-6);  // LOCAL at eye height above the floor
+  EXPECT_EQ(loc.locationFlags & XR_SPACE_LOCATION_POSITION_VALID_BIT, XR_SPACE_LOCATION_POSITION_VALID_BIT);
+  XrExtent2Df bounds;
+  EXPECT_EQ(xrGetReferenceSpaceBoundsRect(session_, XR_REFERENCE_SPACE_TYPE_STAGE, &bounds), XR_SUCCESS);
+  EXPECT_EQ(xrGetReferenceSpaceBoundsRect(session_, XR_REFERENCE_SPACE_TYPE_LOCAL, &bounds), XR_SPACE_BOUNDS_UNAVAILABLE);
+
+  // Views: both eyes valid, IPD apart, the preset's FOV; the head moves slowly.
+  XrViewLocateInfo li{XR_TYPE_VIEW_LOCATE_INFO};
+  li.viewConfigurationType = XR_VIEW_CONFIGURATION_TYPE_PRIMARY_STEREO;
+  li.displayTime = fs.predictedDisplayTime;
+  li.space = view;
+  XrViewState vs{XR_TYPE_VIEW_STATE};
+  XrView views[2]{{XR_TYPE_VIEW}, {XR_TYPE_VIEW}};
+  uint32_t n = 0;
+  EXPECT_EQ(xrLocateViews(session_, &li, &vs, 1, &n, views), XR_ERROR_SIZE_INSUFFICIENT);
+  ASSERT_EQ(xrLocateViews(session_, &li, &vs, 2, &n, views), XR_SUCCESS);
+  EXPECT_EQ(vs.viewStateFlags & (XR_VIEW_STATE_ORIENTATION_VALID_BIT | XR_VIEW_STATE_POSITION_VALID_BIT),
+            XrViewStateFlags(XR_VIEW_STATE_ORIENTATION_VALID_BIT | XR_VIEW_STATE_POSITION_VALID_BIT));
+  EXPECT_NEAR(views[1].pose.position.x - views[0].pose.position.x, 0.063, 1e-6);
+  EXPECT_NEAR(views[0].fov.angleLeft, -50.0 * M_PI / 180, 1e-5);
+  li.viewConfigurationType = XR_VIEW_CONFIGURATION_TYPE_PRIMARY_MONO;
+  EXPECT_EQ(xrLocateViews(session_, &li, &vs, 2, &n, views), XR_ERROR_VIEW_CONFIGURATION_TYPE_UNSUPPORTED);
+
+  // The scripted head pose is a function of time since the display epoch: locating the
+  // same time twice gives the same pose; two seconds later it has turned.
+  XrSpaceLocation a{XR_TYPE_SPACE_LOCATION}, b{XR_TYPE_SPACE_LOCATION}, c{XR_TYPE_SPACE_LOCATION};
+  ASSERT_EQ(xrLocateSpace(view, local, fs.predictedDisplayTime, &a), XR_SUCCESS);
+  ASSERT_EQ(xrLocateSpace(view, local, fs.predictedDisplayTime, &b), XR_SUCCESS);
+  ASSERT_EQ(xrLocateSpace(view, local, fs.predictedDisplayTime + 2'000'000'000, &c), XR_SUCCESS);
+  EXPECT_EQ(std::memcmp(&a.pose, &b.pose, sizeof a.pose), 0);
+  EXPECT_GT(std::abs(c.pose.orientation.y - a.pose.orientation.y), 0.01);
+}
+
+TEST_F(XrTest, SwapchainAcquireWaitRelease) {
+  create_instance();
+  run_to_focused();
+  uint32_t n = 0;
+  ASSERT_EQ(xrEnumerateSwapchainFormats(session_, 0, &n, nullptr), XR_SUCCESS);
+  std::vector<int64_t> formats(n);
+  ASSERT_EQ(xrEnumerateSwapchainFormats(session_, n, &n, formats.data()), XR_SUCCESS);
+  EXPECT_EQ(formats[0], VK_FORMAT_R8G8B8A8_SRGB);
+  const XrSwapchain sc = color_swapchain(64, 72);
+  ASSERT_EQ(xrEnumerateSwapchainImages(sc, 0, &n, nullptr), XR_SUCCESS);
+  ASSERT_EQ(n, 3u);
+  std::vector<XrSwapchainImageVulkan2KHR> images(n, {XR_TYPE_SWAPCHAIN_IMAGE_VULKAN2_KHR});
+  ASSERT_EQ(xrEnumerateSwapchainImages(sc, n, &n, reinterpret_cast<XrSwapchainImageBaseHeader*>(images.data())),
+            XR_SUCCESS);
+  EXPECT_NE(images[0].image, VK_NULL_HANDLE);
+  std::vector<XrSwapchainImageVulkan2KHR> wrong(n, {XR_TYPE_SWAPCHAIN_IMAGE_ACQUIRE_INFO});
+  EXPECT_EQ(xrEnumerateSwapchainImages(sc, n, &n, reinterpret_cast<XrSwapchainImageBaseHeader*>(wrong.data())),
+            XR_ERROR_VALIDATION_FAILURE);
+
+  XrSwapchainImageWaitInfo wi{XR_TYPE_SWAPCHAIN_IMAGE_WAIT_INFO};
+  wi.timeout = XR_INFINITE_DURATION;
+  EXPECT_EQ(xrWaitSwapchainImage(sc, &wi), XR_ERROR_CALL_ORDER_INVALID);
+  EXPECT_EQ(xrReleaseSwapchainImage(sc, nullptr), XR_ERROR_CALL_ORDER_INVALID);
+  uint32_t idx[4];
+  for (int i = 0; i < 3; ++i) ASSERT_EQ(xrAcquireSwapchainImage(sc, nullptr, &idx[i]), XR_SUCCESS);
+  EXPECT_EQ(idx[0], 0u);
+  EXPECT_EQ(idx[1], 1u);
+  EXPECT_EQ(xrAcquireSwapchainImage(sc, nullptr, &idx[3]), XR_ERROR_CALL_ORDER_INVALID);  // all acquired
+  EXPECT_EQ(xrReleaseSwapchainImage(sc, nullptr), XR_ERROR_CALL_ORDER_INVALID);          // not waited
+  for (int i = 0; i < 3; ++i) {
+    ASSERT_EQ(xrWaitSwapchainImage(sc, &wi), XR_SUCCESS);
+    ASSERT_EQ(xrReleaseSwapchainImage(sc, nullptr), XR_SUCCESS);
+  }
+
+  // Layers: a released swapchain with a valid rect is accepted, a bad rect or an
+  // unreleased swapchain is not.
+  const XrSpace local = reference_space(XR_REFERENCE_SPACE_TYPE_LOCAL);
+  XrCompositionLayerProjectionView pv[2];
+  for (auto& v : pv) {
+    v = {XR_TYPE_COMPOSITION_LAYER_PROJECTION_VIEW};
+    v.pose.orientation.w = 1;
+    v.fov = {-0.8f, 0.8f, 0.8f, -0.8f};
+    v.subImage.swapchain = sc;
+    v.subImage.imageRect = {{0, 0}, {64, 72}};
+  }
+  XrCompositionLayerProjection layer{XR_TYPE_COMPOSITION_LAYER_PROJECTION};
+  layer.space = local;
+  layer.viewCount = 2;
+  layer.views = pv;
+  const std::vector<const XrCompositionLayerBaseHeader*> layers{
+      reinterpret_cast<const XrCompositionLayerBaseHeader*>(&layer)};
+  EXPECT_EQ(frame(layers), XR_SUCCESS);
+  pv[1].subImage.imageRect = {{1, 0}, {64, 72}};
+  EXPECT_EQ(frame(layers), XR_ERROR_SWAPCHAIN_RECT_INVALID);
+  pv[1].subImage.imageRect = {{0, 0}, {64, 72}};
+  layer.viewCount = 1;
+  EXPECT_EQ(frame(layers), XR_ERROR_VALIDATION_FAILURE);
+  layer.viewCount = 2;
+  const XrSwapchain fresh = color_swapchain(64, 72);
+  pv[0].subImage.swapchain = fresh;
+  EXPECT_EQ(frame(layers), XR_ERROR_LAYER_INVALID);
+  const std::vector<const XrCompositionLayerBaseHeader*> null_layer{nullptr};
+  EXPECT_EQ(frame(null_layer), XR_ERROR_LAYER_INVALID);
+}
+
+TEST_F(XrTest, ControllerBindingsAcceptedButInactive) {
+  create_instance();
+  create_session();
+  XrActionSetCreateInfo asci{XR_TYPE_ACTION_SET_CREATE_INFO};
+  std::strcpy(asci.actionSetName, "gameplay");
+  std::strcpy(asci.localizedActionSetName, "Gameplay");
+  XrActionSet set = XR_NULL_HANDLE;
+  ASSERT_EQ(xrCreateActionSet(instance_, &asci, &set), XR_SUCCESS);
+  EXPECT_EQ(xrCreateActionSet(instance_, &asci, &set), XR_ERROR_NAME_DUPLICATED);
+  const XrPath hands[2] = {path("/user/hand/left"), path("/user/hand/right")};
+  XrActionCreateInfo aci{XR_TYPE_ACTION_CREATE_INFO};
+  std::strcpy(aci.actionName, "hand_pose");
+  std::strcpy(aci.localizedActionName, "Hand Pose");
+  aci.actionType = XR_ACTION_TYPE_POSE_INPUT;
+  aci.countSubactionPaths = 2;
+  aci.subactionPaths = hands;
+  XrAction pose = XR_NULL_HANDLE;
+  ASSERT_EQ(xrCreateAction(set, &aci, &pose), XR_SUCCESS);
+  std::strcpy(aci.actionName, "Bad Name");
+  XrAction bad = XR_NULL_HANDLE;
+  EXPECT_EQ(xrCreateAction(set, &aci, &bad), XR_ERROR_PATH_FORMAT_INVALID);
+  for (const char* profile : {"/interaction_profiles/khr/simple_controller", "/interaction_profiles/oculus/touch_controller",
+                              "/interaction_profiles/htc/vive_controller", "/interaction_profiles/valve/index_controller",
+                              "/interaction_profiles/microsoft/motion_controller"}) {
+    XrActionSuggestedBinding b[2] = {{pose, path("/user/hand/left/input/grip/pose")},
+                                     {pose, path("/user/hand/right/input/grip/pose")}};
+    XrInteractionProfileSuggestedBinding s{XR_TYPE_INTERACTION_PROFILE_SUGGESTED_BINDING};
+    s.interactionProfile = path(profile);
+    s.countSuggestedBindings = 2;
+    s.suggestedBindings = b;
+    EXPECT_EQ(xrSuggestInteractionProfileBindings(instance_, &s), XR_SUCCESS) << profile;
+  }
+  XrActionSuggestedBinding wrong{pose, path("/user/gamepad/input/a/click")};
+  XrInteractionProfileSuggestedBinding s{XR_TYPE_INTERACTION_PROFILE_SUGGESTED_BINDING};
+  s.interactionProfile = path("/interaction_profiles/khr/simple_controller");
+  s.countSuggestedBindings = 1;
+  s.suggestedBindings = &wrong;
+  EXPECT_EQ(xrSuggestInteractionProfileBindings(instance_, &s), XR_ERROR_PATH_UNSUPPORTED);
+  s.interactionProfile = path("/interaction_profiles/no/such_device");
+  EXPECT_EQ(xrSuggestInteractionProfileBindings(instance_, &s), XR_ERROR_PATH_UNSUPPORTED);
+
+  XrActionStateGetInfo gi{XR_TYPE_ACTION_STATE_GET_INFO};
+  gi.action = pose;
+  XrActionStatePose st{XR_TYPE_ACTION_STATE_POSE};
+  EXPECT_EQ(xrGetActionStatePose(session_, &gi, &st), XR_ERROR_ACTIONSET_NOT_ATTACHED);
+  XrSessionActionSetsAttachInfo ai{XR_TYPE_SESSION_ACTION_SETS_ATTACH_INFO};
+  ai.countActionSets = 1;
+  ai.actionSets = &set;
+  ASSERT_EQ(xrAttachSessionActionSets(session_, &ai), XR_SUCCESS);
+  EXPECT_EQ(xrAttachSessionActionSets(session_, &ai), XR_ERROR_ACTIONSETS_ALREADY_ATTACHED);
+  ASSERT_EQ(xrGetActionStatePose(session_, &gi, &st), XR_SUCCESS);
+  EXPECT_FALSE(st.isActive);
+  XrActionStateBoolean sb{XR_TYPE_ACTION_STATE_BOOLEAN};
+  EXPECT_EQ(xrGetActionStateBoolean(session_, &gi, &sb), XR_ERROR_ACTION_TYPE_MISMATCH);
+  gi.subactionPath = path("/user/head");
+  EXPECT_EQ(xrGetActionStatePose(session_, &gi, &st), XR_ERROR_PATH_UNSUPPORTED);
+  XrInteractionProfileState ips{XR_TYPE_INTERACTION_PROFILE_STATE};
+  ASSERT_EQ(xrGetCurrentInteractionProfile(session_, hands[0], &ips), XR_SUCCESS);
+  EXPECT_EQ(ips.interactionProfile, XrPath(XR_NULL_PATH));
+  // Controllers are never tracked.
+  XrActionSpaceCreateInfo sci{XR_TYPE_ACTION_SPACE_CREATE_INFO};
+  sci.action = pose;
+  sci.subactionPath = hands[0];
+  sci.poseInActionSpace.orientation.w = 1;
+  XrSpace hand = XR_NULL_HANDLE;
+  ASSERT_EQ(xrCreateActionSpace(session_, &sci, &hand), XR_SUCCESS);
+  XrSpaceLocation loc{XR_TYPE_SPACE_LOCATION};
+  ASSERT_EQ(xrLocateSpace(hand, reference_space(XR_REFERENCE_SPACE_TYPE_LOCAL), 1000, &loc), XR_SUCCESS);
+  EXPECT_EQ(loc.locationFlags, 0u);
+  XrActiveActionSet active{set, XR_NULL_PATH};
+  XrActionsSyncInfo sync{XR_TYPE_ACTIONS_SYNC_INFO};
+  sync.countActiveActionSets = 1;
+  sync.activeActionSets = &active;
+  EXPECT_EQ(xrSyncActions(session_, &sync), XR_SESSION_NOT_FOCUSED);
+}
+
+TEST_F(XrTest, EyeGaze) {
+  create_instance({XR_EXT_EYE_GAZE_INTERACTION_EXTENSION_NAME});
+  XrSystemEyeGazeInteractionPropertiesEXT eg{XR_TYPE_SYSTEM_EYE_GAZE_INTERACTION_PROPERTIES_EXT};
+  XrSystemProperties sp{XR_TYPE_SYSTEM_PROPERTIES};
+  sp.next = &eg;
+  ASSERT_EQ(xrGetSystemProperties(instance_, system_, &sp), XR_SUCCESS);
+  EXPECT_TRUE(eg.supportsEyeGazeInteraction);
+  run_to_focused();
+  XrActionSetCreateInfo asci{XR_TYPE_ACTION_SET_CREATE_INFO};
+  std::strcpy(asci.actionSetName, "eyes");
+  std::strcpy(asci.localizedActionSetName, "Eyes");
+  XrActionSet set = XR_NULL_HANDLE;
+  ASSERT_EQ(xrCreateActionSet(instance_, &asci, &set), XR_SUCCESS);
+  XrActionCreateInfo aci{XR_TYPE_ACTION_CREATE_INFO};
+  std::strcpy(aci.actionName, "gaze");
+  std::strcpy(aci.localizedActionName, "Gaze");
+  aci.actionType = XR_ACTION_TYPE_POSE_INPUT;
+  XrAction gaze = XR_NULL_HANDLE;
+  ASSERT_EQ(xrCreateAction(set, &aci, &gaze), XR_SUCCESS);
+  XrActionSuggestedBinding b{gaze, path("/user/eyes_ext/input/gaze_ext/pose")};
+  XrInteractionProfileSuggestedBinding s{XR_TYPE_INTERACTION_PROFILE_SUGGESTED_BINDING};
+  s.interactionProfile = path("/interaction_profiles/ext/eye_gaze_interaction");
+  s.countSuggestedBindings = 1;
+  s.suggestedBindings = &b;
+  ASSERT_EQ(xrSuggestInteractionProfileBindings(instance_, &s), XR_SUCCESS);
+  XrSessionActionSetsAttachInfo ai{XR_TYPE_SESSION_ACTION_SETS_ATTACH_INFO};
+  ai.countActionSets = 1;
+  ai.actionSets = &set;
+  ASSERT_EQ(xrAttachSessionActionSets(session_, &ai), XR_SUCCESS);
+  XrEventDataBuffer ev{XR_TYPE_EVENT_DATA_BUFFER};
+  ASSERT_EQ(xrPollEvent(instance_, &ev), XR_SUCCESS);
+  EXPECT_EQ(ev.type, XR_TYPE_EVENT_DATA_INTERACTION_PROFILE_CHANGED);
+  XrInteractionProfileState ips{XR_TYPE_INTERACTION_PROFILE_STATE};
+  ASSERT_EQ(xrGetCurrentInteractionProfile(session_, path("/user/eyes_ext"), &ips), XR_SUCCESS);
+  EXPECT_EQ(ips.interactionProfile, path("/interaction_profiles/ext/eye_gaze_interaction"));
+  XrActiveActionSet active{set, XR_NULL_PATH};
+  XrActionsSyncInfo sync{XR_TYPE_ACTIONS_SYNC_INFO};
+  sync.countActiveActionSets = 1;
+  sync.activeActionSets = &active;
+  ASSERT_EQ(xrSyncActions(session_, &sync), XR_SUCCESS);
+  XrActionStateGetInfo gi{XR_TYPE_ACTION_STATE_GET_INFO};
+  gi.action = gaze;
+  XrActionStatePose st{XR_TYPE_ACTION_STATE_POSE};
+  ASSERT_EQ(xrGetActionStatePose(session_, &gi, &st), XR_SUCCESS);
+  EXPECT_TRUE(st.isActive);
+
+  XrActionSpaceCreateInfo sci{XR_TYPE_ACTION_SPACE_CREATE_INFO};
+  sci.action = gaze;
+  sci.poseInActionSpace.orientation.w = 1;
+  XrSpace gaze_space = XR_NULL_HANDLE;
+  ASSERT_EQ(xrCreateActionSpace(session_, &sci, &gaze_space), XR_SUCCESS);
+  const XrSpace view = reference_space(XR_REFERENCE_SPACE_TYPE_VIEW);
+  XrFrameState fs{XR_TYPE_FRAME_STATE};
+  ASSERT_EQ(frame({}, &fs), XR_SUCCESS);
+  // Over two simulated seconds the synthetic tracker reports valid gaze at least most of
+  // the time (blinks and dropouts are invalid): valid samples carry both validity bits,
+  // a sample time no later than the requested time, and a forward direction.
+  int valid = 0, invalid = 0;
+  for (int i = 0; i < 200; ++i) {
+    const XrTime t = fs.predictedDisplayTime + XrTime(i) * 10'000'000;
+    XrEyeGazeSampleTimeEXT when{XR_TYPE_EYE_GAZE_SAMPLE_TIME_EXT};
+    XrSpaceLocation loc{XR_TYPE_SPACE_LOCATION};
+    loc.next = &when;
+    ASSERT_EQ(xrLocateSpace(gaze_space, view, t, &loc), XR_SUCCESS);
+    if (loc.locationFlags & XR_SPACE_LOCATION_ORIENTATION_VALID_BIT) {
+      ++valid;
+      EXPECT_TRUE(loc.locationFlags & XR_SPACE_LOCATION_ORIENTATION_TRACKED_BIT);
+      EXPECT_GT(when.time, 0);
+      EXPECT_LE(when.time, t);
+      // Forward of the gaze pose (-Z rotated) points ahead of the viewer.
+      const auto& q = loc.pose.orientation;
+      const double fz = -(1 - 2 * (double(q.x) * q.x + double(q.y) * q.y));
+      EXPECT_LT(fz, -0.5);
+    } else {
+      ++invalid;
+      EXPECT_EQ(loc.locationFlags, 0u);
+    }
+  }
+  EXPECT_GT(valid, 150);
+  SCOPED_TRACE(invalid);
+}
+
+TEST_F(XrTest, VisibilityMask) {
+  create_instance({XR_KHR_VISIBILITY_MASK_EXTENSION_NAME});
+  create_session();
+  auto get = proc<PFN_xrGetVisibilityMaskKHR>("xrGetVisibilityMaskKHR");
+  XrVisibilityMaskKHR m{XR_TYPE_VISIBILITY_MASK_KHR};
+  EXPECT_EQ(get(session_, XR_VIEW_CONFIGURATION_TYPE_PRIMARY_STEREO, 2, XR_VISIBILITY_MASK_TYPE_HIDDEN_TRIANGLE_MESH_KHR, &m),
+            XR_ERROR_VALIDATION_FAILURE);
+  EXPECT_EQ(get(session_, XR_VIEW_CONFIGURATION_TYPE_PRIMARY_MONO, 0, XR_VISIBILITY_MASK_TYPE_HIDDEN_TRIANGLE_MESH_KHR, &m),
+            XR_ERROR_VIEW_CONFIGURATION_TYPE_UNSUPPORTED);
+  XrVisibilityMaskKHR wrong{XR_TYPE_VIEW};
+  EXPECT_EQ(get(session_, XR_VIEW_CONFIGURATION_TYPE_PRIMARY_STEREO, 0, XR_VISIBILITY_MASK_TYPE_HIDDEN_TRIANGLE_MESH_KHR,
+                &wrong),
+            XR_ERROR_VALIDATION_FAILURE);
+  for (auto type : {XR_VISIBILITY_MASK_TYPE_HIDDEN_TRIANGLE_MESH_KHR, XR_VISIBILITY_MASK_TYPE_VISIBLE_TRIANGLE_MESH_KHR,
+                    XR_VISIBILITY_MASK_TYPE_LINE_LOOP_KHR}) {
+    m = {XR_TYPE_VISIBILITY_MASK_KHR};
+    ASSERT_EQ(get(session_, XR_VIEW_CONFIGURATION_TYPE_PRIMARY_STEREO, 0, type, &m), XR_SUCCESS);
+    // The preset's lens hides the panel corners: every mesh is non-empty.
+    ASSERT_GT(m.vertexCountOutput, 2u) << type;
+    ASSERT_GT(m.indexCountOutput, 2u) << type;
+    std::vector<XrVector2f> v(m.vertexCountOutput);
+    std::vector<uint32_t> idx(m.indexCountOutput);
+    m.vertexCapacityInput = m.vertexCountOutput - 1;
+    m.indexCapacityInput = m.indexCountOutput;
+    m.vertices = v.data();
+    m.indices = idx.data();
+    EXPECT_EQ(get(session_, XR_VIEW_CONFIGURATION_TYPE_PRIMARY_STEREO, 0, type, &m), XR_ERROR_SIZE_INSUFFICIENT);
+    m.vertexCapacityInput = uint32_t(v.size());
+    ASSERT_EQ(get(session_, XR_VIEW_CONFIGURATION_TYPE_PRIMARY_STEREO, 0, type, &m), XR_SUCCESS);
+    if (type != XR_VISIBILITY_MASK_TYPE_LINE_LOOP_KHR) {
+      EXPECT_EQ(idx.size() % 3, 0u);
+    }
+    const float tan50 = float(std::tan(50.0 * M_PI / 180));
+    for (uint32_t i : idx) ASSERT_LT(i, v.size());
+    for (const auto& p : v) {  // within the FOV rectangle on the z = -1 plane
+      EXPECT_LE(std::abs(p.x), tan50 * 1.0001f);
+      EXPECT_TRUE(std::isfinite(p.y));
+    }
+  }
+}
+
+TEST_F(XrTest, TimespecConversion) {
+  create_instance({XR_KHR_CONVERT_TIMESPEC_TIME_EXTENSION_NAME});
+  auto to_time = proc<PFN_xrConvertTimespecTimeToTimeKHR>("xrConvertTimespecTimeToTimeKHR");
+  auto to_ts = proc<PFN_xrConvertTimeToTimespecTimeKHR>("xrConvertTimeToTimespecTimeKHR");
+  timespec ts{12, 345};
+  XrTime t = 0;
+  ASSERT_EQ(to_time(instance_, &ts, &t), XR_SUCCESS);
+  EXPECT_EQ(t, 12'000'000'345);
+  timespec back{};
+  ASSERT_EQ(to_ts(instance_, t, &back), XR_SUCCESS);
+  EXPECT_EQ(back.tv_sec, 12);
+  EXPECT_EQ(back.tv_nsec, 345);
+  EXPECT_EQ(to_ts(instance_, 0, &back), XR_ERROR_TIME_INVALID);
+}
+
+TEST_F(XrTest, UnsupportedExtensionRejected) {
+  XrInstanceCreateInfo ci{XR_TYPE_INSTANCE_CREATE_INFO};
+  std::strcpy(ci.applicationInfo.applicationName, "fovea_runtime_tests");
+  ci.applicationInfo.apiVersion = XR_CURRENT_API_VERSION;
+  const char* ext = "XR_MSFT_hand_interaction";
+  ci.enabledExtensionCount = 1;
+  ci.enabledExtensionNames = &ext;
+  XrInstance inst = XR_NULL_HANDLE;
+  EXPECT_EQ(xrCreateInstance(&ci, &inst), XR_ERROR_EXTENSION_NOT_PRESENT);
+}
+
+TEST_F(XrTest, BadConfigurationFailsInitialization) {
+  setenv("FOVEA_DISPLAY", "no-such-display", 1);
+  XrInstanceCreateInfo ci{XR_TYPE_INSTANCE_CREATE_INFO};
+  std::strcpy(ci.applicationInfo.applicationName, "fovea_runtime_tests");
+  ci.applicationInfo.apiVersion = XR_CURRENT_API_VERSION;
+  XrInstance inst = XR_NULL_HANDLE;
+  EXPECT_EQ(xrCreateInstance(&ci, &inst), XR_ERROR_INITIALIZATION_FAILED);
+  setenv("FOVEA_DISPLAY", "tiny", 1);
+  setenv("FOVEA_GAZE", "nonsense:1", 1);
+  EXPECT_EQ(xrCreateInstance(&ci, &inst), XR_ERROR_INITIALIZATION_FAILED);
+  unsetenv("FOVEA_GAZE");
+}
+
+}  // namespace
+}  // namespace fovea::test
