@@ -115,7 +115,7 @@ Scene make_furnace(float albedo, float emission) {
   Material m = diffuse("furnace", glm::vec3(albedo));
   m.emission = glm::vec3(emission);
   const auto mat = s.add_material(m);
-  add_sphere(s, {0, 0, 0}, 1.0f, mat, 24, 48, true);
+  add_sphere(s, {0, 0, 0}, 1.0f, mat, 12, 24, true);
   // Flat shading normals: interpolated normals would break energy balance in the enclosure.
   for (auto& n : s.normals) n = glm::vec3(0);
   return s;

@@ -1,0 +1,78 @@
+#pragma once
+// The grid path tracer: traces one eye's per-sample rays of any sample grid (a storage
+// buffer of shaders::GridSample, index = row * columns + column, cells with flags != 0
+// skipped) and writes per-cell fp32 outputs in the same layout (pt_trace.h):
+// demodulated radiance split into direct+specular and indirect diffuse, albedo, shading
+// normal + linear depth, world position + material id, and plain radiance.
+#include <cstdint>
+#include <vector>
+
+#include <glm/vec4.hpp>
+
+#include "fovea/core/display.hpp"
+#include "fovea/core/view.hpp"
+#include "fovea/gpu/buffer.hpp"
+#include "fovea/gpu/descriptors.hpp"
+#include "fovea/gpu/pipeline.hpp"
+#include "fovea/renderer/gpu_scene.hpp"
+#include "fovea/shaders/grid.h"
+#include "fovea/shaders/pt_trace.h"
+
+namespace fovea::renderer {
+
+// Default: the BMFR/P5 configuration (1 sample per cell, primary hit + NEE, one BSDF
+// bounce + NEE, MIS, no Russian roulette).
+struct PathConfig {
+  std::uint32_t spp = 1;          // samples per cell and frame
+  int max_bounces = 1;            // BSDF-sampled bounces after the primary hit; < 0: unlimited
+  std::uint32_t rr_start = 1000;  // bounce from which Russian roulette applies (large: off)
+  bool jitter = false;            // spread samples over the cell's footprint (anti-aliasing)
+};
+
+// The outputs of one grid, with the descriptor set binding them, the scene and the grid.
+// The grid buffer and the scene must outlive it.
+class TraceOutputs {
+ public:
+  std::uint32_t cells() const { return cells_; }
+  const gpu::Buffer& direct() const { return direct_; }
+  const gpu::Buffer& indirect() const { return indirect_; }
+  const gpu::Buffer& albedo() const { return albedo_; }
+  const gpu::Buffer& normal_depth() const { return normal_depth_; }
+  const gpu::Buffer& position_material() const { return position_material_; }
+  const gpu::Buffer& radiance() const { return radiance_; }
+
+ private:
+  friend class PathTracer;
+  std::uint32_t cells_ = 0;
+  gpu::Buffer direct_, indirect_, albedo_, normal_depth_, position_material_, radiance_;
+  gpu::DescriptorSet set_;
+};
+
+class PathTracer {
+ public:
+  PathTracer(gpu::Context& ctx, const GpuScene& scene);
+
+  // Output buffers for a grid of `cells` GridSample entries held in `grid`.
+  TraceOutputs bind(const gpu::Buffer& grid, std::uint32_t cells) const;
+
+  // Records one frame (split into dispatches of at most kPtMaxSppPerDispatch samples).
+  // `view` gives the eye pose (world) and the display raster used for jitter; `frame`
+  // keys the random numbers together with the cell, the eye and the sample index.
+  // accumulated > 0 averages this frame into the outputs that already hold that many
+  // frames of config.spp samples (equal weight per sample); 0 overwrites them.
+  // Features (normal, depth, position, material) come from the first sample written.
+  void record(VkCommandBuffer cmd, TraceOutputs& out, const core::View& view, core::Eye eye, std::uint32_t frame,
+              const PathConfig& config, std::uint32_t accumulated = 0) const;
+
+  const GpuScene& scene() const { return scene_; }
+
+ private:
+  gpu::Context& ctx_;
+  const GpuScene& scene_;
+  gpu::ComputePipeline pipeline_;
+};
+
+// Cartesian grid of a view's raster, built on the CPU: one cell per pixel centre.
+std::vector<shaders::GridSample> cartesian_grid(const core::View& view);
+
+}  // namespace fovea::renderer

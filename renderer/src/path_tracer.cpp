@@ -1,0 +1,103 @@
+#include "fovea/renderer/path_tracer.hpp"
+
+#include <cmath>
+#include <limits>
+
+#include <glm/gtc/quaternion.hpp>
+#include <glm/mat3x3.hpp>
+
+#include "fovea/core/error.hpp"
+#include "fovea/gpu/barriers.hpp"
+
+namespace fovea::renderer {
+
+namespace {
+constexpr int kOutputs = 6;
+constexpr int kBindings = 8 + kOutputs;
+}  // namespace
+
+PathTracer::PathTracer(gpu::Context& ctx, const GpuScene& scene)
+    : ctx_(ctx),
+      scene_(scene),
+      pipeline_(ctx, {"pt_trace.comp.spv",
+                      {std::vector<gpu::Binding>(kBindings, gpu::Binding::StorageBuffer)},
+                      sizeof(shaders::PtFrameParams)}) {}
+
+TraceOutputs PathTracer::bind(const gpu::Buffer& grid, std::uint32_t cells) const {
+  if (cells == 0) throw core::InputError("path tracer: empty sample grid");
+  if (grid.size() < VkDeviceSize(cells) * sizeof(shaders::GridSample))
+    throw core::InputError("path tracer: grid buffer holds fewer than " + std::to_string(cells) + " samples");
+  TraceOutputs o;
+  o.cells_ = cells;
+  const VkDeviceSize bytes = VkDeviceSize(cells) * sizeof(glm::vec4);
+  auto make = [&](const char* name) {
+    return gpu::Buffer(ctx_, {bytes, gpu::BufferUsage::Storage, gpu::Memory::DeviceLocal, name});
+  };
+  o.direct_ = make("pt.out.direct");
+  o.indirect_ = make("pt.out.indirect");
+  o.albedo_ = make("pt.out.albedo");
+  o.normal_depth_ = make("pt.out.normal_depth");
+  o.position_material_ = make("pt.out.position_material");
+  o.radiance_ = make("pt.out.radiance");
+  o.set_ = gpu::DescriptorSet(ctx_, pipeline_.set_layout(0));
+  o.set_.bind(0, scene_.nodes()).bind(1, scene_.triangles()).bind(2, scene_.shading()).bind(3, scene_.materials());
+  o.set_.bind(4, scene_.lights()).bind(5, scene_.texture_table()).bind(6, scene_.texels()).bind(7, grid);
+  o.set_.bind(8, o.direct_).bind(9, o.indirect_).bind(10, o.albedo_).bind(11, o.normal_depth_);
+  o.set_.bind(12, o.position_material_).bind(13, o.radiance_);
+  return o;
+}
+
+void PathTracer::record(VkCommandBuffer cmd, TraceOutputs& out, const core::View& view, core::Eye eye,
+                        std::uint32_t frame, const PathConfig& c, std::uint32_t accumulated) const {
+  const glm::dmat3 r = glm::mat3_cast(view.pose().orientation);
+  const glm::dvec3 o = view.pose().position;
+  if (!std::isfinite(o.x) || !std::isfinite(o.y) || !std::isfinite(o.z) || !std::isfinite(r[0][0]))
+    throw core::InputError("path tracer: non-finite eye pose");
+  shaders::PtFrameParams p{};
+  p.rot0_x = float(r[0].x); p.rot0_y = float(r[0].y); p.rot0_z = float(r[0].z);
+  p.rot1_x = float(r[1].x); p.rot1_y = float(r[1].y); p.rot1_z = float(r[1].z);
+  p.rot2_x = float(r[2].x); p.rot2_y = float(r[2].y); p.rot2_z = float(r[2].z);
+  p.origin_x = float(o.x); p.origin_y = float(o.y); p.origin_z = float(o.z);
+  const glm::vec3 env = scene_.environment();
+  p.env_r = env.x; p.env_g = env.y; p.env_b = env.z;
+  p.light_count = scene_.light_count();
+  p.cell_count = out.cells_;
+  p.frame = frame;
+  p.eye = static_cast<std::uint32_t>(eye);
+  p.max_bounces = c.max_bounces < 0 ? std::numeric_limits<std::uint32_t>::max() : std::uint32_t(c.max_bounces);
+  p.rr_start = c.rr_start;
+  p.pixel_tx = float((view.tan_right() - view.tan_left()) / view.width());
+  p.pixel_ty = float((view.tan_up() - view.tan_down()) / view.height());
+  const std::uint32_t spp = std::max<std::uint32_t>(c.spp, 1);
+  std::uint64_t done = std::uint64_t(accumulated) * spp;
+  for (std::uint32_t first = 0; first < spp; first += shaders::kPtMaxSppPerDispatch) {
+    if (first) gpu::compute_to_compute(cmd);
+    p.spp = std::min(spp - first, shaders::kPtMaxSppPerDispatch);
+    p.sample_offset = first;
+    p.accumulated_samples = std::uint32_t(std::min<std::uint64_t>(done, 0xFFFFFFFFu));
+    p.flags = (c.jitter ? shaders::kPtJitter : 0u) | (done > 0 ? shaders::kPtAccumulate : 0u);
+    pipeline_.run(cmd, {&out.set_}, p, out.cells_);
+    done += p.spp;
+  }
+}
+
+std::vector<shaders::GridSample> cartesian_grid(const core::View& view) {
+  std::vector<shaders::GridSample> g(std::size_t(view.width()) * view.height());
+  for (int y = 0; y < view.height(); ++y)
+    for (int x = 0; x < view.width(); ++x) {
+      const glm::dvec2 px(x + 0.5, y + 0.5);
+      const glm::dvec3 d = view.pixel_to_dir(px);
+      auto& s = g[std::size_t(y) * view.width() + x];
+      s.dir_x = float(d.x);
+      s.dir_y = float(d.y);
+      s.dir_z = float(d.z);
+      s.flags = 0;
+      s.screen_x = float(px.x);
+      s.screen_y = float(px.y);
+      s.ecc_deg = float(core::angle_deg(d, view.centre_dir()));
+      s.footprint = 1.0f;
+    }
+  return g;
+}
+
+}  // namespace fovea::renderer

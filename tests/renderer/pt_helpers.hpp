@@ -1,0 +1,47 @@
+#pragma once
+// Test helpers: trace a grid with the path tracer and read the outputs back.
+#include <vector>
+
+#include <glm/vec4.hpp>
+
+#include "fovea/gpu/barriers.hpp"
+#include "fovea/renderer/path_tracer.hpp"
+
+namespace fovea::test {
+
+struct Traced {
+  std::vector<glm::vec4> radiance, direct, indirect, albedo, normal_depth, position_material;
+};
+
+// `frames` frames of config.spp samples each, averaged on the GPU in one submission.
+inline Traced trace_grid(gpu::Context& ctx, const renderer::GpuScene& scene,
+                         const std::vector<shaders::GridSample>& grid, const core::View& view, core::Eye eye,
+                         const renderer::PathConfig& config, std::uint32_t frames = 1, std::uint32_t first_frame = 0) {
+  gpu::Buffer g(ctx, {grid.size() * sizeof(shaders::GridSample), gpu::BufferUsage::Storage, gpu::Memory::DeviceLocal,
+                      "test.grid"});
+  g.upload(grid);
+  renderer::PathTracer pt(ctx, scene);
+  renderer::TraceOutputs out = pt.bind(g, std::uint32_t(grid.size()));
+  ctx.submit_and_wait([&](VkCommandBuffer cmd) {
+    for (std::uint32_t f = 0; f < frames; ++f) {
+      if (f) gpu::compute_to_compute(cmd);
+      pt.record(cmd, out, view, eye, first_frame + f, config, f);
+    }
+  });
+  Traced t;
+  t.radiance = out.radiance().download<glm::vec4>();
+  t.direct = out.direct().download<glm::vec4>();
+  t.indirect = out.indirect().download<glm::vec4>();
+  t.albedo = out.albedo().download<glm::vec4>();
+  t.normal_depth = out.normal_depth().download<glm::vec4>();
+  t.position_material = out.position_material().download<glm::vec4>();
+  return t;
+}
+
+inline glm::dvec3 mean_rgb(const std::vector<glm::vec4>& v) {
+  glm::dvec3 s(0);
+  for (const auto& p : v) s += glm::dvec3(p);
+  return s / double(v.size());
+}
+
+}  // namespace fovea::test
