@@ -66,7 +66,7 @@ SourceUri parse_source_uri(std::string_view uri) {
   SourceUri u;
   const std::string s(uri);
   const auto colon = s.find(':');
-  static const char* schemes[] = {"replay", "synthetic", "hid", "usb", "hid-capture", "mouse", "openxr"};
+  static const char* schemes[] = {"replay", "synthetic", "hid", "usb", "hid-capture", "hid-emulated", "mouse", "openxr"};
   std::string rest = s;
   u.scheme = "replay";
   if (colon != std::string::npos) {
@@ -75,7 +75,7 @@ SourceUri parse_source_uri(std::string_view uri) {
       u.scheme = sch;
       rest = s.substr(colon + 1);
     }
-  } else if (s == "mouse" || s == "openxr") {
+  } else if (s == "mouse" || s == "openxr" || s == "hid" || s == "usb") {
     u.scheme = s;
     rest.clear();
   }
@@ -134,6 +134,8 @@ std::unique_ptr<SampleStream> open_sample_stream(std::string_view uri, const Sou
   SourceUri u = parse_source_uri(uri);
   SourceOptions opt = base;
   apply_common_options(u, opt);
+  if ((u.scheme == "replay" || u.scheme == "synthetic") && !opt.raw_capture.empty())
+    throw core::InputError("gaze source \"" + u.text + "\": raw capture needs a HID source (hid:, usb:, hid-emulated:)");
   if (u.scheme == "replay") {
     if (u.body.empty()) throw core::InputError("gaze source \"" + u.text + "\": missing file name");
     if (auto f = u.take("format"); !f.empty()) opt.format = f;

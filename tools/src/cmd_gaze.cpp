@@ -8,7 +8,11 @@
 
 #include "command.hpp"
 #include "fovea/core/error.hpp"
+#include <chrono>
+#include <thread>
+
 #include "fovea/devices/analysis.hpp"
+#include "fovea/devices/hid_stream.hpp"
 #include "fovea/devices/readers.hpp"
 #include "fovea/devices/synthetic.hpp"
 
@@ -25,7 +29,9 @@ const char* kHelp =
     "  synth --task T --seconds S OUT  synthetic gaze (--seed N --rate HZ --noise DEG --color C\n"
     "                                  --dropouts PER_S); tasks: reading search pursuit fixation-grid\n"
     "  plot FILE OUT.png               gaze over time and on the display, saccades marked\n"
-    "  record --source URI --seconds S OUT [--raw CAPTURE]   record a live source\n"
+    "  record --source URI --seconds S OUT [--raw CAPTURE] [--timeout S]\n"
+    "                                  record any source (hid:, usb:, hid-emulated:LAYOUT, synthetic:,\n"
+    "                                  replay); --raw writes the raw HID traffic (docs/hid.md)\n"
     "geometry for 2D formats: --display NAME|FILE (default small), --screen WxH@HFOVxVFOV\n"
     "  (e.g. 1920x1080@95x63: the raster and symmetric field of view the gaze coordinates refer to)\n"
     "--min-confidence C (default 0.6): samples below are marked lost\n"
@@ -146,6 +152,56 @@ int cmd_synth(const std::vector<std::string>& argv) {
   return 0;
 }
 
+// Records any source into the project's format; HID sources can also write the raw traffic.
+int cmd_record(const std::vector<std::string>& argv) {
+  Args a(argv, {"source", "seconds", "raw", "display", "screen", "timeout"}, {}, 1);
+  if (a.positional().size() != 1 || !a.has("source")) throw core::InputError("gaze record needs --source URI and OUT (see --help)");
+  dv::SourceOptions opt = gaze_source_options(a);
+  opt.raw_capture = a.str("raw", "");
+  const double seconds = a.num("seconds", 5);
+  if (!(seconds > 0)) throw core::InputError("--seconds must be positive");
+  const double timeout = a.num("timeout", seconds + 5);  // wall clock, for live devices
+  auto stream = dv::open_sample_stream(a.str("source", ""), opt);
+  auto* hid = dynamic_cast<dv::hid::HidGazeStream*>(stream.get());
+  const nlohmann::json meta = {{"display", opt.display.name}, {"source", stream->describe()}};
+  dv::FoveaCsvWriter w(a.positional()[0], meta.dump());
+  const auto start = std::chrono::steady_clock::now();
+  const auto limit = static_cast<core::TimeNs>(seconds * 1e9);
+  bool have_first = false;
+  core::TimeNs first = 0;
+  dv::GazeSample s;
+  std::uint64_t tracked = 0;
+  for (;;) {
+    if (!stream->next(s)) {
+      if (!stream->live() || (hid && hid->finished())) break;
+      if (std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count() > timeout) break;
+      std::this_thread::sleep_for(std::chrono::milliseconds(1));
+      continue;
+    }
+    if (!have_first) {
+      have_first = true;
+      first = s.t_ns;
+    }
+    s.t_ns -= first;
+    if (s.t_ns >= limit) break;
+    w.write(s);
+    tracked += s.tracked();
+  }
+  if (hid) {
+    hid->stop();
+    const auto st = hid->stats();
+    std::cerr << "reports " << st.reports << ", samples " << st.samples << ", status " << st.status_reports
+              << ", transport errors " << st.transport_errors << ", clock drift " << st.clock_drift_ppm << " ppm";
+    for (const auto& [k, v] : st.dropped) std::cerr << ", " << k << ": " << v;
+    for (const auto& n : st.notes) std::cerr << "\n  note: " << n;
+    std::cerr << "\n";
+  }
+  if (tracked == 0) throw core::InputError(stream->describe() + ": no usable sample recorded; nothing written");
+  w.finish();
+  std::cerr << "recorded " << w.samples() << " samples -> " << a.positional()[0] << "\n";
+  return 0;
+}
+
 int run(std::vector<std::string> args) {
   if (args.empty() || args[0] == "--help" || args[0] == "-h") {
     std::cout << kHelp;
@@ -161,6 +217,7 @@ int run(std::vector<std::string> args) {
   if (sub == "info") return cmd_info(args);
   if (sub == "convert") return cmd_convert(args);
   if (sub == "synth") return cmd_synth(args);
+  if (sub == "record") return cmd_record(args);
   throw core::InputError("unknown gaze subcommand \"" + sub + "\" (info, convert, synth, plot, record)");
 }
 

@@ -71,6 +71,7 @@ struct SourceOptions {
   core::TimeNs max_gap_ns = 100'000'000;  // no interpolation across larger gaps (result: lost)
   core::TimeNs window_ns = 2'000'000'000; // history kept for sample_at()
   double min_confidence = 0.6;            // formats with confidence: below this -> lost
+  std::string raw_capture;  // HID sources: also write the raw device traffic here (docs/hid.md)
 
   core::View screen_view() const { return screen ? *screen : display.view(core::Eye::Left); }
 };
