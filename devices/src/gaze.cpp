@@ -9,6 +9,7 @@
 #include <glm/geometric.hpp>
 
 #include "fovea/core/error.hpp"
+#include "fovea/devices/filters.hpp"
 #include "fovea/devices/readers.hpp"
 #include "fovea/devices/synthetic.hpp"
 #include "fovea/devices/timeline.hpp"
@@ -128,12 +129,27 @@ void SourceUri::finish() const {
 void apply_common_options(SourceUri& u, SourceOptions& opt) {
   opt.horizon_ns = std::llround(u.take_number("horizon_ms", static_cast<double>(opt.horizon_ns) * 1e-6, 0, 1000) * 1e6);
   opt.min_confidence = u.take_number("min_confidence", opt.min_confidence, 0, 1);
+  if (auto f = u.take("filters"); !f.empty()) opt.filters = f;
+}
+
+namespace {
+std::unique_ptr<SampleStream> open_raw_stream(SourceUri& u, const SourceOptions& opt);
 }
 
 std::unique_ptr<SampleStream> open_sample_stream(std::string_view uri, const SourceOptions& base) {
   SourceUri u = parse_source_uri(uri);
   SourceOptions opt = base;
   apply_common_options(u, opt);
+  auto s = open_raw_stream(u, opt);
+  if (opt.filters.empty()) return s;
+  FilterParams fp;
+  fp.centre = opt.screen_view().centre_dir();
+  return apply_filters(std::move(s), opt.filters, fp);
+}
+
+namespace {
+std::unique_ptr<SampleStream> open_raw_stream(SourceUri& u, const SourceOptions& base) {
+  SourceOptions opt = base;
   if ((u.scheme == "replay" || u.scheme == "synthetic") && !opt.raw_capture.empty())
     throw core::InputError("gaze source \"" + u.text + "\": raw capture needs a HID source (hid:, usb:, hid-emulated:)");
   if (u.scheme == "replay") {
@@ -163,6 +179,7 @@ std::unique_ptr<SampleStream> open_sample_stream(std::string_view uri, const Sou
   }
   return open_device_stream(u, opt);
 }
+}  // namespace
 
 std::unique_ptr<GazeSource> open_gaze_source(std::string_view uri, const SourceOptions& base) {
   SourceUri u = parse_source_uri(uri);

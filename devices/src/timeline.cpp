@@ -52,7 +52,12 @@ GazeSample TimelineSource::at_recording_time(core::TimeNs tt) {
     return s;
   }
   if (tt <= win_.front().t_ns) return win_.front();
-  if (tt >= win_.back().t_ns) return win_.back();
+  if (tt >= win_.back().t_ns) {
+    // Live: predict to the requested (display) time, at most horizon_ns ahead. Recordings
+    // are clamped at their end.
+    if (stream_->live() && opt_.horizon_ns > 0) return predictor_.predict(win_, tt, opt_.horizon_ns);
+    return win_.back();
+  }
   const auto it = std::upper_bound(win_.begin(), win_.end(), tt,
                                    [](core::TimeNs t, const GazeSample& s) { return t < s.t_ns; });
   const GazeSample& b = *it;

@@ -31,6 +31,9 @@ struct EyeGaze {
   bool tracked() const { return (flags & kTracked) != 0; }
 };
 
+// Eye-movement class of a sample, set by the I-VT filter stage (filters.hpp); Unknown otherwise.
+enum class Motion : std::uint8_t { Unknown, Fixation, Saccade };
+
 struct GazeSample {
   // On the source's timeline: replays and synthetic gaze count from their first sample
   // (t = 0); live devices use the host monotonic clock (device time mapped through the
@@ -39,6 +42,7 @@ struct GazeSample {
   core::TimeNs device_time_ns = 0;  // as stamped by the tracker / the recording
   core::TimeNs host_time_ns = 0;    // host monotonic receive time (replays: = t_ns)
   EyeGaze combined, left, right;
+  Motion motion = Motion::Unknown;
 
   bool tracked() const { return combined.tracked(); }
   const EyeGaze& eye(core::Eye e) const { return e == core::Eye::Left ? left : right; }
@@ -71,6 +75,8 @@ struct SourceOptions {
   core::TimeNs max_gap_ns = 100'000'000;  // no interpolation across larger gaps (result: lost)
   core::TimeNs window_ns = 2'000'000'000; // history kept for sample_at()
   double min_confidence = 0.6;            // formats with confidence: below this -> lost
+  // Filter stages applied to the stream, in order: "ivt", "oneeuro", "hold" (filters.hpp).
+  std::string filters;
   std::string raw_capture;  // HID sources: also write the raw device traffic here (docs/hid.md)
 
   core::View screen_view() const { return screen ? *screen : display.view(core::Eye::Left); }

@@ -14,8 +14,6 @@ struct IvtParams {
   core::TimeNs velocity_window_ns = 20'000'000;  // velocity over (at least) this span
 };
 
-enum class Motion { Unknown, Fixation, Saccade };
-
 class IvtClassifier {
  public:
   explicit IvtClassifier(const IvtParams& p = {}) : p_(p) {}

@@ -2,11 +2,13 @@
 // A GazeSource over any SampleStream: keeps a bounded window of recent samples and answers
 // sample_at() by interpolation. Recorded streams (replay, synthetic) are played on a
 // timeline starting at their first sample (t = 0), scaled by `speed`, optionally looped;
-// seeking backwards before the window re-reads the stream from its start.
+// seeking backwards before the window re-reads the stream from its start. Live streams are
+// predicted past their newest sample (GazePredictor, at most horizon_ns).
 #include <deque>
 #include <memory>
 #include <mutex>
 
+#include "fovea/devices/filters.hpp"
 #include "fovea/devices/gaze.hpp"
 
 namespace fovea::devices {
@@ -31,6 +33,7 @@ class TimelineSource final : public GazeSource {
   bool ended_ = false, trimmed_ = false;
   core::TimeNs period_ = -1;  // loop period once the end is known
   core::TimeNs opened_ns_ = 0;
+  GazePredictor predictor_;
   std::mutex mutex_;
 };
 

@@ -1,0 +1,213 @@
+#include <cmath>
+#include <random>
+
+#include <glm/geometric.hpp>
+#include <gtest/gtest.h>
+
+#include "fovea/core/error.hpp"
+#include "fovea/devices/filters.hpp"
+#include "fovea/devices/synthetic.hpp"
+#include "fovea/devices/timeline.hpp"
+
+using namespace fovea::devices;
+using fovea::core::angle_deg;
+using fovea::core::TimeNs;
+
+namespace {
+glm::dvec3 dir_deg(double az, double el) {
+  return glm::normalize(glm::dvec3(std::tan(az * M_PI / 180), std::tan(el * M_PI / 180), -1));
+}
+GazeSample sample(TimeNs t, glm::dvec3 d, std::uint32_t flags = kTracked) {
+  GazeSample s;
+  s.t_ns = s.device_time_ns = s.host_time_ns = t;
+  s.combined.dir = d;
+  s.combined.flags = flags;
+  s.combined.confidence = flags == kTracked ? 1 : 0;
+  s.left = s.right = s.combined;
+  return s;
+}
+// A scripted stream; live streams return false until more is "delivered".
+class VectorStream final : public SampleStream {
+ public:
+  explicit VectorStream(std::vector<GazeSample> v, bool live = false) : v_(std::move(v)), live_(live) {}
+  bool next(GazeSample& s) override {
+    if (i_ >= std::min(v_.size(), limit_)) return false;
+    s = v_[i_++];
+    return true;
+  }
+  bool rewindable() const override { return !live_; }
+  void rewind() override { i_ = 0; }
+  bool live() const override { return live_; }
+  std::string describe() const override { return "vector"; }
+  std::size_t limit_ = SIZE_MAX;
+
+ private:
+  std::vector<GazeSample> v_;
+  bool live_;
+  std::size_t i_ = 0;
+};
+std::vector<GazeSample> run(std::unique_ptr<SampleStream> s) {
+  std::vector<GazeSample> v;
+  GazeSample g;
+  while (s->next(g)) v.push_back(g);
+  return v;
+}
+}  // namespace
+
+TEST(OneEuro, SmoothsAtRestFollowsAtSpeedResetsAfterDropout) {
+  std::mt19937 rng(1);
+  std::normal_distribution<double> noise(0, 0.2);
+  std::vector<GazeSample> in;
+  const TimeNs dt = 8'333'333;
+  for (int i = 0; i < 240; ++i) {  // 2 s fixation at 0°, a 10° saccade, 1 s fixation at 10°
+    const double t = i * dt * 1e-9;
+    const double x = t < 2.0 ? 0 : t < 2.043 ? 10 * (t - 2.0) / 0.043 : 10;
+    in.push_back(sample(i * dt, dir_deg(x + noise(rng), noise(rng))));
+  }
+  for (int i = 240; i < 360; ++i) in.push_back(sample(i * dt, dir_deg(10 + noise(rng), noise(rng))));
+  for (int i = 360; i < 400; ++i) in.push_back(sample(i * dt, dir_deg(0, 0), kLost));  // 330 ms dropout
+  in.push_back(sample(400 * dt, dir_deg(-5, 3)));
+  auto filtered = [&](double beta) {
+    FilterParams p;
+    p.one_euro.beta = beta;
+    return run(apply_filters(std::make_unique<VectorStream>(in), "oneeuro", p));
+  };
+  const auto out = filtered(0.05), slow = filtered(0.0);
+  ASSERT_EQ(out.size(), in.size());
+  double raw2 = 0, filt2 = 0;
+  for (int i = 60; i < 230; ++i) {
+    raw2 += std::pow(angle_deg(in[i].combined.dir, dir_deg(0, 0)), 2);
+    filt2 += std::pow(angle_deg(out[i].combined.dir, dir_deg(0, 0)), 2);
+  }
+  EXPECT_LT(std::sqrt(filt2 / raw2), 0.35);  // jitter at rest strongly reduced
+  const int after = 247;                      // ~15 ms after landing
+  EXPECT_LT(angle_deg(out[after].combined.dir, dir_deg(10, 0)), 1.5);
+  EXPECT_GT(angle_deg(slow[after].combined.dir, dir_deg(10, 0)), 4.0);  // beta = 0 lags far behind
+  EXPECT_EQ(out[370].combined.flags, kLost);
+  EXPECT_EQ(out[400].combined.dir, in[400].combined.dir);  // reset: no smoothing across the dropout
+}
+
+TEST(IvtStage, GapFillBelow75msAndSaccadeClasses) {
+  std::vector<GazeSample> in;
+  const TimeNs dt = 4'000'000;  // 250 Hz
+  int i = 0;
+  for (; i < 50; ++i) in.push_back(sample(i * dt, dir_deg(0, 0)));
+  for (; i < 62; ++i) in.push_back(sample(i * dt, dir_deg(0, 0), kLost));  // 48 ms: filled
+  for (; i < 70; ++i) in.push_back(sample(i * dt, dir_deg(1, 0)));
+  for (; i < 95; ++i) in.push_back(sample(i * dt, dir_deg(0, 0), kLost));  // 100 ms: kept lost
+  for (; i < 100; ++i) in.push_back(sample(i * dt, dir_deg(1, 0)));
+  for (; i < 110; ++i) in.push_back(sample(i * dt, dir_deg(1 + (i - 99) * 2.0, 0)));  // 500 °/s
+  for (; i < 130; ++i) in.push_back(sample(i * dt, dir_deg(21, 0)));
+  in[75] = sample(75 * dt, dir_deg(0, 0), kBlink);  // blinks are never filled
+  const auto out = run(apply_filters(std::make_unique<VectorStream>(in), "ivt", FilterParams{}));
+  ASSERT_EQ(out.size(), in.size());
+  for (int k = 50; k < 62; ++k) {
+    EXPECT_TRUE(out[k].tracked()) << k;
+    EXPECT_LT(out[k].combined.confidence, 1.0);
+    EXPECT_EQ(out[k].t_ns, in[k].t_ns);
+  }
+  EXPECT_NEAR(std::atan2(out[56].combined.dir.x, -out[56].combined.dir.z) * 180 / M_PI, 28.0 / 52.0, 0.01);  // interpolated between samples 49 and 62
+  for (int k = 70; k < 95; ++k) EXPECT_FALSE(out[k].tracked()) << k;
+  EXPECT_EQ(out[75].combined.flags, kBlink);
+  EXPECT_EQ(out[40].motion, Motion::Fixation);
+  int saccade = 0;
+  for (int k = 100; k < 112; ++k) saccade += out[k].motion == Motion::Saccade;
+  EXPECT_GE(saccade, 8);
+  EXPECT_EQ(out[128].motion, Motion::Fixation);
+  EXPECT_THROW(apply_filters(std::make_unique<VectorStream>(in), "ivt,kalman", FilterParams{}), fovea::core::InputError);
+}
+
+TEST(HoldStage, BlinkHoldsThenEasesToCentreWithoutJumps) {
+  std::vector<GazeSample> in;
+  const TimeNs dt = 8'333'333;
+  for (int i = 0; i < 30; ++i) in.push_back(sample(i * dt, dir_deg(20, 10)));
+  for (int i = 30; i < 120; ++i) in.push_back(sample(i * dt, glm::dvec3(0, 0, 0), i < 70 ? kBlink : kLost));  // garbage dirs
+  FilterParams p;
+  p.centre = dir_deg(0, 0);
+  const auto out = run(apply_filters(std::make_unique<VectorStream>(in), "hold", p));
+  for (int i = 30; i < 30 + 23; ++i) EXPECT_EQ(out[i].combined.dir, dir_deg(20, 10)) << i;  // held 200 ms
+  EXPECT_LT(angle_deg(out[119].combined.dir, dir_deg(0, 0)), 1e-9);                       // at the centre after 500 ms
+  double worst = 0;
+  for (std::size_t i = 1; i < out.size(); ++i) {
+    ASSERT_NEAR(glm::length(out[i].combined.dir), 1.0, 1e-9);
+    worst = std::max(worst, angle_deg(out[i - 1].combined.dir, out[i].combined.dir));
+  }
+  EXPECT_LT(worst, 1.5);  // 22° eased over 300 ms at 120 Hz: no jump
+  EXPECT_EQ(out[40].combined.flags, kBlink);  // validity is reported unchanged
+}
+
+TEST(Prediction, NoExtrapolationAcrossSaccadeOnsetLandingAfterPeak) {
+  SynthParams sp;
+  sp.seed = 9;
+  sp.seconds = 60;
+  sp.rate_hz = 1000;
+  sp.noise_deg = 0;
+  sp.dropout_per_s = 0;
+  SyntheticStream syn(sp);
+  std::vector<SynthEvent> sacc;
+  syn.on_event([&](const SynthEvent& e) {
+    if (e.kind == SynthEvent::Saccade && e.amplitude_deg > 8) sacc.push_back(e);
+  });
+  std::vector<GazeSample> all;
+  GazeSample g;
+  while (syn.next(g)) all.push_back(g);
+  GazePredictor pred;
+  int checked = 0, landing_better = 0;
+  for (const SynthEvent& e : sacc) {
+    const std::size_t on = static_cast<std::size_t>(e.start_ns / 1'000'000), end = static_cast<std::size_t>(e.end_ns / 1'000'000);
+    if (on < 100 || end + 30 >= all.size() || all[on].combined.flags != kTracked) continue;
+    bool clean = true;
+    for (std::size_t k = on - 60; k <= end + 20; ++k) clean = clean && all[k].tracked();
+    if (!clean) continue;
+    // Early in the saccade (accelerating): hold, never extrapolate.
+    std::deque<GazeSample> h(all.begin() + static_cast<long>(on) - 60, all.begin() + static_cast<long>(on) + 6);
+    const GazeSample p = pred.predict(h, h.back().t_ns + 20'000'000, 20'000'000);
+    EXPECT_LT(angle_deg(p.combined.dir, h.back().combined.dir), 1e-9);
+    // After the peak: the main-sequence landing estimate beats holding.
+    const std::size_t late = on + static_cast<std::size_t>((end - on) * 0.7);
+    std::deque<GazeSample> h2(all.begin() + static_cast<long>(on) - 60, all.begin() + static_cast<long>(late) + 1);
+    const GazeSample p2 = pred.predict(h2, h2.back().t_ns + 20'000'000, 20'000'000);
+    const glm::dvec3 truth = all[std::min(late + 20, all.size() - 1)].combined.dir;
+    landing_better += angle_deg(p2.combined.dir, truth) < angle_deg(h2.back().combined.dir, truth);
+    ++checked;
+  }
+  ASSERT_GT(checked, 20);
+  EXPECT_GT(landing_better, 0.8 * checked);
+}
+
+TEST(Prediction, ConstantVelocityInPursuitAndHorizonThroughTheTimeline) {
+  std::vector<GazeSample> in;
+  const TimeNs dt = 8'333'333;
+  for (int i = 0; i < 60; ++i) in.push_back(sample(i * dt, dir_deg(20.0 * i * dt * 1e-9, 0)));  // 20 °/s pursuit
+  GazePredictor pred;
+  std::deque<GazeSample> h(in.begin(), in.begin() + 40);
+  const GazeSample p = pred.predict(h, h.back().t_ns + 20'000'000, 20'000'000);
+  const double expect = 20.0 * (h.back().t_ns + 20'000'000) * 1e-9;
+  EXPECT_NEAR(std::atan2(p.combined.dir.x, -p.combined.dir.z) * 180 / M_PI, expect, 0.02);
+
+  auto live = std::make_unique<VectorStream>(in, true);
+  live->limit_ = 40;
+  SourceOptions o;
+  o.horizon_ns = 20'000'000;
+  TimelineSource src(std::move(live), o);
+  const TimeNs newest = in[39].t_ns;
+  const GazeSample a = src.sample_at(newest + 20'000'000), b = src.sample_at(newest + 200'000'000);
+  EXPECT_EQ(a.combined.dir, b.combined.dir);  // never further than the horizon
+  EXPECT_EQ(b.t_ns, newest + 200'000'000);
+  EXPECT_GT(angle_deg(a.combined.dir, in[39].combined.dir), 0.3);
+  // Lost newest sample: hold, no prediction from stale velocity.
+  std::deque<GazeSample> lost = h;
+  lost.push_back(sample(h.back().t_ns + dt, dir_deg(0, 0), kLost));
+  EXPECT_EQ(pred.predict(lost, lost.back().t_ns + 10'000'000, 20'000'000).combined.flags, kLost);
+}
+
+TEST(Filters, ComposeOnAnySourceByUri) {
+  SourceOptions o;
+  auto src = open_gaze_source("synthetic:3?rate=250&filters=ivt,oneeuro,hold", o);
+  for (TimeNs t = 0; t < 5'000'000'000; t += 11'111'111) {
+    const GazeSample s = src->sample_at(t);
+    ASSERT_NEAR(glm::length(s.combined.dir), 1.0, 1e-9);
+    ASSERT_LT(s.combined.dir.z, 0);
+  }
+  EXPECT_THROW(open_gaze_source("synthetic:3?filters=median", o), fovea::core::InputError);
+}
