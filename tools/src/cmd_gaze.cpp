@@ -11,6 +11,7 @@
 #include <chrono>
 #include <thread>
 
+#include "fovea/core/image.hpp"
 #include "fovea/devices/analysis.hpp"
 #include "fovea/devices/hid_stream.hpp"
 #include "fovea/devices/readers.hpp"
@@ -152,6 +153,119 @@ int cmd_synth(const std::vector<std::string>& argv) {
   return 0;
 }
 
+// ---- plot: a small rasteriser over core::Image --------------------------------------------
+struct Canvas {
+  core::Image img;
+  Canvas(int w, int h) : img(w, h, {1, 1, 1, 1}) {}
+  void blend(int x, int y, glm::vec4 c) {
+    if (x < 0 || y < 0 || x >= img.width || y >= img.height) return;
+    glm::vec4& p = img.at(x, y);
+    p = glm::vec4(glm::vec3(p) * (1 - c.w) + glm::vec3(c) * c.w, 1);
+  }
+  void rect(int x0, int y0, int x1, int y1, glm::vec4 c) {
+    for (int y = std::max(0, y0); y < std::min(img.height, y1); ++y)
+      for (int x = std::max(0, x0); x < std::min(img.width, x1); ++x) blend(x, y, c);
+  }
+  void line(double x0, double y0, double x1, double y1, glm::vec4 c) {  // DDA, one sample per pixel step
+    const int n = static_cast<int>(std::ceil(std::max(std::abs(x1 - x0), std::abs(y1 - y0)))) + 1;
+    for (int i = 0; i <= n; ++i) {
+      const double u = static_cast<double>(i) / n;
+      blend(static_cast<int>(std::lround(x0 + u * (x1 - x0))), static_cast<int>(std::lround(y0 + u * (y1 - y0))), c);
+    }
+  }
+  void frame(int x0, int y0, int x1, int y1, glm::vec4 c) {
+    line(x0, y0, x1 - 1, y0, c);
+    line(x0, y1 - 1, x1 - 1, y1 - 1, c);
+    line(x0, y0, x0, y1 - 1, c);
+    line(x1 - 1, y0, x1 - 1, y1 - 1, c);
+  }
+};
+
+// Two panels: gaze angles over time (horizontal blue, vertical green; saccades shaded red,
+// untracked time grey; grid every second and every 10°), and the gaze on the display
+// (fixation samples dark, saccade samples red). Two streaming passes, bounded memory.
+int cmd_plot(const std::vector<std::string>& argv) {
+  Args a(argv, {"format", "display", "screen", "min-confidence", "width"}, {}, 2);
+  if (a.positional().size() != 2) throw core::InputError("gaze plot needs FILE and OUT.png (see --help)");
+  const dv::SourceOptions opt = gaze_source_options(a);
+  auto reader = dv::open_reader(a.positional()[0], opt);
+  dv::GazeSample s;
+  core::TimeNs t_end = 0;
+  double max_angle = 10;
+  std::uint64_t tracked = 0;
+  auto angles = [](const glm::dvec3& d) {
+    return glm::dvec2(std::atan2(d.x, -d.z), std::atan2(d.y, std::hypot(d.x, d.z))) * (180.0 / M_PI);
+  };
+  while (reader->next(s)) {
+    t_end = s.t_ns;
+    if (s.tracked()) {
+      ++tracked;
+      const glm::dvec2 g = angles(s.combined.dir);
+      max_angle = std::max({max_angle, std::abs(g.x), std::abs(g.y)});
+    }
+  }
+  if (tracked == 0) throw core::InputError(a.positional()[0] + ": no usable sample to plot");
+  max_angle = std::min(90.0, std::ceil(max_angle / 10) * 10);
+  const int W = static_cast<int>(std::clamp(a.integer("width", 1200), 400L, 4000L));
+  const int top = W * 3 / 10, margin = 20;
+  const core::View view = opt.screen_view();
+  const int disp_h = std::min(W * 6 / 10, static_cast<int>(double(W - 2 * margin) * view.height() / view.width()));
+  const int disp_w = static_cast<int>(double(disp_h) * view.width() / view.height());
+  Canvas c(W, top + disp_h + 3 * margin);
+  const int px0 = margin, px1 = W - margin, py0 = margin, py1 = top;
+  const double span = std::max<double>(static_cast<double>(t_end), 1.0);
+  auto tx = [&](core::TimeNs t) { return px0 + (px1 - px0 - 1) * static_cast<double>(t) / span; };
+  auto ay = [&](double deg) { return py0 + (py1 - py0 - 1) * (0.5 - 0.5 * deg / max_angle); };
+  for (double t = 0; t <= span * 1e-9; t += 1.0) c.line(tx(core::TimeNs(t * 1e9)), py0, tx(core::TimeNs(t * 1e9)), py1 - 1, {0, 0, 0, 0.12f});
+  for (double d = -max_angle; d <= max_angle; d += 10) c.line(px0, ay(d), px1 - 1, ay(d), {0, 0, 0, d == 0 ? 0.4f : 0.12f});
+  c.frame(px0, py0, px1, py1, {0, 0, 0, 1});
+  const int dx0 = (W - disp_w) / 2, dy0 = top + 2 * margin;
+  c.rect(dx0, dy0, dx0 + disp_w, dy0 + disp_h, {0.93f, 0.93f, 0.93f, 1});
+  c.frame(dx0, dy0, dx0 + disp_w, dy0 + disp_h, {0, 0, 0, 1});
+  // Pass 2: events (shading) and traces.
+  reader->rewind();
+  dv::SummaryParams sp;
+  sp.infer_blinks = !reader->reports_blinks();
+  dv::EventSegmenter seg(sp, [&](dv::EventSegmenter::Kind k, core::TimeNs t0, core::TimeNs t1) {
+    if (k == dv::EventSegmenter::Kind::Saccade)
+      c.rect(static_cast<int>(tx(t0)), py0 + 1, static_cast<int>(std::ceil(tx(t1))) + 1, py1 - 1, {0.9f, 0.1f, 0.1f, 0.25f});
+  });
+  bool have_prev = false;
+  dv::GazeSample prev;
+  glm::dvec2 prev_px{};
+  bool prev_on = false;
+  while (reader->next(s)) {
+    seg.add(s);
+    if (!s.tracked()) {
+      c.rect(static_cast<int>(tx(s.t_ns)), py0 + 1, static_cast<int>(tx(s.t_ns)) + 1, py1 - 1, {0.5f, 0.5f, 0.5f, 0.3f});
+      have_prev = false;
+      continue;
+    }
+    const glm::dvec2 g = angles(s.combined.dir);
+    if (have_prev) {
+      const glm::dvec2 p = angles(prev.combined.dir);
+      c.line(tx(prev.t_ns), ay(p.x), tx(s.t_ns), ay(g.x), {0.1f, 0.3f, 0.9f, 0.9f});
+      c.line(tx(prev.t_ns), ay(p.y), tx(s.t_ns), ay(g.y), {0.1f, 0.6f, 0.2f, 0.9f});
+    }
+    const auto pix = view.dir_to_pixel(s.combined.dir);
+    const bool on = pix.has_value();
+    glm::dvec2 q{};
+    if (on) q = glm::dvec2(dx0 + pix->x / view.width() * disp_w, dy0 + pix->y / view.height() * disp_h);
+    const bool sacc = s.motion == dv::Motion::Saccade || (have_prev && core::angle_deg(prev.combined.dir, s.combined.dir) /
+                                                                            std::max(1e-9, (s.t_ns - prev.t_ns) * 1e-9) >= sp.ivt.threshold_deg_s);
+    if (on && prev_on && have_prev) c.line(prev_px.x, prev_px.y, q.x, q.y, sacc ? glm::vec4(0.9f, 0.1f, 0.1f, 0.6f) : glm::vec4(0.1f, 0.1f, 0.3f, 0.15f));
+    if (on && !sacc) c.rect(int(q.x) - 1, int(q.y) - 1, int(q.x) + 2, int(q.y) + 2, {0.1f, 0.1f, 0.4f, 0.25f});
+    prev = s;
+    prev_px = q;
+    prev_on = on;
+    have_prev = true;
+  }
+  seg.finish();
+  core::write_png(a.positional()[1], c.img);
+  std::cerr << "wrote " << a.positional()[1] << " (" << c.img.width << "x" << c.img.height << ")\n";
+  return 0;
+}
+
 // Records any source into the project's format; HID sources can also write the raw traffic.
 int cmd_record(const std::vector<std::string>& argv) {
   Args a(argv, {"source", "seconds", "raw", "display", "screen", "timeout"}, {}, 1);
@@ -218,6 +332,7 @@ int run(std::vector<std::string> args) {
   if (sub == "convert") return cmd_convert(args);
   if (sub == "synth") return cmd_synth(args);
   if (sub == "record") return cmd_record(args);
+  if (sub == "plot") return cmd_plot(args);
   throw core::InputError("unknown gaze subcommand \"" + sub + "\" (info, convert, synth, plot, record)");
 }
 
