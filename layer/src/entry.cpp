@@ -1,0 +1,163 @@
+// Loader negotiation, xrCreateApiLayerInstance and xrGetInstanceProcAddr (api_layer.adoc:
+// negotiation, create-instance process, intercept requirements).
+#include <cstring>
+
+#include "fovea/runtime/loader_interface.hpp"
+#include "layer.hpp"
+#include "log.hpp"
+
+namespace fovea::layer {
+namespace {
+
+struct Entry {
+  const char* name;
+  PFN_xrVoidFunction fn;
+};
+
+#define FOVEA_LAYER_ENTRY(name) {#name, reinterpret_cast<PFN_xrVoidFunction>(&intercept::name)},
+const Entry kIntercepted[] = {FOVEA_LAYER_INTERCEPTED(FOVEA_LAYER_ENTRY)};
+#undef FOVEA_LAYER_ENTRY
+
+XrResult XRAPI_CALL get_instance_proc_addr(XrInstance instance, const char* name, PFN_xrVoidFunction* function) {
+  if (!name || !function) return XR_ERROR_VALIDATION_FAILURE;
+  if (!std::strcmp(name, "xrGetInstanceProcAddr")) {
+    *function = reinterpret_cast<PFN_xrVoidFunction>(&get_instance_proc_addr);
+    return XR_SUCCESS;
+  }
+  PFN_xrGetInstanceProcAddr next = nullptr;
+  {
+    std::lock_guard lock(layer().mutex);
+    auto it = layer().instances.find(instance);
+    if (it != layer().instances.end()) next = it->second.next.xrGetInstanceProcAddr;
+  }
+  if (!next) {
+    *function = nullptr;
+    return XR_ERROR_HANDLE_INVALID;  // not an instance created through this layer
+  }
+  // Resolve down the chain first: an intercepted command the runtime does not have stays
+  // unsupported.
+  const XrResult r = next(instance, name, function);
+  if (XR_FAILED(r)) return r;
+  for (const Entry& e : kIntercepted)
+    if (!std::strcmp(e.name, name)) *function = e.fn;
+  return r;
+}
+
+XrResult XRAPI_CALL create_api_layer_instance(const XrInstanceCreateInfo* info, const XrApiLayerCreateInfo* layer_info,
+                                              XrInstance* instance) {
+  if (!info || !layer_info || !instance) return XR_ERROR_VALIDATION_FAILURE;
+  if (layer_info->structType != XR_LOADER_INTERFACE_STRUCT_API_LAYER_CREATE_INFO ||
+      layer_info->structVersion != XR_API_LAYER_CREATE_INFO_STRUCT_VERSION ||
+      layer_info->structSize != sizeof(XrApiLayerCreateInfo))
+    return XR_ERROR_INITIALIZATION_FAILED;
+  const XrApiLayerNextInfo* next = layer_info->nextInfo;
+  if (!next || next->structType != XR_LOADER_INTERFACE_STRUCT_API_LAYER_NEXT_INFO ||
+      next->structVersion != XR_API_LAYER_NEXT_INFO_STRUCT_VERSION || next->structSize != sizeof(XrApiLayerNextInfo) ||
+      std::strcmp(next->layerName, kLayerName) != 0 || !next->nextGetInstanceProcAddr ||
+      !next->nextCreateApiLayerInstance)
+    return XR_ERROR_INITIALIZATION_FAILED;
+
+  // The layer's own extension is answered by the loader from the manifest; the layers
+  // below and the runtime do not know it.
+  std::vector<const char*> extensions;
+  bool ours = false;
+  for (uint32_t i = 0; i < info->enabledExtensionCount; ++i) {
+    if (!std::strcmp(info->enabledExtensionNames[i], kLayerExtension))
+      ours = true;
+    else
+      extensions.push_back(info->enabledExtensionNames[i]);
+  }
+  XrInstanceCreateInfo down = *info;
+  down.enabledExtensionCount = uint32_t(extensions.size());
+  down.enabledExtensionNames = extensions.data();
+  XrApiLayerCreateInfo down_layer = *layer_info;
+  down_layer.nextInfo = next->next;
+  const XrResult r = next->nextCreateApiLayerInstance(&down, &down_layer, instance);
+  if (XR_FAILED(r)) return r;
+
+  InstanceState state;
+  state.extension_enabled = ours;
+  state.next.xrGetInstanceProcAddr = next->nextGetInstanceProcAddr;
+  bool complete = true;
+#define FOVEA_LAYER_RESOLVE(name)                                                                     \
+  if (XR_FAILED(next->nextGetInstanceProcAddr(*instance, #name,                                      \
+                                              reinterpret_cast<PFN_xrVoidFunction*>(&state.next.name))) || \
+      !state.next.name)                                                                                 \
+    complete = false;
+  FOVEA_LAYER_NEXT(FOVEA_LAYER_RESOLVE)
+#undef FOVEA_LAYER_RESOLVE
+  if (!complete) {
+    FOVEA_LAYER_ERROR("a core command is missing below the layer");
+    if (state.next.xrDestroyInstance) state.next.xrDestroyInstance(*instance);
+    *instance = XR_NULL_HANDLE;
+    return XR_ERROR_INITIALIZATION_FAILED;
+  }
+  {
+    std::lock_guard lock(layer().mutex);
+    layer().instances[*instance] = state;
+    layer().last_instance = *instance;
+  }
+  FOVEA_LAYER_INFO("instance created for \"%s\" (%s %s; layers below: %s)", info->applicationInfo.applicationName,
+                   kLayerExtension, ours ? "enabled" : "not enabled",
+                   next->next ? next->next->layerName : "none");
+  return r;
+}
+
+}  // namespace
+
+Layer& layer() {
+  static Layer l;
+  return l;
+}
+
+const Dispatch* next_for_session(XrSession session) {
+  Layer& l = layer();
+  auto s = l.sessions.find(session);
+  auto i = l.instances.find(s != l.sessions.end() ? s->second.instance : l.last_instance);
+  return i == l.instances.end() ? nullptr : &i->second.next;
+}
+
+XrResult intercept::xrDestroyInstance(XrInstance instance) {
+  PFN_xrDestroyInstance next = nullptr;
+  {
+    std::lock_guard lock(layer().mutex);
+    auto it = layer().instances.find(instance);
+    if (it == layer().instances.end()) return XR_ERROR_HANDLE_INVALID;
+    next = it->second.next.xrDestroyInstance;
+  }
+  const XrResult r = next(instance);
+  if (XR_SUCCEEDED(r)) {
+    std::lock_guard lock(layer().mutex);
+    Layer& l = layer();
+    for (auto it = l.sessions.begin(); it != l.sessions.end();)
+      it = it->second.instance == instance ? l.sessions.erase(it) : std::next(it);
+    l.instances.erase(instance);
+    if (l.last_instance == instance) l.last_instance = l.instances.empty() ? XR_NULL_HANDLE : l.instances.rbegin()->first;
+  }
+  return r;
+}
+
+}  // namespace fovea::layer
+
+extern "C" __attribute__((visibility("default"))) XrResult xrNegotiateLoaderApiLayerInterface(
+    const XrNegotiateLoaderInfo* loaderInfo, const char* layerName, XrNegotiateApiLayerRequest* request) {
+  using namespace fovea::layer;
+  if (!loaderInfo || !layerName || !request || std::strcmp(layerName, kLayerName) != 0)
+    return XR_ERROR_INITIALIZATION_FAILED;
+  if (loaderInfo->structType != XR_LOADER_INTERFACE_STRUCT_LOADER_INFO ||
+      loaderInfo->structVersion != XR_LOADER_INFO_STRUCT_VERSION ||
+      loaderInfo->structSize != sizeof(XrNegotiateLoaderInfo) ||
+      request->structType != XR_LOADER_INTERFACE_STRUCT_API_LAYER_REQUEST ||
+      request->structVersion != XR_API_LAYER_INFO_STRUCT_VERSION ||
+      request->structSize != sizeof(XrNegotiateApiLayerRequest))
+    return XR_ERROR_INITIALIZATION_FAILED;
+  if (loaderInfo->minInterfaceVersion > XR_CURRENT_LOADER_API_LAYER_VERSION ||
+      loaderInfo->maxInterfaceVersion < XR_CURRENT_LOADER_API_LAYER_VERSION ||
+      XR_VERSION_MAJOR(loaderInfo->minApiVersion) > 1 || XR_VERSION_MAJOR(loaderInfo->maxApiVersion) < 1)
+    return XR_ERROR_INITIALIZATION_FAILED;
+  request->layerInterfaceVersion = XR_CURRENT_LOADER_API_LAYER_VERSION;
+  request->layerApiVersion = XR_CURRENT_API_VERSION;
+  request->getInstanceProcAddr = &get_instance_proc_addr;
+  request->createApiLayerInstance = &create_api_layer_instance;
+  return XR_SUCCESS;
+}

@@ -1,0 +1,105 @@
+// Frame intercepts: xrWaitFrame/xrBeginFrame/xrEndFrame are timed, xrLocateViews results
+// are kept for the frame renderer. Without a renderer the application's frame goes down
+// unchanged; with one, its layers replace the application's (frame_renderer.hpp).
+#include "layer.hpp"
+#include "log.hpp"
+
+namespace fovea::layer {
+namespace {
+
+// Runs layer bookkeeping for a session; an exception disables the layer for the session.
+template <class F>
+void bookkeeping(XrSession session, F&& f) {
+  std::lock_guard lock(layer().mutex);
+  auto it = layer().sessions.find(session);
+  if (it == layer().sessions.end() || it->second.disabled) return;
+  try {
+    f(it->second);
+  } catch (const std::exception& e) {
+    FOVEA_LAYER_ERROR("internal failure, the layer passes this session through from now on: %s", e.what());
+    it->second.renderer.reset();
+    it->second.disabled = true;
+  }
+}
+
+template <class PFN>
+PFN next_fn(XrSession session, PFN Dispatch::*member) {
+  std::lock_guard lock(layer().mutex);
+  const Dispatch* d = next_for_session(session);
+  return d ? d->*member : nullptr;
+}
+
+}  // namespace
+
+XrResult intercept::xrWaitFrame(XrSession session, const XrFrameWaitInfo* info, XrFrameState* state) {
+  const auto next = next_fn(session, &Dispatch::xrWaitFrame);
+  if (!next) return XR_ERROR_HANDLE_INVALID;
+  const std::int64_t t0 = now_ns();
+  const XrResult r = next(session, info, state);
+  const std::int64_t t1 = now_ns();
+  if (XR_SUCCEEDED(r))
+    bookkeeping(session, [&](SessionState& s) {
+      s.current.wait_call_ns = t0;
+      s.current.wait_return_ns = t1;
+      s.current.display_time_ns = state->predictedDisplayTime;
+    });
+  return r;
+}
+
+XrResult intercept::xrBeginFrame(XrSession session, const XrFrameBeginInfo* info) {
+  const auto next = next_fn(session, &Dispatch::xrBeginFrame);
+  if (!next) return XR_ERROR_HANDLE_INVALID;
+  const XrResult r = next(session, info);
+  if (XR_SUCCEEDED(r)) bookkeeping(session, [&](SessionState& s) { s.current.begin_ns = now_ns(); });
+  return r;
+}
+
+XrResult intercept::xrLocateViews(XrSession session, const XrViewLocateInfo* info, XrViewState* state,
+                                  uint32_t capacity, uint32_t* count, XrView* views) {
+  const auto next = next_fn(session, &Dispatch::xrLocateViews);
+  if (!next) return XR_ERROR_HANDLE_INVALID;
+  const XrResult r = next(session, info, state, capacity, count, views);
+  if (XR_SUCCEEDED(r) && capacity && views)
+    bookkeeping(session, [&](SessionState& s) {
+      s.views.assign(views, views + *count);
+      for (XrView& v : s.views) v.next = nullptr;
+      s.views_time = info->displayTime;
+    });
+  return r;
+}
+
+XrResult intercept::xrEndFrame(XrSession session, const XrFrameEndInfo* info) {
+  const auto next = next_fn(session, &Dispatch::xrEndFrame);
+  if (!next) return XR_ERROR_HANDLE_INVALID;
+  const XrFrameEndInfo* submit = info;
+  const std::int64_t t_call = now_ns();
+  bookkeeping(session, [&](SessionState& s) {
+    if (!s.renderer || !info) return;
+    FrameInput in;
+    in.frame = s.current.frame;
+    in.display_time = info->displayTime;
+    if (s.views_time == info->displayTime) in.views = s.views;
+    in.app_frame = info;
+    if (const XrFrameEndInfo* replaced = s.renderer->render(in)) submit = replaced;
+  });
+  const XrResult r = next(session, submit);
+  const std::int64_t t_return = now_ns();
+  bookkeeping(session, [&](SessionState& s) {
+    FrameTimes& t = s.current;
+    t.end_call_ns = t_call;
+    t.end_return_ns = t_return;
+    t.layers = info ? info->layerCount : 0;
+    t.projection_views = 0;
+    for (uint32_t i = 0; info && info->layers && i < info->layerCount; ++i)
+      if (info->layers[i] && info->layers[i]->type == XR_TYPE_COMPOSITION_LAYER_PROJECTION)
+        t.projection_views += reinterpret_cast<const XrCompositionLayerProjection*>(info->layers[i])->viewCount;
+    t.replaced = submit != info;
+    s.log.write(t);
+    const std::int64_t frame = t.frame;
+    t = FrameTimes{};
+    t.frame = frame + 1;
+  });
+  return r;
+}
+
+}  // namespace fovea::layer

@@ -1,0 +1,37 @@
+#include "frame_log.hpp"
+
+#include <time.h>
+
+namespace fovea::layer {
+
+std::int64_t now_ns() {
+  timespec ts;
+  clock_gettime(CLOCK_MONOTONIC, &ts);
+  return std::int64_t(ts.tv_sec) * 1'000'000'000 + ts.tv_nsec;
+}
+
+FrameLog::~FrameLog() {
+  if (file_) std::fclose(file_);
+}
+
+void FrameLog::open(const std::string& dir) {
+  if (file_) std::fclose(file_);
+  file_ = dir.empty() ? nullptr : std::fopen((dir + "/layer_timing.jsonl").c_str(), "w");
+}
+
+void FrameLog::write(const FrameTimes& t) {
+  if (!file_) return;
+  std::fprintf(file_,
+               "{\"frame\":%lld,\"display_time_ns\":%lld,\"wait_call_ns\":%lld,\"wait_return_ns\":%lld,"
+               "\"begin_ns\":%lld,\"end_call_ns\":%lld,\"end_return_ns\":%lld,\"app_cpu_ms\":%.3f,"
+               "\"end_frame_ms\":%.3f,\"layers\":%u,\"projection_views\":%u,\"replaced\":%s}\n",
+               static_cast<long long>(t.frame), static_cast<long long>(t.display_time_ns),
+               static_cast<long long>(t.wait_call_ns), static_cast<long long>(t.wait_return_ns),
+               static_cast<long long>(t.begin_ns), static_cast<long long>(t.end_call_ns),
+               static_cast<long long>(t.end_return_ns), double(t.end_call_ns - t.begin_ns) * 1e-6,
+               double(t.end_return_ns - t.end_call_ns) * 1e-6, t.layers, t.projection_views,
+               t.replaced ? "true" : "false");
+  std::fflush(file_);
+}
+
+}  // namespace fovea::layer

@@ -1,0 +1,44 @@
+#pragma once
+// The layer's per-frame timing log (pass-through measurement): one JSON object per line in
+// <FOVEA_LAYER_OUT>/layer_timing.jsonl. Times are int64 ns of CLOCK_MONOTONIC.
+#include <cstdint>
+#include <cstdio>
+#include <string>
+
+namespace fovea::layer {
+
+std::int64_t now_ns();
+
+struct FrameTimes {
+  std::int64_t frame = 0;
+  std::int64_t display_time_ns = 0;               // predicted by xrWaitFrame
+  std::int64_t wait_call_ns = 0, wait_return_ns = 0;
+  std::int64_t begin_ns = 0;
+  std::int64_t end_call_ns = 0, end_return_ns = 0;  // around the call down the chain
+  std::uint32_t layers = 0, projection_views = 0;
+  bool replaced = false;  // a frame renderer replaced the application's layers
+};
+
+class FrameLog {
+ public:
+  FrameLog() = default;
+  ~FrameLog();
+  FrameLog(const FrameLog&) = delete;
+  FrameLog& operator=(const FrameLog&) = delete;
+  FrameLog(FrameLog&& o) noexcept : file_(o.file_) { o.file_ = nullptr; }
+  FrameLog& operator=(FrameLog&& o) noexcept {
+    if (this != &o) {
+      if (file_) std::fclose(file_);
+      file_ = o.file_;
+      o.file_ = nullptr;
+    }
+    return *this;
+  }
+  void open(const std::string& dir);  // empty: no log
+  void write(const FrameTimes& t);
+
+ private:
+  std::FILE* file_ = nullptr;
+};
+
+}  // namespace fovea::layer

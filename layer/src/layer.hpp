@@ -1,0 +1,113 @@
+#pragma once
+// XR_APILAYER_FOVEA_path_tracing: state shared by the layer's entry points. The layer sits
+// between the application and the runtime; every call it does not need passes straight
+// through (it never appears in the layer's xrGetInstanceProcAddr), and the ones it
+// intercepts are always forwarded exactly once with the application's arguments unless a
+// frame renderer is active (frame_renderer.hpp).
+#include <cstdint>
+#include <map>
+#include <memory>
+#include <mutex>
+#include <optional>
+#include <string>
+#include <type_traits>
+#include <vector>
+
+#include <vulkan/vulkan.h>
+
+#define XR_USE_GRAPHICS_API_VULKAN
+#include <openxr/openxr.h>
+#include <openxr/openxr_platform.h>
+
+#include "frame_log.hpp"
+#include "frame_renderer.hpp"
+
+namespace fovea::layer {
+
+constexpr const char* kLayerName = "XR_APILAYER_FOVEA_path_tracing";
+// The layer's own instance extension: the application opts in to having its projection
+// layers replaced by the path-traced image when a scene is configured. Never passed down.
+constexpr const char* kLayerExtension = "XR_FOVEA_path_tracing";
+constexpr std::uint32_t kLayerExtensionVersion = 1;
+
+// The next layer's (or the runtime's) commands the layer calls.
+#define FOVEA_LAYER_NEXT(X) \
+  X(xrGetInstanceProcAddr)  \
+  X(xrDestroyInstance)      \
+  X(xrCreateSession)        \
+  X(xrDestroySession)       \
+  X(xrCreateSwapchain)      \
+  X(xrDestroySwapchain)     \
+  X(xrEnumerateSwapchainImages) \
+  X(xrAcquireSwapchainImage) \
+  X(xrReleaseSwapchainImage) \
+  X(xrWaitFrame)            \
+  X(xrBeginFrame)           \
+  X(xrEndFrame)             \
+  X(xrLocateViews)
+
+struct Dispatch {
+#define FOVEA_LAYER_MEMBER(name) PFN_##name name = nullptr;
+  FOVEA_LAYER_NEXT(FOVEA_LAYER_MEMBER)
+#undef FOVEA_LAYER_MEMBER
+};
+
+struct SwapchainState {
+  XrSession session = XR_NULL_HANDLE;
+  XrSwapchainCreateInfo info{};
+  std::vector<VkImage> images;
+  std::vector<std::uint32_t> acquired;
+  std::int64_t last_released = -1;
+};
+
+struct SessionState {
+  XrInstance instance = XR_NULL_HANDLE;
+  bool disabled = false;  // an internal failure: pass everything through from then on
+  VulkanBinding vulkan;
+  std::unique_ptr<FrameRenderer> renderer;  // null: pass-through, measure only
+  FrameLog log;
+  FrameTimes current;                     // the frame in flight
+  std::vector<XrView> views;              // the last xrLocateViews result
+  XrTime views_time = 0;
+};
+
+struct InstanceState {
+  Dispatch next;
+  bool extension_enabled = false;  // the application enabled kLayerExtension
+};
+
+struct Layer {
+  std::mutex mutex;
+  std::map<XrInstance, InstanceState> instances;
+  std::map<XrSession, SessionState> sessions;
+  std::map<XrSwapchain, SwapchainState> swapchains;
+  XrInstance last_instance = XR_NULL_HANDLE;  // dispatch for handles the layer does not know
+};
+
+Layer& layer();
+
+// The next layer's table for the instance owning `session`; for an unknown session (the
+// application's mistake) the most recent instance's, so the runtime reports the error.
+const Dispatch* next_for_session(XrSession session);
+
+// Intercepted commands (hidden; reached through the layer's xrGetInstanceProcAddr).
+namespace intercept {
+#define FOVEA_LAYER_INTERCEPTED(X) \
+  X(xrDestroyInstance)             \
+  X(xrCreateSession)               \
+  X(xrDestroySession)              \
+  X(xrCreateSwapchain)             \
+  X(xrDestroySwapchain)            \
+  X(xrEnumerateSwapchainImages)    \
+  X(xrAcquireSwapchainImage)       \
+  X(xrReleaseSwapchainImage)       \
+  X(xrWaitFrame)                   \
+  X(xrBeginFrame)                  \
+  X(xrEndFrame)                    \
+  X(xrLocateViews)
+#define FOVEA_LAYER_DECLARE(name) std::remove_pointer_t<PFN_##name> name;
+FOVEA_LAYER_INTERCEPTED(FOVEA_LAYER_DECLARE)
+#undef FOVEA_LAYER_DECLARE
+}  // namespace intercept
+
+}  // namespace fovea::layer
