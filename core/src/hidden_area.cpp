@@ -106,7 +106,7 @@ VisibilityMesh visibility_mesh(const HiddenAreaMask& mask, VisibilityMeshType ty
     const glm::dvec2 u(std::cos(a), std::sin(a));
     const double border = to_border(o, u, lo, hi);
     // March outwards for the last visible step, then bisect the crossing after it.
-    constexpr int kSteps = 128;
+    constexpr int kSteps = 64;
     double last = 0;
     for (int i = 1; i <= kSteps; ++i) {
       const double s = border * i / kSteps * (i == kSteps ? 1 - 1e-12 : 1);
