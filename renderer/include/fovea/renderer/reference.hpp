@@ -1,0 +1,47 @@
+#pragma once
+// Progressive Cartesian reference rendering of one eye: batches of samples per pixel
+// accumulated on the GPU until a sample count or a relative standard error is reached.
+#include <cstdint>
+#include <functional>
+#include <string>
+
+#include <glm/vec3.hpp>
+
+#include "fovea/core/image.hpp"
+#include "fovea/renderer/gpu_scene.hpp"
+#include "fovea/renderer/path_tracer.hpp"
+
+namespace fovea::renderer {
+
+struct ReferenceOptions {
+  PathConfig path;                  // path.spp = samples per batch; jitter is forced on
+  std::uint32_t max_spp = 256;      // stop at this many samples per pixel
+  double until_rel_error = 0;       // > 0: stop earlier once rel_error <= this (>= 4 batches)
+};
+
+struct ReferenceProgress {
+  std::uint32_t spp = 0;
+  double rel_error = 0;  // NaN until two batches exist
+  double seconds = 0;
+};
+
+struct ReferenceResult {
+  core::Image image;  // linear radiance, alpha 1
+  std::uint32_t spp = 0;
+  glm::dvec3 mean_rgb{0};
+  // Relative standard error of the image-mean luminance, from the spread of the
+  // per-batch image means (batch-means estimator).
+  double rel_error = 0;
+  double seconds = 0;
+};
+
+ReferenceResult render_reference(gpu::Context& ctx, const GpuScene& scene, const core::View& view, core::Eye eye,
+                                 const ReferenceOptions& options,
+                                 const std::function<void(const ReferenceProgress&)>& progress = {});
+
+// OpenEXR, 32-bit float RGBA, written through a temporary file and renamed.
+void write_exr(const std::string& path, const core::Image& img);
+// Tone map for display: Reinhard on luminance (c / (1 + L)); write_png adds sRGB.
+core::Image tone_map(const core::Image& linear);
+
+}  // namespace fovea::renderer

@@ -1,0 +1,116 @@
+#include "fovea/renderer/reference.hpp"
+
+#include <unistd.h>
+
+#include <chrono>
+#include <cmath>
+#include <filesystem>
+#include <limits>
+#include <stdexcept>
+
+#include <tinyexr.h>
+
+#include "fovea/core/error.hpp"
+#include "fovea/gpu/barriers.hpp"
+
+namespace fovea::renderer {
+
+namespace {
+double luminance(glm::dvec3 c) { return 0.2126 * c.x + 0.7152 * c.y + 0.0722 * c.z; }
+}  // namespace
+
+ReferenceResult render_reference(gpu::Context& ctx, const GpuScene& scene, const core::View& view, core::Eye eye,
+                                 const ReferenceOptions& o, const std::function<void(const ReferenceProgress&)>& progress) {
+  if (o.max_spp == 0) throw core::InputError("reference: --spp must be at least 1");
+  if (!(o.until_rel_error >= 0) || !std::isfinite(o.until_rel_error))
+    throw core::InputError("reference: --until-rel-error must be a finite number >= 0");
+  const auto t0 = std::chrono::steady_clock::now();
+  const auto grid = cartesian_grid(view);
+  gpu::Buffer g(ctx, {grid.size() * sizeof(shaders::GridSample), gpu::BufferUsage::Storage, gpu::Memory::DeviceLocal,
+                      "reference.grid"});
+  g.upload(grid);
+  PathTracer pt(ctx, scene);
+  TraceOutputs out = pt.bind(g, std::uint32_t(grid.size()));
+  PathConfig cfg = o.path;
+  cfg.jitter = true;  // pixel-area estimate: anti-aliased
+  cfg.spp = std::max<std::uint32_t>(1, std::min(cfg.spp, o.max_spp));
+
+  ReferenceResult r;
+  std::vector<glm::vec4> pixels;
+  std::vector<double> batch_means;  // luminance of each batch's image mean
+  std::uint32_t batches = 0;
+  while (r.spp < o.max_spp) {
+    PathConfig c = cfg;
+    c.spp = std::min(cfg.spp, o.max_spp - r.spp);
+    // Each batch is traced on its own (frame = batch index for fresh random numbers) so
+    // its image mean is an independent estimate for the batch-means error.
+    ctx.submit_and_wait([&](VkCommandBuffer cmd) { pt.record(cmd, out, view, eye, batches, c, 0); });
+    pixels = out.radiance().download<glm::vec4>();
+    glm::dvec3 mean(0);
+    for (const auto& p : pixels) mean += glm::dvec3(p);
+    mean /= double(pixels.size());
+    batch_means.push_back(luminance(mean));
+    // Running mean of the batches on the host, weighted by their sample counts.
+    if (r.image.pixels.empty()) r.image = core::Image(view.width(), view.height());
+    const double w = double(c.spp) / double(r.spp + c.spp);
+    for (std::size_t i = 0; i < pixels.size(); ++i) {
+      glm::vec4& acc = r.image.pixels[i];
+      acc = glm::vec4(glm::mix(glm::dvec3(acc), glm::dvec3(pixels[i]), w), 1.0f);
+    }
+    r.spp += c.spp;
+    ++batches;
+    const std::size_t B = batch_means.size();
+    r.rel_error = std::numeric_limits<double>::quiet_NaN();
+    if (B >= 2) {
+      double m = 0, v = 0;
+      for (double x : batch_means) m += x;
+      m /= double(B);
+      for (double x : batch_means) v += (x - m) * (x - m);
+      v /= double(B - 1);
+      r.rel_error = m > 0 ? std::sqrt(v / double(B)) / m : 0.0;
+    }
+    r.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+    if (progress) progress({r.spp, r.rel_error, r.seconds});
+    if (o.until_rel_error > 0 && B >= 4 && r.rel_error <= o.until_rel_error) break;
+  }
+  glm::dvec3 mean(0);
+  for (const auto& p : r.image.pixels) mean += glm::dvec3(p);
+  r.mean_rgb = mean / double(r.image.pixels.size());
+  if (std::isnan(r.rel_error)) r.rel_error = 0;  // one batch: no spread to estimate from
+  return r;
+}
+
+void write_exr(const std::string& path, const core::Image& img) {
+  std::vector<float> data(img.pixels.size() * 4);
+  for (std::size_t i = 0; i < img.pixels.size(); ++i)
+    for (int c = 0; c < 4; ++c) {
+      const float v = img.pixels[i][c];
+      data[4 * i + c] = std::isfinite(v) ? v : 0.0f;
+    }
+  const std::string tmp = path + ".tmp." + std::to_string(::getpid()) + ".exr";
+  const char* err = nullptr;
+  if (SaveEXR(data.data(), img.width, img.height, 4, 0, tmp.c_str(), &err) != TINYEXR_SUCCESS) {
+    const std::string msg = err ? err : "unknown error";
+    if (err) FreeEXRErrorMessage(err);
+    std::filesystem::remove(tmp);
+    throw std::runtime_error("cannot write " + path + ": " + msg);
+  }
+  std::error_code ec;
+  std::filesystem::rename(tmp, path, ec);
+  if (ec) {
+    std::filesystem::remove(tmp);
+    throw std::runtime_error("cannot write " + path + ": " + ec.message());
+  }
+}
+
+core::Image tone_map(const core::Image& linear) {
+  core::Image out = linear;
+  for (auto& p : out.pixels) {
+    const float l = 0.2126f * p.x + 0.7152f * p.y + 0.0722f * p.z;
+    const float s = std::isfinite(l) && l > 0 ? 1.0f / (1.0f + l) : 0.0f;
+    p = glm::vec4(glm::vec3(p) * s, 1.0f);
+  }
+  return out;
+}
+
+}  // namespace fovea::renderer

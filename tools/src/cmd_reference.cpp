@@ -1,0 +1,118 @@
+// fovea reference: progressive Cartesian path-traced reference image of one eye.
+#include <cmath>
+#include <cstdio>
+#include <filesystem>
+#include <iostream>
+
+#include <nlohmann/json.hpp>
+
+#include "command.hpp"
+#include "fovea/core/display.hpp"
+#include "fovea/core/error.hpp"
+#include "fovea/core/image.hpp"
+#include "fovea/gpu/context.hpp"
+#include "fovea/renderer/reference.hpp"
+#include "fovea/renderer/scene_io.hpp"
+
+namespace fovea::tools {
+namespace {
+
+constexpr const char* kHelp = R"(usage: fovea reference --scene S --out F.exr|F.png [options]
+
+Renders one eye's view of a scene progressively on a Cartesian grid (one jittered
+sample per pixel and pass) until --spp samples per pixel, or earlier once the relative
+standard error of the image mean falls to --until-rel-error. Writes the linear image as
+OpenEXR (32-bit float) and a tone-mapped PNG next to it (same name, other extension),
+and prints JSON: {"spp": N, "mean_rgb": [r, g, b], "rel_error": x, "seconds": t}.
+
+  --scene S             cornell | furnace | glossy-spheres | stereo-occluders | default,
+                        or a .gltf/.glb/.obj file [default]
+  --display NAME|FILE   display preset (fove0, vive, modern, small, tiny) or JSON [small]
+  --eye left|right      which eye; it sits ipd/2 beside the scene's camera [left]
+  --spp N               samples per pixel to stop at [256]
+  --until-rel-error X   stop as soon as the relative standard error is <= X (> 0)
+  --batch N             samples per pixel per progressive pass [16]
+  --bounces N           BSDF-sampled bounces after the primary hit; -1 = unlimited
+                        (with Russian roulette) [1, the BMFR/P5 configuration]
+  --rr-start N          bounce from which Russian roulette applies [3]
+  --out F               output path ending in .exr or .png (both are written)
+  --quiet               no progress bar
+  --help                this text
+
+Exit status: 0 on success, 2 on invalid arguments or scene files, 1 on other errors.
+)";
+
+void progress_bar(const renderer::ReferenceProgress& p, std::uint32_t total) {
+  const int width = 30;
+  const int fill = int(double(width) * p.spp / std::max<std::uint32_t>(total, 1));
+  std::fprintf(stderr, "\r[%s%s] %u/%u spp  rel. error %s  %.1f s", std::string(std::size_t(fill), '#').c_str(),
+               std::string(std::size_t(width - fill), ' ').c_str(), p.spp, total,
+               std::isnan(p.rel_error) ? "  -   " : (std::to_string(p.rel_error).substr(0, 8)).c_str(), p.seconds);
+  std::fflush(stderr);
+}
+
+int run(std::vector<std::string> argv) {
+  for (const auto& a : argv)
+    if (a == "--help" || a == "-h") {
+      std::cout << kHelp;
+      return 0;
+    }
+  const Args args(argv, {"scene", "display", "eye", "spp", "until-rel-error", "batch", "bounces", "rr-start", "out"},
+                  {"quiet"});
+  const auto out = args.opt("out");
+  if (!out) throw core::InputError("--out F.exr|F.png is required (see --help)");
+  const std::filesystem::path out_path(*out);
+  const std::string ext = out_path.extension().string();
+  if (ext != ".exr" && ext != ".png") throw core::InputError("--out must end in .exr or .png, got \"" + *out + "\"");
+  std::filesystem::path exr = out_path, png = out_path;
+  exr.replace_extension(".exr");
+  png.replace_extension(".png");
+
+  const long spp = args.integer("spp", 256), batch = args.integer("batch", 16), bounces = args.integer("bounces", 1),
+             rr = args.integer("rr-start", 3);
+  if (spp < 1 || spp > (1L << 24)) throw core::InputError("--spp must be in 1..16777216");
+  if (batch < 1 || batch > 4096) throw core::InputError("--batch must be in 1..4096");
+  if (bounces < -1 || bounces > 256) throw core::InputError("--bounces must be -1 (unlimited) or 0..256");
+  if (rr < 0 || rr > 1000) throw core::InputError("--rr-start must be in 0..1000");
+  const double until = args.num("until-rel-error", 0);
+  if (until < 0) throw core::InputError("--until-rel-error must be > 0");
+
+  const core::DisplayPreset display = core::load_display(args.str("display", "small"));
+  const core::Eye eye = core::parse_eye(args.str("eye", "left"));
+  const renderer::Scene scene = renderer::load_scene(args.str("scene", "default"));
+  for (const auto& w : scene.warnings) std::cerr << "warning: " << w << "\n";
+
+  core::Pose pose = scene.camera;
+  pose.position += pose.orientation * glm::dvec3((eye == core::Eye::Left ? -0.5 : 0.5) * display.ipd_m, 0, 0);
+  const core::View view = display.view(eye, pose);
+
+  gpu::Context ctx;
+  renderer::GpuScene gs(ctx, scene);
+  renderer::ReferenceOptions o;
+  o.path.spp = std::uint32_t(batch);
+  o.path.max_bounces = int(bounces);
+  o.path.rr_start = std::uint32_t(rr);
+  o.max_spp = std::uint32_t(spp);
+  o.until_rel_error = until;
+  const bool bar = !args.has("quiet") && stderr_is_tty();
+  const auto r = renderer::render_reference(ctx, gs, view, eye, o, [&](const renderer::ReferenceProgress& p) {
+    if (bar) progress_bar(p, o.max_spp);
+  });
+  if (bar) std::fprintf(stderr, "\n");
+
+  renderer::write_exr(exr.string(), r.image);
+  core::write_png(png.string(), renderer::tone_map(r.image));
+  nlohmann::json j;
+  j["spp"] = r.spp;
+  j["mean_rgb"] = {r.mean_rgb.x, r.mean_rgb.y, r.mean_rgb.z};
+  j["rel_error"] = r.rel_error;
+  j["seconds"] = r.seconds;
+  std::cout << j.dump() << "\n";
+  return 0;
+}
+
+}  // namespace
+
+FOVEA_COMMAND(reference_command, "reference", "progressive Cartesian path-traced reference image (EXR + PNG)", run);
+
+}  // namespace fovea::tools
