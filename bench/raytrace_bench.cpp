@@ -1,0 +1,202 @@
+// Ray-tracing throughput per scene on the current Vulkan device: primary rays (closest
+// hit through the BVH, Mrays/s) and full paths of the BMFR/P5 configuration (primary,
+// NEE, one bounce, NEE: Msamples/s). With Embree 3 installed, the same primary rays are
+// traced by Embree on the CPU (all hardware threads) and the ratio is printed.
+//   fovea_bench_raytrace [--benchmark_filter=...]   env FOVEA_BENCH_DISPLAY (default small)
+#include <benchmark/benchmark.h>
+
+#include <chrono>
+#include <cstdio>
+#include <cstdlib>
+#include <map>
+#include <memory>
+#include <string>
+#include <thread>
+#include <vector>
+
+#include <glm/geometric.hpp>
+#include <glm/gtc/quaternion.hpp>
+
+#include "fovea/core/display.hpp"
+#include "fovea/gpu/context.hpp"
+#include "fovea/renderer/path_tracer.hpp"
+#include "fovea/renderer/raycaster.hpp"
+#include "fovea/renderer/scene_io.hpp"
+
+#ifdef FOVEA_HAVE_EMBREE
+#include <embree3/rtcore.h>
+#endif
+
+namespace fr = fovea::renderer;
+namespace fc = fovea::core;
+
+namespace {
+
+const char* const kScenes[] = {"cornell", "furnace", "glossy-spheres", "stereo-occluders", "default"};
+
+struct Fixture {
+  fr::Scene scene;
+  fc::View view;
+  std::vector<fovea::shaders::PtRay> rays;  // the primary rays of the view, world space
+};
+
+fovea::gpu::Context& context() {
+  static fovea::gpu::Context ctx;
+  return ctx;
+}
+
+const Fixture& fixture(const std::string& name) {
+  static std::map<std::string, std::unique_ptr<Fixture>> cache;
+  auto& f = cache[name];
+  if (!f) {
+    f = std::make_unique<Fixture>();
+    f->scene = fr::load_scene(name);
+    const char* d = std::getenv("FOVEA_BENCH_DISPLAY");
+    const fc::DisplayPreset display = fc::load_display(d ? d : "small");
+    f->view = display.view(fc::Eye::Left, f->scene.camera);
+    const glm::dmat3 rot = glm::mat3_cast(f->view.pose().orientation);
+    const glm::dvec3 o = f->view.pose().position;
+    for (const auto& s : fr::cartesian_grid(f->view)) {
+      const glm::dvec3 dir = glm::normalize(rot * glm::dvec3(s.dir_x, s.dir_y, s.dir_z));
+      f->rays.push_back({float(o.x), float(o.y), float(o.z), 0.0f, float(dir.x), float(dir.y), float(dir.z), 1e30f});
+    }
+  }
+  return *f;
+}
+
+std::map<std::string, double>& results() {  // "<kind>/<scene>" -> rays or samples per second
+  static std::map<std::string, double> r;
+  return r;
+}
+
+void BM_PrimaryRays(benchmark::State& state, const char* scene) {
+  const Fixture& f = fixture(scene);
+  fr::GpuScene g(context(), f.scene);
+  fr::Raycaster rc(context(), g);
+  rc.set_rays(f.rays);
+  rc.trace(fr::RayQuery::Closest);  // warm-up (pipeline compilation)
+  const int repeat = 4;
+  double rays = 0, secs = 0;
+  for (auto _ : state) {
+    const auto t0 = std::chrono::steady_clock::now();
+    rc.trace(fr::RayQuery::Closest, repeat);
+    const double s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+    state.SetIterationTime(s);
+    rays += double(f.rays.size()) * repeat;
+    secs += s;
+  }
+  state.counters["Mrays/s"] = rays / secs * 1e-6;
+  state.counters["triangles"] = double(g.stats().triangles);
+  results()["gpu/" + std::string(scene)] = rays / secs;
+}
+
+void BM_Paths(benchmark::State& state, const char* scene) {
+  const Fixture& f = fixture(scene);
+  fr::GpuScene g(context(), f.scene);
+  const auto grid = fr::cartesian_grid(f.view);
+  fovea::gpu::Buffer gb(context(), {grid.size() * sizeof(fovea::shaders::GridSample), fovea::gpu::BufferUsage::Storage,
+                                    fovea::gpu::Memory::DeviceLocal, "bench.grid"});
+  gb.upload(grid);
+  fr::PathTracer pt(context(), g);
+  fr::TraceOutputs out = pt.bind(gb, std::uint32_t(grid.size()));
+  std::uint32_t frame = 0;
+  auto run = [&] { context().submit_and_wait([&](VkCommandBuffer cmd) { pt.record(cmd, out, f.view, fc::Eye::Left, frame++, {}); }); };
+  run();
+  double samples = 0, secs = 0;
+  for (auto _ : state) {
+    const auto t0 = std::chrono::steady_clock::now();
+    run();
+    const double s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+    state.SetIterationTime(s);
+    samples += double(grid.size());
+    secs += s;
+  }
+  state.counters["Msamples/s"] = samples / secs * 1e-6;
+  state.counters["ms/frame"] = secs / double(state.iterations()) * 1e3;
+}
+
+#ifdef FOVEA_HAVE_EMBREE
+void BM_EmbreePrimaryRays(benchmark::State& state, const char* scene) {
+  const Fixture& f = fixture(scene);
+  RTCDevice dev = rtcNewDevice(nullptr);
+  RTCScene sc = rtcNewScene(dev);
+  RTCGeometry geom = rtcNewGeometry(dev, RTC_GEOMETRY_TYPE_TRIANGLE);
+  const std::size_t n = f.scene.triangle_count();
+  auto* v = static_cast<float*>(rtcSetNewGeometryBuffer(geom, RTC_BUFFER_TYPE_VERTEX, 0, RTC_FORMAT_FLOAT3,
+                                                        3 * sizeof(float), 3 * n));
+  auto* idx = static_cast<unsigned*>(rtcSetNewGeometryBuffer(geom, RTC_BUFFER_TYPE_INDEX, 0, RTC_FORMAT_UINT3,
+                                                             3 * sizeof(unsigned), n));
+  for (std::size_t i = 0; i < 3 * n; ++i) {
+    v[3 * i] = f.scene.positions[i].x;
+    v[3 * i + 1] = f.scene.positions[i].y;
+    v[3 * i + 2] = f.scene.positions[i].z;
+    idx[i] = unsigned(i);
+  }
+  rtcCommitGeometry(geom);
+  rtcAttachGeometry(sc, geom);
+  rtcReleaseGeometry(geom);
+  rtcCommitScene(sc);
+  const unsigned threads = std::max(1u, std::thread::hardware_concurrency());
+  auto trace_all = [&] {
+    std::vector<std::thread> pool;
+    for (unsigned t = 0; t < threads; ++t)
+      pool.emplace_back([&, t] {
+        RTCIntersectContext ictx;
+        rtcInitIntersectContext(&ictx);
+        for (std::size_t i = t; i < f.rays.size(); i += threads) {
+          const auto& r = f.rays[i];
+          RTCRayHit rh{};
+          rh.ray.org_x = r.org_x; rh.ray.org_y = r.org_y; rh.ray.org_z = r.org_z;
+          rh.ray.dir_x = r.dir_x; rh.ray.dir_y = r.dir_y; rh.ray.dir_z = r.dir_z;
+          rh.ray.tnear = r.tmin;
+          rh.ray.tfar = r.tmax;
+          rh.ray.mask = ~0u;
+          rh.hit.geomID = RTC_INVALID_GEOMETRY_ID;
+          rtcIntersect1(sc, &ictx, &rh);
+          benchmark::DoNotOptimize(rh.hit.primID);
+        }
+      });
+    for (auto& th : pool) th.join();
+  };
+  trace_all();
+  double rays = 0, secs = 0;
+  for (auto _ : state) {
+    const auto t0 = std::chrono::steady_clock::now();
+    for (int k = 0; k < 4; ++k) trace_all();
+    const double s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+    state.SetIterationTime(s);
+    rays += 4.0 * double(f.rays.size());
+    secs += s;
+  }
+  state.counters["Mrays/s"] = rays / secs * 1e-6;
+  results()["embree/" + std::string(scene)] = rays / secs;
+  rtcReleaseScene(sc);
+  rtcReleaseDevice(dev);
+}
+#endif
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  for (const char* s : kScenes) {
+    benchmark::RegisterBenchmark((std::string("PrimaryRays/") + s).c_str(), BM_PrimaryRays, s)->UseManualTime()->MinTime(1.0);
+    benchmark::RegisterBenchmark((std::string("Paths/") + s).c_str(), BM_Paths, s)->UseManualTime()->MinTime(1.0);
+#ifdef FOVEA_HAVE_EMBREE
+    benchmark::RegisterBenchmark((std::string("EmbreePrimaryRays/") + s).c_str(), BM_EmbreePrimaryRays, s)
+        ->UseManualTime()
+        ->MinTime(1.0);
+#endif
+  }
+  benchmark::Initialize(&argc, argv);
+  if (benchmark::ReportUnrecognizedArguments(argc, argv)) return 1;
+  std::printf("device: %s (%s)\n", context().info().name.c_str(), context().info().driver.c_str());
+  benchmark::RunSpecifiedBenchmarks();
+  benchmark::Shutdown();
+  for (const char* s : kScenes) {
+    const auto g = results().find(std::string("gpu/") + s), e = results().find(std::string("embree/") + s);
+    if (g != results().end() && e != results().end())
+      std::printf("%-18s primary rays: %s %.2f Mrays/s, Embree %.2f Mrays/s, Embree/GPU = %.1fx\n", s,
+                  context().info().name.c_str(), g->second * 1e-6, e->second * 1e-6, e->second / g->second);
+  }
+  return 0;
+}
