@@ -1,6 +1,7 @@
 #include "head_motion.hpp"
 
 #include <cmath>
+#include <cstdlib>
 #include <fstream>
 #include <sstream>
 
@@ -33,15 +34,18 @@ HeadMotion HeadMotion::from_file(const std::string& path) {
   for (int lineno = 1; std::getline(in, line); ++lineno) {
     if (const auto hash = line.find('#'); hash != std::string::npos) line.resize(hash);
     std::istringstream ss(line);
-    double v[8];
-    int n = 0;
-    while (n < 8 && ss >> v[n]) ++n;
-    std::string rest;
-    if (n == 0 && !(ss.clear(), ss >> rest)) continue;  // blank or comment line
+    std::vector<std::string> tokens;
+    for (std::string tok; ss >> tok;) tokens.push_back(tok);
+    if (tokens.empty()) continue;  // blank or comment line
     const std::string where = path + ":" + std::to_string(lineno);
-    if (n != 8 || (ss >> rest)) throw core::InputError(where + ": expected \"t px py pz qx qy qz qw\"");
-    for (double x : v)
-      if (!std::isfinite(x)) throw core::InputError(where + ": non-finite value");
+    if (tokens.size() != 8) throw core::InputError(where + ": expected \"t px py pz qx qy qz qw\"");
+    double v[8];
+    for (int i = 0; i < 8; ++i) {
+      char* end = nullptr;
+      v[i] = std::strtod(tokens[size_t(i)].c_str(), &end);
+      if (*end != '\0' || !std::isfinite(v[i]))
+        throw core::InputError(where + ": \"" + tokens[size_t(i)] + "\" is not a finite number");
+    }
     const glm::dquat q(v[7], v[4], v[5], v[6]);
     const double len = glm::length(q);
     if (std::abs(len - 1.0) > 1e-3) throw core::InputError(where + ": quaternion is not unit length");
