@@ -7,6 +7,7 @@
 #include <stdexcept>
 
 #include "fovea/compositor/distortion.hpp"
+#include "fovea/core/error.hpp"
 #include "log.hpp"
 
 namespace fovea::runtime {
@@ -42,6 +43,13 @@ void apply_hidden_area(core::Image& img, const core::View& view, const core::Hid
 
 }  // namespace
 
+LensMode parse_lens_mode(const std::string& s) {
+  if (s == "gpu") return LensMode::Gpu;
+  if (s == "cpu") return LensMode::Cpu;
+  if (s == "off") return LensMode::Off;
+  throw core::InputError("FOVEA_RUNTIME_LENS=" + s + ": expected gpu, cpu or off");
+}
+
 bool Compositor::readable_format(VkFormat f) {
   return f == VK_FORMAT_R8G8B8A8_SRGB || f == VK_FORMAT_B8G8R8A8_SRGB || f == VK_FORMAT_R8G8B8A8_UNORM ||
          f == VK_FORMAT_B8G8R8A8_UNORM;
@@ -49,7 +57,7 @@ bool Compositor::readable_format(VkFormat f) {
 
 Compositor::Compositor(VkPhysicalDevice physical, VkDevice device, OneShotQueue& queue,
                        const core::DisplayPreset& display, std::array<const core::HiddenAreaMask*, 2> hidden,
-                       bool lens, std::string out_dir, std::int64_t png_every)
+                       LensMode lens, std::string out_dir, std::int64_t png_every)
     : physical_(physical),
       device_(device),
       queue_(queue),
@@ -58,12 +66,16 @@ Compositor::Compositor(VkPhysicalDevice physical, VkDevice device, OneShotQueue&
       lens_(lens),
       out_dir_(std::move(out_dir)),
       png_every_(png_every) {
-  FOVEA_LOG_INFO("compositor: %s, lens model %s, hidden area %.1f%% of the left panel", 
-                 lens_ ? "lens distortion + hidden area" : "undistorted view + hidden area",
+  const char* mode = lens_ == LensMode::Gpu   ? "lens distortion + hidden area (GPU pass)"
+                     : lens_ == LensMode::Cpu ? "lens distortion + hidden area (CPU reference)"
+                                              : "undistorted view + hidden area";
+  FOVEA_LOG_INFO("compositor: %s, lens model %s, hidden area %.1f%% of the left panel", mode,
                  core::lens_model_name(hidden_[0]->lens().kind()), 100.0 * hidden_[0]->hidden_fraction());
 }
 
 Compositor::~Compositor() {
+  for (auto& p : passes_) p.reset();  // before their context
+  gpu_.reset();
   if (staging_) vkDestroyBuffer(device_, staging_, nullptr);
   if (staging_memory_) vkFreeMemory(device_, staging_memory_, nullptr);
 }
@@ -157,7 +169,14 @@ void Compositor::compose(std::int64_t index, const std::vector<ProjectionLayer>&
     }
     const core::HiddenAreaMask& hidden = *hidden_[size_t(e)];
     core::Image panel;
-    if (lens_) {
+    if (lens_ == LensMode::Gpu) {
+      if (!gpu_) {
+        gpu_ = std::make_unique<gpu::Context>();
+        for (int i = 0; i < 2; ++i) passes_[size_t(i)] = std::make_unique<compositor::DistortionPass>(*gpu_, *hidden_[size_t(i)]);
+        FOVEA_LOG_INFO("compositor: distortion pass on \"%s\"", gpu_->info().name.c_str());
+      }
+      panel = passes_[size_t(e)]->run(rendered).to_image();
+    } else if (lens_ == LensMode::Cpu) {
       panel = compositor::distort_reference(hidden, rendered);
     } else {
       apply_hidden_area(rendered, view, hidden);

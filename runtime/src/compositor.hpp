@@ -1,23 +1,31 @@
 #pragma once
 // What the simulated panel shows. The submitted projection layers are read back from the
 // application's swapchain images into each eye's rendered view (the display preset's FOV and
-// raster; a plain copy when the layer matches it, else resampled by direction). Then either
-// the lens: compositor::distort_reference (per-channel distortion, hidden area black, the
-// CPU reference of the distortion pass), or (env FOVEA_RUNTIME_LENS=0) the undistorted view
-// with the directions the lens hides blacked out. Every k-th frame the two panel images
-// are written as PNG files.
+// raster; a plain copy when the layer matches it, else resampled by direction). Then the
+// lens (env FOVEA_RUNTIME_LENS): "gpu" (default) the compositor's distortion pass on a
+// compute context of the runtime's own, "cpu" its double-precision reference
+// (compositor::distort_reference; per-channel distortion, hidden area black), or "off" the
+// undistorted view with the directions the lens hides blacked out. Every k-th frame the two
+// panel images are written as PNG files.
 #include <array>
 #include <cstdint>
+#include <memory>
 #include <string>
 #include <vector>
 
 #include "fovea/core/display.hpp"
 #include "fovea/core/hidden_area.hpp"
 #include "fovea/core/image.hpp"
+#include "fovea/compositor/distortion.hpp"
+#include "fovea/gpu/context.hpp"
 #include "vk_util.hpp"
 #include "xr.hpp"
 
 namespace fovea::runtime {
+
+enum class LensMode { Gpu, Cpu, Off };
+// "gpu" | "cpu" | "off"; throws core::InputError naming FOVEA_RUNTIME_LENS otherwise.
+LensMode parse_lens_mode(const std::string& s);
 
 struct LayerView {
   VkImage image = VK_NULL_HANDLE;
@@ -36,7 +44,8 @@ class Compositor {
  public:
   // `hidden` (one per eye) must outlive the compositor.
   Compositor(VkPhysicalDevice physical, VkDevice device, OneShotQueue& queue, const core::DisplayPreset& display,
-             std::array<const core::HiddenAreaMask*, 2> hidden, bool lens, std::string out_dir, std::int64_t png_every);
+             std::array<const core::HiddenAreaMask*, 2> hidden, LensMode lens, std::string out_dir,
+             std::int64_t png_every);
   ~Compositor();
   Compositor(const Compositor&) = delete;
   Compositor& operator=(const Compositor&) = delete;
@@ -59,7 +68,10 @@ class Compositor {
   OneShotQueue& queue_;
   core::DisplayPreset display_;
   std::array<const core::HiddenAreaMask*, 2> hidden_;
-  bool lens_;
+  LensMode lens_;
+  // Gpu mode: created at the first composed frame.
+  std::unique_ptr<gpu::Context> gpu_;
+  std::array<std::unique_ptr<compositor::DistortionPass>, 2> passes_;
   std::string out_dir_;
   std::int64_t png_every_;
   VkBuffer staging_ = VK_NULL_HANDLE;

@@ -49,7 +49,7 @@ Config read_config() {
   c.gaze = env("FOVEA_GAZE", c.gaze);
   c.head = env("FOVEA_HEAD_POSE", c.head);
   c.vk_validation = env("FOVEA_VK_VALIDATION", "0") == "1";
-  c.lens = env_int("FOVEA_RUNTIME_LENS", 1, 0) != 0;
+  c.lens = parse_lens_mode(env("FOVEA_RUNTIME_LENS", "gpu"));
   return c;
 }
 

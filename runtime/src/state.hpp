@@ -44,7 +44,7 @@ struct Config {
   std::string gaze = "synthetic:1";    // FOVEA_GAZE (a devices::GazeSource URI)
   std::string head = "scripted";       // FOVEA_HEAD_POSE
   bool vk_validation = false;          // FOVEA_VK_VALIDATION=1
-  bool lens = true;                    // FOVEA_RUNTIME_LENS (0: panel shows the undistorted view)
+  LensMode lens = LensMode::Gpu;       // FOVEA_RUNTIME_LENS: gpu | cpu | off
 };
 // Throws core::InputError naming the variable.
 Config read_config();
