@@ -198,7 +198,8 @@ TEST(Replay, OverlongLineIsDroppedAndBufferStaysBounded) {
 }
 
 // 10⁷ samples streamed: the reader's own buffer accounting stays at a few chunks and the
-// process's peak RSS stays far below the file size. (10⁶ under the sanitizers, for time.)
+// process's peak RSS stays far below the file size. (10⁶ under the sanitizers, for time,
+// where only the reader's accounting is checked.)
 TEST(Replay, TenMillionSamplesStreamInBoundedMemory) {
 #if defined(__SANITIZE_ADDRESS__)
   const long rows = 1'000'000;
@@ -231,8 +232,10 @@ TEST(Replay, TenMillionSamplesStreamInBoundedMemory) {
   EXPECT_EQ(r->stats().dropped_total(), 0u);
   EXPECT_NEAR(s.rate_hz, 1e6, 1);
   EXPECT_LE(r->stats().peak_buffer_bytes, 3u * 65536);
+#if !defined(__SANITIZE_ADDRESS__)  // the sanitizer's shadow memory dominates RSS there
   rusage ru{};
   getrusage(RUSAGE_SELF, &ru);
   const double rss = ru.ru_maxrss * 1024.0;
   EXPECT_LT(rss, 0.25 * static_cast<double>(file_size)) << "peak RSS " << rss << " B for a " << file_size << " B file";
+#endif
 }

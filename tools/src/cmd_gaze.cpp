@@ -9,6 +9,8 @@
 #include "command.hpp"
 #include "fovea/core/error.hpp"
 #include <chrono>
+#include <filesystem>
+#include <functional>
 #include <thread>
 
 #include "fovea/core/image.hpp"
@@ -26,6 +28,7 @@ namespace {
 const char* kHelp =
     "usage: fovea gaze <subcommand> ...\n"
     "  info FILE [--format F]          JSON summary: samples, validity, rate, events, dropped rows\n"
+    "                                  (FILE: any replay format, a raw HID capture, or synthetic:SEED?seconds=S)\n"
     "  convert IN OUT [--format F]     any supported format -> the project's CSV (+ OUT.json)\n"
     "  synth --task T --seconds S OUT  synthetic gaze (--seed N --rate HZ --noise DEG --color C\n"
     "                                  --dropouts PER_S); tasks: reading search pursuit fixation-grid\n"
@@ -61,26 +64,75 @@ dv::SourceOptions gaze_source_options(const Args& a) {
   return opt;
 }
 
+// A recording to walk: a file in any replay format, a raw HID capture (file or
+// hid-capture:FILE), or synthetic:SEED?…&seconds=S. Live sources belong to `gaze record`.
+struct Input {
+  std::unique_ptr<dv::SampleStream> stream;
+  std::function<const dv::ReadStats*()> stats = [] { return nullptr; };
+  std::string format;
+  bool reports_blinks = true;
+};
+
+Input open_input(const std::string& arg, const dv::SourceOptions& opt) {
+  Input in;
+  std::string uri = arg;
+  if (uri.find(':') == std::string::npos) {
+    std::FILE* f = std::fopen(arg.c_str(), "rb");
+    char head[20] = {};
+    if (f) {
+      const std::size_t n = std::fread(head, 1, sizeof head - 1, f);
+      head[n] = 0;
+      std::fclose(f);
+    }
+    if (std::string(head).rfind("fovea-hid-capture", 0) == 0) uri = "hid-capture:" + arg;
+  }
+  if (uri.rfind("hid-capture:", 0) == 0) {
+    auto cap = std::make_unique<dv::hid::HidCaptureStream>(uri.substr(12), opt);
+    auto* raw = cap.get();
+    in.stats = [raw] { return &raw->stats(); };
+    in.format = "hid-capture";
+    in.stream = std::move(cap);
+    return in;
+  }
+  if (uri.rfind("synthetic:", 0) == 0) {
+    if (uri.find("seconds=") == std::string::npos) throw core::InputError(arg + ": give the synthetic gaze a length (seconds=S)");
+    in.stream = dv::open_sample_stream(uri, opt);
+    in.format = "synthetic";
+    return in;
+  }
+  if (uri.rfind("replay:", 0) == 0) uri = uri.substr(7);
+  if (uri.find(':') != std::string::npos && !std::filesystem::exists(uri))
+    throw core::InputError(arg + ": not a recording (live sources: use `fovea gaze record`)");
+  auto reader = dv::open_reader(uri, opt);
+  auto* raw = reader.get();
+  in.stats = [raw] { return &raw->stats(); };
+  in.format = dv::format_name(reader->format());
+  in.reports_blinks = reader->reports_blinks();
+  in.stream = std::move(reader);
+  return in;
+}
+
 int cmd_info(const std::vector<std::string>& argv) {
   Args a(argv, kGeometryOpts, {}, 1);
   if (a.positional().size() != 1) throw core::InputError("gaze info needs FILE (see --help)");
   const dv::SourceOptions opt = gaze_source_options(a);
-  auto reader = dv::open_reader(a.positional()[0], opt);
+  Input in = open_input(a.positional()[0], opt);
   dv::SummaryParams sp;
-  sp.infer_blinks = !reader->reports_blinks();
-  const dv::GazeSummary s = dv::summarize(*reader, sp);
-  const dv::ReadStats& st = reader->stats();
+  sp.infer_blinks = !in.reports_blinks;
+  const dv::GazeSummary s = dv::summarize(*in.stream, sp);
+  const dv::ReadStats* st = in.stats();
   if (s.tracked == 0)
-    throw core::InputError(a.positional()[0] + ": no usable sample (" + std::to_string(st.samples) + " kept, " +
-                           std::to_string(st.dropped_total()) + " dropped)");
+    throw core::InputError(a.positional()[0] + ": no usable sample (" + std::to_string(s.samples) + " kept, " +
+                           std::to_string(st ? st->dropped_total() : 0) + " dropped)");
   nlohmann::json j;
-  j["format"] = dv::format_name(reader->format());
+  j["format"] = in.format;
   j["samples"] = s.samples;
   j["valid_fraction"] = std::round(s.valid_fraction() * 1e6) / 1e6;
   j["rate_hz"] = std::round(s.rate_hz * 1e3) / 1e3;
   j["duration_s"] = std::round(s.duration_s * 1e6) / 1e6;
   j["dropped"] = nlohmann::json::object();
-  for (const auto& [k, v] : st.dropped) j["dropped"][k] = v;
+  if (st)
+    for (const auto& [k, v] : st->dropped) j["dropped"][k] = v;
   j["fixations"] = s.fixations;
   j["saccades"] = s.saccades;
   j["blinks"] = s.blinks;
@@ -92,26 +144,27 @@ int cmd_convert(const std::vector<std::string>& argv) {
   Args a(argv, kGeometryOpts, {}, 2);
   if (a.positional().size() != 2) throw core::InputError("gaze convert needs IN and OUT (see --help)");
   const dv::SourceOptions opt = gaze_source_options(a);
-  const std::string& in = a.positional()[0];
-  auto reader = dv::open_reader(in, opt);
-  nlohmann::json meta = {{"source", in},
-                         {"source_format", dv::format_name(reader->format())},
-                         {"display", opt.display.name}};
+  const std::string& in_path = a.positional()[0];
+  Input in = open_input(in_path, opt);
+  nlohmann::json meta = {{"source", in_path}, {"source_format", in.format}, {"display", opt.display.name}};
   const core::View sv = opt.screen_view();
   meta["screen"] = {{"width", sv.width()}, {"height", sv.height()}};
   dv::FoveaCsvWriter w(a.positional()[1], meta.dump());
   dv::GazeSample s;
   std::uint64_t tracked = 0;
-  while (reader->next(s)) {
+  while (in.stream->next(s)) {
     w.write(s);
     tracked += s.tracked();
   }
-  const dv::ReadStats& st = reader->stats();
-  if (tracked == 0) throw core::InputError(in + ": no usable sample; nothing written");
+  if (tracked == 0) throw core::InputError(in_path + ": no usable sample; nothing written");
   w.finish();
-  std::cerr << "converted " << st.samples << " samples (" << st.dropped_total() << " rows dropped";
-  for (const auto& [k, v] : st.dropped) std::cerr << ", " << k << ": " << v;
-  std::cerr << ") -> " << a.positional()[1] << "\n";
+  std::cerr << "converted " << w.samples() << " samples";
+  if (const dv::ReadStats* st = in.stats()) {
+    std::cerr << " (" << st->dropped_total() << " rows dropped";
+    for (const auto& [k, v] : st->dropped) std::cerr << ", " << k << ": " << v;
+    std::cerr << ")";
+  }
+  std::cerr << " -> " << a.positional()[1] << "\n";
   return 0;
 }
 
@@ -188,7 +241,8 @@ int cmd_plot(const std::vector<std::string>& argv) {
   Args a(argv, {"format", "display", "screen", "min-confidence", "width"}, {}, 2);
   if (a.positional().size() != 2) throw core::InputError("gaze plot needs FILE and OUT.png (see --help)");
   const dv::SourceOptions opt = gaze_source_options(a);
-  auto reader = dv::open_reader(a.positional()[0], opt);
+  Input in = open_input(a.positional()[0], opt);
+  dv::SampleStream* reader = in.stream.get();
   dv::GazeSample s;
   core::TimeNs t_end = 0;
   double max_angle = 10;
@@ -225,7 +279,7 @@ int cmd_plot(const std::vector<std::string>& argv) {
   // Pass 2: events (shading) and traces.
   reader->rewind();
   dv::SummaryParams sp;
-  sp.infer_blinks = !reader->reports_blinks();
+  sp.infer_blinks = !in.reports_blinks;
   dv::EventSegmenter seg(sp, [&](dv::EventSegmenter::Kind k, core::TimeNs t0, core::TimeNs t1) {
     if (k == dv::EventSegmenter::Kind::Saccade)
       c.rect(static_cast<int>(tx(t0)), py0 + 1, static_cast<int>(std::ceil(tx(t1))) + 1, py1 - 1, {0.9f, 0.1f, 0.1f, 0.25f});
