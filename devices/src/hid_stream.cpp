@@ -118,7 +118,7 @@ HidGazeStream::HidGazeStream(std::unique_ptr<Transport> t, const SourceOptions& 
   for (std::uint8_t id : codec_->startup_feature_ids()) {
     try {
       const auto r = transport_->get_feature(id, codec_->descriptor().report_bytes(ReportType::Feature, id));
-      if (capture_) capture_->get_feature(core::now_ns(), r);
+      if (capture_) capture_->get_feature(transport_->now(), r);
       mapper_->feature(r);
     } catch (const TransportError& e) {
       stats_.notes.push_back("GET_REPORT(feature " + std::to_string(id) + ") failed: " + e.what());
@@ -129,7 +129,7 @@ HidGazeStream::HidGazeStream(std::unique_ptr<Transport> t, const SourceOptions& 
   if (!mode.empty()) {
     try {
       transport_->set_feature(mode);
-      if (capture_) capture_->set_feature(core::now_ns(), mode);
+      if (capture_) capture_->set_feature(transport_->now(), mode);
     } catch (const TransportError& e) {
       stats_.notes.push_back(std::string("SET_REPORT(Device Mode Request) failed: ") + e.what());
     }

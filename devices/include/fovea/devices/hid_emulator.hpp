@@ -63,6 +63,7 @@ class EmulatedTransport final : public Transport {
   std::vector<std::uint8_t> get_feature(std::uint8_t id, std::size_t length) override;
   void set_feature(std::span<const std::uint8_t> report) override;
   bool exhausted() const override { return exhausted_; }
+  core::TimeNs now() const override { return last_host_ + faults_.clock_offset_ns * (last_host_ == 0); }
   const EmulatedEyeTracker& device() const { return device_; }
   std::uint64_t reads() const { return reads_; }
 

@@ -49,6 +49,8 @@ class Transport {
   virtual std::vector<std::uint8_t> get_feature(std::uint8_t id, std::size_t length) = 0;
   // SET_REPORT(Feature): `report` starts with the ID. Throws TransportError.
   virtual void set_feature(std::span<const std::uint8_t> report) = 0;
+  // The host clock the transport stamps reports with (simulated for an emulated device).
+  virtual core::TimeNs now() const { return core::now_ns(); }
   // True once a finite source (an emulated device playing a recording) has nothing more.
   virtual bool exhausted() const { return false; }
 };
