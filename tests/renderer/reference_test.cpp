@@ -53,9 +53,12 @@ TEST_F(Reference, StopsAtTheRelativeErrorAndWritesExr) {
 }
 
 TEST(ReferenceCli, BadScenesAndArgumentsExitWithTwo) {
+  // FOVEA_BINARY_DIR, else the build tree this test runs from (<build>/tests/renderer/).
   const char* bin = std::getenv("FOVEA_BINARY_DIR");
-  ASSERT_NE(bin, nullptr);
-  const std::string fovea = std::string(bin) + "/tools/fovea";
+  const std::filesystem::path build =
+      bin ? std::filesystem::path(bin) : std::filesystem::read_symlink("/proc/self/exe").parent_path() / "../..";
+  const std::string fovea = (build / "tools/fovea").string();
+  ASSERT_TRUE(std::filesystem::exists(fovea)) << fovea;
   const auto dir = std::filesystem::temp_directory_path() / ("fovea_refcli_" + std::to_string(::getpid()));
   std::filesystem::create_directories(dir);
   std::ofstream(dir / "bad.gltf") << "{\"asset\": {\"version\": \"2.0\"}, \"buffers\": [{\"uri\": \"nope.bin\", \"byteLength\": 9}]}";
