@@ -4,7 +4,12 @@
 #include <cmath>
 #include <cstring>
 
+#include <fstream>
+
+#include <glm/gtc/quaternion.hpp>
+
 #include "xr_fixture.hpp"
+#include "xr_process.hpp"
 
 namespace fovea::test {
 namespace {
@@ -429,6 +434,64 @@ TEST_F(XrTest, ControllerBindingsAcceptedButInactive) {
   EXPECT_EQ(xrSyncActions(session_, &sync), XR_SESSION_NOT_FOCUSED);
 }
 
+// An eye gaze action bound to the eye gaze interaction profile, attached and synced; the
+// session must be running. Returns the action space.
+XrSpace make_gaze_space(XrInstance instance, XrSession session) {
+  XrActionSetCreateInfo asci{XR_TYPE_ACTION_SET_CREATE_INFO};
+  std::strcpy(asci.actionSetName, "eyes");
+  std::strcpy(asci.localizedActionSetName, "Eyes");
+  XrActionSet set = XR_NULL_HANDLE;
+  EXPECT_EQ(xrCreateActionSet(instance, &asci, &set), XR_SUCCESS);
+  XrActionCreateInfo aci{XR_TYPE_ACTION_CREATE_INFO};
+  std::strcpy(aci.actionName, "gaze");
+  std::strcpy(aci.localizedActionName, "Gaze");
+  aci.actionType = XR_ACTION_TYPE_POSE_INPUT;
+  XrAction gaze = XR_NULL_HANDLE;
+  EXPECT_EQ(xrCreateAction(set, &aci, &gaze), XR_SUCCESS);
+  XrPath binding = XR_NULL_PATH, profile = XR_NULL_PATH;
+  EXPECT_EQ(xrStringToPath(instance, "/user/eyes_ext/input/gaze_ext/pose", &binding), XR_SUCCESS);
+  EXPECT_EQ(xrStringToPath(instance, "/interaction_profiles/ext/eye_gaze_interaction", &profile), XR_SUCCESS);
+  XrActionSuggestedBinding b{gaze, binding};
+  XrInteractionProfileSuggestedBinding s{XR_TYPE_INTERACTION_PROFILE_SUGGESTED_BINDING};
+  s.interactionProfile = profile;
+  s.countSuggestedBindings = 1;
+  s.suggestedBindings = &b;
+  EXPECT_EQ(xrSuggestInteractionProfileBindings(instance, &s), XR_SUCCESS);
+  XrSessionActionSetsAttachInfo ai{XR_TYPE_SESSION_ACTION_SETS_ATTACH_INFO};
+  ai.countActionSets = 1;
+  ai.actionSets = &set;
+  EXPECT_EQ(xrAttachSessionActionSets(session, &ai), XR_SUCCESS);
+  XrEventDataBuffer ev{XR_TYPE_EVENT_DATA_BUFFER};
+  EXPECT_EQ(xrPollEvent(instance, &ev), XR_SUCCESS);
+  EXPECT_EQ(ev.type, XR_TYPE_EVENT_DATA_INTERACTION_PROFILE_CHANGED);
+  XrInteractionProfileState ips{XR_TYPE_INTERACTION_PROFILE_STATE};
+  XrPath eyes = XR_NULL_PATH;
+  EXPECT_EQ(xrStringToPath(instance, "/user/eyes_ext", &eyes), XR_SUCCESS);
+  EXPECT_EQ(xrGetCurrentInteractionProfile(session, eyes, &ips), XR_SUCCESS);
+  EXPECT_EQ(ips.interactionProfile, profile);
+  XrActiveActionSet active{set, XR_NULL_PATH};
+  XrActionsSyncInfo sync{XR_TYPE_ACTIONS_SYNC_INFO};
+  sync.countActiveActionSets = 1;
+  sync.activeActionSets = &active;
+  EXPECT_EQ(xrSyncActions(session, &sync), XR_SUCCESS);
+  XrActionStateGetInfo gi{XR_TYPE_ACTION_STATE_GET_INFO};
+  gi.action = gaze;
+  XrActionStatePose st{XR_TYPE_ACTION_STATE_POSE};
+  EXPECT_EQ(xrGetActionStatePose(session, &gi, &st), XR_SUCCESS);
+  EXPECT_TRUE(st.isActive);
+  XrActionSpaceCreateInfo sci{XR_TYPE_ACTION_SPACE_CREATE_INFO};
+  sci.action = gaze;
+  sci.poseInActionSpace.orientation.w = 1;
+  XrSpace space = XR_NULL_HANDLE;
+  EXPECT_EQ(xrCreateActionSpace(session, &sci, &space), XR_SUCCESS);
+  return space;
+}
+
+// The gaze pose's forward direction (-Z rotated by the orientation).
+glm::dvec3 forward(const XrQuaternionf& q) {
+  return glm::dquat(q.w, q.x, q.y, q.z) * glm::dvec3(0, 0, -1);
+}
+
 TEST_F(XrTest, EyeGaze) {
   create_instance({XR_EXT_EYE_GAZE_INTERACTION_EXTENSION_NAME});
   XrSystemEyeGazeInteractionPropertiesEXT eg{XR_TYPE_SYSTEM_EYE_GAZE_INTERACTION_PROPERTIES_EXT};
@@ -437,56 +500,14 @@ TEST_F(XrTest, EyeGaze) {
   ASSERT_EQ(xrGetSystemProperties(instance_, system_, &sp), XR_SUCCESS);
   EXPECT_TRUE(eg.supportsEyeGazeInteraction);
   run_to_focused();
-  XrActionSetCreateInfo asci{XR_TYPE_ACTION_SET_CREATE_INFO};
-  std::strcpy(asci.actionSetName, "eyes");
-  std::strcpy(asci.localizedActionSetName, "Eyes");
-  XrActionSet set = XR_NULL_HANDLE;
-  ASSERT_EQ(xrCreateActionSet(instance_, &asci, &set), XR_SUCCESS);
-  XrActionCreateInfo aci{XR_TYPE_ACTION_CREATE_INFO};
-  std::strcpy(aci.actionName, "gaze");
-  std::strcpy(aci.localizedActionName, "Gaze");
-  aci.actionType = XR_ACTION_TYPE_POSE_INPUT;
-  XrAction gaze = XR_NULL_HANDLE;
-  ASSERT_EQ(xrCreateAction(set, &aci, &gaze), XR_SUCCESS);
-  XrActionSuggestedBinding b{gaze, path("/user/eyes_ext/input/gaze_ext/pose")};
-  XrInteractionProfileSuggestedBinding s{XR_TYPE_INTERACTION_PROFILE_SUGGESTED_BINDING};
-  s.interactionProfile = path("/interaction_profiles/ext/eye_gaze_interaction");
-  s.countSuggestedBindings = 1;
-  s.suggestedBindings = &b;
-  ASSERT_EQ(xrSuggestInteractionProfileBindings(instance_, &s), XR_SUCCESS);
-  XrSessionActionSetsAttachInfo ai{XR_TYPE_SESSION_ACTION_SETS_ATTACH_INFO};
-  ai.countActionSets = 1;
-  ai.actionSets = &set;
-  ASSERT_EQ(xrAttachSessionActionSets(session_, &ai), XR_SUCCESS);
-  XrEventDataBuffer ev{XR_TYPE_EVENT_DATA_BUFFER};
-  ASSERT_EQ(xrPollEvent(instance_, &ev), XR_SUCCESS);
-  EXPECT_EQ(ev.type, XR_TYPE_EVENT_DATA_INTERACTION_PROFILE_CHANGED);
-  XrInteractionProfileState ips{XR_TYPE_INTERACTION_PROFILE_STATE};
-  ASSERT_EQ(xrGetCurrentInteractionProfile(session_, path("/user/eyes_ext"), &ips), XR_SUCCESS);
-  EXPECT_EQ(ips.interactionProfile, path("/interaction_profiles/ext/eye_gaze_interaction"));
-  XrActiveActionSet active{set, XR_NULL_PATH};
-  XrActionsSyncInfo sync{XR_TYPE_ACTIONS_SYNC_INFO};
-  sync.countActiveActionSets = 1;
-  sync.activeActionSets = &active;
-  ASSERT_EQ(xrSyncActions(session_, &sync), XR_SUCCESS);
-  XrActionStateGetInfo gi{XR_TYPE_ACTION_STATE_GET_INFO};
-  gi.action = gaze;
-  XrActionStatePose st{XR_TYPE_ACTION_STATE_POSE};
-  ASSERT_EQ(xrGetActionStatePose(session_, &gi, &st), XR_SUCCESS);
-  EXPECT_TRUE(st.isActive);
-
-  XrActionSpaceCreateInfo sci{XR_TYPE_ACTION_SPACE_CREATE_INFO};
-  sci.action = gaze;
-  sci.poseInActionSpace.orientation.w = 1;
-  XrSpace gaze_space = XR_NULL_HANDLE;
-  ASSERT_EQ(xrCreateActionSpace(session_, &sci, &gaze_space), XR_SUCCESS);
+  const XrSpace gaze_space = make_gaze_space(instance_, session_);
   const XrSpace view = reference_space(XR_REFERENCE_SPACE_TYPE_VIEW);
   XrFrameState fs{XR_TYPE_FRAME_STATE};
   ASSERT_EQ(frame({}, &fs), XR_SUCCESS);
-  // Over two simulated seconds the synthetic tracker reports valid gaze at least most of
-  // the time (blinks and dropouts are invalid): valid samples carry both validity bits,
+  // Over two simulated seconds the synthetic tracker reports valid gaze most of the time
+  // (blinks and dropouts are invalid): valid samples carry the validity and tracking bits,
   // a sample time no later than the requested time, and a forward direction.
-  int valid = 0, invalid = 0;
+  int valid = 0;
   for (int i = 0; i < 200; ++i) {
     const XrTime t = fs.predictedDisplayTime + XrTime(i) * 10'000'000;
     XrEyeGazeSampleTimeEXT when{XR_TYPE_EYE_GAZE_SAMPLE_TIME_EXT};
@@ -498,17 +519,50 @@ TEST_F(XrTest, EyeGaze) {
       EXPECT_TRUE(loc.locationFlags & XR_SPACE_LOCATION_ORIENTATION_TRACKED_BIT);
       EXPECT_GT(when.time, 0);
       EXPECT_LE(when.time, t);
-      // Forward of the gaze pose (-Z rotated) points ahead of the viewer.
-      const auto& q = loc.pose.orientation;
-      const double fz = -(1 - 2 * (double(q.x) * q.x + double(q.y) * q.y));
-      EXPECT_LT(fz, -0.5);
+      EXPECT_LT(forward(loc.pose.orientation).z, -0.5);
     } else {
-      ++invalid;
       EXPECT_EQ(loc.locationFlags, 0u);
+      EXPECT_EQ(when.time, 0);
     }
   }
   EXPECT_GT(valid, 150);
-  SCOPED_TRACE(invalid);
+}
+
+// FOVEA_GAZE=replay:FILE: a recording starts at the display epoch; the gaze space follows it,
+// blinks are invalid.
+TEST_F(XrTest, EyeGazeReplay) {
+  TempDir dir("gaze_replay");
+  const std::string file = dir.path() + "/gaze.csv";
+  {
+    std::ofstream out(file);
+    out << "t_ns,eye,dir_x,dir_y,dir_z,confidence,flags\n";
+    const double yaw = 20.0 * M_PI / 180;  // to the right
+    for (int i = 0; i <= 200; ++i) {
+      const bool blink = i >= 100 && i < 120;  // 1.0 s .. 1.2 s
+      out << std::int64_t(i) * 10'000'000 << ",combined," << std::sin(yaw) << ",0," << -std::cos(yaw) << ","
+          << (blink ? 0.0 : 1.0) << "," << (blink ? 2 : 1) << "\n";
+    }
+  }
+  setenv("FOVEA_GAZE", ("replay:" + file).c_str(), 1);
+  create_instance({XR_EXT_EYE_GAZE_INTERACTION_EXTENSION_NAME});
+  unsetenv("FOVEA_GAZE");
+  run_to_focused();
+  const XrSpace gaze_space = make_gaze_space(instance_, session_);
+  const XrSpace view = reference_space(XR_REFERENCE_SPACE_TYPE_VIEW);
+  XrFrameState fs{XR_TYPE_FRAME_STATE};
+  ASSERT_EQ(frame({}, &fs), XR_SUCCESS);  // frame 1: epoch = its display time - one period
+  const XrTime epoch = fs.predictedDisplayTime - fs.predictedDisplayPeriod;
+  XrEyeGazeSampleTimeEXT when{XR_TYPE_EYE_GAZE_SAMPLE_TIME_EXT};
+  XrSpaceLocation loc{XR_TYPE_SPACE_LOCATION};
+  loc.next = &when;
+  ASSERT_EQ(xrLocateSpace(gaze_space, view, epoch + 500'000'000, &loc), XR_SUCCESS);
+  ASSERT_TRUE(loc.locationFlags & XR_SPACE_LOCATION_ORIENTATION_VALID_BIT);
+  const glm::dvec3 f = forward(loc.pose.orientation);
+  EXPECT_NEAR(f.x, std::sin(20.0 * M_PI / 180), 1e-4);
+  EXPECT_NEAR(f.y, 0.0, 1e-4);
+  EXPECT_EQ(when.time, epoch + 500'000'000);
+  ASSERT_EQ(xrLocateSpace(gaze_space, view, epoch + 1'100'000'000, &loc), XR_SUCCESS);
+  EXPECT_EQ(loc.locationFlags, 0u);  // blink
 }
 
 TEST_F(XrTest, VisibilityMask) {
