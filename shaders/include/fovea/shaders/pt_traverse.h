@@ -89,20 +89,25 @@ bool pt_traverse(vec3 org, vec3 dir, float tmin, float tmax, bool any_hit, out P
     if (node.count > 0u) {
       for (uint i = node.first; i < node.first + node.count; ++i)
         if (pt_hit_triangle(r, i, hit.t, hit) && any_hit) return true;
-      if (sp == 0u) break;
-      n = stack[--sp];
-      continue;
-    }
-    const float tl = pt_box_entry(r, node.first, hit.t), tr = pt_box_entry(r, node.first + 1u, hit.t);
-    if (tl >= kPtInf && tr >= kPtInf) {
-      if (sp == 0u) break;
-      n = stack[--sp];
-    } else if (tl >= kPtInf || tr >= kPtInf) {
-      n = tl < kPtInf ? node.first : node.first + 1u;
     } else {
-      n = tl <= tr ? node.first : node.first + 1u;
-      stack[sp++] = tl <= tr ? node.first + 1u : node.first;
+      const float tl = pt_box_entry(r, node.first, hit.t), tr = pt_box_entry(r, node.first + 1u, hit.t);
+      if (tl < kPtInf && tr < kPtInf) {
+        n = tl <= tr ? node.first : node.first + 1u;
+        stack[sp++] = tl <= tr ? node.first + 1u : node.first;
+        continue;
+      }
+      if (tl < kPtInf || tr < kPtInf) {
+        n = tl < kPtInf ? node.first : node.first + 1u;
+        continue;
+      }
     }
+    // Pop the next subtree that still starts before the closest hit found so far.
+    bool next = false;
+    while (sp > 0u && !next) {
+      n = stack[--sp];
+      next = pt_box_entry(r, n, hit.t) < kPtInf;
+    }
+    if (!next) break;
   }
   return hit.tri != kPtNoHit;
 }
