@@ -61,6 +61,7 @@ class PathTracer {
   // accumulated > 0 averages this frame into the outputs that already hold that many
   // frames of config.spp samples (equal weight per sample); 0 overwrites them.
   // Features (normal, depth, position, material) come from the first sample written.
+  // Earlier commands touching `out` or the grid must be ordered before it by a barrier.
   void record(VkCommandBuffer cmd, TraceOutputs& out, const core::View& view, core::Eye eye, std::uint32_t frame,
               const PathConfig& config, std::uint32_t accumulated = 0) const;
 
