@@ -1,0 +1,40 @@
+#pragma once
+// BMFR Phase II on the GPU (shaders/recon_bmfr_fit.comp): per 32×32 block of a padded grid,
+// the regression of the demodulated input z on the features [1, n, w, w²] and the weighted
+// sum. Inputs per cell (vec4): vpos (world position, .w material; < 0 = no surface),
+// vnrm (normal), z (rgb); output: fitted (rgb, .w = 1).
+#include <cstdint>
+#include <vector>
+
+#include <glm/vec2.hpp>
+#include <glm/vec4.hpp>
+
+#include "fovea/gpu/buffer.hpp"
+#include "fovea/gpu/descriptors.hpp"
+#include "fovea/gpu/pipeline.hpp"
+
+namespace fovea::compositor {
+
+struct BmfrGrid {
+  std::uint32_t padded_columns = 0, padded_rows = 0;  // multiples of 32
+};
+
+class BmfrFit {
+ public:
+  explicit BmfrFit(gpu::Context& ctx);
+  gpu::DescriptorSet bind(const gpu::Buffer& vpos, const gpu::Buffer& vnrm, const gpu::Buffer& z,
+                          const gpu::Buffer& fitted) const;
+  // Records the fit; `offset` is the block-grid displacement in [0, 32)².
+  void record(VkCommandBuffer cmd, const gpu::DescriptorSet& set, BmfrGrid grid, std::uint32_t frame,
+              glm::ivec2 offset, float noise) const;
+  // Upload, fit, download in one submission (tests, tools).
+  std::vector<glm::vec4> fit(BmfrGrid grid, const std::vector<glm::vec4>& vpos, const std::vector<glm::vec4>& vnrm,
+                             const std::vector<glm::vec4>& z, std::uint32_t frame = 0, glm::ivec2 offset = {0, 0},
+                             float noise = 0.01f) const;
+
+ private:
+  gpu::Context* ctx_;
+  gpu::ComputePipeline pipeline_;
+};
+
+}  // namespace fovea::compositor

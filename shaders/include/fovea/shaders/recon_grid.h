@@ -1,0 +1,84 @@
+// Reconstruction in grid space (recon_*.comp), shared C++/GLSL: one grid mapping with its
+// eye pose (the current frame's, the previous frame's, the other eye's), push constants,
+// and — in GLSL — world/display position -> continuous grid coordinate and the bilinear
+// taps of a jagged polar grid (rows differ per column, φ wraps, ρ clamps).
+#ifndef FOVEA_SHADERS_RECON_GRID_H
+#define FOVEA_SHADERS_RECON_GRID_H
+#include "fovea/shaders/common.h"
+#include "fovea/shaders/grid_params.h"
+
+#ifdef __cplusplus
+namespace fovea::shaders {
+#endif
+
+// A grid mapping (core::SampleDistribution::gpu_params) plus the eye's world-to-view
+// transform (rows of the rotation, then the eye position) and where its column table starts
+// in the bound table buffer.
+struct ReconGrid {
+  GridParams g;
+  float w2v0_x, w2v0_y, w2v0_z, eye_x;
+  float w2v1_x, w2v1_y, w2v1_z, eye_y;
+  float w2v2_x, w2v2_y, w2v2_z, eye_z;
+  FOVEA_UINT table_offset, valid, pad0, pad1;  // valid = 0: no such mapping (first frame)
+};
+
+// Slots of the per-eye mapping buffer.
+FOVEA_CONST FOVEA_UINT kReconCurrent = 0u;
+FOVEA_CONST FOVEA_UINT kReconPrevious = 1u;
+FOVEA_CONST FOVEA_UINT kReconOther = 2u;
+
+// Validity of a history/other-eye tap (BMFR §3.2, Gersthofer §3.4.1): same material, normals
+// within |Δn|² < 0.25 (BMFR's Sponza limit, ≈ 29°), and the tap's position within
+// kReconPlaneTol·depth of the sample's tangent plane (scale-free, so large peripheral
+// cells on a plane pass while a foreground/background pair does not).
+FOVEA_CONST float kReconNormalLimit2 = 0.25f;
+FOVEA_CONST float kReconPlaneTol = 0.03f;
+FOVEA_CONST float kReconDistTol = 0.25f;  // and |Δp| < this·depth (other surfaces far along the plane)
+
+// Material value stored in the validation data of cells that carry no sample.
+FOVEA_CONST float kReconNoSample = -2.0f;
+
+struct ReconAccumulatePush {
+  FOVEA_UINT cells, has_history, indirect_fresh, pad;  // indirect_fresh = 0: reuse history only
+  float alpha_min, pad1, pad2, pad3;                   // EMA floor (BMFR Phase I: 0.2)
+};
+
+struct ReconSharePush {
+  FOVEA_UINT cells, enabled, pad0, pad1;
+};
+
+struct ReconBmfrPush {
+  FOVEA_UINT padded_columns, padded_rows, blocks_x, frame;
+  FOVEA_INT offset_x, offset_y;  // this frame's block-grid displacement (cells, in [0, 32))
+  float noise, pad;              // stochastic regularisation ε
+};
+
+struct ReconPostPush {
+  FOVEA_UINT cells, has_history, denoise, pad;  // denoise = 0: remodulated accumulation only
+  float alpha_min, taa_alpha, pad1, pad2;       // BMFR Phase III: 0.1, TAA: 0.2
+};
+
+struct ReconMipPush {
+  FOVEA_UINT padded_columns, rows_in, rows_out, level_in;  // rows_*: allocated rows of the levels
+  FOVEA_UINT offset_in, offset_out, pad0, pad1;            // element offsets in the mip buffer
+};
+
+struct ReconResolvePush {
+  FOVEA_UINT width, height, levels, pad0;
+};
+
+struct ReconBlurPush {
+  FOVEA_UINT width, height, vertical, pad0;
+  float fovea_deg, sigma_deg_per_deg, max_sigma_px, pad1;  // σ(e) = slope·max(e − fovea, 0) degrees
+};
+
+#ifdef __cplusplus
+static_assert(sizeof(ReconGrid) == 192);
+static_assert(sizeof(ReconAccumulatePush) == 32);
+static_assert(sizeof(ReconBmfrPush) == 32);
+static_assert(sizeof(ReconPostPush) == 32);
+static_assert(sizeof(ReconMipPush) == 32);
+static_assert(sizeof(ReconBlurPush) == 32);
+}  // namespace fovea::shaders
+#endif
+#endif

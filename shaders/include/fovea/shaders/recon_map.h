@@ -1,0 +1,124 @@
+// GLSL only: grid-space mapping helpers of the reconstruction (see recon_grid.h). Include
+// after declaring the mapping and column-table buffers:
+//   buffer ... { ReconGrid maps[]; }  and  buffer ... { GridColumn tables[]; }
+#ifndef FOVEA_SHADERS_RECON_MAP_H
+#define FOVEA_SHADERS_RECON_MAP_H
+const float kRgPi = 3.14159265358979323846;
+
+vec3 rg_gaze(ReconGrid m) { return vec3(m.g.gaze_x, m.g.gaze_y, m.g.gaze_z); }
+
+vec3 rg_world_to_view(ReconGrid m, vec3 p, bool is_direction) {
+  vec3 d = is_direction ? p : p - vec3(m.eye_x, m.eye_y, m.eye_z);
+  return vec3(dot(vec3(m.w2v0_x, m.w2v0_y, m.w2v0_z), d), dot(vec3(m.w2v1_x, m.w2v1_y, m.w2v1_z), d),
+              dot(vec3(m.w2v2_x, m.w2v2_y, m.w2v2_z), d));
+}
+
+vec3 rg_view_to_world_dir(ReconGrid m, vec3 d) {
+  return vec3(m.w2v0_x, m.w2v0_y, m.w2v0_z) * d.x + vec3(m.w2v1_x, m.w2v1_y, m.w2v1_z) * d.y +
+         vec3(m.w2v2_x, m.w2v2_y, m.w2v2_z) * d.z;
+}
+
+vec3 rg_pixel_to_dir(ReconGrid m, vec2 px) {
+  float tx = m.g.tan_left + (px.x / m.g.width) * (m.g.tan_right - m.g.tan_left);
+  float ty = m.g.tan_up - (px.y / m.g.height) * (m.g.tan_up - m.g.tan_down);
+  return normalize(vec3(tx, ty, -1.0));
+}
+
+// View direction -> display pixel; false when not in front of the eye or off the raster.
+bool rg_dir_to_pixel(ReconGrid m, vec3 d, out vec2 px) {
+  px = vec2(-1.0);
+  if (!(d.z < 0.0)) return false;
+  vec2 t = d.xy / -d.z;
+  px = vec2((t.x - m.g.tan_left) / (m.g.tan_right - m.g.tan_left) * m.g.width,
+            (m.g.tan_up - t.y) / (m.g.tan_up - m.g.tan_down) * m.g.height);
+  return px.x >= 0.0 && px.y >= 0.0 && px.x <= m.g.width && px.y <= m.g.height;
+}
+
+// Rows of column c (the raster's row count for the Cartesian family).
+uint rg_rows(ReconGrid m, uint c) { return m.g.family == kFamilyCartesian ? m.g.rows : tables[m.table_offset + c].rows; }
+
+// Continuous column coordinate of radius r (core PolarDistribution::screen_to_grid): the
+// last boundary <= r, linear inside the column, clamped to the table (ρ clamp).
+float rg_radius_to_u(ReconGrid m, float r) {
+  uint lo = 0u, hi = m.g.columns;  // find the last i with r0(i) <= r
+  while (hi - lo > 1u) {
+    uint mid = (lo + hi) >> 1;
+    if (tables[m.table_offset + mid].r0 <= r) lo = mid; else hi = mid;
+  }
+  GridColumn c = tables[m.table_offset + lo];
+  float w = c.r1 - c.r0;
+  return float(lo) + (w > 0.0 ? clamp((r - c.r0) / w, 0.0, 1.0) : 0.5);
+}
+
+// Grid coordinate (u = column coordinate, cell centres at +0.5; t = φ / 2π in [0, 1) for
+// polar grids, y / height for the Cartesian raster) of view direction d at display pixel px.
+vec2 rg_grid_coord(ReconGrid m, vec3 d, vec2 px) {
+  if (m.g.family == kFamilyCartesian) return vec2(px.x * float(m.g.columns) / m.g.width, px.y / m.g.height);
+  float r, phi;
+  if (m.g.family == kFamilyAngularPolar) {
+    vec3 g = rg_gaze(m);
+    r = atan(length(cross(d, g)), dot(d, g)) * (180.0 / kRgPi);
+    phi = atan(dot(d, vec3(m.g.b2_x, m.g.b2_y, m.g.b2_z)), dot(d, vec3(m.g.b1_x, m.g.b1_y, m.g.b1_z)));
+  } else {
+    vec2 q = px - vec2(m.g.gaze_px_x, m.g.gaze_px_y);
+    r = length(q);
+    phi = atan(q.y, q.x);
+  }
+  float t = phi / (2.0 * kRgPi);
+  t -= floor(t);
+  return vec2(rg_radius_to_u(m, r), t);
+}
+
+// World point (or, is_direction, world direction of a sky sample) -> grid coordinate of
+// mapping m; false when it is behind the eye or off the display.
+bool rg_world_to_grid(ReconGrid m, vec3 p, bool is_direction, out vec2 uv) {
+  uv = vec2(0.0);
+  vec3 d = rg_world_to_view(m, p, is_direction);
+  vec2 px;
+  if (!rg_dir_to_pixel(m, d, px)) return false;
+  uv = rg_grid_coord(m, normalize(d), px);
+  return true;
+}
+
+// The four bilinear taps of (u, t): two columns (ρ clamped), and in each column the two
+// rows around t·rows(column) (φ wraps on polar grids, clamps on the raster). Cell indices
+// row * padded_columns + column; weights sum to 1.
+void rg_taps(ReconGrid m, vec2 uv, out uvec4 idx, out vec4 w) {
+  float uc = uv.x - 0.5;
+  float c0f = floor(uc);
+  float fx = uc - c0f;
+  bool polar = m.g.family != kFamilyCartesian;
+  for (int i = 0; i < 2; ++i) {
+    uint c = uint(clamp(int(c0f) + i, 0, int(m.g.columns) - 1));
+    uint rows = max(rg_rows(m, c), 1u);
+    float vr = uv.y * float(rows) - 0.5;
+    float r0f = floor(vr);
+    float fy = vr - r0f;
+    int r0 = int(r0f), r1 = r0 + 1;
+    if (polar) {
+      r0 = (r0 % int(rows) + int(rows)) % int(rows);
+      r1 = r1 % int(rows);
+    } else {
+      r0 = clamp(r0, 0, int(rows) - 1);
+      r1 = clamp(r1, 0, int(rows) - 1);
+    }
+    float wc = i == 0 ? 1.0 - fx : fx;
+    idx[2 * i] = uint(r0) * m.g.padded_columns + c;
+    idx[2 * i + 1] = uint(r1) * m.g.padded_columns + c;
+    w[2 * i] = wc * (1.0 - fy);
+    w[2 * i + 1] = wc * fy;
+  }
+}
+
+// Tap validity (see kRecon* above). vpos: xyz world position (sky: world direction),
+// w material (-1 sky, kReconNoSample none); n: unit normal; depth: the sample's distance.
+bool rg_tap_valid(vec4 vpos, vec3 n, float depth, vec4 tap_pos, vec3 tap_n) {
+  if (vpos.w <= kReconNoSample + 0.5 || tap_pos.w != vpos.w) return false;
+  if (vpos.w < 0.0) return dot(vpos.xyz, tap_pos.xyz) > 0.9995;  // sky: nearly the same direction
+  vec3 dn = n - tap_n;
+  if (dot(dn, dn) >= kReconNormalLimit2) return false;
+  vec3 dp = tap_pos.xyz - vpos.xyz;
+  float tol = max(depth, 1e-3);
+  return abs(dot(dp, n)) < kReconPlaneTol * tol && length(dp) < kReconDistTol * tol;
+}
+#endif

@@ -1,0 +1,97 @@
+#version 460
+// BMFR Phase I in grid space (Koskela et al. 2019 §3.2; Koskela et al. 2019 P5 §3.3): each
+// sample's world position is reprojected into the previous frame's view and grid mapping
+// (the gaze moved), the history is fetched bilinearly with a validity test per tap,
+// renormalised over the accepted taps, and blended with α = max(1/n, α_min) (CMA, then EMA).
+// Direct+specular and indirect diffuse are accumulated separately (the indirect one is
+// shared between the eyes later); each carries its own 8-bit sample count in .w.
+#extension GL_GOOGLE_include_directive : require
+
+layout(local_size_x = 64) in;
+
+#include "fovea/shaders/grid.h"
+#include "fovea/shaders/recon_grid.h"
+
+layout(std430, binding = 0) readonly buffer Maps { ReconGrid maps[]; };
+layout(std430, binding = 1) readonly buffer Tables { GridColumn tables[]; };
+layout(std430, binding = 2) readonly buffer Samples { GridSample samples[]; };
+layout(std430, binding = 3) readonly buffer Direct { vec4 direct[]; };
+layout(std430, binding = 4) readonly buffer Indirect { vec4 indirect[]; };
+layout(std430, binding = 5) readonly buffer NormalDepth { vec4 normal_depth[]; };
+layout(std430, binding = 6) readonly buffer PositionMaterial { vec4 position_material[]; };
+layout(std430, binding = 7) readonly buffer PrevDirect { vec4 prev_direct[]; };
+layout(std430, binding = 8) readonly buffer PrevIndirect { vec4 prev_indirect[]; };
+layout(std430, binding = 9) readonly buffer PrevPos { vec4 prev_pos[]; };
+layout(std430, binding = 10) readonly buffer PrevNrm { vec4 prev_nrm[]; };
+layout(std430, binding = 11) writeonly buffer AccDirect { vec4 acc_direct[]; };
+layout(std430, binding = 12) writeonly buffer AccIndirect { vec4 acc_indirect[]; };
+layout(std430, binding = 13) writeonly buffer Pos { vec4 vpos[]; };
+layout(std430, binding = 14) writeonly buffer Nrm { vec4 vnrm[]; };
+layout(std430, binding = 15) writeonly buffer TapIdx { uvec4 tap_idx[]; };
+layout(std430, binding = 16) writeonly buffer TapW { vec4 tap_w[]; };
+
+#include "fovea/shaders/recon_map.h"
+
+layout(push_constant) uniform Push { ReconAccumulatePush pc; };
+
+void main() {
+  uint i = gl_GlobalInvocationID.x;
+  if (i >= pc.cells) return;
+  GridSample s = samples[i];
+  if (s.flags != 0u) {
+    acc_direct[i] = vec4(0.0);
+    acc_indirect[i] = vec4(0.0);
+    vpos[i] = vec4(0.0, 0.0, 0.0, kReconNoSample);
+    vnrm[i] = vec4(0.0);
+    tap_idx[i] = uvec4(0u);
+    tap_w[i] = vec4(0.0);
+    return;
+  }
+  ReconGrid cur = maps[kReconCurrent];
+  vec4 pm = position_material[i];
+  bool sky = pm.w < 0.0;
+  vec3 eye = vec3(cur.eye_x, cur.eye_y, cur.eye_z);
+  vec3 p = sky ? normalize(rg_view_to_world_dir(cur, vec3(s.dir_x, s.dir_y, s.dir_z))) : pm.xyz;
+  vec3 n = normal_depth[i].xyz;
+  float depth = sky ? 0.0 : length(pm.xyz - eye);
+  vec4 here = vec4(p, sky ? -1.0 : pm.w);
+  vpos[i] = here;
+  vnrm[i] = vec4(n, depth);
+
+  vec4 hd = vec4(0.0), hi = vec4(0.0);
+  uvec4 idx = uvec4(0u);
+  vec4 w = vec4(0.0);
+  float wsum = 0.0;
+  if (pc.has_history != 0u && maps[kReconPrevious].valid != 0u) {
+    vec2 uv;
+    if (rg_world_to_grid(maps[kReconPrevious], p, sky, uv)) {
+      rg_taps(maps[kReconPrevious], uv, idx, w);
+      for (int k = 0; k < 4; ++k) {
+        if (w[k] <= 0.0 || !rg_tap_valid(here, n, depth, prev_pos[idx[k]], prev_nrm[idx[k]].xyz)) w[k] = 0.0;
+        wsum += w[k];
+      }
+      if (wsum > 1e-4) {
+        w /= wsum;
+        for (int k = 0; k < 4; ++k) {
+          hd += w[k] * prev_direct[idx[k]];
+          hi += w[k] * prev_indirect[idx[k]];
+        }
+      } else {
+        w = vec4(0.0);
+      }
+    }
+  }
+  tap_idx[i] = idx;
+  tap_w[i] = w;
+  // Counts are fetched with the same weights and rounded (BMFR §3.2).
+  float nd = min(round(hd.w) + 1.0, 255.0);
+  float ad = max(1.0 / nd, pc.alpha_min);
+  acc_direct[i] = vec4(mix(hd.rgb, direct[i].rgb, ad), nd);
+  if (pc.indirect_fresh != 0u) {
+    float ni = min(round(hi.w) + 1.0, 255.0);
+    float ai = max(1.0 / ni, pc.alpha_min);
+    acc_indirect[i] = vec4(mix(hi.rgb, indirect[i].rgb, ai), ni);
+  } else {
+    acc_indirect[i] = vec4(hi.rgb, round(hi.w));  // not traced this frame: history only
+  }
+}

@@ -1,0 +1,74 @@
+#version 460
+// Resolve to the display (P5 §3.4): every display pixel computes its grid coordinate through
+// the current mapping and samples the grid — trilinear over the φ-only mip chain (bilinear
+// in ρ between the two columns, each with its own row count; φ wraps, ρ clamps). The level
+// comes from the pixel's footprint along φ measured in rows of its column.
+#extension GL_GOOGLE_include_directive : require
+
+layout(local_size_x = 8, local_size_y = 8) in;
+
+#include "fovea/shaders/grid.h"
+#include "fovea/shaders/recon_grid.h"
+
+layout(std430, binding = 0) readonly buffer Maps { ReconGrid maps[]; };
+layout(std430, binding = 1) readonly buffer Tables { GridColumn tables[]; };
+layout(std430, binding = 2) readonly buffer Mips { vec4 mips[]; };
+layout(std430, binding = 3) readonly buffer Offsets { uint level_offset[]; };
+layout(std430, binding = 4) writeonly buffer Screen { vec4 screen[]; };
+
+#include "fovea/shaders/recon_map.h"
+
+layout(push_constant) uniform Push { ReconResolvePush pc; };
+
+vec2 coord(ReconGrid m, vec2 px) { return rg_grid_coord(m, rg_pixel_to_dir(m, px), px); }
+
+vec4 fetch_level(ReconGrid m, vec2 uv, uint level) {
+  bool polar = m.g.family != kFamilyCartesian;
+  float uc = uv.x - 0.5;
+  float c0f = floor(uc);
+  float fx = uc - c0f;
+  float scale = float(1u << level);
+  vec4 acc = vec4(0.0);
+  for (int i = 0; i < 2; ++i) {
+    uint c = uint(clamp(int(c0f) + i, 0, int(m.g.columns) - 1));
+    uint full = max(rg_rows(m, c), 1u);
+    int rows = int((full + (1u << level) - 1u) >> level);
+    float vr = uv.y * float(full) / scale - 0.5;
+    float r0f = floor(vr);
+    float fy = vr - r0f;
+    int r0 = int(r0f), r1 = r0 + 1;
+    if (polar) {
+      r0 = (r0 % rows + rows) % rows;
+      r1 = r1 % rows;
+    } else {
+      r0 = clamp(r0, 0, rows - 1);
+      r1 = clamp(r1, 0, rows - 1);
+    }
+    float wc = i == 0 ? 1.0 - fx : fx;
+    uint base = level_offset[level];
+    acc += wc * ((1.0 - fy) * mips[base + uint(r0) * m.g.padded_columns + c] +
+                 fy * mips[base + uint(r1) * m.g.padded_columns + c]);
+  }
+  return acc;
+}
+
+void main() {
+  uvec2 p = gl_GlobalInvocationID.xy;
+  if (p.x >= pc.width || p.y >= pc.height) return;
+  ReconGrid m = maps[kReconCurrent];
+  vec2 px = vec2(p) + 0.5;
+  vec2 uv = coord(m, px);
+  float lod = 0.0;
+  if (pc.levels > 1u && m.g.family != kFamilyCartesian) {
+    vec2 ux = coord(m, px + vec2(1.0, 0.0)), uy = coord(m, px + vec2(0.0, 1.0));
+    float dtx = fract(ux.y - uv.y + 0.5) - 0.5, dty = fract(uy.y - uv.y + 0.5) - 0.5;
+    uint c = uint(clamp(int(uv.x), 0, int(m.g.columns) - 1));
+    float footprint = max(abs(dtx), abs(dty)) * float(rg_rows(m, c));
+    lod = clamp(log2(max(footprint, 1.0)), 0.0, float(pc.levels - 1u));
+  }
+  uint l0 = uint(floor(lod));
+  float f = lod - float(l0);
+  vec4 v = fetch_level(m, uv, l0);
+  if (f > 0.0 && l0 + 1u < pc.levels) v = mix(v, fetch_level(m, uv, l0 + 1u), f);
+  screen[p.y * pc.width + p.x] = v.w > 1e-6 ? vec4(v.rgb / v.w, 1.0) : vec4(0.0, 0.0, 0.0, 1.0);
+}

@@ -1,0 +1,67 @@
+#version 460
+// Stereo sharing of indirect diffuse (Gersthofer 2020 §3.4.2): each sample gathers the other
+// eye's accumulated indirect diffuse through its world position -> the other eye's view ->
+// the other eye's grid, bilinear over the taps that pass the same validity test as the
+// temporal reprojection, and combines it with its own, weighted by sample counts. Direct and
+// specular light are view dependent and never shared. Also writes z = direct + indirect,
+// the demodulated input of the regression.
+#extension GL_GOOGLE_include_directive : require
+
+layout(local_size_x = 64) in;
+
+#include "fovea/shaders/grid.h"
+#include "fovea/shaders/recon_grid.h"
+
+layout(std430, binding = 0) readonly buffer Maps { ReconGrid maps[]; };
+layout(std430, binding = 1) readonly buffer Tables { GridColumn tables[]; };
+layout(std430, binding = 2) readonly buffer Pos { vec4 vpos[]; };
+layout(std430, binding = 3) readonly buffer Nrm { vec4 vnrm[]; };
+layout(std430, binding = 4) readonly buffer AccDirect { vec4 acc_direct[]; };
+layout(std430, binding = 5) readonly buffer AccIndirect { vec4 acc_indirect[]; };
+layout(std430, binding = 6) readonly buffer OtherPos { vec4 other_pos[]; };
+layout(std430, binding = 7) readonly buffer OtherNrm { vec4 other_nrm[]; };
+layout(std430, binding = 8) readonly buffer OtherIndirect { vec4 other_indirect[]; };
+layout(std430, binding = 9) writeonly buffer Shared { vec4 shared_indirect[]; };
+layout(std430, binding = 10) writeonly buffer Z { vec4 z[]; };
+
+#include "fovea/shaders/recon_map.h"
+
+layout(push_constant) uniform Push { ReconSharePush pc; };
+
+void main() {
+  uint i = gl_GlobalInvocationID.x;
+  if (i >= pc.cells) return;
+  vec4 here = vpos[i];
+  vec4 own = acc_indirect[i];
+  if (here.w <= kReconNoSample + 0.5) {
+    shared_indirect[i] = vec4(0.0);
+    z[i] = vec4(0.0);
+    return;
+  }
+  vec4 result = own;
+  if (pc.enabled != 0u && maps[kReconOther].valid != 0u) {
+    ReconGrid other = maps[kReconOther];
+    bool sky = here.w < 0.0;
+    vec2 uv;
+    if (rg_world_to_grid(other, here.xyz, sky, uv)) {
+      uvec4 idx;
+      vec4 w;
+      rg_taps(other, uv, idx, w);
+      vec4 n = vnrm[i];
+      float wsum = 0.0;
+      vec4 acc = vec4(0.0);
+      for (int k = 0; k < 4; ++k) {
+        if (w[k] <= 0.0 || !rg_tap_valid(here, n.xyz, n.w, other_pos[idx[k]], other_nrm[idx[k]].xyz)) continue;
+        acc += w[k] * other_indirect[idx[k]];
+        wsum += w[k];
+      }
+      if (wsum > 1e-4) {
+        acc /= wsum;
+        float total = own.w + acc.w;
+        if (total > 0.0) result = vec4((own.w * own.rgb + acc.w * acc.rgb) / total, total);
+      }
+    }
+  }
+  shared_indirect[i] = result;
+  z[i] = vec4(acc_direct[i].rgb + result.rgb, 1.0);
+}

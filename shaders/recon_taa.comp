@@ -1,0 +1,77 @@
+#version 460
+// Albedo re-modulation and TAA in grid space (Koskela et al. 2019 §3.5, Karis 2014; P5 §3.3:
+// in Visual-Polar space, since screen-space TAA would jitter too much in the fovea): the
+// reprojected history (same taps as Phase I) is clamped to the YCoCg min/max of the cell's
+// 3×3 grid neighbourhood (neighbouring columns at the same φ) and blended with α_taa.
+// .w = 1 marks cells holding a sample (the resolve renormalises over them).
+#extension GL_GOOGLE_include_directive : require
+
+layout(local_size_x = 64) in;
+
+#include "fovea/shaders/grid.h"
+#include "fovea/shaders/pt_trace.h"
+#include "fovea/shaders/recon_grid.h"
+
+layout(std430, binding = 0) readonly buffer Maps { ReconGrid maps[]; };
+layout(std430, binding = 1) readonly buffer Tables { GridColumn tables[]; };
+layout(std430, binding = 2) readonly buffer Pos { vec4 vpos[]; };
+layout(std430, binding = 3) readonly buffer TapIdx { uvec4 tap_idx[]; };
+layout(std430, binding = 4) readonly buffer TapW { vec4 tap_w[]; };
+layout(std430, binding = 5) readonly buffer Post { vec4 post[]; };
+layout(std430, binding = 6) readonly buffer Albedo { vec4 albedo[]; };
+layout(std430, binding = 7) readonly buffer PrevFinal { vec4 prev_final[]; };
+layout(std430, binding = 8) writeonly buffer Final { vec4 final_color[]; };
+
+#include "fovea/shaders/recon_map.h"
+
+layout(push_constant) uniform Push { ReconPostPush pc; };
+
+vec3 to_ycocg(vec3 c) {
+  return vec3(0.25 * c.r + 0.5 * c.g + 0.25 * c.b, 0.5 * c.r - 0.5 * c.b, -0.25 * c.r + 0.5 * c.g - 0.25 * c.b);
+}
+vec3 from_ycocg(vec3 y) { return vec3(y.x + y.y - y.z, y.x + y.z, y.x - y.y - y.z); }
+
+vec3 remodulated(uint i) { return post[i].rgb * max(albedo[i].rgb, vec3(kPtMinDemodAlbedo)); }
+
+void main() {
+  uint i = gl_GlobalInvocationID.x;
+  if (i >= pc.cells) return;
+  if (vpos[i].w <= kReconNoSample + 0.5) {
+    final_color[i] = vec4(0.0);
+    return;
+  }
+  vec3 c = remodulated(i);
+  vec4 w = tap_w[i];
+  float wsum = w.x + w.y + w.z + w.w;
+  if (pc.denoise == 0u || pc.has_history == 0u || wsum <= 0.0) {
+    final_color[i] = vec4(c, 1.0);
+    return;
+  }
+  ReconGrid m = maps[kReconCurrent];
+  uint pcols = m.g.padded_columns;
+  uint col = i % pcols, row = i / pcols;
+  float t = (float(row) + 0.5) / float(max(rg_rows(m, col), 1u));
+  bool polar = m.g.family != kFamilyCartesian;
+  vec3 lo = vec3(3.0e38), hi = vec3(-3.0e38);
+  for (int dc = -1; dc <= 1; ++dc) {
+    int cc = int(col) + dc;
+    if (cc < 0 || cc >= int(m.g.columns)) continue;
+    int rows = int(max(rg_rows(m, uint(cc)), 1u));
+    int r = int(floor(t * float(rows)));
+    for (int dr = -1; dr <= 1; ++dr) {
+      int rr = r + dr;
+      if (polar) rr = (rr % rows + rows) % rows;
+      else if (rr < 0 || rr >= rows) continue;
+      uint j = uint(rr) * pcols + uint(cc);
+      if (vpos[j].w <= kReconNoSample + 0.5) continue;
+      vec3 y = to_ycocg(remodulated(j));
+      lo = min(lo, y);
+      hi = max(hi, y);
+    }
+  }
+  uvec4 idx = tap_idx[i];
+  vec3 h = vec3(0.0);
+  for (int k = 0; k < 4; ++k) h += w[k] * prev_final[idx[k]].rgb;
+  h = from_ycocg(clamp(to_ycocg(h), lo, hi));
+  final_color[i] = vec4(max(mix(h, c, pc.taa_alpha), vec3(0.0)), 1.0);
+}

@@ -1,0 +1,289 @@
+// fovea render: foveated stereo path tracing with reconstruction in grid space, per-frame
+// PNGs, an EXR of the last frame and report.json with timings and quality.
+#include <algorithm>
+#include <array>
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <cstdlib>
+#include <filesystem>
+#include <iostream>
+#include <optional>
+
+#include <nlohmann/json.hpp>
+
+#include "command.hpp"
+#include "fovea/compositor/frame_pipeline.hpp"
+#include "fovea/core/display.hpp"
+#include "fovea/core/error.hpp"
+#include "fovea/core/image.hpp"
+#include "fovea/core/metrics.hpp"
+#include "fovea/devices/gaze.hpp"
+#include "fovea/gpu/context.hpp"
+#include "fovea/renderer/reference.hpp"
+#include "fovea/renderer/scene_io.hpp"
+
+namespace fovea::tools {
+namespace {
+
+namespace fs = std::filesystem;
+
+constexpr const char* kHelp = R"(usage: fovea render [options]
+
+Renders a stereo sequence: per frame and eye the sample grid follows the gaze, the grid is
+path traced (1 sample per cell), reconstructed in grid space (temporal accumulation,
+optional stereo sharing of indirect diffuse, BMFR, TAA) and resolved to the display with
+the peripheral blur. Writes to --out:
+  frame_NNNN_left.png, frame_NNNN_right.png, frame_NNNN_sbs.png   tone-mapped (Reinhard)
+  last_left.exr, last_right.exr                                    linear, last frame
+  report.json   {"frames", "samples_traced_per_eye", "gpu_ms": {trace, reconstruct,
+                 resolve, total, bmfr_fit} (medians), "summary": {"left": {...}, "right": {...}}}
+With --reference SPP each eye's summary compares the last frame with a converged
+Cartesian reference: psnr, fovea_psnr, foveated_psnr, ssim, band_psnr (2° bands), next to
+temporal_error (always). With no options: a short demo on the shipped scene and gaze.
+
+  --scene S             cornell | furnace | glossy-spheres | stereo-occluders | default,
+                        or a .gltf/.glb/.obj file [default]
+  --display NAME|FILE   display preset (fove0, vive, modern, small, tiny) or JSON [small]
+  --gaze URI            recording, or synthetic:<seed>[?...] (docs/gaze.md)
+                        [the shipped recording data/gaze/default.csv]
+  --frames N            frames to render [24]
+  --distribution D      visual-polar | paper-visual-polar | cartesian | cartesian-uniform |
+                        log-polar [visual-polar]
+  --budget B            grid samples as a fraction of display pixels [0.39]
+  --denoiser D          bmfr | none (accumulation only) [bmfr]
+  --stereo-share M      off | gather | alternate [off]
+  --no-blur             skip the peripheral blur
+  --reference SPP       converged reference of the last frame with SPP samples per pixel
+  --png-every N         write PNGs of every N-th frame (0: last frame only) [1]
+  --no-marker           do not mark the gaze in the PNGs
+  --out DIR             output directory [out/render]
+  --quiet               no progress bar
+  --help                this text
+
+Exit status: 0 on success, 2 on invalid arguments or input files, 1 on other errors.
+)";
+
+// The shipped gaze recording: next to the sources ($FOVEA_SOURCE_DIR) or above the binary.
+std::optional<std::string> shipped_gaze() {
+  const fs::path rel = fs::path("data") / "gaze" / "default.csv";
+  if (const char* src = std::getenv("FOVEA_SOURCE_DIR"))
+    if (fs::exists(fs::path(src) / rel)) return (fs::path(src) / rel).string();
+  std::error_code ec;
+  fs::path dir = fs::read_symlink("/proc/self/exe", ec).parent_path();
+  for (int up = 0; !ec && up < 6 && !dir.empty(); ++up, dir = dir.parent_path())
+    if (fs::exists(dir / rel)) return (dir / rel).string();
+  if (fs::exists(rel)) return rel.string();
+  return std::nullopt;
+}
+
+double median(std::vector<double> v) {
+  if (v.empty()) return 0;
+  std::sort(v.begin(), v.end());
+  const std::size_t n = v.size();
+  return n % 2 ? v[n / 2] : 0.5 * (v[n / 2 - 1] + v[n / 2]);
+}
+
+// A small ring around the gaze point (the marker), drawn into a tone-mapped image.
+void mark_gaze(core::Image& img, glm::dvec2 px) {
+  const double r = std::max(3.0, img.width / 80.0);
+  for (int y = int(px.y - r - 2); y <= int(px.y + r + 2); ++y)
+    for (int x = int(px.x - r - 2); x <= int(px.x + r + 2); ++x) {
+      if (x < 0 || y < 0 || x >= img.width || y >= img.height) continue;
+      const double d = std::hypot(x + 0.5 - px.x, y + 0.5 - px.y);
+      if (std::abs(d - r) < 0.8) img.at(x, y) = {0.1f, 1.0f, 0.2f, 1.0f};
+    }
+}
+
+core::Image side_by_side(const core::Image& a, const core::Image& b) {
+  core::Image out(a.width + b.width, std::max(a.height, b.height));
+  for (int y = 0; y < a.height; ++y)
+    for (int x = 0; x < a.width; ++x) out.at(x, y) = a.at(x, y);
+  for (int y = 0; y < b.height; ++y)
+    for (int x = 0; x < b.width; ++x) out.at(a.width + x, y) = b.at(x, y);
+  return out;
+}
+
+void progress(int done, int total, double seconds) {
+  const int width = 30, fill = width * done / std::max(total, 1);
+  std::fprintf(stderr, "\r[%s%s] frame %d/%d  %.1f s", std::string(std::size_t(fill), '#').c_str(),
+               std::string(std::size_t(width - fill), ' ').c_str(), done, total, seconds);
+  std::fflush(stderr);
+}
+
+double mean_w(const std::vector<glm::vec4>& v) {
+  double s = 0;
+  long n = 0;
+  for (const auto& p : v)
+    if (p.w > 0) s += p.w, ++n;
+  return n ? s / double(n) : 0;
+}
+
+int run(std::vector<std::string> argv) {
+  for (const auto& a : argv)
+    if (a == "--help" || a == "-h") {
+      std::cout << kHelp;
+      return 0;
+    }
+  const Args args(argv,
+                  {"scene", "display", "gaze", "frames", "distribution", "budget", "denoiser", "stereo-share",
+                   "reference", "png-every", "out"},
+                  {"no-blur", "no-marker", "quiet"});
+  const long frames = args.integer("frames", 24);
+  if (frames < 1 || frames > 100000) throw core::InputError("--frames must be in 1..100000");
+  const long ref_spp = args.integer("reference", 0);
+  if (ref_spp < 0 || ref_spp > (1L << 20)) throw core::InputError("--reference must be in 1..1048576 samples per pixel");
+  const long png_every = args.integer("png-every", 1);
+  if (png_every < 0) throw core::InputError("--png-every must be >= 0");
+  const core::DisplayPreset display = core::load_display(args.str("display", "small"));
+  core::DistributionParams dp;
+  dp.kind = core::parse_distribution(args.str("distribution", "visual-polar"));
+  dp.budget = args.num("budget", dp.budget);
+  dp.validate();
+  compositor::ReconSettings settings;
+  settings.denoiser = compositor::parse_denoiser(args.str("denoiser", "bmfr"));
+  settings.share = compositor::parse_stereo_share(args.str("stereo-share", "off"));
+  settings.blur = !args.has("no-blur");
+  const fs::path out_dir(args.str("out", "out/render"));
+
+  std::string gaze_uri;
+  if (auto g = args.opt("gaze")) {
+    gaze_uri = *g;
+  } else if (auto shipped = shipped_gaze()) {
+    gaze_uri = *shipped;
+  } else {
+    std::cerr << "warning: the shipped gaze recording (data/gaze/default.csv) was not found; using synthetic:7\n";
+    gaze_uri = "synthetic:7";
+  }
+  devices::SourceOptions so;
+  so.display = display;
+  const auto gaze_source = devices::open_gaze_source(gaze_uri, so);
+
+  const renderer::Scene scene = renderer::load_scene(args.str("scene", "default"));
+  for (const auto& w : scene.warnings) std::cerr << "warning: " << w << "\n";
+  fs::create_directories(out_dir);
+
+  gpu::Context ctx;
+  renderer::GpuScene gpu_scene(ctx, scene);
+  compositor::FramePipeline pipeline(ctx, gpu_scene, display, dp, settings);
+
+  // A static head at the scene's camera; each eye ipd/2 beside it.
+  std::array<core::Pose, 2> poses;
+  for (int e = 0; e < 2; ++e) {
+    poses[e] = scene.camera;
+    poses[e].position += scene.camera.orientation * glm::dvec3((e == 0 ? -0.5 : 0.5) * display.ipd_m, 0, 0);
+  }
+
+  const bool bar = !args.has("quiet") && stderr_is_tty();
+  const bool marker = !args.has("no-marker");
+  std::vector<double> t_trace, t_recon, t_resolve, t_total, t_fit;
+  std::array<core::Image, 2> previous, last;
+  std::array<double, 2> te_sum{0, 0};
+  std::array<glm::dvec3, 2> gaze{glm::dvec3(0, 0, -1), glm::dvec3(0, 0, -1)};
+  const auto start = std::chrono::steady_clock::now();
+  for (long f = 0; f < frames; ++f) {
+    const auto t_ns = core::TimeNs(std::llround(double(f) / display.refresh_hz * 1e9));
+    const devices::GazeSample s = gaze_source->sample_at(t_ns);
+    for (int e = 0; e < 2; ++e) {
+      const devices::EyeGaze& eg = s.eye(core::Eye(e));
+      // Untracked samples keep the previous gaze (the distributions also guard bad input).
+      if (eg.tracked()) gaze[e] = eg.dir;
+      else if (s.combined.tracked()) gaze[e] = s.combined.dir;
+    }
+    const compositor::FrameTimes t = pipeline.render(poses, gaze, std::uint32_t(f));
+    t_trace.push_back(t.trace), t_recon.push_back(t.reconstruct), t_resolve.push_back(t.resolve);
+    t_total.push_back(t.total), t_fit.push_back(t.bmfr_fit);
+    std::array<core::Image, 2> ldr;
+    for (int e = 0; e < 2; ++e) {
+      last[e] = pipeline.image(core::Eye(e));
+      if (f > 0) te_sum[e] += core::temporal_error(previous[e], last[e]);
+      previous[e] = last[e];
+    }
+    const bool write = png_every > 0 ? f % png_every == 0 || f == frames - 1 : f == frames - 1;
+    if (write) {
+      char name[64];
+      for (int e = 0; e < 2; ++e) {
+        ldr[e] = renderer::tone_map(last[e]);
+        const auto& d = pipeline.distribution(core::Eye(e));
+        if (marker)
+          if (auto px = d.view().dir_to_pixel(d.gaze())) mark_gaze(ldr[e], *px);
+        std::snprintf(name, sizeof(name), "frame_%04ld_%s.png", f, e == 0 ? "left" : "right");
+        core::write_png((out_dir / name).string(), ldr[e]);
+      }
+      std::snprintf(name, sizeof(name), "frame_%04ld_sbs.png", f);
+      core::write_png((out_dir / name).string(), side_by_side(ldr[0], ldr[1]));
+    }
+    if (bar)
+      progress(int(f + 1), int(frames),
+               std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count());
+  }
+  if (bar) std::fprintf(stderr, "\n");
+  renderer::write_exr((out_dir / "last_left.exr").string(), last[0]);
+  renderer::write_exr((out_dir / "last_right.exr").string(), last[1]);
+
+  nlohmann::json j;
+  j["frames"] = frames;
+  const std::int64_t traced = (pipeline.traced_cells(core::Eye::Left) + pipeline.traced_cells(core::Eye::Right)) / 2;
+  j["samples_traced_per_eye"] = traced;
+  j["display_pixels_per_eye"] = std::int64_t(display.width) * display.height;
+  j["config"] = {{"scene", args.str("scene", "default")},
+                 {"display", display.name},
+                 {"gaze", gaze_uri},
+                 {"distribution", core::distribution_name(dp.kind)},
+                 {"budget", dp.budget},
+                 {"grid", {pipeline.distribution(core::Eye::Left).columns(), pipeline.distribution(core::Eye::Left).rows()}},
+                 {"denoiser", compositor::denoiser_name(settings.denoiser)},
+                 {"stereo_share", compositor::stereo_share_name(settings.share)},
+                 {"blur", settings.blur}};
+  j["gpu_ms"] = {{"trace", median(t_trace)},
+                 {"reconstruct", median(t_recon)},
+                 {"resolve", median(t_resolve)},
+                 {"total", median(t_total)},
+                 {"bmfr_fit", median(t_fit)}};
+  // Effective indirect-diffuse samples per cell after sharing vs the eye's own.
+  double own = 0, shared = 0;
+  for (int e = 0; e < 2; ++e) {
+    own += mean_w(pipeline.grid_buffer(core::Eye(e), compositor::GridBuffer::AccIndirect));
+    shared += mean_w(pipeline.grid_buffer(core::Eye(e), compositor::GridBuffer::SharedIndirect));
+  }
+  j["stereo"] = {{"own_indirect_samples", own / 2}, {"effective_indirect_samples", shared / 2},
+                 {"gain", own > 0 ? shared / own : 0.0}};
+
+  std::optional<renderer::ReferenceResult> refs[2];
+  for (int e = 0; e < 2; ++e) {
+    const core::Eye eye = core::Eye(e);
+    nlohmann::json s;
+    s["temporal_error"] = frames > 1 ? te_sum[e] / double(frames - 1) : 0.0;
+    if (ref_spp > 0) {
+      renderer::ReferenceOptions o;
+      o.path.spp = std::uint32_t(std::min<long>(ref_spp, 16));
+      o.max_spp = std::uint32_t(ref_spp);
+      const core::View v = pipeline.view(eye);
+      if (bar) std::fprintf(stderr, "reference %s eye, %ld spp...\n", eye == core::Eye::Left ? "left" : "right", ref_spp);
+      const renderer::ReferenceResult r = renderer::render_reference(ctx, gpu_scene, v, eye, o);
+      renderer::write_exr((out_dir / (std::string("reference_") + (e == 0 ? "left" : "right") + ".exr")).string(),
+                          r.image);
+      const glm::dvec3 g = pipeline.distribution(eye).gaze();
+      const std::vector<float> ecc = core::eccentricity_map(v, g);
+      s["psnr"] = core::psnr(last[e], r.image);
+      s["fovea_psnr"] = core::fovea_psnr(last[e], r.image, ecc);
+      s["foveated_psnr"] = core::foveated_psnr(last[e], r.image, v, g);
+      s["ssim"] = core::ssim(last[e], r.image);
+      nlohmann::json bands = nlohmann::json::array();
+      for (const core::BandPsnr& b : core::band_psnr(last[e], r.image, ecc, 2.0))
+        bands.push_back({{"e_min", b.e_min}, {"e_max", b.e_max}, {"pixels", b.pixels}, {"psnr", b.psnr}});
+      s["band_psnr"] = bands;
+      s["reference_spp"] = r.spp;
+    }
+    j["summary"][e == 0 ? "left" : "right"] = s;
+  }
+  core::write_file_atomic((out_dir / "report.json").string(), j.dump(2) + "\n");
+  std::cout << j["gpu_ms"].dump() << "\n";
+  return 0;
+}
+
+}  // namespace
+
+FOVEA_COMMAND(render_command, "render", "foveated stereo path tracing + reconstruction; PNGs, EXR, report.json", run);
+
+}  // namespace fovea::tools
