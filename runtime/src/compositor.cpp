@@ -34,11 +34,14 @@ glm::vec4 bilinear(const core::Image& img, glm::dvec2 px) {
   return glm::mix(top, bottom, fy);
 }
 
-// Blacks out the view pixels whose direction no one can see through the lens.
-void apply_hidden_area(core::Image& img, const core::View& view, const core::HiddenAreaMask& hidden) {
-  for (int y = 0; y < img.height; ++y)
-    for (int x = 0; x < img.width; ++x)
-      if (!hidden.visible(view.pixel_to_dir({x + 0.5, y + 0.5}))) img.at(x, y) = {0, 0, 0, 1};
+// Which pixels of the rendered view anyone can see through the lens (1) — inverse optics
+// per pixel, so computed once per eye.
+std::vector<std::uint8_t> visible_pixels(const core::View& view, const core::HiddenAreaMask& hidden) {
+  std::vector<std::uint8_t> v(size_t(view.width()) * view.height());
+  for (int y = 0; y < view.height(); ++y)
+    for (int x = 0; x < view.width(); ++x)
+      v[size_t(y) * view.width() + x] = hidden.visible(view.pixel_to_dir({x + 0.5, y + 0.5})) ? 1 : 0;
+  return v;
 }
 
 }  // namespace
@@ -179,7 +182,10 @@ void Compositor::compose(std::int64_t index, const std::vector<ProjectionLayer>&
     } else if (lens_ == LensMode::Cpu) {
       panel = compositor::distort_reference(hidden, rendered);
     } else {
-      apply_hidden_area(rendered, view, hidden);
+      auto& visible = visible_[size_t(e)];
+      if (visible.empty()) visible = visible_pixels(view, hidden);
+      for (size_t i = 0; i < visible.size(); ++i)
+        if (!visible[i]) rendered.pixels[i] = {0, 0, 0, 1};
       panel = std::move(rendered);
     }
     char name[64];

@@ -72,6 +72,8 @@ class Compositor {
   // Gpu mode: created at the first composed frame.
   std::unique_ptr<gpu::Context> gpu_;
   std::array<std::unique_ptr<compositor::DistortionPass>, 2> passes_;
+  // Off mode: per eye, whether each rendered-view pixel is visible (computed at first use).
+  std::array<std::vector<std::uint8_t>, 2> visible_;
   std::string out_dir_;
   std::int64_t png_every_;
   VkBuffer staging_ = VK_NULL_HANDLE;
