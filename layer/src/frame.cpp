@@ -1,6 +1,8 @@
 // Frame intercepts: xrWaitFrame/xrBeginFrame/xrEndFrame are timed, xrLocateViews results
 // are kept for the frame renderer. Without a renderer the application's frame goes down
 // unchanged; with one, its layers replace the application's (frame_renderer.hpp).
+#include <stdexcept>
+
 #include "layer.hpp"
 #include "log.hpp"
 
@@ -80,6 +82,19 @@ XrResult intercept::xrEndFrame(XrSession session, const XrFrameEndInfo* info) {
     in.display_time = info->displayTime;
     if (s.views_time == info->displayTime) in.views = s.views;
     in.app_frame = info;
+    for (uint32_t i = 0; info->layers && i < info->layerCount && in.app_views.empty(); ++i) {
+      if (!info->layers[i] || info->layers[i]->type != XR_TYPE_COMPOSITION_LAYER_PROJECTION) continue;
+      const auto* p = reinterpret_cast<const XrCompositionLayerProjection*>(info->layers[i]);
+      for (uint32_t v = 0; v < p->viewCount; ++v) {
+        const XrCompositionLayerProjectionView& pv = p->views[v];
+        auto sc = layer().swapchains.find(pv.subImage.swapchain);
+        if (sc == layer().swapchains.end() || sc->second.last_released < 0 ||
+            size_t(sc->second.last_released) >= sc->second.images.size())
+          throw std::runtime_error("a submitted swapchain has no released image the layer knows");
+        in.app_views.push_back({sc->second.images[size_t(sc->second.last_released)], VkFormat(sc->second.info.format),
+                                pv.subImage.imageRect, pv.subImage.imageArrayIndex, pv.pose, pv.fov});
+      }
+    }
     if (const XrFrameEndInfo* replaced = s.renderer->render(in)) submit = replaced;
   });
   const XrResult r = next(session, submit);

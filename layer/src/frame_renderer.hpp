@@ -27,10 +27,22 @@ struct VulkanBinding {
   bool valid() const { return device != VK_NULL_HANDLE; }
 };
 
+// One projection view the application submitted: its last released swapchain image
+// (COLOR_ATTACHMENT_OPTIMAL, owned by the session queue), for compositing over it.
+struct AppView {
+  VkImage image = VK_NULL_HANDLE;
+  VkFormat format = VK_FORMAT_UNDEFINED;
+  XrRect2Di rect{};
+  std::uint32_t array_index = 0;
+  XrPosef pose{};
+  XrFovf fov{};
+};
+
 struct FrameInput {
   std::int64_t frame = 0;
   XrTime display_time = 0;
-  std::vector<XrView> views;  // as located for display_time (xrLocateViews)
+  std::vector<XrView> views;        // as located for display_time (xrLocateViews)
+  std::vector<AppView> app_views;   // the first projection layer's views
   const XrFrameEndInfo* app_frame = nullptr;
 };
 
