@@ -358,6 +358,67 @@ TEST_F(XrTest, SwapchainAcquireWaitRelease) {
   EXPECT_EQ(frame(null_layer), XR_ERROR_LAYER_INVALID);
 }
 
+// Acquires, waits and releases one image of `sc`.
+void cycle(XrSwapchain sc) {
+  uint32_t i = 0;
+  ASSERT_EQ(xrAcquireSwapchainImage(sc, nullptr, &i), XR_SUCCESS);
+  XrSwapchainImageWaitInfo wi{XR_TYPE_SWAPCHAIN_IMAGE_WAIT_INFO};
+  wi.timeout = XR_INFINITE_DURATION;
+  ASSERT_EQ(xrWaitSwapchainImage(sc, &wi), XR_SUCCESS);
+  ASSERT_EQ(xrReleaseSwapchainImage(sc, nullptr), XR_SUCCESS);
+}
+
+TEST_F(XrTest, CompositionLayerDepthAccepted) {
+  create_instance({XR_KHR_COMPOSITION_LAYER_DEPTH_EXTENSION_NAME});
+  run_to_focused();
+  const XrSwapchain color = color_swapchain(64, 72);
+  XrSwapchainCreateInfo ci{XR_TYPE_SWAPCHAIN_CREATE_INFO};
+  ci.usageFlags = XR_SWAPCHAIN_USAGE_DEPTH_STENCIL_ATTACHMENT_BIT;
+  ci.format = VK_FORMAT_D32_SFLOAT;
+  ci.sampleCount = ci.faceCount = ci.arraySize = ci.mipCount = 1;
+  ci.width = 64;
+  ci.height = 72;
+  XrSwapchain depth = XR_NULL_HANDLE;
+  ASSERT_EQ(xrCreateSwapchain(session_, &ci, &depth), XR_SUCCESS);
+  cycle(color);
+  cycle(depth);
+  XrCompositionLayerDepthInfoKHR di[2];
+  XrCompositionLayerProjectionView pv[2];
+  for (int i = 0; i < 2; ++i) {
+    di[i] = {XR_TYPE_COMPOSITION_LAYER_DEPTH_INFO_KHR};
+    di[i].subImage.swapchain = depth;
+    di[i].subImage.imageRect = {{0, 0}, {64, 72}};
+    di[i].minDepth = 0;
+    di[i].maxDepth = 1;
+    di[i].nearZ = 0.1f;
+    di[i].farZ = 100;
+    pv[i] = {XR_TYPE_COMPOSITION_LAYER_PROJECTION_VIEW};
+    pv[i].next = &di[i];
+    pv[i].pose.orientation.w = 1;
+    pv[i].fov = {-0.8f, 0.8f, 0.8f, -0.8f};
+    pv[i].subImage.swapchain = color;
+    pv[i].subImage.imageRect = {{0, 0}, {64, 72}};
+  }
+  XrCompositionLayerProjection layer{XR_TYPE_COMPOSITION_LAYER_PROJECTION};
+  layer.space = reference_space(XR_REFERENCE_SPACE_TYPE_LOCAL);
+  layer.viewCount = 2;
+  layer.views = pv;
+  const std::vector<const XrCompositionLayerBaseHeader*> layers{
+      reinterpret_cast<const XrCompositionLayerBaseHeader*>(&layer)};
+  EXPECT_EQ(frame(layers), XR_SUCCESS);
+  di[1].minDepth = 0.9f;
+  di[1].maxDepth = 0.1f;
+  EXPECT_EQ(frame(layers), XR_ERROR_VALIDATION_FAILURE);
+  di[1].minDepth = 0;
+  di[1].maxDepth = 1;
+  di[1].subImage.swapchain = color;  // a colour swapchain as depth
+  EXPECT_EQ(frame(layers), XR_ERROR_VALIDATION_FAILURE);
+  // A colour format with depth usage is refused at creation.
+  ci.format = VK_FORMAT_R8G8B8A8_SRGB;
+  XrSwapchain bad = XR_NULL_HANDLE;
+  EXPECT_EQ(xrCreateSwapchain(session_, &ci, &bad), XR_ERROR_FEATURE_UNSUPPORTED);
+}
+
 TEST_F(XrTest, ControllerBindingsAcceptedButInactive) {
   create_instance();
   create_session();
