@@ -113,7 +113,6 @@ XrResult api::xrWaitFrame(XrSession session, const XrFrameWaitInfo* info, XrFram
     r.wait_return_ns = core::now_ns();
     r.late_ns = std::max<core::TimeNs>(0, r.wait_return_ns - slot.wake_ns);
     s->waited.push_back(r);
-    ++s->frames_waited;
     state->predictedDisplayTime = slot.display_ns;
     state->predictedDisplayPeriod = s->clock.period();
     state->shouldRender =
@@ -137,7 +136,6 @@ XrResult api::xrBeginFrame(XrSession session, const XrFrameBeginInfo* info) {
     s->waited.pop_front();
     s->current.begin_ns = core::now_ns();
     s->frame_open = true;
-    ++s->frames_begun;
     return discarded ? XR_FRAME_DISCARDED : XR_SUCCESS;
   });
 }

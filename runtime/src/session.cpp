@@ -37,7 +37,7 @@ XrResult api::xrCreateSession(XrInstance instance, const XrSessionCreateInfo* in
     if (!inst) return XR_ERROR_HANDLE_INVALID;
     if (!has_type(info, XR_TYPE_SESSION_CREATE_INFO) || !session) return XR_ERROR_VALIDATION_FAILURE;
     if (info->createFlags != 0) return XR_ERROR_VALIDATION_FAILURE;
-    if (info->systemId != kSystemId) return XR_ERROR_SYSTEM_INVALID;
+    if (info->systemId != kSystemId || !inst->system_queried) return XR_ERROR_SYSTEM_INVALID;
     const auto* binding =
         find_next<const XrGraphicsBindingVulkanKHR>(info->next, XR_TYPE_GRAPHICS_BINDING_VULKAN_KHR);
     if (!binding || !(inst->has(XR_KHR_VULKAN_ENABLE_EXTENSION_NAME) || inst->has(XR_KHR_VULKAN_ENABLE2_EXTENSION_NAME)))
@@ -57,7 +57,6 @@ XrResult api::xrCreateSession(XrInstance instance, const XrSessionCreateInfo* in
     auto s = std::make_unique<Session>();
     s->instance = inst;
     s->created_ns = xr_now();
-    s->vk_instance = binding->instance;
     s->vk_physical = binding->physicalDevice;
     s->vk_device = binding->device;
     s->queue_family = binding->queueFamilyIndex;

@@ -72,7 +72,8 @@ struct Instance final : Object {
   std::unique_ptr<GazeTracker> gaze;
   // The lens-derived hidden area of each eye (visibility masks, compositor).
   std::array<std::unique_ptr<core::HiddenAreaMask>, 2> hidden;
-  // Vulkan objects the runtime created on the application's behalf (enable2); reported only.
+  // The VkInstance the runtime created for the application (enable2): xrCreateVulkanDeviceKHR
+  // resolves vkCreateDevice through it.
   VkInstance vk_instance = VK_NULL_HANDLE;
 
   bool has(const char* ext) const { return extensions.count(ext) != 0; }
@@ -89,16 +90,14 @@ struct Session final : Object {
   core::TimeNs created_ns = 0;
   bool running = false;
   bool exit_requested = false;
-  XrViewConfigurationType view_config = XR_VIEW_CONFIGURATION_TYPE_PRIMARY_STEREO;
   // Graphics binding (XR_KHR_vulkan_enable / enable2).
-  VkInstance vk_instance = VK_NULL_HANDLE;
   VkPhysicalDevice vk_physical = VK_NULL_HANDLE;
   VkDevice vk_device = VK_NULL_HANDLE;
   std::uint32_t queue_family = 0, queue_index = 0;
   VkQueue queue = VK_NULL_HANDLE;
   // Frame loop.
   DisplayClock clock{90};
-  std::int64_t frames_waited = 0, frames_begun = 0, frames_ended = 0;
+  std::int64_t frames_ended = 0;
   bool frame_open = false;  // between xrBeginFrame and xrEndFrame
   std::deque<FrameRecord> waited;  // frames returned by xrWaitFrame, not yet begun
   FrameRecord current;             // the open frame
