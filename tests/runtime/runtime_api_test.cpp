@@ -248,6 +248,19 @@ TEST_F(XrTest, DisplayClock) {
   const XrTime t_now = XrTime(now.tv_sec) * 1'000'000'000 + now.tv_nsec;
   EXPECT_GT(b.predictedDisplayTime, t_now - 1'000'000'000);
   EXPECT_LT(b.predictedDisplayTime, t_now + 1'000'000'000);
+  // An application faster than the display is paced by xrWaitFrame: 10 frames take at
+  // least 9 periods of wall time.
+  const auto mono = [] {
+    timespec ts{};
+    clock_gettime(CLOCK_MONOTONIC, &ts);
+    return XrTime(ts.tv_sec) * 1'000'000'000 + ts.tv_nsec;
+  };
+  const XrTime start = mono();
+  for (int i = 0; i < 10; ++i) {
+    XrFrameState fs{XR_TYPE_FRAME_STATE};
+    ASSERT_EQ(frame({}, &fs), XR_SUCCESS);
+  }
+  EXPECT_GE(mono() - start, 9 * a.predictedDisplayPeriod);
 }
 
 TEST_F(XrTest, SpacesAndViews) {
