@@ -5,9 +5,6 @@
 // Output layout and conventions: fovea/shaders/pt_trace.h.
 #extension GL_GOOGLE_include_directive : require
 #include "fovea/shaders/common.h"
-// common.h's FOVEA_U pastes a `u` suffix, which glslang rejects; grid.h uses it.
-#undef FOVEA_U
-#define FOVEA_U(x) uint(x)
 #include "fovea/shaders/grid.h"
 #include "fovea/shaders/pt_scene.h"
 #include "fovea/shaders/pt_trace.h"
