@@ -157,7 +157,10 @@ void load_textures(Ctx& c) {
           std::uint8_t px[4] = {0, 0, 0, 255};
           for (int k = 0; k < comp; ++k)  // 16-bit: keep the high byte (little endian)
             px[k] = img.image[(i * comp + k) * bpc + (bpc - 1)];
-          if (comp <= 2) px[2] = px[1] = px[0], px[3] = comp == 2 ? img.image[(i * comp + 1) * bpc + bpc - 1] : 255;
+          if (comp <= 2) {  // grey (+ alpha)
+            px[3] = comp == 2 ? px[1] : 255;
+            px[1] = px[2] = px[0];
+          }
           std::memcpy(&t.rgba[i * 4], px, 4);
         }
       }

@@ -11,7 +11,6 @@
 #include <tinyexr.h>
 
 #include "fovea/core/error.hpp"
-#include "fovea/gpu/barriers.hpp"
 
 namespace fovea::renderer {
 

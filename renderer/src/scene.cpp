@@ -82,6 +82,7 @@ void sanitize(Scene& s, const std::string& origin, const SceneLimits& limits) {
     // GGX with alpha -> 0 is a delta lobe the sampler cannot evaluate; 0.02 is mirror-like enough.
     m.roughness = clamp_finite(m.roughness, 0.02f, 1.0f, 1.0f);
     m.specular = clamp_finite(m.specular, 0.0f, 1.0f, 0.04f);
+    // Raising a valid roughness below 0.02 to the floor is silent; anything invalid warns.
     if (bc != m.base_color || metallic != m.metallic || spec != m.specular ||
         (rough != m.roughness && !(rough >= 0.0f && rough < 0.02f)))
       rep.note("material parameter out of range, clamped");
