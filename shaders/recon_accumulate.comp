@@ -10,6 +10,7 @@
 layout(local_size_x = 64) in;
 
 #include "fovea/shaders/grid.h"
+#include "fovea/shaders/pt_scene.h"
 #include "fovea/shaders/recon_grid.h"
 
 layout(std430, binding = 0) readonly buffer Maps { ReconGrid maps[]; };
@@ -29,6 +30,7 @@ layout(std430, binding = 13) writeonly buffer Pos { vec4 vpos[]; };
 layout(std430, binding = 14) writeonly buffer Nrm { vec4 vnrm[]; };
 layout(std430, binding = 15) writeonly buffer TapIdx { uvec4 tap_idx[]; };
 layout(std430, binding = 16) writeonly buffer TapW { vec4 tap_w[]; };
+layout(std430, binding = 17) readonly buffer Materials { PtMaterial materials[]; };
 
 #include "fovea/shaders/recon_map.h"
 
@@ -54,7 +56,12 @@ void main() {
   vec3 p = sky ? normalize(rg_view_to_world_dir(cur, vec3(s.dir_x, s.dir_y, s.dir_z))) : pm.xyz;
   vec3 n = normal_depth[i].xyz;
   float depth = sky ? 0.0 : length(pm.xyz - eye);
-  vec4 here = vec4(p, sky ? -1.0 : pm.w);
+  float code = kReconSky;
+  if (!sky) {
+    PtMaterial mat = materials[uint(pm.w)];
+    code = max(max(mat.emit_r, mat.emit_g), mat.emit_b) > 0.0 ? kReconEmitterBase - pm.w : pm.w;
+  }
+  vec4 here = vec4(p, code);
   vpos[i] = here;
   vnrm[i] = vec4(n, depth);
 

@@ -5,7 +5,8 @@
 // uniform ±ε noise on the non-constant features (Eq. 7), Householder QR of [T + N | z_r z_g z_b]
 // keeping only R (Q is never formed), back substitution R α = r (Eq. 5) per channel and the
 // weighted sum with the noise-free features (Eq. 6). Cells without a surface sample
-// (clipped, off-screen, padding, sky) are zero rows: masked out of the regression.
+// (clipped, off-screen, padding, sky) and emitters are zero rows: masked out of the regression
+// (the sky and emitters keep their accumulated input).
 //
 // Workgroup: 256 invocations own 4 rows (cells) each, kept in registers for the whole QR.
 // Each reduction sums 4 rows per invocation, then the subgroup (8 lanes on lavapipe), then
@@ -82,7 +83,7 @@ void main() {
     wpos[q] = vec3(0.0);
     if (!inside(c)) continue;
     vec4 p = vpos[uint(c.y) * pc.padded_columns + uint(c.x)];
-    if (p.w < 0.0) continue;  // sky or no sample
+    if (p.w < 0.0) continue;  // sky, emitter or no sample
     valid[q] = true;
     wpos[q] = p.xyz;
     count += 1.0;
@@ -104,7 +105,7 @@ void main() {
       ivec2 c = cell_of(tid + q * 256u);
       if (!inside(c)) continue;
       uint i = uint(c.y) * pc.padded_columns + uint(c.x);
-      fitted[i] = vpos[i].w == -1.0 ? z[i] : vec4(0.0);
+      fitted[i] = rg_no_sample(vpos[i].w) ? vec4(0.0) : z[i];
     }
     return;
   }
@@ -187,7 +188,7 @@ void main() {
     if (!inside(c)) continue;
     uint i = uint(c.y) * pc.padded_columns + uint(c.x);
     if (!valid[q]) {
-      fitted[i] = vpos[i].w == -1.0 ? z[i] : vec4(0.0);
+      fitted[i] = rg_no_sample(vpos[i].w) ? vec4(0.0) : z[i];
       continue;
     }
     vec3 n = feat_n[q];

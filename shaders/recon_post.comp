@@ -22,7 +22,7 @@ layout(push_constant) uniform Push { ReconPostPush pc; };
 void main() {
   uint i = gl_GlobalInvocationID.x;
   if (i >= pc.cells) return;
-  if (vpos[i].w <= kReconNoSample + 0.5) {
+  if (rg_no_sample(vpos[i].w)) {
     post[i] = vec4(0.0);
     return;
   }

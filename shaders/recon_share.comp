@@ -33,7 +33,7 @@ void main() {
   if (i >= pc.cells) return;
   vec4 here = vpos[i];
   vec4 own = acc_indirect[i];
-  if (here.w <= kReconNoSample + 0.5) {
+  if (rg_no_sample(here.w)) {
     shared_indirect[i] = vec4(0.0);
     z[i] = vec4(0.0);
     return;
@@ -41,7 +41,7 @@ void main() {
   vec4 result = own;
   if (pc.enabled != 0u && maps[kReconOther].valid != 0u) {
     ReconGrid other = maps[kReconOther];
-    bool sky = here.w < 0.0;
+    bool sky = here.w == kReconSky;
     vec2 uv;
     if (rg_world_to_grid(other, here.xyz, sky, uv)) {
       uvec4 idx;

@@ -36,7 +36,7 @@ vec3 remodulated(uint i) { return post[i].rgb * max(albedo[i].rgb, vec3(kPtMinDe
 void main() {
   uint i = gl_GlobalInvocationID.x;
   if (i >= pc.cells) return;
-  if (vpos[i].w <= kReconNoSample + 0.5) {
+  if (rg_no_sample(vpos[i].w)) {
     final_color[i] = vec4(0.0);
     return;
   }
@@ -63,7 +63,7 @@ void main() {
       if (polar) rr = (rr % rows + rows) % rows;
       else if (rr < 0 || rr >= rows) continue;
       uint j = uint(rr) * pcols + uint(cc);
-      if (vpos[j].w <= kReconNoSample + 0.5) continue;
+      if (rg_no_sample(vpos[j].w)) continue;
       vec3 y = to_ycocg(remodulated(j));
       lo = min(lo, y);
       hi = max(hi, y);

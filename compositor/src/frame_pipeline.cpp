@@ -46,7 +46,7 @@ struct Kernels {
   gpu::ComputePipeline accumulate, share, post, taa, mip, resolve, blur;
   BmfrFit fit;
   explicit Kernels(gpu::Context& ctx)
-      : accumulate(make_pipeline(ctx, "recon_accumulate.comp.spv", 17, sizeof(shaders::ReconAccumulatePush))),
+      : accumulate(make_pipeline(ctx, "recon_accumulate.comp.spv", 18, sizeof(shaders::ReconAccumulatePush))),
         share(make_pipeline(ctx, "recon_share.comp.spv", 11, sizeof(shaders::ReconSharePush))),
         post(make_pipeline(ctx, "recon_post.comp.spv", 7, sizeof(shaders::ReconPostPush))),
         taa(make_pipeline(ctx, "recon_taa.comp.spv", 9, sizeof(shaders::ReconPostPush))),
@@ -175,7 +175,7 @@ struct FramePipeline::Impl {
       e.acc_set[p] = make_set(ctx, k.accumulate,
                               {&e.maps, &e.tables, &e.grid, &t.direct(), &t.indirect(), &t.normal_depth(),
                                &t.position_material(), &e.acc_d[q], &e.acc_i[q], &e.vpos[q], &e.vnrm[q], &e.acc_d[p],
-                               &e.acc_i[p], &e.vpos[p], &e.vnrm[p], &e.tap_idx, &e.tap_w});
+                               &e.acc_i[p], &e.vpos[p], &e.vnrm[p], &e.tap_idx, &e.tap_w, &tracer.scene().materials()});
       e.share_set[p] = make_set(ctx, k.share,
                                 {&e.maps, &e.tables, &e.vpos[p], &e.vnrm[p], &e.acc_d[p], &e.acc_i[p], &o.vpos[p],
                                  &o.vnrm[p], &o.acc_i[p], &e.shared, &e.z});
@@ -383,6 +383,7 @@ std::vector<glm::vec4> FramePipeline::grid_buffer(core::Eye eye, GridBuffer whic
       case GridBuffer::Fitted: b = &e->fitted; break;
       case GridBuffer::Final: b = &e->final_[p]; break;
       case GridBuffer::Albedo: b = &e->trace.albedo(); break;
+      case GridBuffer::Position: b = &e->vpos[p]; break;
     }
     std::vector<glm::vec4> v = b->download<glm::vec4>();
     v.resize(e->cells);

@@ -39,6 +39,7 @@ enum class GridBuffer {
   Fitted,          // BMFR weighted sum (demodulated)
   Final,           // remodulated output in grid space (.w = 1 where a sample exists)
   Albedo,
+  Position,        // validation data: world position (sky: direction), .w material (-2: no sample)
 };
 
 class FramePipeline {

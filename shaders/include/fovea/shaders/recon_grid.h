@@ -35,8 +35,12 @@ FOVEA_CONST float kReconNormalLimit2 = 0.25f;
 FOVEA_CONST float kReconPlaneTol = 0.03f;
 FOVEA_CONST float kReconDistTol = 0.25f;  // and |Δp| < this·depth (other surfaces far along the plane)
 
-// Material value stored in the validation data of cells that carry no sample.
+// Material codes in the validation data (.w of the position): >= 0 a surface, -1 the sky
+// (position = direction), -2 no sample, <= -3 an emitter (−3 − material): emission is not
+// a function of the regression's features, so emitters pass through BMFR unfitted.
+FOVEA_CONST float kReconSky = -1.0f;
 FOVEA_CONST float kReconNoSample = -2.0f;
+FOVEA_CONST float kReconEmitterBase = -3.0f;
 
 struct ReconAccumulatePush {
   FOVEA_UINT cells, has_history, indirect_fresh, pad;  // indirect_fresh = 0: reuse history only
@@ -80,5 +84,7 @@ static_assert(sizeof(ReconPostPush) == 32);
 static_assert(sizeof(ReconMipPush) == 32);
 static_assert(sizeof(ReconBlurPush) == 32);
 }  // namespace fovea::shaders
+#else
+bool rg_no_sample(float code) { return abs(code - kReconNoSample) < 0.5; }
 #endif
 #endif

@@ -113,8 +113,8 @@ void rg_taps(ReconGrid m, vec2 uv, out uvec4 idx, out vec4 w) {
 // Tap validity (see kRecon* above). vpos: xyz world position (sky: world direction),
 // w material (-1 sky, kReconNoSample none); n: unit normal; depth: the sample's distance.
 bool rg_tap_valid(vec4 vpos, vec3 n, float depth, vec4 tap_pos, vec3 tap_n) {
-  if (vpos.w <= kReconNoSample + 0.5 || tap_pos.w != vpos.w) return false;
-  if (vpos.w < 0.0) return dot(vpos.xyz, tap_pos.xyz) > 0.9995;  // sky: nearly the same direction
+  if (rg_no_sample(vpos.w) || tap_pos.w != vpos.w) return false;
+  if (vpos.w == kReconSky) return dot(vpos.xyz, tap_pos.xyz) > 0.9995;  // nearly the same direction
   vec3 dn = n - tap_n;
   if (dot(dn, dn) >= kReconNormalLimit2) return false;
   vec3 dp = tap_pos.xyz - vpos.xyz;

@@ -1,0 +1,73 @@
+#pragma once
+// Helpers for the reconstruction tests: eye poses, small displays, grid-space references.
+#include <array>
+#include <cmath>
+#include <string>
+#include <vector>
+
+#include <glm/vec4.hpp>
+
+#include "fovea/compositor/frame_pipeline.hpp"
+#include "fovea/core/display.hpp"
+#include "fovea/core/image.hpp"
+#include "fovea/gpu/barriers.hpp"
+#include "fovea/renderer/path_tracer.hpp"
+#include "fovea/renderer/scene.hpp"
+
+namespace fovea::test {
+
+inline std::array<core::Pose, 2> eye_poses(const renderer::Scene& s, double ipd) {
+  std::array<core::Pose, 2> p{s.camera, s.camera};
+  p[0].position += s.camera.orientation * glm::dvec3(-0.5 * ipd, 0, 0);
+  p[1].position += s.camera.orientation * glm::dvec3(0.5 * ipd, 0, 0);
+  return p;
+}
+
+// The tiny preset's optics at another raster size.
+inline core::DisplayPreset display_of_size(int w, int h) {
+  core::DisplayPreset d = core::load_display("tiny");
+  d.width = w;
+  d.height = h;
+  return d;
+}
+
+// Mean of `frames` frames of 1 spp traced on `grid` (the pipeline's current grid): a
+// grid-space reference of the plain radiance and of the demodulated indirect diffuse.
+struct GridReference {
+  std::vector<glm::vec4> radiance, indirect;
+};
+inline GridReference trace_reference(gpu::Context& ctx, const renderer::GpuScene& scene,
+                                     const std::vector<shaders::GridSample>& grid, const core::View& view,
+                                     core::Eye eye, std::uint32_t frames) {
+  gpu::Buffer g(ctx, {grid.size() * sizeof(shaders::GridSample), gpu::BufferUsage::Storage, gpu::Memory::DeviceLocal,
+                      "test.grid"});
+  g.upload(grid);
+  renderer::PathTracer pt(ctx, scene);
+  renderer::TraceOutputs out = pt.bind(g, std::uint32_t(grid.size()));
+  ctx.submit_and_wait([&](VkCommandBuffer cmd) {
+    for (std::uint32_t f = 0; f < frames; ++f) {
+      if (f) gpu::compute_to_compute(cmd);
+      pt.record(cmd, out, view, eye, 100000 + f, {}, f);
+    }
+  });
+  return {out.radiance().download<glm::vec4>(), out.indirect().download<glm::vec4>()};
+}
+
+// Cells as a one-row image (rgb), selected by `keep`.
+template <class Keep>
+inline core::Image cells_image(const std::vector<glm::vec4>& v, Keep keep) {
+  std::vector<glm::vec4> px;
+  for (std::size_t i = 0; i < v.size(); ++i)
+    if (keep(i)) px.push_back(glm::vec4(glm::vec3(v[i]), 1.0f));
+  core::Image img(int(px.size()), 1);
+  img.pixels = px;
+  return img;
+}
+
+inline bool all_finite(const std::vector<glm::vec4>& v) {
+  for (const auto& p : v)
+    if (!std::isfinite(p.x) || !std::isfinite(p.y) || !std::isfinite(p.z) || !std::isfinite(p.w)) return false;
+  return true;
+}
+
+}  // namespace fovea::test

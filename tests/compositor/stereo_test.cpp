@@ -1,0 +1,95 @@
+// Stereo sharing of indirect diffuse on the stereo-occluders scene: gathering the other
+// eye's samples raises indirect PSNR, and never pulls data across a disocclusion.
+#include <glm/gtc/quaternion.hpp>
+
+#include "fovea/core/metrics.hpp"
+#include "fovea/renderer/scene_io.hpp"
+#include "gpu_fixture.hpp"
+#include "reconstruct_helpers.hpp"
+
+namespace compositor = fovea::compositor;
+namespace core = fovea::core;
+namespace renderer = fovea::renderer;
+using fovea::test::GpuTest;
+
+TEST_F(GpuTest, StereoGatherRaisesIndirectPsnrAndRespectsDisocclusions) {
+  const renderer::Scene scene = renderer::load_scene("stereo-occluders");
+  renderer::GpuScene gs(ctx(), scene);
+  const core::DisplayPreset display = fovea::test::display_of_size(96, 108);
+  compositor::ReconSettings off, gather;
+  off.blur = gather.blur = false;
+  gather.share = compositor::StereoShare::Gather;
+  compositor::FramePipeline a(ctx(), gs, display, {}, off), b(ctx(), gs, display, {}, gather);
+  const auto poses = fovea::test::eye_poses(scene, display.ipd_m);
+  const std::array<glm::dvec3, 2> gaze{glm::dvec3(0, 0, -1), glm::dvec3(0, 0, -1)};
+  for (std::uint32_t f = 0; f < 3; ++f) {
+    a.render(poses, gaze, f);
+    b.render(poses, gaze, f);
+  }
+  const core::Eye L = core::Eye::Left;
+  const auto samples = b.grid_samples(L);
+  const auto ref = fovea::test::trace_reference(ctx(), gs, samples, b.view(L), L, 128);
+  const auto pos = b.grid_buffer(L, compositor::GridBuffer::Position);
+  auto keep = [&](std::size_t i) { return samples[i].flags == 0 && pos[i].w >= 0; };
+  const core::Image reference = fovea::test::cells_image(ref.indirect, keep);
+  const auto own = a.grid_buffer(L, compositor::GridBuffer::SharedIndirect);  // sharing off: own only
+  const auto shared = b.grid_buffer(L, compositor::GridBuffer::SharedIndirect);
+  const double p_off = core::psnr(fovea::test::cells_image(own, keep), reference);
+  const double p_gather = core::psnr(fovea::test::cells_image(shared, keep), reference);
+  std::printf("indirect PSNR: own %.2f dB, gather %.2f dB\n", p_off, p_gather);
+  EXPECT_GT(p_gather, p_off + 1.0);
+
+  // Disocclusions: left-eye surface points whose projection into the right eye lands on
+  // another surface (a pillar in front) in the whole 3×3 neighbourhood of right-eye cells.
+  const auto& dr = b.distribution(core::Eye::Right);
+  const core::View vr = b.view(core::Eye::Right);
+  const auto rpos = b.grid_buffer(core::Eye::Right, compositor::GridBuffer::Position);
+  const auto own_b = b.grid_buffer(L, compositor::GridBuffer::AccIndirect);
+  const glm::dquat inv = glm::inverse(vr.pose().orientation);
+  int occluded = 0;
+  for (std::size_t i = 0; i < pos.size(); ++i) {
+    if (!keep(i)) continue;
+    const glm::dvec3 p(pos[i]);
+    const auto px = vr.dir_to_pixel(inv * (p - vr.pose().position));
+    if (!px || !vr.contains_pixel(*px)) continue;
+    const auto g = dr.screen_to_grid(*px);
+    if (!g) continue;
+    bool all_other = true;
+    for (int dc = -1; dc <= 1 && all_other; ++dc)
+      for (int drow = -1; drow <= 1 && all_other; ++drow) {
+        // The same φ in the neighbouring column (rows differ per column; φ wraps).
+        const int c0 = std::clamp(int(g->x), 0, dr.columns() - 1);
+        const int c = std::clamp(c0 + dc, 0, dr.columns() - 1);
+        const double t = g->y / dr.column_table()[c0].rows;
+        const int rows = int(dr.column_table()[c].rows);
+        const int r = ((int(std::floor(t * rows)) + drow) % rows + rows) % rows;
+        const glm::vec4 q = rpos[std::size_t(r) * dr.padded_columns() + c];
+        all_other = q.w >= 0 && glm::length(glm::dvec3(q) - p) > 0.2 * glm::length(p - vr.pose().position);
+      }
+    if (!all_other) continue;
+    ++occluded;
+    EXPECT_EQ(shared[i], own_b[i]) << "cell " << i;
+  }
+  std::printf("%d left-eye cells disoccluded in the right eye\n", occluded);
+  EXPECT_GT(occluded, 3);  // the pillars hide some of the wall from the right eye
+}
+
+TEST_F(GpuTest, StereoAlternateFillsTheUntracedEyeFromTheOther) {
+  const renderer::Scene scene = renderer::load_scene("stereo-occluders");
+  renderer::GpuScene gs(ctx(), scene);
+  const core::DisplayPreset display = fovea::test::display_of_size(64, 72);
+  compositor::ReconSettings s;
+  s.share = compositor::StereoShare::Alternate;
+  compositor::FramePipeline p(ctx(), gs, display, {}, s);
+  const auto poses = fovea::test::eye_poses(scene, display.ipd_m);
+  for (std::uint32_t f = 0; f < 4; ++f) p.render(poses, {glm::dvec3(0, 0, -1), glm::dvec3(0, 0, -1)}, f);
+  for (core::Eye e : {core::Eye::Left, core::Eye::Right}) {
+    const auto own = p.grid_buffer(e, compositor::GridBuffer::AccIndirect);
+    const auto shared = p.grid_buffer(e, compositor::GridBuffer::SharedIndirect);
+    ASSERT_TRUE(fovea::test::all_finite(shared));
+    double n_own = 0, n_shared = 0;
+    for (std::size_t i = 0; i < own.size(); ++i) n_own += own[i].w, n_shared += shared[i].w;
+    EXPECT_GT(n_shared, 1.5 * n_own);  // each eye traced indirect on half of the frames
+    ASSERT_TRUE(fovea::test::all_finite(p.image(e).pixels));
+  }
+}
