@@ -6,6 +6,7 @@
 #include <cmath>
 
 #include <glm/geometric.hpp>
+#include <glm/gtc/quaternion.hpp>
 
 #include "fovea/renderer/procedural.hpp"
 #include "fovea/renderer/scene_io.hpp"
@@ -137,6 +138,58 @@ TEST_F(PathTracer, FlaggedCellsAreSkipped) {
       EXPECT_EQ(r.position_material[i].w, -1.0f);
     } else {
       EXPECT_GE(r.position_material[i].w, 0.0f);  // the box is closed around the view
+    }
+  }
+}
+
+// GGX energy, light sampling: a furnace of rough white metal (F0 = 1) reflects its
+// directional albedo E ≤ 1 by NEE alone (zero bounces): L = 1 + E(wo).
+TEST_F(PathTracer, GgxFurnaceNeeConservesEnergy) {
+  fr::Scene s = fr::make_furnace();
+  s.materials[0].base_color = glm::vec3(1.0f);
+  s.materials[0].metallic = 1.0f;
+  s.materials[0].roughness = 0.5f;
+  fr::sanitize(s, "ggx-furnace");
+  fr::GpuScene g(ctx(), s);
+  const fc::View v = furnace_view(8);
+  fr::PathConfig c;
+  c.spp = 64;
+  c.max_bounces = 0;
+  const double e = mean_rgb(trace_grid(ctx(), g, fr::cartesian_grid(v), v, fc::Eye::Left, c, 2).radiance).x - 1.0;
+  std::printf("GGX roughness 0.5, normal incidence: E = %.4f (NEE)\n", e);
+  EXPECT_LE(e, 1.01);
+  EXPECT_GE(e, 0.85);
+}
+
+// GGX energy, BSDF sampling: a metal floor under a constant white sky (no emitters) has
+// radiance E(wo) ≤ 1; a Lambert floor exactly its albedo.
+TEST_F(PathTracer, FloorUnderWhiteSkyReflectsItsAlbedo) {
+  const fc::View v(fc::Fov::from_degrees(-30, 30, 30, -30), 8, 8,
+                   fc::Pose{glm::angleAxis(-1.5707963, glm::dvec3(1, 0, 0)), {0, 0, 0}});  // looking down
+  for (const float rough : {0.05f, 0.5f, -1.0f}) {
+    fr::Scene s;
+    s.environment = glm::vec3(1.0f);
+    fr::Material m;
+    if (rough > 0) {
+      m.base_color = glm::vec3(1.0f);
+      m.metallic = 1.0f;
+      m.roughness = rough;
+    } else {
+      m.base_color = glm::vec3(0.5f);
+      m.specular = 0.0f;
+    }
+    s.add_quad({-1000, -1, 1000}, {1000, -1, 1000}, {1000, -1, -1000}, {-1000, -1, -1000}, s.add_material(m));
+    fr::sanitize(s, "floor");
+    fr::GpuScene g(ctx(), s);
+    fr::PathConfig c;
+    c.spp = 64;
+    const double l = mean_rgb(trace_grid(ctx(), g, fr::cartesian_grid(v), v, fc::Eye::Left, c, 2).radiance).x;
+    std::printf("floor %s: L = %.4f\n", rough > 0 ? ("GGX " + std::to_string(rough)).c_str() : "Lambert 0.5", l);
+    if (rough < 0) {
+      EXPECT_NEAR(l, 0.5, 1e-3);
+    } else {
+      EXPECT_LE(l, 1.0 + 1e-3);
+      EXPECT_GE(l, rough < 0.1f ? 0.97 : 0.85);
     }
   }
 }
