@@ -695,6 +695,25 @@ TEST_F(XrTest, TimespecConversion) {
   EXPECT_EQ(to_ts(instance_, 0, &back), XR_ERROR_TIME_INVALID);
 }
 
+// Control for the hello_xr core-validation test: misuse through the Khronos core validation
+// layer is written to its report as a VUID, which is what that test looks for.
+TEST_F(XrTest, CoreValidationReportsMisuse) {
+  TempDir dir("cv_control");
+  const std::string report = dir.path() + "/core_validation.txt";
+  setenv("XR_ENABLE_API_LAYERS", "XR_APILAYER_LUNARG_core_validation", 1);
+  setenv("XR_CORE_VALIDATION_EXPORT_TYPE", "text", 1);
+  setenv("XR_CORE_VALIDATION_FILE_NAME", report.c_str(), 1);
+  create_instance();
+  XrInstanceProperties props{XR_TYPE_SYSTEM_PROPERTIES};  // wrong structure type
+  EXPECT_EQ(xrGetInstanceProperties(instance_, &props), XR_ERROR_VALIDATION_FAILURE);
+  ASSERT_EQ(xrDestroyInstance(instance_), XR_SUCCESS);  // flushes the report
+  instance_ = XR_NULL_HANDLE;
+  unsetenv("XR_ENABLE_API_LAYERS");
+  unsetenv("XR_CORE_VALIDATION_EXPORT_TYPE");
+  unsetenv("XR_CORE_VALIDATION_FILE_NAME");
+  EXPECT_NE(read_text(report).find("VUID-XrInstanceProperties-type-type"), std::string::npos) << read_text(report);
+}
+
 TEST_F(XrTest, UnsupportedExtensionRejected) {
   XrInstanceCreateInfo ci{XR_TYPE_INSTANCE_CREATE_INFO};
   std::strcpy(ci.applicationInfo.applicationName, "fovea_runtime_tests");
