@@ -14,11 +14,36 @@ void XrTest::SetUp() {
   unsetenv("XR_ENABLE_API_LAYERS");
 }
 
+namespace {
+
+VKAPI_ATTR VkBool32 VKAPI_CALL count_errors(VkDebugUtilsMessageSeverityFlagBitsEXT severity,
+                                            VkDebugUtilsMessageTypeFlagsEXT, const VkDebugUtilsMessengerCallbackDataEXT* data,
+                                            void* user) {
+  if (severity & VK_DEBUG_UTILS_MESSAGE_SEVERITY_ERROR_BIT_EXT) {
+    ++*static_cast<int*>(user);
+    ADD_FAILURE() << "Vulkan validation: " << (data && data->pMessage ? data->pMessage : "");
+  }
+  return VK_FALSE;
+}
+
+bool validation_requested() {
+  const char* v = std::getenv("FOVEA_VK_VALIDATION");
+  return v && std::string(v) == "1";
+}
+
+}  // namespace
+
 void XrTest::TearDown() {
   if (session_) {
     EXPECT_EQ(xrDestroySession(session_), XR_SUCCESS);
   }
   if (vk_device_) vkDestroyDevice(vk_device_, nullptr);
+  if (messenger_) {
+    auto destroy = reinterpret_cast<PFN_vkDestroyDebugUtilsMessengerEXT>(
+        vkGetInstanceProcAddr(vk_instance_, "vkDestroyDebugUtilsMessengerEXT"));
+    destroy(vk_instance_, messenger_, nullptr);
+  }
+  EXPECT_EQ(validation_errors_, 0);
   if (vk_instance_) vkDestroyInstance(vk_instance_, nullptr);
   if (instance_) {
     EXPECT_EQ(xrDestroyInstance(instance_), XR_SUCCESS);
@@ -46,6 +71,11 @@ void XrTest::create_session() {
   app.apiVersion = VK_API_VERSION_1_0;
   VkInstanceCreateInfo vci{VK_STRUCTURE_TYPE_INSTANCE_CREATE_INFO};
   vci.pApplicationInfo = &app;
+  const char* debug_utils = VK_EXT_DEBUG_UTILS_EXTENSION_NAME;
+  if (validation_requested()) {
+    vci.enabledExtensionCount = 1;
+    vci.ppEnabledExtensionNames = &debug_utils;
+  }
   XrVulkanInstanceCreateInfoKHR xci{XR_TYPE_VULKAN_INSTANCE_CREATE_INFO_KHR};
   xci.systemId = system_;
   xci.pfnGetInstanceProcAddr = &vkGetInstanceProcAddr;
@@ -54,6 +84,17 @@ void XrTest::create_session() {
   ASSERT_EQ(proc<PFN_xrCreateVulkanInstanceKHR>("xrCreateVulkanInstanceKHR")(instance_, &xci, &vk_instance_, &vr),
             XR_SUCCESS);
   ASSERT_EQ(vr, VK_SUCCESS);
+  if (validation_requested()) {
+    VkDebugUtilsMessengerCreateInfoEXT mci{VK_STRUCTURE_TYPE_DEBUG_UTILS_MESSENGER_CREATE_INFO_EXT};
+    mci.messageSeverity = VK_DEBUG_UTILS_MESSAGE_SEVERITY_ERROR_BIT_EXT | VK_DEBUG_UTILS_MESSAGE_SEVERITY_WARNING_BIT_EXT;
+    mci.messageType = VK_DEBUG_UTILS_MESSAGE_TYPE_VALIDATION_BIT_EXT | VK_DEBUG_UTILS_MESSAGE_TYPE_GENERAL_BIT_EXT;
+    mci.pfnUserCallback = &count_errors;
+    mci.pUserData = &validation_errors_;
+    auto create = reinterpret_cast<PFN_vkCreateDebugUtilsMessengerEXT>(
+        vkGetInstanceProcAddr(vk_instance_, "vkCreateDebugUtilsMessengerEXT"));
+    ASSERT_NE(create, nullptr);
+    ASSERT_EQ(create(vk_instance_, &mci, nullptr, &messenger_), VK_SUCCESS);
+  }
   XrVulkanGraphicsDeviceGetInfoKHR dgi{XR_TYPE_VULKAN_GRAPHICS_DEVICE_GET_INFO_KHR};
   dgi.systemId = system_;
   dgi.vulkanInstance = vk_instance_;

@@ -49,6 +49,10 @@ class XrTest : public ::testing::Test {
   VkPhysicalDevice vk_physical_ = VK_NULL_HANDLE;
   VkDevice vk_device_ = VK_NULL_HANDLE;
   uint32_t queue_family_ = 0;
+  // FOVEA_VK_VALIDATION=1: the runtime adds the Khronos validation layer to the instance it
+  // creates; this messenger counts its errors and a test fails if there were any.
+  VkDebugUtilsMessengerEXT messenger_ = VK_NULL_HANDLE;
+  int validation_errors_ = 0;
 };
 
 }  // namespace fovea::test
