@@ -106,9 +106,11 @@ TEST(Layer, CoreValidationWithLayer) {
   env["XR_API_LAYER_PATH"] = std::string(FOVEA_LAYER_EXPLICIT_DIR) + ":/usr/share/openxr/1/api_layers/explicit.d";
   env["XR_CORE_VALIDATION_EXPORT_TYPE"] = "text";
   env["XR_CORE_VALIDATION_FILE_NAME"] = out.path() + "/core_validation.txt";
+  env["XR_LOADER_DEBUG"] = "info";
   const ProcessResult r = hello_xr(out.path(), env);
   ASSERT_EQ(r.exit_code, 0) << r.output;
-  EXPECT_NE(r.output.find("Core Validation output type"), std::string::npos) << r.output;
+  EXPECT_NE(r.output.find("succeeded loading layer XR_APILAYER_LUNARG_core_validation"), std::string::npos) << r.output;
+  EXPECT_NE(r.output.find(std::string("succeeded loading layer ") + kLayer), std::string::npos) << r.output;
   const std::string cv = read_text(out.path() + "/core_validation.txt");
   EXPECT_EQ(cv.find("VUID-"), std::string::npos) << cv;
   EXPECT_EQ(line_count(out.path() + "/layer_timing.jsonl"), size_t(kFrames));

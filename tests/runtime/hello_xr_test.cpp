@@ -110,8 +110,11 @@ TEST(HelloXr, CoreValidationClean) {
   const std::string file = report.path() + "/core_validation.txt";
   const ProcessResult r = run_and_check("Vulkan2", {{"XR_ENABLE_API_LAYERS", "XR_APILAYER_LUNARG_core_validation"},
                             {"XR_CORE_VALIDATION_EXPORT_TYPE", "text"},
-                            {"XR_CORE_VALIDATION_FILE_NAME", file}});
-  EXPECT_NE(r.output.find("Core Validation output type: text"), std::string::npos) << "layer not active:\n" << r.output;
+                            {"XR_CORE_VALIDATION_FILE_NAME", file},
+                            {"XR_LOADER_DEBUG", "info"}});
+  // The loader's own report (stderr, unbuffered) shows the layer was in the chain.
+  EXPECT_NE(r.output.find("succeeded loading layer XR_APILAYER_LUNARG_core_validation"), std::string::npos)
+      << "layer not active:\n" << r.output;
   const std::string text = read_text(file);
   EXPECT_EQ(text.find("VUID-"), std::string::npos) << text;
   EXPECT_EQ(text.find("VALID_ERROR"), std::string::npos) << text;
