@@ -19,6 +19,7 @@
 #include "fovea/core/hidden_area.hpp"
 #include "gaze.hpp"
 #include "head_motion.hpp"
+#include "log.hpp"
 #include "timing_log.hpp"
 #include "vk_util.hpp"
 #include "xr.hpp"
@@ -225,11 +226,6 @@ constexpr XrSystemId kSystemId = 1;
 constexpr std::uint32_t kMaxLayers = 16;
 constexpr std::uint32_t kMaxSwapchainSize = 4096;
 
-}  // namespace fovea::runtime
-
-#include "log.hpp"
-
-namespace fovea::runtime {
 // Runs a command body: serialised, exceptions turned into result codes (never thrown to the
 // application).
 template <class F>
