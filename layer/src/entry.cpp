@@ -77,6 +77,8 @@ XrResult XRAPI_CALL create_api_layer_instance(const XrInstanceCreateInfo* info, 
 
   InstanceState state;
   state.extension_enabled = ours;
+  state.application.assign(info->applicationInfo.applicationName,
+                           strnlen(info->applicationInfo.applicationName, XR_MAX_APPLICATION_NAME_SIZE));
   state.next.xrGetInstanceProcAddr = next->nextGetInstanceProcAddr;
   bool complete = true;
 #define FOVEA_LAYER_RESOLVE(name)                                                                     \

@@ -1,6 +1,5 @@
-// Frame intercepts: xrWaitFrame/xrBeginFrame/xrEndFrame are timed, xrLocateViews results
-// are kept for the frame renderer. Without a renderer the application's frame goes down
-// unchanged; with one, its layers replace the application's (frame_renderer.hpp).
+// Frame intercepts: xrWaitFrame/xrBeginFrame/xrEndFrame are timed. Without a renderer the
+// application's frame goes down unchanged; with one, its layers replace the application's (frame_renderer.hpp).
 #include <stdexcept>
 
 #include "layer.hpp"
@@ -56,20 +55,6 @@ XrResult intercept::xrBeginFrame(XrSession session, const XrFrameBeginInfo* info
   return r;
 }
 
-XrResult intercept::xrLocateViews(XrSession session, const XrViewLocateInfo* info, XrViewState* state,
-                                  uint32_t capacity, uint32_t* count, XrView* views) {
-  const auto next = next_fn(session, &Dispatch::xrLocateViews);
-  if (!next) return XR_ERROR_HANDLE_INVALID;
-  const XrResult r = next(session, info, state, capacity, count, views);
-  if (XR_SUCCEEDED(r) && capacity && views)
-    bookkeeping(session, [&](SessionState& s) {
-      s.views.assign(views, views + *count);
-      for (XrView& v : s.views) v.next = nullptr;
-      s.views_time = info->displayTime;
-    });
-  return r;
-}
-
 XrResult intercept::xrEndFrame(XrSession session, const XrFrameEndInfo* info) {
   const auto next = next_fn(session, &Dispatch::xrEndFrame);
   if (!next) return XR_ERROR_HANDLE_INVALID;
@@ -80,22 +65,28 @@ XrResult intercept::xrEndFrame(XrSession session, const XrFrameEndInfo* info) {
     FrameInput in;
     in.frame = s.current.frame;
     in.display_time = info->displayTime;
-    if (s.views_time == info->displayTime) in.views = s.views;
     in.app_frame = info;
+    // The first stereo projection layer is the one replaced.
     for (uint32_t i = 0; info->layers && i < info->layerCount && in.app_views.empty(); ++i) {
       if (!info->layers[i] || info->layers[i]->type != XR_TYPE_COMPOSITION_LAYER_PROJECTION) continue;
       const auto* p = reinterpret_cast<const XrCompositionLayerProjection*>(info->layers[i]);
+      if (p->viewCount != 2 || !p->views) continue;
+      in.projection_layer = i;
       for (uint32_t v = 0; v < p->viewCount; ++v) {
         const XrCompositionLayerProjectionView& pv = p->views[v];
         auto sc = layer().swapchains.find(pv.subImage.swapchain);
         if (sc == layer().swapchains.end() || sc->second.last_released < 0 ||
             size_t(sc->second.last_released) >= sc->second.images.size())
           throw std::runtime_error("a submitted swapchain has no released image the layer knows");
+        bool depth = false;
+        for (auto* n = static_cast<const XrBaseInStructure*>(pv.next); n; n = n->next)
+          depth |= n->type == XR_TYPE_COMPOSITION_LAYER_DEPTH_INFO_KHR;
         in.app_views.push_back({sc->second.images[size_t(sc->second.last_released)], VkFormat(sc->second.info.format),
-                                pv.subImage.imageRect, pv.subImage.imageArrayIndex, pv.pose, pv.fov});
+                                pv.subImage.imageRect, pv.subImage.imageArrayIndex, pv.pose, pv.fov, depth});
       }
     }
     if (const XrFrameEndInfo* replaced = s.renderer->render(in)) submit = replaced;
+    s.current.render = s.renderer->times();
   });
   const XrResult r = next(session, submit);
   const std::int64_t t_return = now_ns();

@@ -5,6 +5,8 @@
 #include <cstdio>
 #include <string>
 
+#include "frame_renderer.hpp"
+
 namespace fovea::layer {
 
 std::int64_t now_ns();
@@ -17,6 +19,7 @@ struct FrameTimes {
   std::int64_t end_call_ns = 0, end_return_ns = 0;  // around the call down the chain
   std::uint32_t layers = 0, projection_views = 0;
   bool replaced = false;  // a frame renderer replaced the application's layers
+  RenderTimes render;     // the frame renderer's split (zero without one)
 };
 
 class FrameLog {

@@ -1,14 +1,237 @@
+// The layer's path-tracing renderer. Fovea's pipeline runs on its own compute context
+// (gpu::Context creates its own VkInstance/VkDevice and cannot wrap the application's), so
+// each frame moves through host memory: the pipeline's linear images are read back, the
+// application's projection views are read back from its device, both are composited on the
+// host in the application's 8-bit encoding and uploaded into the layer's swapchains on the
+// application's device. On lavapipe both devices are host memory anyway; on a discrete GPU
+// this costs two PCIe round trips of the eye rasters per frame.
 #include "frame_renderer.hpp"
 
+#include <array>
+#include <chrono>
+#include <cmath>
 #include <stdexcept>
 
-namespace fovea::layer {
+#include <glm/gtc/quaternion.hpp>
 
-std::unique_ptr<FrameRenderer> make_frame_renderer(const std::string& scene, const VulkanBinding&) {
-  if (scene.empty()) return nullptr;
-  throw std::runtime_error("FOVEA_LAYER_SCENE=" + scene +
-                           ": scene rendering is not available in this build (the path tracer and the "
-                           "reconstruction are not integrated into the layer yet)");
+#include "app_device.hpp"
+#include "composite.hpp"
+#include "fovea/compositor/frame_pipeline.hpp"
+#include "fovea/core/display.hpp"
+#include "fovea/devices/gaze.hpp"
+#include "fovea/gpu/context.hpp"
+#include "fovea/renderer/gpu_scene.hpp"
+#include "fovea/renderer/scene_io.hpp"
+#include "gaze_hold.hpp"
+#include "layer.hpp"
+#include "log.hpp"
+
+namespace fovea::layer {
+namespace {
+
+double ms_since(std::chrono::steady_clock::time_point t0) {
+  return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
+}
+
+core::Fov to_fov(const XrFovf& f) { return {f.angleLeft, f.angleRight, f.angleUp, f.angleDown}; }
+
+core::Pose to_pose(const XrPosef& p) {
+  core::Pose o;
+  o.orientation = glm::normalize(glm::dquat(p.orientation.w, p.orientation.x, p.orientation.y, p.orientation.z));
+  o.position = {p.position.x, p.position.y, p.position.z};
+  return o;
+}
+
+void xr_check(XrResult r, const char* what) {
+  if (XR_FAILED(r)) throw std::runtime_error(std::string(what) + " failed below the layer: XrResult " + std::to_string(int(r)));
+}
+
+// Live trackers stamp samples with the host clock; recordings and synthetic gaze count
+// from their first sample.
+bool live_gaze(const std::string& uri) {
+  for (const char* s : {"hid:", "usb:", "hid-capture:"})
+    if (uri.rfind(s, 0) == 0) return true;
+  return false;
+}
+
+class PathTraceRenderer final : public FrameRenderer {
+ public:
+  PathTraceRenderer(const LayerConfig& config, const VulkanBinding& vk, const Dispatch& next, XrSession session)
+      : config_(config), next_(next), session_(session), scene_(renderer::load_scene(config.scene)), app_(vk) {
+    for (const auto& w : scene_.warnings) FOVEA_LAYER_WARN("scene %s: %s", config.scene.c_str(), w.c_str());
+    if (config_.gaze.empty()) config_.gaze = "synthetic:1";
+  }
+
+  ~PathTraceRenderer() override {
+    for (Eye& e : eyes_)
+      if (e.swapchain != XR_NULL_HANDLE) next_.xrDestroySwapchain(e.swapchain);
+  }
+
+  const RenderTimes& times() const override { return times_; }
+
+  const XrFrameEndInfo* render(const FrameInput& in) override {
+    times_ = RenderTimes{};
+    if (in.app_views.size() != 2) return nullptr;  // only stereo projection layers are replaced
+    const auto t0 = std::chrono::steady_clock::now();
+    if (!pipeline_) start(in);
+    const XrRect2Di& r0 = in.app_views[0].rect;
+    for (const AppView& v : in.app_views)
+      if (v.rect.extent.width != r0.extent.width || v.rect.extent.height != r0.extent.height || v.format != format_)
+        throw std::runtime_error("the application changed its projection views' size or format during the session");
+
+    // Eye poses: the application's view poses (its reference space) placed at the scene's camera.
+    std::array<core::Pose, 2> poses;
+    std::array<glm::dvec3, 2> gaze;
+    const devices::GazeSample s = gaze_source_->sample_at(live_ ? in.display_time : in.display_time - epoch_);
+    for (int e = 0; e < 2; ++e) {
+      const core::Pose p = to_pose(in.app_views[std::size_t(e)].pose);
+      poses[std::size_t(e)].orientation = scene_.camera.orientation * p.orientation;
+      poses[std::size_t(e)].position = scene_.camera.position + scene_.camera.orientation * p.position;
+      const devices::EyeGaze& eg = s.eye(core::Eye(e));
+      const devices::EyeGaze& g = eg.tracked() ? eg : s.combined;
+      gaze[std::size_t(e)] = hold_[std::size_t(e)].update(in.display_time, g.tracked(), g.dir);
+    }
+    const compositor::FrameTimes gt = pipeline_->render(poses, gaze, std::uint32_t(in.frame));
+    times_.trace = gt.trace;
+    times_.reconstruct = gt.reconstruct;
+    times_.resolve = gt.resolve;
+
+    const auto t1 = std::chrono::steady_clock::now();
+    std::vector<AppDevice::Read> reads;
+    for (const AppView& v : in.app_views) reads.push_back({v.image, v.array_index, v.rect});
+    const std::vector<Pixels8> app = config_.composite == Composite::SceneOnly ? std::vector<Pixels8>{} : app_.read(reads);
+    std::array<Pixels8, 2> out;
+    std::vector<VkImage> targets;
+    for (int e = 0; e < 2; ++e) {
+      const auto ei = std::size_t(e);
+      out[ei] = encode_scene(pipeline_->image(core::Eye(e)), pixel_format(format_));
+      if (!app.empty()) {
+        const core::View app_view(to_fov(in.app_views[ei].fov), app[ei].width, app[ei].height);
+        const Pixels8 a = resample(app[ei], app_view, display_.view(core::Eye(e)));
+        const auto bg = config_.app_background
+                            ? std::array<std::uint8_t, 3>{std::uint8_t((*config_.app_background)[0]),
+                                                          std::uint8_t((*config_.app_background)[1]),
+                                                          std::uint8_t((*config_.app_background)[2])}
+                            : border_colour(app[ei]);
+        composite(out[ei], a, config_.composite, bg);
+      }
+      Eye& eye = eyes_[ei];
+      std::uint32_t index = 0;
+      xr_check(next_.xrAcquireSwapchainImage(eye.swapchain, nullptr, &index), "xrAcquireSwapchainImage");
+      XrSwapchainImageWaitInfo wi{XR_TYPE_SWAPCHAIN_IMAGE_WAIT_INFO};
+      wi.timeout = XR_INFINITE_DURATION;
+      xr_check(next_.xrWaitSwapchainImage(eye.swapchain, &wi), "xrWaitSwapchainImage");
+      if (index >= eye.images.size()) throw std::runtime_error("the runtime acquired an unknown swapchain image");
+      targets.push_back(eye.images[index]);
+    }
+    app_.write(targets, {&out[0], &out[1]});
+    for (Eye& eye : eyes_) xr_check(next_.xrReleaseSwapchainImage(eye.swapchain, nullptr), "xrReleaseSwapchainImage");
+    times_.transfer = ms_since(t1);
+
+    // The application's frame with its stereo projection layer replaced by the layer's.
+    const auto* app_proj = reinterpret_cast<const XrCompositionLayerProjection*>(in.app_frame->layers[in.projection_layer]);
+    projection_ = *app_proj;
+    projection_.next = nullptr;  // the depth it may chain describes the application's image, not this one
+    projection_.viewCount = 2;
+    projection_.views = views_.data();
+    for (int e = 0; e < 2; ++e) {
+      const auto ei = std::size_t(e);
+      views_[ei] = {XR_TYPE_COMPOSITION_LAYER_PROJECTION_VIEW};
+      views_[ei].pose = in.app_views[ei].pose;
+      views_[ei].fov = in.app_views[ei].fov;
+      views_[ei].subImage.swapchain = eyes_[ei].swapchain;
+      views_[ei].subImage.imageRect = {{0, 0}, {display_.width, display_.height}};
+    }
+    layers_.assign(in.app_frame->layers, in.app_frame->layers + in.app_frame->layerCount);
+    layers_[in.projection_layer] = reinterpret_cast<const XrCompositionLayerBaseHeader*>(&projection_);
+    frame_ = *in.app_frame;
+    frame_.layers = layers_.data();
+    times_.total = ms_since(t0);
+    return &frame_;
+  }
+
+ private:
+  struct Eye {
+    XrSwapchain swapchain = XR_NULL_HANDLE;
+    std::vector<VkImage> images;
+  };
+
+  // At the first stereo frame: the pipeline for the application's views, the layer's
+  // swapchains in the application's format, the gaze source.
+  void start(const FrameInput& in) {
+    const AppView& v0 = in.app_views[0];
+    format_ = v0.format;
+    pixel_format(format_);  // throws for formats the layer cannot composite
+    display_ = core::load_display("small");
+    display_.name = "openxr-views";
+    display_.description = "the application's projection views";
+    display_.width = v0.rect.extent.width;
+    display_.height = v0.rect.extent.height;
+    display_.fov_left = to_fov(in.app_views[0].fov);
+    display_.fov_right = to_fov(in.app_views[1].fov);
+    devices::SourceOptions so;
+    so.display = display_;
+    gaze_source_ = devices::open_gaze_source(config_.gaze, so);
+    live_ = live_gaze(config_.gaze);
+    epoch_ = in.display_time;
+
+    for (Eye& e : eyes_) {
+      XrSwapchainCreateInfo ci{XR_TYPE_SWAPCHAIN_CREATE_INFO};
+      ci.usageFlags = XR_SWAPCHAIN_USAGE_COLOR_ATTACHMENT_BIT | XR_SWAPCHAIN_USAGE_TRANSFER_DST_BIT;
+      ci.format = format_;
+      ci.sampleCount = 1;
+      ci.width = std::uint32_t(display_.width);
+      ci.height = std::uint32_t(display_.height);
+      ci.faceCount = ci.arraySize = ci.mipCount = 1;
+      xr_check(next_.xrCreateSwapchain(session_, &ci, &e.swapchain), "xrCreateSwapchain");
+      std::uint32_t n = 0;
+      xr_check(next_.xrEnumerateSwapchainImages(e.swapchain, 0, &n, nullptr), "xrEnumerateSwapchainImages");
+      std::vector<XrSwapchainImageVulkanKHR> imgs(n, {XR_TYPE_SWAPCHAIN_IMAGE_VULKAN_KHR});
+      xr_check(next_.xrEnumerateSwapchainImages(e.swapchain, n, &n,
+                                                reinterpret_cast<XrSwapchainImageBaseHeader*>(imgs.data())),
+               "xrEnumerateSwapchainImages");
+      for (const auto& i : imgs) e.images.push_back(i.image);
+    }
+
+    ctx_ = std::make_unique<gpu::Context>();
+    gpu_scene_ = std::make_unique<renderer::GpuScene>(*ctx_, scene_);
+    compositor::ReconSettings settings;
+    settings.share = compositor::StereoShare::Gather;
+    pipeline_ = std::make_unique<compositor::FramePipeline>(*ctx_, *gpu_scene_, display_, core::DistributionParams{},
+                                                            settings);
+    FOVEA_LAYER_INFO("rendering scene \"%s\" (from %s) at %dx%d per eye on %s, composite %s, gaze %s",
+                     config_.scene.c_str(), config_.origin.c_str(), display_.width, display_.height,
+                     ctx_->info().name.c_str(), composite_name(config_.composite), gaze_source_->describe().c_str());
+  }
+
+  LayerConfig config_;
+  const Dispatch& next_;
+  XrSession session_;
+  renderer::Scene scene_;
+  AppDevice app_;
+  core::DisplayPreset display_;
+  VkFormat format_ = VK_FORMAT_UNDEFINED;
+  std::unique_ptr<devices::GazeSource> gaze_source_;
+  bool live_ = false;
+  XrTime epoch_ = 0;
+  std::array<GazeHold, 2> hold_;
+  std::unique_ptr<gpu::Context> ctx_;
+  std::unique_ptr<renderer::GpuScene> gpu_scene_;
+  std::unique_ptr<compositor::FramePipeline> pipeline_;
+  std::array<Eye, 2> eyes_;
+  RenderTimes times_;
+  XrCompositionLayerProjection projection_{XR_TYPE_COMPOSITION_LAYER_PROJECTION};
+  std::array<XrCompositionLayerProjectionView, 2> views_{};
+  std::vector<const XrCompositionLayerBaseHeader*> layers_;
+  XrFrameEndInfo frame_{XR_TYPE_FRAME_END_INFO};
+};
+
+}  // namespace
+
+std::unique_ptr<FrameRenderer> make_frame_renderer(const LayerConfig& config, const VulkanBinding& vk,
+                                                   const Dispatch& next, XrSession session) {
+  if (config.scene.empty()) return nullptr;
+  return std::make_unique<PathTraceRenderer>(config, vk, next, session);
 }
 
 }  // namespace fovea::layer

@@ -1,10 +1,8 @@
 #pragma once
-// The hook for the path-tracing part of the layer. A FrameRenderer would render the
-// configured scene foveated (renderer/, reconstruction/) for the views the runtime located,
-// on the application's Vulkan device, into layer-owned swapchains, and return the projection
-// layer that replaces the application's. It needs the renderer and the reconstruction
-// modules; until they are integrated make_frame_renderer returns null and the layer passes
-// frames through, measuring only.
+// The path-tracing part of the layer. A FrameRenderer renders the configured scene foveated
+// for the views the application submitted (FramePipeline on Fovea's own compute context),
+// composites the application's pixels (composite.hpp), writes the result into layer-owned
+// swapchains and returns the frame that replaces the application's.
 #include <cstdint>
 #include <memory>
 #include <string>
@@ -16,7 +14,11 @@
 #include <openxr/openxr.h>
 #include <openxr/openxr_platform.h>
 
+#include "config.hpp"
+
 namespace fovea::layer {
+
+struct Dispatch;
 
 // The application's Vulkan objects, from XrGraphicsBindingVulkan(2)KHR at xrCreateSession.
 struct VulkanBinding {
@@ -36,14 +38,24 @@ struct AppView {
   std::uint32_t array_index = 0;
   XrPosef pose{};
   XrFovf fov{};
+  bool has_depth = false;  // an XrCompositionLayerDepthInfoKHR was chained
 };
 
 struct FrameInput {
   std::int64_t frame = 0;
   XrTime display_time = 0;
-  std::vector<XrView> views;        // as located for display_time (xrLocateViews)
-  std::vector<AppView> app_views;   // the first projection layer's views
+  std::vector<AppView> app_views;  // the first stereo projection layer's views
+  std::uint32_t projection_layer = 0;  // its index in app_frame->layers
   const XrFrameEndInfo* app_frame = nullptr;
+};
+
+// Where the layer's time went in the last render() (milliseconds).
+struct RenderTimes {
+  double total = 0;        // wall time of render()
+  double trace = 0;        // GPU: grid generation + path tracing, both eyes
+  double reconstruct = 0;  // GPU: accumulation, stereo sharing, BMFR, TAA
+  double resolve = 0;      // GPU: resolve to the display, blur
+  double transfer = 0;     // read-back of the app's images, compositing, upload
 };
 
 class FrameRenderer {
@@ -53,10 +65,12 @@ class FrameRenderer {
   // stay valid until the next call), or nullptr to submit the application's frame unchanged.
   // Throws on failure; the layer then disables itself for the session.
   virtual const XrFrameEndInfo* render(const FrameInput& in) = 0;
+  virtual const RenderTimes& times() const = 0;
 };
 
-// `scene`: env FOVEA_LAYER_SCENE (empty: none). Null when there is nothing to render;
-// throws std::runtime_error when a scene is configured but cannot be rendered.
-std::unique_ptr<FrameRenderer> make_frame_renderer(const std::string& scene, const VulkanBinding& vk);
+// Null when no scene is configured; throws when one is configured but cannot be loaded or
+// the session has no Vulkan binding. `next` (the layer's table below) must outlive it.
+std::unique_ptr<FrameRenderer> make_frame_renderer(const LayerConfig& config, const VulkanBinding& vk,
+                                                   const Dispatch& next, XrSession session);
 
 }  // namespace fovea::layer

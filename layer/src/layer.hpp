@@ -25,8 +25,8 @@
 namespace fovea::layer {
 
 constexpr const char* kLayerName = "XR_APILAYER_FOVEA_path_tracing";
-// The layer's own instance extension: the application opts in to having its projection
-// layers replaced by the path-traced image when a scene is configured. Never passed down.
+// The layer's own instance extension, advertised so applications can tell the layer is
+// present; rendering is switched on by the configuration (config.hpp). Never passed down.
 constexpr const char* kLayerExtension = "XR_FOVEA_path_tracing";
 constexpr std::uint32_t kLayerExtensionVersion = 1;
 
@@ -40,11 +40,11 @@ constexpr std::uint32_t kLayerExtensionVersion = 1;
   X(xrDestroySwapchain)     \
   X(xrEnumerateSwapchainImages) \
   X(xrAcquireSwapchainImage) \
+  X(xrWaitSwapchainImage)    \
   X(xrReleaseSwapchainImage) \
   X(xrWaitFrame)            \
   X(xrBeginFrame)           \
-  X(xrEndFrame)             \
-  X(xrLocateViews)
+  X(xrEndFrame)
 
 struct Dispatch {
 #define FOVEA_LAYER_MEMBER(name) PFN_##name name = nullptr;
@@ -67,13 +67,12 @@ struct SessionState {
   std::unique_ptr<FrameRenderer> renderer;  // null: pass-through, measure only
   FrameLog log;
   FrameTimes current;                     // the frame in flight
-  std::vector<XrView> views;              // the last xrLocateViews result
-  XrTime views_time = 0;
 };
 
 struct InstanceState {
   Dispatch next;
   bool extension_enabled = false;  // the application enabled kLayerExtension
+  std::string application;         // XrApplicationInfo::applicationName (the config section)
 };
 
 struct Layer {
@@ -103,8 +102,7 @@ namespace intercept {
   X(xrReleaseSwapchainImage)       \
   X(xrWaitFrame)                   \
   X(xrBeginFrame)                  \
-  X(xrEndFrame)                    \
-  X(xrLocateViews)
+  X(xrEndFrame)
 #define FOVEA_LAYER_DECLARE(name) std::remove_pointer_t<PFN_##name> name;
 FOVEA_LAYER_INTERCEPTED(FOVEA_LAYER_DECLARE)
 #undef FOVEA_LAYER_DECLARE

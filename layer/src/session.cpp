@@ -17,13 +17,15 @@ std::string env(const char* name) {
 
 XrResult intercept::xrCreateSession(XrInstance instance, const XrSessionCreateInfo* info, XrSession* session) {
   PFN_xrCreateSession next = nullptr;
-  bool opted_in = false;
+  const Dispatch* dispatch = nullptr;  // stable: instances live in a std::map until xrDestroyInstance
+  std::string application;
   {
     std::lock_guard lock(layer().mutex);
     auto it = layer().instances.find(instance);
     if (it == layer().instances.end()) return XR_ERROR_HANDLE_INVALID;
     next = it->second.next.xrCreateSession;
-    opted_in = it->second.extension_enabled;
+    dispatch = &it->second.next;
+    application = it->second.application;
   }
   const XrResult r = next(instance, info, session);
   if (XR_FAILED(r)) return r;
@@ -36,12 +38,7 @@ XrResult intercept::xrCreateSession(XrInstance instance, const XrSessionCreateIn
         st.vulkan = {b->instance, b->physicalDevice, b->device, b->queueFamilyIndex, b->queueIndex};
       }
     st.log.open(env("FOVEA_LAYER_OUT"));
-    const std::string scene = env("FOVEA_LAYER_SCENE");
-    if (!scene.empty() && !opted_in)
-      FOVEA_LAYER_INFO("FOVEA_LAYER_SCENE is set but the application did not enable %s: passing frames through",
-                       kLayerExtension);
-    else
-      st.renderer = make_frame_renderer(scene, st.vulkan);
+    st.renderer = make_frame_renderer(load_config(application), st.vulkan, *dispatch, *session);
     FOVEA_LAYER_INFO("session: Vulkan device %s (queue family %u index %u); %s", st.vulkan.valid() ? "captured" : "absent",
                      st.vulkan.queue_family, st.vulkan.queue_index,
                      st.renderer ? "rendering the scene" : "no scene: pass-through, measuring only");
@@ -62,6 +59,9 @@ XrResult intercept::xrDestroySession(XrSession session) {
     const Dispatch* d = next_for_session(session);
     if (!d) return XR_ERROR_HANDLE_INVALID;
     next = d->xrDestroySession;
+    // The renderer's swapchains and transfer buffers go before the session they belong to.
+    auto it = layer().sessions.find(session);
+    if (it != layer().sessions.end()) it->second.renderer.reset();
   }
   const XrResult r = next(session);
   if (XR_SUCCEEDED(r)) {

@@ -1,0 +1,210 @@
+#include "app_device.hpp"
+
+#include <cstring>
+#include <stdexcept>
+#include <string>
+
+namespace fovea::layer {
+namespace {
+
+void check(VkResult r, const char* what) {
+  if (r != VK_SUCCESS) throw std::runtime_error(std::string(what) + " failed on the application's device: VkResult " + std::to_string(int(r)));
+}
+
+VkImageMemoryBarrier image_barrier(VkImage image, std::uint32_t layer, VkImageLayout from, VkImageLayout to,
+                                   VkAccessFlags src, VkAccessFlags dst) {
+  VkImageMemoryBarrier b{VK_STRUCTURE_TYPE_IMAGE_MEMORY_BARRIER};
+  b.srcAccessMask = src;
+  b.dstAccessMask = dst;
+  b.oldLayout = from;
+  b.newLayout = to;
+  b.srcQueueFamilyIndex = b.dstQueueFamilyIndex = VK_QUEUE_FAMILY_IGNORED;
+  b.image = image;
+  b.subresourceRange = {VK_IMAGE_ASPECT_COLOR_BIT, 0, 1, layer, 1};
+  return b;
+}
+
+}  // namespace
+
+// The application's device functions come from the Vulkan loader the layer links (through
+// fovea_gpu), the same loader instance the application uses.
+AppDevice::AppDevice(const VulkanBinding& vk) : device_(vk.device) {
+  if (!vk.valid() || !vk.instance || !vk.physical_device)
+    throw std::runtime_error("the session has no Vulkan graphics binding the layer can use");
+  const auto gdpa = reinterpret_cast<PFN_vkGetDeviceProcAddr>(vkGetInstanceProcAddr(vk.instance, "vkGetDeviceProcAddr"));
+  const auto props = reinterpret_cast<PFN_vkGetPhysicalDeviceMemoryProperties>(
+      vkGetInstanceProcAddr(vk.instance, "vkGetPhysicalDeviceMemoryProperties"));
+  if (!gdpa || !props) throw std::runtime_error("the application's VkInstance does not resolve vkGetDeviceProcAddr");
+#define FOVEA_APP_VK_LOAD(name)                                                         \
+  name##_ = reinterpret_cast<PFN_##name>(gdpa(device_, #name));                          \
+  if (!name##_) throw std::runtime_error("the application's VkDevice does not resolve " #name);
+  FOVEA_APP_VK(FOVEA_APP_VK_LOAD)
+#undef FOVEA_APP_VK_LOAD
+  props(vk.physical_device, &memory_);
+  vkGetDeviceQueue_(device_, vk.queue_family, vk.queue_index, &queue_);
+  VkCommandPoolCreateInfo pi{VK_STRUCTURE_TYPE_COMMAND_POOL_CREATE_INFO};
+  pi.flags = VK_COMMAND_POOL_CREATE_RESET_COMMAND_BUFFER_BIT;
+  pi.queueFamilyIndex = vk.queue_family;
+  check(vkCreateCommandPool_(device_, &pi, nullptr, &pool_), "vkCreateCommandPool");
+  VkCommandBufferAllocateInfo ai{VK_STRUCTURE_TYPE_COMMAND_BUFFER_ALLOCATE_INFO};
+  ai.commandPool = pool_;
+  ai.level = VK_COMMAND_BUFFER_LEVEL_PRIMARY;
+  ai.commandBufferCount = 1;
+  VkFenceCreateInfo fi{VK_STRUCTURE_TYPE_FENCE_CREATE_INFO};
+  try {
+    check(vkAllocateCommandBuffers_(device_, &ai, &cmd_), "vkAllocateCommandBuffers");
+    check(vkCreateFence_(device_, &fi, nullptr, &fence_), "vkCreateFence");
+  } catch (...) {
+    destroy();
+    throw;
+  }
+}
+
+AppDevice::~AppDevice() { destroy(); }
+
+void AppDevice::destroy() {
+  release(download_);
+  release(upload_);
+  if (fence_) vkDestroyFence_(device_, fence_, nullptr);
+  if (pool_) vkDestroyCommandPool_(device_, pool_, nullptr);
+  fence_ = VK_NULL_HANDLE;
+  pool_ = VK_NULL_HANDLE;
+}
+
+void AppDevice::release(HostBuffer& b) {
+  if (b.mapped) vkUnmapMemory_(device_, b.memory);
+  if (b.buffer) vkDestroyBuffer_(device_, b.buffer, nullptr);
+  if (b.memory) vkFreeMemory_(device_, b.memory, nullptr);
+  b = HostBuffer{};
+}
+
+void AppDevice::reserve(HostBuffer& b, VkDeviceSize size, VkBufferUsageFlags usage) {
+  if (b.size >= size) return;
+  release(b);
+  VkBufferCreateInfo bi{VK_STRUCTURE_TYPE_BUFFER_CREATE_INFO};
+  bi.size = size;
+  bi.usage = usage;
+  bi.sharingMode = VK_SHARING_MODE_EXCLUSIVE;
+  check(vkCreateBuffer_(device_, &bi, nullptr, &b.buffer), "vkCreateBuffer");
+  VkMemoryRequirements req;
+  vkGetBufferMemoryRequirements_(device_, b.buffer, &req);
+  // Host-coherent memory: no flush/invalidate around the copies.
+  const VkMemoryPropertyFlags want = VK_MEMORY_PROPERTY_HOST_VISIBLE_BIT | VK_MEMORY_PROPERTY_HOST_COHERENT_BIT;
+  std::uint32_t type = ~0u;
+  for (std::uint32_t i = 0; i < memory_.memoryTypeCount && type == ~0u; ++i)
+    if ((req.memoryTypeBits & (1u << i)) && (memory_.memoryTypes[i].propertyFlags & want) == want) type = i;
+  if (type == ~0u) {
+    release(b);
+    throw std::runtime_error("the application's device has no host-visible coherent memory for the layer's transfers");
+  }
+  VkMemoryAllocateInfo mi{VK_STRUCTURE_TYPE_MEMORY_ALLOCATE_INFO};
+  mi.allocationSize = req.size;
+  mi.memoryTypeIndex = type;
+  try {
+    check(vkAllocateMemory_(device_, &mi, nullptr, &b.memory), "vkAllocateMemory");
+    check(vkBindBufferMemory_(device_, b.buffer, b.memory, 0), "vkBindBufferMemory");
+    check(vkMapMemory_(device_, b.memory, 0, VK_WHOLE_SIZE, 0, &b.mapped), "vkMapMemory");
+  } catch (...) {
+    release(b);
+    throw;
+  }
+  b.size = size;
+}
+
+template <class F>
+void AppDevice::submit(F&& record) {
+  check(vkResetCommandBuffer_(cmd_, 0), "vkResetCommandBuffer");
+  VkCommandBufferBeginInfo bi{VK_STRUCTURE_TYPE_COMMAND_BUFFER_BEGIN_INFO};
+  bi.flags = VK_COMMAND_BUFFER_USAGE_ONE_TIME_SUBMIT_BIT;
+  check(vkBeginCommandBuffer_(cmd_, &bi), "vkBeginCommandBuffer");
+  record(cmd_);
+  check(vkEndCommandBuffer_(cmd_), "vkEndCommandBuffer");
+  VkSubmitInfo si{VK_STRUCTURE_TYPE_SUBMIT_INFO};
+  si.commandBufferCount = 1;
+  si.pCommandBuffers = &cmd_;
+  check(vkQueueSubmit_(queue_, 1, &si, fence_), "vkQueueSubmit");
+  check(vkWaitForFences_(device_, 1, &fence_, VK_TRUE, UINT64_MAX), "vkWaitForFences");
+  check(vkResetFences_(device_, 1, &fence_), "vkResetFences");
+}
+
+std::vector<Pixels8> AppDevice::read(const std::vector<Read>& reads) {
+  VkDeviceSize total = 0;
+  std::vector<VkDeviceSize> offsets;
+  for (const Read& r : reads) {
+    if (r.rect.extent.width <= 0 || r.rect.extent.height <= 0 || r.rect.offset.x < 0 || r.rect.offset.y < 0)
+      throw std::runtime_error("a submitted imageRect is empty or negative");
+    offsets.push_back(total);
+    total += VkDeviceSize(r.rect.extent.width) * VkDeviceSize(r.rect.extent.height) * 4;
+  }
+  reserve(download_, total, VK_BUFFER_USAGE_TRANSFER_DST_BIT);
+  submit([&](VkCommandBuffer cb) {
+    for (std::size_t i = 0; i < reads.size(); ++i) {
+      const Read& r = reads[i];
+      // After the application's rendering (earlier submissions on this queue).
+      auto to_src = image_barrier(r.image, r.array_layer, VK_IMAGE_LAYOUT_COLOR_ATTACHMENT_OPTIMAL,
+                                  VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL,
+                                  VK_ACCESS_COLOR_ATTACHMENT_WRITE_BIT | VK_ACCESS_SHADER_WRITE_BIT | VK_ACCESS_TRANSFER_WRITE_BIT,
+                                  VK_ACCESS_TRANSFER_READ_BIT);
+      vkCmdPipelineBarrier_(cb, VK_PIPELINE_STAGE_ALL_COMMANDS_BIT, VK_PIPELINE_STAGE_TRANSFER_BIT, 0, 0, nullptr, 0,
+                            nullptr, 1, &to_src);
+      VkBufferImageCopy c{};
+      c.bufferOffset = offsets[i];
+      c.imageSubresource = {VK_IMAGE_ASPECT_COLOR_BIT, 0, r.array_layer, 1};
+      c.imageOffset = {r.rect.offset.x, r.rect.offset.y, 0};
+      c.imageExtent = {std::uint32_t(r.rect.extent.width), std::uint32_t(r.rect.extent.height), 1};
+      vkCmdCopyImageToBuffer_(cb, r.image, VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL, download_.buffer, 1, &c);
+      auto back = image_barrier(r.image, r.array_layer, VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL,
+                                VK_IMAGE_LAYOUT_COLOR_ATTACHMENT_OPTIMAL, 0, 0);
+      vkCmdPipelineBarrier_(cb, VK_PIPELINE_STAGE_TRANSFER_BIT, VK_PIPELINE_STAGE_ALL_COMMANDS_BIT, 0, 0, nullptr, 0,
+                            nullptr, 1, &back);
+    }
+    VkMemoryBarrier host{VK_STRUCTURE_TYPE_MEMORY_BARRIER};
+    host.srcAccessMask = VK_ACCESS_TRANSFER_WRITE_BIT;
+    host.dstAccessMask = VK_ACCESS_HOST_READ_BIT;
+    vkCmdPipelineBarrier_(cb, VK_PIPELINE_STAGE_TRANSFER_BIT, VK_PIPELINE_STAGE_HOST_BIT, 0, 1, &host, 0, nullptr, 0,
+                          nullptr);
+  });
+  std::vector<Pixels8> out;
+  for (std::size_t i = 0; i < reads.size(); ++i) {
+    Pixels8 p{reads[i].rect.extent.width, reads[i].rect.extent.height, {}};
+    p.data.resize(std::size_t(p.width) * std::size_t(p.height) * 4);
+    std::memcpy(p.data.data(), static_cast<const std::uint8_t*>(download_.mapped) + offsets[i], p.data.size());
+    out.push_back(std::move(p));
+  }
+  return out;
+}
+
+void AppDevice::write(const std::vector<VkImage>& images, const std::vector<const Pixels8*>& pixels) {
+  VkDeviceSize total = 0;
+  std::vector<VkDeviceSize> offsets;
+  for (const Pixels8* p : pixels) {
+    offsets.push_back(total);
+    total += p->data.size();
+  }
+  reserve(upload_, total, VK_BUFFER_USAGE_TRANSFER_SRC_BIT);
+  for (std::size_t i = 0; i < pixels.size(); ++i)
+    std::memcpy(static_cast<std::uint8_t*>(upload_.mapped) + offsets[i], pixels[i]->data.data(), pixels[i]->data.size());
+  submit([&](VkCommandBuffer cb) {
+    for (std::size_t i = 0; i < images.size(); ++i) {
+      // The whole image is overwritten: its old contents are discarded (after the runtime's
+      // earlier reads of it on this queue).
+      auto to_dst = image_barrier(images[i], 0, VK_IMAGE_LAYOUT_UNDEFINED, VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL, 0,
+                                  VK_ACCESS_TRANSFER_WRITE_BIT);
+      vkCmdPipelineBarrier_(cb, VK_PIPELINE_STAGE_ALL_COMMANDS_BIT, VK_PIPELINE_STAGE_TRANSFER_BIT, 0, 0, nullptr, 0,
+                            nullptr, 1, &to_dst);
+      VkBufferImageCopy c{};
+      c.bufferOffset = offsets[i];
+      c.imageSubresource = {VK_IMAGE_ASPECT_COLOR_BIT, 0, 0, 1};
+      c.imageExtent = {std::uint32_t(pixels[i]->width), std::uint32_t(pixels[i]->height), 1};
+      vkCmdCopyBufferToImage_(cb, upload_.buffer, images[i], VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL, 1, &c);
+      auto done = image_barrier(images[i], 0, VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL,
+                                VK_IMAGE_LAYOUT_COLOR_ATTACHMENT_OPTIMAL, VK_ACCESS_TRANSFER_WRITE_BIT,
+                                VK_ACCESS_TRANSFER_READ_BIT | VK_ACCESS_COLOR_ATTACHMENT_READ_BIT |
+                                    VK_ACCESS_COLOR_ATTACHMENT_WRITE_BIT);
+      vkCmdPipelineBarrier_(cb, VK_PIPELINE_STAGE_TRANSFER_BIT, VK_PIPELINE_STAGE_ALL_COMMANDS_BIT, 0, 0, nullptr, 0,
+                            nullptr, 1, &done);
+    }
+  });
+}
+
+}  // namespace fovea::layer

@@ -1,0 +1,68 @@
+#pragma once
+// Transfers between host memory and images on the application's VkDevice, on the
+// session's queue (the queue the runtime also uses; the layer submits only inside
+// xrEndFrame, before calling down). Each transfer is one submission and a fence wait.
+#include <cstdint>
+#include <vector>
+
+#include <vulkan/vulkan.h>
+
+#define XR_USE_GRAPHICS_API_VULKAN
+#include <openxr/openxr.h>
+
+#include "composite.hpp"
+#include "frame_renderer.hpp"
+
+namespace fovea::layer {
+
+class AppDevice {
+ public:
+  explicit AppDevice(const VulkanBinding& vk);  // throws std::runtime_error
+  ~AppDevice();
+  AppDevice(const AppDevice&) = delete;
+  AppDevice& operator=(const AppDevice&) = delete;
+
+  struct Read {
+    VkImage image;
+    std::uint32_t array_layer;
+    XrRect2Di rect;
+  };
+  // Reads 4-byte texels of each image's rect (images in COLOR_ATTACHMENT_OPTIMAL, left so).
+  std::vector<Pixels8> read(const std::vector<Read>& reads);
+  // Overwrites each whole image (array layer 0) with `pixels` (same size); the images end in
+  // COLOR_ATTACHMENT_OPTIMAL.
+  void write(const std::vector<VkImage>& images, const std::vector<const Pixels8*>& pixels);
+
+ private:
+  struct HostBuffer {
+    VkBuffer buffer = VK_NULL_HANDLE;
+    VkDeviceMemory memory = VK_NULL_HANDLE;
+    void* mapped = nullptr;
+    VkDeviceSize size = 0;
+  };
+  void reserve(HostBuffer& b, VkDeviceSize size, VkBufferUsageFlags usage);
+  void release(HostBuffer& b);
+  void destroy();
+  template <class F>
+  void submit(F&& record);
+
+  VkDevice device_ = VK_NULL_HANDLE;
+  VkQueue queue_ = VK_NULL_HANDLE;
+  VkCommandPool pool_ = VK_NULL_HANDLE;
+  VkCommandBuffer cmd_ = VK_NULL_HANDLE;
+  VkFence fence_ = VK_NULL_HANDLE;
+  HostBuffer download_, upload_;
+  VkPhysicalDeviceMemoryProperties memory_{};
+
+#define FOVEA_APP_VK(X)                                                                                          \
+  X(vkGetDeviceQueue) X(vkCreateCommandPool) X(vkDestroyCommandPool) X(vkAllocateCommandBuffers)                \
+  X(vkResetCommandBuffer) X(vkBeginCommandBuffer) X(vkEndCommandBuffer) X(vkCmdPipelineBarrier)                 \
+  X(vkCmdCopyImageToBuffer) X(vkCmdCopyBufferToImage) X(vkQueueSubmit) X(vkCreateFence) X(vkDestroyFence)       \
+  X(vkWaitForFences) X(vkResetFences) X(vkCreateBuffer) X(vkDestroyBuffer) X(vkGetBufferMemoryRequirements)     \
+  X(vkAllocateMemory) X(vkFreeMemory) X(vkBindBufferMemory) X(vkMapMemory) X(vkUnmapMemory)
+#define FOVEA_APP_VK_MEMBER(name) PFN_##name name##_ = nullptr;
+  FOVEA_APP_VK(FOVEA_APP_VK_MEMBER)
+#undef FOVEA_APP_VK_MEMBER
+};
+
+}  // namespace fovea::layer

@@ -1,0 +1,103 @@
+#include "composite.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <map>
+#include <stdexcept>
+#include <string>
+
+#include "fovea/renderer/reference.hpp"
+
+namespace fovea::layer {
+
+PixelFormat pixel_format(VkFormat f) {
+  switch (f) {
+    case VK_FORMAT_R8G8B8A8_SRGB: return {false, true};
+    case VK_FORMAT_B8G8R8A8_SRGB: return {true, true};
+    case VK_FORMAT_R8G8B8A8_UNORM: return {false, false};
+    case VK_FORMAT_B8G8R8A8_UNORM: return {true, false};
+    default: break;
+  }
+  throw std::runtime_error("the application's projection views use VkFormat " + std::to_string(int(f)) +
+                           ", which the layer cannot composite (8-bit RGBA/BGRA, sRGB or UNORM only)");
+}
+
+Pixels8 encode_scene(const core::Image& linear, PixelFormat fmt) {
+  const core::Image mapped = renderer::tone_map(linear);
+  Pixels8 out{mapped.width, mapped.height, std::vector<std::uint8_t>(std::size_t(mapped.width) * std::size_t(mapped.height) * 4)};
+  const auto byte = [&](float v) {
+    v = std::clamp(std::isfinite(v) ? v : 0.0f, 0.0f, 1.0f);
+    return std::uint8_t(std::lround((fmt.srgb ? core::srgb_encode(v) : v) * 255.0f));
+  };
+  for (int y = 0; y < mapped.height; ++y)
+    for (int x = 0; x < mapped.width; ++x) {
+      const auto& c = mapped.at(x, y);
+      std::uint8_t* p = out.at(x, y);
+      p[fmt.bgra ? 2 : 0] = byte(c.x);
+      p[1] = byte(c.y);
+      p[fmt.bgra ? 0 : 2] = byte(c.z);
+      p[3] = 255;
+    }
+  return out;
+}
+
+std::array<std::uint8_t, 3> border_colour(const Pixels8& img) {
+  std::map<std::uint32_t, int> count;
+  const auto add = [&](int x, int y) {
+    const std::uint8_t* p = img.at(x, y);
+    ++count[std::uint32_t(p[0]) | std::uint32_t(p[1]) << 8 | std::uint32_t(p[2]) << 16];
+  };
+  for (int x = 0; x < img.width; ++x) add(x, 0), add(x, img.height - 1);
+  for (int y = 1; y + 1 < img.height; ++y) add(0, y), add(img.width - 1, y);
+  if (count.empty()) return {0, 0, 0};
+  const auto best = std::max_element(count.begin(), count.end(), [](auto& a, auto& b) { return a.second < b.second; });
+  return {std::uint8_t(best->first), std::uint8_t(best->first >> 8), std::uint8_t(best->first >> 16)};
+}
+
+Pixels8 resample(const Pixels8& app, const core::View& app_view, const core::View& scene_view) {
+  const auto same = [](const core::Fov& a, const core::Fov& b) {
+    return std::abs(a.angle_left - b.angle_left) < 1e-6 && std::abs(a.angle_right - b.angle_right) < 1e-6 &&
+           std::abs(a.angle_up - b.angle_up) < 1e-6 && std::abs(a.angle_down - b.angle_down) < 1e-6;
+  };
+  if (same(app_view.fov(), scene_view.fov()) && app.width == scene_view.width() && app.height == scene_view.height())
+    return app;
+  Pixels8 out{scene_view.width(), scene_view.height(),
+              std::vector<std::uint8_t>(std::size_t(scene_view.width()) * std::size_t(scene_view.height()) * 4, 0)};
+  for (int y = 0; y < out.height; ++y)
+    for (int x = 0; x < out.width; ++x) {
+      const auto px = app_view.dir_to_pixel(scene_view.pixel_to_dir({x + 0.5, y + 0.5}));
+      if (!px || px->x < 0 || px->y < 0 || px->x >= app.width || px->y >= app.height) continue;
+      std::copy_n(app.at(int(px->x), int(px->y)), 4, out.at(x, y));
+    }
+  return out;
+}
+
+std::int64_t composite(Pixels8& scene, const Pixels8& app, Composite mode, std::array<std::uint8_t, 3> background,
+                       int tolerance) {
+  if (app.width != scene.width || app.height != scene.height)
+    throw std::logic_error("composite: the application's image and the scene differ in size");
+  std::int64_t shown = 0;
+  if (mode == Composite::SceneOnly) return 0;
+  for (int y = 0; y < scene.height; ++y)
+    for (int x = 0; x < scene.width; ++x) {
+      const std::uint8_t* a = app.at(x, y);
+      std::uint8_t* s = scene.at(x, y);
+      if (mode == Composite::AppOnTop) {
+        if (a[3] == 0) continue;
+        bool differs = false;
+        for (int c = 0; c < 3; ++c) differs |= std::abs(int(a[c]) - int(background[std::size_t(c)])) > tolerance;
+        if (!differs) continue;
+        std::copy_n(a, 4, s);
+        ++shown;
+      } else {
+        const int alpha = a[3];
+        if (alpha == 0) continue;
+        for (int c = 0; c < 3; ++c) s[c] = std::uint8_t((a[c] * alpha + s[c] * (255 - alpha) + 127) / 255);
+        s[3] = 255;
+        ++shown;
+      }
+    }
+  return shown;
+}
+
+}  // namespace fovea::layer

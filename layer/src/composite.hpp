@@ -1,0 +1,55 @@
+#pragma once
+// Combining the path-traced scene with the application's own pixels, on the host, in the
+// 8-bit encoding of the application's swapchain (so the application's pixels pass through
+// bit-exact wherever they are kept).
+#include <array>
+#include <cstdint>
+#include <optional>
+#include <vector>
+
+#include <vulkan/vulkan.h>
+
+#include "config.hpp"
+#include "fovea/core/image.hpp"
+#include "fovea/core/view.hpp"
+
+namespace fovea::layer {
+
+// The colour formats the layer composites (the runtime's colour swapchain formats).
+struct PixelFormat {
+  bool bgra = false;  // B8G8R8A8 channel order
+  bool srgb = false;  // sRGB-encoded (else linear UNORM)
+};
+// Throws std::runtime_error for any other format.
+PixelFormat pixel_format(VkFormat f);
+
+// Tightly packed 4-byte pixels in a swapchain's channel order, top row first.
+struct Pixels8 {
+  int width = 0, height = 0;
+  std::vector<std::uint8_t> data;
+  std::uint8_t* at(int x, int y) { return &data[(std::size_t(y) * std::size_t(width) + std::size_t(x)) * 4]; }
+  const std::uint8_t* at(int x, int y) const {
+    return &data[(std::size_t(y) * std::size_t(width) + std::size_t(x)) * 4];
+  }
+};
+
+// Tone-mapped linear radiance (Reinhard, as `fovea render` shows it) encoded for `fmt`, alpha 1.
+Pixels8 encode_scene(const core::Image& linear, PixelFormat fmt);
+
+// The most frequent colour (first three bytes) among the border pixels: the application's
+// clear colour when it draws content away from the edges.
+std::array<std::uint8_t, 3> border_colour(const Pixels8& img);
+
+// The application's image `app` (seen through `app_view`) resampled (nearest, by direction)
+// into `scene_view`'s raster; identity when both views are the same. Pixels the application
+// did not cover get alpha 0.
+Pixels8 resample(const Pixels8& app, const core::View& app_view, const core::View& scene_view);
+
+// Composites `app` (same raster as `scene`) into `scene` by `mode`. AppOnTop keeps the
+// application's pixel where any channel differs from `background` by more than `tolerance`
+// (8-bit units); Alpha blends by the application's (straight) alpha in the stored encoding.
+// Returns how many pixels show the application.
+std::int64_t composite(Pixels8& scene, const Pixels8& app, Composite mode, std::array<std::uint8_t, 3> background,
+                       int tolerance = 2);
+
+}  // namespace fovea::layer

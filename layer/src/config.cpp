@@ -1,0 +1,107 @@
+#include "config.hpp"
+
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+
+#include <nlohmann/json.hpp>
+
+#include "fovea/core/error.hpp"
+
+namespace fovea::layer {
+namespace {
+
+std::string env(const char* name) {
+  const char* v = std::getenv(name);
+  return v ? v : "";
+}
+
+void apply_section(const nlohmann::json& s, const std::string& where, LayerConfig& c) {
+  if (!s.is_object()) throw core::InputError(where + ": must be an object");
+  for (const auto& [key, v] : s.items()) {
+    const std::string field = where + "." + key;
+    if (key == "scene" || key == "gaze") {
+      if (!v.is_string()) throw core::InputError(field + ": must be a string");
+      (key == "scene" ? c.scene : c.gaze) = v.get<std::string>();
+      if (key == "scene") c.origin = where;
+    } else if (key == "composite") {
+      const std::string m = v.is_string() ? v.get<std::string>() : "";
+      if (m == "app-on-top") c.composite = Composite::AppOnTop;
+      else if (m == "alpha") c.composite = Composite::Alpha;
+      else if (m == "scene-only") c.composite = Composite::SceneOnly;
+      else throw core::InputError(field + ": must be \"app-on-top\", \"alpha\" or \"scene-only\"");
+    } else if (key == "app_background") {
+      if (v.is_string() && v.get<std::string>() == "auto") {
+        c.app_background.reset();
+        continue;
+      }
+      if (!v.is_array() || v.size() != 3) throw core::InputError(field + ": must be \"auto\" or [r, g, b] (0..255)");
+      std::array<int, 3> rgb{};
+      for (int i = 0; i < 3; ++i) {
+        if (!v[i].is_number_integer() || v[i].get<int>() < 0 || v[i].get<int>() > 255)
+          throw core::InputError(field + ": must be \"auto\" or [r, g, b] (0..255)");
+        rgb[i] = v[i].get<int>();
+      }
+      c.app_background = rgb;
+    } else {
+      throw core::InputError(field + ": unknown key (scene, composite, app_background, gaze)");
+    }
+  }
+}
+
+}  // namespace
+
+const char* composite_name(Composite c) {
+  switch (c) {
+    case Composite::AppOnTop: return "app-on-top";
+    case Composite::Alpha: return "alpha";
+    case Composite::SceneOnly: return "scene-only";
+  }
+  return "?";
+}
+
+LayerConfig parse_config(const std::string& text, const std::string& origin, const std::string& application) {
+  nlohmann::json j;
+  try {
+    j = nlohmann::json::parse(text);
+  } catch (const nlohmann::json::exception& e) {
+    throw core::InputError(origin + ": not valid JSON: " + e.what());
+  }
+  if (!j.is_object()) throw core::InputError(origin + ": must be a JSON object");
+  LayerConfig c;
+  for (const auto& [key, v] : j.items())
+    if (key != "default" && key != "applications")
+      throw core::InputError(origin + ": unknown key \"" + key + "\" (default, applications)");
+  if (j.contains("default")) apply_section(j["default"], origin + ": default", c);
+  if (j.contains("applications")) {
+    const auto& apps = j["applications"];
+    if (!apps.is_object()) throw core::InputError(origin + ": applications: must be an object");
+    if (apps.contains(application)) apply_section(apps[application], origin + ": applications." + application, c);
+  }
+  return c;
+}
+
+LayerConfig load_config(const std::string& application) {
+  namespace fs = std::filesystem;
+  LayerConfig c;
+  fs::path dir = env("XDG_CONFIG_HOME");
+  if (dir.empty() && !env("HOME").empty()) dir = fs::path(env("HOME")) / ".config";
+  const fs::path file = dir / "fovea" / "layer.json";
+  std::error_code ec;
+  if (!dir.empty() && fs::is_regular_file(file, ec)) {
+    std::ifstream in(file);
+    std::stringstream ss;
+    ss << in.rdbuf();
+    c = parse_config(ss.str(), file.string(), application);
+  }
+  for (const char* name : {"FOVEA_LAYER_SCENE", "FOVEA_SCENE"})
+    if (!env(name).empty()) {
+      c.scene = env(name);
+      c.origin = name;
+    }
+  if (!env("FOVEA_GAZE").empty()) c.gaze = env("FOVEA_GAZE");
+  return c;
+}
+
+}  // namespace fovea::layer

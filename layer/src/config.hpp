@@ -1,0 +1,38 @@
+#pragma once
+// The layer's configuration for one application. Sources, later ones winning:
+//   $XDG_CONFIG_HOME/fovea/layer.json (else ~/.config/fovea/layer.json):
+//     {"default": {...}, "applications": {"<XrApplicationInfo::applicationName>": {...}}}
+//     with keys "scene", "composite", "app_background", "gaze" (an application's section
+//     over "default");
+//   env FOVEA_LAYER_SCENE, then FOVEA_SCENE (the scene); FOVEA_GAZE (the gaze source).
+#include <array>
+#include <optional>
+#include <string>
+
+namespace fovea::layer {
+
+// How the application's pixels are combined with the path-traced scene.
+enum class Composite {
+  AppOnTop,   // the application's pixels wherever they differ from its background colour
+  Alpha,      // the application's pixels over the scene by their alpha
+  SceneOnly,  // the scene alone (comparisons)
+};
+
+struct LayerConfig {
+  std::string scene;  // renderer::load_scene name or path; empty: none (pass-through)
+  Composite composite = Composite::AppOnTop;
+  // AppOnTop's background colour (8-bit, as stored in the application's image); unset: the
+  // most frequent colour on the image border, per frame.
+  std::optional<std::array<int, 3>> app_background;
+  std::string gaze;  // devices::open_gaze_source URI; empty: synthetic:1
+  std::string origin;  // where the scene setting came from, for the log
+};
+
+// Throws core::InputError naming the file and field for a malformed configuration file.
+LayerConfig load_config(const std::string& application);
+// Parses one configuration file's text (for tests and load_config).
+LayerConfig parse_config(const std::string& text, const std::string& origin, const std::string& application);
+
+const char* composite_name(Composite c);
+
+}  // namespace fovea::layer
