@@ -2,6 +2,7 @@
 // Display-stage distortion pass (compositor/distortion.hpp): per panel pixel, three
 // bilinear taps of the resolved view (one per colour channel at that channel's source
 // position through the lens), black in the hidden area, explicit linear → sRGB encode.
+// The optics are evaluated directly per pixel, or read from the optional LUT cache.
 layout(local_size_x = 8, local_size_y = 8) in;
 
 layout(set = 0, binding = 0, rgba32f) uniform readonly image2D source_image;
@@ -12,12 +13,16 @@ layout(set = 0, binding = 1, rgba8) uniform writeonly image2D panel_image;
 layout(set = 0, binding = 2, std430) readonly buffer Optics { float optics[48]; };
 // Hidden-area bitmask, words_per_row 32-bit words per row, bit set = hidden.
 layout(set = 0, binding = 3, std430) readonly buffer Mask { uint mask_words[]; };
+// Optional optics cache (core/lens_lut.hpp): lut_size² nodes spanning the panel, per node
+// and channel the source uv, float pair at ((j·N + i)·3 + c)·2.
+layout(set = 0, binding = 4, std430) readonly buffer Lut { float lut[]; };
 
 layout(push_constant) uniform Push {
   uint width, height;          // panel
   uint src_width, src_height;  // view image
   uint select;                 // 3: each channel its own optics; 0..2: that channel's for all
   uint words_per_row;
+  uint lut_size;               // 0: direct evaluation; else N of the LUT
 } pc;
 
 float k(int c, int i) { return optics[c * 16 + i]; }
@@ -35,6 +40,23 @@ float profile(int c, float r) {
 vec2 source_uv(int c, vec2 uv) {
   vec2 t = (uv - vec2(k(c, 0), k(c, 1))) * vec2(k(c, 2), k(c, 3));
   return vec2(k(c, 4), k(c, 5)) + vec2(k(c, 6), k(c, 7)) * t * profile(c, length(t));
+}
+
+vec2 lut_node(int c, ivec2 ij) {
+  int b = ((ij.y * int(pc.lut_size) + ij.x) * 3 + c) * 2;
+  return vec2(lut[b], lut[b + 1]);
+}
+
+// Bilinear in the LUT, as LensLut::source_uv.
+vec2 lut_source_uv(int c, vec2 uv) {
+  float n1 = float(pc.lut_size - 1u);
+  vec2 p = clamp(uv, 0.0, 1.0) * n1;
+  vec2 i0 = min(floor(p), vec2(n1 - 1.0));
+  vec2 f = p - i0;
+  ivec2 q = ivec2(i0);
+  vec2 top = mix(lut_node(c, q), lut_node(c, q + ivec2(1, 0)), f.x);
+  vec2 bottom = mix(lut_node(c, q + ivec2(0, 1)), lut_node(c, q + ivec2(1, 1)), f.x);
+  return mix(top, bottom, f.y);
 }
 
 // Non-finite texels are black, huge ones bounded so the filter cannot overflow.
@@ -72,7 +94,8 @@ void main() {
     vec2 uv = (vec2(id) + 0.5) / vec2(pc.width, pc.height);
     for (int c = 0; c < 3; ++c) {
       int optic = pc.select == 3u ? c : int(pc.select);
-      out_value[c] = srgb_encode(tap(c, source_uv(optic, uv)));
+      vec2 src = pc.lut_size > 0u ? lut_source_uv(optic, uv) : source_uv(optic, uv);
+      out_value[c] = srgb_encode(tap(c, src));
     }
   }
   imageStore(panel_image, ivec2(id), out_value);

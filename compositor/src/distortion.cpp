@@ -14,7 +14,7 @@ namespace fovea::compositor {
 namespace {
 
 struct Push {  // lens_distort.comp's push_constant block
-  std::uint32_t width, height, src_width, src_height, select, words_per_row;
+  std::uint32_t width, height, src_width, src_height, select, words_per_row, lut_size;
 };
 
 // lens_distort.comp's Optics buffer: 16 floats per channel.
@@ -69,7 +69,8 @@ core::Image PanelImage::to_image() const {
   return img;
 }
 
-core::Image distort_reference(const core::HiddenAreaMask& mask, const core::Image& view_image, ChannelSelect select) {
+core::Image distort_reference(const core::HiddenAreaMask& mask, const core::Image& view_image, ChannelSelect select,
+                              const core::LensLut* lut) {
   check_raster(mask, view_image.width, view_image.height, "the view image");
   const core::Lens& lens = mask.lens();
   const int W = mask.width(), H = mask.height();
@@ -80,7 +81,8 @@ core::Image distort_reference(const core::HiddenAreaMask& mask, const core::Imag
       const glm::dvec2 uv((x + 0.5) / W, (y + 0.5) / H);
       for (int c = 0; c < 3; ++c) {
         const int optic = select == ChannelSelect::All ? c : int(select);
-        out.at(x, y)[c] = float(std::clamp(tap(view_image, c, lens.source_uv(optic, uv)), 0.0, 1.0));
+        const glm::dvec2 src = lut ? lut->source_uv(optic, uv) : lens.source_uv(optic, uv);
+        out.at(x, y)[c] = float(std::clamp(tap(view_image, c, src), 0.0, 1.0));
       }
     }
   return out;
@@ -107,12 +109,13 @@ core::Image direction_grid(const core::View& v, double step_deg) {
   return img;
 }
 
-DistortionPass::DistortionPass(gpu::Context& ctx, const core::HiddenAreaMask& mask, ChannelSelect select)
+DistortionPass::DistortionPass(gpu::Context& ctx, const core::HiddenAreaMask& mask, ChannelSelect select,
+                               OpticsEval eval)
     : ctx_(&ctx), width_(mask.width()), height_(mask.height()), select_(select) {
   pipeline_ = gpu::ComputePipeline(
       ctx, {.shader = "lens_distort.comp.spv",
             .sets = {{gpu::Binding::StorageImage, gpu::Binding::StorageImage, gpu::Binding::StorageBuffer,
-                      gpu::Binding::StorageBuffer}},
+                      gpu::Binding::StorageBuffer, gpu::Binding::StorageBuffer}},
             .push_constant_bytes = sizeof(Push)});
   const auto optics = pack_optics(mask.lens());
   optics_ = gpu::Buffer(ctx, {.size = sizeof(optics), .name = "lens optics"});
@@ -121,6 +124,15 @@ DistortionPass::DistortionPass(gpu::Context& ctx, const core::HiddenAreaMask& ma
   mask_ = gpu::Buffer(ctx, {.size = words.size_bytes(), .name = "hidden-area mask"});
   mask_.upload(words);
   words_per_row_ = std::uint32_t(mask.words_per_row());
+  // Direct evaluation binds a one-float placeholder: the shader never reads it then.
+  std::vector<float> lut(1, 0.0f);
+  if (eval == OpticsEval::Lut) {
+    const core::LensLut cache(mask.lens());
+    lut = cache.packed();
+    lut_size_ = std::uint32_t(cache.size());
+  }
+  lut_ = gpu::Buffer(ctx, {.size = lut.size() * sizeof(float), .name = "lens optics LUT"});
+  lut_.upload(lut);
 }
 
 void DistortionPass::record(VkCommandBuffer cmd, const gpu::Image2D& source, const gpu::Image2D& target) {
@@ -132,12 +144,12 @@ void DistortionPass::record(VkCommandBuffer cmd, const gpu::Image2D& source, con
   while (i < set_keys_.size() && set_keys_[i] != key) ++i;
   if (i == set_keys_.size()) {
     auto set = std::make_unique<gpu::DescriptorSet>(*ctx_, pipeline_.set_layout(0));
-    set->bind(0, source).bind(1, target).bind(2, optics_).bind(3, mask_);
+    set->bind(0, source).bind(1, target).bind(2, optics_).bind(3, mask_).bind(4, lut_);
     sets_.push_back(std::move(set));
     set_keys_.push_back(key);
   }
   const Push push{std::uint32_t(width_), std::uint32_t(height_), source.width(), source.height(),
-                  std::uint32_t(select_), words_per_row_};
+                  std::uint32_t(select_), words_per_row_, lut_size_};
   pipeline_.run(cmd, {sets_[i].get()}, push, std::uint32_t(width_), std::uint32_t(height_));
 }
 

@@ -1,19 +1,29 @@
 // fovea view: the mirror window — what both panels of a display show, through the lens
-// distortion pass on the GPU, with the gaze marker; `--gaze mouse` makes the mouse
-// position on the window the gaze.
+// distortion pass on the GPU, with the gaze marker. With --scene each frame is path traced
+// foveated at the current gaze (FramePipeline) and distorted; `--gaze mouse` makes the
+// mouse position on the window the gaze.
+#include <array>
 #include <chrono>
+#include <cmath>
+#include <cstdlib>
 #include <iostream>
+#include <memory>
 #include <optional>
 #include <thread>
 
 #include "command.hpp"
 #include "fovea/compositor/distortion.hpp"
+#include "fovea/compositor/frame_pipeline.hpp"
 #include "fovea/compositor/mirror_window.hpp"
 #include "fovea/core/display.hpp"
 #include "fovea/core/error.hpp"
 #include "fovea/core/hidden_area.hpp"
 #include "fovea/core/image.hpp"
+#include "fovea/devices/gaze.hpp"
 #include "fovea/gpu/context.hpp"
+#include "fovea/renderer/gpu_scene.hpp"
+#include "fovea/renderer/reference.hpp"
+#include "fovea/renderer/scene_io.hpp"
 #include "gaze_arg.hpp"
 
 namespace fovea::tools {
@@ -23,23 +33,58 @@ constexpr const char* kHelp = R"(usage: fovea view [options]
 
 Opens the mirror window (X11; e.g. under Xvfb with DISPLAY set): both eyes' panels side
 by side as the headset shows them, through the lens distortion pass, with a gaze marker.
-Until the path tracer and reconstruction feed it, each eye shows a grid of view
-directions (lines every 5 degrees) as the resolved image.
+With --scene every frame is path traced foveated at the current gaze (grid generation,
+path tracing, reconstruction, resolve; as fovea render), tone-mapped (Reinhard) and
+distorted for the panels. Without --scene each eye shows a grid of view directions (lines
+every 5 degrees), a picture of the optics.
 
   --display NAME|FILE   display preset (fove0, vive, modern, small, tiny) or JSON file [small]
-  --scene S             scene to path-trace (needs the renderer; not available yet)
-  --gaze mouse|X,Y      mouse: the cursor over a panel is the gaze (looked at through the
-                        lens); X,Y: fixed gaze in normalised view coordinates [0.5,0.5]
+  --scene S             cornell | furnace | glossy-spheres | stereo-occluders | default, or a
+                        .gltf/.glb/.obj file: path trace it (otherwise the direction grid)
+  --gaze G              mouse: the cursor over a panel is the gaze (looked at through that
+                        eye's lens; kept when the cursor leaves the panels);
+                        X,Y: fixed gaze in normalised view coordinates;
+                        FILE or synthetic:SEED[?...]: a recording or synthetic gaze
+                        (docs/gaze.md), sampled at frame / refresh rate [0.5,0.5]
   --gaze-dir x,y,z      fixed gaze as a view-space direction (OpenXR: -Z forward, +Y up)
+  --budget B            grid samples as a fraction of display pixels [0.39]
+  --optics direct|lut   distortion pass: evaluate the optics per pixel, or read them from
+                        the 128x128 LUT cache [direct]
   --window WxH          window size [fits both panels in 1280x720]
   --frames N            close after N frames; 0 = when the window is closed [0]
   --screenshot PNG      write the last frame the window showed
   --panels PREFIX       write PREFIX-left.png, PREFIX-right.png (display space, per eye)
-                        and PREFIX-panel.png (both side by side)
+                        and PREFIX-panel.png (both side by side), of the last frame
   --help                this text
 
 Exit status: 0 on success, 1 when no window can be opened, 2 on invalid arguments.
 )";
+
+// "X,Y": two numbers, the fixed gaze; anything else that is not "mouse" names a source.
+bool is_point(const std::string& s) {
+  const auto comma = s.find(',');
+  if (comma == std::string::npos || s.find(',', comma + 1) != std::string::npos) return false;
+  for (const std::string& part : {s.substr(0, comma), s.substr(comma + 1)}) {
+    char* end = nullptr;
+    std::strtod(part.c_str(), &end);
+    if (part.empty() || *end != '\0') return false;
+  }
+  return true;
+}
+
+compositor::OpticsEval parse_optics(const std::string& s) {
+  if (s == "direct") return compositor::OpticsEval::Direct;
+  if (s == "lut") return compositor::OpticsEval::Lut;
+  throw core::InputError("option --optics: expected direct or lut, got \"" + s + "\"");
+}
+
+// What draws the resolved view images: the foveated pipeline on a scene.
+struct SceneRenderer {
+  renderer::Scene scene;
+  std::unique_ptr<renderer::GpuScene> gpu_scene;
+  std::unique_ptr<compositor::FramePipeline> pipeline;
+  std::array<core::Pose, 2> poses;  // a static head at the scene camera, eyes ipd/2 beside it
+};
 
 std::pair<int, int> parse_size(const std::string& s) {
   const auto x = s.find('x');
@@ -71,50 +116,95 @@ int run(std::vector<std::string> argv) {
       std::cout << kHelp;
       return 0;
     }
-  const Args args(argv, {"display", "scene", "gaze", "gaze-dir", "window", "frames", "screenshot", "panels"}, {});
-  if (args.has("scene"))
-    throw core::InputError("--scene needs the path tracer and the reconstruction, which this build does not "
-                           "have yet; run without --scene to see the lens on a direction grid");
+  const Args args(argv,
+                  {"display", "scene", "gaze", "gaze-dir", "budget", "optics", "window", "frames", "screenshot",
+                   "panels"},
+                  {});
   const core::DisplayPreset d = core::load_display(args.str("display", "small"));
   const long frames = args.integer("frames", 0);
   if (frames < 0) throw core::InputError("option --frames: must be 0 or more");
-  const bool mouse = args.str("gaze", "") == "mouse";
+  const compositor::OpticsEval optics = parse_optics(args.str("optics", "direct"));
+  core::DistributionParams dp;
+  dp.budget = args.num("budget", dp.budget);
+  dp.validate();
   const core::Lens lenses[2] = {core::Lens::for_eye(d, core::Eye::Left), core::Lens::for_eye(d, core::Eye::Right)};
-  std::optional<glm::dvec3> fixed_gaze;
-  if (!mouse) fixed_gaze = parse_gaze(args, lenses[0].view());
 
-  // The resolved images are static for now: distort once on the GPU.
-  gpu::Context ctx;
-  compositor::PanelImage panels[2];
-  for (int e = 0; e < 2; ++e) {
-    const core::HiddenAreaMask mask(lenses[e]);
-    compositor::DistortionPass pass(ctx, mask);
-    panels[e] = pass.run(compositor::direction_grid(lenses[e].view()));
+  // The gaze: the mouse, a fixed direction, or a gaze source (recording, synthetic).
+  const std::string gaze_arg = args.str("gaze", "");
+  const bool mouse = gaze_arg == "mouse";
+  std::unique_ptr<devices::GazeSource> source;
+  std::array<glm::dvec3, 2> gaze{glm::dvec3(0, 0, -1), glm::dvec3(0, 0, -1)};
+  if (!mouse && !gaze_arg.empty() && !args.has("gaze-dir") && !is_point(gaze_arg)) {
+    devices::SourceOptions so;
+    so.display = d;
+    source = devices::open_gaze_source(gaze_arg, so);
+  } else if (!mouse) {
+    gaze[0] = gaze[1] = parse_gaze(args, lenses[0].view());
   }
-  if (auto prefix = args.opt("panels")) write_panels(*prefix, panels);
+
+  gpu::Context ctx;
+  std::array<std::unique_ptr<compositor::DistortionPass>, 2> passes;
+  for (int e = 0; e < 2; ++e)
+    passes[size_t(e)] = std::make_unique<compositor::DistortionPass>(ctx, core::HiddenAreaMask(lenses[e]),
+                                                                      compositor::ChannelSelect::All, optics);
+  compositor::PanelImage panels[2];
+  std::optional<SceneRenderer> sr;
+  if (auto name = args.opt("scene")) {
+    sr.emplace();
+    sr->scene = renderer::load_scene(*name);
+    for (const auto& w : sr->scene.warnings) std::cerr << "warning: " << w << "\n";
+    sr->gpu_scene = std::make_unique<renderer::GpuScene>(ctx, sr->scene);
+    sr->pipeline = std::make_unique<compositor::FramePipeline>(ctx, *sr->gpu_scene, d, dp, compositor::ReconSettings{});
+    for (int e = 0; e < 2; ++e) {
+      sr->poses[size_t(e)] = sr->scene.camera;
+      sr->poses[size_t(e)].position +=
+          sr->scene.camera.orientation * glm::dvec3((e == 0 ? -0.5 : 0.5) * d.ipd_m, 0, 0);
+    }
+  } else {
+    // The direction grid is static: distort it once.
+    for (int e = 0; e < 2; ++e) panels[e] = passes[size_t(e)]->run(compositor::direction_grid(lenses[e].view()));
+  }
 
   const double fit = std::min({1.0, 1280.0 / (2 * d.width), 720.0 / d.height});
   const auto [ww, wh] = args.has("window") ? parse_size(args.str("window", ""))
                                            : std::pair<int, int>{std::max(16, int(2 * d.width * fit)),
                                                                  std::max(16, int(d.height * fit))};
   compositor::MirrorWindow window(ww, wh, "fovea view: " + d.name);
+  const auto period = std::chrono::microseconds(long(1e6 / d.refresh_hz));
   for (long frame = 0; frames == 0 || frame < frames; ++frame) {
+    const auto frame_start = std::chrono::steady_clock::now();
     if (!window.poll()) break;
-    std::optional<glm::dvec3> gaze = fixed_gaze;
-    if (mouse)
-      if (const auto p = window.cursor()) gaze = compositor::gaze_direction(lenses[int(p->eye)], p->uv);
+    if (mouse) {
+      // Both eyes look along the direction seen through the lens under the cursor
+      // (parallel eyes: vergence is ignored); off the panels the last gaze holds.
+      if (const auto p = window.cursor()) gaze[0] = gaze[1] = compositor::gaze_direction(lenses[int(p->eye)], p->uv);
+    } else if (source) {
+      const devices::GazeSample s = source->sample_at(core::TimeNs(std::llround(double(frame) / d.refresh_hz * 1e9)));
+      for (int e = 0; e < 2; ++e) {
+        // Untracked samples keep the previous gaze.
+        const devices::EyeGaze& eg = s.eye(core::Eye(e));
+        if (eg.tracked()) gaze[size_t(e)] = eg.dir;
+        else if (s.combined.tracked()) gaze[size_t(e)] = s.combined.dir;
+      }
+    }
+    if (sr) {
+      sr->pipeline->render(sr->poses, gaze, std::uint32_t(frame));
+      for (int e = 0; e < 2; ++e)
+        panels[e] = passes[size_t(e)]->run(renderer::tone_map(sr->pipeline->image(core::Eye(e))));
+    }
     std::optional<glm::dvec2> marker[2];
-    if (gaze)
-      for (int e = 0; e < 2; ++e) marker[e] = compositor::gaze_panel_uv(lenses[e], *gaze);
+    for (int e = 0; e < 2; ++e) marker[e] = compositor::gaze_panel_uv(lenses[e], gaze[size_t(e)]);
     window.show(panels[0], panels[1], marker[0], marker[1]);
-    std::this_thread::sleep_for(std::chrono::microseconds(long(1e6 / d.refresh_hz)));
+    std::this_thread::sleep_until(frame_start + period);
   }
+  // (A window closed before the first frame leaves no scene panels to write.)
+  if (auto prefix = args.opt("panels"); prefix && panels[0].width > 0) write_panels(*prefix, panels);
   if (auto shot = args.opt("screenshot")) core::write_png(*shot, window.screenshot().to_image());
   return 0;
 }
 
 }  // namespace
 
-FOVEA_COMMAND(view_command, "view", "mirror window: both panels through the lens, gaze marker, mouse gaze", run);
+FOVEA_COMMAND(view_command, "view", "mirror window: foveated path tracing of a scene through the lens, gaze marker, mouse gaze", run);
 
 }  // namespace fovea::tools

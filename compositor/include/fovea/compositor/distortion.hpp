@@ -3,8 +3,9 @@
 // view image per colour channel at that channel's source position (core/lens.hpp);
 // hidden-area pixels (core/hidden_area.hpp) and taps outside the view are black; the
 // result is encoded linear → sRGB explicitly, so every device gives the same bytes.
-// The GPU pass evaluates the optics directly per pixel (float32); distort_reference is
-// the double-precision CPU reference it is tested against.
+// The GPU pass evaluates the optics directly per pixel (float32) or, optionally, reads them
+// from a 128² LUT cache (core/lens_lut.hpp); distort_reference is the double-precision CPU
+// reference it is tested against.
 #include <cstdint>
 #include <memory>
 #include <utility>
@@ -13,6 +14,7 @@
 #include "fovea/core/hidden_area.hpp"
 #include "fovea/core/image.hpp"
 #include "fovea/core/lens.hpp"
+#include "fovea/core/lens_lut.hpp"
 #include "fovea/gpu/buffer.hpp"
 #include "fovea/gpu/context.hpp"
 #include "fovea/gpu/descriptors.hpp"
@@ -25,6 +27,10 @@ namespace fovea::compositor {
 // three (a picture of that channel's distortion).
 enum class ChannelSelect : std::uint32_t { All = 3, Red = 0, Green = 1, Blue = 2 };
 
+// How the pass gets each pixel's source positions: the optics evaluated directly (the
+// reference), or bilinear reads of a LensLut of LensLut::kDefaultSize² nodes.
+enum class OpticsEval { Direct, Lut };
+
 // What a panel receives: 8-bit sRGB RGBA, row-major, top row first.
 struct PanelImage {
   int width = 0, height = 0;
@@ -34,9 +40,10 @@ struct PanelImage {
 };
 
 // CPU reference in linear light (not yet encoded). `view_image` has the view's raster;
-// non-finite texels count as black, values are clamped to [0, 1].
+// non-finite texels count as black, values are clamped to [0, 1]. With `lut` the source
+// positions come from the cache instead of direct evaluation.
 core::Image distort_reference(const core::HiddenAreaMask& mask, const core::Image& view_image,
-                              ChannelSelect select = ChannelSelect::All);
+                              ChannelSelect select = ChannelSelect::All, const core::LensLut* lut = nullptr);
 
 // A linear view-space reference image: lines every `step_deg` of angle along both axes
 // (the two through the view axis yellow) on a dark background, i.e. a grid of directions
@@ -45,7 +52,8 @@ core::Image direction_grid(const core::View& view, double step_deg = 5);
 
 class DistortionPass {
  public:
-  DistortionPass(gpu::Context& ctx, const core::HiddenAreaMask& mask, ChannelSelect select = ChannelSelect::All);
+  DistortionPass(gpu::Context& ctx, const core::HiddenAreaMask& mask, ChannelSelect select = ChannelSelect::All,
+                 OpticsEval eval = OpticsEval::Direct);
 
   int width() const { return width_; }
   int height() const { return height_; }
@@ -62,8 +70,8 @@ class DistortionPass {
   int width_, height_;
   ChannelSelect select_;
   gpu::ComputePipeline pipeline_;
-  gpu::Buffer optics_, mask_;
-  std::uint32_t words_per_row_ = 0;
+  gpu::Buffer optics_, mask_, lut_;
+  std::uint32_t words_per_row_ = 0, lut_size_ = 0;
   std::vector<std::unique_ptr<gpu::DescriptorSet>> sets_;  // one per (source, target) pair seen
   std::vector<std::pair<VkImageView, VkImageView>> set_keys_;
 };
