@@ -164,3 +164,14 @@ TEST(DistortionReference, ChromaticAberrationSeparatesTheChannelsAtTheEdge) {
   EXPECT_NEAR(position[0] - position[2], sep_px, 0.05 * sep_px);
   EXPECT_GT(position[0] - position[2], 2.0);  // visible colour fringes at the edge
 }
+
+// The LUT cache on the GPU reads the same nodes and interpolates as LensLut does.
+TEST_F(Distortion, LutCacheMatchesCpuReferenceWithTheSameCache) {
+  const core::DisplayPreset d = core::load_display("small");
+  const core::HiddenAreaMask mask(core::Lens::for_eye(d, core::Eye::Right));
+  const core::Image src = pattern(d.width, d.height);
+  compositor::DistortionPass pass(ctx(), mask, compositor::ChannelSelect::All, compositor::OpticsEval::Lut);
+  const core::LensLut lut(mask.lens());
+  expect_matches_reference(pass.run(src),
+                           compositor::distort_reference(mask, src, compositor::ChannelSelect::All, &lut));
+}
