@@ -14,11 +14,27 @@ LensLut::LensLut(const Lens& lens, int size) : n_(size) {
   if (size < 2 || size > 4096)
     throw InputError("lens LUT: size must be in 2..4096, got " + std::to_string(size));
   uv_.resize(size_t(n_) * n_ * 3);
-  for (int j = 0; j < n_; ++j)
-    for (int i = 0; i < n_; ++i) {
-      const glm::dvec2 uv(double(i) / (n_ - 1), double(j) / (n_ - 1));
-      for (int c = 0; c < 3; ++c) uv_[(size_t(j) * n_ + i) * 3 + c] = lens.source_uv(c, uv);
-    }
+  const double cell = 1.0 / (n_ - 1);
+  for (int c = 0; c < 3; ++c) {
+    const Lens::Channel& ch = lens.channel(c);
+    // Past the edge Lens::source_uv continues with the edge's radial scale, a kink that a
+    // cell straddling the edge would smear over the visible pixels inside it. Nodes within
+    // one cell beyond the edge hold the model's own smooth continuation instead (when
+    // finite), so those cells interpolate the profile the visible pixels follow.
+    const double reach = ch.r_edge + glm::length(glm::dvec2(cell) * ch.to_radial);
+    for (int j = 0; j < n_; ++j)
+      for (int i = 0; i < n_; ++i) {
+        const glm::dvec2 uv(i * cell, j * cell);
+        const glm::dvec2 t = (uv - ch.display_centre) * ch.to_radial;
+        const double r = glm::length(t);
+        glm::dvec2 v = lens.source_uv(c, uv);
+        if (r > ch.r_edge && r <= reach) {
+          const glm::dvec2 smooth = ch.source_centre + ch.from_radial * t * (lens.radial(c, r) / r);
+          if (std::isfinite(smooth.x) && std::isfinite(smooth.y)) v = smooth;
+        }
+        uv_[(size_t(j) * n_ + i) * 3 + size_t(c)] = v;
+      }
+  }
 }
 
 glm::dvec2 LensLut::source_uv(int c, glm::dvec2 display_uv) const {
@@ -52,10 +68,17 @@ std::array<LutError, 3> measure_lut_error(const LensLut& lut, const HiddenAreaMa
       for (int c = 0; c < 3; ++c) {
         const glm::dvec2 cached = lut.source_uv(c, uv);
         const double view_px = glm::length((cached - lens.source_uv(c, uv)) * px);
-        // Visible pixels' sources lie inside the lens edge, so the inverse exists; were it
-        // not to, the cached point is shown nowhere: count it as the whole panel away.
-        const auto shown = lens.inverse(c, lens.uv_to_tangent(cached));
-        const double display_px = shown ? glm::length((*shown - uv) * px) : glm::length(px);
+        // The panel displacement that moves the direct source point onto the cached one:
+        // J⁻¹·Δsource with J = ∂source_uv/∂display_uv (central differences; the error is
+        // far below the scale on which J varies). The inverse optics cannot be used: near
+        // the aperture the cached point may need a radius just beyond the edge.
+        const glm::dvec2 delta = cached - lens.source_uv(c, uv);
+        const double h = 1e-6;
+        const glm::dvec2 ju = (lens.source_uv(c, uv + glm::dvec2(h, 0)) - lens.source_uv(c, uv - glm::dvec2(h, 0))) / (2 * h);
+        const glm::dvec2 jv = (lens.source_uv(c, uv + glm::dvec2(0, h)) - lens.source_uv(c, uv - glm::dvec2(0, h))) / (2 * h);
+        const double det = ju.x * jv.y - jv.x * ju.y;
+        const glm::dvec2 shift = glm::dvec2(jv.y * delta.x - jv.x * delta.y, -ju.y * delta.x + ju.x * delta.y) / det;
+        const double display_px = std::isfinite(det) && det != 0 ? glm::length(shift * px) : glm::length(px);
         LutError& le = e[size_t(c)];
         le.max_view_px = std::max(le.max_view_px, view_px);
         le.mean_view_px += view_px;
