@@ -43,7 +43,9 @@ std::map<std::string, std::string> explicit_layer_env(const std::string& out) {
           {"XR_ENABLE_API_LAYERS", kLayer},
           {"FOVEA_LAYER_OUT", out},
           {"FOVEA_LAYER_LOG_FILE", out + "/layer.log"},
-          {"FOVEA_LAYER_SCENE", ""}};
+          {"FOVEA_LAYER_SCENE", ""},
+          {"FOVEA_SCENE", ""},
+          {"XDG_CONFIG_HOME", out + "/no-config"}};
 }
 
 // With no scene the layer only measures: what the panel shows is byte-identical to a run

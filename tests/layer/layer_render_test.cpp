@@ -1,0 +1,153 @@
+// End to end: hello_xr -g Vulkan2 on the Fovea runtime with the layer path tracing a
+// configured scene. Three runs on the same lockstep clock (head pose and gaze are functions
+// of the frame index, so the runs see the same views): the application alone, the layer
+// compositing hello_xr's cubes over the scene, and the layer showing the scene alone.
+#include <cmath>
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+
+#include <gtest/gtest.h>
+#include <nlohmann/json.hpp>
+
+#include "fovea/core/image.hpp"
+#include "xr_fixture.hpp"
+#include "xr_process.hpp"
+
+namespace fovea::test {
+namespace {
+
+#ifdef FOVEA_SANITIZED_BUILD
+constexpr int kFrames = 2;
+#else
+constexpr int kFrames = 4;
+#endif
+
+// The tiny preset's optics at a raster where hello_xr's cubes cover a few hundred pixels.
+std::string write_display(const std::string& dir) {
+  auto j = nlohmann::json::parse(read_text(std::string(std::getenv("FOVEA_SOURCE_DIR")) + "/data/displays/tiny.json"));
+  j["name"] = "layer-test";
+  j["width"] = 128;
+  j["height"] = 144;
+  const std::string path = dir + "/display.json";
+  std::ofstream(path) << j.dump();
+  return path;
+}
+
+// Configuration file in $XDG_CONFIG_HOME/fovea/layer.json with hello_xr's section.
+std::string write_config(const std::string& dir, const std::string& composite) {
+  std::filesystem::create_directories(dir + "/fovea");
+  nlohmann::json j = {{"default", {{"scene", "no-such-scene.gltf"}}},
+                      {"applications", {{"HelloXR", {{"scene", "cornell"}, {"composite", composite}}}}}};
+  std::ofstream(dir + "/fovea/layer.json") << j.dump(2);
+  return dir;
+}
+
+ProcessResult run(const std::string& out, const std::string& display, const std::string& config_home, bool layer) {
+  auto env = runtime_env(out, kFrames, kFrames - 1);
+  env["FOVEA_DISPLAY"] = display;
+  env["XDG_CONFIG_HOME"] = config_home;
+  env["FOVEA_SCENE"] = "";
+  env["FOVEA_LAYER_SCENE"] = "";
+  if (layer) {
+    env["XR_API_LAYER_PATH"] = FOVEA_LAYER_EXPLICIT_DIR;
+    env["XR_ENABLE_API_LAYERS"] = "XR_APILAYER_FOVEA_path_tracing";
+    env["FOVEA_LAYER_OUT"] = out;
+    env["FOVEA_LAYER_LOG_FILE"] = out + "/layer.log";
+  }
+  return run_process({FOVEA_HELLO_XR, "-g", "Vulkan2"}, env, 120);
+}
+
+struct Rgb {
+  int r, g, b;
+};
+Rgb px(const core::Image& img, int x, int y) {
+  const auto& p = img.at(x, y);
+  return {int(std::lround(p.x * 255)), int(std::lround(p.y * 255)), int(std::lround(p.z * 255))};
+}
+int diff(Rgb a, Rgb b) { return std::max({std::abs(a.r - b.r), std::abs(a.g - b.g), std::abs(a.b - b.b)}); }
+
+TEST(LayerRender, HelloXrCubesCompositedOverThePathTracedScene) {
+  TempDir app("lr_app"), both("lr_both"), scene("lr_scene"), cfg_both("lr_cfg1"), cfg_scene("lr_cfg2");
+  const std::string display = write_display(app.path());
+  const ProcessResult a = run(app.path(), display, cfg_both.path(), false);
+  ASSERT_EQ(a.exit_code, 0) << a.output;
+  const ProcessResult b = run(both.path(), display, write_config(cfg_both.path(), "app-on-top"), true);
+  ASSERT_EQ(b.exit_code, 0) << b.output;
+  const ProcessResult c = run(scene.path(), display, write_config(cfg_scene.path(), "scene-only"), true);
+  ASSERT_EQ(c.exit_code, 0) << c.output;
+  for (const ProcessResult* r : {&b, &c}) {
+    EXPECT_EQ(r->output.find("VUID-"), std::string::npos) << r->output;
+    EXPECT_EQ(r->output.find("Validation Error"), std::string::npos) << r->output;
+  }
+
+  const std::string log = read_text(both.path() + "/layer.log");
+  EXPECT_NE(log.find("rendering scene \"cornell\""), std::string::npos) << log;
+  EXPECT_NE(log.find("applications.HelloXR"), std::string::npos) << log;
+  {
+    std::ifstream in(both.path() + "/layer_timing.jsonl");
+    int n = 0, replaced = 0;
+    for (std::string line; std::getline(in, line); ++n) {
+      const auto j = nlohmann::json::parse(line);
+      // hello_xr submits no layers before the session is visible (after the first frame).
+      if (j["projection_views"].get<int>() != 2) continue;
+      EXPECT_TRUE(j["replaced"].get<bool>()) << line;
+      EXPECT_GT(j["render_ms"].get<double>(), 0) << line;
+      ++replaced;
+    }
+    EXPECT_EQ(n, kFrames);
+    EXPECT_GE(replaced, kFrames - 1);
+  }
+
+  char name[64];
+  std::snprintf(name, sizeof(name), "panel_%06d_", kFrames - 1);
+  for (const char* eye : {"left", "right"}) {
+    SCOPED_TRACE(eye);
+    const std::string f = std::string(name) + eye + ".png";
+    const auto A = core::read_png(app.path() + "/" + f, core::Encoding::Linear);
+    const auto B = core::read_png(both.path() + "/" + f, core::Encoding::Linear);
+    const auto C = core::read_png(scene.path() + "/" + f, core::Encoding::Linear);
+    ASSERT_EQ(A.width, B.width);
+    ASSERT_EQ(A.width, C.width);
+    // hello_xr's background: its clear colour as the panel shows it, the panel centre's
+    // most common colour; the hidden area is black.
+    const Rgb bg = px(A, A.width / 2, A.height / 4);
+    ASSERT_GT(bg.r + bg.g + bg.b, 60);
+    // Pixels well inside the cubes or well inside the background (the lens filter mixes
+    // neighbours at the edges): all pixels within 2 px agree on the class.
+    const auto cls = [&](int x, int y) {
+      const Rgb p = px(A, x, y);
+      if (diff(p, bg) <= 3) return 1;                 // background
+      if (p.r + p.g + p.b < 10) return 0;             // hidden area
+      return diff(p, bg) > 40 ? 2 : 3;                // cube, edge
+    };
+    long cube = 0, cube_kept = 0, cube_changed = 0, back = 0, back_scene = 0, back_not_clear = 0;
+    for (int y = 2; y < A.height - 2; ++y)
+      for (int x = 2; x < A.width - 2; ++x) {
+        const int k = cls(x, y);
+        if (k != 1 && k != 2) continue;
+        bool uniform = true;
+        for (int dy = -2; dy <= 2 && uniform; ++dy)
+          for (int dx = -2; dx <= 2 && uniform; ++dx) uniform = cls(x + dx, y + dy) == k;
+        if (!uniform) continue;
+        if (k == 2) {
+          ++cube;
+          cube_kept += diff(px(B, x, y), px(A, x, y)) <= 3;
+          cube_changed += diff(px(B, x, y), px(C, x, y)) > 10;
+        } else {
+          ++back;
+          back_scene += diff(px(B, x, y), px(C, x, y)) <= 3;
+          back_not_clear += diff(px(B, x, y), bg) > 10;
+        }
+      }
+    ASSERT_GE(cube, 20) << "hello_xr's cubes cover too few pixels to check";
+    ASSERT_GE(back, 1000);
+    EXPECT_GE(double(cube_kept) / double(cube), 0.95) << cube_kept << "/" << cube;
+    EXPECT_GE(double(cube_changed) / double(cube), 0.8) << cube_changed << "/" << cube;
+    EXPECT_GE(double(back_scene) / double(back), 0.95) << back_scene << "/" << back;
+    EXPECT_GE(double(back_not_clear) / double(back), 0.95) << back_not_clear << "/" << back;
+  }
+}
+
+}  // namespace
+}  // namespace fovea::test
