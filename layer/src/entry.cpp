@@ -1,5 +1,6 @@
 // Loader negotiation, xrCreateApiLayerInstance and xrGetInstanceProcAddr (api_layer.adoc:
 // negotiation, create-instance process, intercept requirements).
+#include <algorithm>
 #include <cstring>
 
 #include "fovea/runtime/loader_interface.hpp"
@@ -67,6 +68,18 @@ XrResult XRAPI_CALL create_api_layer_instance(const XrInstanceCreateInfo* info, 
     else
       extensions.push_back(info->enabledExtensionNames[i]);
   }
+  // With a scene configured, the layer's own eye-gaze input needs the extension enabled below.
+  const std::string application(info->applicationInfo.applicationName,
+                                strnlen(info->applicationInfo.applicationName, XR_MAX_APPLICATION_NAME_SIZE));
+  bool want_gaze = false;
+  try {
+    want_gaze = !load_config(application).scene.empty() && runtime_has_eye_gaze(next->nextGetInstanceProcAddr);
+  } catch (const std::exception& e) {
+    FOVEA_LAYER_WARN("layer configuration: %s", e.what());  // reported again when the session starts
+  }
+  if (want_gaze && std::none_of(extensions.begin(), extensions.end(),
+                                [](const char* e) { return !std::strcmp(e, kEyeGazeExtension); }))
+    extensions.push_back(kEyeGazeExtension);
   XrInstanceCreateInfo down = *info;
   down.enabledExtensionCount = uint32_t(extensions.size());
   down.enabledExtensionNames = extensions.data();
@@ -77,8 +90,7 @@ XrResult XRAPI_CALL create_api_layer_instance(const XrInstanceCreateInfo* info, 
 
   InstanceState state;
   state.extension_enabled = ours;
-  state.application.assign(info->applicationInfo.applicationName,
-                           strnlen(info->applicationInfo.applicationName, XR_MAX_APPLICATION_NAME_SIZE));
+  state.application = application;
   state.next.xrGetInstanceProcAddr = next->nextGetInstanceProcAddr;
   bool complete = true;
 #define FOVEA_LAYER_RESOLVE(name)                                                                     \
@@ -94,6 +106,11 @@ XrResult XRAPI_CALL create_api_layer_instance(const XrInstanceCreateInfo* info, 
     *instance = XR_NULL_HANDLE;
     return XR_ERROR_INITIALIZATION_FAILED;
   }
+  if (want_gaze) try {
+      state.gaze = create_eye_gaze_actions(state.next, *instance);
+    } catch (const std::exception& e) {
+      FOVEA_LAYER_WARN("eye-gaze action unavailable, gaze from FOVEA_GAZE: %s", e.what());
+    }
   {
     std::lock_guard lock(layer().mutex);
     layer().instances[*instance] = state;

@@ -85,6 +85,10 @@ XrResult intercept::xrEndFrame(XrSession session, const XrFrameEndInfo* info) {
                                 pv.subImage.imageRect, pv.subImage.imageArrayIndex, pv.pose, pv.fov, depth});
       }
     }
+    if (s.gaze.attached()) {
+      in.gaze_from_action = true;
+      in.action_gaze = locate_eye_gaze(*next_for_session(session), s.gaze, info->displayTime);
+    }
     if (const XrFrameEndInfo* replaced = s.renderer->render(in)) submit = replaced;
     s.current.render = s.renderer->times();
   });

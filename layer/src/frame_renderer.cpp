@@ -83,10 +83,20 @@ class PathTraceRenderer final : public FrameRenderer {
     std::array<core::Pose, 2> poses;
     std::array<glm::dvec3, 2> gaze;
     const devices::GazeSample s = gaze_source_->sample_at(live_ ? in.display_time : in.display_time - epoch_);
+    if (in.gaze_from_action != gaze_from_action_) {
+      FOVEA_LAYER_INFO("gaze: %s", in.gaze_from_action ? "the eye-gaze action" : gaze_source_->describe().c_str());
+      gaze_from_action_ = in.gaze_from_action;
+    }
     for (int e = 0; e < 2; ++e) {
       const core::Pose p = to_pose(in.app_views[std::size_t(e)].pose);
       poses[std::size_t(e)].orientation = scene_.camera.orientation * p.orientation;
       poses[std::size_t(e)].position = scene_.camera.position + scene_.camera.orientation * p.position;
+      if (in.gaze_from_action) {
+        // The combined gaze in head space serves both eyes (views parallel to the head).
+        gaze[std::size_t(e)] = hold_[std::size_t(e)].update(in.display_time, in.action_gaze.has_value(),
+                                                            in.action_gaze.value_or(glm::dvec3(0, 0, -1)));
+        continue;
+      }
       const devices::EyeGaze& eg = s.eye(core::Eye(e));
       const devices::EyeGaze& g = eg.tracked() ? eg : s.combined;
       gaze[std::size_t(e)] = hold_[std::size_t(e)].update(in.display_time, g.tracked(), g.dir);
@@ -213,6 +223,7 @@ class PathTraceRenderer final : public FrameRenderer {
   VkFormat format_ = VK_FORMAT_UNDEFINED;
   std::unique_ptr<devices::GazeSource> gaze_source_;
   bool live_ = false;
+  bool gaze_from_action_ = false;
   XrTime epoch_ = 0;
   std::array<GazeHold, 2> hold_;
   std::unique_ptr<gpu::Context> ctx_;

@@ -5,9 +5,11 @@
 // swapchains and returns the frame that replaces the application's.
 #include <cstdint>
 #include <memory>
+#include <optional>
 #include <string>
 #include <vector>
 
+#include <glm/vec3.hpp>
 #include <vulkan/vulkan.h>
 
 #define XR_USE_GRAPHICS_API_VULKAN
@@ -47,6 +49,10 @@ struct FrameInput {
   std::vector<AppView> app_views;  // the first stereo projection layer's views
   std::uint32_t projection_layer = 0;  // its index in app_frame->layers
   const XrFrameEndInfo* app_frame = nullptr;
+  // The layer's eye-gaze action, once attached: the gaze in VIEW space (nullopt: not tracked
+  // this frame). Without it the renderer's devices/ source (FOVEA_GAZE) is used.
+  bool gaze_from_action = false;
+  std::optional<glm::dvec3> action_gaze;
 };
 
 // Where the layer's time went in the last render() (milliseconds).

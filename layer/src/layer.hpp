@@ -19,6 +19,7 @@
 #include <openxr/openxr.h>
 #include <openxr/openxr_platform.h>
 
+#include "eye_gaze.hpp"
 #include "frame_log.hpp"
 #include "frame_renderer.hpp"
 
@@ -44,7 +45,17 @@ constexpr std::uint32_t kLayerExtensionVersion = 1;
   X(xrReleaseSwapchainImage) \
   X(xrWaitFrame)            \
   X(xrBeginFrame)           \
-  X(xrEndFrame)
+  X(xrEndFrame)              \
+  X(xrCreateActionSet)       \
+  X(xrCreateAction)          \
+  X(xrStringToPath)          \
+  X(xrSuggestInteractionProfileBindings) \
+  X(xrAttachSessionActionSets) \
+  X(xrSyncActions)           \
+  X(xrCreateActionSpace)     \
+  X(xrCreateReferenceSpace)  \
+  X(xrLocateSpace)           \
+  X(xrDestroySpace)
 
 struct Dispatch {
 #define FOVEA_LAYER_MEMBER(name) PFN_##name name = nullptr;
@@ -67,12 +78,14 @@ struct SessionState {
   std::unique_ptr<FrameRenderer> renderer;  // null: pass-through, measure only
   FrameLog log;
   FrameTimes current;                     // the frame in flight
+  EyeGazeSession gaze;                    // after an attach that included the layer's action set
 };
 
 struct InstanceState {
   Dispatch next;
   bool extension_enabled = false;  // the application enabled kLayerExtension
   std::string application;         // XrApplicationInfo::applicationName (the config section)
+  EyeGazeActions gaze;             // the layer's eye-gaze action (a scene configured, the runtime has it)
 };
 
 struct Layer {
@@ -102,7 +115,10 @@ namespace intercept {
   X(xrReleaseSwapchainImage)       \
   X(xrWaitFrame)                   \
   X(xrBeginFrame)                  \
-  X(xrEndFrame)
+  X(xrEndFrame)                    \
+  X(xrSuggestInteractionProfileBindings) \
+  X(xrAttachSessionActionSets)     \
+  X(xrSyncActions)
 #define FOVEA_LAYER_DECLARE(name) std::remove_pointer_t<PFN_##name> name;
 FOVEA_LAYER_INTERCEPTED(FOVEA_LAYER_DECLARE)
 #undef FOVEA_LAYER_DECLARE

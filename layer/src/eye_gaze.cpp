@@ -1,0 +1,84 @@
+#include "eye_gaze.hpp"
+
+#include <cstring>
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+#include <glm/gtc/quaternion.hpp>
+
+#include "layer.hpp"
+
+namespace fovea::layer {
+namespace {
+
+void check(XrResult r, const char* what) {
+  if (XR_FAILED(r)) throw std::runtime_error(std::string(what) + " failed below the layer: XrResult " + std::to_string(int(r)));
+}
+
+}  // namespace
+
+bool runtime_has_eye_gaze(PFN_xrGetInstanceProcAddr next_gipa) {
+  PFN_xrEnumerateInstanceExtensionProperties enumerate = nullptr;
+  if (XR_FAILED(next_gipa(XR_NULL_HANDLE, "xrEnumerateInstanceExtensionProperties",
+                          reinterpret_cast<PFN_xrVoidFunction*>(&enumerate))) ||
+      !enumerate)
+    return false;
+  std::uint32_t n = 0;
+  if (XR_FAILED(enumerate(nullptr, 0, &n, nullptr))) return false;
+  std::vector<XrExtensionProperties> props(n, {XR_TYPE_EXTENSION_PROPERTIES});
+  if (XR_FAILED(enumerate(nullptr, n, &n, props.data()))) return false;
+  for (const auto& p : props)
+    if (!std::strcmp(p.extensionName, kEyeGazeExtension)) return true;
+  return false;
+}
+
+EyeGazeActions create_eye_gaze_actions(const Dispatch& next, XrInstance instance) {
+  EyeGazeActions a;
+  XrActionSetCreateInfo si{XR_TYPE_ACTION_SET_CREATE_INFO};
+  std::strcpy(si.actionSetName, "xr_apilayer_fovea_gaze");
+  std::strcpy(si.localizedActionSetName, "Fovea layer eye gaze");
+  check(next.xrCreateActionSet(instance, &si, &a.set), "xrCreateActionSet");
+  XrActionCreateInfo ai{XR_TYPE_ACTION_CREATE_INFO};
+  ai.actionType = XR_ACTION_TYPE_POSE_INPUT;
+  std::strcpy(ai.actionName, "gaze");
+  std::strcpy(ai.localizedActionName, "Eye gaze");
+  check(next.xrCreateAction(a.set, &ai, &a.pose), "xrCreateAction");
+  check(next.xrStringToPath(instance, kEyeGazeProfile, &a.profile), "xrStringToPath");
+  check(next.xrStringToPath(instance, kEyeGazePath, &a.binding), "xrStringToPath");
+  const XrActionSuggestedBinding b{a.pose, a.binding};
+  XrInteractionProfileSuggestedBinding sb{XR_TYPE_INTERACTION_PROFILE_SUGGESTED_BINDING};
+  sb.interactionProfile = a.profile;
+  sb.countSuggestedBindings = 1;
+  sb.suggestedBindings = &b;
+  check(next.xrSuggestInteractionProfileBindings(instance, &sb), "xrSuggestInteractionProfileBindings");
+  return a;
+}
+
+EyeGazeSession create_eye_gaze_session(const Dispatch& next, const EyeGazeActions& a, XrSession session) {
+  EyeGazeSession s;
+  XrActionSpaceCreateInfo ai{XR_TYPE_ACTION_SPACE_CREATE_INFO};
+  ai.action = a.pose;
+  ai.poseInActionSpace.orientation.w = 1;
+  check(next.xrCreateActionSpace(session, &ai, &s.gaze), "xrCreateActionSpace");
+  XrReferenceSpaceCreateInfo ri{XR_TYPE_REFERENCE_SPACE_CREATE_INFO};
+  ri.referenceSpaceType = XR_REFERENCE_SPACE_TYPE_VIEW;
+  ri.poseInReferenceSpace.orientation.w = 1;
+  if (XR_FAILED(next.xrCreateReferenceSpace(session, &ri, &s.view))) {
+    next.xrDestroySpace(s.gaze);
+    throw std::runtime_error("xrCreateReferenceSpace(VIEW) failed below the layer");
+  }
+  return s;
+}
+
+std::optional<glm::dvec3> locate_eye_gaze(const Dispatch& next, const EyeGazeSession& s, XrTime time) {
+  XrSpaceLocation loc{XR_TYPE_SPACE_LOCATION};
+  if (XR_FAILED(next.xrLocateSpace(s.gaze, s.view, time, &loc))) return std::nullopt;
+  const XrSpaceLocationFlags need = XR_SPACE_LOCATION_ORIENTATION_VALID_BIT | XR_SPACE_LOCATION_ORIENTATION_TRACKED_BIT;
+  if ((loc.locationFlags & need) != need) return std::nullopt;
+  const auto& q = loc.pose.orientation;
+  // The gaze ray is the pose's -Z axis (XR_EXT_eye_gaze_interaction).
+  return glm::dquat(q.w, q.x, q.y, q.z) * glm::dvec3(0, 0, -1);
+}
+
+}  // namespace fovea::layer

@@ -1,0 +1,47 @@
+#pragma once
+// The layer's own eye-gaze input (XR_EXT_eye_gaze_interaction), used when a scene is
+// configured and the runtime offers the extension: an action set with one pose action bound
+// to /user/eyes_ext/input/gaze_ext/pose, merged into the application's
+// xrSuggestInteractionProfileBindings (for the eye-gaze profile), xrAttachSessionActionSets
+// and xrSyncActions. The gaze is located in VIEW space at each frame's display time.
+#include <optional>
+
+#include <glm/vec3.hpp>
+
+#define XR_USE_GRAPHICS_API_VULKAN
+#include <vulkan/vulkan.h>
+#include <openxr/openxr.h>
+
+namespace fovea::layer {
+
+struct Dispatch;
+
+constexpr const char* kEyeGazeExtension = "XR_EXT_eye_gaze_interaction";
+constexpr const char* kEyeGazeProfile = "/interaction_profiles/ext/eye_gaze_interaction";
+constexpr const char* kEyeGazePath = "/user/eyes_ext/input/gaze_ext/pose";
+
+// Per instance: created after xrCreateInstance when the extension was enabled below.
+struct EyeGazeActions {
+  XrActionSet set = XR_NULL_HANDLE;
+  XrAction pose = XR_NULL_HANDLE;
+  XrPath profile = XR_NULL_PATH, binding = XR_NULL_PATH;
+  bool suggested = false;  // the application's own suggestion for the profile included ours
+  bool valid() const { return pose != XR_NULL_HANDLE; }
+};
+
+// Per session, after an attach that included the layer's set.
+struct EyeGazeSession {
+  XrSpace gaze = XR_NULL_HANDLE, view = XR_NULL_HANDLE;
+  bool attached() const { return gaze != XR_NULL_HANDLE; }
+};
+
+// Whether the runtime (below the layer) offers the extension; false when it cannot be asked.
+bool runtime_has_eye_gaze(PFN_xrGetInstanceProcAddr next_gipa);
+// Creates the action set and action and suggests the binding; throws std::runtime_error.
+EyeGazeActions create_eye_gaze_actions(const Dispatch& next, XrInstance instance);
+// The spaces for a session whose attach included the set; throws std::runtime_error.
+EyeGazeSession create_eye_gaze_session(const Dispatch& next, const EyeGazeActions& a, XrSession session);
+// The gaze direction in VIEW space at `time`, nullopt when not tracked.
+std::optional<glm::dvec3> locate_eye_gaze(const Dispatch& next, const EyeGazeSession& s, XrTime time);
+
+}  // namespace fovea::layer
