@@ -80,7 +80,6 @@ compositor::OpticsEval parse_optics(const std::string& s) {
 
 // What draws the resolved view images: the foveated pipeline on a scene.
 struct SceneRenderer {
-  renderer::Scene scene;
   std::unique_ptr<renderer::GpuScene> gpu_scene;
   std::unique_ptr<compositor::FramePipeline> pipeline;
   std::array<core::Pose, 2> poses;  // a static head at the scene camera, eyes ipd/2 beside it
@@ -140,7 +139,22 @@ int run(std::vector<std::string> argv) {
     source = devices::open_gaze_source(gaze_arg, so);
   } else if (!mouse) {
     gaze[0] = gaze[1] = parse_gaze(args, lenses[0].view());
+  } else if (args.has("gaze-dir")) {
+    throw core::InputError("give either --gaze or --gaze-dir, not both");
   }
+
+  // Inputs are checked (the scene loaded) before the window opens, the window before the
+  // GPU work: without an X display there is no point building the renderer.
+  std::optional<renderer::Scene> scene;
+  if (auto name = args.opt("scene")) {
+    scene = renderer::load_scene(*name);
+    for (const auto& w : scene->warnings) std::cerr << "warning: " << w << "\n";
+  }
+  const double fit = std::min({1.0, 1280.0 / (2 * d.width), 720.0 / d.height});
+  const auto [ww, wh] = args.has("window") ? parse_size(args.str("window", ""))
+                                           : std::pair<int, int>{std::max(16, int(2 * d.width * fit)),
+                                                                 std::max(16, int(d.height * fit))};
+  compositor::MirrorWindow window(ww, wh, "fovea view: " + d.name);
 
   gpu::Context ctx;
   std::array<std::unique_ptr<compositor::DistortionPass>, 2> passes;
@@ -149,27 +163,20 @@ int run(std::vector<std::string> argv) {
                                                                       compositor::ChannelSelect::All, optics);
   compositor::PanelImage panels[2];
   std::optional<SceneRenderer> sr;
-  if (auto name = args.opt("scene")) {
+  if (scene) {
     sr.emplace();
-    sr->scene = renderer::load_scene(*name);
-    for (const auto& w : sr->scene.warnings) std::cerr << "warning: " << w << "\n";
-    sr->gpu_scene = std::make_unique<renderer::GpuScene>(ctx, sr->scene);
+    sr->gpu_scene = std::make_unique<renderer::GpuScene>(ctx, *scene);
     sr->pipeline = std::make_unique<compositor::FramePipeline>(ctx, *sr->gpu_scene, d, dp, compositor::ReconSettings{});
     for (int e = 0; e < 2; ++e) {
-      sr->poses[size_t(e)] = sr->scene.camera;
+      sr->poses[size_t(e)] = scene->camera;
       sr->poses[size_t(e)].position +=
-          sr->scene.camera.orientation * glm::dvec3((e == 0 ? -0.5 : 0.5) * d.ipd_m, 0, 0);
+          scene->camera.orientation * glm::dvec3((e == 0 ? -0.5 : 0.5) * d.ipd_m, 0, 0);
     }
   } else {
     // The direction grid is static: distort it once.
     for (int e = 0; e < 2; ++e) panels[e] = passes[size_t(e)]->run(compositor::direction_grid(lenses[e].view()));
   }
 
-  const double fit = std::min({1.0, 1280.0 / (2 * d.width), 720.0 / d.height});
-  const auto [ww, wh] = args.has("window") ? parse_size(args.str("window", ""))
-                                           : std::pair<int, int>{std::max(16, int(2 * d.width * fit)),
-                                                                 std::max(16, int(d.height * fit))};
-  compositor::MirrorWindow window(ww, wh, "fovea view: " + d.name);
   const auto period = std::chrono::microseconds(long(1e6 / d.refresh_hz));
   for (long frame = 0; frames == 0 || frame < frames; ++frame) {
     const auto frame_start = std::chrono::steady_clock::now();
