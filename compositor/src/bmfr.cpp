@@ -1,16 +1,32 @@
 #include "fovea/compositor/bmfr.hpp"
 
+#include <string>
+
 #include "fovea/core/error.hpp"
 #include "fovea/gpu/context.hpp"
 #include "fovea/shaders/recon_grid.h"
 
 namespace fovea::compositor {
 
-BmfrFit::BmfrFit(gpu::Context& ctx)
+namespace {
+
+std::uint32_t checked_workgroup(const BmfrOptions& o) {
+  const std::uint32_t w = o.workgroup ? o.workgroup : kBmfrDefaultWorkgroup;
+  if (w < 8 || w > 1024 || 1024 % w != 0)
+    throw core::InputError("bmfr: workgroup must divide 1024 and be 8..1024, got " + std::to_string(w));
+  return w;
+}
+
+}  // namespace
+
+BmfrFit::BmfrFit(gpu::Context& ctx, const BmfrOptions& options)
     : ctx_(&ctx),
+      workgroup_(checked_workgroup(options)),
       pipeline_(ctx, {.shader = "recon_bmfr_fit.comp.spv",
                       .sets = {std::vector<gpu::Binding>(4, gpu::Binding::StorageBuffer)},
-                      .push_constant_bytes = sizeof(shaders::ReconBmfrPush)}) {}
+                      .push_constant_bytes = sizeof(shaders::ReconBmfrPush),
+                      .specialization = {gpu::SpecConstant::u32(0, workgroup_),
+                                         gpu::SpecConstant::boolean(1, options.precision == BmfrPrecision::Fp16)}}) {}
 
 gpu::DescriptorSet BmfrFit::bind(const gpu::Buffer& vpos, const gpu::Buffer& vnrm, const gpu::Buffer& z,
                                  const gpu::Buffer& fitted) const {
@@ -25,7 +41,7 @@ void BmfrFit::record(VkCommandBuffer cmd, const gpu::DescriptorSet& set, BmfrGri
   const std::uint32_t bx = g.padded_columns / 32 + 1, by = g.padded_rows / 32 + 1;
   pipeline_.run(cmd, {&set},
                 shaders::ReconBmfrPush{g.padded_columns, g.padded_rows, bx, frame, offset.x, offset.y, noise, 0},
-                bx * by * 256);
+                bx * by * workgroup_);
 }
 
 std::vector<glm::vec4> BmfrFit::fit(BmfrGrid g, const std::vector<glm::vec4>& vpos, const std::vector<glm::vec4>& vnrm,

@@ -19,9 +19,21 @@ struct BmfrGrid {
   std::uint32_t padded_columns = 0, padded_rows = 0;  // multiples of 32
 };
 
+// Storage of the block's regression matrix [T + N | z] during the QR: fp32, or fp16 (the
+// BMFR paper's temporary storage type; w is scaled to [−1, 1] before squaring, so no
+// feature exceeds the fp16 range). Arithmetic is fp32 in both.
+enum class BmfrPrecision { Fp32, Fp16 };
+
+inline constexpr std::uint32_t kBmfrDefaultWorkgroup = 256;
+
+struct BmfrOptions {
+  BmfrPrecision precision = BmfrPrecision::Fp32;
+  std::uint32_t workgroup = 0;  // invocations per block (divides 1024); 0: the default
+};
+
 class BmfrFit {
  public:
-  explicit BmfrFit(gpu::Context& ctx);
+  explicit BmfrFit(gpu::Context& ctx, const BmfrOptions& options = {});
   gpu::DescriptorSet bind(const gpu::Buffer& vpos, const gpu::Buffer& vnrm, const gpu::Buffer& z,
                           const gpu::Buffer& fitted) const;
   // Records the fit; `offset` is the block-grid displacement in [0, 32)².
@@ -34,6 +46,7 @@ class BmfrFit {
 
  private:
   gpu::Context* ctx_;
+  std::uint32_t workgroup_;
   gpu::ComputePipeline pipeline_;
 };
 
