@@ -84,6 +84,8 @@ TEST(LayerRender, HelloXrCubesCompositedOverThePathTracedScene) {
   const std::string log = read_text(both.path() + "/layer.log");
   EXPECT_NE(log.find("rendering scene \"cornell\""), std::string::npos) << log;
   EXPECT_NE(log.find("applications.HelloXR"), std::string::npos) << log;
+  // The runtime offers XR_EXT_eye_gaze_interaction: the layer's action rides along hello_xr's.
+  EXPECT_NE(log.find("gaze: the eye-gaze action"), std::string::npos) << log;
   {
     std::ifstream in(both.path() + "/layer_timing.jsonl");
     int n = 0, replaced = 0;
