@@ -74,6 +74,11 @@ class PathTraceRenderer final : public FrameRenderer {
     if (in.app_views.size() != 2) return nullptr;  // only stereo projection layers are replaced
     const auto t0 = std::chrono::steady_clock::now();
     if (!pipeline_) start(in);
+    if (!depth_noted_ && (in.app_views[0].has_depth || in.app_views[1].has_depth)) {
+      FOVEA_LAYER_WARN("the application submits depth; depth compositing is not implemented, compositing %s",
+                       composite_name(config_.composite));
+      depth_noted_ = true;
+    }
     const XrRect2Di& r0 = in.app_views[0].rect;
     for (const AppView& v : in.app_views)
       if (v.rect.extent.width != r0.extent.width || v.rect.extent.height != r0.extent.height || v.format != format_)
@@ -82,7 +87,9 @@ class PathTraceRenderer final : public FrameRenderer {
     // Eye poses: the application's view poses (its reference space) placed at the scene's camera.
     std::array<core::Pose, 2> poses;
     std::array<glm::dvec3, 2> gaze;
-    const devices::GazeSample s = gaze_source_->sample_at(live_ ? in.display_time : in.display_time - epoch_);
+    const devices::GazeSample s = in.gaze_from_action
+                                      ? devices::GazeSample{}
+                                      : gaze_source_->sample_at(live_ ? in.display_time : in.display_time - epoch_);
     if (in.gaze_from_action != gaze_from_action_) {
       FOVEA_LAYER_INFO("gaze: %s", in.gaze_from_action ? "the eye-gaze action" : gaze_source_->describe().c_str());
       gaze_from_action_ = in.gaze_from_action;
@@ -224,6 +231,7 @@ class PathTraceRenderer final : public FrameRenderer {
   std::unique_ptr<devices::GazeSource> gaze_source_;
   bool live_ = false;
   bool gaze_from_action_ = false;
+  bool depth_noted_ = false;
   XrTime epoch_ = 0;
   std::array<GazeHold, 2> hold_;
   std::unique_ptr<gpu::Context> ctx_;
