@@ -13,6 +13,7 @@
 #include "fovea/core/display.hpp"
 #include "fovea/core/hidden_area.hpp"
 #include "gpu_fixture.hpp"
+#include "xvfb.hpp"
 
 // Xlib last: its None/Bool/Status macros clash with GoogleTest's names.
 #include <X11/Xlib.h>
@@ -25,43 +26,7 @@ using namespace fovea;
 
 namespace {
 
-// A private Xvfb server for the test, on a display number it picks itself (-displayfd).
-class Xvfb {
- public:
-  Xvfb() {
-    if (::access("/usr/bin/Xvfb", X_OK) != 0) return;
-    int fds[2];
-    if (::pipe(fds) != 0) return;
-    pid_ = ::fork();
-    if (pid_ == 0) {
-      ::close(fds[0]);
-      const std::string fd = std::to_string(fds[1]);
-      ::execl("/usr/bin/Xvfb", "Xvfb", "-displayfd", fd.c_str(), "-screen", "0", "800x600x24", "-nolisten", "tcp",
-              static_cast<char*>(nullptr));
-      ::_exit(127);
-    }
-    ::close(fds[1]);
-    std::string number;
-    char c;
-    while (::read(fds[0], &c, 1) == 1 && c != '\n') number += c;
-    ::close(fds[0]);
-    if (pid_ > 0 && !number.empty()) {
-      display_ = ":" + number;
-      ::setenv("DISPLAY", display_.c_str(), 1);
-    }
-  }
-  ~Xvfb() {
-    if (pid_ > 0) {
-      ::kill(pid_, SIGTERM);
-      ::waitpid(pid_, nullptr, 0);
-    }
-  }
-  bool running() const { return !display_.empty(); }
-
- private:
-  pid_t pid_ = -1;
-  std::string display_;
-};
+using fovea::test::Xvfb;
 
 compositor::PanelImage solid(int w, int h, std::uint8_t r, std::uint8_t g, std::uint8_t b) {
   compositor::PanelImage p{w, h, std::vector<std::uint8_t>(size_t(w) * h * 4)};

@@ -13,43 +13,14 @@
 
 #include "cli.hpp"
 #include "fovea/core/image.hpp"
+#include "xvfb.hpp"
 
 using namespace fovea;
 using fovea::test::run_fovea;
 
 namespace {
 
-// An X server for the command, on a display number Xvfb picks itself (-displayfd); the
-// child `fovea` inherits DISPLAY.
-class Xvfb {
- public:
-  Xvfb() {
-    int fds[2];
-    if (::access("/usr/bin/Xvfb", X_OK) != 0 || ::pipe(fds) != 0) return;
-    pid_ = ::fork();
-    if (pid_ == 0) {
-      ::close(fds[0]);
-      const std::string fd = std::to_string(fds[1]);
-      ::execl("/usr/bin/Xvfb", "Xvfb", "-displayfd", fd.c_str(), "-screen", "0", "800x600x24", "-nolisten", "tcp",
-              static_cast<char*>(nullptr));
-      ::_exit(127);
-    }
-    ::close(fds[1]);
-    std::string number;
-    char c;
-    while (::read(fds[0], &c, 1) == 1 && c != '\n') number += c;
-    ::close(fds[0]);
-    if (pid_ > 0 && !number.empty()) ::setenv("DISPLAY", (":" + number).c_str(), 1), running_ = true;
-  }
-  ~Xvfb() {
-    if (pid_ > 0) ::kill(pid_, SIGTERM), ::waitpid(pid_, nullptr, 0);
-  }
-  bool running() const { return running_; }
-
- private:
-  pid_t pid_ = -1;
-  bool running_ = false;
-};
+using fovea::test::Xvfb;
 
 // Mean linear colour of the lit (non-black) pixels in columns [x0, x1) of the screenshot.
 glm::dvec3 mean_lit(const core::Image& img, int x0, int x1) {
