@@ -1,6 +1,7 @@
 // Instance lifetime, extensions, events, paths, string conversions and time conversion.
 #include <cstdio>
 #include <cstring>
+#include <string>
 
 #include <openxr/openxr_reflection.h>
 
@@ -163,50 +164,48 @@ XrResult api::xrPollEvent(XrInstance instance, XrEventDataBuffer* event) {
   });
 }
 
-XrResult api::xrResultToString(XrInstance instance, XrResult value, char buffer[XR_MAX_RESULT_STRING_SIZE]) {
-  return guarded(__func__, [&]() -> XrResult {
-    if (!find<Instance>(instance)) return XR_ERROR_HANDLE_INVALID;
-    if (!buffer) return XR_ERROR_VALIDATION_FAILURE;
-    const char* name = nullptr;
-    switch (value) {
+namespace {
+
 #define FOVEA_CASE(n, v) \
   case n:                \
-    name = #n;           \
-    break;
-      XR_LIST_ENUM_XrResult(FOVEA_CASE)
+    return #n;
+const char* result_name(XrResult value) {
+  switch (value) {
+    XR_LIST_ENUM_XrResult(FOVEA_CASE)
+    default: return nullptr;
+  }
+}
+const char* structure_type_name(XrStructureType value) {
+  switch (value) {
+    XR_LIST_ENUM_XrStructureType(FOVEA_CASE)
+    default: return nullptr;
+  }
+}
 #undef FOVEA_CASE
-      default: break;
-    }
-    if (name)
-      std::snprintf(buffer, XR_MAX_RESULT_STRING_SIZE, "%s", name);
-    else
-      std::snprintf(buffer, XR_MAX_RESULT_STRING_SIZE, "XR_UNKNOWN_%s_%d", value >= 0 ? "SUCCESS" : "FAILURE",
-                    int(value));
+
+// The shared body of xr*ToString: the enum's name, or `unknown` for values this header
+// version does not list.
+XrResult enum_to_string(const char* call, XrInstance instance, char* buffer, std::size_t size, const char* name,
+                        const std::string& unknown) {
+  return guarded(call, [&]() -> XrResult {
+    if (!find<Instance>(instance)) return XR_ERROR_HANDLE_INVALID;
+    if (!buffer) return XR_ERROR_VALIDATION_FAILURE;
+    std::snprintf(buffer, size, "%s", name ? name : unknown.c_str());
     return XR_SUCCESS;
   });
 }
 
+}  // namespace
+
+XrResult api::xrResultToString(XrInstance instance, XrResult value, char buffer[XR_MAX_RESULT_STRING_SIZE]) {
+  return enum_to_string(__func__, instance, buffer, XR_MAX_RESULT_STRING_SIZE, result_name(value),
+                        std::string("XR_UNKNOWN_") + (value >= 0 ? "SUCCESS_" : "FAILURE_") + std::to_string(int(value)));
+}
+
 XrResult api::xrStructureTypeToString(XrInstance instance, XrStructureType value,
                                       char buffer[XR_MAX_STRUCTURE_NAME_SIZE]) {
-  return guarded(__func__, [&]() -> XrResult {
-    if (!find<Instance>(instance)) return XR_ERROR_HANDLE_INVALID;
-    if (!buffer) return XR_ERROR_VALIDATION_FAILURE;
-    const char* name = nullptr;
-    switch (value) {
-#define FOVEA_CASE(n, v) \
-  case n:                \
-    name = #n;           \
-    break;
-      XR_LIST_ENUM_XrStructureType(FOVEA_CASE)
-#undef FOVEA_CASE
-      default: break;
-    }
-    if (name)
-      std::snprintf(buffer, XR_MAX_STRUCTURE_NAME_SIZE, "%s", name);
-    else
-      std::snprintf(buffer, XR_MAX_STRUCTURE_NAME_SIZE, "XR_UNKNOWN_STRUCTURE_TYPE_%d", int(value));
-    return XR_SUCCESS;
-  });
+  return enum_to_string(__func__, instance, buffer, XR_MAX_STRUCTURE_NAME_SIZE, structure_type_name(value),
+                        "XR_UNKNOWN_STRUCTURE_TYPE_" + std::to_string(int(value)));
 }
 
 XrResult api::xrStringToPath(XrInstance instance, const char* pathString, XrPath* path) {
