@@ -225,6 +225,26 @@ struct FramePipeline::Impl {
     }
   }
 
+  // Every device buffer written per frame, set to `word`. Vulkan leaves new memory undefined
+  // (lavapipe hands out recycled heap memory), and a buffer that a configuration never writes
+  // (BMFR's output without BMFR) would otherwise read back differently from run to run.
+  void fill(std::uint32_t word) {
+    ctx.submit_and_wait([&](VkCommandBuffer cmd) {
+      for (auto& e : eyes) {
+        const renderer::TraceOutputs& t = e->trace;
+        for (const gpu::Buffer* b : {static_cast<const gpu::Buffer*>(&e->grid), &t.direct(), &t.indirect(), &t.albedo(), &t.normal_depth(),
+                                     &t.position_material(), &t.radiance()})
+          gpu::fill_buffer(cmd, *b, word);
+        for (const gpu::Buffer* b : {&e->tap_idx, &e->tap_w, &e->shared, &e->z, &e->fitted, &e->mips, &e->screen_a,
+                                     &e->screen_b})
+          gpu::fill_buffer(cmd, *b, word);
+        for (int p = 0; p < 2; ++p)
+          for (const gpu::Buffer* b : {&e->acc_d[p], &e->acc_i[p], &e->vpos[p], &e->vnrm[p], &e->post[p], &e->final_[p]})
+            gpu::fill_buffer(cmd, *b, word);
+      }
+    });
+  }
+
   std::uint32_t max_levels() const {
     std::uint32_t m = 1;
     for (const auto& e : eyes) m = std::max(m, e->levels);
@@ -248,11 +268,17 @@ FramePipeline::FramePipeline(gpu::Context& ctx, const renderer::GpuScene& scene,
     const EyeState* o = impl_->other(*e);
     impl_->bind_eye(*e, o ? *o : *e);
   }
+  impl_->fill(0);
 }
 
 FramePipeline::~FramePipeline() = default;
 
 void FramePipeline::reset() { impl_->frames_done = 0; }
+
+void FramePipeline::fill_buffers(std::uint32_t word) {
+  impl_->fill(word);
+  impl_->frames_done = 0;
+}
 
 FrameTimes FramePipeline::render(const std::array<core::Pose, 2>& eye_pose, const std::array<glm::dvec3, 2>& gaze,
                                  std::uint32_t frame) {

@@ -58,6 +58,11 @@ class FramePipeline {
                     std::uint32_t frame);
   // Forget the history (the next frame starts fresh).
   void reset();
+  // Overwrites every device buffer the pipeline writes per frame (grid, the path tracer's
+  // outputs, history, reconstruction and screen buffers; not BMFR's internal ones) with the
+  // 32-bit `word`, and forgets the history: tests fill them with a NaN pattern to show that
+  // no stage reads memory the frames since have not written.
+  void fill_buffers(std::uint32_t word);
 
   // Resolves a grid image given in the padded grid layout (premultiplied rgb, .w coverage)
   // with eye `e`'s current mapping, optionally blurred; for round-trip tests.

@@ -1,0 +1,118 @@
+// Determinism of FramePipeline: the same frames (scene, poses, gaze, frame indices) give
+// bit-identical grid buffers and displayed images in a fresh pipeline, after reset(), and
+// after every per-frame buffer was filled with NaN (a stage reading memory that the frames
+// have not written shows up as a difference or a NaN).
+#include <cmath>
+#include <cstring>
+#include <string>
+
+#include "fovea/renderer/scene_io.hpp"
+#include "gpu_fixture.hpp"
+#include "reconstruct_helpers.hpp"
+
+namespace compositor = fovea::compositor;
+namespace core = fovea::core;
+namespace renderer = fovea::renderer;
+using fovea::test::GpuTest;
+
+namespace {
+
+constexpr std::uint32_t kQuietNan = 0x7fc00001u;
+constexpr std::uint32_t kFrames = 4;
+
+// Everything a frame leaves behind that a test or tool can read, per eye, as raw bytes.
+struct Snapshot {
+  std::vector<std::string> names;
+  std::vector<std::vector<std::uint32_t>> words;
+
+  template <class T>
+  void add(std::string name, const std::vector<T>& v) {
+    std::vector<std::uint32_t> w(v.size() * sizeof(T) / 4);
+    std::memcpy(w.data(), v.data(), w.size() * 4);
+    names.push_back(std::move(name));
+    words.push_back(std::move(w));
+  }
+};
+
+// The gaze wanders so that each frame regenerates the grids and reprojects the history.
+std::array<glm::dvec3, 2> gaze_of(std::uint32_t f) {
+  const glm::dvec3 g = glm::normalize(glm::dvec3(0.08 * std::sin(0.9 * f), 0.05 * std::cos(1.3 * f), -1.0));
+  return {g, g};
+}
+
+Snapshot render_sequence(compositor::FramePipeline& p, const std::array<core::Pose, 2>& poses) {
+  for (std::uint32_t f = 0; f < kFrames; ++f) p.render(poses, gaze_of(f), 10 + f);
+  Snapshot s;
+  for (int e = 0; e < p.eyes(); ++e) {
+    const core::Eye eye = core::Eye(e);
+    const std::string tag = e == 0 ? "left " : "right ";
+    s.add(tag + "image", p.image(eye).pixels);
+    s.add(tag + "grid samples", p.grid_samples(eye));
+    const std::pair<compositor::GridBuffer, const char*> buffers[] = {
+        {compositor::GridBuffer::Radiance, "radiance"},   {compositor::GridBuffer::AccDirect, "acc direct"},
+        {compositor::GridBuffer::AccIndirect, "acc indirect"}, {compositor::GridBuffer::SharedIndirect, "shared"},
+        {compositor::GridBuffer::Fitted, "fitted"},       {compositor::GridBuffer::Final, "final"},
+        {compositor::GridBuffer::Albedo, "albedo"},       {compositor::GridBuffer::Position, "position"}};
+    for (const auto& [which, name] : buffers)
+      // Without BMFR nothing produces the fitted buffer: it keeps what it was filled with.
+      if (which != compositor::GridBuffer::Fitted || p.settings().denoiser == compositor::Denoiser::Bmfr)
+        s.add(tag + name, p.grid_buffer(eye, which));
+  }
+  return s;
+}
+
+// Bit-exact comparison, buffer by buffer; reports how many 32-bit words differ.
+void expect_identical(const Snapshot& a, const Snapshot& b, const char* what) {
+  ASSERT_EQ(a.names, b.names);
+  for (std::size_t i = 0; i < a.words.size(); ++i) {
+    ASSERT_EQ(a.words[i].size(), b.words[i].size()) << what << ": " << a.names[i];
+    std::size_t differ = 0, nan = 0;
+    for (std::size_t k = 0; k < a.words[i].size(); ++k) {
+      differ += a.words[i][k] != b.words[i][k] ? 1 : 0;
+      nan += b.words[i][k] == kQuietNan ? 1 : 0;
+    }
+    EXPECT_EQ(differ, 0u) << what << ": " << a.names[i] << " differs in " << differ << " of " << a.words[i].size()
+                          << " words (" << nan << " hold the fill pattern)";
+  }
+}
+
+void check_determinism(fovea::gpu::Context& ctx, const char* scene_name, const compositor::ReconSettings& settings) {
+  const renderer::Scene scene = renderer::load_scene(scene_name);
+  renderer::GpuScene gs(ctx, scene);
+  const core::DisplayPreset display = fovea::test::display_of_size(40, 44);
+  const auto poses = fovea::test::eye_poses(scene, display.ipd_m);
+  Snapshot first;
+  {
+    compositor::FramePipeline p(ctx, gs, display, {}, settings);
+    first = render_sequence(p, poses);
+  }
+  for (const auto& v : first.words) {
+    std::size_t nan = 0;
+    for (std::uint32_t w : v) nan += (w & 0x7f800000u) == 0x7f800000u ? 1 : 0;
+    ASSERT_EQ(nan, 0u) << "non-finite values in a fresh render";
+  }
+  compositor::FramePipeline p(ctx, gs, display, {}, settings);
+  expect_identical(first, render_sequence(p, poses), "second fresh pipeline");
+  // Other frames in between, then reset(): the history of those must not leak in.
+  for (std::uint32_t f = 0; f < 3; ++f) p.render(poses, gaze_of(7 + f), 99 + f);
+  p.reset();
+  expect_identical(first, render_sequence(p, poses), "after reset()");
+  p.fill_buffers(kQuietNan);
+  expect_identical(first, render_sequence(p, poses), "after a NaN fill");
+}
+
+}  // namespace
+
+TEST_F(GpuTest, FramePipelineIsDeterministicWithBmfrGatherAndBlur) {
+  compositor::ReconSettings s;
+  s.share = compositor::StereoShare::Gather;
+  check_determinism(ctx(), "default", s);
+}
+
+TEST_F(GpuTest, FramePipelineIsDeterministicWithoutDenoiserAlternating) {
+  compositor::ReconSettings s;
+  s.denoiser = compositor::Denoiser::None;
+  s.share = compositor::StereoShare::Alternate;
+  s.blur = false;
+  check_determinism(ctx(), "stereo-occluders", s);
+}
