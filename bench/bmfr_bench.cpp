@@ -93,7 +93,7 @@ void fit(benchmark::State& state) {
 
 BENCHMARK(fit)
     ->ArgNames({"workgroup", "fp16"})
-    ->ArgsProduct({{32, 64, 128, 256}, {0, 1}})
+    ->ArgsProduct({{64, 128, 256, 512}, {0, 1}})
     ->Unit(benchmark::kMillisecond)
     ->UseRealTime()
     ->MinTime(1.0);

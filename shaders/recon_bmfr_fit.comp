@@ -41,7 +41,21 @@ shared float s_rowk[2][kCols];
 shared float s_r[kM][kCols];
 shared float s_coef[3][kM];
 
+// The block's rows of [T + N | z], fp32 or fp16 pairs (kFp16); the unused one is dead code.
 float A[kRows][kCols];
+uint A16[kRows][(kCols + 1u) / 2u];
+
+float a_get(uint q, uint j) { return kFp16 ? unpackHalf2x16(A16[q][j >> 1u])[j & 1u] : A[q][j]; }
+
+void a_set(uint q, uint j, float v) {
+  if (kFp16) {
+    vec2 h = unpackHalf2x16(A16[q][j >> 1u]);
+    h[j & 1u] = v;
+    A16[q][j >> 1u] = packHalf2x16(h);
+  } else {
+    A[q][j] = v;
+  }
+}
 
 // Sum (op 0) or max (op 1) of vals[0..n) over the workgroup; every invocation gets the
 // result. Each invocation stores its values, then invocation j folds value j over the group
@@ -70,10 +84,10 @@ void householder_column(const uint k) {
   [[unroll]] for (uint q = 0u; q < kRows; ++q) {
     uint row = tid + q * kGroup;
     if (row >= k) {
-      float x = A[q][k];
-      [[unroll]] for (uint j = k; j < kCols; ++j) vals[j] += x * A[q][j];
+      float x = a_get(q, k);
+      [[unroll]] for (uint j = k; j < kCols; ++j) vals[j] += x * a_get(q, j);
       if (row == k)
-        [[unroll]] for (uint j = 0u; j < kCols; ++j) s_rowk[k & 1u][j] = A[q][j];
+        [[unroll]] for (uint j = 0u; j < kCols; ++j) s_rowk[k & 1u][j] = a_get(q, j);
     }
   }
   reduce(vals, kCols, 0u);
@@ -91,8 +105,8 @@ void householder_column(const uint k) {
   [[unroll]] for (uint q = 0u; q < kRows; ++q) {
     uint row = tid + q * kGroup;
     if (row >= k) {
-      float v = row == k ? xk - alpha : A[q][k];
-      [[unroll]] for (uint j = k + 1u; j < kCols; ++j) A[q][j] -= beta[j] * v;
+      float v = row == k ? xk - alpha : a_get(q, k);
+      [[unroll]] for (uint j = k + 1u; j < kCols; ++j) a_set(q, j, a_get(q, j) - beta[j] * v);
     }
   }
 }
@@ -108,36 +122,39 @@ bool inside(ivec2 c) { return c.x >= 0 && c.y >= 0 && c.x < int(pc.padded_column
 void main() {
   uint tid = gl_LocalInvocationIndex;
   bool valid[kRows];
-  vec3 wpos[kRows];
+  vec3 wpos[kRows], zin[kRows];
   float vals[kVals];
 
-  // Per-block position range: max of (w, −w) over valid rows; and the number of valid rows.
+  // One max reduction over the valid rows: the position range (max of w and −w), whether
+  // any row is valid, and the largest input value.
   [[unroll]] for (uint j = 0u; j < kVals; ++j) vals[j] = -3.0e38;
-  float count = 0.0;
   [[unroll]] for (uint q = 0u; q < kRows; ++q) {
     ivec2 c = cell_of(tid + q * kGroup);
     valid[q] = false;
     wpos[q] = vec3(0.0);
+    zin[q] = vec3(0.0);
     if (!inside(c)) continue;
-    vec4 p = vpos[uint(c.y) * pc.padded_columns + uint(c.x)];
+    uint i = uint(c.y) * pc.padded_columns + uint(c.x);
+    vec4 p = vpos[i];
     if (p.w < 0.0) continue;  // sky, emitter or no sample
     valid[q] = true;
     wpos[q] = p.xyz;
-    count += 1.0;
+    zin[q] = z[i].rgb;
     [[unroll]] for (uint a = 0u; a < 3u; ++a) {
       vals[a] = max(vals[a], p[a]);
       vals[3u + a] = max(vals[3u + a], -p[a]);
     }
+    vals[6] = 1.0;
+    vals[7] = max(vals[7], max(max(zin[q].r, zin[q].g), zin[q].b));
   }
-  reduce(vals, 6u, 1u);
+  reduce(vals, 8u, 1u);
   vec3 wmax = vec3(vals[0], vals[1], vals[2]), wmin = -vec3(vals[3], vals[4], vals[5]);
-  [[unroll]] for (uint j = 0u; j < kVals; ++j) vals[j] = 0.0;
-  vals[0] = count;
-  reduce(vals, 1u, 0u);
-  float valid_rows = vals[0];
+  // z enters the regression divided by its block maximum (the fit is linear in z, so the
+  // fitted values scale back): every column then stays within fp16 range, fireflies too.
+  float zmax = vals[7] > 0.0 ? vals[7] : 1.0;
 
   // Blocks without a surface sample only pass sky through (uniform branch: no barrier inside).
-  if (valid_rows < 0.5) {
+  if (vals[6] < 0.5) {
     [[unroll]] for (uint q = 0u; q < kRows; ++q) {
       ivec2 c = cell_of(tid + q * kGroup);
       if (!inside(c)) continue;
@@ -154,7 +171,7 @@ void main() {
   vec3 feat_n[kRows];
   [[unroll]] for (uint q = 0u; q < kRows; ++q) {
     uint row = tid + q * kGroup;
-    [[unroll]] for (uint j = 0u; j < kCols; ++j) A[q][j] = 0.0;
+    [[unroll]] for (uint j = 0u; j < kCols; ++j) a_set(q, j, 0.0);
     feat_n[q] = vec3(0.0);
     if (!valid[q]) continue;
     ivec2 c = cell_of(row);
@@ -162,14 +179,14 @@ void main() {
     vec3 n = vnrm[i].xyz;
     vec3 w = clamp((wpos[q] - mid) * inv_half, -1.0, 1.0);
     feat_n[q] = n;
-    vec3 zz = z[i].rgb;
+    vec3 zz = zin[q] / zmax;
     float t[kCols] = float[kCols](1.0, n.x, n.y, n.z, w.x, w.y, w.z, w.x * w.x, w.y * w.y, w.z * w.z, zz.r, zz.g, zz.b);
     // Eq. 7: zero-mean uniform noise on the non-constant features, keyed by block, row, feature, frame.
     [[unroll]] for (uint j = 0u; j < kCols; ++j) {
       float noise = 0.0;
       if (j >= 1u && j < kM)
         noise = pc.noise * (2.0 * hash_to_unit(hash3(gl_WorkGroupID.x * 1024u + row, j, pc.frame)) - 1.0);
-      A[q][j] = t[j] + noise;
+      a_set(q, j, t[j] + noise);
     }
   }
 
@@ -216,7 +233,7 @@ void main() {
     float t[kM] = float[kM](1.0, n.x, n.y, n.z, w.x, w.y, w.z, w.x * w.x, w.y * w.y, w.z * w.z);
     vec3 y = vec3(0.0);
     [[unroll]] for (uint m = 0u; m < kM; ++m) y += vec3(s_coef[0][m], s_coef[1][m], s_coef[2][m]) * t[m];
-    y = clamp(y, vec3(0.0), vec3(1e9));
+    y = clamp(y * zmax, vec3(0.0), vec3(1e9));
     fitted[i] = vec4(isnan(y.r) || isnan(y.g) || isnan(y.b) ? vec3(0.0) : y, 1.0);
   }
 }

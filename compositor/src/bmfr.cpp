@@ -12,8 +12,8 @@ namespace {
 
 std::uint32_t checked_workgroup(const BmfrOptions& o) {
   const std::uint32_t w = o.workgroup ? o.workgroup : kBmfrDefaultWorkgroup;
-  if (w < 8 || w > 1024 || 1024 % w != 0)
-    throw core::InputError("bmfr: workgroup must divide 1024 and be 8..1024, got " + std::to_string(w));
+  if (w < 8 || w > 512 || 1024 % w != 0)
+    throw core::InputError("bmfr: workgroup must divide 1024 and be 8..512, got " + std::to_string(w));
   return w;
 }
 

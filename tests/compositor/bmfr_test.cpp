@@ -2,8 +2,11 @@
 // on a static Cornell box.
 #include "fovea/compositor/bmfr.hpp"
 
+#include <map>
+#include <memory>
 #include <random>
 
+#include "fovea/core/error.hpp"
 #include "fovea/core/metrics.hpp"
 #include "fovea/renderer/scene_io.hpp"
 #include "gpu_fixture.hpp"
@@ -39,12 +42,25 @@ Inputs flat_wall(float value, unsigned seed, double scale = 1.0, glm::dvec3 orig
   return in;
 }
 
+// A smooth radiance that the features represent exactly (quadratic in position on one
+// plane), times unit-mean exponential noise: the fit should recover the smooth part.
+double smooth_radiance(std::uint32_t x, std::uint32_t y) {
+  const double u = x / double(kSide), v = y / double(kSide);
+  return 0.2 + 0.5 * u + 0.3 * v * v;
+}
+
 class Bmfr : public GpuTest {
  protected:
-  std::vector<glm::vec4> run(const Inputs& in, glm::ivec2 offset = {0, 0}) {
-    compositor::BmfrFit fit(ctx());
-    return fit.fit({kSide, kSide}, in.pos, in.nrm, in.z, 3, offset);
+  // One pipeline per configuration (lavapipe compiles the unrolled shader in ~1 s).
+  const compositor::BmfrFit& fitter(compositor::BmfrOptions o) {
+    auto& f = fits_[{int(o.precision), o.workgroup}];
+    if (!f) f = std::make_unique<compositor::BmfrFit>(ctx(), o);
+    return *f;
   }
+  std::vector<glm::vec4> run(const Inputs& in, glm::ivec2 offset = {0, 0}, compositor::BmfrOptions o = {}) {
+    return fitter(o).fit({kSide, kSide}, in.pos, in.nrm, in.z, 3, offset);
+  }
+  std::map<std::pair<int, std::uint32_t>, std::unique_ptr<compositor::BmfrFit>> fits_;
   static void expect_sane(const std::vector<glm::vec4>& out) {
     ASSERT_TRUE(fovea::test::all_finite(out));
     for (const auto& p : out) {
@@ -89,11 +105,48 @@ TEST_F(Bmfr, FirefliesOfAMillionStayFinite) {
   Inputs in = flat_wall(0.3f, 4);
   for (std::size_t i = 0; i < in.z.size(); i += 97) in.z[i] = {1e6f, 1e6f, 1e6f, 1};
   expect_sane(run(in, {11, 2}));
+  expect_sane(run(in, {11, 2}, {.precision = compositor::BmfrPrecision::Fp16}));  // 1e6 > fp16 max
 }
 
 TEST_F(Bmfr, PositionsAtTenToTheFiveUnitsStayFinite) {
-  expect_sane(run(flat_wall(0.5f, 5, 1.0, {1e5, -1e5, 1e5}), {0, 0}));
-  expect_sane(run(flat_wall(0.5f, 6, 1e3, {1e5, 1e5, 0}), {17, 23}));  // blocks spanning 10⁵ units
+  for (auto precision : {compositor::BmfrPrecision::Fp32, compositor::BmfrPrecision::Fp16}) {
+    expect_sane(run(flat_wall(0.5f, 5, 1.0, {1e5, -1e5, 1e5}), {0, 0}, {.precision = precision}));
+    // Blocks spanning 10⁵ units: w² would be 10¹⁰ unscaled, far beyond fp16.
+    expect_sane(run(flat_wall(0.5f, 6, 1e3, {1e5, 1e5, 0}), {17, 23}, {.precision = precision}));
+  }
+}
+
+// fp16 storage of the regression matrix against fp32, and the workgroup size (a pure
+// schedule choice) against the default, on a smooth ramp under heavy noise.
+TEST_F(Bmfr, Fp16StorageAndWorkgroupSizesMatchFp32) {
+  Inputs in = flat_wall(1.0f, 8);
+  std::vector<glm::vec4> truth(in.z.size());
+  for (std::uint32_t y = 0; y < kSide; ++y)
+    for (std::uint32_t x = 0; x < kSide; ++x) {
+      const std::size_t i = y * kSide + x;
+      truth[i] = glm::vec4(glm::vec3(float(smooth_radiance(x, y))), 1);
+      in.z[i] = glm::vec4(glm::vec3(in.z[i]) * truth[i].x, 1);
+    }
+  auto as_image = [](const std::vector<glm::vec4>& v) {
+    return fovea::test::cells_image(v, [](std::size_t) { return true; });
+  };
+  const core::Image ref = as_image(truth);
+  const auto fp32 = run(in, {7, 19});
+  const auto fp16 = run(in, {7, 19}, {.precision = compositor::BmfrPrecision::Fp16});
+  const double p_in = core::psnr(as_image(in.z), ref), p32 = core::psnr(as_image(fp32), ref),
+               p16 = core::psnr(as_image(fp16), ref);
+  std::printf("smooth ramp: input %.2f dB, fp32 fit %.2f dB, fp16 fit %.2f dB\n", p_in, p32, p16);
+  EXPECT_GE(p32, p_in + 15.0);
+  EXPECT_NEAR(p16, p32, 0.5);
+  for (std::uint32_t wg : {512u}) {
+    const auto other = run(in, {7, 19}, {.workgroup = wg});
+    for (std::size_t i = 0; i < other.size(); ++i) ASSERT_NEAR(other[i].x, fp32[i].x, 1e-3f) << wg << " " << i;
+  }
+}
+
+TEST_F(Bmfr, WorkgroupMustDivideTheBlock) {
+  EXPECT_THROW(compositor::BmfrFit(ctx(), {.workgroup = 96}), core::InputError);
+  EXPECT_THROW(compositor::BmfrFit(ctx(), {.workgroup = 1024}), core::InputError);
 }
 
 TEST_F(Bmfr, MaskedAndNearlyEmptyBlocksStayFinite) {

@@ -28,7 +28,7 @@ inline constexpr std::uint32_t kBmfrDefaultWorkgroup = 256;
 
 struct BmfrOptions {
   BmfrPrecision precision = BmfrPrecision::Fp32;
-  std::uint32_t workgroup = 0;  // invocations per block (divides 1024); 0: the default
+  std::uint32_t workgroup = 0;  // invocations per block: 8..512 dividing 1024 (shared memory); 0: default
 };
 
 class BmfrFit {
