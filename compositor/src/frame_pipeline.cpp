@@ -43,7 +43,7 @@ gpu::Buffer storage(gpu::Context& ctx, VkDeviceSize bytes, const char* name,
 }
 
 struct Kernels {
-  gpu::ComputePipeline accumulate, share, post, taa, mip, resolve, blur;
+  gpu::ComputePipeline accumulate, share, post, taa, mip, resolve, blur, depth;
   BmfrFit fit;
   explicit Kernels(gpu::Context& ctx)
       : accumulate(make_pipeline(ctx, "recon_accumulate.comp.spv", 18, sizeof(shaders::ReconAccumulatePush))),
@@ -53,6 +53,7 @@ struct Kernels {
         mip(make_pipeline(ctx, "recon_mip.comp.spv", 3, sizeof(shaders::ReconMipPush))),
         resolve(make_pipeline(ctx, "recon_resolve.comp.spv", 5, sizeof(shaders::ReconResolvePush))),
         blur(make_pipeline(ctx, "recon_blur.comp.spv", 4, sizeof(shaders::ReconBlurPush))),
+        depth(make_pipeline(ctx, "recon_depth.comp.spv", 4, sizeof(shaders::ReconResolvePush))),
         fit(ctx) {}
 };
 
@@ -74,8 +75,8 @@ struct EyeState {
   gpu::Buffer tap_idx, tap_w, shared, z, fitted;
   std::uint32_t levels = 1;
   std::vector<std::uint32_t> level_rows, level_offset;
-  gpu::Buffer mips, offsets, screen_a, screen_b;
-  gpu::DescriptorSet acc_set[2], share_set[2], fit_set[2], post_set[2], taa_set[2];
+  gpu::Buffer mips, offsets, screen_a, screen_b, depth;
+  gpu::DescriptorSet acc_set[2], share_set[2], fit_set[2], post_set[2], taa_set[2], depth_set[2];
   gpu::DescriptorSet mip_set, resolve_set, blur_h, blur_v;
 
   std::vector<GridColumn> table() const {
@@ -163,6 +164,7 @@ struct FramePipeline::Impl {
     const VkDeviceSize screen = VkDeviceSize(e.base_view.width()) * e.base_view.height() * 16;
     e.screen_a = storage(ctx, screen, "recon.screen");
     e.screen_b = storage(ctx, screen, "recon.screen_tmp");
+    e.depth = storage(ctx, screen / 4, "recon.depth");
   }
 
   void bind_eye(EyeState& e, const EyeState& o) {
@@ -184,6 +186,7 @@ struct FramePipeline::Impl {
       e.post_set[p] = make_set(ctx, k.post, {&e.vpos[p], &e.tap_idx, &e.tap_w, source, &e.acc_d[p], &e.post[q], &e.post[p]});
       e.taa_set[p] = make_set(ctx, k.taa, {&e.maps, &e.tables, &e.vpos[p], &e.tap_idx, &e.tap_w, &e.post[p],
                                             &t.albedo(), &e.final_[q], &e.final_[p]});
+      e.depth_set[p] = make_set(ctx, k.depth, {&e.maps, &e.tables, &e.vpos[p], &e.depth});
     }
     e.mip_set = make_set(ctx, k.mip, {&e.maps, &e.tables, &e.mips});
     e.resolve_set = make_set(ctx, k.resolve, {&e.maps, &e.tables, &e.mips, &e.offsets, &e.screen_a});
@@ -236,7 +239,7 @@ struct FramePipeline::Impl {
                                      &t.position_material(), &t.radiance()})
           gpu::fill_buffer(cmd, *b, word);
         for (const gpu::Buffer* b : {&e->tap_idx, &e->tap_w, &e->shared, &e->z, &e->fitted, &e->mips, &e->screen_a,
-                                     &e->screen_b})
+                                     &e->screen_b, &e->depth})
           gpu::fill_buffer(cmd, *b, word);
         for (int p = 0; p < 2; ++p)
           for (const gpu::Buffer* b : {&e->acc_d[p], &e->acc_i[p], &e->vpos[p], &e->vnrm[p], &e->post[p], &e->final_[p]})
@@ -347,6 +350,10 @@ FrameTimes FramePipeline::render(const std::array<core::Pose, 2>& eye_pose, cons
     m.timer.stage(cmd, "post");
     for (auto& e : m.eyes) gpu::copy_buffer(cmd, e->final_[p], e->mips, VkDeviceSize(e->cells) * 16);
     gpu::transfer_to_compute(cmd);
+    for (auto& e : m.eyes) {
+      const auto w = std::uint32_t(e->base_view.width()), h = std::uint32_t(e->base_view.height());
+      m.k.depth.run(cmd, {&e->depth_set[p]}, shaders::ReconResolvePush{w, h, 0, 0}, w, h);
+    }
     m.record_resolve(cmd, m.settings.blur);
     m.timer.stage(cmd, "resolve");
   });
@@ -394,6 +401,16 @@ core::Image FramePipeline::image(core::Eye e) const {
       return img;
     }
   throw core::InputError("image: eye not rendered");
+}
+
+std::vector<float> FramePipeline::depth(core::Eye e) const {
+  for (const auto& s : impl_->eyes)
+    if (s->eye == e) {
+      std::vector<float> d = s->depth.download<float>();
+      d.resize(std::size_t(s->base_view.width()) * std::size_t(s->base_view.height()));
+      return d;
+    }
+  throw core::InputError("depth: eye not rendered");
 }
 
 std::vector<glm::vec4> FramePipeline::grid_buffer(core::Eye eye, GridBuffer which) const {

@@ -47,6 +47,7 @@ Snapshot render_sequence(compositor::FramePipeline& p, const std::array<core::Po
     const core::Eye eye = core::Eye(e);
     const std::string tag = e == 0 ? "left " : "right ";
     s.add(tag + "image", p.image(eye).pixels);
+    s.add(tag + "depth", p.depth(eye));
     s.add(tag + "grid samples", p.grid_samples(eye));
     const std::pair<compositor::GridBuffer, const char*> buffers[] = {
         {compositor::GridBuffer::Radiance, "radiance"},   {compositor::GridBuffer::AccDirect, "acc direct"},

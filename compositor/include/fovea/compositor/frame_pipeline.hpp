@@ -69,6 +69,10 @@ class FramePipeline {
   core::Image resolve_grid(core::Eye e, const std::vector<glm::vec4>& grid, bool blur);
 
   core::Image image(core::Eye e) const;  // the displayed image of the last frame
+  // The last frame's display-space linear depth, row-major like image(): per pixel the
+  // view-space distance along -Z (scene units) of the nearest grid sample's surface; 0 where
+  // that sample saw the sky or none exists. For depth compositing; the image ignores it.
+  std::vector<float> depth(core::Eye e) const;
   std::vector<glm::vec4> grid_buffer(core::Eye e, GridBuffer which) const;
   std::vector<shaders::GridSample> grid_samples(core::Eye e) const;
   std::int64_t traced_cells(core::Eye e) const;  // cells with a sample in the last frame

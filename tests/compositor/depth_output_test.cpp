@@ -1,0 +1,53 @@
+// FramePipeline::depth(): per display pixel the view-space distance along -Z of the grid
+// sample its direction falls in (the nearest sample), 0 for the sky.
+#include <cmath>
+
+#include "fovea/renderer/scene_io.hpp"
+#include "gpu_fixture.hpp"
+#include "reconstruct_helpers.hpp"
+
+namespace compositor = fovea::compositor;
+namespace core = fovea::core;
+namespace renderer = fovea::renderer;
+using fovea::test::GpuTest;
+
+TEST_F(GpuTest, FramePipelineDepthIsTheNearestSamplesViewZ) {
+  const renderer::Scene scene = renderer::load_scene("stereo-occluders");
+  renderer::GpuScene gs(ctx(), scene);
+  const core::DisplayPreset display = fovea::test::display_of_size(48, 54);
+  compositor::ReconSettings s;
+  s.blur = false;
+  compositor::FramePipeline p(ctx(), gs, display, {}, s);
+  const auto poses = fovea::test::eye_poses(scene, display.ipd_m);
+  p.render(poses, {glm::dvec3(0.05, 0, -1), glm::dvec3(0.05, 0, -1)}, 3);
+  for (core::Eye eye : {core::Eye::Left, core::Eye::Right}) {
+    const std::vector<float> depth = p.depth(eye);
+    const auto pos = p.grid_buffer(eye, compositor::GridBuffer::Position);
+    const auto& d = p.distribution(eye);
+    const core::View v = p.view(eye);
+    ASSERT_EQ(depth.size(), std::size_t(v.width()) * std::size_t(v.height()));
+    const glm::dvec3 forward = v.pose().orientation * glm::dvec3(0, 0, -1);
+    int match = 0, surfaces = 0, sky = 0, n = 0;
+    for (int y = 0; y < v.height(); ++y)
+      for (int x = 0; x < v.width(); ++x) {
+        const auto g = d.screen_to_grid({x + 0.5, y + 0.5});
+        if (!g) continue;
+        ++n;
+        const int c = std::clamp(int(std::floor(g->x)), 0, d.columns() - 1);
+        const int rows = int(d.column_table()[std::size_t(c)].rows);
+        const int r = std::clamp(int(std::floor(g->y)), 0, rows - 1);
+        const glm::vec4 q = pos[std::size_t(r) * std::size_t(d.padded_columns()) + std::size_t(c)];
+        const bool surface = q.w >= 0 || q.w <= -2.5f;
+        const double expected = surface ? glm::dot(glm::dvec3(q) - v.pose().position, forward) : 0.0;
+        const float got = depth[std::size_t(y) * std::size_t(v.width()) + std::size_t(x)];
+        ASSERT_TRUE(std::isfinite(got) && got >= 0);
+        surfaces += got > 0 ? 1 : 0;
+        sky += got == 0 ? 1 : 0;
+        match += std::abs(got - expected) <= 1e-4 * std::max(1.0, expected) ? 1 : 0;
+      }
+    std::printf("eye %d: %d of %d pixels match the nearest cell, %d surface, %d sky\n", int(eye), match, n, surfaces,
+                sky);
+    EXPECT_GE(match, int(0.97 * n));  // cell-boundary pixels may round to the neighbouring cell
+    EXPECT_GT(surfaces, n / 2);
+  }
+}
