@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <map>
 #include <stdexcept>
 #include <string>
@@ -96,6 +97,40 @@ std::int64_t composite(Pixels8& scene, const Pixels8& app, Composite mode, std::
         s[3] = 255;
         ++shown;
       }
+    }
+  return shown;
+}
+
+double view_distance(float d, const DepthRange& r) {
+  if (!(r.max_depth != r.min_depth) || !(r.near_z > 0) || !(r.far_z > 0) || r.near_z == r.far_z)
+    throw std::runtime_error("XrCompositionLayerDepthInfoKHR: degenerate depth range (minDepth " +
+                             std::to_string(r.min_depth) + ", maxDepth " + std::to_string(r.max_depth) + ", nearZ " +
+                             std::to_string(r.near_z) + ", farZ " + std::to_string(r.far_z) + ")");
+  const double t = std::clamp((double(d) - r.min_depth) / (double(r.max_depth) - r.min_depth), 0.0, 1.0);
+  const auto inverse = [](float z) { return std::isinf(z) ? 0.0 : 1.0 / double(z); };
+  const double inv_z = (1.0 - t) * inverse(r.near_z) + t * inverse(r.far_z);
+  return inv_z > 0 ? 1.0 / inv_z : std::numeric_limits<double>::infinity();
+}
+
+std::int64_t composite_depth(Pixels8& scene, const std::vector<float>& scene_depth, const Pixels8& app,
+                             const std::vector<float>& app_depth, const DepthRange& range) {
+  const std::size_t n = std::size_t(scene.width) * std::size_t(scene.height);
+  if (app.width != scene.width || app.height != scene.height || scene_depth.size() != n || app_depth.size() != n)
+    throw std::logic_error("composite_depth: the images and depths differ in size");
+  // The cleared value is the far end: max_depth normally, min_depth with reversed Z.
+  const double far = std::max(view_distance(range.min_depth, range), view_distance(range.max_depth, range));
+  std::int64_t shown = 0;
+  for (int y = 0; y < scene.height; ++y)
+    for (int x = 0; x < scene.width; ++x) {
+      const std::size_t i = std::size_t(y) * std::size_t(scene.width) + std::size_t(x);
+      const std::uint8_t* a = app.at(x, y);
+      if (a[3] == 0) continue;
+      const double za = view_distance(app_depth[i], range);
+      if (za >= far) continue;  // the cleared far plane: the application drew nothing here
+      const double zs = scene_depth[i] > 0 ? double(scene_depth[i]) : std::numeric_limits<double>::infinity();
+      if (za >= zs) continue;
+      std::copy_n(a, 4, scene.at(x, y));
+      ++shown;
     }
   return shown;
 }

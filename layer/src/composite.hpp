@@ -52,4 +52,25 @@ Pixels8 resample(const Pixels8& app, const core::View& app_view, const core::Vie
 std::int64_t composite(Pixels8& scene, const Pixels8& app, Composite mode, std::array<std::uint8_t, 3> background,
                        int tolerance = 2);
 
+// The mapping of the application's depth values (XrCompositionLayerDepthInfoKHR): window
+// depth min_depth lies at view distance near_z, max_depth at far_z. near_z > far_z is
+// reversed Z; either plane may be +infinity (an infinite far plane).
+struct DepthRange {
+  float min_depth = 0, max_depth = 1;
+  float near_z = 0.1f, far_z = 100;
+};
+// View-space distance along -Z of window depth `d` under a perspective projection: its
+// normalised depth t = (d - min_depth) / (max_depth - min_depth) is affine in 1/z,
+// 1/z = (1 - t)/near_z + t/far_z. +infinity at an infinite plane; throws std::runtime_error
+// for a degenerate range (equal depths or planes, a plane <= 0).
+double view_distance(float d, const DepthRange& range);
+
+// Keeps the application's pixel where its surface is nearer than the scene's. `app_depth`
+// holds the application's window depths (same raster as `app`), `scene_depth` the scene's
+// view distances along -Z (FramePipeline::depth: 0 = nothing at a finite distance). Pixels
+// where the application left its depth at the far plane (cleared, drew nothing) or its
+// alpha at 0 keep the scene. Returns how many pixels show the application.
+std::int64_t composite_depth(Pixels8& scene, const std::vector<float>& scene_depth, const Pixels8& app,
+                             const std::vector<float>& app_depth, const DepthRange& range);
+
 }  // namespace fovea::layer

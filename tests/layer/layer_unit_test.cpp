@@ -1,5 +1,6 @@
 // The layer's host-side parts without an OpenXR session: configuration, compositing, gaze hold.
 #include <cmath>
+#include <limits>
 
 #include <gtest/gtest.h>
 
@@ -121,6 +122,55 @@ TEST(LayerGazeHold, HoldsThenEasesToFixedFoveation) {
   EXPECT_LT(glm::distance(h.update(2'100'000'000, false, {}), fixed), 1e-12);
   EXPECT_LT(glm::distance(h.update(2'200'000'000, true, right), right), 1e-12);  // back on the tracker at once
   EXPECT_LT(glm::distance(h.update(2'300'000'000, true, glm::dvec3(NAN, 0, -1)), right), 1e-12);  // a bad sample is a loss
+}
+
+// The window depth an application stores for view distance z (the inverse of view_distance).
+float window_depth(double z, const DepthRange& r) {
+  const auto inverse = [](double v) { return std::isinf(v) ? 0.0 : 1.0 / v; };
+  const double t = (inverse(z) - inverse(r.near_z)) / (inverse(r.far_z) - inverse(r.near_z));
+  return float(r.min_depth + t * (double(r.max_depth) - r.min_depth));
+}
+
+TEST(LayerDepth, ViewDistanceMapsTheRangeEnds) {
+  const double inf = std::numeric_limits<double>::infinity();
+  const float finf = std::numeric_limits<float>::infinity();
+  for (const DepthRange r : {DepthRange{0, 1, 0.1f, 100}, DepthRange{0, 1, 100, 0.1f}, DepthRange{0.25f, 0.75f, 0.05f, 20},
+                             DepthRange{0, 1, 0.1f, finf}, DepthRange{0, 1, finf, 0.1f}}) {
+    const double zn = view_distance(r.min_depth, r), zf = view_distance(r.max_depth, r);
+    if (std::isinf(r.near_z)) EXPECT_EQ(zn, inf); else EXPECT_NEAR(zn, r.near_z, 1e-5 * r.near_z);
+    if (std::isinf(r.far_z)) EXPECT_EQ(zf, inf); else EXPECT_NEAR(zf, r.far_z, 1e-5 * r.far_z);
+    for (double z : {0.5, 1.0, 3.0, 17.0}) EXPECT_NEAR(view_distance(window_depth(z, r), r), z, 1e-4 * z);
+  }
+  EXPECT_THROW(view_distance(0.5f, DepthRange{0, 1, 1, 1}), std::runtime_error);
+  EXPECT_THROW(view_distance(0.5f, DepthRange{0.5f, 0.5f, 0.1f, 10}), std::runtime_error);
+  EXPECT_THROW(view_distance(0.5f, DepthRange{0, 1, 0, 10}), std::runtime_error);
+}
+
+TEST(LayerDepth, KeepsTheNearerSurfaceForEveryDepthConvention) {
+  const float finf = std::numeric_limits<float>::infinity();
+  // Scene: surfaces at 2 m and 5 m, sky (0) in pixel 2.
+  const std::vector<float> scene_depth{2, 2, 0, 5, 5};
+  for (const DepthRange r : {DepthRange{0, 1, 0.1f, 100}, DepthRange{0, 1, 100, 0.1f}, DepthRange{0.25f, 0.75f, 0.05f, 200},
+                             DepthRange{0, 1, 0.1f, finf}, DepthRange{0, 1, finf, 0.1f}}) {
+    Pixels8 app = filled(5, 1, {10, 20, 30, 255});
+    app.at(4, 0)[3] = 0;  // not covered by the application
+    // App surfaces at 1 m (nearer), 3 m (behind the scene), 50 m (in front of the sky),
+    // cleared (the far end), 1 m but alpha 0.
+    const bool reversed = r.near_z > r.far_z;
+    const float cleared = reversed ? r.min_depth : r.max_depth;
+    const std::vector<float> app_depth{window_depth(1, r), window_depth(3, r), window_depth(50, r), cleared,
+                                       window_depth(1, r)};
+    Pixels8 scene = filled(5, 1, {200, 100, 50, 255});
+    EXPECT_EQ(composite_depth(scene, scene_depth, app, app_depth, r), 2)
+        << "near " << r.near_z << " far " << r.far_z;
+    EXPECT_EQ(scene.at(0, 0)[0], 10);
+    EXPECT_EQ(scene.at(1, 0)[0], 200);
+    EXPECT_EQ(scene.at(2, 0)[0], 10);
+    EXPECT_EQ(scene.at(3, 0)[0], 200);
+    EXPECT_EQ(scene.at(4, 0)[0], 200);
+  }
+  Pixels8 scene = filled(2, 1, {0, 0, 0, 255});
+  EXPECT_THROW(composite_depth(scene, {1}, filled(2, 1, {0, 0, 0, 255}), {0, 0}, DepthRange{}), std::logic_error);
 }
 
 }  // namespace
