@@ -1,6 +1,7 @@
 // Frame intercepts: xrWaitFrame/xrBeginFrame/xrEndFrame are timed. Without a renderer the
 // application's frame goes down unchanged; with one, its layers replace the application's (frame_renderer.hpp).
 #include <stdexcept>
+#include <vector>
 
 #include "layer.hpp"
 #include "log.hpp"
@@ -21,6 +22,35 @@ void bookkeeping(XrSession session, F&& f) {
     it->second.renderer.reset();
     it->second.disabled = true;
   }
+}
+
+// The views of an application's stereo projection layer, if the layer can replace it: each
+// is a projection view on a swapchain of this session with a released image, its rect inside
+// the image and its array layer present. Otherwise nothing: the application's frame goes down
+// unchanged and the runtime reports the application's error, while the layer stays enabled.
+std::vector<AppView> replaceable_views(XrSession session, const XrCompositionLayerProjection& p) {
+  std::vector<AppView> views;
+  if (p.viewCount != 2 || !p.views) return views;
+  for (uint32_t v = 0; v < p.viewCount; ++v) {
+    const XrCompositionLayerProjectionView& pv = p.views[v];
+    if (pv.type != XR_TYPE_COMPOSITION_LAYER_PROJECTION_VIEW) return {};
+    const auto sc = layer().swapchains.find(pv.subImage.swapchain);
+    if (sc == layer().swapchains.end() || sc->second.session != session) return {};
+    const SwapchainState& st = sc->second;
+    const XrRect2Di& r = pv.subImage.imageRect;
+    if (st.last_released < 0 || std::size_t(st.last_released) >= st.images.size() || r.offset.x < 0 ||
+        r.offset.y < 0 || r.extent.width <= 0 || r.extent.height <= 0 ||
+        std::int64_t(r.offset.x) + r.extent.width > std::int64_t(st.info.width) ||
+        std::int64_t(r.offset.y) + r.extent.height > std::int64_t(st.info.height) ||
+        pv.subImage.imageArrayIndex >= st.info.arraySize)
+      return {};
+    bool depth = false;
+    for (auto* n = static_cast<const XrBaseInStructure*>(pv.next); n; n = n->next)
+      depth |= n->type == XR_TYPE_COMPOSITION_LAYER_DEPTH_INFO_KHR;
+    views.push_back({st.images[std::size_t(st.last_released)], VkFormat(st.info.format), r,
+                     pv.subImage.imageArrayIndex, pv.pose, pv.fov, depth});
+  }
+  return views;
 }
 
 template <class PFN>
@@ -66,24 +96,16 @@ XrResult intercept::xrEndFrame(XrSession session, const XrFrameEndInfo* info) {
     in.frame = s.current.frame;
     in.display_time = info->displayTime;
     in.app_frame = info;
+    // Only a frame the runtime may accept is rendered: begun, with a valid end info.
+    if (info->type != XR_TYPE_FRAME_END_INFO || info->displayTime <= 0 || s.current.begin_ns == 0) return;
     // The first stereo projection layer is the one replaced.
-    for (uint32_t i = 0; info->layers && i < info->layerCount && in.app_views.empty(); ++i) {
+    for (uint32_t i = 0; info->layers && i < info->layerCount; ++i) {
       if (!info->layers[i] || info->layers[i]->type != XR_TYPE_COMPOSITION_LAYER_PROJECTION) continue;
       const auto* p = reinterpret_cast<const XrCompositionLayerProjection*>(info->layers[i]);
       if (p->viewCount != 2 || !p->views) continue;
       in.projection_layer = i;
-      for (uint32_t v = 0; v < p->viewCount; ++v) {
-        const XrCompositionLayerProjectionView& pv = p->views[v];
-        auto sc = layer().swapchains.find(pv.subImage.swapchain);
-        if (sc == layer().swapchains.end() || sc->second.last_released < 0 ||
-            size_t(sc->second.last_released) >= sc->second.images.size())
-          throw std::runtime_error("a submitted swapchain has no released image the layer knows");
-        bool depth = false;
-        for (auto* n = static_cast<const XrBaseInStructure*>(pv.next); n; n = n->next)
-          depth |= n->type == XR_TYPE_COMPOSITION_LAYER_DEPTH_INFO_KHR;
-        in.app_views.push_back({sc->second.images[size_t(sc->second.last_released)], VkFormat(sc->second.info.format),
-                                pv.subImage.imageRect, pv.subImage.imageArrayIndex, pv.pose, pv.fov, depth});
-      }
+      in.app_views = replaceable_views(session, *p);
+      break;
     }
     if (s.gaze.attached()) {
       in.gaze_from_action = true;

@@ -110,7 +110,6 @@ namespace intercept {
   X(xrDestroySession)              \
   X(xrCreateSwapchain)             \
   X(xrDestroySwapchain)            \
-  X(xrEnumerateSwapchainImages)    \
   X(xrAcquireSwapchainImage)       \
   X(xrReleaseSwapchainImage)       \
   X(xrWaitFrame)                   \

@@ -1,6 +1,7 @@
-// Swapchain intercepts: forwarded unchanged; the layer records each swapchain's images and
-// which one was released last (what the application submits in xrEndFrame).
-#include <algorithm>
+// Swapchain intercepts: forwarded unchanged; the layer records each swapchain's images
+// (enumerated by the layer itself at creation: an application need not enumerate them to
+// submit them) and which one was released last (what the application submits in xrEndFrame).
+#include <vector>
 
 #include "layer.hpp"
 #include "log.hpp"
@@ -17,19 +18,30 @@ const Dispatch* next_for_swapchain(XrSwapchain sc) {
 
 XrResult intercept::xrCreateSwapchain(XrSession session, const XrSwapchainCreateInfo* info, XrSwapchain* swapchain) {
   PFN_xrCreateSwapchain next = nullptr;
+  PFN_xrEnumerateSwapchainImages enumerate = nullptr;
   {
     std::lock_guard lock(layer().mutex);
     const Dispatch* d = next_for_session(session);
     if (!d) return XR_ERROR_HANDLE_INVALID;
     next = d->xrCreateSwapchain;
+    enumerate = d->xrEnumerateSwapchainImages;
   }
   const XrResult r = next(session, info, swapchain);
   if (XR_SUCCEEDED(r)) {
+    // Without the images (an enumeration failure) the swapchain is never composited.
+    std::vector<VkImage> images;
+    uint32_t n = 0;
+    if (XR_SUCCEEDED(enumerate(*swapchain, 0, &n, nullptr))) {
+      std::vector<XrSwapchainImageVulkanKHR> vk(n, {XR_TYPE_SWAPCHAIN_IMAGE_VULKAN_KHR});
+      if (XR_SUCCEEDED(enumerate(*swapchain, n, &n, reinterpret_cast<XrSwapchainImageBaseHeader*>(vk.data()))))
+        for (const auto& i : vk) images.push_back(i.image);
+    }
     std::lock_guard lock(layer().mutex);
     SwapchainState& s = layer().swapchains[*swapchain];
     s.session = session;
     s.info = *info;
     s.info.next = nullptr;
+    s.images = std::move(images);
   }
   return r;
 }
@@ -46,28 +58,6 @@ XrResult intercept::xrDestroySwapchain(XrSwapchain swapchain) {
   if (XR_SUCCEEDED(r)) {
     std::lock_guard lock(layer().mutex);
     layer().swapchains.erase(swapchain);
-  }
-  return r;
-}
-
-XrResult intercept::xrEnumerateSwapchainImages(XrSwapchain swapchain, uint32_t capacity, uint32_t* count,
-                                               XrSwapchainImageBaseHeader* images) {
-  PFN_xrEnumerateSwapchainImages next = nullptr;
-  {
-    std::lock_guard lock(layer().mutex);
-    const Dispatch* d = next_for_swapchain(swapchain);
-    if (!d) return XR_ERROR_HANDLE_INVALID;
-    next = d->xrEnumerateSwapchainImages;
-  }
-  const XrResult r = next(swapchain, capacity, count, images);
-  if (XR_SUCCEEDED(r) && capacity && images && images->type == XR_TYPE_SWAPCHAIN_IMAGE_VULKAN_KHR) {
-    std::lock_guard lock(layer().mutex);
-    auto it = layer().swapchains.find(swapchain);
-    if (it != layer().swapchains.end()) {
-      const auto* vk = reinterpret_cast<const XrSwapchainImageVulkanKHR*>(images);
-      it->second.images.assign(*count, VK_NULL_HANDLE);
-      std::transform(vk, vk + *count, it->second.images.begin(), [](const auto& i) { return i.image; });
-    }
   }
   return r;
 }
