@@ -166,13 +166,10 @@ TEST_F(Bmfr, MaskedAndNearlyEmptyBlocksStayFinite) {
 // BMFR to +1.3 dB (+4.1 dB at 128×128, where the test would take ~20 s): this asserts the
 // measured margin, >= 1 dB (analysis in docs/results.md).
 TEST_F(Bmfr, CornellAfter32FramesBeatsInputAndAccumulation) {
-#ifdef FOVEA_SANITIZED_BUILD
-  const int size = 64;
-  const std::uint32_t frames = 32, ref_frames = 64;
-#else
+  // Also in the sanitized build: the time is lavapipe's (not instrumented), and at 64×64
+  // (2×2 blocks) BMFR falls below accumulation (37.5 vs 38.3 dB), nothing to assert there.
   const int size = 96;
   const std::uint32_t frames = 32, ref_frames = 256;
-#endif
   const renderer::Scene scene = renderer::load_scene("cornell");
   renderer::GpuScene gs(ctx(), scene);
   const core::DisplayPreset display = fovea::test::display_of_size(size, size);
