@@ -161,14 +161,13 @@ TEST_F(Bmfr, MaskedAndNearlyEmptyBlocksStayFinite) {
 }
 
 // Static Cornell box, 32 frames on a Cartesian grid (PSNR against a 256-frame mean of the
-// same grid). The issue asks for >= 10 dB over the 1-spp input (met: ~11 dB) and >= 2 dB over
-// accumulation alone. At 96×96 a block covers a ninth of the box and the fit's bias limits
-// BMFR to +1.3 dB (+4.1 dB at 128×128, where the test would take ~20 s): this asserts the
-// measured margin, >= 1 dB (analysis in docs/results.md).
+// same grid): >= 10 dB over the 1-spp input and >= 2 dB over accumulation alone. BMFR's
+// 32×32 blocks need a raster several blocks wide to resolve the box: at 96×96 a block
+// covers a ninth of it and BMFR gains only +1.3 dB over accumulation, at 128×128 +4.1 dB,
+// at 192×192 +7.3 dB (docs/results.md); the paper's blocks are ~1/900 of a 720p frame.
 TEST_F(Bmfr, CornellAfter32FramesBeatsInputAndAccumulation) {
-  // Also in the sanitized build: the time is lavapipe's (not instrumented), and at 64×64
-  // (2×2 blocks) BMFR falls below accumulation (37.5 vs 38.3 dB), nothing to assert there.
-  const int size = 96;
+  // Also in the sanitized build: the time is lavapipe's (not instrumented).
+  const int size = 128;
   const std::uint32_t frames = 32, ref_frames = 256;
   const renderer::Scene scene = renderer::load_scene("cornell");
   renderer::GpuScene gs(ctx(), scene);
@@ -203,5 +202,5 @@ TEST_F(Bmfr, CornellAfter32FramesBeatsInputAndAccumulation) {
   std::printf("Cornell %dx%d after %u frames: 1 spp %.2f dB, accumulation %.2f dB, BMFR %.2f dB\n", size, size,
               frames, p_input, p_accum, p_bmfr);
   EXPECT_GE(p_bmfr, p_input + 10.0);
-  EXPECT_GE(p_bmfr, p_accum + 1.0);
+  EXPECT_GE(p_bmfr, p_accum + 2.0);
 }
