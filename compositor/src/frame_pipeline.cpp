@@ -45,7 +45,7 @@ gpu::Buffer storage(gpu::Context& ctx, VkDeviceSize bytes, const char* name,
 struct Kernels {
   gpu::ComputePipeline accumulate, share, post, taa, mip, resolve, blur, depth;
   BmfrFit fit;
-  explicit Kernels(gpu::Context& ctx)
+  Kernels(gpu::Context& ctx, BmfrPrecision precision)
       : accumulate(make_pipeline(ctx, "recon_accumulate.comp.spv", 18, sizeof(shaders::ReconAccumulatePush))),
         share(make_pipeline(ctx, "recon_share.comp.spv", 11, sizeof(shaders::ReconSharePush))),
         post(make_pipeline(ctx, "recon_post.comp.spv", 7, sizeof(shaders::ReconPostPush))),
@@ -54,7 +54,7 @@ struct Kernels {
         resolve(make_pipeline(ctx, "recon_resolve.comp.spv", 5, sizeof(shaders::ReconResolvePush))),
         blur(make_pipeline(ctx, "recon_blur.comp.spv", 4, sizeof(shaders::ReconBlurPush))),
         depth(make_pipeline(ctx, "recon_depth.comp.spv", 4, sizeof(shaders::ReconResolvePush))),
-        fit(ctx) {}
+        fit(ctx, {.precision = precision}) {}
 };
 
 }  // namespace
@@ -98,7 +98,7 @@ struct FramePipeline::Impl {
   int parity = 0;                 // history buffers written by the last frame
 
   Impl(gpu::Context& c, const renderer::GpuScene& scene, const renderer::PathConfig& p, const ReconSettings& s)
-      : ctx(c), settings(s), path(p), k(c), tracer(c, scene), timer(c) {}
+      : ctx(c), settings(s), path(p), k(c, s.bmfr_precision), tracer(c, scene), timer(c) {}
 
   void write_maps(EyeState& e, const EyeState* other) {
     ReconGrid m[3] = {recon_grid(*e.dist, e.pose, 0), e.prev, ReconGrid{}};

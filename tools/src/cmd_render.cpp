@@ -52,6 +52,7 @@ temporal_error (always). With no options: a short demo on the shipped scene and 
                         log-polar [visual-polar]
   --budget B            grid samples as a fraction of display pixels [0.39]
   --denoiser D          bmfr | none (accumulation only) [bmfr]
+  --bmfr-precision P    fp32 | fp16: storage of BMFR's regression matrix [fp32]
   --stereo-share M      off | gather | alternate [off]
   --no-blur             skip the peripheral blur
   --reference SPP       converged reference of the last frame with SPP samples per pixel
@@ -126,7 +127,7 @@ int run(std::vector<std::string> argv) {
       return 0;
     }
   const Args args(argv,
-                  {"scene", "display", "gaze", "frames", "distribution", "budget", "denoiser", "stereo-share",
+                  {"scene", "display", "gaze", "frames", "distribution", "budget", "denoiser", "bmfr-precision", "stereo-share",
                    "reference", "png-every", "out"},
                   {"no-blur", "no-marker", "quiet"});
   const long frames = args.integer("frames", 24);
@@ -143,6 +144,10 @@ int run(std::vector<std::string> argv) {
   compositor::ReconSettings settings;
   settings.denoiser = compositor::parse_denoiser(args.str("denoiser", "bmfr"));
   settings.share = compositor::parse_stereo_share(args.str("stereo-share", "off"));
+  const std::string precision = args.str("bmfr-precision", "fp32");
+  if (precision != "fp32" && precision != "fp16")
+    throw core::InputError("--bmfr-precision: expected fp32 or fp16, got \"" + precision + "\"");
+  settings.bmfr_precision = precision == "fp16" ? compositor::BmfrPrecision::Fp16 : compositor::BmfrPrecision::Fp32;
   settings.blur = !args.has("no-blur");
   const fs::path out_dir(args.str("out", "out/render"));
 
@@ -233,6 +238,7 @@ int run(std::vector<std::string> argv) {
                  {"budget", dp.budget},
                  {"grid", {pipeline.distribution(core::Eye::Left).columns(), pipeline.distribution(core::Eye::Left).rows()}},
                  {"denoiser", compositor::denoiser_name(settings.denoiser)},
+                 {"bmfr_precision", precision},
                  {"stereo_share", compositor::stereo_share_name(settings.share)},
                  {"blur", settings.blur}};
   j["gpu_ms"] = {{"trace", median(t_trace)},

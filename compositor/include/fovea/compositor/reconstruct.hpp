@@ -4,6 +4,7 @@
 #include <cstdint>
 #include <string_view>
 
+#include "fovea/compositor/bmfr.hpp"
 #include "fovea/core/distribution.hpp"
 #include "fovea/core/view.hpp"
 #include "fovea/shaders/recon_grid.h"
@@ -27,6 +28,7 @@ constexpr double kBlurSigmaDegAt30 = 0.544;
 
 struct ReconSettings {
   Denoiser denoiser = Denoiser::Bmfr;
+  BmfrPrecision bmfr_precision = BmfrPrecision::Fp32;  // storage of BMFR's regression matrix
   StereoShare share = StereoShare::Off;
   float alpha_min = 0.2f;        // BMFR Phase I EMA floor
   float post_alpha_min = 0.1f;   // BMFR Phase III EMA floor
