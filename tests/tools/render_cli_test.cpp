@@ -1,0 +1,68 @@
+// `fovea render`: the main job end to end on the tiny display — report.json with the
+// issue's fields (finite), per-frame PNGs and the last frame's EXRs; bad input -> exit 2.
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+
+#include <gtest/gtest.h>
+#include <nlohmann/json.hpp>
+
+#include "cli.hpp"
+
+using fovea::test::run_fovea;
+
+namespace {
+
+void expect_finite_numbers(const nlohmann::json& j, const std::string& where) {
+  if (j.is_number()) {
+    EXPECT_TRUE(std::isfinite(j.get<double>())) << where;
+  } else if (j.is_object()) {
+    for (auto it = j.begin(); it != j.end(); ++it) expect_finite_numbers(it.value(), where + "." + it.key());
+  } else if (j.is_array()) {
+    for (size_t i = 0; i < j.size(); ++i) expect_finite_numbers(j[i], where + "[" + std::to_string(i) + "]");
+  }
+}
+
+TEST(RenderCli, ReportFramesAndExrOnTheTinyDisplay) {
+  namespace fs = std::filesystem;
+  const std::string dir = fovea::test::temp_dir("render");
+  const auto r = run_fovea("render --display tiny --scene cornell --gaze synthetic:3 --frames 3 --reference 4 "
+                           "--stereo-share gather --quiet --out " + dir);
+  ASSERT_EQ(r.status, 0) << r.err;
+  EXPECT_EQ(r.err.find("VUID"), std::string::npos) << "validation messages:\n" << r.err;
+  std::ifstream in(dir + "/report.json");
+  const auto j = nlohmann::json::parse(in);
+  EXPECT_EQ(j["frames"], 3);
+  EXPECT_GT(j["samples_traced_per_eye"].get<double>(), 0);
+  EXPECT_LT(j["samples_traced_per_eye"].get<double>(), 64 * 72);  // foveated: fewer than the pixels
+  for (const char* k : {"trace", "reconstruct", "resolve", "total"}) EXPECT_TRUE(j["gpu_ms"].contains(k)) << k;
+  for (const char* eye : {"left", "right"}) {
+    const auto& s = j["summary"][eye];
+    for (const char* k : {"psnr", "fovea_psnr", "foveated_psnr", "ssim", "temporal_error", "band_psnr"})
+      EXPECT_TRUE(s.contains(k)) << eye << "." << k;
+    EXPECT_TRUE(s["band_psnr"].is_array());
+    EXPECT_GT(s["band_psnr"].size(), 3u);
+  }
+  expect_finite_numbers(j, "report");
+  for (const char* f : {"frame_0002_left.png", "frame_0002_right.png", "frame_0002_sbs.png", "last_left.exr",
+                        "last_right.exr"})
+    EXPECT_TRUE(fs::exists(dir + "/" + f)) << f;
+  for (const auto& e : fs::directory_iterator(dir))
+    EXPECT_EQ(e.path().string().find(".tmp"), std::string::npos) << "temporary file left: " << e.path();
+  fs::remove_all(dir);
+}
+
+TEST(RenderCli, BadInputExitsWithTwo) {
+  const std::string dir = fovea::test::temp_dir("render-bad");
+  for (const char* args : {"render --frames 0", "render --frames x", "render --distribution bogus",
+                           "render --denoiser magic", "render --stereo-share both", "render --bmfr-precision fp8",
+                           "render --scene /nonexistent/scene.gltf", "render --display nonexistent",
+                           "render --gaze /nonexistent/gaze.csv", "render --budget 0"}) {
+    const auto r = run_fovea(std::string(args) + " --quiet --out " + dir);
+    EXPECT_EQ(r.status, 2) << args << "\n" << r.err;
+    EXPECT_FALSE(r.err.empty()) << args;
+  }
+  std::filesystem::remove_all(dir);
+}
+
+}  // namespace
