@@ -1,5 +1,6 @@
 #include "app_device.hpp"
 
+#include <cmath>
 #include <cstring>
 #include <stdexcept>
 #include <string>
@@ -12,7 +13,8 @@ void check(VkResult r, const char* what) {
 }
 
 VkImageMemoryBarrier image_barrier(VkImage image, std::uint32_t layer, VkImageLayout from, VkImageLayout to,
-                                   VkAccessFlags src, VkAccessFlags dst) {
+                                   VkAccessFlags src, VkAccessFlags dst,
+                                   VkImageAspectFlags aspect = VK_IMAGE_ASPECT_COLOR_BIT) {
   VkImageMemoryBarrier b{VK_STRUCTURE_TYPE_IMAGE_MEMORY_BARRIER};
   b.srcAccessMask = src;
   b.dstAccessMask = dst;
@@ -20,11 +22,49 @@ VkImageMemoryBarrier image_barrier(VkImage image, std::uint32_t layer, VkImageLa
   b.newLayout = to;
   b.srcQueueFamilyIndex = b.dstQueueFamilyIndex = VK_QUEUE_FAMILY_IGNORED;
   b.image = image;
-  b.subresourceRange = {VK_IMAGE_ASPECT_COLOR_BIT, 0, 1, layer, 1};
+  b.subresourceRange = {aspect, 0, 1, layer, 1};
   return b;
 }
 
+// Bytes per texel of a depth aspect copied to a buffer (Vulkan's packing for buffer copies:
+// D24 formats as 32-bit words with the depth in the low 24 bits), 0 for other formats.
+std::uint32_t depth_texel_bytes(VkFormat f) {
+  switch (f) {
+    case VK_FORMAT_D16_UNORM: return 2;
+    case VK_FORMAT_X8_D24_UNORM_PACK32:
+    case VK_FORMAT_D24_UNORM_S8_UINT:
+    case VK_FORMAT_D32_SFLOAT:
+    case VK_FORMAT_D32_SFLOAT_S8_UINT: return 4;
+    default: return 0;
+  }
+}
+
+bool has_stencil(VkFormat f) { return f == VK_FORMAT_D24_UNORM_S8_UINT || f == VK_FORMAT_D32_SFLOAT_S8_UINT; }
+
+float decode_depth(const std::uint8_t* p, VkFormat f) {
+  switch (f) {
+    case VK_FORMAT_D16_UNORM: {
+      std::uint16_t v;
+      std::memcpy(&v, p, 2);
+      return float(v) / 65535.0f;
+    }
+    case VK_FORMAT_X8_D24_UNORM_PACK32:
+    case VK_FORMAT_D24_UNORM_S8_UINT: {
+      std::uint32_t v;
+      std::memcpy(&v, p, 4);
+      return float(double(v & 0xffffffu) / 16777215.0);
+    }
+    default: {
+      float v;
+      std::memcpy(&v, p, 4);
+      return std::isfinite(v) ? v : 1.0f;  // a garbage texel counts as the far plane
+    }
+  }
+}
+
 }  // namespace
+
+bool depth_format_supported(VkFormat f) { return depth_texel_bytes(f) != 0; }
 
 // The application's device functions come from the Vulkan loader the layer links (through
 // fovea_gpu), the same loader instance the application uses.
@@ -170,6 +210,62 @@ std::vector<Pixels8> AppDevice::read(const std::vector<Read>& reads) {
     p.data.resize(std::size_t(p.width) * std::size_t(p.height) * 4);
     std::memcpy(p.data.data(), static_cast<const std::uint8_t*>(download_.mapped) + offsets[i], p.data.size());
     out.push_back(std::move(p));
+  }
+  return out;
+}
+
+std::vector<std::vector<float>> AppDevice::read_depth(const std::vector<AppDepth>& reads) {
+  VkDeviceSize total = 0;
+  std::vector<VkDeviceSize> offsets;
+  for (const AppDepth& r : reads) {
+    if (r.rect.extent.width <= 0 || r.rect.extent.height <= 0 || r.rect.offset.x < 0 || r.rect.offset.y < 0)
+      throw std::runtime_error("a submitted depth imageRect is empty or negative");
+    if (!depth_format_supported(r.format))
+      throw std::runtime_error("depth swapchain format " + std::to_string(int(r.format)) + " has no decoding");
+    offsets.push_back(total);
+    // Offsets stay multiples of 4 (buffer copies of depth aspects require it).
+    total += (VkDeviceSize(r.rect.extent.width) * VkDeviceSize(r.rect.extent.height) * depth_texel_bytes(r.format) + 3) &
+             ~VkDeviceSize(3);
+  }
+  reserve(download_, total, VK_BUFFER_USAGE_TRANSFER_DST_BIT);
+  submit([&](VkCommandBuffer cb) {
+    for (std::size_t i = 0; i < reads.size(); ++i) {
+      const AppDepth& r = reads[i];
+      // Layout transitions cover every aspect of a combined depth/stencil image.
+      const VkImageAspectFlags aspects =
+          VK_IMAGE_ASPECT_DEPTH_BIT | (has_stencil(r.format) ? VK_IMAGE_ASPECT_STENCIL_BIT : 0);
+      auto to_src = image_barrier(r.image, r.array_index, VK_IMAGE_LAYOUT_DEPTH_STENCIL_ATTACHMENT_OPTIMAL,
+                                  VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL,
+                                  VK_ACCESS_DEPTH_STENCIL_ATTACHMENT_WRITE_BIT | VK_ACCESS_TRANSFER_WRITE_BIT,
+                                  VK_ACCESS_TRANSFER_READ_BIT, aspects);
+      vkCmdPipelineBarrier_(cb, VK_PIPELINE_STAGE_ALL_COMMANDS_BIT, VK_PIPELINE_STAGE_TRANSFER_BIT, 0, 0, nullptr, 0,
+                            nullptr, 1, &to_src);
+      VkBufferImageCopy c{};
+      c.bufferOffset = offsets[i];
+      c.imageSubresource = {VK_IMAGE_ASPECT_DEPTH_BIT, 0, r.array_index, 1};
+      c.imageOffset = {r.rect.offset.x, r.rect.offset.y, 0};
+      c.imageExtent = {std::uint32_t(r.rect.extent.width), std::uint32_t(r.rect.extent.height), 1};
+      vkCmdCopyImageToBuffer_(cb, r.image, VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL, download_.buffer, 1, &c);
+      auto back = image_barrier(r.image, r.array_index, VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL,
+                                VK_IMAGE_LAYOUT_DEPTH_STENCIL_ATTACHMENT_OPTIMAL, 0, 0, aspects);
+      vkCmdPipelineBarrier_(cb, VK_PIPELINE_STAGE_TRANSFER_BIT, VK_PIPELINE_STAGE_ALL_COMMANDS_BIT, 0, 0, nullptr, 0,
+                            nullptr, 1, &back);
+    }
+    VkMemoryBarrier host{VK_STRUCTURE_TYPE_MEMORY_BARRIER};
+    host.srcAccessMask = VK_ACCESS_TRANSFER_WRITE_BIT;
+    host.dstAccessMask = VK_ACCESS_HOST_READ_BIT;
+    vkCmdPipelineBarrier_(cb, VK_PIPELINE_STAGE_TRANSFER_BIT, VK_PIPELINE_STAGE_HOST_BIT, 0, 1, &host, 0, nullptr, 0,
+                          nullptr);
+  });
+  std::vector<std::vector<float>> out;
+  for (std::size_t i = 0; i < reads.size(); ++i) {
+    const AppDepth& r = reads[i];
+    const std::size_t n = std::size_t(r.rect.extent.width) * std::size_t(r.rect.extent.height);
+    const std::uint32_t bytes = depth_texel_bytes(r.format);
+    const auto* src = static_cast<const std::uint8_t*>(download_.mapped) + offsets[i];
+    std::vector<float> d(n);
+    for (std::size_t k = 0; k < n; ++k) d[k] = decode_depth(src + k * bytes, r.format);
+    out.push_back(std::move(d));
   }
   return out;
 }

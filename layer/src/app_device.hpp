@@ -15,6 +15,9 @@
 
 namespace fovea::layer {
 
+// D16_UNORM, X8_D24_UNORM_PACK32, D24_UNORM_S8_UINT, D32_SFLOAT, D32_SFLOAT_S8_UINT.
+bool depth_format_supported(VkFormat f);
+
 class AppDevice {
  public:
   explicit AppDevice(const VulkanBinding& vk);  // throws std::runtime_error
@@ -29,6 +32,10 @@ class AppDevice {
   };
   // Reads 4-byte texels of each image's rect (images in COLOR_ATTACHMENT_OPTIMAL, left so).
   std::vector<Pixels8> read(const std::vector<Read>& reads);
+  // Reads the depth aspect of each depth image's rect (images in
+  // DEPTH_STENCIL_ATTACHMENT_OPTIMAL, left so) as window depths in [0, 1], row-major.
+  // Throws std::runtime_error for a format without a decoding (depth_format_supported).
+  std::vector<std::vector<float>> read_depth(const std::vector<AppDepth>& reads);
   // Overwrites each whole image (array layer 0) with `pixels` (same size); the images end in
   // COLOR_ATTACHMENT_OPTIMAL.
   void write(const std::vector<VkImage>& images, const std::vector<const Pixels8*>& pixels);

@@ -28,27 +28,50 @@ void bookkeeping(XrSession session, F&& f) {
 // is a projection view on a swapchain of this session with a released image, its rect inside
 // the image and its array layer present. Otherwise nothing: the application's frame goes down
 // unchanged and the runtime reports the application's error, while the layer stays enabled.
+// A released image of a swapchain of `session` whose rect and array layer lie inside it.
+const SwapchainState* usable_sub_image(XrSession session, const XrSwapchainSubImage& sub) {
+  const auto sc = layer().swapchains.find(sub.swapchain);
+  if (sc == layer().swapchains.end() || sc->second.session != session) return nullptr;
+  const SwapchainState& st = sc->second;
+  const XrRect2Di& r = sub.imageRect;
+  if (st.last_released < 0 || std::size_t(st.last_released) >= st.images.size() || r.offset.x < 0 ||
+      r.offset.y < 0 || r.extent.width <= 0 || r.extent.height <= 0 ||
+      std::int64_t(r.offset.x) + r.extent.width > std::int64_t(st.info.width) ||
+      std::int64_t(r.offset.y) + r.extent.height > std::int64_t(st.info.height) ||
+      sub.imageArrayIndex >= st.info.arraySize)
+    return nullptr;
+  return &st;
+}
+
+// The views of an application's stereo projection layer, if the layer can replace it: each
+// is a projection view on a swapchain of this session with a released image, its rect inside
+// the image and its array layer present, and so is the depth it may chain (with a range
+// view_distance accepts). Otherwise nothing: the application's frame goes down unchanged and
+// the runtime reports the application's error, while the layer stays enabled.
 std::vector<AppView> replaceable_views(XrSession session, const XrCompositionLayerProjection& p) {
   std::vector<AppView> views;
   if (p.viewCount != 2 || !p.views) return views;
   for (uint32_t v = 0; v < p.viewCount; ++v) {
     const XrCompositionLayerProjectionView& pv = p.views[v];
     if (pv.type != XR_TYPE_COMPOSITION_LAYER_PROJECTION_VIEW) return {};
-    const auto sc = layer().swapchains.find(pv.subImage.swapchain);
-    if (sc == layer().swapchains.end() || sc->second.session != session) return {};
-    const SwapchainState& st = sc->second;
-    const XrRect2Di& r = pv.subImage.imageRect;
-    if (st.last_released < 0 || std::size_t(st.last_released) >= st.images.size() || r.offset.x < 0 ||
-        r.offset.y < 0 || r.extent.width <= 0 || r.extent.height <= 0 ||
-        std::int64_t(r.offset.x) + r.extent.width > std::int64_t(st.info.width) ||
-        std::int64_t(r.offset.y) + r.extent.height > std::int64_t(st.info.height) ||
-        pv.subImage.imageArrayIndex >= st.info.arraySize)
-      return {};
-    bool depth = false;
-    for (auto* n = static_cast<const XrBaseInStructure*>(pv.next); n; n = n->next)
-      depth |= n->type == XR_TYPE_COMPOSITION_LAYER_DEPTH_INFO_KHR;
-    views.push_back({st.images[std::size_t(st.last_released)], VkFormat(st.info.format), r,
-                     pv.subImage.imageArrayIndex, pv.pose, pv.fov, depth});
+    const SwapchainState* st = usable_sub_image(session, pv.subImage);
+    if (!st) return {};
+    AppView view{st->images[std::size_t(st->last_released)], VkFormat(st->info.format), pv.subImage.imageRect,
+                 pv.subImage.imageArrayIndex, pv.pose, pv.fov, std::nullopt};
+    for (auto* n = static_cast<const XrBaseInStructure*>(pv.next); n; n = n->next) {
+      if (n->type != XR_TYPE_COMPOSITION_LAYER_DEPTH_INFO_KHR) continue;
+      const auto& d = *reinterpret_cast<const XrCompositionLayerDepthInfoKHR*>(n);
+      const SwapchainState* ds = usable_sub_image(session, d.subImage);
+      if (!ds || !(ds->info.usageFlags & XR_SWAPCHAIN_USAGE_DEPTH_STENCIL_ATTACHMENT_BIT)) return {};
+      const DepthRange range{d.minDepth, d.maxDepth, d.nearZ, d.farZ};
+      if (!(d.minDepth >= 0 && d.minDepth < d.maxDepth && d.maxDepth <= 1 && d.nearZ > 0 && d.farZ > 0 &&
+            d.nearZ != d.farZ))
+        return {};
+      view.depth = AppDepth{ds->images[std::size_t(ds->last_released)], VkFormat(ds->info.format),
+                            d.subImage.imageRect, d.subImage.imageArrayIndex, range};
+      break;
+    }
+    views.push_back(view);
   }
   return views;
 }

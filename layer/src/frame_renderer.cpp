@@ -10,6 +10,7 @@
 #include <array>
 #include <chrono>
 #include <cmath>
+#include <cstring>
 #include <stdexcept>
 
 #include <glm/gtc/quaternion.hpp>
@@ -54,6 +55,19 @@ bool live_gaze(const std::string& uri) {
   return false;
 }
 
+// The application's window depths resampled into the scene's raster like its colour:
+// resample moves 4-byte texels by direction, so each float travels as its bytes (pixels the
+// application did not cover read 0, where the colour's alpha 0 already keeps the scene).
+std::vector<float> resample_depth(const std::vector<float>& depth, const core::View& app_view,
+                                  const core::View& scene_view) {
+  Pixels8 packed{app_view.width(), app_view.height(), std::vector<std::uint8_t>(depth.size() * 4)};
+  std::memcpy(packed.data.data(), depth.data(), packed.data.size());
+  const Pixels8 moved = resample(packed, app_view, scene_view);
+  std::vector<float> out(moved.data.size() / 4);
+  std::memcpy(out.data(), moved.data.data(), moved.data.size());
+  return out;
+}
+
 class PathTraceRenderer final : public FrameRenderer {
  public:
   PathTraceRenderer(const LayerConfig& config, const VulkanBinding& vk, const Dispatch& next, XrSession session)
@@ -74,11 +88,6 @@ class PathTraceRenderer final : public FrameRenderer {
     if (in.app_views.size() != 2) return nullptr;  // only stereo projection layers are replaced
     const auto t0 = std::chrono::steady_clock::now();
     if (!pipeline_) start(in);
-    if (!depth_noted_ && (in.app_views[0].has_depth || in.app_views[1].has_depth)) {
-      FOVEA_LAYER_WARN("the application submits depth; depth compositing is not implemented, compositing %s",
-                       composite_name(config_.composite));
-      depth_noted_ = true;
-    }
     const XrRect2Di& r0 = in.app_views[0].rect;
     for (const AppView& v : in.app_views)
       if (v.rect.extent.width != r0.extent.width || v.rect.extent.height != r0.extent.height || v.format != format_)
@@ -117,6 +126,7 @@ class PathTraceRenderer final : public FrameRenderer {
     std::vector<AppDevice::Read> reads;
     for (const AppView& v : in.app_views) reads.push_back({v.image, v.array_index, v.rect});
     const std::vector<Pixels8> app = config_.composite == Composite::SceneOnly ? std::vector<Pixels8>{} : app_.read(reads);
+    const std::vector<std::vector<float>> app_depth = app.empty() ? std::vector<std::vector<float>>{} : read_depth(in);
     std::array<Pixels8, 2> out;
     std::vector<VkImage> targets;
     for (int e = 0; e < 2; ++e) {
@@ -124,13 +134,19 @@ class PathTraceRenderer final : public FrameRenderer {
       out[ei] = encode_scene(pipeline_->image(core::Eye(e)), pixel_format(format_));
       if (!app.empty()) {
         const core::View app_view(to_fov(in.app_views[ei].fov), app[ei].width, app[ei].height);
-        const Pixels8 a = resample(app[ei], app_view, display_.view(core::Eye(e)));
-        const auto bg = config_.app_background
-                            ? std::array<std::uint8_t, 3>{std::uint8_t((*config_.app_background)[0]),
-                                                          std::uint8_t((*config_.app_background)[1]),
-                                                          std::uint8_t((*config_.app_background)[2])}
-                            : border_colour(app[ei]);
-        composite(out[ei], a, config_.composite, bg);
+        const core::View scene_view = display_.view(core::Eye(e));
+        const Pixels8 a = resample(app[ei], app_view, scene_view);
+        if (!app_depth.empty()) {
+          composite_depth(out[ei], pipeline_->depth(core::Eye(e)), a,
+                          resample_depth(app_depth[ei], app_view, scene_view), in.app_views[ei].depth->range);
+        } else {
+          const auto bg = config_.app_background
+                              ? std::array<std::uint8_t, 3>{std::uint8_t((*config_.app_background)[0]),
+                                                            std::uint8_t((*config_.app_background)[1]),
+                                                            std::uint8_t((*config_.app_background)[2])}
+                              : border_colour(app[ei]);
+          composite(out[ei], a, config_.composite, bg);
+        }
       }
       Eye& eye = eyes_[ei];
       std::uint32_t index = 0;
@@ -172,6 +188,33 @@ class PathTraceRenderer final : public FrameRenderer {
     XrSwapchain swapchain = XR_NULL_HANDLE;
     std::vector<VkImage> images;
   };
+
+  // The application's window depths of both views, when it chained depth to both and the layer
+  // can use it (a format it decodes, the colour rect's size); else nothing and the configured
+  // mode composites. The decision is logged once.
+  std::vector<std::vector<float>> read_depth(const FrameInput& in) {
+    const AppView &l = in.app_views[0], &r = in.app_views[1];
+    if (!l.depth && !r.depth) return {};
+    std::string why;
+    if (!l.depth || !r.depth) why = "depth is chained to one view only";
+    for (std::size_t i = 0; i < 2 && why.empty(); ++i) {
+      const AppView& v = in.app_views[i];
+      if (!depth_format_supported(v.depth->format))
+        why = "depth format " + std::to_string(int(v.depth->format)) + " is not decoded";
+      else if (v.depth->rect.extent.width != v.rect.extent.width || v.depth->rect.extent.height != v.rect.extent.height)
+        why = "the depth imageRect differs in size from the colour imageRect";
+    }
+    if (!depth_noted_) {
+      if (why.empty())
+        FOVEA_LAYER_INFO("the application submits depth: compositing by depth");
+      else
+        FOVEA_LAYER_WARN("the application submits depth but %s: compositing %s", why.c_str(),
+                         composite_name(config_.composite));
+      depth_noted_ = true;
+    }
+    if (!why.empty()) return {};
+    return app_.read_depth({*l.depth, *r.depth});
+  }
 
   // At the first stereo frame: the pipeline for the application's views, the layer's
   // swapchains in the application's format, the gaze source.
@@ -231,7 +274,7 @@ class PathTraceRenderer final : public FrameRenderer {
   std::unique_ptr<devices::GazeSource> gaze_source_;
   bool live_ = false;
   bool gaze_from_action_ = false;
-  bool depth_noted_ = false;
+  bool depth_noted_ = false;  // the depth decision was logged
   XrTime epoch_ = 0;
   std::array<GazeHold, 2> hold_;
   std::unique_ptr<gpu::Context> ctx_;

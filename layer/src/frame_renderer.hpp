@@ -16,6 +16,7 @@
 #include <openxr/openxr.h>
 #include <openxr/openxr_platform.h>
 
+#include "composite.hpp"
 #include "config.hpp"
 
 namespace fovea::layer {
@@ -31,6 +32,16 @@ struct VulkanBinding {
   bool valid() const { return device != VK_NULL_HANDLE; }
 };
 
+// The depth an application chained to a projection view (XrCompositionLayerDepthInfoKHR):
+// the depth swapchain's last released image (DEPTH_STENCIL_ATTACHMENT_OPTIMAL) and its range.
+struct AppDepth {
+  VkImage image = VK_NULL_HANDLE;
+  VkFormat format = VK_FORMAT_UNDEFINED;
+  XrRect2Di rect{};
+  std::uint32_t array_index = 0;
+  DepthRange range;
+};
+
 // One projection view the application submitted: its last released swapchain image
 // (COLOR_ATTACHMENT_OPTIMAL, owned by the session queue), for compositing over it.
 struct AppView {
@@ -40,7 +51,7 @@ struct AppView {
   std::uint32_t array_index = 0;
   XrPosef pose{};
   XrFovf fov{};
-  bool has_depth = false;  // an XrCompositionLayerDepthInfoKHR was chained
+  std::optional<AppDepth> depth;  // an XrCompositionLayerDepthInfoKHR was chained
 };
 
 struct FrameInput {
