@@ -46,7 +46,7 @@ const SwapchainState* usable_sub_image(XrSession session, const XrSwapchainSubIm
 // The views of an application's stereo projection layer, if the layer can replace it: each
 // is a projection view on a swapchain of this session with a released image, its rect inside
 // the image and its array layer present, and so is the depth it may chain (with a range
-// view_distance accepts). Otherwise nothing: the application's frame goes down unchanged and
+// the specification allows). Otherwise nothing: the application's frame goes down unchanged and
 // the runtime reports the application's error, while the layer stays enabled.
 std::vector<AppView> replaceable_views(XrSession session, const XrCompositionLayerProjection& p) {
   std::vector<AppView> views;
@@ -63,10 +63,12 @@ std::vector<AppView> replaceable_views(XrSession session, const XrCompositionLay
       const auto& d = *reinterpret_cast<const XrCompositionLayerDepthInfoKHR*>(n);
       const SwapchainState* ds = usable_sub_image(session, d.subImage);
       if (!ds || !(ds->info.usageFlags & XR_SWAPCHAIN_USAGE_DEPTH_STENCIL_ATTACHMENT_BIT)) return {};
-      const DepthRange range{d.minDepth, d.maxDepth, d.nearZ, d.farZ};
-      if (!(d.minDepth >= 0 && d.minDepth < d.maxDepth && d.maxDepth <= 1 && d.nearZ > 0 && d.farZ > 0 &&
+      if (!(d.minDepth >= 0 && d.minDepth <= d.maxDepth && d.maxDepth <= 1 && d.nearZ > 0 && d.farZ > 0 &&
             d.nearZ != d.farZ))
         return {};
+      // An empty depth range is valid but says nothing: the configured mode composites.
+      if (d.minDepth == d.maxDepth) break;
+      const DepthRange range{d.minDepth, d.maxDepth, d.nearZ, d.farZ};
       view.depth = AppDepth{ds->images[std::size_t(ds->last_released)], VkFormat(ds->info.format),
                             d.subImage.imageRect, d.subImage.imageArrayIndex, range};
       break;
