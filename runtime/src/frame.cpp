@@ -61,8 +61,10 @@ XrResult check_projection(const Session* s, const XrCompositionLayerProjection& 
         Swapchain* dsc = nullptr;
         if (XrResult r = check_sub_image(s, d->subImage, &dsc); r != XR_SUCCESS) return r;
         if (!dsc->is_depth()) return XR_ERROR_VALIDATION_FAILURE;
-        if (!(d->minDepth >= 0 && d->minDepth <= d->maxDepth && d->maxDepth <= 1) || !std::isfinite(d->nearZ) ||
-            !std::isfinite(d->farZ) || d->nearZ == d->farZ)
+        // nearZ, farZ in (0, +infinity] and not equal: an infinite plane is allowed (the
+        // extension's valid usage); NaN fails every comparison below.
+        if (!(d->minDepth >= 0 && d->minDepth <= d->maxDepth && d->maxDepth <= 1) || !(d->nearZ > 0) ||
+            !(d->farZ > 0) || d->nearZ == d->farZ)
           return XR_ERROR_VALIDATION_FAILURE;
       }
     }

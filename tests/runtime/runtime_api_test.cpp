@@ -3,6 +3,7 @@
 // state machine; spaces, swapchains, frames, eye gaze and visibility masks.
 #include <cmath>
 #include <cstring>
+#include <limits>
 
 #include <fstream>
 
@@ -425,6 +426,19 @@ TEST_F(XrTest, CompositionLayerDepthAccepted) {
   di[1].minDepth = 0;
   di[1].maxDepth = 1;
   di[1].subImage.swapchain = color;  // a colour swapchain as depth
+  EXPECT_EQ(frame(layers), XR_ERROR_VALIDATION_FAILURE);
+  di[1].subImage.swapchain = depth;
+  // nearZ, farZ in (0, +infinity], not equal: infinite planes (also reversed) are valid.
+  di[1].farZ = std::numeric_limits<float>::infinity();
+  EXPECT_EQ(frame(layers), XR_SUCCESS);
+  di[1].nearZ = std::numeric_limits<float>::infinity();
+  di[1].farZ = 0.1f;
+  EXPECT_EQ(frame(layers), XR_SUCCESS);
+  for (float bad_z : {0.0f, -1.0f, std::numeric_limits<float>::quiet_NaN(), -std::numeric_limits<float>::infinity()}) {
+    di[1].nearZ = bad_z;
+    EXPECT_EQ(frame(layers), XR_ERROR_VALIDATION_FAILURE) << bad_z;
+  }
+  di[1].nearZ = di[1].farZ = 1.0f;
   EXPECT_EQ(frame(layers), XR_ERROR_VALIDATION_FAILURE);
   // A colour format with depth usage is refused at creation.
   ci.format = VK_FORMAT_R8G8B8A8_SRGB;
