@@ -21,7 +21,7 @@ TEST(Acuity, CdfIsIntegralOfRadialPdf) {
     const double num = (a::h(x + dx) - a::h(x - dx)) / (2 * dx);
     EXPECT_NEAR(num, 2 * std::numbers::pi * x * a::m(x), 1e-5 * num) << x;
   }
-  EXPECT_NEAR(a::h(80.0), 1091.8, 0.5);  // the normaliser quoted in the notes
+  EXPECT_NEAR(a::h(80.0), 1091.8, 0.5);  // G(80), the normaliser of the truncated CDF
 }
 
 TEST(Acuity, ExactInverseRoundTrips) {
