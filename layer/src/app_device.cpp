@@ -180,29 +180,11 @@ std::vector<Pixels8> AppDevice::read(const std::vector<Read>& reads) {
   submit([&](VkCommandBuffer cb) {
     for (std::size_t i = 0; i < reads.size(); ++i) {
       const Read& r = reads[i];
-      // After the application's rendering (earlier submissions on this queue).
-      auto to_src = image_barrier(r.image, r.array_layer, VK_IMAGE_LAYOUT_COLOR_ATTACHMENT_OPTIMAL,
-                                  VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL,
-                                  VK_ACCESS_COLOR_ATTACHMENT_WRITE_BIT | VK_ACCESS_SHADER_WRITE_BIT | VK_ACCESS_TRANSFER_WRITE_BIT,
-                                  VK_ACCESS_TRANSFER_READ_BIT);
-      vkCmdPipelineBarrier_(cb, VK_PIPELINE_STAGE_ALL_COMMANDS_BIT, VK_PIPELINE_STAGE_TRANSFER_BIT, 0, 0, nullptr, 0,
-                            nullptr, 1, &to_src);
-      VkBufferImageCopy c{};
-      c.bufferOffset = offsets[i];
-      c.imageSubresource = {VK_IMAGE_ASPECT_COLOR_BIT, 0, r.array_layer, 1};
-      c.imageOffset = {r.rect.offset.x, r.rect.offset.y, 0};
-      c.imageExtent = {std::uint32_t(r.rect.extent.width), std::uint32_t(r.rect.extent.height), 1};
-      vkCmdCopyImageToBuffer_(cb, r.image, VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL, download_.buffer, 1, &c);
-      auto back = image_barrier(r.image, r.array_layer, VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL,
-                                VK_IMAGE_LAYOUT_COLOR_ATTACHMENT_OPTIMAL, 0, 0);
-      vkCmdPipelineBarrier_(cb, VK_PIPELINE_STAGE_TRANSFER_BIT, VK_PIPELINE_STAGE_ALL_COMMANDS_BIT, 0, 0, nullptr, 0,
-                            nullptr, 1, &back);
+      record_download(cb, {r.image, r.array_layer, VK_IMAGE_LAYOUT_COLOR_ATTACHMENT_OPTIMAL,
+                           VK_ACCESS_COLOR_ATTACHMENT_WRITE_BIT | VK_ACCESS_SHADER_WRITE_BIT | VK_ACCESS_TRANSFER_WRITE_BIT,
+                           VK_IMAGE_ASPECT_COLOR_BIT, VK_IMAGE_ASPECT_COLOR_BIT, r.rect, offsets[i]});
     }
-    VkMemoryBarrier host{VK_STRUCTURE_TYPE_MEMORY_BARRIER};
-    host.srcAccessMask = VK_ACCESS_TRANSFER_WRITE_BIT;
-    host.dstAccessMask = VK_ACCESS_HOST_READ_BIT;
-    vkCmdPipelineBarrier_(cb, VK_PIPELINE_STAGE_TRANSFER_BIT, VK_PIPELINE_STAGE_HOST_BIT, 0, 1, &host, 0, nullptr, 0,
-                          nullptr);
+    record_host_read_barrier(cb);
   });
   std::vector<Pixels8> out;
   for (std::size_t i = 0; i < reads.size(); ++i) {
@@ -212,6 +194,32 @@ std::vector<Pixels8> AppDevice::read(const std::vector<Read>& reads) {
     out.push_back(std::move(p));
   }
   return out;
+}
+
+void AppDevice::record_download(VkCommandBuffer cb, const Download& d) {
+  // After the application's rendering (earlier submissions on this queue).
+  auto to_src = image_barrier(d.image, d.array_layer, d.attachment_layout, VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL,
+                              d.attachment_writes, VK_ACCESS_TRANSFER_READ_BIT, d.aspects);
+  vkCmdPipelineBarrier_(cb, VK_PIPELINE_STAGE_ALL_COMMANDS_BIT, VK_PIPELINE_STAGE_TRANSFER_BIT, 0, 0, nullptr, 0, nullptr,
+                        1, &to_src);
+  VkBufferImageCopy c{};
+  c.bufferOffset = d.offset;
+  c.imageSubresource = {d.copy_aspect, 0, d.array_layer, 1};
+  c.imageOffset = {d.rect.offset.x, d.rect.offset.y, 0};
+  c.imageExtent = {std::uint32_t(d.rect.extent.width), std::uint32_t(d.rect.extent.height), 1};
+  vkCmdCopyImageToBuffer_(cb, d.image, VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL, download_.buffer, 1, &c);
+  auto back = image_barrier(d.image, d.array_layer, VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL, d.attachment_layout, 0, 0,
+                            d.aspects);
+  vkCmdPipelineBarrier_(cb, VK_PIPELINE_STAGE_TRANSFER_BIT, VK_PIPELINE_STAGE_ALL_COMMANDS_BIT, 0, 0, nullptr, 0, nullptr,
+                        1, &back);
+}
+
+void AppDevice::record_host_read_barrier(VkCommandBuffer cb) {
+  VkMemoryBarrier host{VK_STRUCTURE_TYPE_MEMORY_BARRIER};
+  host.srcAccessMask = VK_ACCESS_TRANSFER_WRITE_BIT;
+  host.dstAccessMask = VK_ACCESS_HOST_READ_BIT;
+  vkCmdPipelineBarrier_(cb, VK_PIPELINE_STAGE_TRANSFER_BIT, VK_PIPELINE_STAGE_HOST_BIT, 0, 1, &host, 0, nullptr, 0,
+                        nullptr);
 }
 
 std::vector<std::vector<float>> AppDevice::read_depth(const std::vector<AppDepth>& reads) {
@@ -234,28 +242,11 @@ std::vector<std::vector<float>> AppDevice::read_depth(const std::vector<AppDepth
       // Layout transitions cover every aspect of a combined depth/stencil image.
       const VkImageAspectFlags aspects =
           VK_IMAGE_ASPECT_DEPTH_BIT | (has_stencil(r.format) ? VK_IMAGE_ASPECT_STENCIL_BIT : 0);
-      auto to_src = image_barrier(r.image, r.array_index, VK_IMAGE_LAYOUT_DEPTH_STENCIL_ATTACHMENT_OPTIMAL,
-                                  VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL,
-                                  VK_ACCESS_DEPTH_STENCIL_ATTACHMENT_WRITE_BIT | VK_ACCESS_TRANSFER_WRITE_BIT,
-                                  VK_ACCESS_TRANSFER_READ_BIT, aspects);
-      vkCmdPipelineBarrier_(cb, VK_PIPELINE_STAGE_ALL_COMMANDS_BIT, VK_PIPELINE_STAGE_TRANSFER_BIT, 0, 0, nullptr, 0,
-                            nullptr, 1, &to_src);
-      VkBufferImageCopy c{};
-      c.bufferOffset = offsets[i];
-      c.imageSubresource = {VK_IMAGE_ASPECT_DEPTH_BIT, 0, r.array_index, 1};
-      c.imageOffset = {r.rect.offset.x, r.rect.offset.y, 0};
-      c.imageExtent = {std::uint32_t(r.rect.extent.width), std::uint32_t(r.rect.extent.height), 1};
-      vkCmdCopyImageToBuffer_(cb, r.image, VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL, download_.buffer, 1, &c);
-      auto back = image_barrier(r.image, r.array_index, VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL,
-                                VK_IMAGE_LAYOUT_DEPTH_STENCIL_ATTACHMENT_OPTIMAL, 0, 0, aspects);
-      vkCmdPipelineBarrier_(cb, VK_PIPELINE_STAGE_TRANSFER_BIT, VK_PIPELINE_STAGE_ALL_COMMANDS_BIT, 0, 0, nullptr, 0,
-                            nullptr, 1, &back);
+      record_download(cb, {r.image, r.array_index, VK_IMAGE_LAYOUT_DEPTH_STENCIL_ATTACHMENT_OPTIMAL,
+                           VK_ACCESS_DEPTH_STENCIL_ATTACHMENT_WRITE_BIT | VK_ACCESS_TRANSFER_WRITE_BIT, aspects,
+                           VK_IMAGE_ASPECT_DEPTH_BIT, r.rect, offsets[i]});
     }
-    VkMemoryBarrier host{VK_STRUCTURE_TYPE_MEMORY_BARRIER};
-    host.srcAccessMask = VK_ACCESS_TRANSFER_WRITE_BIT;
-    host.dstAccessMask = VK_ACCESS_HOST_READ_BIT;
-    vkCmdPipelineBarrier_(cb, VK_PIPELINE_STAGE_TRANSFER_BIT, VK_PIPELINE_STAGE_HOST_BIT, 0, 1, &host, 0, nullptr, 0,
-                          nullptr);
+    record_host_read_barrier(cb);
   });
   std::vector<std::vector<float>> out;
   for (std::size_t i = 0; i < reads.size(); ++i) {

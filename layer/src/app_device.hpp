@@ -52,6 +52,20 @@ class AppDevice {
   void destroy();
   template <class F>
   void submit(F&& record);
+  // One region of an attachment image copied into download_ at `offset`: transition to
+  // TRANSFER_SRC after the application's writes, copy `copy_aspect`, transition back.
+  struct Download {
+    VkImage image;
+    std::uint32_t array_layer;
+    VkImageLayout attachment_layout;
+    VkAccessFlags attachment_writes;
+    VkImageAspectFlags aspects;  // every aspect of the image, for the layout transitions
+    VkImageAspectFlags copy_aspect;
+    XrRect2Di rect;
+    VkDeviceSize offset;
+  };
+  void record_download(VkCommandBuffer cb, const Download& d);
+  void record_host_read_barrier(VkCommandBuffer cb);
 
   VkDevice device_ = VK_NULL_HANDLE;
   VkQueue queue_ = VK_NULL_HANDLE;
