@@ -13,6 +13,7 @@
 #include "fovea/gpu/barriers.hpp"
 #include "fovea/renderer/path_tracer.hpp"
 #include "fovea/renderer/scene.hpp"
+#include "pt_helpers.hpp"
 
 namespace fovea::test {
 
@@ -33,24 +34,10 @@ inline core::DisplayPreset display_of_size(int w, int h) {
 
 // Mean of `frames` frames of 1 spp traced on `grid` (the pipeline's current grid): a
 // grid-space reference of the plain radiance and of the demodulated indirect diffuse.
-struct GridReference {
-  std::vector<glm::vec4> radiance, indirect;
-};
-inline GridReference trace_reference(gpu::Context& ctx, const renderer::GpuScene& scene,
-                                     const std::vector<shaders::GridSample>& grid, const core::View& view,
-                                     core::Eye eye, std::uint32_t frames) {
-  gpu::Buffer g(ctx, {grid.size() * sizeof(shaders::GridSample), gpu::BufferUsage::Storage, gpu::Memory::DeviceLocal,
-                      "test.grid"});
-  g.upload(grid);
-  renderer::PathTracer pt(ctx, scene);
-  renderer::TraceOutputs out = pt.bind(g, std::uint32_t(grid.size()));
-  ctx.submit_and_wait([&](VkCommandBuffer cmd) {
-    for (std::uint32_t f = 0; f < frames; ++f) {
-      if (f) gpu::compute_to_compute(cmd);
-      pt.record(cmd, out, view, eye, 100000 + f, {}, f);
-    }
-  });
-  return {out.radiance().download<glm::vec4>(), out.indirect().download<glm::vec4>()};
+inline Traced trace_reference(gpu::Context& ctx, const renderer::GpuScene& scene,
+                              const std::vector<shaders::GridSample>& grid, const core::View& view, core::Eye eye,
+                              std::uint32_t frames) {
+  return trace_grid(ctx, scene, grid, view, eye, {}, frames, 100000);
 }
 
 // Cells as a one-row image (rgb), selected by `keep`.
