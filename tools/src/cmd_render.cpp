@@ -18,7 +18,7 @@
 #include "fovea/core/error.hpp"
 #include "fovea/core/image.hpp"
 #include "fovea/core/metrics.hpp"
-#include "fovea/devices/gaze.hpp"
+#include "fovea/devices/foveation_gaze.hpp"
 #include "fovea/gpu/context.hpp"
 #include "fovea/renderer/reference.hpp"
 #include "fovea/renderer/scene_io.hpp"
@@ -162,7 +162,7 @@ int run(std::vector<std::string> argv) {
   }
   devices::SourceOptions so;
   so.display = display;
-  const auto gaze_source = devices::open_gaze_source(gaze_uri, so);
+  devices::FoveationGaze gaze_source(gaze_uri, so);
 
   const renderer::Scene scene = renderer::load_scene(args.str("scene", "default"));
   for (const auto& w : scene.warnings) std::cerr << "warning: " << w << "\n";
@@ -188,13 +188,8 @@ int run(std::vector<std::string> argv) {
   const auto start = std::chrono::steady_clock::now();
   for (long f = 0; f < frames; ++f) {
     const auto t_ns = core::TimeNs(std::llround(double(f) / display.refresh_hz * 1e9));
-    const devices::GazeSample s = gaze_source->sample_at(t_ns);
-    for (int e = 0; e < 2; ++e) {
-      const devices::EyeGaze& eg = s.eye(core::Eye(e));
-      // Untracked samples keep the previous gaze (the distributions also guard bad input).
-      if (eg.tracked()) gaze[e] = eg.dir;
-      else if (s.combined.tracked()) gaze[e] = s.combined.dir;
-    }
+    const devices::FoveaGaze g = gaze_source.at_frame_time(t_ns);
+    for (int e = 0; e < 2; ++e) gaze[e] = g.eye(core::Eye(e)).dir;
     const compositor::FrameTimes t = pipeline.render(poses, gaze, std::uint32_t(f));
     t_trace.push_back(t.trace), t_recon.push_back(t.reconstruct), t_resolve.push_back(t.resolve);
     t_total.push_back(t.total), t_fit.push_back(t.bmfr_fit);

@@ -73,6 +73,9 @@ class FoveationGaze {
 
   // The fovea at time t (caller's clock) from the samples measured by t.
   FoveaGaze at(core::TimeNs t);
+  // For programs whose frames carry a virtual time (frame index / refresh rate, from 0):
+  // recordings play on it, live sources are read at the host clock now.
+  FoveaGaze at_frame_time(core::TimeNs frame_ns) { return at(live() ? core::now_ns() : frame_ns); }
   // The fovea at time t from a measurement made elsewhere (the OpenXR eye-gaze action);
   // `s.t_ns` on the caller's clock, kNoSample when nothing was measured.
   FoveaGaze use(core::TimeNs t, const GazeSample& s);
