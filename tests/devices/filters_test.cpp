@@ -8,44 +8,14 @@
 #include "fovea/devices/filters.hpp"
 #include "fovea/devices/synthetic.hpp"
 #include "fovea/devices/timeline.hpp"
+#include "scripted.hpp"
 
 using namespace fovea::devices;
+using namespace fovea::devices::test;
 using fovea::core::angle_deg;
 using fovea::core::TimeNs;
 
 namespace {
-glm::dvec3 dir_deg(double az, double el) {
-  return glm::normalize(glm::dvec3(std::tan(az * M_PI / 180), std::tan(el * M_PI / 180), -1));
-}
-GazeSample sample(TimeNs t, glm::dvec3 d, std::uint32_t flags = kTracked) {
-  GazeSample s;
-  s.t_ns = s.device_time_ns = s.host_time_ns = t;
-  s.combined.dir = d;
-  s.combined.flags = flags;
-  s.combined.confidence = flags == kTracked ? 1 : 0;
-  s.left = s.right = s.combined;
-  return s;
-}
-// A scripted stream; live streams return false until more is "delivered".
-class VectorStream final : public SampleStream {
- public:
-  explicit VectorStream(std::vector<GazeSample> v, bool live = false) : v_(std::move(v)), live_(live) {}
-  bool next(GazeSample& s) override {
-    if (i_ >= std::min(v_.size(), limit_)) return false;
-    s = v_[i_++];
-    return true;
-  }
-  bool rewindable() const override { return !live_; }
-  void rewind() override { i_ = 0; }
-  bool live() const override { return live_; }
-  std::string describe() const override { return "vector"; }
-  std::size_t limit_ = SIZE_MAX;
-
- private:
-  std::vector<GazeSample> v_;
-  bool live_;
-  std::size_t i_ = 0;
-};
 std::vector<GazeSample> run(std::unique_ptr<SampleStream> s) {
   std::vector<GazeSample> v;
   GazeSample g;

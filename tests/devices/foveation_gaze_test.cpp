@@ -12,57 +12,29 @@
 #include "fovea/devices/foveation_gaze.hpp"
 #include "fovea/devices/hid_stream.hpp"
 #include "fovea/devices/timeline.hpp"
+#include "scripted.hpp"
 #include "test_util.hpp"
 
 using namespace fovea::devices;
+using namespace fovea::devices::test;
 using fovea::core::angle_deg;
 using fovea::core::TimeNs;
 
 namespace {
-constexpr double kPi = 3.14159265358979323846;
+double az_deg(const glm::dvec3& d) { return std::atan2(d.x, -d.z) * 180 / M_PI; }
 
-glm::dvec3 dir_deg(double az, double el = 0) {
-  return glm::normalize(glm::dvec3(std::tan(az * kPi / 180), std::tan(el * kPi / 180), -1));
-}
-double az_deg(const glm::dvec3& d) { return std::atan2(d.x, -d.z) * 180 / kPi; }
-
-GazeSample sample(TimeNs t, glm::dvec3 d, std::uint32_t flags = kTracked) {
-  GazeSample s;
-  s.t_ns = t;
-  s.device_time_ns = t + 123'456'789;  // a tracker clock of its own
-  s.host_time_ns = t + 2'000'000;      // received 2 ms after it was measured
-  s.combined.dir = d;
-  s.combined.flags = flags;
-  s.combined.confidence = flags == kTracked ? 1 : 0;
-  s.left = s.right = s.combined;
+// A sample with a tracker clock of its own, received 2 ms after it was measured.
+GazeSample stamped(TimeNs t, glm::dvec3 d) {
+  GazeSample s = sample(t, d);
+  s.device_time_ns = t + 123'456'789;
+  s.host_time_ns = t + 2'000'000;
   return s;
 }
-
-// A scripted stream; a live one has delivered everything already (the source must still
-// not use samples measured after the time asked for).
-class Script final : public SampleStream {
- public:
-  Script(std::vector<GazeSample> v, bool live) : v_(std::move(v)), live_(live) {}
-  bool next(GazeSample& s) override {
-    if (i_ >= v_.size()) return false;
-    s = v_[i_++];
-    return true;
-  }
-  bool rewindable() const override { return !live_; }
-  void rewind() override { i_ = 0; }
-  bool live() const override { return live_; }
-  std::string describe() const override { return live_ ? "script (live)" : "script"; }
-
- private:
-  std::vector<GazeSample> v_;
-  bool live_;
-  std::size_t i_ = 0;
-};
 
 FoveationGaze make(std::vector<GazeSample> v, bool live, TimeNs horizon_ns, const LossPolicy& policy = {}) {
   SourceOptions o;
   o.horizon_ns = horizon_ns;
-  return FoveationGaze(std::make_unique<TimelineSource>(std::make_unique<Script>(std::move(v), live), o), policy);
+  return FoveationGaze(std::make_unique<TimelineSource>(std::make_unique<VectorStream>(std::move(v), live), o), policy);
 }
 
 // Smooth pursuit at 10 °/s starting at `t0`, sampled at `rate_hz`, for one second.
@@ -70,7 +42,7 @@ std::vector<GazeSample> pursuit(double rate_hz, TimeNs t0) {
   std::vector<GazeSample> v;
   for (int i = 0; i < int(rate_hz); ++i) {
     const TimeNs t = t0 + std::llround(i * 1e9 / rate_hz);
-    v.push_back(sample(t, dir_deg(-5 + 10.0 * double(t - t0) * 1e-9)));
+    v.push_back(stamped(t, dir_deg(-5 + 10.0 * double(t - t0) * 1e-9)));
   }
   return v;
 }
@@ -219,7 +191,7 @@ TEST(FoveationGaze, EachEyeFollowsItsOwnMeasurementOrTheCombinedGaze) {
   const FoveaGaze u = g.use(600'000'000, sample(100'000'000, dir_deg(0), kLost));
   EXPECT_EQ(u.sample_ns, 100'000'000);
   EXPECT_EQ(u.left.state, FoveaState::Easing);  // 600 ms after the last tracked one at 0
-  EXPECT_THROW(FoveationGaze(std::make_unique<TimelineSource>(std::make_unique<Script>(std::vector<GazeSample>{}, false),
+  EXPECT_THROW(FoveationGaze(std::make_unique<TimelineSource>(std::make_unique<VectorStream>(std::vector<GazeSample>{}),
                                                               SourceOptions{}),
                              LossPolicy{-1, 0, {0, 0, -1}}),
                fovea::core::InputError);
