@@ -30,7 +30,11 @@ struct Material {
   float metallic = 0.0f;
   float roughness = 1.0f;        // perceptual (GGX alpha = roughness²)
   float specular = 0.04f;        // dielectric F0; 0 makes a pure Lambert surface
-  glm::vec3 emission{0.0f};      // radiance emitted from the front face (linear)
+  glm::vec3 emission{0.0f};      // radiance emitted (linear)
+  // glTF `doubleSided`: back faces are shaded and emit with the normal reversed. Single-sided
+  // back faces neither reflect nor emit (black, still opaque). Built-in scenes and OBJ files
+  // (which cannot say) are double-sided except the built-in emitters.
+  bool double_sided = true;
 };
 
 struct Scene {

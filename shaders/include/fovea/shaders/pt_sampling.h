@@ -1,5 +1,6 @@
-// GLSL only: the counter-based random numbers and the BSDF (Lambert + GGX with Smith
-// masking, glTF metallic-roughness) of the path tracer.
+// GLSL only: the counter-based random numbers and the BSDF (GGX with Smith masking over an
+// energy-compensated Lambert base, glTF metallic-roughness) of the path tracer. The includer
+// declares `vec4 ggx_albedo[]`, the table described with kPtGgxTableSize (pt_scene.h).
 #ifndef FOVEA_SHADERS_PT_SAMPLING_H
 #define FOVEA_SHADERS_PT_SAMPLING_H
 
@@ -68,6 +69,17 @@ vec3 pt_fresnel(vec3 f0, float c) {
   return f0 + (1.0 - f0) * (m * m * m * m * m);
 }
 
+// Table entry (A, B, A_avg, B_avg) at (μ, α), bilinear between the nodes.
+vec4 pt_ggx_albedo(float mu, float alpha) {
+  const float n1 = float(kPtGgxTableSize - 1u);
+  const vec2 p = clamp(vec2(mu, sqrt(alpha)), 0.0, 1.0) * n1;
+  const uvec2 i0 = uvec2(min(p, vec2(n1 - 1.0)));
+  const vec2 f = p - vec2(i0);
+  const uint row = kPtGgxTableSize;
+  const uint k = i0.y * row + i0.x;
+  return mix(mix(ggx_albedo[k], ggx_albedo[k + 1u], f.x), mix(ggx_albedo[k + row], ggx_albedo[k + row + 1u], f.x), f.y);
+}
+
 // Probability of sampling the specular lobe, from the lobes' rough weights.
 float pt_spec_prob(PtBsdf m, float cos_o) {
   const float es = pt_luminance(pt_fresnel(m.f0, cos_o)) * float(pt_max3(m.f0) > 0.0);
@@ -98,6 +110,13 @@ void pt_bsdf_eval(PtBsdf m, vec3 n, vec3 wo, vec3 wi, out vec3 f_diff, out vec3 
     f_spec = pt_fresnel(m.f0, hoo) * (D * G2 / (4.0 * co));
     // Visible-normal sampling pdf of wi: G1(wo)·D / (4 cos_o) (Heitz 2018, Eq. 17 with the Jacobian).
     pdf += ps * G1 * D / (4.0 * co);
+    // Energy-compensated layering (Kelemen & Szirmay-Kalos 2001; Kulla & Conty 2017):
+    // the diffuse base receives what the specular layer does not reflect, reciprocally,
+    // f_d = ρ/π · (1 − E(μo))(1 − E(μi)) / (1 − E_avg); its albedo is then ρ(1 − E(μo)), so
+    // E(μo) + ρ(1 − E(μo)) ≤ 1 for every ρ ≤ 1 (the plain sum reached 1.33 at grazing).
+    const vec4 to = pt_ggx_albedo(co, m.alpha), ti = pt_ggx_albedo(ci, m.alpha);
+    const vec3 eo = m.f0 * to.x + to.y, ei = m.f0 * ti.x + ti.y, eavg = m.f0 * to.z + to.w;
+    f_diff *= clamp((1.0 - eo) * (1.0 - ei) / max(1.0 - eavg, vec3(1e-4)), 0.0, 1e4);
   }
 }
 
