@@ -21,8 +21,9 @@ struct Texture {
   std::vector<std::uint8_t> rgba;
 };
 
-// Lambert diffuse + GGX specular (Smith masking), glTF metallic-roughness semantics:
-// diffuse colour = base·(1−metallic); specular F0 = mix(specular, base, metallic).
+// GGX specular (Smith masking, multiple-scattering compensated) over an energy-compensated
+// Lambert base, glTF metallic-roughness semantics: diffuse colour = base·(1−metallic);
+// specular F0 = mix(specular, base, metallic). docs/renderer.md has the model.
 struct Material {
   std::string name;
   glm::vec3 base_color{0.8f};

@@ -65,8 +65,8 @@ struct PtLight {
 // Directional albedo of the GGX specular lobe (pt_bsdf_eval's f_spec with Schlick Fresnel,
 // which is linear in F0): E(μ, α, F0) = F0·A + B, and its cosine-weighted hemispherical
 // mean E_avg = 2∫E(μ)μ dμ = F0·A_avg + B_avg. A table of vec4 (A, B, A_avg, B_avg) with
-// kPtGgxTableSize² entries, index = r_index · size + μ_index, nodes μ = i/(size−1) and
-// √α = j/(size−1), bilinear; built by renderer/src/ggx_albedo.cpp.
+// kPtGgxTableSize² entries, index = r_index · size + μ_index, nodes √μ = i/(size−1) and
+// √α = j/(size−1), bilinear in (√μ, √α); built by renderer/src/ggx_albedo.cpp.
 FOVEA_CONST FOVEA_UINT kPtGgxTableSize = 32;
 
 #ifdef __cplusplus
