@@ -71,7 +71,8 @@ constexpr double kRelMseEpsilon = 0.01;
 ErrorMaps error_maps(const Image& test, const Image& reference, double ppd, double exposure = 0.0);
 
 // Weighted means of the maps (weights ≥ 0, one per pixel; empty: all 1). PSNR comes from
-// the weighted MSE (peak 1, kPsnrIdentical when it vanishes), the others are means.
+// the weighted MSE (peak 1, kPsnrIdentical when it vanishes), the others are means. A zero
+// total weight gives the scores of identical images with weight 0.
 struct Scores {
   double psnr = kPsnrIdentical, ssim = 1, rel_mse = 0, ldr_flip = 0, hdr_flip = 0;
   double weight = 0;  // Σ weights
