@@ -16,7 +16,7 @@ namespace {
 constexpr int kN = int(shaders::kPtGgxTableSize);
 // Visible-normal samples per entry, on a Fibonacci lattice: every sample has its own radius
 // on the sampling disk, so the horizon cut (where the energy goes) is resolved to 1/kSamples
-// rather than to one ring of a square grid (which left steps of 2% in E).
+// rather than to one ring of a square grid (which left visible steps in E over α).
 constexpr int kSamples = 512;
 
 double lambda(double cos_t, double a2) {  // Smith Λ, as pt_ggx_lambda (Heitz 2014, Eq. 72)
