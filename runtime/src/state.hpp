@@ -150,7 +150,7 @@ struct Swapchain final : Object {
   std::vector<VkDeviceMemory> memory;
   std::vector<bool> layout_ready;  // transitioned to the layout the application expects
   std::deque<std::uint32_t> acquired;  // acquired, not yet released, oldest first
-  std::uint32_t waited = 0;            // how many of `acquired` have been waited on
+  bool waited = false;                 // the oldest of `acquired` has been waited on
   std::uint32_t next_image = 0;
   std::int64_t last_released = -1;
   bool ever_acquired = false;

@@ -179,10 +179,12 @@ XrResult api::xrWaitSwapchainImage(XrSwapchain swapchain, const XrSwapchainImage
     Swapchain* sc = find<Swapchain>(swapchain);
     if (!sc) return XR_ERROR_HANDLE_INVALID;
     if (!has_type(info, XR_TYPE_SWAPCHAIN_IMAGE_WAIT_INFO)) return XR_ERROR_VALIDATION_FAILURE;
-    if (sc->waited >= sc->acquired.size()) return XR_ERROR_CALL_ORDER_INVALID;
+    // One image at a time: a waited image must be released before the next wait (core spec,
+    // xrWaitSwapchainImage), and only an acquired image can be waited on.
+    if (sc->waited || sc->acquired.empty()) return XR_ERROR_CALL_ORDER_INVALID;
     // The compositor finishes with an image inside xrEndFrame, so an acquired image is
     // always ready: no timeout can occur.
-    ++sc->waited;
+    sc->waited = true;
     return XR_SUCCESS;
   });
 }
@@ -192,10 +194,10 @@ XrResult api::xrReleaseSwapchainImage(XrSwapchain swapchain, const XrSwapchainIm
     Swapchain* sc = find<Swapchain>(swapchain);
     if (!sc) return XR_ERROR_HANDLE_INVALID;
     if (info && info->type != XR_TYPE_SWAPCHAIN_IMAGE_RELEASE_INFO) return XR_ERROR_VALIDATION_FAILURE;
-    if (sc->waited == 0) return XR_ERROR_CALL_ORDER_INVALID;
+    if (!sc->waited) return XR_ERROR_CALL_ORDER_INVALID;
     sc->last_released = sc->acquired.front();
     sc->acquired.pop_front();
-    --sc->waited;
+    sc->waited = false;
     return XR_SUCCESS;
   });
 }

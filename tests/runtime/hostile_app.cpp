@@ -243,8 +243,10 @@ TEST_P(HostileApp, SwapchainMisuseIsRefusedWithTheirCodes) {
   expect("acquire info of the wrong structure type", xrAcquireSwapchainImage(sc, &wrong_acquire, &index),
          XR_ERROR_VALIDATION_FAILURE);
   expect("wait for acquired image 1", xrWaitSwapchainImage(sc, &wi), XR_SUCCESS);
-  expect("wait for acquired image 2", xrWaitSwapchainImage(sc, &wi), XR_SUCCESS);
+  // The CTS's pattern: a waited image must be released before the next wait.
+  expect("wait for image 2 before releasing image 1", xrWaitSwapchainImage(sc, &wi), XR_ERROR_CALL_ORDER_INVALID);
   expect("release image 1", xrReleaseSwapchainImage(sc, nullptr), XR_SUCCESS);
+  expect("wait for acquired image 2", xrWaitSwapchainImage(sc, &wi), XR_SUCCESS);
   expect("release image 2", xrReleaseSwapchainImage(sc, nullptr), XR_SUCCESS);
   expect("release image 3 (acquired, never waited)", xrReleaseSwapchainImage(sc, nullptr), XR_ERROR_CALL_ORDER_INVALID);
   expect("wait with a NULL wait info", xrWaitSwapchainImage(sc, nullptr), XR_ERROR_VALIDATION_FAILURE);

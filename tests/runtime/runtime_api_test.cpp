@@ -694,6 +694,246 @@ TEST_F(XrTest, VisibilityMask) {
   }
 }
 
+// Findings of the OpenXR conformance suite (CTS 1.1.41, --apiVersion 1.0), reproduced.
+
+// Once an image has been waited on, it must be released before the next wait (core spec,
+// xrWaitSwapchainImage); more acquires than images fail; release follows wait.
+TEST_F(XrTest, CtsSwapchainWaitTwiceBeforeRelease) {
+  create_instance();
+  run_to_focused();
+  const XrSwapchain sc = color_swapchain(64, 72);
+  XrSwapchainImageWaitInfo wi{XR_TYPE_SWAPCHAIN_IMAGE_WAIT_INFO};
+  wi.timeout = XR_INFINITE_DURATION;
+  uint32_t i = 0;
+  ASSERT_EQ(xrAcquireSwapchainImage(sc, nullptr, &i), XR_SUCCESS);
+  ASSERT_EQ(xrAcquireSwapchainImage(sc, nullptr, &i), XR_SUCCESS);
+  ASSERT_EQ(xrWaitSwapchainImage(sc, &wi), XR_SUCCESS);
+  EXPECT_EQ(xrWaitSwapchainImage(sc, &wi), XR_ERROR_CALL_ORDER_INVALID);  // first not released
+  ASSERT_EQ(xrReleaseSwapchainImage(sc, nullptr), XR_SUCCESS);
+  EXPECT_EQ(xrReleaseSwapchainImage(sc, nullptr), XR_ERROR_CALL_ORDER_INVALID);  // second not waited
+  ASSERT_EQ(xrWaitSwapchainImage(sc, &wi), XR_SUCCESS);
+  EXPECT_EQ(xrWaitSwapchainImage(sc, &wi), XR_ERROR_CALL_ORDER_INVALID);
+  ASSERT_EQ(xrReleaseSwapchainImage(sc, nullptr), XR_SUCCESS);
+  EXPECT_EQ(xrWaitSwapchainImage(sc, &wi), XR_ERROR_CALL_ORDER_INVALID);  // nothing acquired
+}
+
+// Two-call idiom: a capacity of 0 is a size query, whatever the array pointer. For the
+// visibility mask either capacity being 0 makes it one.
+TEST_F(XrTest, CtsSizeQueriesWithZeroCapacity) {
+  create_instance({XR_KHR_VISIBILITY_MASK_EXTENSION_NAME});
+  create_session();
+  auto get = proc<PFN_xrGetVisibilityMaskKHR>("xrGetVisibilityMaskKHR");
+  XrVisibilityMaskKHR full{XR_TYPE_VISIBILITY_MASK_KHR};
+  ASSERT_EQ(get(session_, XR_VIEW_CONFIGURATION_TYPE_PRIMARY_STEREO, 0, XR_VISIBILITY_MASK_TYPE_HIDDEN_TRIANGLE_MESH_KHR,
+                &full),
+            XR_SUCCESS);
+  std::vector<XrVector2f> v(full.vertexCountOutput);
+  std::vector<uint32_t> idx(full.indexCountOutput);
+  for (int zero = 0; zero < 2; ++zero) {
+    XrVisibilityMaskKHR m{XR_TYPE_VISIBILITY_MASK_KHR};
+    m.vertexCapacityInput = zero == 0 ? 0 : uint32_t(v.size());
+    m.vertices = zero == 0 ? nullptr : v.data();
+    m.indexCapacityInput = zero == 1 ? 0 : uint32_t(idx.size());
+    m.indices = zero == 1 ? nullptr : idx.data();
+    EXPECT_EQ(get(session_, XR_VIEW_CONFIGURATION_TYPE_PRIMARY_STEREO, 0,
+                  XR_VISIBILITY_MASK_TYPE_HIDDEN_TRIANGLE_MESH_KHR, &m),
+              XR_SUCCESS)
+        << "capacity " << (zero == 0 ? "vertex" : "index") << " 0";
+    EXPECT_EQ(m.vertexCountOutput, full.vertexCountOutput);
+    EXPECT_EQ(m.indexCountOutput, full.indexCountOutput);
+  }
+  uint32_t n = 99;
+  EXPECT_EQ(xrEnumerateSwapchainFormats(session_, 0, &n, nullptr), XR_SUCCESS);
+  EXPECT_GT(n, 0u);
+  EXPECT_EQ(xrEnumerateReferenceSpaces(session_, 0, &n, nullptr), XR_SUCCESS);
+  EXPECT_EQ(n, 3u);
+  EXPECT_EQ(xrEnumerateViewConfigurations(instance_, system_, 0, &n, nullptr), XR_SUCCESS);
+  EXPECT_EQ(n, 1u);
+  EXPECT_EQ(xrEnumerateEnvironmentBlendModes(instance_, system_, XR_VIEW_CONFIGURATION_TYPE_PRIMARY_STEREO, 0, &n,
+                                             nullptr),
+            XR_SUCCESS);
+  EXPECT_EQ(n, 1u);
+  EXPECT_EQ(xrEnumerateApiLayerProperties(0, &n, nullptr), XR_SUCCESS);
+  EXPECT_EQ(xrEnumerateInstanceExtensionProperties(nullptr, 0, &n, nullptr), XR_SUCCESS);
+  EXPECT_GT(n, 0u);
+  EXPECT_EQ(xrPathToString(instance_, path("/user/head"), 0, &n, nullptr), XR_SUCCESS);
+  EXPECT_EQ(n, 11u);  // with the terminator
+  const XrSwapchain sc = color_swapchain(16, 16);
+  EXPECT_EQ(xrEnumerateSwapchainImages(sc, 0, &n, nullptr), XR_SUCCESS);
+  EXPECT_EQ(n, 3u);
+  XrViewLocateInfo li{XR_TYPE_VIEW_LOCATE_INFO};
+  li.viewConfigurationType = XR_VIEW_CONFIGURATION_TYPE_PRIMARY_STEREO;
+  li.displayTime = 1'000'000;
+  li.space = reference_space(XR_REFERENCE_SPACE_TYPE_LOCAL);
+  XrViewState vs{XR_TYPE_VIEW_STATE};
+  EXPECT_EQ(xrLocateViews(session_, &li, &vs, 0, &n, nullptr), XR_SUCCESS);
+  EXPECT_EQ(n, 2u);
+}
+
+XrResult create_set(XrInstance instance, const char* name, const char* localized, XrActionSet* set) {
+  XrActionSetCreateInfo ci{XR_TYPE_ACTION_SET_CREATE_INFO};
+  std::strcpy(ci.actionSetName, name);
+  std::strcpy(ci.localizedActionSetName, localized);
+  return xrCreateActionSet(instance, &ci, set);
+}
+
+XrResult create_action(XrActionSet set, const char* name, const char* localized, XrActionType type,
+                       XrAction* action) {
+  XrActionCreateInfo ci{XR_TYPE_ACTION_CREATE_INFO};
+  std::strcpy(ci.actionName, name);
+  std::strcpy(ci.localizedActionName, localized);
+  ci.actionType = type;
+  return xrCreateAction(set, &ci, action);
+}
+
+// Empty names are XR_ERROR_NAME_INVALID; names that are not well-formed path components are
+// XR_ERROR_PATH_FORMAT_INVALID; empty localized names XR_ERROR_LOCALIZED_NAME_INVALID.
+TEST_F(XrTest, CtsActionNames) {
+  create_instance();
+  XrActionSet set = XR_NULL_HANDLE;
+  EXPECT_EQ(create_set(instance_, "", "Empty", &set), XR_ERROR_NAME_INVALID);
+  EXPECT_EQ(create_set(instance_, "Upper", "Upper", &set), XR_ERROR_PATH_FORMAT_INVALID);
+  EXPECT_EQ(create_set(instance_, "has space", "Space", &set), XR_ERROR_PATH_FORMAT_INVALID);
+  EXPECT_EQ(create_set(instance_, "has/slash", "Slash", &set), XR_ERROR_PATH_FORMAT_INVALID);
+  EXPECT_EQ(create_set(instance_, "set", "", &set), XR_ERROR_LOCALIZED_NAME_INVALID);
+  ASSERT_EQ(create_set(instance_, "set-1_a.b", "Set", &set), XR_SUCCESS);
+  XrAction a = XR_NULL_HANDLE;
+  EXPECT_EQ(create_action(set, "", "Empty", XR_ACTION_TYPE_BOOLEAN_INPUT, &a), XR_ERROR_NAME_INVALID);
+  EXPECT_EQ(create_action(set, "Bad", "Bad", XR_ACTION_TYPE_BOOLEAN_INPUT, &a), XR_ERROR_PATH_FORMAT_INVALID);
+  EXPECT_EQ(create_action(set, "a", "", XR_ACTION_TYPE_BOOLEAN_INPUT, &a), XR_ERROR_LOCALIZED_NAME_INVALID);
+  EXPECT_EQ(create_action(set, "a", "A", XR_ACTION_TYPE_BOOLEAN_INPUT, &a), XR_SUCCESS);
+}
+
+// Bindings are checked against the OpenXR 1.0 interaction profile tables: components a
+// profile does not have (and 1.1's grip_surface) are XR_ERROR_PATH_UNSUPPORTED, every
+// listed one is accepted, an identifier without its component too.
+TEST_F(XrTest, CtsBindingPathsPerProfile) {
+  create_instance();
+  XrActionSet set = XR_NULL_HANDLE;
+  ASSERT_EQ(create_set(instance_, "bindings", "Bindings", &set), XR_SUCCESS);
+  XrAction pose = XR_NULL_HANDLE, button = XR_NULL_HANDLE, haptic = XR_NULL_HANDLE;
+  ASSERT_EQ(create_action(set, "pose", "Pose", XR_ACTION_TYPE_POSE_INPUT, &pose), XR_SUCCESS);
+  ASSERT_EQ(create_action(set, "button", "Button", XR_ACTION_TYPE_BOOLEAN_INPUT, &button), XR_SUCCESS);
+  ASSERT_EQ(create_action(set, "haptic", "Haptic", XR_ACTION_TYPE_VIBRATION_OUTPUT, &haptic), XR_SUCCESS);
+  const auto suggest = [&](const char* profile, XrAction action, const char* binding) {
+    XrActionSuggestedBinding b{action, path(binding)};
+    XrInteractionProfileSuggestedBinding s{XR_TYPE_INTERACTION_PROFILE_SUGGESTED_BINDING};
+    s.interactionProfile = path(profile);
+    s.countSuggestedBindings = 1;
+    s.suggestedBindings = &b;
+    return xrSuggestInteractionProfileBindings(instance_, &s);
+  };
+  const char* xbox = "/interaction_profiles/microsoft/xbox_controller";
+  const char* touch = "/interaction_profiles/oculus/touch_controller";
+  const char* simple = "/interaction_profiles/khr/simple_controller";
+  EXPECT_EQ(suggest(xbox, haptic, "/user/gamepad/output/haptic_left"), XR_SUCCESS);
+  EXPECT_EQ(suggest(xbox, haptic, "/user/gamepad/output/haptic_right_trigger"), XR_SUCCESS);
+  EXPECT_EQ(suggest(xbox, button, "/user/gamepad/input/a/click"), XR_SUCCESS);
+  EXPECT_EQ(suggest(xbox, haptic, "/user/gamepad/output/haptic"), XR_ERROR_PATH_UNSUPPORTED);
+  EXPECT_EQ(suggest(xbox, button, "/user/gamepad/input/z/click"), XR_ERROR_PATH_UNSUPPORTED);
+  EXPECT_EQ(suggest(simple, pose, "/user/hand/left/input/grip/pose"), XR_SUCCESS);
+  EXPECT_EQ(suggest(simple, pose, "/user/hand/left/input/grip_surface/pose"), XR_ERROR_PATH_UNSUPPORTED);
+  EXPECT_EQ(suggest(simple, button, "/user/hand/left/input/trigger/click"), XR_ERROR_PATH_UNSUPPORTED);
+  EXPECT_EQ(suggest(simple, button, "/user/hand/right/input/select"), XR_SUCCESS);  // identifier only
+  EXPECT_EQ(suggest(simple, button, "/user/hand/right/input/select/value"), XR_ERROR_PATH_UNSUPPORTED);
+  EXPECT_EQ(suggest(simple, button, "/user/hand/left/input"), XR_ERROR_PATH_UNSUPPORTED);
+  EXPECT_EQ(suggest(simple, haptic, "/user/hand/right/output/haptic"), XR_SUCCESS);
+  // Oculus Touch: X/Y on the left controller, A/B on the right.
+  EXPECT_EQ(suggest(touch, button, "/user/hand/left/input/x/click"), XR_SUCCESS);
+  EXPECT_EQ(suggest(touch, button, "/user/hand/right/input/x/click"), XR_ERROR_PATH_UNSUPPORTED);
+  EXPECT_EQ(suggest(touch, button, "/user/hand/right/input/a/touch"), XR_SUCCESS);
+  EXPECT_EQ(suggest(touch, button, "/user/hand/left/input/system/click"), XR_ERROR_PATH_UNSUPPORTED);
+  EXPECT_EQ(suggest("/interaction_profiles/htc/vive_pro", button, "/user/head/input/volume_up/click"), XR_SUCCESS);
+  EXPECT_EQ(suggest("/interaction_profiles/htc/vive_pro", button, "/user/head/input/trigger/click"),
+            XR_ERROR_PATH_UNSUPPORTED);
+  EXPECT_EQ(suggest("/interaction_profiles/valve/index_controller", button, "/user/hand/left/input/trackpad/force"),
+            XR_SUCCESS);
+  EXPECT_EQ(suggest("/interaction_profiles/google/daydream_controller", haptic, "/user/hand/left/output/haptic"),
+            XR_ERROR_PATH_UNSUPPORTED);
+}
+
+// XR_FORM_FACTOR_MAX_ENUM and unknown reference space types: the *_UNSUPPORTED codes the
+// CTS expects.
+TEST_F(XrTest, CtsUnsupportedEnums) {
+  create_instance();
+  XrSystemGetInfo gi{XR_TYPE_SYSTEM_GET_INFO};
+  gi.formFactor = XR_FORM_FACTOR_MAX_ENUM;
+  XrSystemId id = 0;
+  EXPECT_EQ(xrGetSystem(instance_, &gi, &id), XR_ERROR_FORM_FACTOR_UNSUPPORTED);
+  create_session();
+  XrReferenceSpaceCreateInfo rci{XR_TYPE_REFERENCE_SPACE_CREATE_INFO};
+  rci.poseInReferenceSpace.orientation.w = 1;
+  XrSpace space = XR_NULL_HANDLE;
+  for (auto t : {XR_REFERENCE_SPACE_TYPE_MAX_ENUM, XrReferenceSpaceType(12345)}) {
+    rci.referenceSpaceType = t;
+    EXPECT_EQ(xrCreateReferenceSpace(session_, &rci, &space), XR_ERROR_REFERENCE_SPACE_UNSUPPORTED) << t;
+    XrExtent2Df bounds;
+    EXPECT_EQ(xrGetReferenceSpaceBoundsRect(session_, t, &bounds), XR_ERROR_REFERENCE_SPACE_UNSUPPORTED) << t;
+  }
+}
+
+// Actions are inactive while the session is not focused: the eye gaze action reports
+// inactive and its space untracked before FOCUSED and again after focus is lost.
+TEST_F(XrTest, CtsEyeGazeInactiveWhenNotFocused) {
+  create_instance({XR_EXT_EYE_GAZE_INTERACTION_EXTENSION_NAME});
+  create_session();
+  XrActionSet set = XR_NULL_HANDLE;
+  ASSERT_EQ(create_set(instance_, "eyes", "Eyes", &set), XR_SUCCESS);
+  XrAction gaze = XR_NULL_HANDLE;
+  ASSERT_EQ(create_action(set, "gaze", "Gaze", XR_ACTION_TYPE_POSE_INPUT, &gaze), XR_SUCCESS);
+  XrActionSuggestedBinding b{gaze, path("/user/eyes_ext/input/gaze_ext/pose")};
+  XrInteractionProfileSuggestedBinding s{XR_TYPE_INTERACTION_PROFILE_SUGGESTED_BINDING};
+  s.interactionProfile = path("/interaction_profiles/ext/eye_gaze_interaction");
+  s.countSuggestedBindings = 1;
+  s.suggestedBindings = &b;
+  ASSERT_EQ(xrSuggestInteractionProfileBindings(instance_, &s), XR_SUCCESS);
+  XrSessionActionSetsAttachInfo ai{XR_TYPE_SESSION_ACTION_SETS_ATTACH_INFO};
+  ai.countActionSets = 1;
+  ai.actionSets = &set;
+  ASSERT_EQ(xrAttachSessionActionSets(session_, &ai), XR_SUCCESS);
+  XrActionSpaceCreateInfo sci{XR_TYPE_ACTION_SPACE_CREATE_INFO};
+  sci.action = gaze;
+  sci.poseInActionSpace.orientation.w = 1;
+  XrSpace gaze_space = XR_NULL_HANDLE;
+  ASSERT_EQ(xrCreateActionSpace(session_, &sci, &gaze_space), XR_SUCCESS);
+  const XrSpace view = reference_space(XR_REFERENCE_SPACE_TYPE_VIEW);
+  XrActiveActionSet active{set, XR_NULL_PATH};
+  XrActionsSyncInfo sync{XR_TYPE_ACTIONS_SYNC_INFO};
+  sync.countActiveActionSets = 1;
+  sync.activeActionSets = &active;
+  XrActionStateGetInfo gsi{XR_TYPE_ACTION_STATE_GET_INFO};
+  gsi.action = gaze;
+  const auto check = [&](bool focused, const char* when) {
+    EXPECT_EQ(xrSyncActions(session_, &sync), focused ? XR_SUCCESS : XR_SESSION_NOT_FOCUSED) << when;
+    XrActionStatePose st{XR_TYPE_ACTION_STATE_POSE};
+    ASSERT_EQ(xrGetActionStatePose(session_, &gsi, &st), XR_SUCCESS) << when;
+    EXPECT_EQ(bool(st.isActive), focused) << when;
+    // Over a second of tracker samples (a blink is never that long) at least one is tracked
+    // when focused, none when not.
+    timespec now{};
+    clock_gettime(CLOCK_MONOTONIC, &now);
+    const XrTime base = XrTime(now.tv_sec) * 1'000'000'000 + now.tv_nsec;
+    int tracked = 0;
+    for (int i = 0; i < 20; ++i) {
+      XrSpaceLocation loc{XR_TYPE_SPACE_LOCATION};
+      ASSERT_EQ(xrLocateSpace(gaze_space, view, base + XrTime(i) * 50'000'000, &loc), XR_SUCCESS);
+      tracked += (loc.locationFlags & XR_SPACE_LOCATION_ORIENTATION_TRACKED_BIT) != 0;
+    }
+    EXPECT_EQ(tracked > 0, focused) << when << ": " << tracked;
+  };
+  check(false, "IDLE/READY");
+  poll_states();
+  XrSessionBeginInfo bi{XR_TYPE_SESSION_BEGIN_INFO};
+  bi.primaryViewConfigurationType = XR_VIEW_CONFIGURATION_TYPE_PRIMARY_STEREO;
+  ASSERT_EQ(xrBeginSession(session_, &bi), XR_SUCCESS);
+  ASSERT_EQ(frame(), XR_SUCCESS);
+  poll_states();
+  check(true, "FOCUSED");
+  ASSERT_EQ(xrRequestExitSession(session_), XR_SUCCESS);
+  poll_states();  // VISIBLE, SYNCHRONIZED, STOPPING
+  check(false, "STOPPING");
+}
+
 TEST_F(XrTest, TimespecConversion) {
   create_instance({XR_KHR_CONVERT_TIMESPEC_TIME_EXTENSION_NAME});
   auto to_time = proc<PFN_xrConvertTimespecTimeToTimeKHR>("xrConvertTimespecTimeToTimeKHR");
