@@ -3,6 +3,7 @@
 // ids looked up in one table (never dereferenced), so a stale or garbage handle is reported
 // as XR_ERROR_HANDLE_INVALID instead of crashing. One mutex serialises all commands.
 #include <array>
+#include <condition_variable>
 #include <cstdint>
 #include <deque>
 #include <map>
@@ -46,6 +47,7 @@ struct Config {
   std::string head = "scripted";       // FOVEA_HEAD_POSE
   bool vk_validation = false;          // FOVEA_VK_VALIDATION=1
   LensMode lens = LensMode::Gpu;       // FOVEA_RUNTIME_LENS: gpu | cpu | off
+  Pacing pacing = Pacing::Realtime;    // FOVEA_RUNTIME_PACING: realtime | lockstep
 };
 // Throws core::InputError naming the variable.
 Config read_config();
@@ -101,6 +103,7 @@ struct Session final : Object {
   std::int64_t frames_ended = 0;
   bool frame_open = false;  // between xrBeginFrame and xrEndFrame
   std::deque<FrameRecord> waited;  // frames returned by xrWaitFrame, not yet begun
+  bool wait_sleeping = false;      // an xrWaitFrame is sleeping until its wake time
   FrameRecord current;             // the open frame
   TimingLog timing;
   // Actions.
@@ -160,6 +163,9 @@ struct Swapchain final : Object {
 // ---- handle table -----------------------------------------------------------------------
 
 std::mutex& api_mutex();
+// Signalled (under api_mutex) when a frame is begun, a session ends or an object is
+// destroyed: a pipelined xrWaitFrame blocks on it until the previous frame has begun.
+std::condition_variable& frame_begun();
 std::uint64_t add_object(std::unique_ptr<Object> obj, std::uint64_t parent);
 Object* find_object(std::uint64_t id, Kind kind);
 void destroy_object(std::uint64_t id);  // and its children, children first

@@ -5,7 +5,13 @@
 #include <cstring>
 #include <limits>
 
+#include <atomic>
+#include <condition_variable>
+#include <deque>
+#include <filesystem>
 #include <fstream>
+#include <mutex>
+#include <thread>
 
 #include <glm/gtc/quaternion.hpp>
 
@@ -932,6 +938,172 @@ TEST_F(XrTest, CtsEyeGazeInactiveWhenNotFocused) {
   ASSERT_EQ(xrRequestExitSession(session_), XR_SUCCESS);
   poll_states();  // VISIBLE, SYNCHRONIZED, STOPPING
   check(false, "STOPPING");
+}
+
+XrTime mono_now() {
+  timespec ts{};
+  clock_gettime(CLOCK_MONOTONIC, &ts);
+  return XrTime(ts.tv_sec) * 1'000'000'000 + ts.tv_nsec;
+}
+
+// A missing FOVEA_RUNTIME_OUT directory is created (with its parents): the first frame
+// succeeds and the timing log and runtime log are written. A path that cannot be a
+// directory fails instance creation with the variable named, not a frame.
+TEST_F(XrTest, RuntimeOutDirectoryCreated) {
+  TempDir dir("out_missing");
+  const std::string out = dir.path() + "/not/yet/there";
+  setenv("FOVEA_RUNTIME_OUT", out.c_str(), 1);
+  setenv("FOVEA_RUNTIME_PNG_EVERY", "1", 1);
+  create_instance();
+  run_to_focused();
+  ASSERT_EQ(frame(), XR_SUCCESS);
+  unsetenv("FOVEA_RUNTIME_PNG_EVERY");
+  unsetenv("FOVEA_RUNTIME_OUT");
+  std::ifstream in(out + "/timing.jsonl");
+  int lines = 0;
+  for (std::string l; std::getline(in, l);) ++lines;
+  EXPECT_EQ(lines, 2);
+  EXPECT_TRUE(std::filesystem::exists(out + "/runtime.log"));
+  ASSERT_EQ(xrDestroyInstance(instance_), XR_SUCCESS);  // one instance at a time
+  instance_ = XR_NULL_HANDLE;
+  session_ = XR_NULL_HANDLE;
+
+  const std::string file = dir.path() + "/a_file";
+  std::ofstream(file) << "x";
+  setenv("FOVEA_RUNTIME_OUT", (file + "/sub").c_str(), 1);
+  XrInstanceCreateInfo ci{XR_TYPE_INSTANCE_CREATE_INFO};
+  std::strcpy(ci.applicationInfo.applicationName, "fovea_runtime_tests");
+  ci.applicationInfo.apiVersion = XR_CURRENT_API_VERSION;
+  XrInstance inst = XR_NULL_HANDLE;
+  EXPECT_EQ(xrCreateInstance(&ci, &inst), XR_ERROR_INITIALIZATION_FAILED);
+  unsetenv("FOVEA_RUNTIME_OUT");
+}
+
+// Honest pacing (realtime, the default), with a real slow frame and invariants only: the
+// predicted display time is never in the past when xrWaitFrame returns, even after a frame
+// five periods late; xrWaitFrame throttles again afterwards (it never returns before the
+// frame's wake time, one period plus the compositor budget before its display time); every
+// frame's display time is on the vsync grid and later than the previous one; the timing log
+// never shows a frame displayed before it was submitted.
+TEST_F(XrTest, PacingNeverPredictsThePast) {
+  TempDir dir("pacing");
+  setenv("FOVEA_RUNTIME_OUT", dir.path().c_str(), 1);
+  setenv("FOVEA_RUNTIME_PNG_EVERY", "1000000", 1);
+  create_instance();
+  unsetenv("FOVEA_RUNTIME_OUT");
+  unsetenv("FOVEA_RUNTIME_PNG_EVERY");
+  run_to_focused();
+  XrFrameState first{XR_TYPE_FRAME_STATE};
+  ASSERT_EQ(frame({}, &first), XR_SUCCESS);
+  const XrDuration period = first.predictedDisplayPeriod;
+  const XrDuration budget = std::max<XrDuration>(period / 5, 3'000'000);
+  XrTime last = first.predictedDisplayTime;
+  XrFrameEndInfo ei{XR_TYPE_FRAME_END_INFO};
+  ei.environmentBlendMode = XR_ENVIRONMENT_BLEND_MODE_OPAQUE;
+  for (int i = 0; i < 8; ++i) {
+    XrFrameState fs{XR_TYPE_FRAME_STATE};
+    ASSERT_EQ(xrWaitFrame(session_, nullptr, &fs), XR_SUCCESS);
+    const XrTime returned = mono_now();
+    EXPECT_GT(fs.predictedDisplayTime, returned) << "frame " << i;
+    EXPECT_GE(returned, fs.predictedDisplayTime - period - budget) << "frame " << i << ": not throttled";
+    EXPECT_GT(fs.predictedDisplayTime, last);
+    EXPECT_EQ((fs.predictedDisplayTime - first.predictedDisplayTime) % period, 0);
+    last = fs.predictedDisplayTime;
+    ASSERT_EQ(xrBeginFrame(session_, nullptr), XR_SUCCESS);
+    if (i == 2) {  // a slow frame: five periods of work
+      const timespec slow{0, long(5 * period)};
+      nanosleep(&slow, nullptr);
+    }
+    ei.displayTime = fs.predictedDisplayTime;
+    ASSERT_EQ(xrEndFrame(session_, &ei), XR_SUCCESS);
+  }
+  ASSERT_EQ(xrDestroySession(session_), XR_SUCCESS);  // flushes nothing: records are flushed per frame
+  session_ = XR_NULL_HANDLE;
+  std::ifstream in(dir.path() + "/timing.jsonl");
+  int records = 0, missed = 0;
+  for (std::string line; std::getline(in, line); ++records) {
+    const auto field = [&](const char* name) {
+      const auto at = line.find(std::string("\"") + name + "\":");
+      EXPECT_NE(at, std::string::npos) << name;
+      return std::stoll(line.substr(at + std::strlen(name) + 3));
+    };
+    EXPECT_GE(field("displayed_ns"), field("end_call_ns")) << line;
+    EXPECT_GE(field("displayed_ns"), field("predicted_display_ns")) << line;
+    EXPECT_GT(field("predicted_display_ns"), field("wait_return_ns")) << line;
+    missed += int(field("missed_vsyncs"));
+  }
+  EXPECT_EQ(records, 10);
+  EXPECT_GE(missed, 4);  // the slow frame cost at least four vsyncs
+}
+
+// A pipelined engine: xrWaitFrame on one thread, xrBeginFrame/xrEndFrame on another (the
+// CTS's pipelined-submission pattern). Every call succeeds, no frame is discarded, display
+// times increase, and a further xrWaitFrame returns only after the previous frame was begun.
+TEST_F(XrTest, PipelinedFramesOnTwoThreads) {
+  create_instance();
+  run_to_focused();
+  const XrSwapchain sc = color_swapchain(64, 72);
+  const XrSpace local = reference_space(XR_REFERENCE_SPACE_TYPE_LOCAL);
+  constexpr int kFrames = 12;
+  std::mutex m;
+  std::condition_variable cv;
+  std::deque<XrTime> ready;
+  std::atomic<int> begun{0};
+  std::vector<XrResult> wait_results, end_results;
+  std::vector<int> begun_at_wait;  // frames begun when each xrWaitFrame returned
+  std::thread waiter([&] {
+    for (int i = 0; i < kFrames; ++i) {
+      XrFrameState fs{XR_TYPE_FRAME_STATE};
+      const XrResult r = xrWaitFrame(session_, nullptr, &fs);
+      std::lock_guard lock(m);
+      wait_results.push_back(r);
+      begun_at_wait.push_back(begun.load());
+      ready.push_back(r == XR_SUCCESS ? fs.predictedDisplayTime : 0);
+      cv.notify_all();
+    }
+  });
+  XrCompositionLayerProjectionView pv[2];
+  for (auto& v : pv) {
+    v = {XR_TYPE_COMPOSITION_LAYER_PROJECTION_VIEW};
+    v.pose.orientation.w = 1;
+    v.fov = {-0.8f, 0.8f, 0.8f, -0.8f};
+    v.subImage.swapchain = sc;
+    v.subImage.imageRect = {{0, 0}, {64, 72}};
+  }
+  XrCompositionLayerProjection layer{XR_TYPE_COMPOSITION_LAYER_PROJECTION};
+  layer.space = local;
+  layer.viewCount = 2;
+  layer.views = pv;
+  const XrCompositionLayerBaseHeader* layers[] = {reinterpret_cast<const XrCompositionLayerBaseHeader*>(&layer)};
+  XrTime last = 0;
+  std::vector<XrResult> begin_results;
+  for (int i = 0; i < kFrames; ++i) {
+    XrTime t = 0;
+    {
+      std::unique_lock lock(m);
+      cv.wait(lock, [&] { return !ready.empty(); });
+      t = ready.front();
+      ready.pop_front();
+    }
+    ++begun;  // before the call: the waiter may return as soon as the runtime has begun it
+    begin_results.push_back(xrBeginFrame(session_, nullptr));
+    EXPECT_GT(t, last);
+    last = t;
+    cycle(sc);
+    XrFrameEndInfo ei{XR_TYPE_FRAME_END_INFO};
+    ei.displayTime = t;
+    ei.environmentBlendMode = XR_ENVIRONMENT_BLEND_MODE_OPAQUE;
+    ei.layerCount = 1;
+    ei.layers = layers;
+    end_results.push_back(xrEndFrame(session_, &ei));
+  }
+  waiter.join();
+  for (int i = 0; i < kFrames; ++i) {
+    EXPECT_EQ(wait_results[size_t(i)], XR_SUCCESS) << i;
+    EXPECT_EQ(begin_results[size_t(i)], XR_SUCCESS) << i;
+    EXPECT_EQ(end_results[size_t(i)], XR_SUCCESS) << i;
+    EXPECT_GE(begun_at_wait[size_t(i)], i) << "xrWaitFrame " << i << " returned before frame " << i - 1 << " began";
+  }
 }
 
 TEST_F(XrTest, TimespecConversion) {
