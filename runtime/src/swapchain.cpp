@@ -19,8 +19,13 @@ constexpr uint32_t kImageCount = 3;
 
 bool depth_format(int64_t f) { return f == VK_FORMAT_D32_SFLOAT || f == VK_FORMAT_D16_UNORM; }
 
+// The application's usage (XR_KHR_vulkan_enable's table), plus sampling: the compositor
+// samples the images, as compositors do (the extension lets a runtime create images with at
+// least the requested usage; it also keeps an image with usage 0 creatable). Nothing else is
+// added, so an application or API layer that copies from its images must ask for
+// XR_SWAPCHAIN_USAGE_TRANSFER_SRC_BIT, as on other runtimes.
 VkImageUsageFlags vk_usage(XrSwapchainUsageFlags u) {
-  VkImageUsageFlags v = VK_IMAGE_USAGE_TRANSFER_SRC_BIT;  // the compositor reads the images back
+  VkImageUsageFlags v = VK_IMAGE_USAGE_SAMPLED_BIT;
   if (u & XR_SWAPCHAIN_USAGE_COLOR_ATTACHMENT_BIT) v |= VK_IMAGE_USAGE_COLOR_ATTACHMENT_BIT;
   if (u & XR_SWAPCHAIN_USAGE_DEPTH_STENCIL_ATTACHMENT_BIT) v |= VK_IMAGE_USAGE_DEPTH_STENCIL_ATTACHMENT_BIT;
   if (u & XR_SWAPCHAIN_USAGE_UNORDERED_ACCESS_BIT) v |= VK_IMAGE_USAGE_STORAGE_BIT;

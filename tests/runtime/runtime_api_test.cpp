@@ -979,12 +979,13 @@ TEST_F(XrTest, RuntimeOutDirectoryCreated) {
   unsetenv("FOVEA_RUNTIME_OUT");
 }
 
-// Honest pacing (realtime, the default), with a real slow frame and invariants only: the
-// predicted display time is never in the past when xrWaitFrame returns, even after a frame
-// five periods late; xrWaitFrame throttles again afterwards (it never returns before the
-// frame's wake time, one period plus the compositor budget before its display time); every
-// frame's display time is on the vsync grid and later than the previous one; the timing log
-// never shows a frame displayed before it was submitted.
+// Honest pacing (realtime, the default), with a real slow frame and invariants only (a
+// loaded host may deschedule the test at any point): the predicted display time is never
+// in the past — after the call, and in the runtime's record when it returned — even after a
+// frame five periods late; xrWaitFrame throttles again afterwards (it never returns before
+// the frame's wake time, one period plus the compositor budget before its display time);
+// every frame's display time is on the vsync grid and later than the previous one; the
+// timing log never shows a frame displayed before it was submitted.
 TEST_F(XrTest, PacingNeverPredictsThePast) {
   TempDir dir("pacing");
   setenv("FOVEA_RUNTIME_OUT", dir.path().c_str(), 1);
@@ -1002,9 +1003,10 @@ TEST_F(XrTest, PacingNeverPredictsThePast) {
   ei.environmentBlendMode = XR_ENVIRONMENT_BLEND_MODE_OPAQUE;
   for (int i = 0; i < 8; ++i) {
     XrFrameState fs{XR_TYPE_FRAME_STATE};
+    const XrTime called = mono_now();
     ASSERT_EQ(xrWaitFrame(session_, nullptr, &fs), XR_SUCCESS);
     const XrTime returned = mono_now();
-    EXPECT_GT(fs.predictedDisplayTime, returned) << "frame " << i;
+    EXPECT_GT(fs.predictedDisplayTime, called) << "frame " << i;
     EXPECT_GE(returned, fs.predictedDisplayTime - period - budget) << "frame " << i << ": not throttled";
     EXPECT_GT(fs.predictedDisplayTime, last);
     EXPECT_EQ((fs.predictedDisplayTime - first.predictedDisplayTime) % period, 0);
@@ -1104,6 +1106,131 @@ TEST_F(XrTest, PipelinedFramesOnTwoThreads) {
     EXPECT_EQ(end_results[size_t(i)], XR_SUCCESS) << i;
     EXPECT_GE(begun_at_wait[size_t(i)], i) << "xrWaitFrame " << i << " returned before frame " << i - 1 << " began";
   }
+}
+
+// Copies `image` (64×72 RGBA8, COLOR_ATTACHMENT_OPTIMAL) to a host buffer on the test's
+// device and back to its layout, as an API layer reading the application's images does.
+void copy_image_out(VkPhysicalDevice physical, VkDevice device, uint32_t family, VkImage image) {
+  VkBufferCreateInfo bi{VK_STRUCTURE_TYPE_BUFFER_CREATE_INFO};
+  bi.size = 64 * 72 * 4;
+  bi.usage = VK_BUFFER_USAGE_TRANSFER_DST_BIT;
+  VkBuffer buffer = VK_NULL_HANDLE;
+  ASSERT_EQ(vkCreateBuffer(device, &bi, nullptr, &buffer), VK_SUCCESS);
+  VkMemoryRequirements req;
+  vkGetBufferMemoryRequirements(device, buffer, &req);
+  VkPhysicalDeviceMemoryProperties mp;
+  vkGetPhysicalDeviceMemoryProperties(physical, &mp);
+  VkMemoryAllocateInfo ai{VK_STRUCTURE_TYPE_MEMORY_ALLOCATE_INFO};
+  ai.allocationSize = req.size;
+  for (uint32_t i = 0; i < mp.memoryTypeCount; ++i)
+    if ((req.memoryTypeBits & (1u << i)) && (mp.memoryTypes[i].propertyFlags & VK_MEMORY_PROPERTY_HOST_VISIBLE_BIT)) {
+      ai.memoryTypeIndex = i;
+      break;
+    }
+  VkDeviceMemory memory = VK_NULL_HANDLE;
+  ASSERT_EQ(vkAllocateMemory(device, &ai, nullptr, &memory), VK_SUCCESS);
+  ASSERT_EQ(vkBindBufferMemory(device, buffer, memory, 0), VK_SUCCESS);
+  VkCommandPoolCreateInfo pci{VK_STRUCTURE_TYPE_COMMAND_POOL_CREATE_INFO};
+  pci.queueFamilyIndex = family;
+  VkCommandPool pool = VK_NULL_HANDLE;
+  ASSERT_EQ(vkCreateCommandPool(device, &pci, nullptr, &pool), VK_SUCCESS);
+  VkCommandBufferAllocateInfo cai{VK_STRUCTURE_TYPE_COMMAND_BUFFER_ALLOCATE_INFO};
+  cai.commandPool = pool;
+  cai.level = VK_COMMAND_BUFFER_LEVEL_PRIMARY;
+  cai.commandBufferCount = 1;
+  VkCommandBuffer cmd = VK_NULL_HANDLE;
+  ASSERT_EQ(vkAllocateCommandBuffers(device, &cai, &cmd), VK_SUCCESS);
+  VkCommandBufferBeginInfo begin{VK_STRUCTURE_TYPE_COMMAND_BUFFER_BEGIN_INFO};
+  vkBeginCommandBuffer(cmd, &begin);
+  VkImageMemoryBarrier b{VK_STRUCTURE_TYPE_IMAGE_MEMORY_BARRIER};
+  b.srcAccessMask = VK_ACCESS_COLOR_ATTACHMENT_WRITE_BIT;
+  b.dstAccessMask = VK_ACCESS_TRANSFER_READ_BIT;
+  b.oldLayout = VK_IMAGE_LAYOUT_COLOR_ATTACHMENT_OPTIMAL;
+  b.newLayout = VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL;
+  b.srcQueueFamilyIndex = b.dstQueueFamilyIndex = VK_QUEUE_FAMILY_IGNORED;
+  b.image = image;
+  b.subresourceRange = {VK_IMAGE_ASPECT_COLOR_BIT, 0, 1, 0, 1};
+  vkCmdPipelineBarrier(cmd, VK_PIPELINE_STAGE_COLOR_ATTACHMENT_OUTPUT_BIT, VK_PIPELINE_STAGE_TRANSFER_BIT, 0, 0, nullptr,
+                       0, nullptr, 1, &b);
+  VkBufferImageCopy region{};
+  region.imageSubresource = {VK_IMAGE_ASPECT_COLOR_BIT, 0, 0, 1};
+  region.imageExtent = {64, 72, 1};
+  vkCmdCopyImageToBuffer(cmd, image, VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL, buffer, 1, &region);
+  std::swap(b.oldLayout, b.newLayout);
+  b.srcAccessMask = VK_ACCESS_TRANSFER_READ_BIT;
+  b.dstAccessMask = VK_ACCESS_COLOR_ATTACHMENT_WRITE_BIT;
+  vkCmdPipelineBarrier(cmd, VK_PIPELINE_STAGE_TRANSFER_BIT, VK_PIPELINE_STAGE_COLOR_ATTACHMENT_OUTPUT_BIT, 0, 0, nullptr,
+                       0, nullptr, 1, &b);
+  vkEndCommandBuffer(cmd);
+  VkQueue queue = VK_NULL_HANDLE;
+  vkGetDeviceQueue(device, family, 0, &queue);
+  VkSubmitInfo si{VK_STRUCTURE_TYPE_SUBMIT_INFO};
+  si.commandBufferCount = 1;
+  si.pCommandBuffers = &cmd;
+  EXPECT_EQ(vkQueueSubmit(queue, 1, &si, VK_NULL_HANDLE), VK_SUCCESS);
+  vkQueueWaitIdle(queue);
+  vkDestroyCommandPool(device, pool, nullptr);
+  vkDestroyBuffer(device, buffer, nullptr);
+  vkFreeMemory(device, memory, nullptr);
+}
+
+// Swapchain images carry the usage the application asked for (plus the sampling the
+// compositor needs), never an unrequested transfer source: copying from an image of a
+// swapchain created without XR_SWAPCHAIN_USAGE_TRANSFER_SRC_BIT is reported by the Vulkan
+// validation layer, as it would be on other runtimes, and from one created with it is not.
+// The compositor itself reads an attachment-only swapchain cleanly (by sampling).
+TEST_F(XrTest, SwapchainUsageIsWhatWasAsked) {
+  const char* v = std::getenv("FOVEA_VK_VALIDATION");
+  if (!v || std::string(v) != "1") GTEST_SKIP() << "needs FOVEA_VK_VALIDATION=1 (the validation layer observes the usage)";
+  TempDir dir("usage");
+  setenv("FOVEA_RUNTIME_OUT", dir.path().c_str(), 1);
+  create_instance();
+  unsetenv("FOVEA_RUNTIME_OUT");
+  run_to_focused();
+  const auto make = [&](XrSwapchainUsageFlags usage) {
+    XrSwapchainCreateInfo ci{XR_TYPE_SWAPCHAIN_CREATE_INFO};
+    ci.usageFlags = usage;
+    ci.format = VK_FORMAT_R8G8B8A8_SRGB;
+    ci.sampleCount = ci.faceCount = ci.arraySize = ci.mipCount = 1;
+    ci.width = 64;
+    ci.height = 72;
+    XrSwapchain sc = XR_NULL_HANDLE;
+    EXPECT_EQ(xrCreateSwapchain(session_, &ci, &sc), XR_SUCCESS);
+    uint32_t n = 3, i = 0;
+    std::vector<XrSwapchainImageVulkan2KHR> images(n, {XR_TYPE_SWAPCHAIN_IMAGE_VULKAN2_KHR});
+    EXPECT_EQ(xrEnumerateSwapchainImages(sc, n, &n, reinterpret_cast<XrSwapchainImageBaseHeader*>(images.data())),
+              XR_SUCCESS);
+    EXPECT_EQ(xrAcquireSwapchainImage(sc, nullptr, &i), XR_SUCCESS);
+    XrSwapchainImageWaitInfo wi{XR_TYPE_SWAPCHAIN_IMAGE_WAIT_INFO};
+    wi.timeout = XR_INFINITE_DURATION;
+    EXPECT_EQ(xrWaitSwapchainImage(sc, &wi), XR_SUCCESS);
+    return std::pair{sc, images[i].image};
+  };
+  const auto copyable = make(XR_SWAPCHAIN_USAGE_COLOR_ATTACHMENT_BIT | XR_SWAPCHAIN_USAGE_TRANSFER_SRC_BIT);
+  const auto attachment = make(XR_SWAPCHAIN_USAGE_COLOR_ATTACHMENT_BIT);
+  copy_image_out(vk_physical_, vk_device_, queue_family_, copyable.second);
+  EXPECT_EQ(validation_errors_, 0) << "copy from a swapchain created with the transfer-source usage";
+  expect_validation_errors(true);
+  copy_image_out(vk_physical_, vk_device_, queue_family_, attachment.second);
+  expect_validation_errors(false);
+  EXPECT_GT(validation_errors_, 0) << "copy from a swapchain created without it";
+  validation_errors_ = 0;
+  for (auto sc : {copyable.first, attachment.first}) ASSERT_EQ(xrReleaseSwapchainImage(sc, nullptr), XR_SUCCESS);
+  XrCompositionLayerProjectionView pv[2];
+  for (auto& view : pv) {
+    view = {XR_TYPE_COMPOSITION_LAYER_PROJECTION_VIEW};
+    view.pose.orientation.w = 1;
+    view.fov = {-0.8f, 0.8f, 0.8f, -0.8f};
+    view.subImage.swapchain = attachment.first;
+    view.subImage.imageRect = {{0, 0}, {64, 72}};
+  }
+  XrCompositionLayerProjection layer{XR_TYPE_COMPOSITION_LAYER_PROJECTION};
+  layer.space = reference_space(XR_REFERENCE_SPACE_TYPE_LOCAL);
+  layer.viewCount = 2;
+  layer.views = pv;
+  ASSERT_EQ(frame({reinterpret_cast<const XrCompositionLayerBaseHeader*>(&layer)}), XR_SUCCESS);
+  EXPECT_TRUE(std::filesystem::exists(dir.path() + "/panel_000001_left.png"));
+  // TearDown: no validation message from the compositor's read.
 }
 
 TEST_F(XrTest, TimespecConversion) {
