@@ -33,6 +33,16 @@ FrameSlot DisplayClock::next(core::TimeNs now) {
   return s;
 }
 
+void DisplayClock::reslot(FrameSlot& s, core::TimeNs now) {
+  if (pacing_ != Pacing::Realtime) return;
+  const std::int64_t skip = (displayed(s.display_ns, now) - s.display_ns) / period_;
+  s.vsync += skip;
+  s.missed += skip;
+  s.display_ns += skip * period_;
+  s.wake_ns += skip * period_;
+  next_vsync_ = s.vsync + 1;
+}
+
 core::TimeNs DisplayClock::displayed(core::TimeNs display_ns, core::TimeNs submitted_ns) const {
   const core::TimeNs ready = submitted_ns + budget_;  // the compositor's share of the frame
   if (ready <= display_ns) return display_ns;

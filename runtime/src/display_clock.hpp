@@ -39,6 +39,10 @@ class DisplayClock {
   // shown: its vsync if the compositor budget is left before it, else the first later vsync
   // that leaves it. Never earlier than the submission.
   core::TimeNs displayed(core::TimeNs display_ns, core::TimeNs submitted_ns) const;
+  // Realtime: for the slot just returned by next(), when xrWaitFrame wakes at `now` so late
+  // (a loaded host) that less than the compositor budget is left before its vsync, moves it
+  // to the first vsync that leaves it, so the prediction is still ahead when the call returns.
+  void reslot(FrameSlot& s, core::TimeNs now);
   core::TimeNs epoch() const { return t0_; }
   bool started() const { return started_; }
 

@@ -110,10 +110,7 @@ XrResult api::xrWaitFrame(XrSession session, const XrFrameWaitInfo* info, XrFram
       if (!s) return XR_ERROR_HANDLE_INVALID;
       if (!s->running) return XR_ERROR_SESSION_NOT_RUNNING;
     }
-    const FrameSlot slot = s->clock.next(core::now_ns());
-    r.frame = slot.index;
-    r.predicted_display_ns = slot.display_ns;
-    r.missed_vsyncs = slot.missed;
+    FrameSlot slot = s->clock.next(core::now_ns());
     if (s->queued_state == XR_SESSION_STATE_READY) s->queue_state(XR_SESSION_STATE_SYNCHRONIZED);
     // Other threads may use the runtime while this one sleeps.
     s->wait_sleeping = true;
@@ -126,6 +123,10 @@ XrResult api::xrWaitFrame(XrSession session, const XrFrameWaitInfo* info, XrFram
     if (!s->running) return XR_ERROR_SESSION_NOT_RUNNING;  // ended while this call slept
     r.wait_return_ns = core::now_ns();
     r.late_ns = std::max<core::TimeNs>(0, r.wait_return_ns - slot.wake_ns);
+    s->clock.reslot(slot, r.wait_return_ns);
+    r.frame = slot.index;
+    r.predicted_display_ns = slot.display_ns;
+    r.missed_vsyncs = slot.missed;
     s->waited.push_back(r);
     state->predictedDisplayTime = slot.display_ns;
     state->predictedDisplayPeriod = s->clock.period();

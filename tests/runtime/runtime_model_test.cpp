@@ -64,6 +64,18 @@ TEST(DisplayClock, RealtimeSkipsMissedVsyncsAndThrottlesAgain) {
   // Exactly on the wake time is on time.
   const FrameSlot g = c.next(last - p - c.compositor_budget() + p);
   EXPECT_EQ(g.missed, 0);
+  // Woken on time: the slot stays. Woken after its vsync (a descheduled thread): it moves to
+  // the first vsync that leaves the compositor budget, and the next slot follows it.
+  FrameSlot h = c.next(g.wake_ns);
+  const FrameSlot h0 = h;
+  c.reslot(h, h.wake_ns + 1000);
+  EXPECT_EQ(h.display_ns, h0.display_ns);
+  const core::TimeNs woke = h.display_ns + 2 * p + p / 3;
+  c.reslot(h, woke);
+  EXPECT_GE(h.display_ns, woke + c.compositor_budget());
+  EXPECT_LT(h.display_ns - p, woke + c.compositor_budget());
+  EXPECT_EQ(h.missed, h0.missed + 3);
+  EXPECT_EQ(c.next(woke).display_ns, h.display_ns + p);
 }
 
 // A frame is displayed at its predicted vsync when submitted with the compositor budget to
