@@ -26,6 +26,29 @@ H bogus(std::uint64_t v) {
   return reinterpret_cast<H>(v);
 }
 
+// A stereo projection layer with both views on the whole of `sc` (64×72) in `space`.
+struct StereoLayer {
+  XrCompositionLayerProjectionView views[2];
+  XrCompositionLayerProjection layer{XR_TYPE_COMPOSITION_LAYER_PROJECTION};
+  StereoLayer(XrSwapchain sc, XrSpace space) {
+    for (auto& v : views) {
+      v = {XR_TYPE_COMPOSITION_LAYER_PROJECTION_VIEW};
+      v.pose.orientation.w = 1;
+      v.fov = {-0.8f, 0.8f, 0.8f, -0.8f};
+      v.subImage.swapchain = sc;
+      v.subImage.imageRect = {{0, 0}, {64, 72}};
+    }
+    layer.space = space;
+    layer.viewCount = 2;
+    layer.views = views;
+  }
+  StereoLayer(const StereoLayer&) = delete;  // `layer` points at `views`
+  StereoLayer& operator=(const StereoLayer&) = delete;
+  const XrCompositionLayerBaseHeader* header() const {
+    return reinterpret_cast<const XrCompositionLayerBaseHeader*>(&layer);
+  }
+};
+
 TEST_F(XrTest, InstanceBasics) {
   create_instance();
   XrInstanceProperties props{XR_TYPE_INSTANCE_PROPERTIES};
@@ -350,20 +373,10 @@ TEST_F(XrTest, SwapchainAcquireWaitRelease) {
   // Layers: a released swapchain with a valid rect is accepted, a bad rect or an
   // unreleased swapchain is not.
   const XrSpace local = reference_space(XR_REFERENCE_SPACE_TYPE_LOCAL);
-  XrCompositionLayerProjectionView pv[2];
-  for (auto& v : pv) {
-    v = {XR_TYPE_COMPOSITION_LAYER_PROJECTION_VIEW};
-    v.pose.orientation.w = 1;
-    v.fov = {-0.8f, 0.8f, 0.8f, -0.8f};
-    v.subImage.swapchain = sc;
-    v.subImage.imageRect = {{0, 0}, {64, 72}};
-  }
-  XrCompositionLayerProjection layer{XR_TYPE_COMPOSITION_LAYER_PROJECTION};
-  layer.space = local;
-  layer.viewCount = 2;
-  layer.views = pv;
-  const std::vector<const XrCompositionLayerBaseHeader*> layers{
-      reinterpret_cast<const XrCompositionLayerBaseHeader*>(&layer)};
+  StereoLayer stereo(sc, local);
+  auto& pv = stereo.views;
+  auto& layer = stereo.layer;
+  const std::vector<const XrCompositionLayerBaseHeader*> layers{stereo.header()};
   EXPECT_EQ(frame(layers), XR_SUCCESS);
   pv[1].subImage.imageRect = {{1, 0}, {64, 72}};
   EXPECT_EQ(frame(layers), XR_ERROR_SWAPCHAIN_RECT_INVALID);
@@ -528,9 +541,9 @@ TEST_F(XrTest, ControllerBindingsAcceptedButInactive) {
   EXPECT_EQ(xrSyncActions(session_, &sync), XR_SESSION_NOT_FOCUSED);
 }
 
-// An eye gaze action bound to the eye gaze interaction profile, attached and synced; the
-// session must be running. Returns the action space.
-XrSpace make_gaze_space(XrInstance instance, XrSession session) {
+// An eye gaze pose action in a new action set `set`, suggested on the eye gaze interaction
+// profile and attached to the session.
+XrAction attach_gaze_action(XrInstance instance, XrSession session, XrActionSet* set_out) {
   XrActionSetCreateInfo asci{XR_TYPE_ACTION_SET_CREATE_INFO};
   std::strcpy(asci.actionSetName, "eyes");
   std::strcpy(asci.localizedActionSetName, "Eyes");
@@ -555,6 +568,15 @@ XrSpace make_gaze_space(XrInstance instance, XrSession session) {
   ai.countActionSets = 1;
   ai.actionSets = &set;
   EXPECT_EQ(xrAttachSessionActionSets(session, &ai), XR_SUCCESS);
+  *set_out = set;
+  return gaze;
+}
+
+// An eye gaze action bound to the eye gaze interaction profile, attached and synced; the
+// session must be running. Returns the action space.
+XrSpace make_gaze_space(XrInstance instance, XrSession session) {
+  XrActionSet set = XR_NULL_HANDLE;
+  const XrAction gaze = attach_gaze_action(instance, session, &set);
   XrEventDataBuffer ev{XR_TYPE_EVENT_DATA_BUFFER};
   EXPECT_EQ(xrPollEvent(instance, &ev), XR_SUCCESS);
   EXPECT_EQ(ev.type, XR_TYPE_EVENT_DATA_INTERACTION_PROFILE_CHANGED);
@@ -562,6 +584,8 @@ XrSpace make_gaze_space(XrInstance instance, XrSession session) {
   XrPath eyes = XR_NULL_PATH;
   EXPECT_EQ(xrStringToPath(instance, "/user/eyes_ext", &eyes), XR_SUCCESS);
   EXPECT_EQ(xrGetCurrentInteractionProfile(session, eyes, &ips), XR_SUCCESS);
+  XrPath profile = XR_NULL_PATH;
+  EXPECT_EQ(xrStringToPath(instance, "/interaction_profiles/ext/eye_gaze_interaction", &profile), XR_SUCCESS);
   EXPECT_EQ(ips.interactionProfile, profile);
   XrActiveActionSet active{set, XR_NULL_PATH};
   XrActionsSyncInfo sync{XR_TYPE_ACTIONS_SYNC_INFO};
@@ -884,19 +908,7 @@ TEST_F(XrTest, CtsEyeGazeInactiveWhenNotFocused) {
   create_instance({XR_EXT_EYE_GAZE_INTERACTION_EXTENSION_NAME});
   create_session();
   XrActionSet set = XR_NULL_HANDLE;
-  ASSERT_EQ(create_set(instance_, "eyes", "Eyes", &set), XR_SUCCESS);
-  XrAction gaze = XR_NULL_HANDLE;
-  ASSERT_EQ(create_action(set, "gaze", "Gaze", XR_ACTION_TYPE_POSE_INPUT, &gaze), XR_SUCCESS);
-  XrActionSuggestedBinding b{gaze, path("/user/eyes_ext/input/gaze_ext/pose")};
-  XrInteractionProfileSuggestedBinding s{XR_TYPE_INTERACTION_PROFILE_SUGGESTED_BINDING};
-  s.interactionProfile = path("/interaction_profiles/ext/eye_gaze_interaction");
-  s.countSuggestedBindings = 1;
-  s.suggestedBindings = &b;
-  ASSERT_EQ(xrSuggestInteractionProfileBindings(instance_, &s), XR_SUCCESS);
-  XrSessionActionSetsAttachInfo ai{XR_TYPE_SESSION_ACTION_SETS_ATTACH_INFO};
-  ai.countActionSets = 1;
-  ai.actionSets = &set;
-  ASSERT_EQ(xrAttachSessionActionSets(session_, &ai), XR_SUCCESS);
+  const XrAction gaze = attach_gaze_action(instance_, session_, &set);
   XrActionSpaceCreateInfo sci{XR_TYPE_ACTION_SPACE_CREATE_INFO};
   sci.action = gaze;
   sci.poseInActionSpace.orientation.w = 1;
@@ -1064,19 +1076,8 @@ TEST_F(XrTest, PipelinedFramesOnTwoThreads) {
       cv.notify_all();
     }
   });
-  XrCompositionLayerProjectionView pv[2];
-  for (auto& v : pv) {
-    v = {XR_TYPE_COMPOSITION_LAYER_PROJECTION_VIEW};
-    v.pose.orientation.w = 1;
-    v.fov = {-0.8f, 0.8f, 0.8f, -0.8f};
-    v.subImage.swapchain = sc;
-    v.subImage.imageRect = {{0, 0}, {64, 72}};
-  }
-  XrCompositionLayerProjection layer{XR_TYPE_COMPOSITION_LAYER_PROJECTION};
-  layer.space = local;
-  layer.viewCount = 2;
-  layer.views = pv;
-  const XrCompositionLayerBaseHeader* layers[] = {reinterpret_cast<const XrCompositionLayerBaseHeader*>(&layer)};
+  const StereoLayer stereo(sc, local);
+  const XrCompositionLayerBaseHeader* layers[] = {stereo.header()};
   XrTime last = 0;
   std::vector<XrResult> begin_results;
   for (int i = 0; i < kFrames; ++i) {
@@ -1188,14 +1189,7 @@ TEST_F(XrTest, SwapchainUsageIsWhatWasAsked) {
   unsetenv("FOVEA_RUNTIME_OUT");
   run_to_focused();
   const auto make = [&](XrSwapchainUsageFlags usage) {
-    XrSwapchainCreateInfo ci{XR_TYPE_SWAPCHAIN_CREATE_INFO};
-    ci.usageFlags = usage;
-    ci.format = VK_FORMAT_R8G8B8A8_SRGB;
-    ci.sampleCount = ci.faceCount = ci.arraySize = ci.mipCount = 1;
-    ci.width = 64;
-    ci.height = 72;
-    XrSwapchain sc = XR_NULL_HANDLE;
-    EXPECT_EQ(xrCreateSwapchain(session_, &ci, &sc), XR_SUCCESS);
+    const XrSwapchain sc = color_swapchain(64, 72, usage);
     uint32_t n = 3, i = 0;
     std::vector<XrSwapchainImageVulkan2KHR> images(n, {XR_TYPE_SWAPCHAIN_IMAGE_VULKAN2_KHR});
     EXPECT_EQ(xrEnumerateSwapchainImages(sc, n, &n, reinterpret_cast<XrSwapchainImageBaseHeader*>(images.data())),
@@ -1216,19 +1210,8 @@ TEST_F(XrTest, SwapchainUsageIsWhatWasAsked) {
   EXPECT_GT(validation_errors_, 0) << "copy from a swapchain created without it";
   validation_errors_ = 0;
   for (auto sc : {copyable.first, attachment.first}) ASSERT_EQ(xrReleaseSwapchainImage(sc, nullptr), XR_SUCCESS);
-  XrCompositionLayerProjectionView pv[2];
-  for (auto& view : pv) {
-    view = {XR_TYPE_COMPOSITION_LAYER_PROJECTION_VIEW};
-    view.pose.orientation.w = 1;
-    view.fov = {-0.8f, 0.8f, 0.8f, -0.8f};
-    view.subImage.swapchain = attachment.first;
-    view.subImage.imageRect = {{0, 0}, {64, 72}};
-  }
-  XrCompositionLayerProjection layer{XR_TYPE_COMPOSITION_LAYER_PROJECTION};
-  layer.space = reference_space(XR_REFERENCE_SPACE_TYPE_LOCAL);
-  layer.viewCount = 2;
-  layer.views = pv;
-  ASSERT_EQ(frame({reinterpret_cast<const XrCompositionLayerBaseHeader*>(&layer)}), XR_SUCCESS);
+  const StereoLayer stereo(attachment.first, reference_space(XR_REFERENCE_SPACE_TYPE_LOCAL));
+  ASSERT_EQ(frame({stereo.header()}), XR_SUCCESS);
   EXPECT_TRUE(std::filesystem::exists(dir.path() + "/panel_000001_left.png"));
   // TearDown: no validation message from the compositor's read.
 }

@@ -198,9 +198,9 @@ XrSpace XrTest::reference_space(XrReferenceSpaceType t, XrPosef pose) {
   return s;
 }
 
-XrSwapchain XrTest::color_swapchain(uint32_t w, uint32_t h) {
+XrSwapchain XrTest::color_swapchain(uint32_t w, uint32_t h, XrSwapchainUsageFlags usage) {
   XrSwapchainCreateInfo ci{XR_TYPE_SWAPCHAIN_CREATE_INFO};
-  ci.usageFlags = XR_SWAPCHAIN_USAGE_COLOR_ATTACHMENT_BIT | XR_SWAPCHAIN_USAGE_SAMPLED_BIT;
+  ci.usageFlags = usage;
   ci.format = VK_FORMAT_R8G8B8A8_SRGB;
   ci.sampleCount = 1;
   ci.width = w;
