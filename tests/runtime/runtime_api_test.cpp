@@ -265,7 +265,10 @@ TEST_F(XrTest, ExitAfterFrames) {
   EXPECT_EQ(poll_states(), (std::vector<XrSessionState>{XR_SESSION_STATE_IDLE, XR_SESSION_STATE_EXITING}));
 }
 
+// Lockstep pacing: consecutive frames are exactly one period apart however loaded the host
+// (realtime pacing: XrTest.DisplayClockThrottles, XrTest.PacingNeverPredictsThePast).
 TEST_F(XrTest, DisplayClock) {
+  setenv("FOVEA_RUNTIME_PACING", "lockstep", 1);
   create_instance();
   run_to_focused();
   XrFrameState a{XR_TYPE_FRAME_STATE}, b{XR_TYPE_FRAME_STATE};
@@ -278,6 +281,16 @@ TEST_F(XrTest, DisplayClock) {
   const XrTime t_now = XrTime(now.tv_sec) * 1'000'000'000 + now.tv_nsec;
   EXPECT_GT(b.predictedDisplayTime, t_now - 1'000'000'000);
   EXPECT_LT(b.predictedDisplayTime, t_now + 1'000'000'000);
+}
+
+// Realtime pacing (the default): an application faster than the display is paced by
+// xrWaitFrame, whatever happened before: each wait sleeps until its wake time, a period
+// after the previous one (lockstep lets an application that was late catch up unpaced).
+TEST_F(XrTest, DisplayClockThrottles) {
+  create_instance();
+  run_to_focused();
+  XrFrameState a{XR_TYPE_FRAME_STATE};
+  ASSERT_EQ(frame({}, &a), XR_SUCCESS);
   // An application faster than the display is paced by xrWaitFrame: 10 frames take at
   // least 9 periods of wall time.
   const auto mono = [] {
@@ -662,6 +675,7 @@ TEST_F(XrTest, EyeGazeReplay) {
     }
   }
   setenv("FOVEA_GAZE", ("replay:" + file).c_str(), 1);
+  setenv("FOVEA_RUNTIME_PACING", "lockstep", 1);  // frame 1 at the epoch plus one period
   create_instance({XR_EXT_EYE_GAZE_INTERACTION_EXTENSION_NAME});
   unsetenv("FOVEA_GAZE");
   run_to_focused();

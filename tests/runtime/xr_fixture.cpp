@@ -11,6 +11,7 @@ void XrTest::SetUp() {
   setenv("FOVEA_DISPLAY", "tiny", 1);
   unsetenv("FOVEA_RUNTIME_OUT");
   unsetenv("FOVEA_EXIT_AFTER_FRAMES");
+  unsetenv("FOVEA_RUNTIME_PACING");
   unsetenv("XR_ENABLE_API_LAYERS");
 }
 
