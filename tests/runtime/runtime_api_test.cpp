@@ -5,13 +5,8 @@
 #include <cstring>
 #include <limits>
 
-#include <atomic>
-#include <condition_variable>
-#include <deque>
 #include <filesystem>
 #include <fstream>
-#include <mutex>
-#include <thread>
 
 #include <glm/gtc/quaternion.hpp>
 
@@ -1062,65 +1057,6 @@ TEST_F(XrTest, PacingNeverPredictsThePast) {
   }
   EXPECT_EQ(records, 10);
   EXPECT_GE(missed, 4);  // the slow frame cost at least four vsyncs
-}
-
-// A pipelined engine: xrWaitFrame on one thread, xrBeginFrame/xrEndFrame on another (the
-// CTS's pipelined-submission pattern). Every call succeeds, no frame is discarded, display
-// times increase, and a further xrWaitFrame returns only after the previous frame was begun.
-TEST_F(XrTest, PipelinedFramesOnTwoThreads) {
-  create_instance();
-  run_to_focused();
-  const XrSwapchain sc = color_swapchain(64, 72);
-  const XrSpace local = reference_space(XR_REFERENCE_SPACE_TYPE_LOCAL);
-  constexpr int kFrames = 12;
-  std::mutex m;
-  std::condition_variable cv;
-  std::deque<XrTime> ready;
-  std::atomic<int> begun{0};
-  std::vector<XrResult> wait_results, end_results;
-  std::vector<int> begun_at_wait;  // frames begun when each xrWaitFrame returned
-  std::thread waiter([&] {
-    for (int i = 0; i < kFrames; ++i) {
-      XrFrameState fs{XR_TYPE_FRAME_STATE};
-      const XrResult r = xrWaitFrame(session_, nullptr, &fs);
-      std::lock_guard lock(m);
-      wait_results.push_back(r);
-      begun_at_wait.push_back(begun.load());
-      ready.push_back(r == XR_SUCCESS ? fs.predictedDisplayTime : 0);
-      cv.notify_all();
-    }
-  });
-  const StereoLayer stereo(sc, local);
-  const XrCompositionLayerBaseHeader* layers[] = {stereo.header()};
-  XrTime last = 0;
-  std::vector<XrResult> begin_results;
-  for (int i = 0; i < kFrames; ++i) {
-    XrTime t = 0;
-    {
-      std::unique_lock lock(m);
-      cv.wait(lock, [&] { return !ready.empty(); });
-      t = ready.front();
-      ready.pop_front();
-    }
-    ++begun;  // before the call: the waiter may return as soon as the runtime has begun it
-    begin_results.push_back(xrBeginFrame(session_, nullptr));
-    EXPECT_GT(t, last);
-    last = t;
-    cycle(sc);
-    XrFrameEndInfo ei{XR_TYPE_FRAME_END_INFO};
-    ei.displayTime = t;
-    ei.environmentBlendMode = XR_ENVIRONMENT_BLEND_MODE_OPAQUE;
-    ei.layerCount = 1;
-    ei.layers = layers;
-    end_results.push_back(xrEndFrame(session_, &ei));
-  }
-  waiter.join();
-  for (int i = 0; i < kFrames; ++i) {
-    EXPECT_EQ(wait_results[size_t(i)], XR_SUCCESS) << i;
-    EXPECT_EQ(begin_results[size_t(i)], XR_SUCCESS) << i;
-    EXPECT_EQ(end_results[size_t(i)], XR_SUCCESS) << i;
-    EXPECT_GE(begun_at_wait[size_t(i)], i) << "xrWaitFrame " << i << " returned before frame " << i - 1 << " began";
-  }
 }
 
 // Copies `image` (64×72 RGBA8, COLOR_ATTACHMENT_OPTIMAL) to a host buffer on the test's
