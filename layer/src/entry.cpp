@@ -73,7 +73,12 @@ XrResult XRAPI_CALL create_api_layer_instance(const XrInstanceCreateInfo* info, 
                                 strnlen(info->applicationInfo.applicationName, XR_MAX_APPLICATION_NAME_SIZE));
   bool want_gaze = false;
   try {
-    want_gaze = !load_config(application).scene.empty() && runtime_has_eye_gaze(next->nextGetInstanceProcAddr);
+    // Asked of the end of the chain (the loader's terminator, then the runtime): a layer below
+    // need not answer a global command without an instance (the core validation layer reports
+    // an internal error when asked).
+    const XrApiLayerNextInfo* last = next;
+    while (last->next) last = last->next;
+    want_gaze = !load_config(application).scene.empty() && runtime_has_eye_gaze(last->nextGetInstanceProcAddr);
   } catch (const std::exception& e) {
     FOVEA_LAYER_WARN("layer configuration: %s", e.what());  // reported again when the session starts
   }

@@ -1,4 +1,4 @@
-// Swapchain intercepts: forwarded unchanged; the layer records each swapchain's images
+// Swapchain intercepts: forwarded (creation with the transfer-source usage added); the layer records each swapchain's images
 // (enumerated by the layer itself at creation: an application need not enumerate them to
 // submit them) and which one was released last (what the application submits in xrEndFrame).
 #include <vector>
@@ -26,7 +26,15 @@ XrResult intercept::xrCreateSwapchain(XrSession session, const XrSwapchainCreate
     next = d->xrCreateSwapchain;
     enumerate = d->xrEnumerateSwapchainImages;
   }
-  const XrResult r = next(session, info, swapchain);
+  // The layer copies the application's released images back (colour, and depth for depth
+  // compositing), so it asks for the transfer usage that needs; anything else unchanged, and
+  // a malformed create info goes down as it is, for the runtime to report.
+  XrSwapchainCreateInfo readable{};
+  if (info && info->type == XR_TYPE_SWAPCHAIN_CREATE_INFO) {
+    readable = *info;
+    readable.usageFlags |= XR_SWAPCHAIN_USAGE_TRANSFER_SRC_BIT;
+  }
+  const XrResult r = next(session, readable.type == XR_TYPE_SWAPCHAIN_CREATE_INFO ? &readable : info, swapchain);
   if (XR_SUCCEEDED(r)) {
     // Without the images (an enumeration failure) the swapchain is never composited.
     std::vector<VkImage> images;

@@ -1,9 +1,9 @@
 // Actions. The simulated HMD has an eye tracker (XR_EXT_eye_gaze_interaction) and no
 // controllers: bindings for the common controller profiles are accepted and validated, but
 // those devices are never connected, so their actions stay inactive.
-#include <cstring>
-
 #include <algorithm>
+#include <optional>
+#include <string>
 
 #include "api.hpp"
 #include "state.hpp"
@@ -14,23 +14,66 @@ namespace {
 constexpr const char* kEyeGazeProfile = "/interaction_profiles/ext/eye_gaze_interaction";
 constexpr const char* kEyeGazePose = "/user/eyes_ext/input/gaze_ext/pose";
 
+// An interaction profile of the OpenXR 1.0 specification (section 6.4, "Interaction
+// Profile Paths") with its component paths. A component listed without a user path exists
+// on every user path of the profile; one prefixed "left:" or "right:" only on that hand.
+// Only what 1.0 lists: grip_surface (1.1, XR_EXT_palm_pose) and extension profiles are not
+// offered.
 struct Profile {
   const char* path;
-  std::vector<const char*> users;  // top-level user paths the profile binds
+  std::vector<const char*> users;       // top-level user paths the profile binds
+  std::vector<const char*> components;  // relative to the user path
 };
 
 const std::vector<Profile>& profiles() {
   static const std::vector<Profile> p = {
-      {"/interaction_profiles/khr/simple_controller", {"/user/hand/left", "/user/hand/right"}},
-      {"/interaction_profiles/google/daydream_controller", {"/user/hand/left", "/user/hand/right"}},
-      {"/interaction_profiles/htc/vive_controller", {"/user/hand/left", "/user/hand/right"}},
-      {"/interaction_profiles/htc/vive_pro", {"/user/head"}},
-      {"/interaction_profiles/microsoft/motion_controller", {"/user/hand/left", "/user/hand/right"}},
-      {"/interaction_profiles/microsoft/xbox_controller", {"/user/gamepad"}},
-      {"/interaction_profiles/oculus/go_controller", {"/user/hand/left", "/user/hand/right"}},
-      {"/interaction_profiles/oculus/touch_controller", {"/user/hand/left", "/user/hand/right"}},
-      {"/interaction_profiles/valve/index_controller", {"/user/hand/left", "/user/hand/right"}},
-      {kEyeGazeProfile, {"/user/eyes_ext"}},
+      {"/interaction_profiles/khr/simple_controller",
+       {"/user/hand/left", "/user/hand/right"},
+       {"input/select/click", "input/menu/click", "input/grip/pose", "input/aim/pose", "output/haptic"}},
+      {"/interaction_profiles/google/daydream_controller",
+       {"/user/hand/left", "/user/hand/right"},
+       {"input/select/click", "input/trackpad/x", "input/trackpad/y", "input/trackpad/click", "input/trackpad/touch",
+        "input/grip/pose", "input/aim/pose"}},
+      {"/interaction_profiles/htc/vive_controller",
+       {"/user/hand/left", "/user/hand/right"},
+       {"input/system/click", "input/squeeze/click", "input/menu/click", "input/trigger/click", "input/trigger/value",
+        "input/trackpad/x", "input/trackpad/y", "input/trackpad/click", "input/trackpad/touch", "input/grip/pose",
+        "input/aim/pose", "output/haptic"}},
+      {"/interaction_profiles/htc/vive_pro",
+       {"/user/head"},
+       {"input/system/click", "input/volume_up/click", "input/volume_down/click", "input/mute_mic/click"}},
+      {"/interaction_profiles/microsoft/motion_controller",
+       {"/user/hand/left", "/user/hand/right"},
+       {"input/menu/click", "input/squeeze/click", "input/trigger/value", "input/thumbstick/x", "input/thumbstick/y",
+        "input/thumbstick/click", "input/trackpad/x", "input/trackpad/y", "input/trackpad/click",
+        "input/trackpad/touch", "input/grip/pose", "input/aim/pose", "output/haptic"}},
+      {"/interaction_profiles/microsoft/xbox_controller",
+       {"/user/gamepad"},
+       {"input/menu/click", "input/view/click", "input/a/click", "input/b/click", "input/x/click", "input/y/click",
+        "input/dpad_down/click", "input/dpad_right/click", "input/dpad_up/click", "input/dpad_left/click",
+        "input/shoulder_left/click", "input/shoulder_right/click", "input/thumbstick_left/click",
+        "input/thumbstick_right/click", "input/trigger_left/value", "input/trigger_right/value",
+        "input/thumbstick_left/x", "input/thumbstick_left/y", "input/thumbstick_right/x", "input/thumbstick_right/y",
+        "output/haptic_left", "output/haptic_right", "output/haptic_left_trigger", "output/haptic_right_trigger"}},
+      {"/interaction_profiles/oculus/go_controller",
+       {"/user/hand/left", "/user/hand/right"},
+       {"input/system/click", "input/trigger/click", "input/back/click", "input/trackpad/x", "input/trackpad/y",
+        "input/trackpad/click", "input/trackpad/touch", "input/grip/pose", "input/aim/pose"}},
+      {"/interaction_profiles/oculus/touch_controller",
+       {"/user/hand/left", "/user/hand/right"},
+       {"left:input/x/click", "left:input/x/touch", "left:input/y/click", "left:input/y/touch", "left:input/menu/click",
+        "right:input/a/click", "right:input/a/touch", "right:input/b/click", "right:input/b/touch",
+        "right:input/system/click", "input/squeeze/value", "input/trigger/value", "input/trigger/touch",
+        "input/thumbstick/x", "input/thumbstick/y", "input/thumbstick/click", "input/thumbstick/touch",
+        "input/thumbrest/touch", "input/grip/pose", "input/aim/pose", "output/haptic"}},
+      {"/interaction_profiles/valve/index_controller",
+       {"/user/hand/left", "/user/hand/right"},
+       {"input/system/click", "input/system/touch", "input/a/click", "input/a/touch", "input/b/click", "input/b/touch",
+        "input/squeeze/value", "input/squeeze/force", "input/trigger/click", "input/trigger/value",
+        "input/trigger/touch", "input/thumbstick/x", "input/thumbstick/y", "input/thumbstick/click",
+        "input/thumbstick/touch", "input/trackpad/x", "input/trackpad/y", "input/trackpad/force",
+        "input/trackpad/touch", "input/grip/pose", "input/aim/pose", "output/haptic"}},
+      {kEyeGazeProfile, {"/user/eyes_ext"}, {"input/gaze_ext/pose"}},
   };
   return p;
 }
@@ -40,24 +83,40 @@ bool is_top_level_user_path(const std::string& s, bool eye_gaze) {
          (eye_gaze && s == "/user/eyes_ext");
 }
 
-// Action and action-set names: non-empty, [a-z0-9-_.] only.
-bool well_formed_name(const char* s, size_t size) {
-  if (!terminated(s, size) || !*s) return false;
+// Action and action-set names: [a-z0-9-_.] only (emptiness is checked separately: it has
+// its own error code).
+bool well_formed_name(const char* s) {
   for (; *s; ++s)
     if (!((*s >= 'a' && *s <= 'z') || (*s >= '0' && *s <= '9') || *s == '-' || *s == '_' || *s == '.')) return false;
   return true;
 }
 
-// A binding path the profile can bind: "<user path>/input/<component>..." or
-// "<user path>/output/haptic"; for the eye gaze profile exactly its gaze pose.
-bool bindable(const Profile& p, const std::string& b) {
-  if (!std::strcmp(p.path, kEyeGazeProfile)) return b == kEyeGazePose;
+// The error for a name field: XR_ERROR_NAME_INVALID when empty or unterminated,
+// XR_ERROR_PATH_FORMAT_INVALID when not a well-formed path component.
+XrResult check_name(const char* s, size_t size) {
+  if (!terminated(s, size) || !*s) return XR_ERROR_NAME_INVALID;
+  return well_formed_name(s) ? XR_SUCCESS : XR_ERROR_PATH_FORMAT_INVALID;
+}
+
+// The full component path a binding path names in the profile: "<user path>/<component>"
+// for a component on that user path, or an input identifier without its component
+// ("…/input/select"), which the specification lets the runtime resolve (to the first
+// component listed). nullopt when the profile has no such input or output.
+std::optional<std::string> bindable(const Profile& p, const std::string& b) {
   for (const char* u : p.users) {
     const std::string user = u;
-    if (b.rfind(user + "/input/", 0) == 0 && b.size() > user.size() + 7) return true;
-    if (b == user + "/output/haptic") return true;
+    if (b.size() <= user.size() + 1 || b.compare(0, user.size() + 1, user + "/") != 0) continue;
+    const std::string rest = b.substr(user.size() + 1);
+    const std::string hand = user.substr(user.rfind('/') + 1);  // "left", "right", …
+    for (std::string c : p.components) {
+      if (const auto colon = c.find(':'); colon != std::string::npos) {
+        if (c.substr(0, colon) != hand) continue;
+        c = c.substr(colon + 1);
+      }
+      if (rest == c || (c.rfind("input/", 0) == 0 && rest == c.substr(0, c.rfind('/')))) return user + "/" + c;
+    }
   }
-  return false;
+  return std::nullopt;
 }
 
 // The action's set attached to `s`, or the result code saying why not.
@@ -101,7 +160,7 @@ XrResult api::xrCreateActionSet(XrInstance instance, const XrActionSetCreateInfo
     Instance* inst = find<Instance>(instance);
     if (!inst) return XR_ERROR_HANDLE_INVALID;
     if (!has_type(info, XR_TYPE_ACTION_SET_CREATE_INFO) || !set) return XR_ERROR_VALIDATION_FAILURE;
-    if (!well_formed_name(info->actionSetName, sizeof info->actionSetName)) return XR_ERROR_PATH_FORMAT_INVALID;
+    if (XrResult r = check_name(info->actionSetName, sizeof info->actionSetName); r != XR_SUCCESS) return r;
     if (!terminated(info->localizedActionSetName, sizeof info->localizedActionSetName) ||
         !info->localizedActionSetName[0])
       return XR_ERROR_LOCALIZED_NAME_INVALID;
@@ -135,7 +194,7 @@ XrResult api::xrCreateAction(XrActionSet set, const XrActionCreateInfo* info, Xr
     if (!as) return XR_ERROR_HANDLE_INVALID;
     if (!has_type(info, XR_TYPE_ACTION_CREATE_INFO) || !action) return XR_ERROR_VALIDATION_FAILURE;
     if (as->attached) return XR_ERROR_ACTIONSETS_ALREADY_ATTACHED;
-    if (!well_formed_name(info->actionName, sizeof info->actionName)) return XR_ERROR_PATH_FORMAT_INVALID;
+    if (XrResult r = check_name(info->actionName, sizeof info->actionName); r != XR_SUCCESS) return r;
     if (!terminated(info->localizedActionName, sizeof info->localizedActionName) || !info->localizedActionName[0])
       return XR_ERROR_LOCALIZED_NAME_INVALID;
     switch (info->actionType) {
@@ -205,11 +264,12 @@ XrResult api::xrSuggestInteractionProfileBindings(XrInstance instance,
       if (!a || a->set->instance != inst) return XR_ERROR_HANDLE_INVALID;
       const std::string* bp = inst->path_string(b.binding);
       if (!bp) return XR_ERROR_PATH_INVALID;
-      if (!bindable(*profile, *bp)) {
+      const std::optional<std::string> component = bindable(*profile, *bp);
+      if (!component) {
         FOVEA_LOG_WARN("xrSuggestInteractionProfileBindings: binding %s is not in %s", bp->c_str(), profile->path);
         return XR_ERROR_PATH_UNSUPPORTED;
       }
-      bindings.push_back(b);
+      bindings.push_back({b.action, inst->path(*component)});
     }
     inst->suggested[info->interactionProfile] = std::move(bindings);
     return XR_SUCCESS;
@@ -332,7 +392,9 @@ XrResult api::xrGetActionStatePose(XrSession session, const XrActionStateGetInfo
       return r;
     const std::string* sub = s->instance->path_string(info->subactionPath);
     const bool eyes = !sub || *sub == "/user/eyes_ext";
-    state->isActive = (s->gaze_profile_active && a->gaze_bound() && eyes) ? XR_TRUE : XR_FALSE;
+    // Input reaches only the focused session (core spec, "Input Actions and Focus").
+    state->isActive =
+        (s->state == XR_SESSION_STATE_FOCUSED && s->gaze_profile_active && a->gaze_bound() && eyes) ? XR_TRUE : XR_FALSE;
     return XR_SUCCESS;
   });
 }

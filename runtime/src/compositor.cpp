@@ -8,13 +8,18 @@
 
 #include "fovea/compositor/distortion.hpp"
 #include "fovea/core/error.hpp"
+#include "fovea/shaders/embedded.hpp"
 #include "log.hpp"
 
 namespace fovea::runtime {
 namespace {
 
-bool is_bgra(VkFormat f) { return f == VK_FORMAT_B8G8R8A8_SRGB || f == VK_FORMAT_B8G8R8A8_UNORM; }
-bool is_srgb(VkFormat f) { return f == VK_FORMAT_B8G8R8A8_SRGB || f == VK_FORMAT_R8G8B8A8_SRGB; }
+// xr_readback.comp's push constants.
+struct ReadbackPush {
+  std::int32_t offset_x, offset_y;
+  std::uint32_t width, height, layer;
+};
+constexpr std::uint32_t kReadbackGroup = 8;  // local size in x and y
 
 bool same_fov(const core::Fov& a, const core::Fov& b) {
   constexpr double eps = 1e-6;
@@ -79,6 +84,12 @@ Compositor::Compositor(VkPhysicalDevice physical, VkDevice device, OneShotQueue&
 Compositor::~Compositor() {
   for (auto& p : passes_) p.reset();  // before their context
   gpu_.reset();
+  if (pool_) vkDestroyDescriptorPool(device_, pool_, nullptr);
+  if (pipeline_) vkDestroyPipeline(device_, pipeline_, nullptr);
+  if (shader_) vkDestroyShaderModule(device_, shader_, nullptr);
+  if (pipeline_layout_) vkDestroyPipelineLayout(device_, pipeline_layout_, nullptr);
+  if (set_layout_) vkDestroyDescriptorSetLayout(device_, set_layout_, nullptr);
+  if (sampler_) vkDestroySampler(device_, sampler_, nullptr);
   if (staging_) vkDestroyBuffer(device_, staging_, nullptr);
   if (staging_memory_) vkFreeMemory(device_, staging_memory_, nullptr);
 }
@@ -92,7 +103,7 @@ void Compositor::ensure_staging(VkDeviceSize bytes) {
   staging_size_ = 0;
   VkBufferCreateInfo bi{VK_STRUCTURE_TYPE_BUFFER_CREATE_INFO};
   bi.size = bytes;
-  bi.usage = VK_BUFFER_USAGE_TRANSFER_DST_BIT;
+  bi.usage = VK_BUFFER_USAGE_STORAGE_BUFFER_BIT;
   bi.sharingMode = VK_SHARING_MODE_EXCLUSIVE;
   vk_check(vkCreateBuffer(device_, &bi, nullptr, &staging_), "vkCreateBuffer");
   VkMemoryRequirements req;
@@ -106,41 +117,113 @@ void Compositor::ensure_staging(VkDeviceSize bytes) {
   staging_size_ = bytes;
 }
 
+void Compositor::ensure_pipeline() {
+  if (pipeline_) return;
+  VkSamplerCreateInfo si{VK_STRUCTURE_TYPE_SAMPLER_CREATE_INFO};
+  si.magFilter = si.minFilter = VK_FILTER_NEAREST;
+  si.addressModeU = si.addressModeV = si.addressModeW = VK_SAMPLER_ADDRESS_MODE_CLAMP_TO_EDGE;
+  vk_check(vkCreateSampler(device_, &si, nullptr, &sampler_), "vkCreateSampler");
+  const VkDescriptorSetLayoutBinding bindings[2] = {
+      {0, VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER, 1, VK_SHADER_STAGE_COMPUTE_BIT, nullptr},
+      {1, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, 1, VK_SHADER_STAGE_COMPUTE_BIT, nullptr}};
+  VkDescriptorSetLayoutCreateInfo li{VK_STRUCTURE_TYPE_DESCRIPTOR_SET_LAYOUT_CREATE_INFO};
+  li.bindingCount = 2;
+  li.pBindings = bindings;
+  vk_check(vkCreateDescriptorSetLayout(device_, &li, nullptr, &set_layout_), "vkCreateDescriptorSetLayout");
+  const VkPushConstantRange push{VK_SHADER_STAGE_COMPUTE_BIT, 0, sizeof(ReadbackPush)};
+  VkPipelineLayoutCreateInfo pli{VK_STRUCTURE_TYPE_PIPELINE_LAYOUT_CREATE_INFO};
+  pli.setLayoutCount = 1;
+  pli.pSetLayouts = &set_layout_;
+  pli.pushConstantRangeCount = 1;
+  pli.pPushConstantRanges = &push;
+  vk_check(vkCreatePipelineLayout(device_, &pli, nullptr, &pipeline_layout_), "vkCreatePipelineLayout");
+  const auto spv = shaders::find("xr_readback.comp.spv");
+  if (spv.empty()) throw std::runtime_error("xr_readback.comp.spv is not embedded");
+  VkShaderModuleCreateInfo mi{VK_STRUCTURE_TYPE_SHADER_MODULE_CREATE_INFO};
+  mi.codeSize = spv.size();
+  mi.pCode = reinterpret_cast<const std::uint32_t*>(spv.data());
+  vk_check(vkCreateShaderModule(device_, &mi, nullptr, &shader_), "vkCreateShaderModule");
+  VkComputePipelineCreateInfo ci{VK_STRUCTURE_TYPE_COMPUTE_PIPELINE_CREATE_INFO};
+  ci.stage = {VK_STRUCTURE_TYPE_PIPELINE_SHADER_STAGE_CREATE_INFO};
+  ci.stage.stage = VK_SHADER_STAGE_COMPUTE_BIT;
+  ci.stage.module = shader_;
+  ci.stage.pName = "main";
+  ci.layout = pipeline_layout_;
+  vk_check(vkCreateComputePipelines(device_, VK_NULL_HANDLE, 1, &ci, nullptr, &pipeline_), "vkCreateComputePipelines");
+  const VkDescriptorPoolSize sizes[2] = {{VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER, 1},
+                                         {VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, 1}};
+  VkDescriptorPoolCreateInfo pi{VK_STRUCTURE_TYPE_DESCRIPTOR_POOL_CREATE_INFO};
+  pi.maxSets = 1;
+  pi.poolSizeCount = 2;
+  pi.pPoolSizes = sizes;
+  vk_check(vkCreateDescriptorPool(device_, &pi, nullptr, &pool_), "vkCreateDescriptorPool");
+  VkDescriptorSetAllocateInfo ai{VK_STRUCTURE_TYPE_DESCRIPTOR_SET_ALLOCATE_INFO};
+  ai.descriptorPool = pool_;
+  ai.descriptorSetCount = 1;
+  ai.pSetLayouts = &set_layout_;
+  vk_check(vkAllocateDescriptorSets(device_, &ai, &set_), "vkAllocateDescriptorSets");
+}
+
 core::Image Compositor::read_back(const LayerView& v) {
   const int w = v.rect.extent.width, h = v.rect.extent.height;
-  ensure_staging(VkDeviceSize(w) * h * 4);
+  ensure_pipeline();
+  ensure_staging(VkDeviceSize(w) * h * sizeof(glm::vec4));
+  VkImageViewCreateInfo vi{VK_STRUCTURE_TYPE_IMAGE_VIEW_CREATE_INFO};
+  vi.image = v.image;
+  vi.viewType = VK_IMAGE_VIEW_TYPE_2D_ARRAY;
+  vi.format = v.format;
+  vi.subresourceRange = {VK_IMAGE_ASPECT_COLOR_BIT, 0, 1, v.array_layer, 1};
+  VkImageView view = VK_NULL_HANDLE;
+  vk_check(vkCreateImageView(device_, &vi, nullptr, &view), "vkCreateImageView");
+  struct ViewGuard {
+    VkDevice d;
+    VkImageView v;
+    ~ViewGuard() { vkDestroyImageView(d, v, nullptr); }
+  } guard{device_, view};
+  const VkDescriptorImageInfo ii{sampler_, view, VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL};
+  const VkDescriptorBufferInfo bi{staging_, 0, VK_WHOLE_SIZE};
+  VkWriteDescriptorSet writes[2] = {{VK_STRUCTURE_TYPE_WRITE_DESCRIPTOR_SET}, {VK_STRUCTURE_TYPE_WRITE_DESCRIPTOR_SET}};
+  writes[0].dstSet = writes[1].dstSet = set_;
+  writes[0].dstBinding = 0;
+  writes[0].descriptorCount = 1;
+  writes[0].descriptorType = VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER;
+  writes[0].pImageInfo = &ii;
+  writes[1].dstBinding = 1;
+  writes[1].descriptorCount = 1;
+  writes[1].descriptorType = VK_DESCRIPTOR_TYPE_STORAGE_BUFFER;
+  writes[1].pBufferInfo = &bi;
+  vkUpdateDescriptorSets(device_, 2, writes, 0, nullptr);
+  const ReadbackPush push{v.rect.offset.x, v.rect.offset.y, std::uint32_t(w), std::uint32_t(h), v.array_layer};
   queue_.run([&](VkCommandBuffer cmd) {
-    transition(cmd, v.image, false, VK_IMAGE_LAYOUT_COLOR_ATTACHMENT_OPTIMAL, VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL,
-               VK_ACCESS_COLOR_ATTACHMENT_WRITE_BIT, VK_ACCESS_TRANSFER_READ_BIT,
-               VK_PIPELINE_STAGE_COLOR_ATTACHMENT_OUTPUT_BIT, VK_PIPELINE_STAGE_TRANSFER_BIT);
-    VkBufferImageCopy r{};
-    r.imageSubresource = {VK_IMAGE_ASPECT_COLOR_BIT, 0, v.array_layer, 1};
-    r.imageOffset = {v.rect.offset.x, v.rect.offset.y, 0};
-    r.imageExtent = {uint32_t(w), uint32_t(h), 1};
-    vkCmdCopyImageToBuffer(cmd, v.image, VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL, staging_, 1, &r);
-    transition(cmd, v.image, false, VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL, VK_IMAGE_LAYOUT_COLOR_ATTACHMENT_OPTIMAL,
-               VK_ACCESS_TRANSFER_READ_BIT, VK_ACCESS_COLOR_ATTACHMENT_READ_BIT | VK_ACCESS_COLOR_ATTACHMENT_WRITE_BIT,
-               VK_PIPELINE_STAGE_TRANSFER_BIT, VK_PIPELINE_STAGE_COLOR_ATTACHMENT_OUTPUT_BIT);
+    transition(cmd, v.image, false, VK_IMAGE_LAYOUT_COLOR_ATTACHMENT_OPTIMAL, VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL,
+               VK_ACCESS_COLOR_ATTACHMENT_WRITE_BIT, VK_ACCESS_SHADER_READ_BIT,
+               VK_PIPELINE_STAGE_COLOR_ATTACHMENT_OUTPUT_BIT, VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT);
+    vkCmdBindPipeline(cmd, VK_PIPELINE_BIND_POINT_COMPUTE, pipeline_);
+    vkCmdBindDescriptorSets(cmd, VK_PIPELINE_BIND_POINT_COMPUTE, pipeline_layout_, 0, 1, &set_, 0, nullptr);
+    vkCmdPushConstants(cmd, pipeline_layout_, VK_SHADER_STAGE_COMPUTE_BIT, 0, sizeof push, &push);
+    vkCmdDispatch(cmd, (std::uint32_t(w) + kReadbackGroup - 1) / kReadbackGroup,
+                  (std::uint32_t(h) + kReadbackGroup - 1) / kReadbackGroup, 1);
+    transition(cmd, v.image, false, VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL, VK_IMAGE_LAYOUT_COLOR_ATTACHMENT_OPTIMAL,
+               VK_ACCESS_SHADER_READ_BIT, VK_ACCESS_COLOR_ATTACHMENT_READ_BIT | VK_ACCESS_COLOR_ATTACHMENT_WRITE_BIT,
+               VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT, VK_PIPELINE_STAGE_COLOR_ATTACHMENT_OUTPUT_BIT);
     VkBufferMemoryBarrier hb{VK_STRUCTURE_TYPE_BUFFER_MEMORY_BARRIER};
-    hb.srcAccessMask = VK_ACCESS_TRANSFER_WRITE_BIT;
+    hb.srcAccessMask = VK_ACCESS_SHADER_WRITE_BIT;
     hb.dstAccessMask = VK_ACCESS_HOST_READ_BIT;
     hb.srcQueueFamilyIndex = hb.dstQueueFamilyIndex = VK_QUEUE_FAMILY_IGNORED;
     hb.buffer = staging_;
     hb.size = VK_WHOLE_SIZE;
-    vkCmdPipelineBarrier(cmd, VK_PIPELINE_STAGE_TRANSFER_BIT, VK_PIPELINE_STAGE_HOST_BIT, 0, 0, nullptr, 1, &hb, 0,
-                         nullptr);
+    vkCmdPipelineBarrier(cmd, VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT, VK_PIPELINE_STAGE_HOST_BIT, 0, 0, nullptr, 1, &hb,
+                         0, nullptr);
   });
   void* mapped = nullptr;
   vk_check(vkMapMemory(device_, staging_memory_, 0, VK_WHOLE_SIZE, 0, &mapped), "vkMapMemory");
-  const auto* px = static_cast<const std::uint8_t*>(mapped);
+  // The view already decoded sRGB and swizzled BGRA; non-finite texels never reach the panel.
   core::Image img(w, h);
-  const bool bgra = is_bgra(v.format), srgb = is_srgb(v.format);
-  for (int i = 0; i < w * h; ++i) {
-    const std::uint8_t* p = px + size_t(i) * 4;
-    glm::vec4 c(p[bgra ? 2 : 0], p[1], p[bgra ? 0 : 2], p[3]);
-    c /= 255.0f;
-    if (srgb) c = {core::srgb_decode(c.x), core::srgb_decode(c.y), core::srgb_decode(c.z), c.w};
-    img.pixels[size_t(i)] = c;
+  const auto* texels = static_cast<const glm::vec4*>(mapped);
+  for (size_t i = 0; i < img.pixels.size(); ++i) {
+    const glm::vec4 c = texels[i];
+    img.pixels[i] = glm::vec4(std::isfinite(c.x) ? c.x : 0, std::isfinite(c.y) ? c.y : 0,
+                              std::isfinite(c.z) ? c.z : 0, std::isfinite(c.w) ? c.w : 1);
   }
   vkUnmapMemory(device_, staging_memory_);
   return img;

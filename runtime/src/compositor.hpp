@@ -53,15 +53,19 @@ class Compositor {
   // Whether frame `index` is one whose panel images are produced.
   bool wants(std::int64_t index) const { return !out_dir_.empty() && index % png_every_ == 0; }
   // Composes and writes <out>/panel_<index>_{left,right}.png. The images must be in
-  // COLOR_ATTACHMENT_OPTIMAL layout and owned by the session queue (as after release);
-  // they are left that way. Throws std::runtime_error on Vulkan or I/O failure.
+  // COLOR_ATTACHMENT_OPTIMAL layout, owned by the session queue (as after release) and
+  // sampleable (VK_IMAGE_USAGE_SAMPLED_BIT); they are left that way. Throws std::runtime_error on Vulkan or I/O failure.
   void compose(std::int64_t index, const std::vector<ProjectionLayer>& layers);
 
   static bool readable_format(VkFormat f);
 
  private:
+  // The view's rect in linear RGBA, read by sampling the image (xr_readback.comp on the
+  // application's device): swapchain images carry the sampled usage the runtime adds, not
+  // necessarily the transfer usage a copy would need.
   core::Image read_back(const LayerView& v);
   void ensure_staging(VkDeviceSize bytes);
+  void ensure_pipeline();
 
   VkPhysicalDevice physical_;
   VkDevice device_;
@@ -76,6 +80,14 @@ class Compositor {
   std::array<std::vector<std::uint8_t>, 2> visible_;
   std::string out_dir_;
   std::int64_t png_every_;
+  // The read-back pipeline (created at the first composed frame).
+  VkSampler sampler_ = VK_NULL_HANDLE;
+  VkDescriptorSetLayout set_layout_ = VK_NULL_HANDLE;
+  VkPipelineLayout pipeline_layout_ = VK_NULL_HANDLE;
+  VkShaderModule shader_ = VK_NULL_HANDLE;
+  VkPipeline pipeline_ = VK_NULL_HANDLE;
+  VkDescriptorPool pool_ = VK_NULL_HANDLE;
+  VkDescriptorSet set_ = VK_NULL_HANDLE;
   VkBuffer staging_ = VK_NULL_HANDLE;
   VkDeviceMemory staging_memory_ = VK_NULL_HANDLE;
   VkDeviceSize staging_size_ = 0;

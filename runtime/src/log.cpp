@@ -1,5 +1,6 @@
 #include "log.hpp"
 
+#include <cerrno>
 #include <cstdio>
 #include <cstdlib>
 #include <cstring>
@@ -38,7 +39,11 @@ const char* name(Level l) {
 void set_file_dir(const std::string& dir) {
   std::lock_guard lock(g_mutex);
   if (g_file) std::fclose(g_file);
-  g_file = dir.empty() ? nullptr : std::fopen((dir + "/runtime.log").c_str(), "a");
+  g_file = nullptr;
+  if (dir.empty()) return;
+  const std::string path = dir + "/runtime.log";
+  g_file = std::fopen(path.c_str(), "a");
+  if (!g_file) std::fprintf(stderr, "[fovea-runtime] error: %s: cannot open: %s\n", path.c_str(), std::strerror(errno));
 }
 
 void write(Level level, const char* fmt, ...) {

@@ -67,7 +67,7 @@ XrResult api::xrCreateSession(XrInstance instance, const XrSessionCreateInfo* in
         s->vk_physical, s->vk_device, *s->gpu, inst->display,
         std::array<const core::HiddenAreaMask*, 2>{inst->hidden[0].get(), inst->hidden[1].get()}, inst->config.lens,
         inst->config.out_dir, inst->config.png_every);
-    s->clock = DisplayClock(inst->display.refresh_hz);
+    s->clock = DisplayClock(inst->display.refresh_hz, inst->config.pacing);
     s->timing.open(inst->config.out_dir);
     Session* raw = s.get();
     const std::uint64_t id = add_object(std::move(s), inst->id);
@@ -118,6 +118,7 @@ XrResult api::xrEndSession(XrSession session) {
     s->running = false;
     s->frame_open = false;
     s->waited.clear();
+    frame_begun().notify_all();
     s->queue_state(XR_SESSION_STATE_IDLE);
     if (s->exit_requested) s->queue_state(XR_SESSION_STATE_EXITING);
     FOVEA_LOG_INFO("session ended after %lld frames", static_cast<long long>(s->frames_ended));

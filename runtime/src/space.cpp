@@ -40,11 +40,6 @@ bool known_reference(XrReferenceSpaceType t) {
   return t == XR_REFERENCE_SPACE_TYPE_VIEW || t == XR_REFERENCE_SPACE_TYPE_LOCAL || t == XR_REFERENCE_SPACE_TYPE_STAGE;
 }
 
-bool valid_reference_enum(XrReferenceSpaceType t) {
-  return known_reference(t) || t == XR_REFERENCE_SPACE_TYPE_UNBOUNDED_MSFT ||
-         t == XR_REFERENCE_SPACE_TYPE_COMBINED_EYE_VARJO;
-}
-
 core::Pose head_pose(const Session& s, XrTime t) { return s.instance->head.at(t - display_epoch(s)); }
 
 // The pose of `sp` in LOCAL space at time t, or nullopt when it is not tracked. For the eye
@@ -59,7 +54,9 @@ std::optional<core::Pose> world_pose(Session& s, const Space& sp, XrTime t, Gaze
     }
   } else {
     const auto* action = static_cast<const Action*>(find_object(sp.action, Kind::Action));
-    if (!action || !s.gaze_profile_active || !action->gaze_bound()) return std::nullopt;
+    // Untracked unless focused: an unfocused session receives no input.
+    if (!action || s.state != XR_SESSION_STATE_FOCUSED || !s.gaze_profile_active || !action->gaze_bound())
+      return std::nullopt;
     const GazeSample g = s.instance->gaze->sample_at(t, display_epoch(s));
     if (gaze) *gaze = g;
     if (!g.valid) return std::nullopt;
@@ -98,7 +95,7 @@ XrResult api::xrCreateReferenceSpace(XrSession session, const XrReferenceSpaceCr
     Session* s = find<Session>(session);
     if (!s) return XR_ERROR_HANDLE_INVALID;
     if (!has_type(info, XR_TYPE_REFERENCE_SPACE_CREATE_INFO) || !space) return XR_ERROR_VALIDATION_FAILURE;
-    if (!valid_reference_enum(info->referenceSpaceType)) return XR_ERROR_VALIDATION_FAILURE;
+    // Any other type, known or not (the CTS passes MAX_ENUM), is unsupported.
     if (!known_reference(info->referenceSpaceType)) return XR_ERROR_REFERENCE_SPACE_UNSUPPORTED;
     if (!valid_pose(info->poseInReferenceSpace)) return XR_ERROR_POSE_INVALID;
     auto sp = std::make_unique<Space>();
@@ -113,7 +110,8 @@ XrResult api::xrCreateReferenceSpace(XrSession session, const XrReferenceSpaceCr
 XrResult api::xrGetReferenceSpaceBoundsRect(XrSession session, XrReferenceSpaceType type, XrExtent2Df* bounds) {
   return guarded(__func__, [&]() -> XrResult {
     if (!find<Session>(session)) return XR_ERROR_HANDLE_INVALID;
-    if (!bounds || !valid_reference_enum(type)) return XR_ERROR_VALIDATION_FAILURE;
+    if (!bounds) return XR_ERROR_VALIDATION_FAILURE;
+    // Any other type, known or not (the CTS passes MAX_ENUM), is unsupported.
     if (!known_reference(type)) return XR_ERROR_REFERENCE_SPACE_UNSUPPORTED;
     if (type == XR_REFERENCE_SPACE_TYPE_STAGE) {
       *bounds = {2.0f, 2.0f};  // a 2 m x 2 m play area

@@ -50,6 +50,10 @@ Config read_config() {
   c.head = env("FOVEA_HEAD_POSE", c.head);
   c.vk_validation = env("FOVEA_VK_VALIDATION", "0") == "1";
   c.lens = parse_lens_mode(env("FOVEA_RUNTIME_LENS", "gpu"));
+  const std::string pacing = env("FOVEA_RUNTIME_PACING", "realtime");
+  if (pacing != "realtime" && pacing != "lockstep")
+    throw core::InputError("FOVEA_RUNTIME_PACING=" + pacing + ": expected realtime or lockstep");
+  c.pacing = pacing == "lockstep" ? Pacing::Lockstep : Pacing::Realtime;
   return c;
 }
 
@@ -96,6 +100,11 @@ std::mutex& api_mutex() {
   return m;
 }
 
+std::condition_variable& frame_begun() {
+  static std::condition_variable cv;
+  return cv;
+}
+
 std::uint64_t add_object(std::unique_ptr<Object> obj, std::uint64_t parent) {
   Table& t = table();
   const std::uint64_t id = t.next;
@@ -127,6 +136,7 @@ void destroy_object(std::uint64_t id) {
     if (obj->parent == id) kids.push_back(oid);
   for (std::uint64_t k : kids) destroy_object(k);
   t.objects.erase(id);
+  frame_begun().notify_all();  // a blocked xrWaitFrame rechecks its session
 }
 
 XrResult two_call_string(std::uint32_t capacity, std::uint32_t* count, char* out, const std::string& s) {

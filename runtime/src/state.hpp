@@ -3,6 +3,7 @@
 // ids looked up in one table (never dereferenced), so a stale or garbage handle is reported
 // as XR_ERROR_HANDLE_INVALID instead of crashing. One mutex serialises all commands.
 #include <array>
+#include <condition_variable>
 #include <cstdint>
 #include <deque>
 #include <map>
@@ -46,6 +47,7 @@ struct Config {
   std::string head = "scripted";       // FOVEA_HEAD_POSE
   bool vk_validation = false;          // FOVEA_VK_VALIDATION=1
   LensMode lens = LensMode::Gpu;       // FOVEA_RUNTIME_LENS: gpu | cpu | off
+  Pacing pacing = Pacing::Realtime;    // FOVEA_RUNTIME_PACING: realtime | lockstep
 };
 // Throws core::InputError naming the variable.
 Config read_config();
@@ -101,6 +103,7 @@ struct Session final : Object {
   std::int64_t frames_ended = 0;
   bool frame_open = false;  // between xrBeginFrame and xrEndFrame
   std::deque<FrameRecord> waited;  // frames returned by xrWaitFrame, not yet begun
+  bool wait_sleeping = false;      // an xrWaitFrame is sleeping until its wake time
   FrameRecord current;             // the open frame
   TimingLog timing;
   // Actions.
@@ -150,7 +153,7 @@ struct Swapchain final : Object {
   std::vector<VkDeviceMemory> memory;
   std::vector<bool> layout_ready;  // transitioned to the layout the application expects
   std::deque<std::uint32_t> acquired;  // acquired, not yet released, oldest first
-  std::uint32_t waited = 0;            // how many of `acquired` have been waited on
+  bool waited = false;                 // the oldest of `acquired` has been waited on
   std::uint32_t next_image = 0;
   std::int64_t last_released = -1;
   bool ever_acquired = false;
@@ -160,6 +163,9 @@ struct Swapchain final : Object {
 // ---- handle table -----------------------------------------------------------------------
 
 std::mutex& api_mutex();
+// Signalled (under api_mutex) when a frame is begun, a session ends or an object is
+// destroyed: a pipelined xrWaitFrame blocks on it until the previous frame has begun.
+std::condition_variable& frame_begun();
 std::uint64_t add_object(std::unique_ptr<Object> obj, std::uint64_t parent);
 Object* find_object(std::uint64_t id, Kind kind);
 void destroy_object(std::uint64_t id);  // and its children, children first

@@ -19,8 +19,13 @@ constexpr uint32_t kImageCount = 3;
 
 bool depth_format(int64_t f) { return f == VK_FORMAT_D32_SFLOAT || f == VK_FORMAT_D16_UNORM; }
 
+// The application's usage (XR_KHR_vulkan_enable's table), plus sampling: the compositor
+// samples the images, as compositors do (the extension lets a runtime create images with at
+// least the requested usage; it also keeps an image with usage 0 creatable). Nothing else is
+// added, so an application or API layer that copies from its images must ask for
+// XR_SWAPCHAIN_USAGE_TRANSFER_SRC_BIT, as on other runtimes.
 VkImageUsageFlags vk_usage(XrSwapchainUsageFlags u) {
-  VkImageUsageFlags v = VK_IMAGE_USAGE_TRANSFER_SRC_BIT;  // the compositor reads the images back
+  VkImageUsageFlags v = VK_IMAGE_USAGE_SAMPLED_BIT;
   if (u & XR_SWAPCHAIN_USAGE_COLOR_ATTACHMENT_BIT) v |= VK_IMAGE_USAGE_COLOR_ATTACHMENT_BIT;
   if (u & XR_SWAPCHAIN_USAGE_DEPTH_STENCIL_ATTACHMENT_BIT) v |= VK_IMAGE_USAGE_DEPTH_STENCIL_ATTACHMENT_BIT;
   if (u & XR_SWAPCHAIN_USAGE_UNORDERED_ACCESS_BIT) v |= VK_IMAGE_USAGE_STORAGE_BIT;
@@ -179,10 +184,12 @@ XrResult api::xrWaitSwapchainImage(XrSwapchain swapchain, const XrSwapchainImage
     Swapchain* sc = find<Swapchain>(swapchain);
     if (!sc) return XR_ERROR_HANDLE_INVALID;
     if (!has_type(info, XR_TYPE_SWAPCHAIN_IMAGE_WAIT_INFO)) return XR_ERROR_VALIDATION_FAILURE;
-    if (sc->waited >= sc->acquired.size()) return XR_ERROR_CALL_ORDER_INVALID;
+    // One image at a time: a waited image must be released before the next wait (core spec,
+    // xrWaitSwapchainImage), and only an acquired image can be waited on.
+    if (sc->waited || sc->acquired.empty()) return XR_ERROR_CALL_ORDER_INVALID;
     // The compositor finishes with an image inside xrEndFrame, so an acquired image is
     // always ready: no timeout can occur.
-    ++sc->waited;
+    sc->waited = true;
     return XR_SUCCESS;
   });
 }
@@ -192,10 +199,10 @@ XrResult api::xrReleaseSwapchainImage(XrSwapchain swapchain, const XrSwapchainIm
     Swapchain* sc = find<Swapchain>(swapchain);
     if (!sc) return XR_ERROR_HANDLE_INVALID;
     if (info && info->type != XR_TYPE_SWAPCHAIN_IMAGE_RELEASE_INFO) return XR_ERROR_VALIDATION_FAILURE;
-    if (sc->waited == 0) return XR_ERROR_CALL_ORDER_INVALID;
+    if (!sc->waited) return XR_ERROR_CALL_ORDER_INVALID;
     sc->last_released = sc->acquired.front();
     sc->acquired.pop_front();
-    --sc->waited;
+    sc->waited = false;
     return XR_SUCCESS;
   });
 }

@@ -43,8 +43,9 @@ XrResult api::xrGetSystem(XrInstance instance, const XrSystemGetInfo* getInfo, X
     Instance* inst = find<Instance>(instance);
     if (!inst) return XR_ERROR_HANDLE_INVALID;
     if (!has_type(getInfo, XR_TYPE_SYSTEM_GET_INFO) || !systemId) return XR_ERROR_VALIDATION_FAILURE;
-    if (getInfo->formFactor == XR_FORM_FACTOR_HANDHELD_DISPLAY) return XR_ERROR_FORM_FACTOR_UNSUPPORTED;
-    if (getInfo->formFactor != XR_FORM_FACTOR_HEAD_MOUNTED_DISPLAY) return XR_ERROR_VALIDATION_FAILURE;
+    // Any other value, known or not (the CTS passes XR_FORM_FACTOR_MAX_ENUM), is a form
+    // factor this runtime does not support.
+    if (getInfo->formFactor != XR_FORM_FACTOR_HEAD_MOUNTED_DISPLAY) return XR_ERROR_FORM_FACTOR_UNSUPPORTED;
     inst->system_queried = true;
     *systemId = kSystemId;
     return XR_SUCCESS;
@@ -148,7 +149,8 @@ XrResult api::xrGetVisibilityMaskKHR(XrSession session, XrViewConfigurationType 
     FOVEA_LOG_INFO("visibility mask: view %u type %d: %zu vertices, %zu indices (lens: %s)", viewIndex, int(maskType),
                    m.vertices.size(), m.indices.size(),
                    core::lens_model_name(s->instance->hidden[viewIndex]->lens().kind()));
-    if (mask->vertexCapacityInput == 0 && mask->indexCapacityInput == 0) return XR_SUCCESS;
+    // Either capacity 0 makes the call a size query (XR_KHR_visibility_mask).
+    if (mask->vertexCapacityInput == 0 || mask->indexCapacityInput == 0) return XR_SUCCESS;
     if (mask->vertexCapacityInput < m.vertices.size() || mask->indexCapacityInput < m.indices.size())
       return XR_ERROR_SIZE_INSUFFICIENT;
     std::copy(m.vertices.begin(), m.vertices.end(), mask->vertices);

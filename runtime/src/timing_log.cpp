@@ -1,6 +1,10 @@
 #include "timing_log.hpp"
 
+#include <cerrno>
 #include <cmath>
+#include <cstring>
+
+#include "log.hpp"
 
 namespace fovea::runtime {
 
@@ -10,24 +14,35 @@ TimingLog::~TimingLog() {
 
 void TimingLog::open(const std::string& dir) {
   if (file_) std::fclose(file_);
-  file_ = dir.empty() ? nullptr : std::fopen((dir + "/timing.jsonl").c_str(), "w");
+  file_ = nullptr;
+  if (dir.empty()) return;
+  path_ = dir + "/timing.jsonl";
+  file_ = std::fopen(path_.c_str(), "w");
+  if (!file_) FOVEA_LOG_ERROR("timing log %s: cannot open: %s", path_.c_str(), std::strerror(errno));
 }
 
 void TimingLog::write(const FrameRecord& r) {
   if (!file_) return;
   const double ms = std::isfinite(r.compositor_ms) ? r.compositor_ms : 0.0;
-  std::fprintf(file_,
-               "{\"frame\":%lld,\"predicted_display_ns\":%lld,\"wait_call_ns\":%lld,\"wait_return_ns\":%lld,"
-               "\"late_ns\":%lld,\"begin_ns\":%lld,\"end_call_ns\":%lld,\"end_return_ns\":%lld,"
-               "\"compositor_ms\":%.3f,\"composited\":%s,\"layers\":%u,\"gaze_sample_ns\":%lld,\"gaze_receive_ns\":%lld,"
-               "\"gaze_read_ns\":%lld,\"gaze_valid\":%s}\n",
-               static_cast<long long>(r.frame), static_cast<long long>(r.predicted_display_ns),
-               static_cast<long long>(r.wait_call_ns), static_cast<long long>(r.wait_return_ns),
-               static_cast<long long>(r.late_ns), static_cast<long long>(r.begin_ns),
-               static_cast<long long>(r.end_call_ns), static_cast<long long>(r.end_return_ns), ms,
-               r.composited ? "true" : "false", r.layers, static_cast<long long>(r.gaze_sample_ns),
-               static_cast<long long>(r.gaze_receive_ns), static_cast<long long>(r.gaze_read_ns), r.gaze_valid ? "true" : "false");
-  std::fflush(file_);
+  const int n = std::fprintf(
+      file_,
+      "{\"frame\":%lld,\"predicted_display_ns\":%lld,\"wait_call_ns\":%lld,\"wait_return_ns\":%lld,"
+      "\"late_ns\":%lld,\"missed_vsyncs\":%lld,\"begin_ns\":%lld,\"end_call_ns\":%lld,\"end_return_ns\":%lld,"
+      "\"displayed_ns\":%lld,\"compositor_ms\":%.3f,\"composited\":%s,\"layers\":%u,\"gaze_sample_ns\":%lld,"
+      "\"gaze_receive_ns\":%lld,\"gaze_read_ns\":%lld,\"gaze_valid\":%s}\n",
+      static_cast<long long>(r.frame), static_cast<long long>(r.predicted_display_ns),
+      static_cast<long long>(r.wait_call_ns), static_cast<long long>(r.wait_return_ns),
+      static_cast<long long>(r.late_ns), static_cast<long long>(r.missed_vsyncs), static_cast<long long>(r.begin_ns),
+      static_cast<long long>(r.end_call_ns), static_cast<long long>(r.end_return_ns),
+      static_cast<long long>(r.displayed_ns), ms, r.composited ? "true" : "false", r.layers,
+      static_cast<long long>(r.gaze_sample_ns), static_cast<long long>(r.gaze_receive_ns),
+      static_cast<long long>(r.gaze_read_ns), r.gaze_valid ? "true" : "false");
+  if (n < 0 || std::fflush(file_) != 0) {
+    FOVEA_LOG_ERROR("timing log %s: write failed at frame %lld: %s; no further records", path_.c_str(),
+                    static_cast<long long>(r.frame), std::strerror(errno));
+    std::fclose(file_);
+    file_ = nullptr;
+  }
 }
 
 }  // namespace fovea::runtime

@@ -14,8 +14,10 @@ struct FrameRecord {
   core::TimeNs predicted_display_ns = 0;
   core::TimeNs wait_call_ns = 0, wait_return_ns = 0;  // xrWaitFrame entry and return
   core::TimeNs late_ns = 0;                            // wait return past the frame's wake time
+  std::int64_t missed_vsyncs = 0;                      // vsyncs skipped because xrWaitFrame came late
   core::TimeNs begin_ns = 0;                           // xrBeginFrame
   core::TimeNs end_call_ns = 0, end_return_ns = 0;     // xrEndFrame entry and return
+  core::TimeNs displayed_ns = 0;  // the vsync that shows the frame (>= submission + compositor budget)
   double compositor_ms = 0;                            // read-back, resampling, mask, PNG
   bool composited = false;                             // panel images produced for this frame
   std::uint32_t layers = 0;
@@ -31,12 +33,14 @@ class TimingLog {
   ~TimingLog();
   TimingLog(const TimingLog&) = delete;
   TimingLog& operator=(const TimingLog&) = delete;
-  // Starts <dir>/timing.jsonl (truncating); an empty dir disables the log.
+  // Starts <dir>/timing.jsonl (truncating); an empty dir disables the log. A file that
+  // cannot be opened or written is reported (error log naming it), never silently dropped.
   void open(const std::string& dir);
   void write(const FrameRecord& r);
 
  private:
   std::FILE* file_ = nullptr;
+  std::string path_;
 };
 
 }  // namespace fovea::runtime

@@ -118,6 +118,26 @@ TEST(Layer, CoreValidationWithLayer) {
   EXPECT_EQ(line_count(out.path() + "/layer_timing.jsonl"), size_t(kFrames));
 }
 
+// The core validation layer below the layer, with a scene (the layer then asks below it
+// whether the runtime offers eye gaze): no internal validation error at start-up (it came
+// from asking core validation for a global command without an instance), no VUID.
+TEST(Layer, CoreValidationBelowLayerWithScene) {
+  TempDir out("layer_cv_below");
+  auto env = explicit_layer_env(out.path());
+  env["XR_ENABLE_API_LAYERS"] = std::string(kLayer) + ":XR_APILAYER_LUNARG_core_validation";
+  env["XR_API_LAYER_PATH"] = std::string(FOVEA_LAYER_EXPLICIT_DIR) + ":/usr/share/openxr/1/api_layers/explicit.d";
+  env["XR_CORE_VALIDATION_EXPORT_TYPE"] = "text";
+  env["XR_CORE_VALIDATION_FILE_NAME"] = out.path() + "/core_validation.txt";
+  env["FOVEA_SCENE"] = "cornell";
+  env["FOVEA_DISPLAY"] = "tiny";
+  env["FOVEA_EXIT_AFTER_FRAMES"] = "2";
+  const ProcessResult r = hello_xr(out.path(), env);
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  EXPECT_EQ(r.output.find("INTERNAL VALIDATION LAYER ERROR"), std::string::npos) << r.output;
+  const std::string cv = read_text(out.path() + "/core_validation.txt");
+  EXPECT_EQ(cv.find("VUID-"), std::string::npos) << cv;
+}
+
 class LayerApiTest : public XrTest {
  protected:
   void SetUp() override {

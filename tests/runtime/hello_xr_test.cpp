@@ -113,6 +113,36 @@ TEST(HelloXr, Vulkan2) { run_and_check("Vulkan2"); }
 
 TEST(HelloXr, Vulkan) { run_and_check("Vulkan"); }
 
+// hello_xr under realtime pacing (the default outside these comparisons), with the panel
+// composed every 4th frame making it late: every prediction is ahead of xrWaitFrame's return
+// and on the vsync grid, no wait returns before its wake time, no frame is displayed before
+// it was submitted.
+TEST(HelloXr, RealtimePacing) {
+  TempDir dir("hello_xr_rt");
+  auto env = runtime_env(dir.path(), kFrames, kPngEvery);
+  env["FOVEA_RUNTIME_PACING"] = "realtime";
+  const ProcessResult r = run_process({FOVEA_HELLO_XR, "-g", "Vulkan2"}, env, 120);
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  expect_clean_output(r);
+  const auto frames = timing(dir.path());
+  ASSERT_EQ(frames.size(), size_t(kFrames));
+  const std::int64_t period = 14285714;   // 70 Hz ("small")
+  const std::int64_t budget = 3'000'000;  // the compositor budget's 3 ms floor
+  const auto t = [](const nlohmann::json& f, const char* k) { return f[k].get<std::int64_t>(); };
+  for (size_t i = 0; i < frames.size(); ++i) {
+    const auto& f = frames[i];
+    EXPECT_GT(t(f, "predicted_display_ns"), t(f, "wait_return_ns")) << i;
+    EXPECT_GE(t(f, "wait_return_ns"), t(f, "predicted_display_ns") - period - budget) << i;
+    EXPECT_GE(t(f, "displayed_ns"), t(f, "end_call_ns") + budget) << i;
+    EXPECT_GE(t(f, "displayed_ns"), t(f, "predicted_display_ns")) << i;
+    if (i > 0) {
+      const std::int64_t dt = t(f, "predicted_display_ns") - t(frames[i - 1], "predicted_display_ns");
+      EXPECT_GE(dt, period - 1) << i;
+      EXPECT_EQ(dt % period, 0) << i;  // on the vsync grid
+    }
+  }
+}
+
 // The Khronos core validation layer between hello_xr and the runtime reports nothing.
 TEST(HelloXr, CoreValidationClean) {
   TempDir report("xr_cv");

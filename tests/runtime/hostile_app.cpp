@@ -1,13 +1,29 @@
 #include "hostile_app.hpp"
 
+#include <atomic>
+#include <condition_variable>
 #include <cstdlib>
+#include <deque>
 #include <fstream>
+#include <mutex>
+#include <thread>
+#include <vector>
 
 namespace fovea::test {
 
 namespace {
 
 const XrCompositionLayerBaseHeader* base(const void* p) { return static_cast<const XrCompositionLayerBaseHeader*>(p); }
+
+// An opaque frame end info for display time t with the one layer *layer.
+XrFrameEndInfo end_info(XrTime t, const XrCompositionLayerBaseHeader* const* layer) {
+  XrFrameEndInfo ei{XR_TYPE_FRAME_END_INFO};
+  ei.displayTime = t;
+  ei.environmentBlendMode = XR_ENVIRONMENT_BLEND_MODE_OPAQUE;
+  ei.layerCount = 1;
+  ei.layers = layer;
+  return ei;
+}
 
 template <class Handle>
 Handle garbage() {
@@ -115,11 +131,7 @@ void HostileApp::expect_end(const char* what, XrResult expected, const std::func
   const XrTime t = open_frame();
   for (XrSwapchain sc : eye_) cycle(sc);
   const XrCompositionLayerBaseHeader* layers[] = {projection()};
-  XrFrameEndInfo ei{XR_TYPE_FRAME_END_INFO};
-  ei.displayTime = t;
-  ei.environmentBlendMode = XR_ENVIRONMENT_BLEND_MODE_OPAQUE;
-  ei.layerCount = 1;
-  ei.layers = layers;
+  XrFrameEndInfo ei = end_info(t, layers);
   spoil(ei);
   expect(what, xrEndFrame(session_, &ei), expected);
 }
@@ -243,8 +255,10 @@ TEST_P(HostileApp, SwapchainMisuseIsRefusedWithTheirCodes) {
   expect("acquire info of the wrong structure type", xrAcquireSwapchainImage(sc, &wrong_acquire, &index),
          XR_ERROR_VALIDATION_FAILURE);
   expect("wait for acquired image 1", xrWaitSwapchainImage(sc, &wi), XR_SUCCESS);
-  expect("wait for acquired image 2", xrWaitSwapchainImage(sc, &wi), XR_SUCCESS);
+  // The CTS's pattern: a waited image must be released before the next wait.
+  expect("wait for image 2 before releasing image 1", xrWaitSwapchainImage(sc, &wi), XR_ERROR_CALL_ORDER_INVALID);
   expect("release image 1", xrReleaseSwapchainImage(sc, nullptr), XR_SUCCESS);
+  expect("wait for acquired image 2", xrWaitSwapchainImage(sc, &wi), XR_SUCCESS);
   expect("release image 2", xrReleaseSwapchainImage(sc, nullptr), XR_SUCCESS);
   expect("release image 3 (acquired, never waited)", xrReleaseSwapchainImage(sc, nullptr), XR_ERROR_CALL_ORDER_INVALID);
   expect("wait with a NULL wait info", xrWaitSwapchainImage(sc, nullptr), XR_ERROR_VALIDATION_FAILURE);
@@ -284,11 +298,7 @@ TEST_P(HostileApp, SwapchainMisuseIsRefusedWithTheirCodes) {
   expect("destroy an eye swapchain between acquire and release", xrDestroySwapchain(destroyed), XR_SUCCESS);
   expect("release the destroyed eye swapchain", xrReleaseSwapchainImage(destroyed, nullptr), XR_ERROR_HANDLE_INVALID);
   const XrCompositionLayerBaseHeader* layers[] = {projection()};
-  XrFrameEndInfo ei{XR_TYPE_FRAME_END_INFO};
-  ei.displayTime = t;
-  ei.environmentBlendMode = XR_ENVIRONMENT_BLEND_MODE_OPAQUE;
-  ei.layerCount = 1;
-  ei.layers = layers;
+  XrFrameEndInfo ei = end_info(t, layers);
   expect("xrEndFrame on the eye swapchain destroyed before release", xrEndFrame(session_, &ei), XR_ERROR_HANDLE_INVALID);
   eye_[1] = color_swapchain(width_, height_);
   cycle(eye_[1]);
@@ -389,5 +399,57 @@ TEST_P(HostileApp, OutOfOrderCallsAndDeadHandlesAreRefused) {
   expect("xrLocateSpace of a space of the destroyed session", xrLocateSpace(local_, local_, 1, &loc),
          XR_ERROR_HANDLE_INVALID);
 }
+
+// A pipelined engine (the CTS's pipelined-submission pattern): xrWaitFrame on one thread,
+// xrBeginFrame/xrEndFrame on another. Every call succeeds, no frame is discarded, display
+// times increase, and a further xrWaitFrame returns only after the previous frame was begun.
+TEST_P(HostileApp, PipelinedFramesOnTwoThreads) {
+  ASSERT_NO_FATAL_FAILURE(start());
+  constexpr int kFrames = 8;
+  std::mutex m;
+  std::condition_variable cv;
+  std::deque<XrTime> ready;
+  std::atomic<int> begun{0};
+  std::vector<XrResult> wait_results, begin_results, end_results;
+  std::vector<int> begun_at_wait;  // frames begun when each xrWaitFrame returned
+  std::thread waiter([&] {
+    for (int i = 0; i < kFrames; ++i) {
+      XrFrameState fs{XR_TYPE_FRAME_STATE};
+      const XrResult r = xrWaitFrame(session_, nullptr, &fs);
+      std::lock_guard lock(m);
+      wait_results.push_back(r);
+      begun_at_wait.push_back(begun.load());
+      ready.push_back(r == XR_SUCCESS ? fs.predictedDisplayTime : 0);
+      cv.notify_all();
+    }
+  });
+  XrTime last = 0;
+  for (int i = 0; i < kFrames; ++i) {
+    XrTime t = 0;
+    {
+      std::unique_lock lock(m);
+      cv.wait(lock, [&] { return !ready.empty(); });
+      t = ready.front();
+      ready.pop_front();
+    }
+    ++begun;  // before the call: the waiter may return as soon as the runtime has begun it
+    begin_results.push_back(xrBeginFrame(session_, nullptr));
+    EXPECT_GT(t, last);
+    last = t;
+    for (XrSwapchain sc : eye_) cycle(sc);
+    const XrCompositionLayerBaseHeader* layers[] = {projection()};
+    const XrFrameEndInfo ei = end_info(t, layers);
+    end_results.push_back(xrEndFrame(session_, &ei));
+  }
+  waiter.join();
+  for (int i = 0; i < kFrames; ++i) {
+    EXPECT_EQ(wait_results[size_t(i)], XR_SUCCESS) << i;
+    EXPECT_EQ(begin_results[size_t(i)], XR_SUCCESS) << i;
+    EXPECT_EQ(end_results[size_t(i)], XR_SUCCESS) << i;
+    EXPECT_GE(begun_at_wait[size_t(i)], i) << "xrWaitFrame " << i << " returned before frame " << i - 1 << " began";
+  }
+  check_layer_after();
+}
+
 
 }  // namespace fovea::test

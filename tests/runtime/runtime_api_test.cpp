@@ -5,6 +5,7 @@
 #include <cstring>
 #include <limits>
 
+#include <filesystem>
 #include <fstream>
 
 #include <glm/gtc/quaternion.hpp>
@@ -19,6 +20,29 @@ template <class H>
 H bogus(std::uint64_t v) {
   return reinterpret_cast<H>(v);
 }
+
+// A stereo projection layer with both views on the whole of `sc` (64×72) in `space`.
+struct StereoLayer {
+  XrCompositionLayerProjectionView views[2];
+  XrCompositionLayerProjection layer{XR_TYPE_COMPOSITION_LAYER_PROJECTION};
+  StereoLayer(XrSwapchain sc, XrSpace space) {
+    for (auto& v : views) {
+      v = {XR_TYPE_COMPOSITION_LAYER_PROJECTION_VIEW};
+      v.pose.orientation.w = 1;
+      v.fov = {-0.8f, 0.8f, 0.8f, -0.8f};
+      v.subImage.swapchain = sc;
+      v.subImage.imageRect = {{0, 0}, {64, 72}};
+    }
+    layer.space = space;
+    layer.viewCount = 2;
+    layer.views = views;
+  }
+  StereoLayer(const StereoLayer&) = delete;  // `layer` points at `views`
+  StereoLayer& operator=(const StereoLayer&) = delete;
+  const XrCompositionLayerBaseHeader* header() const {
+    return reinterpret_cast<const XrCompositionLayerBaseHeader*>(&layer);
+  }
+};
 
 TEST_F(XrTest, InstanceBasics) {
   create_instance();
@@ -236,7 +260,10 @@ TEST_F(XrTest, ExitAfterFrames) {
   EXPECT_EQ(poll_states(), (std::vector<XrSessionState>{XR_SESSION_STATE_IDLE, XR_SESSION_STATE_EXITING}));
 }
 
+// Lockstep pacing: consecutive frames are exactly one period apart however loaded the host
+// (realtime pacing: XrTest.DisplayClockThrottles, XrTest.PacingNeverPredictsThePast).
 TEST_F(XrTest, DisplayClock) {
+  setenv("FOVEA_RUNTIME_PACING", "lockstep", 1);
   create_instance();
   run_to_focused();
   XrFrameState a{XR_TYPE_FRAME_STATE}, b{XR_TYPE_FRAME_STATE};
@@ -249,6 +276,16 @@ TEST_F(XrTest, DisplayClock) {
   const XrTime t_now = XrTime(now.tv_sec) * 1'000'000'000 + now.tv_nsec;
   EXPECT_GT(b.predictedDisplayTime, t_now - 1'000'000'000);
   EXPECT_LT(b.predictedDisplayTime, t_now + 1'000'000'000);
+}
+
+// Realtime pacing (the default): an application faster than the display is paced by
+// xrWaitFrame, whatever happened before: each wait sleeps until its wake time, a period
+// after the previous one (lockstep lets an application that was late catch up unpaced).
+TEST_F(XrTest, DisplayClockThrottles) {
+  create_instance();
+  run_to_focused();
+  XrFrameState a{XR_TYPE_FRAME_STATE};
+  ASSERT_EQ(frame({}, &a), XR_SUCCESS);
   // An application faster than the display is paced by xrWaitFrame: 10 frames take at
   // least 9 periods of wall time.
   const auto mono = [] {
@@ -344,20 +381,10 @@ TEST_F(XrTest, SwapchainAcquireWaitRelease) {
   // Layers: a released swapchain with a valid rect is accepted, a bad rect or an
   // unreleased swapchain is not.
   const XrSpace local = reference_space(XR_REFERENCE_SPACE_TYPE_LOCAL);
-  XrCompositionLayerProjectionView pv[2];
-  for (auto& v : pv) {
-    v = {XR_TYPE_COMPOSITION_LAYER_PROJECTION_VIEW};
-    v.pose.orientation.w = 1;
-    v.fov = {-0.8f, 0.8f, 0.8f, -0.8f};
-    v.subImage.swapchain = sc;
-    v.subImage.imageRect = {{0, 0}, {64, 72}};
-  }
-  XrCompositionLayerProjection layer{XR_TYPE_COMPOSITION_LAYER_PROJECTION};
-  layer.space = local;
-  layer.viewCount = 2;
-  layer.views = pv;
-  const std::vector<const XrCompositionLayerBaseHeader*> layers{
-      reinterpret_cast<const XrCompositionLayerBaseHeader*>(&layer)};
+  StereoLayer stereo(sc, local);
+  auto& pv = stereo.views;
+  auto& layer = stereo.layer;
+  const std::vector<const XrCompositionLayerBaseHeader*> layers{stereo.header()};
   EXPECT_EQ(frame(layers), XR_SUCCESS);
   pv[1].subImage.imageRect = {{1, 0}, {64, 72}};
   EXPECT_EQ(frame(layers), XR_ERROR_SWAPCHAIN_RECT_INVALID);
@@ -522,9 +549,9 @@ TEST_F(XrTest, ControllerBindingsAcceptedButInactive) {
   EXPECT_EQ(xrSyncActions(session_, &sync), XR_SESSION_NOT_FOCUSED);
 }
 
-// An eye gaze action bound to the eye gaze interaction profile, attached and synced; the
-// session must be running. Returns the action space.
-XrSpace make_gaze_space(XrInstance instance, XrSession session) {
+// An eye gaze pose action in a new action set `set`, suggested on the eye gaze interaction
+// profile and attached to the session.
+XrAction attach_gaze_action(XrInstance instance, XrSession session, XrActionSet* set_out) {
   XrActionSetCreateInfo asci{XR_TYPE_ACTION_SET_CREATE_INFO};
   std::strcpy(asci.actionSetName, "eyes");
   std::strcpy(asci.localizedActionSetName, "Eyes");
@@ -549,6 +576,15 @@ XrSpace make_gaze_space(XrInstance instance, XrSession session) {
   ai.countActionSets = 1;
   ai.actionSets = &set;
   EXPECT_EQ(xrAttachSessionActionSets(session, &ai), XR_SUCCESS);
+  *set_out = set;
+  return gaze;
+}
+
+// An eye gaze action bound to the eye gaze interaction profile, attached and synced; the
+// session must be running. Returns the action space.
+XrSpace make_gaze_space(XrInstance instance, XrSession session) {
+  XrActionSet set = XR_NULL_HANDLE;
+  const XrAction gaze = attach_gaze_action(instance, session, &set);
   XrEventDataBuffer ev{XR_TYPE_EVENT_DATA_BUFFER};
   EXPECT_EQ(xrPollEvent(instance, &ev), XR_SUCCESS);
   EXPECT_EQ(ev.type, XR_TYPE_EVENT_DATA_INTERACTION_PROFILE_CHANGED);
@@ -556,6 +592,8 @@ XrSpace make_gaze_space(XrInstance instance, XrSession session) {
   XrPath eyes = XR_NULL_PATH;
   EXPECT_EQ(xrStringToPath(instance, "/user/eyes_ext", &eyes), XR_SUCCESS);
   EXPECT_EQ(xrGetCurrentInteractionProfile(session, eyes, &ips), XR_SUCCESS);
+  XrPath profile = XR_NULL_PATH;
+  EXPECT_EQ(xrStringToPath(instance, "/interaction_profiles/ext/eye_gaze_interaction", &profile), XR_SUCCESS);
   EXPECT_EQ(ips.interactionProfile, profile);
   XrActiveActionSet active{set, XR_NULL_PATH};
   XrActionsSyncInfo sync{XR_TYPE_ACTIONS_SYNC_INFO};
@@ -632,6 +670,7 @@ TEST_F(XrTest, EyeGazeReplay) {
     }
   }
   setenv("FOVEA_GAZE", ("replay:" + file).c_str(), 1);
+  setenv("FOVEA_RUNTIME_PACING", "lockstep", 1);  // frame 1 at the epoch plus one period
   create_instance({XR_EXT_EYE_GAZE_INTERACTION_EXTENSION_NAME});
   unsetenv("FOVEA_GAZE");
   run_to_focused();
@@ -696,6 +735,439 @@ TEST_F(XrTest, VisibilityMask) {
       EXPECT_TRUE(std::isfinite(p.y));
     }
   }
+}
+
+// Findings of the OpenXR conformance suite (CTS 1.1.41, --apiVersion 1.0), reproduced.
+
+// Once an image has been waited on, it must be released before the next wait (core spec,
+// xrWaitSwapchainImage); more acquires than images fail; release follows wait.
+TEST_F(XrTest, CtsSwapchainWaitTwiceBeforeRelease) {
+  create_instance();
+  run_to_focused();
+  const XrSwapchain sc = color_swapchain(64, 72);
+  XrSwapchainImageWaitInfo wi{XR_TYPE_SWAPCHAIN_IMAGE_WAIT_INFO};
+  wi.timeout = XR_INFINITE_DURATION;
+  uint32_t i = 0;
+  ASSERT_EQ(xrAcquireSwapchainImage(sc, nullptr, &i), XR_SUCCESS);
+  ASSERT_EQ(xrAcquireSwapchainImage(sc, nullptr, &i), XR_SUCCESS);
+  ASSERT_EQ(xrWaitSwapchainImage(sc, &wi), XR_SUCCESS);
+  EXPECT_EQ(xrWaitSwapchainImage(sc, &wi), XR_ERROR_CALL_ORDER_INVALID);  // first not released
+  ASSERT_EQ(xrReleaseSwapchainImage(sc, nullptr), XR_SUCCESS);
+  EXPECT_EQ(xrReleaseSwapchainImage(sc, nullptr), XR_ERROR_CALL_ORDER_INVALID);  // second not waited
+  ASSERT_EQ(xrWaitSwapchainImage(sc, &wi), XR_SUCCESS);
+  EXPECT_EQ(xrWaitSwapchainImage(sc, &wi), XR_ERROR_CALL_ORDER_INVALID);
+  ASSERT_EQ(xrReleaseSwapchainImage(sc, nullptr), XR_SUCCESS);
+  EXPECT_EQ(xrWaitSwapchainImage(sc, &wi), XR_ERROR_CALL_ORDER_INVALID);  // nothing acquired
+}
+
+// Two-call idiom: a capacity of 0 is a size query, whatever the array pointer. For the
+// visibility mask either capacity being 0 makes it one.
+TEST_F(XrTest, CtsSizeQueriesWithZeroCapacity) {
+  create_instance({XR_KHR_VISIBILITY_MASK_EXTENSION_NAME});
+  create_session();
+  auto get = proc<PFN_xrGetVisibilityMaskKHR>("xrGetVisibilityMaskKHR");
+  XrVisibilityMaskKHR full{XR_TYPE_VISIBILITY_MASK_KHR};
+  ASSERT_EQ(get(session_, XR_VIEW_CONFIGURATION_TYPE_PRIMARY_STEREO, 0, XR_VISIBILITY_MASK_TYPE_HIDDEN_TRIANGLE_MESH_KHR,
+                &full),
+            XR_SUCCESS);
+  std::vector<XrVector2f> v(full.vertexCountOutput);
+  std::vector<uint32_t> idx(full.indexCountOutput);
+  for (int zero = 0; zero < 2; ++zero) {
+    XrVisibilityMaskKHR m{XR_TYPE_VISIBILITY_MASK_KHR};
+    m.vertexCapacityInput = zero == 0 ? 0 : uint32_t(v.size());
+    m.vertices = zero == 0 ? nullptr : v.data();
+    m.indexCapacityInput = zero == 1 ? 0 : uint32_t(idx.size());
+    m.indices = zero == 1 ? nullptr : idx.data();
+    EXPECT_EQ(get(session_, XR_VIEW_CONFIGURATION_TYPE_PRIMARY_STEREO, 0,
+                  XR_VISIBILITY_MASK_TYPE_HIDDEN_TRIANGLE_MESH_KHR, &m),
+              XR_SUCCESS)
+        << "capacity " << (zero == 0 ? "vertex" : "index") << " 0";
+    EXPECT_EQ(m.vertexCountOutput, full.vertexCountOutput);
+    EXPECT_EQ(m.indexCountOutput, full.indexCountOutput);
+  }
+  uint32_t n = 99;
+  EXPECT_EQ(xrEnumerateSwapchainFormats(session_, 0, &n, nullptr), XR_SUCCESS);
+  EXPECT_GT(n, 0u);
+  EXPECT_EQ(xrEnumerateReferenceSpaces(session_, 0, &n, nullptr), XR_SUCCESS);
+  EXPECT_EQ(n, 3u);
+  EXPECT_EQ(xrEnumerateViewConfigurations(instance_, system_, 0, &n, nullptr), XR_SUCCESS);
+  EXPECT_EQ(n, 1u);
+  EXPECT_EQ(xrEnumerateEnvironmentBlendModes(instance_, system_, XR_VIEW_CONFIGURATION_TYPE_PRIMARY_STEREO, 0, &n,
+                                             nullptr),
+            XR_SUCCESS);
+  EXPECT_EQ(n, 1u);
+  EXPECT_EQ(xrEnumerateApiLayerProperties(0, &n, nullptr), XR_SUCCESS);
+  EXPECT_EQ(xrEnumerateInstanceExtensionProperties(nullptr, 0, &n, nullptr), XR_SUCCESS);
+  EXPECT_GT(n, 0u);
+  EXPECT_EQ(xrPathToString(instance_, path("/user/head"), 0, &n, nullptr), XR_SUCCESS);
+  EXPECT_EQ(n, 11u);  // with the terminator
+  const XrSwapchain sc = color_swapchain(16, 16);
+  EXPECT_EQ(xrEnumerateSwapchainImages(sc, 0, &n, nullptr), XR_SUCCESS);
+  EXPECT_EQ(n, 3u);
+  XrViewLocateInfo li{XR_TYPE_VIEW_LOCATE_INFO};
+  li.viewConfigurationType = XR_VIEW_CONFIGURATION_TYPE_PRIMARY_STEREO;
+  li.displayTime = 1'000'000;
+  li.space = reference_space(XR_REFERENCE_SPACE_TYPE_LOCAL);
+  XrViewState vs{XR_TYPE_VIEW_STATE};
+  EXPECT_EQ(xrLocateViews(session_, &li, &vs, 0, &n, nullptr), XR_SUCCESS);
+  EXPECT_EQ(n, 2u);
+}
+
+XrResult create_set(XrInstance instance, const char* name, const char* localized, XrActionSet* set) {
+  XrActionSetCreateInfo ci{XR_TYPE_ACTION_SET_CREATE_INFO};
+  std::strcpy(ci.actionSetName, name);
+  std::strcpy(ci.localizedActionSetName, localized);
+  return xrCreateActionSet(instance, &ci, set);
+}
+
+XrResult create_action(XrActionSet set, const char* name, const char* localized, XrActionType type,
+                       XrAction* action) {
+  XrActionCreateInfo ci{XR_TYPE_ACTION_CREATE_INFO};
+  std::strcpy(ci.actionName, name);
+  std::strcpy(ci.localizedActionName, localized);
+  ci.actionType = type;
+  return xrCreateAction(set, &ci, action);
+}
+
+// Empty names are XR_ERROR_NAME_INVALID; names that are not well-formed path components are
+// XR_ERROR_PATH_FORMAT_INVALID; empty localized names XR_ERROR_LOCALIZED_NAME_INVALID.
+TEST_F(XrTest, CtsActionNames) {
+  create_instance();
+  XrActionSet set = XR_NULL_HANDLE;
+  EXPECT_EQ(create_set(instance_, "", "Empty", &set), XR_ERROR_NAME_INVALID);
+  EXPECT_EQ(create_set(instance_, "Upper", "Upper", &set), XR_ERROR_PATH_FORMAT_INVALID);
+  EXPECT_EQ(create_set(instance_, "has space", "Space", &set), XR_ERROR_PATH_FORMAT_INVALID);
+  EXPECT_EQ(create_set(instance_, "has/slash", "Slash", &set), XR_ERROR_PATH_FORMAT_INVALID);
+  EXPECT_EQ(create_set(instance_, "set", "", &set), XR_ERROR_LOCALIZED_NAME_INVALID);
+  ASSERT_EQ(create_set(instance_, "set-1_a.b", "Set", &set), XR_SUCCESS);
+  XrAction a = XR_NULL_HANDLE;
+  EXPECT_EQ(create_action(set, "", "Empty", XR_ACTION_TYPE_BOOLEAN_INPUT, &a), XR_ERROR_NAME_INVALID);
+  EXPECT_EQ(create_action(set, "Bad", "Bad", XR_ACTION_TYPE_BOOLEAN_INPUT, &a), XR_ERROR_PATH_FORMAT_INVALID);
+  EXPECT_EQ(create_action(set, "a", "", XR_ACTION_TYPE_BOOLEAN_INPUT, &a), XR_ERROR_LOCALIZED_NAME_INVALID);
+  EXPECT_EQ(create_action(set, "a", "A", XR_ACTION_TYPE_BOOLEAN_INPUT, &a), XR_SUCCESS);
+}
+
+// Bindings are checked against the OpenXR 1.0 interaction profile tables: components a
+// profile does not have (and 1.1's grip_surface) are XR_ERROR_PATH_UNSUPPORTED, every
+// listed one is accepted, an identifier without its component too.
+TEST_F(XrTest, CtsBindingPathsPerProfile) {
+  create_instance();
+  XrActionSet set = XR_NULL_HANDLE;
+  ASSERT_EQ(create_set(instance_, "bindings", "Bindings", &set), XR_SUCCESS);
+  XrAction pose = XR_NULL_HANDLE, button = XR_NULL_HANDLE, haptic = XR_NULL_HANDLE;
+  ASSERT_EQ(create_action(set, "pose", "Pose", XR_ACTION_TYPE_POSE_INPUT, &pose), XR_SUCCESS);
+  ASSERT_EQ(create_action(set, "button", "Button", XR_ACTION_TYPE_BOOLEAN_INPUT, &button), XR_SUCCESS);
+  ASSERT_EQ(create_action(set, "haptic", "Haptic", XR_ACTION_TYPE_VIBRATION_OUTPUT, &haptic), XR_SUCCESS);
+  const auto suggest = [&](const char* profile, XrAction action, const char* binding) {
+    XrActionSuggestedBinding b{action, path(binding)};
+    XrInteractionProfileSuggestedBinding s{XR_TYPE_INTERACTION_PROFILE_SUGGESTED_BINDING};
+    s.interactionProfile = path(profile);
+    s.countSuggestedBindings = 1;
+    s.suggestedBindings = &b;
+    return xrSuggestInteractionProfileBindings(instance_, &s);
+  };
+  const char* xbox = "/interaction_profiles/microsoft/xbox_controller";
+  const char* touch = "/interaction_profiles/oculus/touch_controller";
+  const char* simple = "/interaction_profiles/khr/simple_controller";
+  EXPECT_EQ(suggest(xbox, haptic, "/user/gamepad/output/haptic_left"), XR_SUCCESS);
+  EXPECT_EQ(suggest(xbox, haptic, "/user/gamepad/output/haptic_right_trigger"), XR_SUCCESS);
+  EXPECT_EQ(suggest(xbox, button, "/user/gamepad/input/a/click"), XR_SUCCESS);
+  EXPECT_EQ(suggest(xbox, haptic, "/user/gamepad/output/haptic"), XR_ERROR_PATH_UNSUPPORTED);
+  EXPECT_EQ(suggest(xbox, button, "/user/gamepad/input/z/click"), XR_ERROR_PATH_UNSUPPORTED);
+  EXPECT_EQ(suggest(simple, pose, "/user/hand/left/input/grip/pose"), XR_SUCCESS);
+  EXPECT_EQ(suggest(simple, pose, "/user/hand/left/input/grip_surface/pose"), XR_ERROR_PATH_UNSUPPORTED);
+  EXPECT_EQ(suggest(simple, button, "/user/hand/left/input/trigger/click"), XR_ERROR_PATH_UNSUPPORTED);
+  EXPECT_EQ(suggest(simple, button, "/user/hand/right/input/select"), XR_SUCCESS);  // identifier only
+  EXPECT_EQ(suggest(simple, button, "/user/hand/right/input/select/value"), XR_ERROR_PATH_UNSUPPORTED);
+  EXPECT_EQ(suggest(simple, button, "/user/hand/left/input"), XR_ERROR_PATH_UNSUPPORTED);
+  EXPECT_EQ(suggest(simple, haptic, "/user/hand/right/output/haptic"), XR_SUCCESS);
+  // Oculus Touch: X/Y on the left controller, A/B on the right.
+  EXPECT_EQ(suggest(touch, button, "/user/hand/left/input/x/click"), XR_SUCCESS);
+  EXPECT_EQ(suggest(touch, button, "/user/hand/right/input/x/click"), XR_ERROR_PATH_UNSUPPORTED);
+  EXPECT_EQ(suggest(touch, button, "/user/hand/right/input/a/touch"), XR_SUCCESS);
+  EXPECT_EQ(suggest(touch, button, "/user/hand/left/input/system/click"), XR_ERROR_PATH_UNSUPPORTED);
+  EXPECT_EQ(suggest("/interaction_profiles/htc/vive_pro", button, "/user/head/input/volume_up/click"), XR_SUCCESS);
+  EXPECT_EQ(suggest("/interaction_profiles/htc/vive_pro", button, "/user/head/input/trigger/click"),
+            XR_ERROR_PATH_UNSUPPORTED);
+  EXPECT_EQ(suggest("/interaction_profiles/valve/index_controller", button, "/user/hand/left/input/trackpad/force"),
+            XR_SUCCESS);
+  EXPECT_EQ(suggest("/interaction_profiles/google/daydream_controller", haptic, "/user/hand/left/output/haptic"),
+            XR_ERROR_PATH_UNSUPPORTED);
+}
+
+// XR_FORM_FACTOR_MAX_ENUM and unknown reference space types: the *_UNSUPPORTED codes the
+// CTS expects.
+TEST_F(XrTest, CtsUnsupportedEnums) {
+  create_instance();
+  XrSystemGetInfo gi{XR_TYPE_SYSTEM_GET_INFO};
+  gi.formFactor = XR_FORM_FACTOR_MAX_ENUM;
+  XrSystemId id = 0;
+  EXPECT_EQ(xrGetSystem(instance_, &gi, &id), XR_ERROR_FORM_FACTOR_UNSUPPORTED);
+  create_session();
+  XrReferenceSpaceCreateInfo rci{XR_TYPE_REFERENCE_SPACE_CREATE_INFO};
+  rci.poseInReferenceSpace.orientation.w = 1;
+  XrSpace space = XR_NULL_HANDLE;
+  for (auto t : {XR_REFERENCE_SPACE_TYPE_MAX_ENUM, XrReferenceSpaceType(12345)}) {
+    rci.referenceSpaceType = t;
+    EXPECT_EQ(xrCreateReferenceSpace(session_, &rci, &space), XR_ERROR_REFERENCE_SPACE_UNSUPPORTED) << t;
+    XrExtent2Df bounds;
+    EXPECT_EQ(xrGetReferenceSpaceBoundsRect(session_, t, &bounds), XR_ERROR_REFERENCE_SPACE_UNSUPPORTED) << t;
+  }
+}
+
+// Actions are inactive while the session is not focused: the eye gaze action reports
+// inactive and its space untracked before FOCUSED and again after focus is lost.
+TEST_F(XrTest, CtsEyeGazeInactiveWhenNotFocused) {
+  create_instance({XR_EXT_EYE_GAZE_INTERACTION_EXTENSION_NAME});
+  create_session();
+  XrActionSet set = XR_NULL_HANDLE;
+  const XrAction gaze = attach_gaze_action(instance_, session_, &set);
+  XrActionSpaceCreateInfo sci{XR_TYPE_ACTION_SPACE_CREATE_INFO};
+  sci.action = gaze;
+  sci.poseInActionSpace.orientation.w = 1;
+  XrSpace gaze_space = XR_NULL_HANDLE;
+  ASSERT_EQ(xrCreateActionSpace(session_, &sci, &gaze_space), XR_SUCCESS);
+  const XrSpace view = reference_space(XR_REFERENCE_SPACE_TYPE_VIEW);
+  XrActiveActionSet active{set, XR_NULL_PATH};
+  XrActionsSyncInfo sync{XR_TYPE_ACTIONS_SYNC_INFO};
+  sync.countActiveActionSets = 1;
+  sync.activeActionSets = &active;
+  XrActionStateGetInfo gsi{XR_TYPE_ACTION_STATE_GET_INFO};
+  gsi.action = gaze;
+  const auto check = [&](bool focused, const char* when) {
+    EXPECT_EQ(xrSyncActions(session_, &sync), focused ? XR_SUCCESS : XR_SESSION_NOT_FOCUSED) << when;
+    XrActionStatePose st{XR_TYPE_ACTION_STATE_POSE};
+    ASSERT_EQ(xrGetActionStatePose(session_, &gsi, &st), XR_SUCCESS) << when;
+    EXPECT_EQ(bool(st.isActive), focused) << when;
+    // Over a second of tracker samples (a blink is never that long) at least one is tracked
+    // when focused, none when not.
+    timespec now{};
+    clock_gettime(CLOCK_MONOTONIC, &now);
+    const XrTime base = XrTime(now.tv_sec) * 1'000'000'000 + now.tv_nsec;
+    int tracked = 0;
+    for (int i = 0; i < 20; ++i) {
+      XrSpaceLocation loc{XR_TYPE_SPACE_LOCATION};
+      ASSERT_EQ(xrLocateSpace(gaze_space, view, base + XrTime(i) * 50'000'000, &loc), XR_SUCCESS);
+      tracked += (loc.locationFlags & XR_SPACE_LOCATION_ORIENTATION_TRACKED_BIT) != 0;
+    }
+    EXPECT_EQ(tracked > 0, focused) << when << ": " << tracked;
+  };
+  check(false, "IDLE/READY");
+  poll_states();
+  XrSessionBeginInfo bi{XR_TYPE_SESSION_BEGIN_INFO};
+  bi.primaryViewConfigurationType = XR_VIEW_CONFIGURATION_TYPE_PRIMARY_STEREO;
+  ASSERT_EQ(xrBeginSession(session_, &bi), XR_SUCCESS);
+  ASSERT_EQ(frame(), XR_SUCCESS);
+  poll_states();
+  check(true, "FOCUSED");
+  ASSERT_EQ(xrRequestExitSession(session_), XR_SUCCESS);
+  poll_states();  // VISIBLE, SYNCHRONIZED, STOPPING
+  check(false, "STOPPING");
+}
+
+XrTime mono_now() {
+  timespec ts{};
+  clock_gettime(CLOCK_MONOTONIC, &ts);
+  return XrTime(ts.tv_sec) * 1'000'000'000 + ts.tv_nsec;
+}
+
+// A missing FOVEA_RUNTIME_OUT directory is created (with its parents): the first frame
+// succeeds and the timing log and runtime log are written. A path that cannot be a
+// directory fails instance creation with the variable named, not a frame.
+TEST_F(XrTest, RuntimeOutDirectoryCreated) {
+  TempDir dir("out_missing");
+  const std::string out = dir.path() + "/not/yet/there";
+  setenv("FOVEA_RUNTIME_OUT", out.c_str(), 1);
+  setenv("FOVEA_RUNTIME_PNG_EVERY", "1", 1);
+  create_instance();
+  run_to_focused();
+  ASSERT_EQ(frame(), XR_SUCCESS);
+  unsetenv("FOVEA_RUNTIME_PNG_EVERY");
+  unsetenv("FOVEA_RUNTIME_OUT");
+  std::ifstream in(out + "/timing.jsonl");
+  int lines = 0;
+  for (std::string l; std::getline(in, l);) ++lines;
+  EXPECT_EQ(lines, 2);
+  EXPECT_TRUE(std::filesystem::exists(out + "/runtime.log"));
+  ASSERT_EQ(xrDestroyInstance(instance_), XR_SUCCESS);  // one instance at a time
+  instance_ = XR_NULL_HANDLE;
+  session_ = XR_NULL_HANDLE;
+
+  const std::string file = dir.path() + "/a_file";
+  std::ofstream(file) << "x";
+  setenv("FOVEA_RUNTIME_OUT", (file + "/sub").c_str(), 1);
+  XrInstanceCreateInfo ci{XR_TYPE_INSTANCE_CREATE_INFO};
+  std::strcpy(ci.applicationInfo.applicationName, "fovea_runtime_tests");
+  ci.applicationInfo.apiVersion = XR_CURRENT_API_VERSION;
+  XrInstance inst = XR_NULL_HANDLE;
+  EXPECT_EQ(xrCreateInstance(&ci, &inst), XR_ERROR_INITIALIZATION_FAILED);
+  unsetenv("FOVEA_RUNTIME_OUT");
+}
+
+// Honest pacing (realtime, the default), with a real slow frame and invariants only (a
+// loaded host may deschedule the test at any point): the predicted display time is never
+// in the past — after the call, and in the runtime's record when it returned — even after a
+// frame five periods late; xrWaitFrame throttles again afterwards (it never returns before
+// the frame's wake time, one period plus the compositor budget before its display time);
+// every frame's display time is on the vsync grid and later than the previous one; the
+// timing log never shows a frame displayed before it was submitted.
+TEST_F(XrTest, PacingNeverPredictsThePast) {
+  TempDir dir("pacing");
+  setenv("FOVEA_RUNTIME_OUT", dir.path().c_str(), 1);
+  setenv("FOVEA_RUNTIME_PNG_EVERY", "1000000", 1);
+  create_instance();
+  unsetenv("FOVEA_RUNTIME_OUT");
+  unsetenv("FOVEA_RUNTIME_PNG_EVERY");
+  run_to_focused();
+  XrFrameState first{XR_TYPE_FRAME_STATE};
+  ASSERT_EQ(frame({}, &first), XR_SUCCESS);
+  const XrDuration period = first.predictedDisplayPeriod;
+  const XrDuration budget = std::max<XrDuration>(period / 5, 3'000'000);
+  XrTime last = first.predictedDisplayTime;
+  XrFrameEndInfo ei{XR_TYPE_FRAME_END_INFO};
+  ei.environmentBlendMode = XR_ENVIRONMENT_BLEND_MODE_OPAQUE;
+  for (int i = 0; i < 8; ++i) {
+    XrFrameState fs{XR_TYPE_FRAME_STATE};
+    const XrTime called = mono_now();
+    ASSERT_EQ(xrWaitFrame(session_, nullptr, &fs), XR_SUCCESS);
+    const XrTime returned = mono_now();
+    EXPECT_GT(fs.predictedDisplayTime, called) << "frame " << i;
+    EXPECT_GE(returned, fs.predictedDisplayTime - period - budget) << "frame " << i << ": not throttled";
+    EXPECT_GT(fs.predictedDisplayTime, last);
+    EXPECT_EQ((fs.predictedDisplayTime - first.predictedDisplayTime) % period, 0);
+    last = fs.predictedDisplayTime;
+    ASSERT_EQ(xrBeginFrame(session_, nullptr), XR_SUCCESS);
+    if (i == 2) {  // a slow frame: five periods of work
+      const timespec slow{0, long(5 * period)};
+      nanosleep(&slow, nullptr);
+    }
+    ei.displayTime = fs.predictedDisplayTime;
+    ASSERT_EQ(xrEndFrame(session_, &ei), XR_SUCCESS);
+  }
+  ASSERT_EQ(xrDestroySession(session_), XR_SUCCESS);  // flushes nothing: records are flushed per frame
+  session_ = XR_NULL_HANDLE;
+  std::ifstream in(dir.path() + "/timing.jsonl");
+  int records = 0, missed = 0;
+  for (std::string line; std::getline(in, line); ++records) {
+    const auto field = [&](const char* name) {
+      const auto at = line.find(std::string("\"") + name + "\":");
+      EXPECT_NE(at, std::string::npos) << name;
+      return std::stoll(line.substr(at + std::strlen(name) + 3));
+    };
+    EXPECT_GE(field("displayed_ns"), field("end_call_ns")) << line;
+    EXPECT_GE(field("displayed_ns"), field("predicted_display_ns")) << line;
+    EXPECT_GT(field("predicted_display_ns"), field("wait_return_ns")) << line;
+    missed += int(field("missed_vsyncs"));
+  }
+  EXPECT_EQ(records, 10);
+  EXPECT_GE(missed, 4);  // the slow frame cost at least four vsyncs
+}
+
+// Copies `image` (64×72 RGBA8, COLOR_ATTACHMENT_OPTIMAL) to a host buffer on the test's
+// device and back to its layout, as an API layer reading the application's images does.
+void copy_image_out(VkPhysicalDevice physical, VkDevice device, uint32_t family, VkImage image) {
+  VkBufferCreateInfo bi{VK_STRUCTURE_TYPE_BUFFER_CREATE_INFO};
+  bi.size = 64 * 72 * 4;
+  bi.usage = VK_BUFFER_USAGE_TRANSFER_DST_BIT;
+  VkBuffer buffer = VK_NULL_HANDLE;
+  ASSERT_EQ(vkCreateBuffer(device, &bi, nullptr, &buffer), VK_SUCCESS);
+  VkMemoryRequirements req;
+  vkGetBufferMemoryRequirements(device, buffer, &req);
+  VkPhysicalDeviceMemoryProperties mp;
+  vkGetPhysicalDeviceMemoryProperties(physical, &mp);
+  VkMemoryAllocateInfo ai{VK_STRUCTURE_TYPE_MEMORY_ALLOCATE_INFO};
+  ai.allocationSize = req.size;
+  for (uint32_t i = 0; i < mp.memoryTypeCount; ++i)
+    if ((req.memoryTypeBits & (1u << i)) && (mp.memoryTypes[i].propertyFlags & VK_MEMORY_PROPERTY_HOST_VISIBLE_BIT)) {
+      ai.memoryTypeIndex = i;
+      break;
+    }
+  VkDeviceMemory memory = VK_NULL_HANDLE;
+  ASSERT_EQ(vkAllocateMemory(device, &ai, nullptr, &memory), VK_SUCCESS);
+  ASSERT_EQ(vkBindBufferMemory(device, buffer, memory, 0), VK_SUCCESS);
+  VkCommandPoolCreateInfo pci{VK_STRUCTURE_TYPE_COMMAND_POOL_CREATE_INFO};
+  pci.queueFamilyIndex = family;
+  VkCommandPool pool = VK_NULL_HANDLE;
+  ASSERT_EQ(vkCreateCommandPool(device, &pci, nullptr, &pool), VK_SUCCESS);
+  VkCommandBufferAllocateInfo cai{VK_STRUCTURE_TYPE_COMMAND_BUFFER_ALLOCATE_INFO};
+  cai.commandPool = pool;
+  cai.level = VK_COMMAND_BUFFER_LEVEL_PRIMARY;
+  cai.commandBufferCount = 1;
+  VkCommandBuffer cmd = VK_NULL_HANDLE;
+  ASSERT_EQ(vkAllocateCommandBuffers(device, &cai, &cmd), VK_SUCCESS);
+  VkCommandBufferBeginInfo begin{VK_STRUCTURE_TYPE_COMMAND_BUFFER_BEGIN_INFO};
+  vkBeginCommandBuffer(cmd, &begin);
+  VkImageMemoryBarrier b{VK_STRUCTURE_TYPE_IMAGE_MEMORY_BARRIER};
+  b.srcAccessMask = VK_ACCESS_COLOR_ATTACHMENT_WRITE_BIT;
+  b.dstAccessMask = VK_ACCESS_TRANSFER_READ_BIT;
+  b.oldLayout = VK_IMAGE_LAYOUT_COLOR_ATTACHMENT_OPTIMAL;
+  b.newLayout = VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL;
+  b.srcQueueFamilyIndex = b.dstQueueFamilyIndex = VK_QUEUE_FAMILY_IGNORED;
+  b.image = image;
+  b.subresourceRange = {VK_IMAGE_ASPECT_COLOR_BIT, 0, 1, 0, 1};
+  vkCmdPipelineBarrier(cmd, VK_PIPELINE_STAGE_COLOR_ATTACHMENT_OUTPUT_BIT, VK_PIPELINE_STAGE_TRANSFER_BIT, 0, 0, nullptr,
+                       0, nullptr, 1, &b);
+  VkBufferImageCopy region{};
+  region.imageSubresource = {VK_IMAGE_ASPECT_COLOR_BIT, 0, 0, 1};
+  region.imageExtent = {64, 72, 1};
+  vkCmdCopyImageToBuffer(cmd, image, VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL, buffer, 1, &region);
+  std::swap(b.oldLayout, b.newLayout);
+  b.srcAccessMask = VK_ACCESS_TRANSFER_READ_BIT;
+  b.dstAccessMask = VK_ACCESS_COLOR_ATTACHMENT_WRITE_BIT;
+  vkCmdPipelineBarrier(cmd, VK_PIPELINE_STAGE_TRANSFER_BIT, VK_PIPELINE_STAGE_COLOR_ATTACHMENT_OUTPUT_BIT, 0, 0, nullptr,
+                       0, nullptr, 1, &b);
+  vkEndCommandBuffer(cmd);
+  VkQueue queue = VK_NULL_HANDLE;
+  vkGetDeviceQueue(device, family, 0, &queue);
+  VkSubmitInfo si{VK_STRUCTURE_TYPE_SUBMIT_INFO};
+  si.commandBufferCount = 1;
+  si.pCommandBuffers = &cmd;
+  EXPECT_EQ(vkQueueSubmit(queue, 1, &si, VK_NULL_HANDLE), VK_SUCCESS);
+  vkQueueWaitIdle(queue);
+  vkDestroyCommandPool(device, pool, nullptr);
+  vkDestroyBuffer(device, buffer, nullptr);
+  vkFreeMemory(device, memory, nullptr);
+}
+
+// Swapchain images carry the usage the application asked for (plus the sampling the
+// compositor needs), never an unrequested transfer source: copying from an image of a
+// swapchain created without XR_SWAPCHAIN_USAGE_TRANSFER_SRC_BIT is reported by the Vulkan
+// validation layer, as it would be on other runtimes, and from one created with it is not.
+// The compositor itself reads an attachment-only swapchain cleanly (by sampling).
+TEST_F(XrTest, SwapchainUsageIsWhatWasAsked) {
+  const char* v = std::getenv("FOVEA_VK_VALIDATION");
+  if (!v || std::string(v) != "1") GTEST_SKIP() << "needs FOVEA_VK_VALIDATION=1 (the validation layer observes the usage)";
+  TempDir dir("usage");
+  setenv("FOVEA_RUNTIME_OUT", dir.path().c_str(), 1);
+  create_instance();
+  unsetenv("FOVEA_RUNTIME_OUT");
+  run_to_focused();
+  const auto make = [&](XrSwapchainUsageFlags usage) {
+    const XrSwapchain sc = color_swapchain(64, 72, usage);
+    uint32_t n = 3, i = 0;
+    std::vector<XrSwapchainImageVulkan2KHR> images(n, {XR_TYPE_SWAPCHAIN_IMAGE_VULKAN2_KHR});
+    EXPECT_EQ(xrEnumerateSwapchainImages(sc, n, &n, reinterpret_cast<XrSwapchainImageBaseHeader*>(images.data())),
+              XR_SUCCESS);
+    EXPECT_EQ(xrAcquireSwapchainImage(sc, nullptr, &i), XR_SUCCESS);
+    XrSwapchainImageWaitInfo wi{XR_TYPE_SWAPCHAIN_IMAGE_WAIT_INFO};
+    wi.timeout = XR_INFINITE_DURATION;
+    EXPECT_EQ(xrWaitSwapchainImage(sc, &wi), XR_SUCCESS);
+    return std::pair{sc, images[i].image};
+  };
+  const auto copyable = make(XR_SWAPCHAIN_USAGE_COLOR_ATTACHMENT_BIT | XR_SWAPCHAIN_USAGE_TRANSFER_SRC_BIT);
+  const auto attachment = make(XR_SWAPCHAIN_USAGE_COLOR_ATTACHMENT_BIT);
+  copy_image_out(vk_physical_, vk_device_, queue_family_, copyable.second);
+  EXPECT_EQ(validation_errors_, 0) << "copy from a swapchain created with the transfer-source usage";
+  expect_validation_errors(true);
+  copy_image_out(vk_physical_, vk_device_, queue_family_, attachment.second);
+  expect_validation_errors(false);
+  EXPECT_GT(validation_errors_, 0) << "copy from a swapchain created without it";
+  validation_errors_ = 0;
+  for (auto sc : {copyable.first, attachment.first}) ASSERT_EQ(xrReleaseSwapchainImage(sc, nullptr), XR_SUCCESS);
+  const StereoLayer stereo(attachment.first, reference_space(XR_REFERENCE_SPACE_TYPE_LOCAL));
+  ASSERT_EQ(frame({stereo.header()}), XR_SUCCESS);
+  EXPECT_TRUE(std::filesystem::exists(dir.path() + "/panel_000001_left.png"));
+  // TearDown: no validation message from the compositor's read.
 }
 
 TEST_F(XrTest, TimespecConversion) {

@@ -13,7 +13,7 @@ namespace fovea::runtime {
 namespace {
 
 TEST(DisplayClock, LockstepSlots) {
-  DisplayClock c(70);
+  DisplayClock c(70, Pacing::Lockstep);
   EXPECT_EQ(c.period(), 14285714);
   EXPECT_EQ(c.compositor_budget(), 3'000'000);  // 20 % of 14.3 ms is below the 3 ms floor
   const FrameSlot a = c.next(1'000'000'000);
@@ -26,6 +26,74 @@ TEST(DisplayClock, LockstepSlots) {
   EXPECT_EQ(b.display_ns, a.display_ns + c.period());
   EXPECT_EQ(DisplayClock(90).compositor_budget(), 3'000'000);
   EXPECT_EQ(DisplayClock(30).compositor_budget(), DisplayClock(30).period() / 5);
+}
+
+// Realtime pacing on a deterministic clock: an on-time application gets consecutive vsyncs;
+// after a slow frame the prediction is the first vsync whose wake time is still ahead (never
+// in the past), and the following frames are throttled one period apart again.
+TEST(DisplayClock, RealtimeSkipsMissedVsyncsAndThrottlesAgain) {
+  DisplayClock c(70);
+  EXPECT_EQ(c.pacing(), Pacing::Realtime);
+  const core::TimeNs p = c.period();
+  const FrameSlot a = c.next(1'000'000'000);
+  EXPECT_EQ(a.wake_ns, 1'000'000'000);
+  const FrameSlot b = c.next(a.wake_ns + p / 2);  // on time: the next vsync
+  EXPECT_EQ(b.display_ns, a.display_ns + p);
+  EXPECT_EQ(b.missed, 0);
+  // A slow frame: xrWaitFrame called 5.5 periods after b's wake time.
+  const core::TimeNs now = b.wake_ns + 5 * p + p / 2;
+  const FrameSlot s = c.next(now);
+  EXPECT_EQ(s.index, 2);
+  EXPECT_GE(s.wake_ns, now);
+  EXPECT_LT(s.wake_ns - now, p);  // the first such vsync, not a later one
+  EXPECT_GT(s.display_ns, now);
+  EXPECT_EQ(s.missed, 5);
+  EXPECT_EQ(s.vsync, b.vsync + 6);
+  EXPECT_EQ((s.display_ns - a.display_ns) % p, 0);  // on the vsync grid
+  // Fast frames after it: throttled, one vsync each.
+  core::TimeNs t = s.wake_ns;
+  core::TimeNs last = s.display_ns;
+  for (int i = 0; i < 5; ++i) {
+    const FrameSlot f = c.next(t + 1000);
+    EXPECT_EQ(f.display_ns, last + p);
+    EXPECT_EQ(f.missed, 0);
+    EXPECT_GT(f.wake_ns, t);
+    last = f.display_ns;
+    t = f.wake_ns;
+  }
+  // Exactly on the wake time is on time.
+  const FrameSlot g = c.next(last - p - c.compositor_budget() + p);
+  EXPECT_EQ(g.missed, 0);
+  // Woken on time: the slot stays. Woken after its vsync (a descheduled thread): it moves to
+  // the first vsync that leaves the compositor budget, and the next slot follows it.
+  FrameSlot h = c.next(g.wake_ns);
+  const FrameSlot h0 = h;
+  c.reslot(h, h.wake_ns + 1000);
+  EXPECT_EQ(h.display_ns, h0.display_ns);
+  const core::TimeNs woke = h.display_ns + 2 * p + p / 3;
+  c.reslot(h, woke);
+  EXPECT_GE(h.display_ns, woke + c.compositor_budget());
+  EXPECT_LT(h.display_ns - p, woke + c.compositor_budget());
+  EXPECT_EQ(h.missed, h0.missed + 3);
+  EXPECT_EQ(c.next(woke).display_ns, h.display_ns + p);
+}
+
+// A frame is displayed at its predicted vsync when submitted with the compositor budget to
+// spare, else at the first later vsync that leaves it; never before its submission.
+TEST(DisplayClock, DisplayedNeverBeforeSubmission) {
+  const DisplayClock c(70);
+  const core::TimeNs p = c.period(), budget = c.compositor_budget(), d = 10'000'000'000;
+  EXPECT_EQ(c.displayed(d, d - budget), d);
+  EXPECT_EQ(c.displayed(d, d - budget + 1), d + p);
+  EXPECT_EQ(c.displayed(d, d + 3 * p), d + 4 * p);
+  for (core::TimeNs sub = d - 2 * p; sub < d + 5 * p; sub += 777'777) {
+    const core::TimeNs shown = c.displayed(d, sub);
+    EXPECT_GE(shown, sub + budget);
+    if (shown > d) {
+      EXPECT_LT(shown - p, sub + budget);  // the first vsync that makes it
+    }
+    EXPECT_EQ((shown - d) % p, 0);
+  }
 }
 
 TEST(HeadMotion, ScriptedIsSmoothAndStartsAtIdentity) {

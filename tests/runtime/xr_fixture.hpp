@@ -40,7 +40,12 @@ class XrTest : public ::testing::Test {
   }
   XrPath path(const char* s);
   XrSpace reference_space(XrReferenceSpaceType t, XrPosef pose = {{0, 0, 0, 1}, {0, 0, 0}});
-  XrSwapchain color_swapchain(uint32_t w, uint32_t h);
+  XrSwapchain color_swapchain(uint32_t w, uint32_t h,
+                              XrSwapchainUsageFlags usage = XR_SWAPCHAIN_USAGE_COLOR_ATTACHMENT_BIT |
+                                                            XR_SWAPCHAIN_USAGE_SAMPLED_BIT);
+  // While true, validation errors are counted in validation_errors_ without failing the test
+  // (a test that provokes one on purpose checks the count, then resets it).
+  void expect_validation_errors(bool expected);
 
   XrInstance instance_ = XR_NULL_HANDLE;
   XrSystemId system_ = XR_NULL_SYSTEM_ID;

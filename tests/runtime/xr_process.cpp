@@ -86,6 +86,9 @@ std::map<std::string, std::string> runtime_env(const std::string& out, int exit_
       {"FOVEA_RUNTIME_OUT", out},
       {"FOVEA_RUNTIME_PNG_EVERY", std::to_string(png_every)},
       {"FOVEA_DISPLAY", "small"},
+      // Lockstep pacing: these runs are compared with each other frame by frame, so the
+      // content must be a function of the frame index (realtime pacing is tested in-process).
+      {"FOVEA_RUNTIME_PACING", "lockstep"},
       {"XR_ENABLE_API_LAYERS", ""},
       {"LD_PRELOAD", FOVEA_TEST_PRELOAD},
   };
