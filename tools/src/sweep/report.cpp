@@ -97,9 +97,18 @@ Config read_config(const json& r, const std::vector<Row>& rows) {
     return v;
   };
   c.quality = strings("quality");
-  if (c.quality.empty())
-    for (const char* m : {"fovea_psnr", "foveated_psnr", "psnr", "ssim"})
-      if (present.count(m)) c.quality.push_back(m);
+  if (c.quality.empty()) {
+    // Every both-eye quality metric the renders report, the fovea's first: new metrics in
+    // report.json (FLIP, tone-mapped PSNR, ...) are plotted without a change here.
+    for (const auto& m : present)
+      if (m.find('.') == std::string::npos)
+        for (const char* kind : {"psnr", "ssim", "flip", "mse"})
+          if (m.find(kind) != std::string::npos) {
+            c.quality.push_back(m);
+            break;
+          }
+    std::stable_partition(c.quality.begin(), c.quality.end(), [](const std::string& m) { return m.rfind("fovea_", 0) == 0; });
+  }
   if (c.quality.empty() && present.count("temporal_error")) c.quality.push_back("temporal_error");
   if (auto t = strings("time"); !t.empty()) c.time = t[0];
   if (auto g = strings("group"); !g.empty()) c.group = g[0];
