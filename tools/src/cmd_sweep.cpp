@@ -162,9 +162,13 @@ int cmd_report(const std::vector<std::string>& argv) {
 }
 
 int run(std::vector<std::string> argv) {
-  if (argv.empty() || argv[0] == "--help" || argv[0] == "-h") {
+  if (argv.empty()) {
+    std::cerr << kHelp;
+    return 2;
+  }
+  if (argv[0] == "--help" || argv[0] == "-h") {
     std::cout << kHelp;
-    return argv.empty() ? 2 : 0;
+    return 0;
   }
   const std::string sub = argv[0];
   argv.erase(argv.begin());
