@@ -163,7 +163,7 @@ class Pool {
     }
     if (g_stop) {
       sum.interrupted = true;
-      for (auto& r : running_) ::kill(r.pid, SIGTERM);
+      for (auto& r : running_) ::kill(-r.pid, SIGTERM);
       for (auto& r : running_) {
         int st = 0;
         ::waitpid(r.pid, &st, 0);
@@ -213,6 +213,7 @@ class Pool {
       // A killed pool takes its renders with it: nothing finishes behind its back.
       ::prctl(PR_SET_PDEATHSIG, SIGKILL);
       if (::getppid() != parent) ::_exit(127);
+      ::setpgid(0, 0);  // its own group, so stopping the task reaches everything it started
       ::signal(SIGINT, SIG_DFL);
       ::signal(SIGTERM, SIG_DFL);
       const int fo = ::open(out_file.c_str(), O_WRONLY | O_CREAT | O_APPEND, 0644);
@@ -223,6 +224,7 @@ class Pool {
       std::fprintf(stderr, "cannot execute %s: %s\n", cargv[0], std::strerror(errno));
       ::_exit(127);
     }
+    ::setpgid(pid, pid);  // also here: no window in which a stop misses the group
     return pid;
   }
 
