@@ -116,7 +116,10 @@ std::vector<double> nice_ticks(double lo, double hi, int target) {
 
 core::Image draw_chart(const Chart& chart, int W, int H) {
   tools::Canvas c(W, H);
-  const int legend_w = 250;
+  // The legend takes the width its longest label needs, up to 40% of the picture.
+  int label_w = 0;
+  for (const auto& s : chart.series) label_w = std::max(label_w, text_width(s.label, 2));
+  const int legend_w = std::clamp(label_w + 60, 200, W * 2 / 5);
   const int x0 = 90, x1 = W - legend_w - 20, y0 = chart.note.empty() ? 80 : 104, y1 = H - 70;
   Range rx, ry;
   for (const auto& s : chart.series)
