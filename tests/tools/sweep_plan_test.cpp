@@ -113,6 +113,7 @@ TEST(SweepPlan, RejectsBadSweepFilesNamingKeyAndFile) {
   EXPECT_NE(error(R"({"scenes": "a", "scene": "b"})").find("already set"), std::string::npos);
   EXPECT_NE(error(R"({"reference": 1.5})").find("whole numbers"), std::string::npos);
   EXPECT_NE(error(R"([1, 2])").find("JSON object"), std::string::npos);
+  EXPECT_NE(error(R"({"report": {"qualty": "psnr"}})").find("key \"report.qualty\": unknown key"), std::string::npos);
   // Through the program: exit 2 and the key named.
   const std::string dir = test::temp_dir("sweep-plan");
   core::write_file_atomic(dir + "/bad.json", R"({"scenes": "cornell", "kappa": [1, 2]})");

@@ -26,6 +26,7 @@ json render_report(double ms, double fovea_psnr, double flip, double band0) {
                                {{"e_min", 2.0}, {"e_max", 4.0}, {"pixels", 9}, {"psnr", band0 - 5 + d}}}}};
   };
   return {{"frames", 8}, {"config", {{"budget", 0.5}}}, {"gpu_ms", {{"total", ms}, {"trace", ms / 2}}},
+          {"latency", {{"gaze_to_photon_ms", 20 + ms}}},
           {"summary", {{"left", eye(-1)}, {"right", eye(1)}}}};
 }
 
@@ -55,6 +56,7 @@ TEST(SweepReport, ParetoFrontOfKnownPoints) {
   EXPECT_EQ(pareto_front(f, false), (std::vector<bool>{true, true, false, true}));
   EXPECT_TRUE(lower_is_better_by_name("fovea_flip"));
   EXPECT_TRUE(lower_is_better_by_name("gpu_ms.total"));
+  EXPECT_TRUE(lower_is_better_by_name("latency.gaze_to_photon_ms"));
   EXPECT_FALSE(lower_is_better_by_name("fovea_psnr"));
   EXPECT_EQ(nice_ticks(0, 1, 5), (std::vector<double>{0, 0.2, 0.4, 0.6000000000000001, 0.8, 1}));
 }
@@ -119,7 +121,7 @@ TEST(SweepReport, SyntheticSweepGivesKnownFrontsTablesAndPlots) {
   EXPECT_EQ(rows, 10);
 
   for (const char* png : {"quality_vs_time_fovea_psnr.png", "quality_vs_budget_fovea_psnr.png", "quality_vs_time_fovea_flip.png",
-                          "bands_band_psnr_psnr.png"}) {
+                          "bands_band_psnr_psnr.png", "latency_vs_fovea_psnr.png"}) {
     const core::Image img = core::read_png(dir + "/report/" + png);
     EXPECT_EQ(img.width, 1000) << png;
     EXPECT_EQ(img.height, 640) << png;

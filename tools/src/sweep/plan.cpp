@@ -148,6 +148,12 @@ Plan expand_sweep(const json& sweep, const std::string& source, const std::vecto
     const std::string& key = it.key();
     if (key == "report") {
       if (!it->is_object()) throw InputError(where(source, key) + ": expected an object");
+      static const std::set<std::string> fields = {"quality", "time",           "group",           "budget",
+                                                   "latency", "lower_is_better", "higher_is_better"};
+      for (auto f = it->begin(); f != it->end(); ++f)
+        if (!fields.count(f.key()))
+          throw InputError(where(source, "report." + f.key()) +
+                           ": unknown key (expected quality, time, group, budget, latency, lower_is_better, higher_is_better)");
       report = *it;
       continue;
     }
