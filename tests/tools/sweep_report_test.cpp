@@ -1,0 +1,137 @@
+// fovea sweep report: a synthetic result set with a known Pareto front per distribution,
+// metric flattening and per-band averaging, CSV/JSON and the plots.
+#include <gtest/gtest.h>
+
+#include <filesystem>
+#include <fstream>
+
+#include "cli.hpp"
+#include "fovea/core/image.hpp"
+#include "sweep/plan.hpp"
+#include "sweep/plot.hpp"
+#include "sweep/report.hpp"
+
+namespace fovea::sweep {
+namespace {
+
+namespace fs = std::filesystem;
+using nlohmann::json;
+
+json render_report(double ms, double fovea_psnr, double flip, double band0) {
+  auto eye = [&](double d) {
+    return json{{"psnr", fovea_psnr - 10 + d},
+                {"fovea_psnr", fovea_psnr + d},
+                {"fovea_flip", flip + d * 0.01},
+                {"band_psnr", {{{"e_min", 0.0}, {"e_max", 2.0}, {"pixels", 4}, {"psnr", band0 + d}},
+                               {{"e_min", 2.0}, {"e_max", 4.0}, {"pixels", 9}, {"psnr", band0 - 5 + d}}}}};
+  };
+  return {{"frames", 8}, {"config", {{"budget", 0.5}}}, {"gpu_ms", {{"total", ms}, {"trace", ms / 2}}},
+          {"latency", {{"gaze_to_photon_ms", 20 + ms}}},
+          {"summary", {{"left", eye(-1)}, {"right", eye(1)}}}};
+}
+
+TEST(SweepReport, FlattensMetricsAndAveragesEyesAndBands) {
+  const json r = render_report(10, 30, 0.2, 40);
+  const auto m = flatten_metrics(r);
+  EXPECT_DOUBLE_EQ(m.at("gpu_ms.total"), 10);
+  EXPECT_DOUBLE_EQ(m.at("summary.left.fovea_psnr"), 29);
+  EXPECT_DOUBLE_EQ(m.at("fovea_psnr"), 30);  // mean of the eyes
+  EXPECT_DOUBLE_EQ(m.at("fovea_flip"), 0.2);
+  EXPECT_EQ(m.count("budget"), 0u);  // config is settings, not a metric
+  EXPECT_EQ(m.count("config.budget"), 0u);
+  const auto b = band_metrics(r);
+  ASSERT_EQ(b.count("band_psnr.psnr"), 1u);
+  ASSERT_EQ(b.at("band_psnr.psnr").size(), 2u);
+  EXPECT_DOUBLE_EQ(b.at("band_psnr.psnr")[0].value, 40);
+  EXPECT_DOUBLE_EQ(b.at("band_psnr.psnr")[1].value, 35);
+  EXPECT_DOUBLE_EQ(b.at("band_psnr.psnr")[1].e_min, 2);
+}
+
+TEST(SweepReport, ParetoFrontOfKnownPoints) {
+  // (time, quality): (2, 29) is beaten by (1, 30); (4, 35) ties (3, 35) at more time.
+  const std::vector<glm::dvec2> p = {{1, 30}, {2, 29}, {3, 35}, {4, 35}, {5, 40}, {5, 39}, {NAN, 50}};
+  EXPECT_EQ(pareto_front(p, true), (std::vector<bool>{true, false, true, false, true, false, false}));
+  // Lower is better (FLIP): the front runs the other way.
+  const std::vector<glm::dvec2> f = {{1, 0.5}, {2, 0.3}, {3, 0.4}, {4, 0.1}};
+  EXPECT_EQ(pareto_front(f, false), (std::vector<bool>{true, true, false, true}));
+  EXPECT_TRUE(lower_is_better_by_name("fovea_flip"));
+  EXPECT_TRUE(lower_is_better_by_name("gpu_ms.total"));
+  EXPECT_TRUE(lower_is_better_by_name("latency.gaze_to_photon_ms"));
+  EXPECT_FALSE(lower_is_better_by_name("fovea_psnr"));
+  EXPECT_EQ(nice_ticks(0, 1, 5), (std::vector<double>{0, 0.2, 0.4, 0.6000000000000001, 0.8, 1}));
+}
+
+TEST(SweepReport, SyntheticSweepGivesKnownFrontsTablesAndPlots) {
+  const std::string dir = test::temp_dir("sweep-report");
+  const std::vector<RenderOption> opts = {{"distribution", true}, {"budget", true}, {"out", true}, {"quiet", false}};
+  const Plan plan = expand_sweep(json::parse(R"({"distribution": ["a", "b"], "budget": [0.1, 0.2, 0.3, 0.4, 0.5]})"),
+                                 "synthetic.json", opts);
+  ASSERT_EQ(plan.jobs.size(), 10u);
+  // distribution a, budgets 0.1..0.5: (time, fovea_psnr) as in ParetoFrontOfKnownPoints.
+  // distribution b: (2, 31) beaten by (2, 33); (6, 32) beaten; 0.5 failed.
+  const std::map<std::pair<std::string, double>, std::array<double, 2>> data = {
+      {{"a", 0.1}, {1, 30}}, {{"a", 0.2}, {2, 29}}, {{"a", 0.3}, {3, 35}}, {{"a", 0.4}, {4, 35}}, {{"a", 0.5}, {5, 40}},
+      {{"b", 0.1}, {2, 31}}, {{"b", 0.2}, {2, 33}}, {{"b", 0.3}, {6, 32}}};
+  std::map<std::pair<std::string, double>, std::string> id;
+  for (const Job& j : plan.jobs) {
+    const auto key = std::make_pair(j.settings["distribution"].get<std::string>(), j.settings["budget"].get<double>());
+    id[key] = j.id;
+    if (const auto it = data.find(key); it != data.end()) {
+      fs::create_directories(dir + "/" + j.out);
+      core::write_file_atomic(dir + "/" + j.out + "/report.json",
+                              render_report(it->second[0], it->second[1], 1.0 / it->second[1], 50).dump());
+    } else if (key.first == "b" && key.second == 0.5) {
+      fs::create_directories(dir + "/failed");
+      core::write_file_atomic(dir + "/failed/" + j.id + ".json", json{{"id", j.id}, {"exit_code", 2}}.dump());
+    }  // b 0.4: never ran
+  }
+  const std::string plan_path = dir + "/plan.jsonl";
+  core::write_file_atomic(plan_path, plan_to_jsonl(plan));
+  const auto r = test::run_fovea("sweep report " + plan_path + " --out " + dir + "/report");
+  ASSERT_EQ(r.status, 0) << r.err;
+
+  std::ifstream in(dir + "/report/results.json");
+  const json j = json::parse(in);
+  EXPECT_EQ(j["counts"]["done"], 8);
+  EXPECT_EQ(j["counts"]["failed"], 1);
+  EXPECT_EQ(j["counts"]["missing"], 1);
+  const std::string never_ran = id[{"b", 0.4}];
+  EXPECT_EQ(j["missing"][0], never_ran);
+  const json front_a = {id[{"a", 0.1}], id[{"a", 0.3}], id[{"a", 0.5}]}, front_b = {id[{"b", 0.2}]};
+  EXPECT_EQ(j["pareto"]["fovea_psnr"]["a"], front_a);
+  EXPECT_EQ(j["pareto"]["fovea_psnr"]["b"], front_b);
+  // fovea_flip = 1 / fovea_psnr here, lower is better: the same jobs win.
+  EXPECT_EQ(j["pareto"]["fovea_flip"]["a"], j["pareto"]["fovea_psnr"]["a"]);
+  for (const auto& row : j["jobs"])
+    if (row["id"] == front_a[1]) {
+      EXPECT_EQ(row["status"], "done");
+      EXPECT_DOUBLE_EQ(row["metrics"]["fovea_psnr"].get<double>(), 35);
+      EXPECT_EQ(row["pareto"]["fovea_psnr"], true);
+      EXPECT_DOUBLE_EQ(row["bands"]["band_psnr.psnr"][1]["value"].get<double>(), 45);
+    }
+
+  std::ifstream csv(dir + "/report/results.csv");
+  std::string header, line;
+  std::getline(csv, header);
+  EXPECT_EQ(header.rfind("id,status,--budget,--distribution,", 0), 0u) << header;
+  EXPECT_NE(header.find("band_psnr.psnr[0-2]"), std::string::npos);
+  EXPECT_NE(header.find("pareto:fovea_psnr"), std::string::npos);
+  int rows = 0;
+  while (std::getline(csv, line)) ++rows;
+  EXPECT_EQ(rows, 10);
+
+  for (const char* png : {"quality_vs_time_fovea_psnr.png", "quality_vs_budget_fovea_psnr.png", "quality_vs_time_fovea_flip.png",
+                          "bands_band_psnr_psnr.png", "latency_vs_fovea_psnr.png"}) {
+    const core::Image img = core::read_png(dir + "/report/" + png);
+    EXPECT_EQ(img.width, 1000) << png;
+    EXPECT_EQ(img.height, 640) << png;
+    // Something was drawn in the series' colours, not just axes on white.
+    long coloured = 0;
+    for (const auto& p : img.pixels) coloured += std::abs(p.x - p.z) > 0.2f;
+    EXPECT_GT(coloured, 100) << png;
+  }
+  fs::remove_all(dir);
+}
+
+}  // namespace
+}  // namespace fovea::sweep

@@ -1,0 +1,426 @@
+#include "sweep/report.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <numeric>
+#include <set>
+
+#include "fovea/core/error.hpp"
+#include "fovea/core/image.hpp"
+#include "sweep/plot.hpp"
+
+namespace fovea::sweep {
+namespace {
+
+namespace fs = std::filesystem;
+using nlohmann::json;
+
+bool is_band_array(const json& v) {
+  return v.is_array() && !v.empty() && v[0].is_object() && v[0].contains("e_min") && v[0].contains("e_max");
+}
+
+void flatten(const json& j, const std::string& prefix, std::map<std::string, double>& out) {
+  for (auto it = j.begin(); it != j.end(); ++it) {
+    const std::string name = prefix.empty() ? it.key() : prefix + "." + it.key();
+    if (it->is_object()) flatten(*it, name, out);
+    else if (it->is_number() && std::isfinite(it->get<double>())) out[name] = it->get<double>();
+  }
+}
+
+std::string cell(double v) {
+  char buf[32];
+  std::snprintf(buf, sizeof buf, "%.10g", v);
+  return buf;
+}
+
+std::string csv_escape(const std::string& s) {
+  if (s.find_first_of(",\"\n") == std::string::npos) return s;
+  std::string o = "\"";
+  for (char c : s) o += c == '"' ? std::string("\"\"") : std::string(1, c);
+  return o + "\"";
+}
+
+std::string file_stem(const std::string& metric) {
+  std::string s = metric;
+  for (char& c : s)
+    if (!std::isalnum(static_cast<unsigned char>(c))) c = '_';
+  return s;
+}
+
+// Axis label with the unit the metric's name implies.
+std::string axis_label(const std::string& m) {
+  if (m.find("psnr") != std::string::npos) return m + " (dB)";
+  if (m.find("_ms") != std::string::npos || m.rfind("ms", m.size() - 2) == m.size() - 2) return m + " (ms)";
+  if (m.find("seconds") != std::string::npos) return m + " (s)";
+  return m;
+}
+
+struct Row {
+  std::string id, status;
+  json settings;
+  std::map<std::string, double> metrics;
+  std::map<std::string, std::vector<BandValue>> bands;
+};
+
+std::string setting_text(const json& v) { return v.is_string() ? v.get<std::string>() : v.dump(); }
+
+struct Config {
+  std::vector<std::string> quality;
+  std::string time = "gpu_ms.total", group = "distribution", budget = "budget", latency;
+  std::set<std::string> lower, higher;
+  bool lower_better(const std::string& m) const {
+    if (lower.count(m)) return true;
+    if (higher.count(m)) return false;
+    return lower_is_better_by_name(m);
+  }
+};
+
+Config read_config(const json& r, const std::vector<Row>& rows) {
+  Config c;
+  std::set<std::string> present;
+  for (const auto& row : rows)
+    for (const auto& [k, v] : row.metrics) present.insert(k);
+  auto strings = [&](const char* key) {
+    std::vector<std::string> v;
+    if (!r.contains(key)) return v;
+    const json& x = r[key];
+    if (x.is_string()) v.push_back(x);
+    else if (x.is_array())
+      for (const auto& e : x) {
+        if (!e.is_string()) throw core::InputError(std::string("report.") + key + ": expected metric names");
+        v.push_back(e);
+      }
+    else throw core::InputError(std::string("report.") + key + ": expected a name or a list of names");
+    return v;
+  };
+  c.quality = strings("quality");
+  if (c.quality.empty()) {
+    // Every both-eye quality metric the renders report, the fovea's first: new metrics in
+    // report.json (FLIP, tone-mapped PSNR, ...) are plotted without a change here.
+    for (const auto& m : present)
+      if (m.find('.') == std::string::npos)
+        for (const char* kind : {"psnr", "ssim", "flip", "mse"})
+          if (m.find(kind) != std::string::npos) {
+            c.quality.push_back(m);
+            break;
+          }
+    std::stable_partition(c.quality.begin(), c.quality.end(), [](const std::string& m) { return m.rfind("fovea_", 0) == 0; });
+  }
+  if (c.quality.empty() && present.count("temporal_error")) c.quality.push_back("temporal_error");
+  if (auto t = strings("time"); !t.empty()) c.time = t[0];
+  if (auto g = strings("group"); !g.empty()) c.group = g[0];
+  if (auto b = strings("budget"); !b.empty()) c.budget = b[0];
+  if (auto l = strings("latency"); !l.empty()) c.latency = l[0];
+  else
+    for (const auto& m : present)
+      if (m.find("photon") != std::string::npos || m.find("latency") != std::string::npos) {
+        c.latency = m;
+        break;
+      }
+  for (const auto& m : strings("lower_is_better")) c.lower.insert(m);
+  for (const auto& m : strings("higher_is_better")) c.higher.insert(m);
+  return c;
+}
+
+// Settings keys whose value differs between jobs: what distinguishes them in a legend.
+std::vector<std::string> varied_keys(const std::vector<Row>& rows) {
+  std::map<std::string, std::set<std::string>> values;
+  for (const auto& r : rows)
+    for (auto it = r.settings.begin(); it != r.settings.end(); ++it) values[it.key()].insert(it->dump());
+  std::vector<std::string> out;
+  for (const auto& [k, v] : values)
+    if (v.size() > 1 || std::any_of(rows.begin(), rows.end(), [&](const Row& r) { return !r.settings.contains(k); }))
+      out.push_back(k);
+  return out;
+}
+
+}  // namespace
+
+std::map<std::string, double> flatten_metrics(const json& report) {
+  std::map<std::string, double> out;
+  json j = report;
+  if (j.is_object()) j.erase("config");
+  flatten(j, "", out);
+  if (j.contains("summary") && j["summary"].contains("left") && j["summary"].contains("right")) {
+    std::map<std::string, double> l, r;
+    flatten(j["summary"]["left"], "", l);
+    flatten(j["summary"]["right"], "", r);
+    for (const auto& [k, v] : l)
+      if (r.count(k)) out[k] = 0.5 * (v + r[k]);
+  }
+  return out;
+}
+
+std::map<std::string, std::vector<BandValue>> band_metrics(const json& report) {
+  std::map<std::string, std::vector<BandValue>> out;
+  if (!report.contains("summary") || !report["summary"].is_object()) return out;
+  std::map<std::string, std::vector<std::vector<BandValue>>> per_eye;
+  for (const auto& eye : report["summary"]) {
+    if (!eye.is_object()) continue;
+    for (auto it = eye.begin(); it != eye.end(); ++it) {
+      if (!is_band_array(*it)) continue;
+      std::map<std::string, std::vector<BandValue>> series;
+      for (const auto& b : *it)
+        for (auto f = b.begin(); f != b.end(); ++f)
+          if (f.key() != "e_min" && f.key() != "e_max" && f.key() != "pixels" && f->is_number() &&
+              std::isfinite(f->get<double>()))
+            series[it.key() + "." + f.key()].push_back({b["e_min"].get<double>(), b["e_max"].get<double>(), f->get<double>()});
+      for (auto& [k, v] : series) per_eye[k].push_back(std::move(v));
+    }
+  }
+  for (auto& [name, eyes] : per_eye) {
+    // Mean over the eyes of the bands both have (same e_min).
+    std::vector<BandValue> merged;
+    for (const BandValue& b : eyes[0]) {
+      double sum = b.value;
+      std::size_t n = 1;
+      for (std::size_t e = 1; e < eyes.size(); ++e)
+        for (const BandValue& o : eyes[e])
+          if (std::abs(o.e_min - b.e_min) < 1e-9) sum += o.value, ++n;
+      if (n == eyes.size()) merged.push_back({b.e_min, b.e_max, sum / double(n)});
+    }
+    out[name] = merged;
+  }
+  return out;
+}
+
+bool lower_is_better_by_name(const std::string& m) {
+  for (const char* s : {"flip", "error", "mse", "_ms", "gpu_ms", "cpu_ms", "seconds", "latency", "photon"})
+    if (m.find(s) != std::string::npos) return true;
+  return false;
+}
+
+std::vector<bool> pareto_front(const std::vector<glm::dvec2>& p, bool higher_is_better) {
+  std::vector<std::size_t> idx;
+  for (std::size_t i = 0; i < p.size(); ++i)
+    if (std::isfinite(p[i].x) && std::isfinite(p[i].y)) idx.push_back(i);
+  const double sign = higher_is_better ? 1.0 : -1.0;
+  std::sort(idx.begin(), idx.end(), [&](std::size_t a, std::size_t b) {
+    return p[a].x != p[b].x ? p[a].x < p[b].x : sign * p[a].y > sign * p[b].y;
+  });
+  std::vector<bool> front(p.size(), false);
+  double best = -std::numeric_limits<double>::infinity();
+  for (std::size_t i : idx)
+    if (sign * p[i].y > best) {
+      front[i] = true;
+      best = sign * p[i].y;
+    }
+  return front;
+}
+
+ReportSummary write_report(const Plan& plan, const ReportOptions& o) {
+  const fs::path dir(o.dir), out(o.out);
+  ReportSummary sum;
+  std::vector<Row> rows;
+  json failed = json::array(), missing = json::array();
+  for (const Job& j : plan.jobs) {
+    Row r{j.id, "missing", j.settings, {}, {}};
+    const fs::path rep = dir / j.out / "report.json";
+    if (fs::exists(dir / j.out)) {
+      std::ifstream in(rep);
+      if (!in) throw core::InputError(rep.string() + ": finished job without report.json");
+      json rj;
+      try {
+        rj = json::parse(in);
+      } catch (const json::parse_error& e) {
+        throw core::InputError(rep.string() + ": not valid JSON (" + e.what() + ")");
+      }
+      r.metrics = flatten_metrics(rj);
+      r.bands = band_metrics(rj);
+      std::ifstream tin(dir / j.out / "task.json");
+      if (tin) {
+        const json t = json::parse(tin, nullptr, false);
+        if (t.is_object() && t.contains("seconds") && t["seconds"].is_number()) r.metrics["wall_seconds"] = t["seconds"];
+      }
+      r.status = "done";
+      ++sum.done;
+    } else if (fs::exists(dir / "failed" / (j.id + ".json"))) {
+      std::ifstream in(dir / "failed" / (j.id + ".json"));
+      const json f = json::parse(in, nullptr, false);
+      failed.push_back(f.is_discarded() ? json{{"id", j.id}} : f);
+      r.status = "failed";
+      ++sum.failed;
+    } else {
+      missing.push_back(j.id);
+      ++sum.missing;
+    }
+    rows.push_back(std::move(r));
+  }
+  const Config cfg = read_config(plan.header.value("report", json::object()), rows);
+  const std::vector<std::string> varied = varied_keys(rows);
+  auto group_of = [&](const Row& r) { return r.settings.contains(cfg.group) ? setting_text(r.settings[cfg.group]) : std::string("all"); };
+  std::vector<std::string> groups;
+  for (const auto& r : rows)
+    if (r.status == "done" && std::find(groups.begin(), groups.end(), group_of(r)) == groups.end()) groups.push_back(group_of(r));
+  auto label_of = [&](const Row& r) {
+    std::string s;
+    for (const auto& k : varied)
+      if (k != cfg.group && r.settings.contains(k)) s += (s.empty() ? "" : " ") + k + "=" + setting_text(r.settings[k]);
+    return s;
+  };
+  fs::create_directories(out);
+  auto save = [&](const core::Image& img, const std::string& name) {
+    core::write_png((out / name).string(), img);
+    sum.files.push_back(name);
+  };
+
+  // Pareto fronts of quality against time, per group.
+  std::map<std::string, std::map<std::string, bool>> on_front;  // quality -> id -> flag
+  json fronts = json::object();
+  for (const auto& q : cfg.quality) {
+    Chart ch;
+    ch.title = q + " against time per frame";
+    ch.note = "ringed: Pareto front per " + cfg.group + " (" + (cfg.lower_better(q) ? "lower" : "higher") + " " + q +
+              " is better, less time is better)";
+    ch.x_label = axis_label(cfg.time) + " per stereo frame";
+    ch.y_label = axis_label(q);
+    for (std::size_t g = 0; g < groups.size(); ++g) {
+      std::vector<const Row*> members;
+      std::vector<glm::dvec2> pts;
+      for (const auto& r : rows)
+        if (r.status == "done" && group_of(r) == groups[g] && r.metrics.count(cfg.time) && r.metrics.count(q)) {
+          members.push_back(&r);
+          pts.push_back({r.metrics.at(cfg.time), r.metrics.at(q)});
+        }
+      if (pts.empty()) continue;
+      const std::vector<bool> f = pareto_front(pts, !cfg.lower_better(q));
+      Series s{groups[g], palette(g), pts, false, true, f};
+      Series line{"", palette(g), {}, true, false, {}};
+      json ids = json::array();
+      std::vector<std::pair<glm::dvec2, std::string>> fp;
+      for (std::size_t i = 0; i < pts.size(); ++i) {
+        on_front[q][members[i]->id] = f[i];
+        if (f[i]) fp.push_back({pts[i], members[i]->id});
+      }
+      std::sort(fp.begin(), fp.end(), [](const auto& a, const auto& b) { return a.first.x < b.first.x; });
+      for (const auto& [p, id] : fp) line.points.push_back(p), ids.push_back(id);
+      fronts[q][groups[g]] = ids;
+      ch.series.push_back(line);
+      ch.series.push_back(s);
+    }
+    if (!ch.series.empty()) save(draw_chart(ch), "quality_vs_time_" + file_stem(q) + ".png");
+
+    // Quality against budget: the best job at each budget, per group.
+    std::set<std::string> budgets;
+    for (const auto& r : rows)
+      if (r.settings.contains(cfg.budget)) budgets.insert(r.settings[cfg.budget].dump());
+    if (budgets.size() > 1) {
+      Chart cb;
+      cb.title = q + " against " + cfg.budget;
+      cb.note = "best job at each " + cfg.budget + " over the other settings, per " + cfg.group;
+      cb.x_label = cfg.budget == "budget" ? "budget (grid samples / display pixels)" : cfg.budget;
+      cb.y_label = axis_label(q);
+      for (std::size_t g = 0; g < groups.size(); ++g) {
+        std::map<double, double> best;
+        for (const auto& r : rows)
+          if (r.status == "done" && group_of(r) == groups[g] && r.metrics.count(q) && r.settings.contains(cfg.budget) &&
+              r.settings[cfg.budget].is_number()) {
+            const double b = r.settings[cfg.budget].get<double>(), v = r.metrics.at(q);
+            auto it = best.find(b);
+            if (it == best.end() || (cfg.lower_better(q) ? v < it->second : v > it->second)) best[b] = v;
+          }
+        Series s{groups[g], palette(g), {}, true, true, {}};
+        for (const auto& [b, v] : best) s.points.push_back({b, v});
+        if (!s.points.empty()) cb.series.push_back(s);
+      }
+      if (!cb.series.empty()) save(draw_chart(cb), "quality_vs_budget_" + file_stem(q) + ".png");
+    }
+
+    if (!cfg.latency.empty()) {
+      Chart cl;
+      cl.title = q + " against " + cfg.latency;
+      cl.x_label = axis_label(cfg.latency);
+      cl.y_label = axis_label(q);
+      for (std::size_t g = 0; g < groups.size(); ++g) {
+        Series s{groups[g], palette(g), {}, false, true, {}};
+        for (const auto& r : rows)
+          if (r.status == "done" && group_of(r) == groups[g] && r.metrics.count(q) && r.metrics.count(cfg.latency))
+            s.points.push_back({r.metrics.at(cfg.latency), r.metrics.at(q)});
+        if (!s.points.empty()) cl.series.push_back(s);
+      }
+      if (!cl.series.empty()) save(draw_chart(cl), "latency_vs_" + file_stem(q) + ".png");
+    }
+  }
+
+  // Per-band curves of the jobs on the first quality metric's fronts (at most 8 lines).
+  std::set<std::string> band_names;
+  for (const auto& r : rows)
+    for (const auto& [k, v] : r.bands) band_names.insert(k);
+  for (const auto& bname : band_names) {
+    Chart cb;
+    cb.title = bname + " per eccentricity band";
+    cb.note = cfg.quality.empty() ? "" : "jobs on the " + cfg.quality[0] + " Pareto fronts";
+    cb.x_label = "eccentricity, band centre (deg)";
+    cb.y_label = axis_label(bname);
+    std::size_t n = 0;
+    for (const auto& r : rows) {
+      if (r.status != "done" || !r.bands.count(bname) || n >= 8) continue;
+      if (!cfg.quality.empty() && !on_front[cfg.quality[0]][r.id]) continue;
+      Series s{group_of(r) + " " + label_of(r), palette(n++), {}, true, true, {}};
+      for (const BandValue& b : r.bands.at(bname)) s.points.push_back({0.5 * (b.e_min + b.e_max), b.value});
+      cb.series.push_back(s);
+    }
+    if (!cb.series.empty()) save(draw_chart(cb), "bands_" + file_stem(bname) + ".png");
+  }
+
+  // results.csv: one row per job; settings, metrics and bands as columns.
+  std::set<std::string> setting_cols, metric_cols, band_cols;
+  for (const auto& r : rows) {
+    for (auto it = r.settings.begin(); it != r.settings.end(); ++it) setting_cols.insert(it.key());
+    for (const auto& [k, v] : r.metrics) metric_cols.insert(k);
+  }
+  auto band_col = [](const std::string& name, const BandValue& b) { return name + "[" + cell(b.e_min) + "-" + cell(b.e_max) + "]"; };
+  std::vector<std::string> band_order;
+  for (const auto& r : rows)
+    for (const auto& [k, v] : r.bands)
+      for (const auto& b : v)
+        if (band_cols.insert(band_col(k, b)).second) band_order.push_back(band_col(k, b));
+  std::string csv = "id,status";
+  for (const auto& k : setting_cols) csv += ",--" + csv_escape(k);  // the render option
+  for (const auto& k : metric_cols) csv += "," + csv_escape(k);
+  for (const auto& k : band_order) csv += "," + csv_escape(k);
+  for (const auto& q : cfg.quality) csv += ",pareto:" + csv_escape(q);
+  csv += "\n";
+  json jobs = json::array();
+  for (const auto& r : rows) {
+    csv += r.id + "," + r.status;
+    for (const auto& k : setting_cols) csv += "," + (r.settings.contains(k) ? csv_escape(setting_text(r.settings[k])) : "");
+    for (const auto& k : metric_cols) csv += "," + (r.metrics.count(k) ? cell(r.metrics.at(k)) : "");
+    std::map<std::string, double> bands;
+    json jb = json::object();
+    for (const auto& [k, v] : r.bands)
+      for (const auto& b : v) {
+        bands[band_col(k, b)] = b.value;
+        jb[k].push_back({{"e_min", b.e_min}, {"e_max", b.e_max}, {"value", b.value}});
+      }
+    for (const auto& k : band_order) csv += "," + (bands.count(k) ? cell(bands[k]) : "");
+    json jp = json::object();
+    for (const auto& q : cfg.quality) {
+      const bool f = on_front[q].count(r.id) && on_front[q][r.id];
+      csv += f ? ",1" : ",0";
+      jp[q] = f;
+    }
+    csv += "\n";
+    jobs.push_back({{"id", r.id}, {"status", r.status}, {"settings", r.settings}, {"metrics", r.metrics}, {"bands", jb}, {"pareto", jp}});
+  }
+  core::write_file_atomic((out / "results.csv").string(), csv);
+  sum.files.insert(sum.files.begin(), "results.csv");
+  json j = {{"source", plan.header.value("source", "")},
+            {"quality", cfg.quality},
+            {"time", cfg.time},
+            {"group", cfg.group},
+            {"jobs", jobs},
+            {"pareto", fronts},
+            {"failed", failed},
+            {"missing", missing},
+            {"counts", {{"done", sum.done}, {"failed", sum.failed}, {"missing", sum.missing}}}};
+  sum.files.insert(sum.files.begin() + 1, "results.json");
+  j["files"] = sum.files;
+  core::write_file_atomic((out / "results.json").string(), j.dump(2) + "\n");
+  return sum;
+}
+
+}  // namespace fovea::sweep
