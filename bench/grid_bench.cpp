@@ -5,6 +5,8 @@
 //            (27°/s at 90 Hz, smooth pursuit speed), so consecutive frames are close;
 //   saccade  every frame jumps to another pseudo-random gaze inside the view (fixed seed),
 //            the worst case for a solve that starts from the previous frame.
+// Each also with the reference σ0 solver (…/bisection: the 56-step bisection the secant
+// replaced), so one run gives the ratio; `evaluations` counts column marches per frame.
 //   fovea_bench_grid [--benchmark_filter=fove0]
 #include <benchmark/benchmark.h>
 
@@ -16,6 +18,7 @@
 
 #include "fovea/core/display.hpp"
 #include "fovea/core/distribution.hpp"
+#include "fovea/core/visual_polar_testing.hpp"
 
 namespace fc = fovea::core;
 
@@ -44,18 +47,22 @@ std::vector<glm::dvec3> saccade_path(const fc::View& v) {
   return path;
 }
 
-void grid_build(benchmark::State& state, const std::string& preset, bool saccades) {
+void grid_build(benchmark::State& state, const std::string& preset, bool saccades, bool bisection) {
   const fc::View view = fc::load_display(preset).view(fc::Eye::Left);
   const auto dist = fc::make_distribution(view, fc::DistributionParams{});
+  fc::set_reference_sigma0_solve(*dist, bisection);
   const auto path = saccades ? saccade_path(view) : pursuit_path(view);
   std::size_t i = 0;
+  double evaluations = 0;
   for (auto _ : state) {
     dist->set_frame(path[i], std::uint32_t(i));
     benchmark::DoNotOptimize(dist->column_table().data());
+    evaluations += fc::visual_polar_state(*dist)->evaluations;
     i = (i + 1) % path.size();
   }
   state.counters["columns"] = dist->columns();
   state.counters["rows"] = dist->rows();
+  state.counters["evaluations"] = evaluations / double(state.iterations());
 }
 
 }  // namespace
@@ -63,9 +70,12 @@ void grid_build(benchmark::State& state, const std::string& preset, bool saccade
 int main(int argc, char** argv) {
   for (const std::string& preset : fc::display_preset_names())
     for (const bool saccades : {false, true})
-      benchmark::RegisterBenchmark(("grid_build/" + preset + (saccades ? "/saccade" : "/pursuit")).c_str(),
-                                   grid_build, preset, saccades)
-          ->Unit(benchmark::kMicrosecond);
+      for (const bool bisection : {false, true})
+        benchmark::RegisterBenchmark(("grid_build/" + preset + (saccades ? "/saccade" : "/pursuit") +
+                                      (bisection ? "/bisection" : "/secant"))
+                                         .c_str(),
+                                     grid_build, preset, saccades, bisection)
+            ->Unit(benchmark::kMicrosecond);
   benchmark::Initialize(&argc, argv);
   if (benchmark::ReportUnrecognizedArguments(argc, argv)) return 1;
   benchmark::RunSpecifiedBenchmarks();
