@@ -36,27 +36,31 @@ constexpr double kColumnTol = 1e-9;
 
 double circumference_deg(double e) { return 360.0 * std::sin(std::clamp(e, 0.0, 180.0) * kDeg); }
 
+// Both solvers take g(x, d) of x = log σ0, which returns g and sets d to its derivative
+// where g is smooth around x (NaN if unknown).
+
 // The reference solver: the root of an increasing g on [kLogLo, kLogHi] by 56 bisection
 // steps, returning the upper end (g >= 0).
 template <class G>
 double bisect(G&& g) {
-  double lo = kLogLo, hi = kLogHi;
+  double lo = kLogLo, hi = kLogHi, d;
   for (int it = 0; it < 56; ++it) {
     const double mid = 0.5 * (lo + hi);
-    (g(mid) < 0 ? lo : hi) = mid;
+    (g(mid, d) < 0 ? lo : hi) = mid;
   }
   return hi;
 }
 
 // Root of an increasing g near x0 (|g| <= tol), given `slope`, an estimate of g' over
-// the distance to the root. Secant steps (the first one Newton's with that slope); until
-// the root is bracketed a step that does not halve |g| makes the next one at least twice
-// as long, and once bracketed a step leaving the bracket, or three steps that do not halve
-// it, fall back to bisection, so jumps or flat parts of g cost at most what bisection
-// would. g is close to linear in log σ0 over a frame's gaze change, so a warm start needs a
-// few evaluations. On return `slope` is the first secant's, the scale of that change.
+// the distance to the root. g may be smooth only in pieces `piece` long with small jumps
+// between them: steps longer than that are secant steps (the first one Newton's with
+// `slope`), shorter ones Newton steps with the piece's own derivative. Until the root is
+// bracketed a step that does not halve |g| makes the next one at least twice as long;
+// once bracketed a step leaving the bracket, or three steps that do not halve it, fall
+// back to bisection, so jumps or flat parts cost at most what bisection would. On return
+// `slope` is the first secant's, the scale of a frame's gaze change, for the next start.
 template <class G>
-double solve_increasing(G&& g, double x0, double& slope, double tol) {
+double solve_increasing(G&& g, double x0, double& slope, double tol, double piece = INFINITY) {
   double lo = kLogLo, hi = kLogHi;  // g(lo) < 0 <= g(hi) where evaluated
   bool has_lo = false, has_hi = false;
   double x = std::clamp(x0, kLogLo, kLogHi), xp = x, gp = 0;
@@ -64,7 +68,8 @@ double solve_increasing(G&& g, double x0, double& slope, double tol) {
   double width = hi - lo;  // bracket width when the halving rule last checked it
   int bracketed_steps = 0;
   for (int it = 0; it < 200; ++it) {
-    const double gx = g(x);
+    double d = NAN;
+    const double gx = g(x, d);
     if (it > 0 && gx != gp) {
       const double secant = (gx - gp) / (x - xp);
       if (secant > 0 && std::isfinite(secant)) {
@@ -77,6 +82,7 @@ double solve_increasing(G&& g, double x0, double& slope, double tol) {
     (gx < 0 ? has_lo : has_hi) = true;
     if (hi - lo <= 1e-15 * std::max(1.0, std::abs(x))) break;
     double next = x - gx / s;
+    if (d > 0 && std::abs(gx) < piece * d) next = x - gx / d;
     if (!(has_lo && has_hi)) {
       if (it > 0 && std::abs(gx) > 0.5 * std::abs(gp) && std::abs(next - x) < 2 * std::abs(x - xp))
         next = x + std::copysign(2 * std::abs(x - xp), -gx);
@@ -150,10 +156,11 @@ class VisualPolar final : public PolarDistribution {
     const double e_max = e_max_ = farthest_view_angle(gaze_);
     sigma_disp_ = fovea_pixel_density(gaze_);
     // Warm start: the previous root, moved by the columns the change of e_max adds at the
-    // previous outermost column's width.
+    // previous outermost column's width (relative to N_ρ: the solve is in log columns).
     const double last_width = r_.size() > 1 ? r_.back() - r_[r_.size() - 2] : 0;
     double x0 = std::log(sigma0_);
-    if (previous_e_max > 0 && last_width > 0 && std::isfinite(slope_) && slope_ > 0) x0 -= (e_max - previous_e_max) / last_width / slope_;
+    if (previous_e_max > 0 && last_width > 0)
+      x0 -= (e_max - previous_e_max) / last_width / columns_ / slope_;
     sigma0_ = std::exp(solve_columns(e_max, x0));
     // The solve leaves the last boundary within 10⁻⁹ of a column of e_max: cover it exactly.
     r_.back() = std::max(r_.back(), e_max);
@@ -191,13 +198,22 @@ class VisualPolar final : public PolarDistribution {
     const double slope = (f_[k + 1] - f_[k]) / kStep;
     return s_[k] + f_[k] * t + 0.5 * slope * t * t;
   }
-  double prefix_inverse(double target) const {
+  // `from`: a node at or below the answer (the column's inner edge): the search gallops
+  // outwards from it (a column spans a few nodes) rather than bisecting the whole table,
+  // and finds the same node.
+  double prefix_inverse(double target, int from = 0) const {
     const int n = int(s_.size()) - 1;
     if (target >= s_[n]) {  // beyond the table: extend with the last density
       const double fl = std::max(f_[n], 1e-300);
       return n * kStep + (target - s_[n]) / fl;
     }
-    const int k = std::clamp(int(std::upper_bound(s_.begin(), s_.end(), target) - s_.begin()) - 1, 0, n - 1);
+    int lo = from > 0 && from < n && s_[from] <= target ? from : 0, step = 1;
+    while (lo + step <= n && s_[lo + step] <= target) {
+      lo += step;
+      step *= 2;
+    }
+    const auto end = s_.begin() + std::min(lo + step, n + 1);
+    const int k = std::clamp(int(std::upper_bound(s_.begin() + lo, end, target) - s_.begin()) - 1, 0, n - 1);
     const double rem = target - s_[k];
     const double slope = (f_[k + 1] - f_[k]) / kStep;
     double t;
@@ -215,12 +231,23 @@ class VisualPolar final : public PolarDistribution {
   }
   int rows_at(double e, double s0) const { return rows_for(circumference_deg(e), sigma(e, s0)); }
 
+  // d S(e)/d log σ0 (to within one node): the prefix without its capped part, σ0·a >=
+  // κσ_disp on [0, e_K) as a(e) is non-increasing.
+  double prefix_dlog(double s0, double e) const {
+    const double cap = params_.cap * sigma_disp_;
+    const auto capped = [&](double a) { return s0 * a >= cap; };
+    const int k = int(std::partition_point(a_.begin(), a_.begin() + int(s_.size()), capped) - a_.begin());
+    return k * kStep >= e ? 0.0 : prefix(e) - s_[std::min(k, int(s_.size()) - 1)];
+  }
+
   // March columns outwards from the gaze until they pass e_max (and at least `record`
   // columns are in r, h when given; r starts at 0) or `limit` columns. Returns the
   // (fractional) number of columns needed to reach e_max; beyond `limit` it is continued
   // with the last column's rows, so the solves see an increasing function, not a plateau.
+  // `dlog`, when given, receives its derivative in log σ0 with the rows held: the column
+  // count is i + (S(e_max) − Σ rows)/rows_i, so only S(e_max) moves.
   double march(double s0, double e_max, int limit, int record = 0, std::vector<double>* r = nullptr,
-               std::vector<int>* h = nullptr) const {
+               std::vector<int>* h = nullptr, double* dlog = nullptr) const {
     build_prefix(s0, e_max);
     if (r) {
       r->assign(1, 0.0);
@@ -236,17 +263,21 @@ class VisualPolar final : public PolarDistribution {
       const double guess =
           std::clamp(rows_for(circ, sg0) / (sg * std::max(circ, 1e-300)), 0.0, 1.0 / std::sqrt(sg));
       rows = rows_at(e + 0.5 * guess, s0);
-      double next = prefix_inverse(s + rows);
+      const int from = int(e / kStep) - 1;
+      double next = prefix_inverse(s + rows, from);
       const int rows2 = rows_at(0.5 * (e + next), s0);
       if (rows2 != rows) {
         rows = rows2;
-        next = prefix_inverse(s + rows);
+        next = prefix_inverse(s + rows, from);
       }
       if (r) {
         r->push_back(next);
         h->push_back(rows);
       }
-      if (next >= e_max && !std::isfinite(needed)) needed = i + (prefix(e_max) - s) / rows;
+      if (next >= e_max && !std::isfinite(needed)) {
+        needed = i + (prefix(e_max) - s) / rows;
+        if (dlog) *dlog = prefix_dlog(s0, e_max) / rows;
+      }
       if (std::isfinite(needed) && i + 1 >= record) break;
       e = next;
       s += rows;
@@ -259,13 +290,21 @@ class VisualPolar final : public PolarDistribution {
   double solve_columns(double e_max, double x0) {
     evaluations_ = 0;
     double kept = NAN;
-    auto g = [&](double x) {
+    auto g = [&](double x, double& d) {
       ++evaluations_;
       kept = x;
-      return march(std::exp(x), e_max, columns_ + 2, columns_, &r_, &h_) - columns_;
+      // In log columns: the count grows like √σ0, so g is close to linear in x.
+      const double n = std::max(march(std::exp(x), e_max, columns_ + 2, columns_, &r_, &h_, &d), 1e-12);
+      d /= n;
+      return std::log(n / columns_);
     };
-    const double x = reference_solve_ ? bisect(g) : solve_increasing(g, x0, slope_, kColumnTol);
-    if (kept != x) g(x);
+    // A column's rows change where √σ0 grows by 1/rows, so over the grid every ~2/samples
+    // in log σ0; between those points the rows are constant and g smooth. The pieces are
+    // taken as 1/(N_ρ·N_φ), about half that.
+    const double piece = 1.0 / (double(columns_) * rows_);
+    const double x =
+        reference_solve_ ? bisect(g) : solve_increasing(g, x0, slope_, kColumnTol / columns_, piece);
+    if (double d; kept != x) g(x, d);
     r_.resize(size_t(columns_) + 1);
     h_.resize(size_t(columns_));
     return x;
@@ -324,13 +363,15 @@ class VisualPolar final : public PolarDistribution {
     auto solve_budget = [&](glm::dvec3 g, double& e_max) {
       sigma_disp_ = fovea_pixel_density(g);
       e_max = farthest_view_angle(g);
-      double slope = NAN;
+      double slope = 1;  // samples ∝ σ0 where σ is not capped
       return std::exp(solve_increasing(
-          [&](double x) {
+          [&](double x, double& d) {
             build_prefix(std::exp(x), e_max);
-            return prefix(e_max) - budget;
+            const double total = std::max(prefix(e_max), 1e-300);
+            d = prefix_dlog(std::exp(x), e_max) / total;
+            return std::log(total / budget);
           },
-          0.0, slope, 1e-12 * budget));
+          0.0, slope, 1e-12));
     };
     auto rows_needed = [&](double s0, double e_max) {
       double n = 1;
@@ -370,7 +411,9 @@ class VisualPolar final : public PolarDistribution {
   mutable std::vector<double> f_, s_;   // per node for the current σ0: σ·circ and prefix
   glm::dvec3 b1_{1, 0, 0}, b2_{0, 1, 0};
   double sigma0_ = 1, sigma_disp_ = 1, e_max_ = 0;
-  double slope_ = NAN;        // d(columns)/d(log σ0) at the last root: the warm start's slope
+  // d log(columns)/d log σ0 for the warm start: ~1/2 (columns ∝ √σ0 where σ is not
+  // capped), then the previous solve's first secant.
+  double slope_ = 0.5;
   int evaluations_ = 0;       // column marches the last per-frame solve used
   bool reference_solve_ = false;
 };
