@@ -263,7 +263,7 @@ class VisualPolar final : public PolarDistribution {
       const double guess =
           std::clamp(rows_for(circ, sg0) / (sg * std::max(circ, 1e-300)), 0.0, 1.0 / std::sqrt(sg));
       rows = rows_at(e + 0.5 * guess, s0);
-      const int from = int(e / kStep) - 1;
+      const int from = e < 180.0 ? int(e / kStep) - 1 : kNodes;  // e runs past the table for tiny σ0
       double next = prefix_inverse(s + rows, from);
       const int rows2 = rows_at(0.5 * (e + next), s0);
       if (rows2 != rows) {
