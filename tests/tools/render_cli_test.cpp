@@ -36,6 +36,9 @@ TEST(RenderCli, ReportFramesAndExrOnTheTinyDisplay) {
   EXPECT_GT(j["samples_traced_per_eye"].get<double>(), 0);
   EXPECT_LT(j["samples_traced_per_eye"].get<double>(), 64 * 72);  // foveated: fewer than the pixels
   for (const char* k : {"trace", "reconstruct", "resolve", "total"}) EXPECT_TRUE(j["gpu_ms"].contains(k)) << k;
+  // The Vulkan device and driver the timings come from.
+  EXPECT_FALSE(j["device"]["name"].get<std::string>().empty());
+  EXPECT_FALSE(j["device"]["driver"].get<std::string>().empty());
   for (const char* eye : {"left", "right"}) {
     const auto& s = j["summary"][eye];
     for (const char* k : {"psnr", "fovea_psnr", "foveated_psnr", "ssim", "temporal_error", "band_psnr"})
