@@ -6,6 +6,9 @@
 //            ∫_{e_i}^{e_i+1} σ(e)·circ(e) de = H_i                    (density exact per column)
 //   N_φ = max_e circ(e)·√(σ(e)/A),  N_ρ from the budget at a centred gaze (fixed per session);
 //   per frame σ0 is re-solved so that the N_ρ columns reach E, the farthest frustum point.
+// The σ0 equations are solved by a safeguarded secant in log σ0, warm-started per frame
+// from the previous frame's root and slope; the 56-step bisection it replaced stays
+// selectable as the reference the tests and bench/grid_bench.cpp compare against.
 #include <algorithm>
 #include <cmath>
 #include <numbers>
@@ -16,6 +19,7 @@
 #include "distribution_impl.hpp"
 #include "fovea/core/acuity.hpp"
 #include "fovea/core/error.hpp"
+#include "fovea/core/visual_polar_testing.hpp"
 
 namespace fovea::core {
 
@@ -26,7 +30,78 @@ constexpr double kDeg = kPi / 180.0;
 constexpr int kNodes = 16384;       // tabulation of a(e), circ(e) over [0°, 180°]
 constexpr double kStep = 180.0 / kNodes;
 
+constexpr double kLogLo = -30, kLogHi = 30;  // search range of log σ0
+// The per-frame solve stops when the N_ρ columns end within 10⁻⁹ of a column of E.
+constexpr double kColumnTol = 1e-9;
+
 double circumference_deg(double e) { return 360.0 * std::sin(std::clamp(e, 0.0, 180.0) * kDeg); }
+
+// Both solvers take g(x, d) of x = log σ0, which returns g and sets d to its derivative
+// where g is smooth around x (NaN if unknown).
+
+// The reference solver: the root of an increasing g on [kLogLo, kLogHi] by 56 bisection
+// steps, returning the upper end (g >= 0).
+template <class G>
+double bisect(G&& g) {
+  double lo = kLogLo, hi = kLogHi, d;
+  for (int it = 0; it < 56; ++it) {
+    const double mid = 0.5 * (lo + hi);
+    (g(mid, d) < 0 ? lo : hi) = mid;
+  }
+  return hi;
+}
+
+// Root of an increasing g near x0 (|g| <= tol), given `slope`, an estimate of g' over
+// the distance to the root. g may be smooth only in pieces `piece` long with small jumps
+// between them: steps longer than that are secant steps (the first one Newton's with
+// `slope`), shorter ones Newton steps with the piece's own derivative. Until the root is
+// bracketed a step that does not halve |g| makes the next one at least twice as long;
+// once bracketed a step leaving the bracket, or three steps that do not halve it, fall
+// back to bisection, so jumps or flat parts cost at most what bisection would. On return
+// `slope` is the first secant's, the scale of a frame's gaze change, for the next start.
+template <class G>
+double solve_increasing(G&& g, double x0, double& slope, double tol, double piece = INFINITY) {
+  double lo = kLogLo, hi = kLogHi;  // g(lo) < 0 <= g(hi) where evaluated
+  bool has_lo = false, has_hi = false;
+  double x = std::clamp(x0, kLogLo, kLogHi), xp = x, gp = 0;
+  double s = std::isfinite(slope) && slope > 0 ? slope : 1.0;
+  double width = hi - lo;  // bracket width when the halving rule last checked it
+  int bracketed_steps = 0;
+  for (int it = 0; it < 200; ++it) {
+    double d = NAN;
+    const double gx = g(x, d);
+    if (it > 0 && gx != gp) {
+      const double secant = (gx - gp) / (x - xp);
+      if (secant > 0 && std::isfinite(secant)) {
+        s = secant;
+        if (it == 1) slope = secant;
+      }
+    }
+    if (std::abs(gx) <= tol) return x;
+    (gx < 0 ? lo : hi) = x;
+    (gx < 0 ? has_lo : has_hi) = true;
+    if (hi - lo <= 1e-15 * std::max(1.0, std::abs(x))) break;
+    double next = x - gx / s;
+    if (d > 0 && std::abs(gx) < piece * d) next = x - gx / d;
+    if (!(has_lo && has_hi)) {
+      if (it > 0 && std::abs(gx) > 0.5 * std::abs(gp) && std::abs(next - x) < 2 * std::abs(x - xp))
+        next = x + std::copysign(2 * std::abs(x - xp), -gx);
+      next = std::clamp(next, kLogLo, kLogHi);
+      if (next == x) break;  // no root in the range: stay at its end
+    } else {
+      bool bisect_now = !(next > lo && next < hi);
+      if (++bracketed_steps % 3 == 0) {
+        bisect_now = bisect_now || hi - lo > 0.5 * width;
+        width = hi - lo;
+      }
+      if (bisect_now) next = 0.5 * (lo + hi);
+    }
+    xp = x;
+    gp = gx;
+    x = next;
+  }
+  return has_hi ? hi : x;
+}
 
 class VisualPolar final : public PolarDistribution {
  public:
@@ -35,7 +110,7 @@ class VisualPolar final : public PolarDistribution {
     circ_.resize(kNodes + 1);
     for (int k = 0; k <= kNodes; ++k) {
       const double e = k * kStep;
-      a_[k] = std::pow(acuity::m(std::max(e - p.margin_deg, 0.0)), p.gamma);
+      a_[k] = acuity_term(e);
       circ_[k] = circumference_deg(e);
     }
     setup_session();
@@ -52,7 +127,11 @@ class VisualPolar final : public PolarDistribution {
     return sr / (kDeg * kDeg) / h_[column] * view_.pixels_per_deg2(dir);
   }
 
-  VisualPolarState state() const { return {sigma0_, sigma_disp_, e_max_}; }
+  VisualPolarState state() const { return {sigma0_, sigma_disp_, e_max_, evaluations_}; }
+  void set_reference_solve(bool on) {
+    reference_solve_ = on;
+    on_frame();
+  }
 
  protected:
   void from_polar(double e, double phi, glm::dvec3& dir, glm::dvec2& px) const override {
@@ -73,28 +152,29 @@ class VisualPolar final : public PolarDistribution {
 
   void on_frame() override {
     orthonormal_basis(gaze_, b1_, b2_);
+    const double previous_e_max = e_max_;
     const double e_max = e_max_ = farthest_view_angle(gaze_);
     sigma_disp_ = fovea_pixel_density(gaze_);
-    // Solve σ0 so that the session's N_ρ columns end exactly at e_max (bisection in log σ0;
-    // the column count grows with σ0).
-    double lo = -30, hi = 30;
-    for (int it = 0; it < 56; ++it) {
-      const double mid = 0.5 * (lo + hi);
-      (columns_needed(std::exp(mid), e_max) < columns_ ? lo : hi) = mid;
-    }
-    sigma0_ = std::exp(hi);
-    build_columns(sigma0_, e_max, columns_, &r_, &h_);
-    // The bisection leaves the last boundary within rounding of e_max: cover it exactly.
+    // Warm start: the previous root, moved by the columns the change of e_max adds at the
+    // previous outermost column's width (relative to N_ρ: the solve is in log columns).
+    const double last_width = r_.size() > 1 ? r_.back() - r_[r_.size() - 2] : 0;
+    double x0 = std::log(sigma0_);
+    if (previous_e_max > 0 && last_width > 0)
+      x0 -= (e_max - previous_e_max) / last_width / columns_ / slope_;
+    sigma0_ = std::exp(solve_columns(e_max, x0));
+    // The solve leaves the last boundary within 10⁻⁹ of a column of e_max: cover it exactly.
     r_.back() = std::max(r_.back(), e_max);
     if (params_.staircase) apply_staircase();
     publish_table();
   }
 
  private:
-  double sigma(double e, double s0) const {
-    const double a = std::pow(acuity::m(std::max(e - params_.margin_deg, 0.0)), params_.gamma);
-    return std::min(params_.cap * sigma_disp_, s0 * a);
+  // a(e) = m(max(e − s, 0))^γ (pow(x, 1) == x, so γ = 1 skips it exactly).
+  double acuity_term(double e) const {
+    const double m = acuity::m(std::max(e - params_.margin_deg, 0.0));
+    return params_.gamma == 1.0 ? m : std::pow(m, params_.gamma);
   }
+  double sigma(double e, double s0) const { return std::min(params_.cap * sigma_disp_, s0 * acuity_term(e)); }
   double sigma_node(int k, double s0) const { return std::min(params_.cap * sigma_disp_, s0 * a_[k]); }
 
   // Prefix table S(e_k) = ∫0^{e_k} σ·circ de with σ·circ linear between nodes, so S is
@@ -118,13 +198,22 @@ class VisualPolar final : public PolarDistribution {
     const double slope = (f_[k + 1] - f_[k]) / kStep;
     return s_[k] + f_[k] * t + 0.5 * slope * t * t;
   }
-  double prefix_inverse(double target) const {
+  // `from`: a node at or below the answer (the column's inner edge): the search gallops
+  // outwards from it (a column spans a few nodes) rather than bisecting the whole table,
+  // and finds the same node.
+  double prefix_inverse(double target, int from = 0) const {
     const int n = int(s_.size()) - 1;
     if (target >= s_[n]) {  // beyond the table: extend with the last density
       const double fl = std::max(f_[n], 1e-300);
       return n * kStep + (target - s_[n]) / fl;
     }
-    const int k = std::clamp(int(std::upper_bound(s_.begin(), s_.end(), target) - s_.begin()) - 1, 0, n - 1);
+    int lo = from > 0 && from < n && s_[from] <= target ? from : 0, step = 1;
+    while (lo + step <= n && s_[lo + step] <= target) {
+      lo += step;
+      step *= 2;
+    }
+    const auto end = s_.begin() + std::min(lo + step, n + 1);
+    const int k = std::clamp(int(std::upper_bound(s_.begin() + lo, end, target) - s_.begin()) - 1, 0, n - 1);
     const double rem = target - s_[k];
     const double slope = (f_[k + 1] - f_[k]) / kStep;
     double t;
@@ -137,47 +226,89 @@ class VisualPolar final : public PolarDistribution {
     return k * kStep + std::clamp(t, 0.0, kStep);
   }
 
-  int rows_at(double e, double s0) const {
-    const double h = circumference_deg(e) * std::sqrt(sigma(e, s0));
-    return int(std::clamp(std::round(h), 1.0, double(rows_)));
+  int rows_for(double circ, double sg) const {
+    return int(std::clamp(std::round(circ * std::sqrt(sg)), 1.0, double(rows_)));
+  }
+  int rows_at(double e, double s0) const { return rows_for(circumference_deg(e), sigma(e, s0)); }
+
+  // d S(e)/d log σ0 (to within one node): the prefix without its capped part, σ0·a >=
+  // κσ_disp on [0, e_K) as a(e) is non-increasing.
+  double prefix_dlog(double s0, double e) const {
+    const double cap = params_.cap * sigma_disp_;
+    const auto capped = [&](double a) { return s0 * a >= cap; };
+    const int k = int(std::partition_point(a_.begin(), a_.begin() + int(s_.size()), capped) - a_.begin());
+    return k * kStep >= e ? 0.0 : prefix(e) - s_[std::min(k, int(s_.size()) - 1)];
   }
 
-  // March columns outwards from the gaze. Returns the (fractional) number of columns
-  // needed to reach e_max; with `out_r`/`out_h` records exactly `limit` columns.
-  double build_columns(double s0, double e_max, int limit, std::vector<double>* out_r = nullptr,
-                       std::vector<int>* out_h = nullptr) const {
+  // March columns outwards from the gaze until they pass e_max (and at least `record`
+  // columns are in r, h when given; r starts at 0) or `limit` columns. Returns the
+  // (fractional) number of columns needed to reach e_max; beyond `limit` it is continued
+  // with the last column's rows, so the solves see an increasing function, not a plateau.
+  // `dlog`, when given, receives its derivative in log σ0 with the rows held: the column
+  // count is i + (S(e_max) − Σ rows)/rows_i, so only S(e_max) moves.
+  double march(double s0, double e_max, int limit, int record = 0, std::vector<double>* r = nullptr,
+               std::vector<int>* h = nullptr, double* dlog = nullptr) const {
     build_prefix(s0, e_max);
-    if (out_r) {
-      out_r->assign(1, 0.0);
-      out_h->clear();
+    if (r) {
+      r->assign(1, 0.0);
+      h->clear();
     }
-    double e = 0, s = 0;
+    double e = 0, s = 0, needed = INFINITY;
+    int rows = 1;
     for (int i = 0; i < limit; ++i) {
       // Rows from the column's mid-eccentricity: guess the width from the isotropic
       // spacing, then refine once with the width the rows imply.
-      const double sg = std::max(sigma(e, s0), 1e-300);
-      const double guess = std::clamp(rows_at(e, s0) / (sg * std::max(circumference_deg(e), 1e-300)), 0.0,
-                                      1.0 / std::sqrt(sg));
-      int h = rows_at(e + 0.5 * guess, s0);
-      double next = prefix_inverse(s + h);
-      const int h2 = rows_at(0.5 * (e + next), s0);
-      if (h2 != h) {
-        h = h2;
-        next = prefix_inverse(s + h);
+      const double circ = circumference_deg(e), sg0 = sigma(e, s0);
+      const double sg = std::max(sg0, 1e-300);
+      const double guess =
+          std::clamp(rows_for(circ, sg0) / (sg * std::max(circ, 1e-300)), 0.0, 1.0 / std::sqrt(sg));
+      rows = rows_at(e + 0.5 * guess, s0);
+      const int from = e < 180.0 ? int(e / kStep) - 1 : kNodes;  // e runs past the table for tiny σ0
+      double next = prefix_inverse(s + rows, from);
+      const int rows2 = rows_at(0.5 * (e + next), s0);
+      if (rows2 != rows) {
+        rows = rows2;
+        next = prefix_inverse(s + rows, from);
       }
-      if (out_r) {
-        out_r->push_back(next);
-        out_h->push_back(h);
-      } else if (next >= e_max) {
-        return i + (prefix(e_max) - s) / h;
+      if (r) {
+        r->push_back(next);
+        h->push_back(rows);
       }
+      if (next >= e_max && !std::isfinite(needed)) {
+        needed = i + (prefix(e_max) - s) / rows;
+        if (dlog) *dlog = prefix_dlog(s0, e_max) / rows;
+      }
+      if (std::isfinite(needed) && i + 1 >= record) break;
       e = next;
-      s += h;
+      s += rows;
     }
-    return limit + 1.0;  // did not reach e_max within the limit
+    return std::isfinite(needed) ? needed : limit + (prefix(e_max) - s) / rows;
   }
 
-  double columns_needed(double s0, double e_max) const { return build_columns(s0, e_max, columns_ + 2); }
+  // log σ0 such that the N_ρ columns end at e_max (the column count grows with σ0),
+  // starting from x0; leaves the root's column table (N_ρ columns) in r_, h_.
+  double solve_columns(double e_max, double x0) {
+    evaluations_ = 0;
+    double kept = NAN;
+    auto g = [&](double x, double& d) {
+      ++evaluations_;
+      kept = x;
+      // In log columns: the count grows like √σ0, so g is close to linear in x.
+      const double n = std::max(march(std::exp(x), e_max, columns_ + 2, columns_, &r_, &h_, &d), 1e-12);
+      d /= n;
+      return std::log(n / columns_);
+    };
+    // A column's rows change where √σ0 grows by 1/rows, so over the grid every ~2/samples
+    // in log σ0; between those points the rows are constant and g smooth. The pieces are
+    // taken as 1/(N_ρ·N_φ), about half that.
+    const double piece = 1.0 / (double(columns_) * rows_);
+    const double x =
+        reference_solve_ ? bisect(g) : solve_increasing(g, x0, slope_, kColumnTol / columns_, piece);
+    if (double d; kept != x) g(x, d);
+    r_.resize(size_t(columns_) + 1);
+    h_.resize(size_t(columns_));
+    return x;
+  }
 
   // Largest angle from the gaze to the frustum boundary (corners, and the edges sampled
   // for views wider than a hemisphere around the gaze).
@@ -232,13 +363,15 @@ class VisualPolar final : public PolarDistribution {
     auto solve_budget = [&](glm::dvec3 g, double& e_max) {
       sigma_disp_ = fovea_pixel_density(g);
       e_max = farthest_view_angle(g);
-      double lo = -30, hi = 30;
-      for (int it = 0; it < 56; ++it) {
-        const double mid = 0.5 * (lo + hi);
-        build_prefix(std::exp(mid), e_max);
-        (prefix(e_max) < budget ? lo : hi) = mid;
-      }
-      return std::exp(hi);
+      double slope = 1;  // samples ∝ σ0 where σ is not capped
+      return std::exp(solve_increasing(
+          [&](double x, double& d) {
+            build_prefix(std::exp(x), e_max);
+            const double total = std::max(prefix(e_max), 1e-300);
+            d = prefix_dlog(std::exp(x), e_max) / total;
+            return std::log(total / budget);
+          },
+          0.0, slope, 1e-12));
     };
     auto rows_needed = [&](double s0, double e_max) {
       double n = 1;
@@ -257,7 +390,7 @@ class VisualPolar final : public PolarDistribution {
     const glm::dvec2 probes[] = {{0, 0}, {0.5, 0}, {1, 0}, {0, 0.5}, {1, 0.5}, {0, 1}, {0.5, 1}, {1, 1}};
     for (int round = 0; round < 2; ++round) {
       sigma_disp_ = disp_centre;
-      columns_ = std::max(1, int(std::ceil(build_columns(s0, e_centre, 1 << 24) - 1e-9)));
+      columns_ = std::max(1, int(std::ceil(march(s0, e_centre, 1 << 24) - 1e-9)));
       if (columns_ > (1 << 22) || rows_ > (1 << 22))
         throw InputError("visual-polar: grid of " + std::to_string(columns_) + "x" + std::to_string(rows_) +
                          " is too large for this display and budget");
@@ -266,21 +399,23 @@ class VisualPolar final : public PolarDistribution {
         const glm::dvec3 g = view_.pixel_to_dir({q.x * view_.width(), q.y * view_.height()});
         sigma_disp_ = fovea_pixel_density(g);
         const double e_max = farthest_view_angle(g);
-        double lo = -30, hi = 30;
-        for (int it = 0; it < 56; ++it) {
-          const double mid = 0.5 * (lo + hi);
-          (columns_needed(std::exp(mid), e_max) < columns_ ? lo : hi) = mid;
-        }
-        rows_ = std::max(rows_, int(std::ceil(rows_needed(std::exp(hi), e_max) - 1e-9)));
+        const double x = solve_columns(e_max, std::log(s0));
+        rows_ = std::max(rows_, int(std::ceil(rows_needed(std::exp(x), e_max) - 1e-9)));
       }
     }
     sigma_disp_ = disp_centre;
+    sigma0_ = s0;  // the first frame's warm start
   }
 
   std::vector<double> a_, circ_;        // per node: a(e), circ(e)
   mutable std::vector<double> f_, s_;   // per node for the current σ0: σ·circ and prefix
   glm::dvec3 b1_{1, 0, 0}, b2_{0, 1, 0};
   double sigma0_ = 1, sigma_disp_ = 1, e_max_ = 0;
+  // d log(columns)/d log σ0 for the warm start: ~1/2 (columns ∝ √σ0 where σ is not
+  // capped), then the previous solve's first secant.
+  double slope_ = 0.5;
+  int evaluations_ = 0;       // column marches the last per-frame solve used
+  bool reference_solve_ = false;
 };
 
 }  // namespace
@@ -288,6 +423,12 @@ class VisualPolar final : public PolarDistribution {
 std::optional<VisualPolarState> visual_polar_state(const SampleDistribution& d) {
   if (const auto* vp = dynamic_cast<const VisualPolar*>(&d)) return vp->state();
   return std::nullopt;
+}
+
+void set_reference_sigma0_solve(SampleDistribution& d, bool on) {
+  auto* vp = dynamic_cast<VisualPolar*>(&d);
+  if (!vp) throw std::invalid_argument("set_reference_sigma0_solve: not a visual-polar distribution");
+  vp->set_reference_solve(on);
 }
 
 std::unique_ptr<SampleDistribution> make_visual_polar(const View& view, const DistributionParams& p) {

@@ -15,6 +15,7 @@
 #include "fovea/core/display.hpp"
 #include "fovea/core/distribution.hpp"
 #include "fovea/core/error.hpp"
+#include "fovea/core/visual_polar_testing.hpp"
 
 using namespace fovea::core;
 namespace sh = fovea::shaders;
@@ -332,6 +333,75 @@ TEST(VisualPolarExtremes, InvalidConfigurationsRefused) {
   EXPECT_THROW(View(Fov::from_degrees(-90, 90, 45, -45), 10, 10), InputError);
   EXPECT_THROW(View(Fov::from_degrees(10, -10, 45, -45), 10, 10), InputError);
   EXPECT_THROW(View(Fov::from_degrees(-45, 45, 45, -45), 0, 10), InputError);
+}
+
+// The per-frame σ0 solve (warm-started safeguarded secant) against the reference 56-step
+// bisection, frame by frame over every gaze case in order (so the warm start crosses
+// corners, the outside-view clamp and the NaN/zero fallbacks). Rounding rows per column
+// makes the column count a fine sawtooth in σ0, so the equation can have several close
+// roots and the bisection picks one of them; the bounds below are docs/visual-polar.md's
+// ("Per-frame σ0 solve").
+TEST(VisualPolarSolve, SecantMatchesBisection) {
+  int cases = 0, identical = 0;
+  for (const char* preset : {FOVEA_PRESETS}) {
+    const View v = load_display(preset).view(Eye::Left);
+    auto d = make_distribution(v, DistributionParams{});
+    int evaluations = 0;
+    for (const GazeCase& gc : kGazes) {
+      SCOPED_TRACE(std::string(preset) + " " + gc.name);
+      d->set_frame(gaze_dir(v, gc));
+      const VisualPolarState fast = *visual_polar_state(*d);
+      const auto table = d->column_table();
+      evaluations += fast.evaluations;
+      set_reference_sigma0_solve(*d, true);
+      const VisualPolarState ref = *visual_polar_state(*d);
+      EXPECT_GE(ref.evaluations, 56) << "the reference bisects 56 times";
+      // Each column's rounding moves the count by up to half a row of ~N_φ; √N_ρ of them
+      // add up, and the count grows like √σ0.
+      const double cells = double(d->columns()) * d->rows();
+      const double dlog = std::abs(std::log(fast.sigma0 / ref.sigma0));
+      EXPECT_LE(dlog, 8 * std::sqrt(d->columns()) / cells);
+      const auto& t = d->column_table();
+      ASSERT_EQ(t.size(), table.size());
+      int row_mismatches = 0;
+      double worst = 0;  // radius difference in widths of the column
+      for (size_t i = 0; i < t.size(); ++i) {
+        EXPECT_LE(std::abs(int(t[i].rows) - int(table[i].rows)), 1) << "column " << i;
+        row_mismatches += t[i].rows != table[i].rows;
+        const double width = double(t[i].r1) - double(t[i].r0);
+        worst = std::max({worst, std::abs(double(t[i].r0) - double(table[i].r0)) / width,
+                          std::abs(double(t[i].r1) - double(table[i].r1)) / width});
+      }
+      // A column's rounding flips where its ~N_φ·√σ0 rows cross a half: over Δlog σ0 about
+      // N_ρ·N_φ·Δlog σ0 / 2 columns (allowed: twice that, plus 3).
+      EXPECT_LE(row_mismatches, cells * dlog + 3);
+      EXPECT_LE(worst, 0.1);
+      ++cases;
+      identical += row_mismatches == 0 && worst <= 1e-5;
+      set_reference_sigma0_solve(*d, false);
+    }
+    // The warm start pays even here, where the gaze jumps across the view each frame.
+    EXPECT_LE(double(evaluations) / std::size(kGazes), 16) << preset;
+  }
+  // Mostly the same root: identical rows, radii equal to float rounding.
+  EXPECT_GE(identical, 0.75 * cases);
+  RecordProperty("identical_fraction", std::to_string(double(identical) / cases));
+}
+
+// Along a smooth pursuit the warm start needs at most a handful of column marches.
+TEST(VisualPolarSolve, PursuitNeedsFewEvaluations) {
+  const View v = load_display("small").view(Eye::Left);
+  auto d = make_distribution(v, DistributionParams{});
+  int evaluations = 0, worst = 0;
+  for (int f = 0; f < 60; ++f) {
+    const double t = f / 60.0;
+    d->set_frame(v.pixel_to_dir({(0.3 + 0.4 * t) * v.width(), (0.4 + 0.1 * t) * v.height()}), std::uint32_t(f));
+    const int n = visual_polar_state(*d)->evaluations;
+    evaluations += n;
+    worst = std::max(worst, n);
+  }
+  EXPECT_LE(evaluations / 60.0, 6.0);
+  EXPECT_LT(worst, 56);
 }
 
 TEST(VisualPolarExtremes, GammaTwoAndStaircaseStaySound) {

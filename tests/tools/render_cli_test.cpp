@@ -1,6 +1,7 @@
 // `fovea render`: the main job end to end on the tiny display — report.json with the
 // issue's fields (finite), per-frame PNGs and the last frame's EXRs; bad input -> exit 2.
 #include <cmath>
+#include <cstdlib>
 #include <filesystem>
 #include <fstream>
 
@@ -36,6 +37,9 @@ TEST(RenderCli, ReportFramesAndExrOnTheTinyDisplay) {
   EXPECT_GT(j["samples_traced_per_eye"].get<double>(), 0);
   EXPECT_LT(j["samples_traced_per_eye"].get<double>(), 64 * 72);  // foveated: fewer than the pixels
   for (const char* k : {"trace", "reconstruct", "resolve", "total"}) EXPECT_TRUE(j["gpu_ms"].contains(k)) << k;
+  // The Vulkan device and driver the timings come from.
+  EXPECT_FALSE(j["device"]["name"].get<std::string>().empty());
+  EXPECT_FALSE(j["device"]["driver"].get<std::string>().empty());
   for (const char* eye : {"left", "right"}) {
     const auto& s = j["summary"][eye];
     for (const char* k : {"psnr", "fovea_psnr", "foveated_psnr", "ssim", "temporal_error", "band_psnr"})
@@ -62,6 +66,12 @@ TEST(RenderCli, BadInputExitsWithTwo) {
     EXPECT_EQ(r.status, 2) << args << "\n" << r.err;
     EXPECT_FALSE(r.err.empty()) << args;
   }
+  // An unknown driver choice is refused whatever else selects the driver.
+  setenv("FOVEA_VK_DRIVER", "bogus", 1);
+  const auto r = run_fovea("render --display tiny --frames 1 --quiet --out " + dir);
+  unsetenv("FOVEA_VK_DRIVER");
+  EXPECT_EQ(r.status, 2) << r.err;
+  EXPECT_NE(r.err.find("FOVEA_VK_DRIVER"), std::string::npos) << r.err;
   std::filesystem::remove_all(dir);
 }
 

@@ -36,7 +36,7 @@ optional stereo sharing of indirect diffuse, BMFR, TAA) and resolved to the disp
 the peripheral blur. Writes to --out:
   frame_NNNN_left.png, frame_NNNN_right.png, frame_NNNN_sbs.png   tone-mapped (Reinhard)
   last_left.exr, last_right.exr                                    linear, last frame
-  report.json   {"frames", "samples_traced_per_eye", "gpu_ms": {trace, reconstruct,
+  report.json   {"frames", "samples_traced_per_eye", "device": {name, driver}, "gpu_ms": {trace, reconstruct,
                  resolve, total, bmfr_fit} (medians), "summary": {"left": {...}, "right": {...}}}
 With --reference SPP each eye's summary compares the last frame with a converged
 Cartesian reference: psnr, fovea_psnr, foveated_psnr, ssim, band_psnr (2° bands), next to
@@ -236,6 +236,8 @@ int run(std::vector<std::string> argv) {
                  {"bmfr_precision", precision},
                  {"stereo_share", compositor::stereo_share_name(settings.share)},
                  {"blur", settings.blur}};
+  // Which Vulkan driver produced the timings (lavapipe 22.3 and 25 differ ~2x).
+  j["device"] = {{"name", ctx.info().name}, {"driver", ctx.info().driver}};
   j["gpu_ms"] = {{"trace", median(t_trace)},
                  {"reconstruct", median(t_recon)},
                  {"resolve", median(t_resolve)},

@@ -5,6 +5,7 @@
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
+#include <filesystem>
 #include <iostream>
 #include <set>
 
@@ -95,6 +96,25 @@ void usage(std::ostream& os) {
 
 }  // namespace fovea::tools
 
+namespace {
+
+// The Vulkan driver, as ./x chooses it (docs/building.md, "The Vulkan driver"): one the
+// user selected wins; else FOVEA_VK_DRIVER=system is the system's lavapipe, =loader the
+// loader's own search, and the default the Mesa 25 lavapipe ./x installs into the source
+// tree, where it is (without it the loader's search, which prefers a GPU).
+void select_vulkan_driver() {
+  const char* env = std::getenv("FOVEA_VK_DRIVER");
+  const std::string choice = env && *env ? env : "embedded";
+  if (choice != "embedded" && choice != "system" && choice != "loader")
+    throw fovea::core::InputError("FOVEA_VK_DRIVER: expected embedded, system or loader, got \"" + choice + "\"");
+  if (std::getenv("VK_ICD_FILENAMES") || std::getenv("VK_DRIVER_FILES")) return;
+  if (choice == "system") setenv("VK_ICD_FILENAMES", FOVEA_SYSTEM_VK_ICD, 1);
+  if (choice == "embedded" && std::filesystem::exists(FOVEA_EMBEDDED_VK_ICD))
+    setenv("VK_ICD_FILENAMES", FOVEA_EMBEDDED_VK_ICD, 1);
+}
+
+}  // namespace
+
 int main(int argc, char** argv) {
   using namespace fovea::tools;
   if (argc < 2) {
@@ -113,6 +133,7 @@ int main(int argc, char** argv) {
     return 2;
   }
   try {
+    select_vulkan_driver();
     return it->second.run(std::vector<std::string>(argv + 2, argv + argc));
   } catch (const fovea::core::InputError& e) {
     std::cerr << "fovea " << name << ": " << e.what() << "\n";

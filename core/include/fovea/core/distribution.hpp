@@ -127,6 +127,7 @@ struct VisualPolarState {
   double sigma0 = 0;       // acuity scale solved for this frame (samples/deg² at m = 1)
   double sigma_disp = 0;   // display pixel density that κ caps against (pixels/deg²)
   double e_max = 0;        // farthest view direction from the gaze, degrees
+  int evaluations = 0;     // column marches the σ0 solve of this frame used
 };
 std::optional<VisualPolarState> visual_polar_state(const SampleDistribution& d);
 
