@@ -17,6 +17,7 @@
 #include "fovea/compositor/mirror_window.hpp"
 #include "fovea/core/display.hpp"
 #include "fovea/core/error.hpp"
+#include "fovea/core/eye_optics.hpp"
 #include "fovea/core/hidden_area.hpp"
 #include "fovea/core/image.hpp"
 #include "fovea/devices/gaze.hpp"
@@ -184,7 +185,7 @@ int run(std::vector<std::string> argv) {
     if (mouse) {
       // Both eyes look along the direction seen through the lens under the cursor
       // (parallel eyes: vergence is ignored); off the panels the last gaze holds.
-      if (const auto p = window.cursor()) gaze[0] = gaze[1] = compositor::gaze_direction(lenses[int(p->eye)], p->uv);
+      if (const auto p = window.cursor()) gaze[0] = gaze[1] = core::gaze_direction(lenses[int(p->eye)], p->uv);
     } else if (source) {
       const devices::GazeSample s = source->sample_at(core::TimeNs(std::llround(double(frame) / d.refresh_hz * 1e9)));
       for (int e = 0; e < 2; ++e) {
@@ -200,7 +201,7 @@ int run(std::vector<std::string> argv) {
         panels[e] = passes[size_t(e)]->run(renderer::tone_map(sr->pipeline->image(core::Eye(e))));
     }
     std::optional<glm::dvec2> marker[2];
-    for (int e = 0; e < 2; ++e) marker[e] = compositor::gaze_panel_uv(lenses[e], gaze[size_t(e)]);
+    for (int e = 0; e < 2; ++e) marker[e] = core::gaze_panel_uv(lenses[e], gaze[size_t(e)]);
     window.show(panels[0], panels[1], marker[0], marker[1]);
     std::this_thread::sleep_until(frame_start + period);
   }
