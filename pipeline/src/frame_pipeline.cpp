@@ -137,9 +137,8 @@ FrameTimes FramePipeline::render(const std::array<core::Pose, 2>& eye_pose, cons
   const bool stereo = m.eyes.size() == 2;
   const bool alternate = stereo && m.settings.share == reconstruct::StereoShare::Alternate;
   // Alternating sharing: only one eye traces indirect diffuse this frame.
-  std::vector<bool> fresh_bits;
-  for (auto& e : m.eyes) fresh_bits.push_back(!alternate || int(e->eye) == int(frame % 2));
-  const bool fresh[2] = {fresh_bits[0], fresh_bits.size() > 1 && fresh_bits[1]};
+  bool fresh[2] = {true, true};
+  for (std::size_t i = 0; i < m.eyes.size(); ++i) fresh[i] = !alternate || int(m.eyes[i]->eye) == int(frame % 2);
 
   double recording_ms = 0;  // inside submit_and_wait, counted to the stages
   m.ctx.submit_and_wait([&](VkCommandBuffer cmd) {

@@ -14,12 +14,12 @@ namespace fovea::reconstruct {
 
 using Buf = const gpu::Buffer*;
 
-#define FOVEA_BINDING_COUNT(Struct, count)  \
+#define FOVEA_BINDING_COUNT(count)           \
   static constexpr std::uint32_t kCount = count; \
   using Slots = std::array<gpu::BufferSlot, kCount>;
 
 struct AccumulateBindings {
-  FOVEA_BINDING_COUNT(AccumulateBindings, RECON_ACC_COUNT)
+  FOVEA_BINDING_COUNT(RECON_ACC_COUNT)
   Buf maps, tables, samples, direct, indirect, normal_depth, position_material, prev_direct, prev_indirect, prev_pos,
       prev_nrm, out_direct, out_indirect, out_pos, out_nrm, tap_idx, tap_w, materials;
   Slots slots() const {
@@ -45,7 +45,7 @@ struct AccumulateBindings {
 };
 
 struct ShareBindings {
-  FOVEA_BINDING_COUNT(ShareBindings, RECON_SHARE_COUNT)
+  FOVEA_BINDING_COUNT(RECON_SHARE_COUNT)
   Buf maps, tables, pos, nrm, acc_direct, acc_indirect, other_pos, other_nrm, other_indirect, shared, z;
   Slots slots() const {
     return {{{RECON_MAPS, maps},
@@ -63,7 +63,7 @@ struct ShareBindings {
 };
 
 struct BmfrBindings {
-  FOVEA_BINDING_COUNT(BmfrBindings, RECON_BMFR_COUNT)
+  FOVEA_BINDING_COUNT(RECON_BMFR_COUNT)
   Buf pos, nrm, z, fitted;
   Slots slots() const {
     return {{{RECON_BMFR_POS, pos}, {RECON_BMFR_NRM, nrm}, {RECON_BMFR_Z, z}, {RECON_BMFR_FITTED, fitted}}};
@@ -71,7 +71,7 @@ struct BmfrBindings {
 };
 
 struct PostBindings {
-  FOVEA_BINDING_COUNT(PostBindings, RECON_POST_COUNT)
+  FOVEA_BINDING_COUNT(RECON_POST_COUNT)
   Buf pos, tap_idx, tap_w, source, acc_direct, prev, out;
   Slots slots() const {
     return {{{RECON_POST_POS, pos},
@@ -85,7 +85,7 @@ struct PostBindings {
 };
 
 struct TaaBindings {
-  FOVEA_BINDING_COUNT(TaaBindings, RECON_TAA_COUNT)
+  FOVEA_BINDING_COUNT(RECON_TAA_COUNT)
   Buf maps, tables, pos, tap_idx, tap_w, post, albedo, prev_final, final_color;
   Slots slots() const {
     return {{{RECON_MAPS, maps},
@@ -101,13 +101,13 @@ struct TaaBindings {
 };
 
 struct MipBindings {
-  FOVEA_BINDING_COUNT(MipBindings, RECON_MIP_COUNT)
+  FOVEA_BINDING_COUNT(RECON_MIP_COUNT)
   Buf maps, tables, mips;
   Slots slots() const { return {{{RECON_MAPS, maps}, {RECON_TABLES, tables}, {RECON_MIP_MIPS, mips}}}; }
 };
 
 struct ResolveBindings {
-  FOVEA_BINDING_COUNT(ResolveBindings, RECON_RESOLVE_COUNT)
+  FOVEA_BINDING_COUNT(RECON_RESOLVE_COUNT)
   Buf maps, tables, mips, offsets, screen;
   Slots slots() const {
     return {{{RECON_MAPS, maps},
@@ -119,7 +119,7 @@ struct ResolveBindings {
 };
 
 struct BlurBindings {
-  FOVEA_BINDING_COUNT(BlurBindings, RECON_BLUR_COUNT)
+  FOVEA_BINDING_COUNT(RECON_BLUR_COUNT)
   Buf maps, tables, src, dst;
   Slots slots() const {
     return {{{RECON_MAPS, maps}, {RECON_TABLES, tables}, {RECON_BLUR_SRC, src}, {RECON_BLUR_DST, dst}}};
@@ -127,7 +127,7 @@ struct BlurBindings {
 };
 
 struct DepthBindings {
-  FOVEA_BINDING_COUNT(DepthBindings, RECON_DEPTH_COUNT)
+  FOVEA_BINDING_COUNT(RECON_DEPTH_COUNT)
   Buf maps, tables, pos, depth;
   Slots slots() const {
     return {{{RECON_MAPS, maps}, {RECON_TABLES, tables}, {RECON_DEPTH_POS, pos}, {RECON_DEPTH_OUT, depth}}};
