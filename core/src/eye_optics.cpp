@@ -41,7 +41,7 @@ bool ViewMask::visible_at(glm::dvec2 px) const {
   return !hidden(x, y);
 }
 
-EyeOptics::EyeOptics(const Lens& lens) : hidden_(lens), view_mask_(hidden_) {}
+EyeOptics::EyeOptics(const Lens& lens) : hidden_(lens) {}
 
 glm::dvec3 gaze_direction(const Lens& lens, glm::dvec2 panel_uv) {
   const glm::dvec2 t = lens.forward(panel_uv).tangent[1];

@@ -46,7 +46,7 @@ TEST(StereoViews, EyesBesideTheHead) {
 // the row-padded layout the grid shader reads.
 TEST(ViewMask, MatchesVisibilityAtPixelCentres) {
   const core::EyeOptics optics(core::load_display("tiny"), core::Eye::Left);
-  const core::ViewMask& m = optics.view_mask();
+  const core::ViewMask m = optics.view_mask();
   ASSERT_EQ(m.width(), optics.view().width());
   ASSERT_EQ(m.words_per_row(), (m.width() + 31) / 32);
   long hidden = 0;

@@ -82,7 +82,7 @@ TEST_F(GpuTest, GridPassMaskMatchesCpuReference) {
   for (const char* name : {"tiny", "vive"}) {
     const core::DisplayPreset display = core::load_display(name);
     const core::EyeOptics optics(display, core::Eye::Right);
-    const core::ViewMask& mask = optics.view_mask();
+    const core::ViewMask mask = optics.view_mask();
     auto d = core::make_distribution(optics.view(), core::DistributionParams{});
     d->set_visibility([&mask](glm::dvec2 px) { return mask.visible_at(px); });
     gpu::GridPass pass(ctx());

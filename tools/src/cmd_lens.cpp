@@ -100,7 +100,7 @@ struct SamplesHidden {
 SamplesHidden samples_hidden(const core::EyeOptics& optics) {
   auto dist = core::make_distribution(optics.view(), core::DistributionParams{});
   dist->set_frame({0, 0, -1});
-  const core::ViewMask& mask = optics.view_mask();
+  const core::ViewMask mask = optics.view_mask();
   dist->set_visibility([&mask](glm::dvec2 px) { return mask.visible_at(px); });
   std::size_t traced = 0, hidden = 0;
   for (int row = 0; row < dist->rows(); ++row)

@@ -1,6 +1,6 @@
 #pragma once
 // One eye's optics for the display stage: the rendered view, the lens and its hidden area,
-// and the view-space visibility mask the sample grids skip; plus the gaze conversions between
+// and on request the view-space visibility mask the sample grids skip; plus the gaze conversions between
 // panel positions and view directions.
 #include <cstdint>
 #include <optional>
@@ -50,11 +50,12 @@ class EyeOptics {
   const View& view() const { return hidden_.lens().view(); }
   const Lens& lens() const { return hidden_.lens(); }
   const HiddenAreaMask& hidden() const { return hidden_; }
-  const ViewMask& view_mask() const { return view_mask_; }
+  // Built on each call (up to three inverse lens solves per view pixel, seconds on the large
+  // presets): callers that cull keep the result, the display stage alone never pays for it.
+  ViewMask view_mask() const { return ViewMask(hidden_); }
 
  private:
   HiddenAreaMask hidden_;
-  ViewMask view_mask_;
 };
 
 // The view direction an eye looks along when it looks at a panel position: the green
