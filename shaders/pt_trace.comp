@@ -24,6 +24,7 @@ layout(std430, set = 0, binding = 10) buffer OutAlbedo { vec4 out_albedo[]; };
 layout(std430, set = 0, binding = 11) buffer OutNormalDepth { vec4 out_normal_depth[]; };
 layout(std430, set = 0, binding = 12) buffer OutPosMat { vec4 out_position_material[]; };
 layout(std430, set = 0, binding = 13) buffer OutRadiance { vec4 out_radiance[]; };
+layout(std430, set = 0, binding = 14) readonly buffer GgxAlbedo { vec4 ggx_albedo[]; };  // read by pt_sampling.h
 layout(push_constant) uniform Params { PtFrameParams pc; };
 
 #include "fovea/shaders/pt_sampling.h"
@@ -53,7 +54,8 @@ vec3 sample_texture(int index, vec2 uv) {
 
 struct Surface {
   vec3 p, ng, ns;  // position, geometric and shading normals, both facing the incoming ray
-  bool front;      // the ray hit the emitting (front) side
+  bool front;      // the ray hit the front (counter-clockwise) side
+  bool lit;        // front face, or a back face of a double-sided material
   uint material;
   vec3 base;
   vec3 emission;
@@ -72,19 +74,21 @@ Surface surface(PtHit h, vec3 org, vec3 dir) {
   vec3 ns = w0 * vec3(sh.n0_x, sh.n0_y, sh.n0_z) + h.bary.x * vec3(sh.n1_x, sh.n1_y, sh.n1_z) +
             h.bary.y * vec3(sh.n2_x, sh.n2_y, sh.n2_z);
   ns = dot(ns, ns) > 0.0 ? normalize(ns) : ng;
-  // Two-sided shading: both normals on the viewer's side.
+  // Both normals on the viewer's side: glTF lights the back faces of double-sided materials
+  // with the normal reversed (glTF 2.0 §3.9.5); single-sided back faces stay black.
   if (!s.front) ng = -ng;
   if (dot(ns, ng) < 0.0) ns = -ns;
   s.ng = ng;
   s.ns = ns;
   s.material = t.material;
   const PtMaterial m = materials[t.material];
-  s.base = vec3(m.base_r, m.base_g, m.base_b);
-  if (m.texture >= 0) {
+  s.lit = s.front || m.double_sided != 0u;
+  s.base = s.lit ? vec3(m.base_r, m.base_g, m.base_b) : vec3(0.0);
+  if (m.texture >= 0 && s.lit) {
     const vec2 uv = w0 * vec2(sh.uv0_x, sh.uv0_y) + h.bary.x * vec2(sh.uv1_x, sh.uv1_y) + h.bary.y * vec2(sh.uv2_x, sh.uv2_y);
     s.base *= sample_texture(m.texture, uv);
   }
-  s.emission = s.front ? vec3(m.emit_r, m.emit_g, m.emit_b) : vec3(0.0);
+  s.emission = s.lit ? vec3(m.emit_r, m.emit_g, m.emit_b) : vec3(0.0);
   s.light_pdf = t.light_pdf;
   return s;
 }
@@ -93,7 +97,7 @@ PtBsdf bsdf_of(Surface s) {
   const PtMaterial m = materials[s.material];
   PtBsdf b;
   b.diffuse = s.base * (1.0 - m.metallic);
-  b.f0 = mix(vec3(m.specular), s.base, m.metallic);
+  b.f0 = s.lit ? mix(vec3(m.specular), s.base, m.metallic) : vec3(0.0);
   b.alpha = max(m.roughness * m.roughness, 4e-4);
   return b;
 }
@@ -125,7 +129,9 @@ vec3 sample_light(Surface s, PtBsdf b, vec3 wo, bool mis, inout PtRng rng) {
   if (!(d2 > 0.0)) return vec3(0.0);
   const float dist = sqrt(d2);
   const vec3 wi = to / dist;
-  const float cos_l = -dot(nl, wi);  // emitters emit from their front face only
+  const PtMaterial lm = materials[t.material];
+  // Single-sided emitters emit from their front face only, double-sided ones from both.
+  const float cos_l = lm.double_sided != 0u ? abs(dot(nl, wi)) : -dot(nl, wi);
   if (cos_l <= 0.0 || dot(s.ng, wi) <= 0.0) return vec3(0.0);
   vec3 fd, fs;
   float bsdf_pdf;
@@ -135,7 +141,6 @@ vec3 sample_light(Surface s, PtBsdf b, vec3 wo, bool mis, inout PtRng rng) {
   const vec3 org = offset_origin(s, wi);
   PtHit sh;
   if (pt_traverse(org, wi, 0.0, distance(q, org) * (1.0 - 1e-4), true, sh)) return vec3(0.0);
-  const PtMaterial lm = materials[t.material];
   const float light_pdf = l.pmf / l.area * d2 / cos_l;  // area -> solid angle
   const float w = mis ? pt_power_heuristic(light_pdf, bsdf_pdf) : 1.0;
   return f * vec3(lm.emit_r, lm.emit_g, lm.emit_b) * (w / light_pdf);

@@ -1,12 +1,15 @@
 #include "fovea/core/metrics.hpp"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <numbers>
 #include <stdexcept>
 
 #include "fovea/core/acuity.hpp"
 #include "fovea/core/error.hpp"
+#include "fovea/core/flip.hpp"
+#include "fovea/core/tonemap.hpp"
 
 namespace fovea::core {
 
@@ -38,12 +41,12 @@ double squared_error(const glm::vec4& p, const glm::vec4& q) {
 
 double luminance(const glm::vec4& p) { return 0.2126 * finite(p.x) + 0.7152 * finite(p.y) + 0.0722 * finite(p.z); }
 
-// SSIM's input: Reinhard on luminance (c / (1 + L)), sRGB-encoded luminance of the result.
-std::vector<double> tone_mapped_luma(const Image& img) {
+// Luma (Rec. 709 weights) of the sRGB-encoded display transform: SSIM's and flicker's input.
+std::vector<double> tone_mapped_luma(const Image& img, double exposure = 0.0) {
   std::vector<double> out(img.pixels.size());
   for (std::size_t i = 0; i < out.size(); ++i) {
-    const double l = std::max(0.0, luminance(img.pixels[i]));
-    out[i] = srgb_encode(float(l / (1.0 + l)));
+    const glm::vec3 c = tonemap_srgb(glm::vec3(img.pixels[i]), exposure);
+    out[i] = 0.2126 * c.x + 0.7152 * c.y + 0.0722 * c.z;
   }
   return out;
 }
@@ -97,53 +100,44 @@ double psnr_masked(const Image& a, const Image& b, const std::vector<bool>& mask
   return n ? psnr_from_mse(s / double(n)) : kPsnrIdentical;
 }
 
-double ssim(const Image& a, const Image& b) {
+double ssim(const Image& a, const Image& b) { return weighted_mean(ssim_map(a, b)); }
+
+std::vector<float> ssim_map(const Image& a, const Image& b) {
   require_same_size(a, b, "ssim");
   constexpr int kR = 5;  // 11×11 window
   constexpr double kSigma = 1.5, kC1 = 0.01 * 0.01, kC2 = 0.03 * 0.03;
-  double w1[2 * kR + 1], wsum = 0;
-  for (int k = -kR; k <= kR; ++k) wsum += w1[k + kR] = std::exp(-0.5 * k * k / (kSigma * kSigma));
-  for (double& w : w1) w /= wsum;
+  double w1[2 * kR + 1];
+  for (int k = -kR; k <= kR; ++k) w1[k + kR] = std::exp(-0.5 * k * k / (kSigma * kSigma));
   const std::vector<double> x = tone_mapped_luma(a), y = tone_mapped_luma(b);
   const int W = a.width, H = a.height;
-  // Separable moments: horizontal pass into five planes, then vertical per valid window.
-  std::vector<double> hx(x.size()), hy(x.size()), hxx(x.size()), hyy(x.size()), hxy(x.size());
-  for (int r = 0; r < H; ++r)
-    for (int c = kR; c < W - kR; ++c) {
-      double sx = 0, sy = 0, sxx = 0, syy = 0, sxy = 0;
-      for (int k = -kR; k <= kR; ++k) {
-        const std::size_t j = std::size_t(r) * W + c + k;
-        const double w = w1[k + kR];
-        sx += w * x[j], sy += w * y[j], sxx += w * x[j] * x[j], syy += w * y[j] * y[j], sxy += w * x[j] * y[j];
-      }
-      const std::size_t i = std::size_t(r) * W + c;
-      hx[i] = sx, hy[i] = sy, hxx[i] = sxx, hyy[i] = syy, hxy[i] = sxy;
+  // Separable moments x, y, x², y², xy; windows cut by the border are renormalised.
+  std::array<std::vector<double>, 5> m;
+  for (auto& p : m) p.assign(x.size(), 0.0);
+  for (std::size_t i = 0; i < x.size(); ++i) m[0][i] = x[i], m[1][i] = y[i], m[2][i] = x[i] * x[i], m[3][i] = y[i] * y[i], m[4][i] = x[i] * y[i];
+  std::vector<double> tmp(x.size());
+  for (auto& p : m)
+    for (int pass = 0; pass < 2; ++pass) {
+      const int n = pass == 0 ? W : H;
+      for (int r = 0; r < H; ++r)
+        for (int c = 0; c < W; ++c) {
+          const int at = pass == 0 ? c : r;
+          double s = 0, ws = 0;
+          for (int k = std::max(-kR, -at); k <= std::min(kR, n - 1 - at); ++k) {
+            const std::size_t j = pass == 0 ? std::size_t(r) * W + c + k : std::size_t(r + k) * W + c;
+            s += w1[k + kR] * p[j];
+            ws += w1[k + kR];
+          }
+          tmp[std::size_t(r) * W + c] = s / ws;
+        }
+      p.swap(tmp);
     }
-  double total = 0;
-  long count = 0;
-  for (int r = kR; r < H - kR; ++r)
-    for (int c = kR; c < W - kR; ++c) {
-      double mx = 0, my = 0, mxx = 0, myy = 0, mxy = 0;
-      for (int k = -kR; k <= kR; ++k) {
-        const std::size_t j = std::size_t(r + k) * W + c;
-        const double w = w1[k + kR];
-        mx += w * hx[j], my += w * hy[j], mxx += w * hxx[j], myy += w * hyy[j], mxy += w * hxy[j];
-      }
-      const double vx = mxx - mx * mx, vy = myy - my * my, cov = mxy - mx * my;
-      total += ((2 * mx * my + kC1) * (2 * cov + kC2)) / ((mx * mx + my * my + kC1) * (vx + vy + kC2));
-      ++count;
-    }
-  if (count == 0) {  // smaller than one window: the global statistics
-    double mx = 0, my = 0;
-    for (std::size_t i = 0; i < x.size(); ++i) mx += x[i], my += y[i];
-    mx /= double(x.size()), my /= double(x.size());
-    double vx = 0, vy = 0, cov = 0;
-    for (std::size_t i = 0; i < x.size(); ++i)
-      vx += (x[i] - mx) * (x[i] - mx), vy += (y[i] - my) * (y[i] - my), cov += (x[i] - mx) * (y[i] - my);
-    vx /= double(x.size()), vy /= double(x.size()), cov /= double(x.size());
-    return ((2 * mx * my + kC1) * (2 * cov + kC2)) / ((mx * mx + my * my + kC1) * (vx + vy + kC2));
+  std::vector<float> out(x.size());
+  for (std::size_t i = 0; i < out.size(); ++i) {
+    const double mx = m[0][i], my = m[1][i];
+    const double vx = m[2][i] - mx * mx, vy = m[3][i] - my * my, cov = m[4][i] - mx * my;
+    out[i] = float(((2 * mx * my + kC1) * (2 * cov + kC2)) / ((mx * mx + my * my + kC1) * (vx + vy + kC2)));
   }
-  return total / double(count);
+  return out;
 }
 
 double temporal_error(const Image& previous, const Image& current) {
@@ -216,6 +210,93 @@ double foveated_psnr(const Image& a, const Image& b, const View& view, glm::dvec
       sigma[std::size_t(y) * a.width + x] = float(acuity_sigma_deg(angle_deg(d, gaze)) * px_per_deg);
     }
   return psnr(variable_gaussian(a, sigma), variable_gaussian(b, sigma));
+}
+
+ErrorMaps error_maps(const Image& test, const Image& reference, double ppd, double exposure) {
+  require_same_size(test, reference, "error_maps");
+  ErrorMaps m;
+  const std::size_t n = test.pixels.size();
+  m.squared_error.resize(n);
+  m.rel_mse.resize(n);
+  for (std::size_t i = 0; i < n; ++i) {
+    const glm::vec3 t = tonemap_srgb(glm::vec3(test.pixels[i]), exposure),
+                    r = tonemap_srgb(glm::vec3(reference.pixels[i]), exposure);
+    const glm::vec3 d = t - r;
+    m.squared_error[i] = glm::dot(d, d) / 3.0f;
+    double rel = 0;
+    for (int c = 0; c < 3; ++c) {
+      const double tc = finite(test.pixels[i][c]), rc = finite(reference.pixels[i][c]);
+      rel += (tc - rc) * (tc - rc) / (rc * rc + kRelMseEpsilon);
+    }
+    m.rel_mse[i] = float(std::min(rel / 3.0, 1e30));
+  }
+  m.ssim = ssim_map(test, reference);
+  m.ldr_flip = ldr_flip(tonemap_linear(test, exposure), tonemap_linear(reference, exposure), ppd);
+  m.hdr_flip = hdr_flip(test, reference, ppd).error;
+  return m;
+}
+
+double weighted_mean(const std::vector<float>& map, const std::vector<float>& weights) {
+  if (!weights.empty() && weights.size() != map.size())
+    throw InputError("weighted_mean: weight map size differs from the error map size");
+  double s = 0, ws = 0;
+  for (std::size_t i = 0; i < map.size(); ++i) {
+    const double w = weights.empty() ? 1.0 : std::max(0.0, finite(weights[i]));
+    s += w * finite(map[i]);
+    ws += w;
+  }
+  return ws > 0 ? s / ws : 0.0;
+}
+
+Scores pool(const ErrorMaps& maps, const std::vector<float>& weights) {
+  Scores s;
+  for (const auto w : weights) s.weight += std::max(0.0, finite(w));
+  if (weights.empty()) s.weight = double(maps.squared_error.size());
+  if (!(s.weight > 0)) return s;
+  s.psnr = psnr_from_mse(weighted_mean(maps.squared_error, weights));
+  s.ssim = weighted_mean(maps.ssim, weights);
+  s.rel_mse = weighted_mean(maps.rel_mse, weights);
+  s.ldr_flip = weighted_mean(maps.ldr_flip, weights);
+  s.hdr_flip = weighted_mean(maps.hdr_flip, weights);
+  return s;
+}
+
+std::vector<BandScores> band_scores(const ErrorMaps& maps, const std::vector<float>& ecc, double band_deg) {
+  if (ecc.size() != maps.squared_error.size())
+    throw InputError("band_scores: eccentricity map size differs from the image size");
+  if (!(band_deg > 0)) throw InputError("band_scores: band width must be > 0");
+  float e_max = 0;
+  for (float e : ecc)
+    if (std::isfinite(e)) e_max = std::max(e_max, e);
+  std::vector<BandScores> out;
+  std::vector<float> w(ecc.size());
+  for (int k = 0; k <= int(e_max / band_deg); ++k) {
+    const double lo = k * band_deg, hi = (k + 1) * band_deg;
+    long n = 0;
+    for (std::size_t i = 0; i < ecc.size(); ++i) n += (w[i] = std::isfinite(ecc[i]) && ecc[i] >= lo && ecc[i] < hi) ? 1 : 0;
+    if (n) out.push_back({lo, hi, n, pool(maps, w)});
+  }
+  return out;
+}
+
+std::vector<float> foveation_weights(const std::vector<float>& ecc) {
+  std::vector<float> w(ecc.size());
+  for (std::size_t i = 0; i < ecc.size(); ++i) w[i] = std::isfinite(ecc[i]) ? float(acuity::m(std::max(0.0f, ecc[i]))) : 0.0f;
+  return w;
+}
+
+std::vector<float> flicker_map(const std::vector<Image>& frames, double exposure) {
+  if (frames.size() < 2) throw InputError("flicker_map: needs at least 2 frames");
+  for (const Image& f : frames) require_same_size(frames[0], f, "flicker_map");
+  std::vector<double> s(frames[0].pixels.size(), 0.0), s2 = s;
+  for (const Image& f : frames) {
+    const std::vector<double> y = tone_mapped_luma(f, exposure);
+    for (std::size_t i = 0; i < y.size(); ++i) s[i] += y[i], s2[i] += y[i] * y[i];
+  }
+  const double n = double(frames.size());
+  std::vector<float> out(s.size());
+  for (std::size_t i = 0; i < s.size(); ++i) out[i] = float(std::sqrt(std::max(0.0, s2[i] / n - (s[i] / n) * (s[i] / n))));
+  return out;
 }
 
 }  // namespace fovea::core

@@ -25,11 +25,6 @@ glm::dvec3 from_angles(glm::dvec2 a) {
   a = glm::clamp(a, glm::dvec2(-89.0), glm::dvec2(89.0));
   return glm::normalize(glm::dvec3(std::tan(a.x / kDeg), std::tan(a.y / kDeg), -1.0));
 }
-glm::dvec3 nlerp(const glm::dvec3& a, const glm::dvec3& b, double u) {
-  const glm::dvec3 d = a + u * (b - a);
-  const double n = glm::length(d);
-  return n > 1e-12 ? d / n : b;
-}
 EyeGaze& slot(GazeSample& s, int i) { return i == 0 ? s.combined : i == 1 ? s.left : s.right; }
 
 // ---- ivt: gap fill + classification ---------------------------------------------------
@@ -147,50 +142,6 @@ class OneEuroStream final : public SampleStream {
   State state_[3];
 };
 
-// ---- hold ------------------------------------------------------------------------------
-class HoldStream final : public SampleStream {
- public:
-  HoldStream(std::unique_ptr<SampleStream> in, const HoldParams& p, glm::dvec3 centre)
-      : in_(std::move(in)), p_(p), centre_(glm::normalize(centre)) {}
-  bool next(GazeSample& s) override {
-    if (!in_->next(s)) return false;
-    for (int k = 0; k < 3; ++k) {
-      EyeGaze& g = slot(s, k);
-      if (g.tracked()) {
-        last_[k] = g.dir;
-        last_t_[k] = s.t_ns;
-        have_[k] = true;
-        continue;
-      }
-      if (!have_[k]) {
-        g.dir = centre_;
-        continue;
-      }
-      const core::TimeNs since = s.t_ns - last_t_[k];
-      double u = p_.ease_ns > 0 ? static_cast<double>(since - p_.hold_ns) / static_cast<double>(p_.ease_ns) : 1.0;
-      u = std::clamp(u, 0.0, 1.0);
-      u = u * u * (3 - 2 * u);  // smoothstep: no velocity jump at either end
-      g.dir = since <= p_.hold_ns ? last_[k] : nlerp(last_[k], centre_, u);
-    }
-    return true;
-  }
-  bool rewindable() const override { return in_->rewindable(); }
-  void rewind() override {
-    in_->rewind();
-    have_[0] = have_[1] = have_[2] = false;
-  }
-  bool live() const override { return in_->live(); }
-  std::string describe() const override { return in_->describe() + " | hold"; }
-
- private:
-  std::unique_ptr<SampleStream> in_;
-  HoldParams p_;
-  glm::dvec3 centre_;
-  glm::dvec3 last_[3];
-  core::TimeNs last_t_[3] = {};
-  bool have_[3] = {};
-};
-
 }  // namespace
 
 double OneEuro::filter(double x, double dt) {
@@ -218,25 +169,26 @@ std::unique_ptr<SampleStream> apply_filters(std::unique_ptr<SampleStream> s, std
     const std::string_view name = spec.substr(start, comma == std::string_view::npos ? std::string_view::npos : comma - start);
     if (name == "ivt") s = std::make_unique<IvtStream>(std::move(s), p.ivt);
     else if (name == "oneeuro") s = std::make_unique<OneEuroStream>(std::move(s), p.one_euro);
-    else if (name == "hold") s = std::make_unique<HoldStream>(std::move(s), p.hold, p.centre);
-    else if (!name.empty()) throw core::InputError("unknown gaze filter \"" + std::string(name) + "\" (ivt, oneeuro, hold)");
+    else if (!name.empty())
+      throw core::InputError("unknown gaze filter \"" + std::string(name) +
+                             "\" (ivt, oneeuro; losses and blinks are handled by the foveation gaze)");
     if (comma == std::string_view::npos) break;
     start = comma + 1;
   }
   return s;
 }
 
-GazeSample GazePredictor::predict(const std::deque<GazeSample>& h, core::TimeNs t, core::TimeNs horizon) const {
-  GazeSample out = h.back();
-  out.t_ns = t;
-  const GazeSample& last = h.back();
+GazeSample GazePredictor::predict(const std::deque<GazeSample>& h, std::size_t count, core::TimeNs t,
+                                  core::TimeNs horizon) const {
+  const GazeSample& last = h[count - 1];
+  GazeSample out = last;
   if (!last.tracked() || t <= last.t_ns) return out;
   const double ahead = static_cast<double>(std::min(t - last.t_ns, horizon)) * 1e-9;
   glm::dvec2 a_last;
   if (!to_angles(last.combined.dir, a_last)) return out;
   // Sample-to-sample speeds backwards from the newest: the current motion and, in a
   // saccade, its onset and peak.
-  std::size_t i = h.size() - 1;
+  std::size_t i = count - 1;
   double peak = 0, current = -1;
   glm::dvec2 onset_angles = a_last, window_start = a_last;
   core::TimeNs window_t = last.t_ns;

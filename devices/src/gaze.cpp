@@ -142,9 +142,7 @@ std::unique_ptr<SampleStream> open_sample_stream(std::string_view uri, const Sou
   apply_common_options(u, opt);
   auto s = open_raw_stream(u, opt);
   if (opt.filters.empty()) return s;
-  FilterParams fp;
-  fp.centre = opt.screen_view().centre_dir();
-  return apply_filters(std::move(s), opt.filters, fp);
+  return apply_filters(std::move(s), opt.filters, FilterParams{});
 }
 
 namespace {

@@ -31,6 +31,7 @@ void TimelineSource::pull_until(core::TimeNs t) {
 }
 
 GazeSample TimelineSource::at_recording_time(core::TimeNs tt) {
+  loop_base_ = 0;
   if (!stream_->live()) {
     if (!win_.empty() && tt < win_.front().t_ns && trimmed_) restart();
     pull_until(tt);
@@ -39,6 +40,7 @@ GazeSample TimelineSource::at_recording_time(core::TimeNs tt) {
         const core::TimeNs dt = win_.size() > 1 ? win_.back().t_ns - win_[win_.size() - 2].t_ns : 0;
         period_ = win_.back().t_ns + std::max<core::TimeNs>(dt, 1);
       }
+      loop_base_ = tt - tt % period_;
       tt %= period_;
       if (win_.empty() || tt < win_.front().t_ns) restart();
       pull_until(tt);
@@ -46,36 +48,34 @@ GazeSample TimelineSource::at_recording_time(core::TimeNs tt) {
   } else {
     pull_until(tt);
   }
-  if (win_.empty()) {  // nothing yet: a lost sample looking ahead
-    GazeSample s;
-    s.t_ns = tt;
-    return s;
-  }
-  if (tt <= win_.front().t_ns) return win_.front();
-  if (tt >= win_.back().t_ns) {
-    // Live: predict to the requested (display) time, at most horizon_ns ahead. Recordings
-    // are clamped at their end.
-    if (stream_->live() && opt_.horizon_ns > 0) return predictor_.predict(win_, tt, opt_.horizon_ns);
-    return win_.back();
-  }
+  // The newest sample measured at or before tt: a later one is not known yet at tt.
   const auto it = std::upper_bound(win_.begin(), win_.end(), tt,
                                    [](core::TimeNs t, const GazeSample& s) { return t < s.t_ns; });
-  const GazeSample& b = *it;
-  const GazeSample& a = *(it - 1);
-  if (b.t_ns - a.t_ns > opt_.max_gap_ns) {  // no interpolation across a gap: lost
-    GazeSample s = (tt - a.t_ns < b.t_ns - tt) ? a : b;
+  if (it == win_.begin()) {  // nothing measured yet
+    GazeSample s;
+    s.t_ns = kNoSample;
+    return s;
+  }
+  const std::size_t count = static_cast<std::size_t>(it - win_.begin());
+  GazeSample s = win_[count - 1];
+  // The end of a recording holds its last sample; elsewhere an old newest sample is stale.
+  const bool recording_over = ended_ && count == win_.size();
+  if (recording_over || tt == s.t_ns) return s;
+  if (tt - s.t_ns > opt_.max_gap_ns) {
     s.combined.flags = s.left.flags = s.right.flags = kLost;
     s.combined.confidence = s.left.confidence = s.right.confidence = 0;
     return s;
   }
-  return interpolate(a, b, tt);
+  return opt_.horizon_ns > 0 ? predictor_.predict(win_, count, tt, opt_.horizon_ns) : s;
 }
 
 GazeSample TimelineSource::sample_at(core::TimeNs t) {
   std::lock_guard lock(mutex_);
-  const core::TimeNs tt = stream_->live() ? t : std::llround(static_cast<double>(t) * opt_.speed);
-  GazeSample s = at_recording_time(tt);
-  s.t_ns = t;
+  const bool live = stream_->live();
+  GazeSample s = at_recording_time(live ? t : std::llround(static_cast<double>(t) * opt_.speed));
+  // Back from recording time to the caller's timeline: the sample's own time, not t.
+  if (!live && s.t_ns != kNoSample)
+    s.t_ns = std::min<core::TimeNs>(t, std::llround(static_cast<double>(s.t_ns + loop_base_) / opt_.speed));
   return s;
 }
 

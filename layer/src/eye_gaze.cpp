@@ -71,14 +71,19 @@ EyeGazeSession create_eye_gaze_session(const Dispatch& next, const EyeGazeAction
   return s;
 }
 
-std::optional<glm::dvec3> locate_eye_gaze(const Dispatch& next, const EyeGazeSession& s, XrTime time) {
+ActionGaze locate_eye_gaze(const Dispatch& next, const EyeGazeSession& s, XrTime time) {
+  XrEyeGazeSampleTimeEXT when{XR_TYPE_EYE_GAZE_SAMPLE_TIME_EXT};
   XrSpaceLocation loc{XR_TYPE_SPACE_LOCATION};
-  if (XR_FAILED(next.xrLocateSpace(s.gaze, s.view, time, &loc))) return std::nullopt;
+  loc.next = &when;
+  ActionGaze g;
+  if (XR_FAILED(next.xrLocateSpace(s.gaze, s.view, time, &loc))) return g;
   const XrSpaceLocationFlags need = XR_SPACE_LOCATION_ORIENTATION_VALID_BIT | XR_SPACE_LOCATION_ORIENTATION_TRACKED_BIT;
-  if ((loc.locationFlags & need) != need) return std::nullopt;
+  if ((loc.locationFlags & need) != need) return g;
   const auto& q = loc.pose.orientation;
   // The gaze ray is the pose's -Z axis (XR_EXT_eye_gaze_interaction).
-  return glm::dquat(q.w, q.x, q.y, q.z) * glm::dvec3(0, 0, -1);
+  g.dir = glm::dquat(q.w, q.x, q.y, q.z) * glm::dvec3(0, 0, -1);
+  g.sample_time_ns = when.time;
+  return g;
 }
 
 }  // namespace fovea::layer

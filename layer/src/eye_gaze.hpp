@@ -4,13 +4,12 @@
 // to /user/eyes_ext/input/gaze_ext/pose, merged into the application's
 // xrSuggestInteractionProfileBindings (for the eye-gaze profile), xrAttachSessionActionSets
 // and xrSyncActions. The gaze is located in VIEW space at each frame's display time.
-#include <optional>
-
-#include <glm/vec3.hpp>
 
 #define XR_USE_GRAPHICS_API_VULKAN
 #include <vulkan/vulkan.h>
 #include <openxr/openxr.h>
+
+#include "gaze_input.hpp"
 
 namespace fovea::layer {
 
@@ -41,7 +40,8 @@ bool runtime_has_eye_gaze(PFN_xrGetInstanceProcAddr next_gipa);
 EyeGazeActions create_eye_gaze_actions(const Dispatch& next, XrInstance instance);
 // The spaces for a session whose attach included the set; throws std::runtime_error.
 EyeGazeSession create_eye_gaze_session(const Dispatch& next, const EyeGazeActions& a, XrSession session);
-// The gaze direction in VIEW space at `time`, nullopt when not tracked.
-std::optional<glm::dvec3> locate_eye_gaze(const Dispatch& next, const EyeGazeSession& s, XrTime time);
+// The gaze direction in VIEW space at `time` (nullopt when not tracked) and the time of the
+// tracker sample behind it.
+ActionGaze locate_eye_gaze(const Dispatch& next, const EyeGazeSession& s, XrTime time);
 
 }  // namespace fovea::layer

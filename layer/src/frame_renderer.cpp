@@ -19,12 +19,10 @@
 #include "composite.hpp"
 #include "fovea/core/display.hpp"
 #include "fovea/core/stereo_views.hpp"
-#include "fovea/devices/gaze.hpp"
 #include "fovea/gpu/context.hpp"
 #include "fovea/pipeline/frame_pipeline.hpp"
 #include "fovea/renderer/gpu_scene.hpp"
 #include "fovea/renderer/scene_io.hpp"
-#include "gaze_hold.hpp"
 #include "layer.hpp"
 #include "log.hpp"
 
@@ -46,14 +44,6 @@ core::Pose to_pose(const XrPosef& p) {
 
 void xr_check(XrResult r, const char* what) {
   if (XR_FAILED(r)) throw std::runtime_error(std::string(what) + " failed below the layer: XrResult " + std::to_string(int(r)));
-}
-
-// Live trackers stamp samples with the host clock; recordings and synthetic gaze count
-// from their first sample.
-bool live_gaze(const std::string& uri) {
-  for (const char* s : {"hid:", "usb:", "hid-capture:"})
-    if (uri.rfind(s, 0) == 0) return true;
-  return false;
 }
 
 // The views the application submitted: FOV, raster from the imageRect, pose (its reference
@@ -110,26 +100,21 @@ class PathTraceRenderer final : public FrameRenderer {
     // Eye poses: the application's view poses (its reference space) placed at the scene's camera.
     std::array<core::Pose, 2> poses;
     std::array<glm::dvec3, 2> gaze;
-    const devices::GazeSample s = in.gaze_from_action
-                                      ? devices::GazeSample{}
-                                      : gaze_source_->sample_at(live_ ? in.display_time : in.display_time - epoch_);
+    const devices::FoveaGaze fg = gaze_->frame(in.display_time, in.gaze_from_action ? &in.action_gaze : nullptr);
     if (in.gaze_from_action != gaze_from_action_) {
-      FOVEA_LAYER_INFO("gaze: %s", in.gaze_from_action ? "the eye-gaze action" : gaze_source_->describe().c_str());
+      FOVEA_LAYER_INFO("gaze: %s", in.gaze_from_action ? "the eye-gaze action" : gaze_->describe().c_str());
       gaze_from_action_ = in.gaze_from_action;
     }
+    if (fg.has_sample) {
+      times_.gaze_sample_ns = fg.sample_ns;
+      times_.gaze_receive_ns = fg.receive_ns;
+    }
+    times_.gaze_read_ns = fg.read_ns;
     for (int e = 0; e < 2; ++e) {
       const core::Pose p = to_pose(in.app_views[std::size_t(e)].pose);
       poses[std::size_t(e)].orientation = scene_.camera.orientation * p.orientation;
       poses[std::size_t(e)].position = scene_.camera.position + scene_.camera.orientation * p.position;
-      if (in.gaze_from_action) {
-        // The combined gaze in head space serves both eyes (views parallel to the head).
-        gaze[std::size_t(e)] = hold_[std::size_t(e)].update(in.display_time, in.action_gaze.has_value(),
-                                                            in.action_gaze.value_or(glm::dvec3(0, 0, -1)));
-        continue;
-      }
-      const devices::EyeGaze& eg = s.eye(core::Eye(e));
-      const devices::EyeGaze& g = eg.tracked() ? eg : s.combined;
-      gaze[std::size_t(e)] = hold_[std::size_t(e)].update(in.display_time, g.tracked(), g.dir);
+      gaze[std::size_t(e)] = fg.eye(core::Eye(e)).dir;
     }
     times_.gaze_cpu = ms_since(t_gaze);
     const pipeline::FrameTimes gt = pipeline_->render(poses, gaze, std::uint32_t(in.frame));
@@ -252,11 +237,7 @@ class PathTraceRenderer final : public FrameRenderer {
     display_.fov_left = views_in_[core::Eye::Left].fov();
     display_.fov_right = views_in_[core::Eye::Right].fov();
     display_.ipd_m = views_in_.ipd_m;
-    devices::SourceOptions so;
-    so.display = display_;
-    gaze_source_ = devices::open_gaze_source(config_.gaze, so);
-    live_ = live_gaze(config_.gaze);
-    epoch_ = in.display_time;
+    gaze_ = std::make_unique<LayerGaze>(config_.gaze, display_);
 
     for (Eye& e : eyes_) {
       XrSwapchainCreateInfo ci{XR_TYPE_SWAPCHAIN_CREATE_INFO};
@@ -284,7 +265,7 @@ class PathTraceRenderer final : public FrameRenderer {
                                                           settings);
     FOVEA_LAYER_INFO("rendering scene \"%s\" (from %s) at %dx%d per eye on %s, composite %s, gaze %s",
                      config_.scene.c_str(), config_.origin.c_str(), display_.width, display_.height,
-                     ctx_->info().name.c_str(), composite_name(config_.composite), gaze_source_->describe().c_str());
+                     ctx_->info().name.c_str(), composite_name(config_.composite), gaze_->describe().c_str());
   }
 
   LayerConfig config_;
@@ -295,12 +276,9 @@ class PathTraceRenderer final : public FrameRenderer {
   core::StereoViews views_in_;  // the submitted views: FOV, raster (imageRect), pose, IPD
   core::DisplayPreset display_;
   VkFormat format_ = VK_FORMAT_UNDEFINED;
-  std::unique_ptr<devices::GazeSource> gaze_source_;
-  bool live_ = false;
+  std::unique_ptr<LayerGaze> gaze_;
   bool gaze_from_action_ = false;
   bool depth_noted_ = false;  // the depth decision was logged
-  XrTime epoch_ = 0;
-  std::array<GazeHold, 2> hold_;
   std::unique_ptr<gpu::Context> ctx_;
   std::unique_ptr<renderer::GpuScene> gpu_scene_;
   std::unique_ptr<pipeline::FramePipeline> pipeline_;

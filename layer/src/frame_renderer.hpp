@@ -18,6 +18,7 @@
 
 #include "composite.hpp"
 #include "config.hpp"
+#include "gaze_input.hpp"
 
 namespace fovea::layer {
 
@@ -60,10 +61,10 @@ struct FrameInput {
   std::vector<AppView> app_views;  // the first stereo projection layer's views
   std::uint32_t projection_layer = 0;  // its index in app_frame->layers
   const XrFrameEndInfo* app_frame = nullptr;
-  // The layer's eye-gaze action, once attached: the gaze in VIEW space (nullopt: not tracked
-  // this frame). Without it the renderer's devices/ source (FOVEA_GAZE) is used.
+  // The layer's eye-gaze action, once attached. Without it the renderer's devices/ source
+  // (FOVEA_GAZE) is used.
   bool gaze_from_action = false;
-  std::optional<glm::dvec3> action_gaze;
+  ActionGaze action_gaze;
 };
 
 // Where the layer's time went in the last render() (milliseconds).
@@ -76,6 +77,9 @@ struct RenderTimes {
   // CPU (monotonic clock): the gaze sample, the grids' per-frame build, recording and
   // submission until the GPU finished, read-back of the rendered images.
   double gaze_cpu = 0, grid_cpu = 0, submit_cpu = 0, readback_cpu = 0;
+  // The gaze sample the frame was foveated for (CLOCK_MONOTONIC ns; 0: none measured yet):
+  // when it was measured, when the host received it, when the renderer read it.
+  std::int64_t gaze_sample_ns = 0, gaze_receive_ns = 0, gaze_read_ns = 0;
 };
 
 class FrameRenderer {

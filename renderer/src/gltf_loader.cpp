@@ -179,6 +179,7 @@ void load_materials(Ctx& c) {
   def.base_color = glm::vec3(1.0f);
   def.metallic = 1.0f;
   def.roughness = 1.0f;
+  def.double_sided = false;
   c.default_material = c.s.add_material(def);
   for (const auto& gm : c.m.materials) {
     Material m;
@@ -188,6 +189,7 @@ void load_materials(Ctx& c) {
       m.base_color = glm::vec3(float(pbr.baseColorFactor[0]), float(pbr.baseColorFactor[1]), float(pbr.baseColorFactor[2]));
     m.metallic = float(pbr.metallicFactor);
     m.roughness = float(pbr.roughnessFactor);
+    m.double_sided = gm.doubleSided;  // glTF §3.9.5, default false
     const int ti = pbr.baseColorTexture.index;
     if (ti >= 0 && std::size_t(ti) < c.s.textures.size()) m.base_color_texture = ti;
     else if (ti >= 0) c.warn("material \"" + gm.name + "\" references a missing texture, ignored");

@@ -5,6 +5,8 @@
 
 #include <glm/geometric.hpp>
 
+#include "ggx_albedo.hpp"
+
 namespace fovea::renderer {
 
 namespace {
@@ -64,7 +66,7 @@ GpuScene::GpuScene(gpu::Context& ctx, const Scene& s, const BvhOptions& bvh_opti
   std::vector<PtMaterial> mats;
   for (const Material& m : s.materials)
     mats.push_back({m.base_color.x, m.base_color.y, m.base_color.z, m.base_color_texture, m.emission.x, m.emission.y,
-                    m.emission.z, m.metallic, m.roughness, m.specular, 0.0f, 0.0f});
+                    m.emission.z, m.metallic, m.roughness, m.specular, m.double_sided ? 1u : 0u, 0.0f});
 
   std::vector<PtTextureInfo> table;
   std::vector<std::uint32_t> texels;
@@ -85,6 +87,7 @@ GpuScene::GpuScene(gpu::Context& ctx, const Scene& s, const BvhOptions& bvh_opti
   lights_ = upload(ctx, lights, "pt.lights");
   texture_table_ = upload(ctx, table, "pt.texture_table");
   texels_ = upload(ctx, texels, "pt.texels");
+  ggx_albedo_ = upload(ctx, ggx_albedo_table(), "pt.ggx_albedo");
   environment_ = s.environment;
   stats_.triangles = std::uint32_t(n);
   stats_.nodes = std::uint32_t(bvh.nodes.size());

@@ -13,7 +13,7 @@ namespace fovea::renderer {
 
 namespace {
 constexpr int kOutputs = 6;
-constexpr int kBindings = 8 + kOutputs;
+constexpr int kBindings = 8 + kOutputs + 1;  // scene, grid, outputs, GGX albedo table
 }  // namespace
 
 PathTracer::PathTracer(gpu::Context& ctx, const GpuScene& scene)
@@ -43,7 +43,7 @@ TraceOutputs PathTracer::bind(const gpu::Buffer& grid, std::uint32_t cells) cons
   o.set_.bind(0, scene_.nodes()).bind(1, scene_.triangles()).bind(2, scene_.shading()).bind(3, scene_.materials());
   o.set_.bind(4, scene_.lights()).bind(5, scene_.texture_table()).bind(6, scene_.texels()).bind(7, grid);
   o.set_.bind(8, o.direct_).bind(9, o.indirect_).bind(10, o.albedo_).bind(11, o.normal_depth_);
-  o.set_.bind(12, o.position_material_).bind(13, o.radiance_);
+  o.set_.bind(12, o.position_material_).bind(13, o.radiance_).bind(14, scene_.ggx_albedo());
   return o;
 }
 

@@ -23,6 +23,7 @@ Material diffuse(const char* name, glm::vec3 albedo) {
 Material emitter(const char* name, glm::vec3 radiance) {
   Material m = diffuse(name, glm::vec3(0.78f));
   m.emission = radiance;
+  m.double_sided = false;  // area lights emit from their front face only
   return m;
 }
 

@@ -11,6 +11,7 @@
 #include <tinyexr.h>
 
 #include "fovea/core/error.hpp"
+#include "fovea/core/tonemap.hpp"
 
 namespace fovea::renderer {
 
@@ -103,12 +104,8 @@ void write_exr(const std::string& path, const core::Image& img) {
 }
 
 core::Image tone_map(const core::Image& linear) {
-  core::Image out = linear;
-  for (auto& p : out.pixels) {
-    const float l = 0.2126f * p.x + 0.7152f * p.y + 0.0722f * p.z;
-    const float s = std::isfinite(l) && l > 0 ? 1.0f / (1.0f + l) : 0.0f;
-    p = glm::vec4(glm::vec3(p) * s, 1.0f);
-  }
+  core::Image out = core::tonemap_linear(linear);
+  for (auto& p : out.pixels) p.w = 1.0f;
   return out;
 }
 

@@ -181,6 +181,8 @@ XrResult api::xrEndFrame(XrSession session, const XrFrameEndInfo* info) {
     r.layers = info->layerCount;
     const GazeSample g = s->instance->gaze->sample_at(r.predicted_display_ns, display_epoch(*s));
     r.gaze_sample_ns = g.sample_ns;
+    r.gaze_receive_ns = g.receive_ns;
+    r.gaze_read_ns = g.read_ns;
     r.gaze_valid = g.valid;
     s->frame_open = false;
     ++s->frames_ended;

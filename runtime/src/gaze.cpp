@@ -1,33 +1,31 @@
 #include "gaze.hpp"
 
-#include <cmath>
-
-#include <glm/geometric.hpp>
-
-#include "fovea/devices/gaze.hpp"
+#include "fovea/devices/foveation_gaze.hpp"
 
 namespace fovea::runtime {
 
 GazeTracker::GazeTracker(const std::string& uri, const core::DisplayPreset& display) {
   devices::SourceOptions opt;
   opt.display = display;
-  source_ = devices::open_gaze_source(uri, opt);
-  live_ = uri.rfind("hid:", 0) == 0 || uri.rfind("usb:", 0) == 0;
+  gaze_ = std::make_unique<devices::FoveationGaze>(uri, opt);
 }
 
 GazeTracker::~GazeTracker() = default;
 
 GazeSample GazeTracker::sample_at(core::TimeNs t_ns, core::TimeNs epoch_ns) {
-  const core::TimeNs offset = live_ ? 0 : epoch_ns;
-  const devices::GazeSample s = source_->sample_at(std::max<core::TimeNs>(0, t_ns - offset));
+  gaze_->set_epoch(epoch_ns);
+  const devices::FoveaGaze f = gaze_->at(t_ns);
   GazeSample g;
-  const glm::dvec3 d = s.combined.dir;
-  g.valid = s.tracked() && std::isfinite(d.x) && std::isfinite(d.y) && std::isfinite(d.z) && glm::length(d) > 0.5;
-  if (g.valid) g.dir = glm::normalize(d);
-  g.sample_ns = s.t_ns + offset;
+  g.valid = f.combined.tracked();
+  if (g.valid) g.dir = f.combined.dir;
+  if (f.has_sample) {
+    g.sample_ns = f.sample_ns;
+    g.receive_ns = f.receive_ns;
+  }
+  g.read_ns = f.read_ns;
   return g;
 }
 
-std::string GazeTracker::describe() const { return source_->describe(); }
+std::string GazeTracker::describe() const { return gaze_->describe(); }
 
 }  // namespace fovea::runtime

@@ -19,7 +19,9 @@ struct FrameRecord {
   double compositor_ms = 0;                            // read-back, resampling, mask, PNG
   bool composited = false;                             // panel images produced for this frame
   std::uint32_t layers = 0;
-  core::TimeNs gaze_sample_ns = 0;  // the eye tracker sample for the predicted display time
+  // The newest eye-tracker sample used for the predicted display time: when it was
+  // measured, received by the host, and read for this frame (0: none measured yet).
+  core::TimeNs gaze_sample_ns = 0, gaze_receive_ns = 0, gaze_read_ns = 0;
   bool gaze_valid = false;
 };
 

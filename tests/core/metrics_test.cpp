@@ -7,6 +7,8 @@
 
 #include "fovea/core/display.hpp"
 #include "fovea/core/error.hpp"
+#include "fovea/core/flip.hpp"
+#include "fovea/core/tonemap.hpp"
 
 namespace core = fovea::core;
 
@@ -126,4 +128,69 @@ TEST(Metrics, FoveatedPsnrForgivesPeripheralDetailOnly) {
     }
   EXPECT_GT(core::foveated_psnr(ref, periph, v, gaze), core::psnr(ref, periph) + 3.0);
   EXPECT_LT(core::foveated_psnr(ref, fovea, v, gaze), core::psnr(ref, fovea) + 0.5);
+}
+
+TEST(Metrics, ToneMapIsTheStatedAcesFit) {
+  // t(1) = (0.36·2.51 + 0.6·0.03) / (0.36·2.43 + 0.6·0.59 + 0.14) = 0.9216 / 1.3688.
+  EXPECT_NEAR(core::tonemap_linear(glm::vec3(1.0f)).x, 0.9216 / 1.3688, 1e-6);
+  EXPECT_NEAR(core::tonemap_linear(glm::vec3(0.5f), 1.0).y, 0.9216 / 1.3688, 1e-6);  // exposure +1
+  EXPECT_NEAR(core::tonemap_srgb(glm::vec3(1.0f)).z, core::srgb_encode(float(0.9216 / 1.3688)), 1e-6);
+  EXPECT_EQ(core::tonemap_linear(glm::vec3(1e6f)).x, 1.0f);  // clamped
+  EXPECT_EQ(core::tonemap_linear(glm::vec3(NAN, -1.0f, 0.0f)), glm::vec3(0.0f));
+}
+
+TEST(Metrics, PooledScoresOfKnownErrors) {
+  core::Image ref(24, 24, {1.0f, 1.0f, 1.0f, 1}), test(24, 24, {1.1f, 1.1f, 1.1f, 1});
+  const core::ErrorMaps m = core::error_maps(test, ref, 10.0);
+  const core::Scores s = core::pool(m);
+  const double d = core::tonemap_srgb(glm::vec3(1.1f)).x - core::tonemap_srgb(glm::vec3(1.0f)).x;
+  EXPECT_NEAR(s.psnr, -10.0 * std::log10(d * d), 1e-3);
+  EXPECT_NEAR(s.rel_mse, 0.01 / (1.0 + core::kRelMseEpsilon), 1e-6);
+  EXPECT_NEAR(s.ssim, 1.0, 1e-3);  // a uniform offset barely changes structure
+  EXPECT_GT(s.ldr_flip, 0.0);
+  EXPECT_GT(s.hdr_flip, 0.0);
+  const core::Scores same = core::pool(core::error_maps(ref, ref, 10.0));
+  EXPECT_EQ(same.psnr, core::kPsnrIdentical);
+  EXPECT_EQ(same.ldr_flip, 0.0);
+  EXPECT_EQ(same.hdr_flip, 0.0);
+  EXPECT_NEAR(same.ssim, 1.0, 1e-9);
+}
+
+TEST(Metrics, BandAndFoveatedScoresLocaliseError) {
+  const core::View v = core::load_display("tiny").view(core::Eye::Left);
+  const glm::dvec3 gaze = v.centre_dir();
+  const std::vector<float> ecc = core::eccentricity_map(v, gaze);
+  core::Image ref(v.width(), v.height(), {0.3f, 0.3f, 0.3f, 1}), test = ref;
+  for (std::size_t i = 0; i < ecc.size(); ++i)
+    if (ecc[i] >= 20) test.pixels[i] += glm::vec4(0.2f, 0.2f, 0.2f, 0);
+  const core::ErrorMaps m = core::error_maps(test, ref, core::flip_ppd(v));
+  const auto bands = core::band_scores(m, ecc, 2.0);
+  ASSERT_GT(bands.size(), 12u);
+  for (const auto& b : bands) {
+    if (b.e_max <= 16) {  // beyond the FLIP/SSIM filter reach of the 20° boundary
+      EXPECT_EQ(b.scores.psnr, core::kPsnrIdentical) << b.e_min;
+      EXPECT_NEAR(b.scores.ldr_flip, 0.0, 1e-6) << b.e_min;
+      EXPECT_NEAR(b.scores.hdr_flip, 0.0, 1e-6) << b.e_min;
+    }
+    if (b.e_min >= 24) {
+      EXPECT_LT(b.scores.psnr, 30.0) << b.e_min;
+      EXPECT_GT(b.scores.ldr_flip, 0.05) << b.e_min;
+      EXPECT_GT(b.scores.rel_mse, 0.1) << b.e_min;
+    }
+  }
+  const std::vector<float> w = core::foveation_weights(ecc);
+  const core::Scores fov = core::pool(m, w), all = core::pool(m);
+  EXPECT_GT(fov.psnr, all.psnr + 1.0);  // 93% of the pixels carry the error, 63% of the weight
+  EXPECT_LT(fov.ldr_flip, all.ldr_flip);
+  EXPECT_NEAR(core::foveation_weights({0.0f, 5.0f, 30.0f})[2], 7.49 / (10.0 * 10.0), 1e-6);
+  EXPECT_EQ(core::foveation_weights({0.0f, 5.0f, 30.0f})[1], 1.0f);
+}
+
+TEST(Metrics, FlickerIsTheTemporalStdOfToneMappedLuma) {
+  core::Image a(8, 8, {0.2f, 0.2f, 0.2f, 1}), b(8, 8, {0.4f, 0.4f, 0.4f, 1});
+  const double ya = core::tonemap_srgb(glm::vec3(0.2f)).x, yb = core::tonemap_srgb(glm::vec3(0.4f)).x;
+  for (float f : core::flicker_map({a, b, a, b})) EXPECT_NEAR(f, 0.5 * (yb - ya), 1e-6);
+  for (float f : core::flicker_map({a, a, a})) EXPECT_NEAR(f, 0.0f, 1e-7f);
+  EXPECT_THROW(core::flicker_map({a}), core::InputError);
+  EXPECT_THROW(core::flicker_map({a, core::Image(4, 4)}), core::InputError);
 }

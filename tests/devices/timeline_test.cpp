@@ -47,21 +47,25 @@ double x_at(GazeSource& s, TimeNs t) {
 }
 }  // namespace
 
-TEST(Timeline, InterpolatesBetweenSamplesAndClampsAtTheEnds) {
+TEST(Timeline, NewestSampleAtOrBeforeTheQueryWithItsOwnTime) {
   SourceOptions o;
+  o.horizon_ns = 0;  // no prediction: the newest sample as measured
   TimelineSource src(std::make_unique<RampStream>(11, 10'000'000), o);  // 0..100 ms
   EXPECT_NEAR(x_at(src, 0), 0.0, 1e-12);
-  EXPECT_NEAR(x_at(src, 15'000'000), 0.015, 1e-6);  // between samples 1 and 2
-  EXPECT_NEAR(x_at(src, 42'500'000), 0.0425, 1e-6);
-  EXPECT_NEAR(x_at(src, -5'000'000), 0.0, 1e-12);   // before the first: clamped
+  EXPECT_NEAR(x_at(src, 15'000'000), 0.010, 1e-12);  // between samples 1 and 2: sample 1
+  EXPECT_NEAR(x_at(src, 42'500'000), 0.040, 1e-12);
   EXPECT_NEAR(x_at(src, 500'000'000), 0.1, 1e-12);  // after the last: clamped, not extrapolated
   const GazeSample g = src.sample_at(15'000'000);
-  EXPECT_EQ(g.t_ns, 15'000'000);
-  EXPECT_EQ(g.device_time_ns, 5'015'000'000);
+  EXPECT_EQ(g.t_ns, 10'000'000);  // when it was measured, not the query time
+  EXPECT_EQ(g.device_time_ns, 5'010'000'000);
   EXPECT_TRUE(g.tracked());
+  EXPECT_EQ(src.sample_at(500'000'000).t_ns, 100'000'000);
+  const GazeSample before = src.sample_at(-5'000'000);  // nothing measured yet
+  EXPECT_EQ(before.t_ns, kNoSample);
+  EXPECT_FALSE(before.tracked());
 }
 
-TEST(Timeline, NoInterpolationAcrossGaps) {
+TEST(Timeline, AStaleNewestSampleIsLost) {
   SourceOptions o;
   o.max_gap_ns = 50'000'000;
   TimelineSource src(std::make_unique<RampStream>(10, 10'000'000, 5, 200'000'000), o);
@@ -70,6 +74,7 @@ TEST(Timeline, NoInterpolationAcrossGaps) {
   const GazeSample mid = src.sample_at(100'000'000);
   EXPECT_FALSE(mid.tracked());
   EXPECT_EQ(mid.combined.flags, kLost);
+  EXPECT_EQ(mid.t_ns, 40'000'000);  // the newest sample there was
   EXPECT_TRUE(src.sample_at(260'000'000).tracked());
 }
 

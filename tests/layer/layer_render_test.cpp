@@ -95,6 +95,12 @@ TEST(LayerRender, HelloXrCubesCompositedOverThePathTracedScene) {
       if (j["projection_views"].get<int>() != 2) continue;
       EXPECT_TRUE(j["replaced"].get<bool>()) << line;
       EXPECT_GT(j["render_ms"].get<double>(), 0) << line;
+      // Foveated for the runtime's newest tracker sample (XrEyeGazeSampleTimeEXT of the
+      // layer's action): measured at or before the display time, never the display time.
+      const std::int64_t gaze_t = j["gaze_sample_ns"].get<std::int64_t>();
+      EXPECT_GT(gaze_t, 0) << line;
+      EXPECT_LT(gaze_t, j["display_time_ns"].get<std::int64_t>()) << line;
+      EXPECT_GT(j["gaze_read_ns"].get<std::int64_t>(), 0) << line;
       ++replaced;
     }
     EXPECT_EQ(n, kFrames);

@@ -1,13 +1,18 @@
-// The layer's host-side parts without an OpenXR session: configuration, compositing, gaze hold.
+// The layer's host-side parts without an OpenXR session: configuration, compositing, gaze.
+#include <algorithm>
 #include <cmath>
+#include <cstdlib>
 #include <limits>
+#include <vector>
 
 #include <gtest/gtest.h>
 
 #include "composite.hpp"
 #include "config.hpp"
 #include "fovea/core/error.hpp"
-#include "gaze_hold.hpp"
+#include "fovea/core/clock.hpp"
+#include "fovea/devices/hid_stream.hpp"
+#include "gaze_input.hpp"
 
 namespace fovea::layer {
 namespace {
@@ -108,20 +113,55 @@ TEST(LayerComposite, ResamplesByDirection) {
   EXPECT_EQ(out.at(0, 0)[3], 0);
 }
 
-TEST(LayerGazeHold, HoldsThenEasesToFixedFoveation) {
-  GazeHold h;
-  const glm::dvec3 fixed(0, 0, -1), right = glm::normalize(glm::dvec3(0.5, 0, -1));
-  EXPECT_LT(glm::distance(h.update(0, false, right), fixed), 1e-12);  // nothing seen yet
-  EXPECT_LT(glm::distance(h.update(1'000'000'000, true, right), right), 1e-12);
-  EXPECT_LT(glm::distance(h.update(1'500'000'000, false, {}), right), 1e-12);  // 500 ms: held
-  EXPECT_LT(glm::distance(h.update(1'600'000'000, false, {}), right), 1e-12);  // 600 ms: still held
-  const glm::dvec3 mid = h.update(1'800'000'000, false, {});  // half-way through the ease
-  EXPECT_GT(mid.x, 0.01);
-  EXPECT_LT(mid.x, right.x - 0.01);
-  EXPECT_NEAR(glm::length(mid), 1.0, 1e-12);
-  EXPECT_LT(glm::distance(h.update(2'100'000'000, false, {}), fixed), 1e-12);
-  EXPECT_LT(glm::distance(h.update(2'200'000'000, true, right), right), 1e-12);  // back on the tracker at once
-  EXPECT_LT(glm::distance(h.update(2'300'000'000, true, glm::dvec3(NAN, 0, -1)), right), 1e-12);  // a bad sample is a loss
+// A raw HID capture configured as the layer's gaze is a recording: at display times on the
+// host clock the fovea follows it from the first frame on (it used to be taken for a live
+// device and froze on its last sample).
+TEST(LayerGaze, HidCaptureFollowsTheRecordingFromTheFirstFrame) {
+  const std::string file = std::string(std::getenv("FOVEA_SOURCE_DIR")) + "/data/gaze/hid-ms.hidcap";
+  const core::DisplayPreset display = core::load_display("small");
+  std::vector<devices::GazeSample> rec;
+  {
+    devices::SourceOptions o;
+    o.display = display;
+    devices::hid::HidCaptureStream cap(file, o);
+    devices::GazeSample s;
+    while (cap.next(s)) rec.push_back(s);
+  }
+  ASSERT_EQ(rec.size(), 240u);
+  LayerGaze gaze("hid-capture:" + file, display);
+  const std::int64_t first = core::now_ns() + 20'000'000;  // XrTime of the first frame
+  const std::int64_t period = std::llround(1e9 / display.refresh_hz);
+  int moved = 0;
+  glm::dvec3 prev(0, 0, -1);
+  for (int f = 0; f * period < 2'000'000'000; ++f) {
+    const std::int64_t t = first + f * period;
+    const devices::FoveaGaze g = gaze.frame(t, nullptr);
+    const auto newest = std::upper_bound(rec.begin(), rec.end(), t - first,
+                                         [](std::int64_t q, const devices::GazeSample& s) { return q < s.t_ns; }) - 1;
+    ASSERT_TRUE(g.has_sample);
+    ASSERT_EQ(g.sample_ns, first + newest->t_ns) << f;
+    ASSERT_LE(g.sample_ns, t);
+    moved += core::angle_deg(prev, g.left.dir) > 0.01;
+    prev = g.left.dir;
+  }
+  EXPECT_GT(moved, 40);  // ~140 frames of a search task: the fovea keeps moving
+}
+
+TEST(LayerGaze, TheActionGoesThroughTheSamePolicyWithItsSampleTime) {
+  LayerGaze gaze("synthetic:1", core::load_display("small"));
+  const glm::dvec3 right = glm::normalize(glm::dvec3(0.5, 0, -1));
+  const std::int64_t t0 = 1'000'000'000'000;
+  ActionGaze a{right, t0 - 4'000'000};
+  const devices::FoveaGaze g = gaze.frame(t0, &a);
+  EXPECT_EQ(g.sample_ns, t0 - 4'000'000);  // the runtime's XrEyeGazeSampleTimeEXT, not the display time
+  EXPECT_LT(core::angle_deg(g.right.dir, right), 1e-9);
+  const ActionGaze lost{std::nullopt, 0};
+  const devices::FoveaGaze held = gaze.frame(t0 + 300'000'000, &lost);  // within the hold
+  EXPECT_EQ(held.left.state, devices::FoveaState::Holding);
+  EXPECT_LT(core::angle_deg(held.left.dir, right), 1e-9);
+  const devices::FoveaGaze rest = gaze.frame(t0 + 800'000'000, &lost);  // past hold + ease
+  EXPECT_EQ(rest.left.state, devices::FoveaState::Resting);
+  EXPECT_LT(core::angle_deg(rest.left.dir, glm::dvec3(0, 0, -1)), 1e-9);
 }
 
 // The window depth an application stores for view distance z (the inverse of view_distance).

@@ -118,6 +118,30 @@ TEST(Scene, ObjWithMtlReadsMaterials) {
   std::filesystem::remove_all(dir);
 }
 
+TEST(Scene, GltfDoubleSidedIsReadAndDefaultsToFalse) {
+  // Two one-triangle primitives: material 0 double-sided, material 1 without the flag.
+  const auto dir = std::filesystem::temp_directory_path() / "fovea_gltf_sides_test";
+  std::filesystem::create_directories(dir);
+  const float pos[9] = {0, 0, 0, 1, 0, 0, 0, 1, 0};
+  std::ofstream(dir / "t.bin", std::ios::binary).write(reinterpret_cast<const char*>(pos), sizeof(pos));
+  std::ofstream(dir / "t.gltf") << R"({"asset": {"version": "2.0"}, "scene": 0, "scenes": [{"nodes": [0, 1]}],
+    "nodes": [{"mesh": 0}, {"mesh": 1}],
+    "meshes": [{"primitives": [{"attributes": {"POSITION": 0}, "material": 0}]},
+               {"primitives": [{"attributes": {"POSITION": 0}, "material": 1}]}],
+    "materials": [{"name": "two", "doubleSided": true}, {"name": "one"}],
+    "buffers": [{"uri": "t.bin", "byteLength": 36}],
+    "bufferViews": [{"buffer": 0, "byteLength": 36}],
+    "accessors": [{"bufferView": 0, "componentType": 5126, "count": 3, "type": "VEC3",
+                   "min": [0, 0, 0], "max": [1, 1, 0]}]})";
+  const fr::Scene s = fr::load_scene((dir / "t.gltf").string());
+  ASSERT_EQ(s.triangle_count(), 2u);
+  for (std::size_t t = 0; t < 2; ++t) {
+    const fr::Material& m = s.materials[s.material[t]];
+    EXPECT_EQ(m.double_sided, m.name == "two") << m.name;
+  }
+  std::filesystem::remove_all(dir);
+}
+
 TEST(Scene, UnknownNameIsAnInputError) {
   EXPECT_THROW(fr::load_scene("no-such-scene"), fovea::core::InputError);
   EXPECT_THROW(fr::load_scene("/nonexistent/x.gltf"), fovea::core::InputError);

@@ -67,10 +67,19 @@ ProcessResult run_and_check(const std::string& graphics, std::map<std::string, s
     EXPECT_LE(f["wait_call_ns"].get<std::int64_t>(), f["wait_return_ns"].get<std::int64_t>());
     EXPECT_LE(f["begin_ns"].get<std::int64_t>(), f["end_call_ns"].get<std::int64_t>());
     EXPECT_LE(f["end_call_ns"].get<std::int64_t>(), f["end_return_ns"].get<std::int64_t>());
-    // The eye tracker was sampled for the frame: a sample at or before the display time.
+    // The eye tracker was sampled for the frame: the newest 120 Hz sample measured by the
+    // display time, never the display time itself (a 70 Hz display time falls on a sample
+    // only at the epoch), received when measured (a synthetic tracker) and read before it.
     const std::int64_t gaze_t = f["gaze_sample_ns"].get<std::int64_t>();
+    const std::int64_t display_t = f["predicted_display_ns"].get<std::int64_t>();
     EXPECT_GT(gaze_t, 0);
-    EXPECT_LE(gaze_t, f["predicted_display_ns"].get<std::int64_t>());
+    EXPECT_LE(gaze_t, display_t);
+    EXPECT_GT(gaze_t, display_t - 8'333'334);
+    if (i > 0) {
+      EXPECT_NE(gaze_t, display_t);
+    }
+    EXPECT_EQ(f["gaze_receive_ns"].get<std::int64_t>(), gaze_t);
+    EXPECT_GT(f["gaze_read_ns"].get<std::int64_t>(), 0);
     EXPECT_EQ(f["composited"].get<bool>(), i % kPngEvery == 0);
   }
   // hello_xr renders from its second frame on (the first one is not yet visible).

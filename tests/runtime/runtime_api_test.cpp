@@ -649,6 +649,10 @@ TEST_F(XrTest, EyeGazeReplay) {
   EXPECT_NEAR(f.x, std::sin(20.0 * M_PI / 180), 1e-4);
   EXPECT_NEAR(f.y, 0.0, 1e-4);
   EXPECT_EQ(when.time, epoch + 500'000'000);
+  // Between samples the sample time is the newest sample's, never the time asked for.
+  ASSERT_EQ(xrLocateSpace(gaze_space, view, epoch + 507'000'000, &loc), XR_SUCCESS);
+  ASSERT_TRUE(loc.locationFlags & XR_SPACE_LOCATION_ORIENTATION_VALID_BIT);
+  EXPECT_EQ(when.time, epoch + 500'000'000);
   ASSERT_EQ(xrLocateSpace(gaze_space, view, epoch + 1'100'000'000, &loc), XR_SUCCESS);
   EXPECT_EQ(loc.locationFlags, 0u);  // blink
 }

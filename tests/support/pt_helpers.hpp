@@ -1,5 +1,7 @@
 #pragma once
 // Test helpers: trace a grid with the path tracer and read the outputs back.
+#include <algorithm>
+#include <cmath>
 #include <vector>
 
 #include <glm/vec4.hpp>
@@ -36,6 +38,18 @@ inline Traced trace_grid(gpu::Context& ctx, const renderer::GpuScene& scene,
   t.normal_depth = out.normal_depth().download<glm::vec4>();
   t.position_material = out.position_material().download<glm::vec4>();
   return t;
+}
+
+// Mean of per-cell estimates and the standard error of that mean (cells as independent
+// samples; an upper bound where the cells' expected values differ).
+struct MeanSe {
+  double mean = 0, se = 0;
+};
+inline MeanSe mean_se(const std::vector<double>& v) {
+  double s = 0, s2 = 0;
+  for (double x : v) s += x, s2 += x * x;
+  const double n = double(v.size()), m = s / n;
+  return {m, n > 1 ? std::sqrt(std::max(0.0, s2 / n - m * m) / (n - 1)) : 0.0};
 }
 
 inline glm::dvec3 mean_rgb(const std::vector<glm::vec4>& v) {

@@ -21,7 +21,7 @@
 #include "fovea/core/error.hpp"
 #include "fovea/core/image.hpp"
 #include "fovea/core/metrics.hpp"
-#include "fovea/devices/gaze.hpp"
+#include "fovea/devices/foveation_gaze.hpp"
 #include "fovea/gpu/context.hpp"
 #include "fovea/pipeline/frame_pipeline.hpp"
 #include "fovea/renderer/reference.hpp"
@@ -163,7 +163,7 @@ int run(std::vector<std::string> argv) {
   }
   devices::SourceOptions so;
   so.display = display;
-  const auto gaze_source = devices::open_gaze_source(gaze_uri, so);
+  devices::FoveationGaze gaze_source(gaze_uri, so);
 
   const renderer::Scene scene = renderer::load_scene(args.str("scene", "default"));
   for (const auto& w : scene.warnings) std::cerr << "warning: " << w << "\n";
@@ -191,13 +191,8 @@ int run(std::vector<std::string> argv) {
   for (long f = 0; f < frames; ++f) {
     core::TimeNs t0 = core::now_ns();
     const auto t_ns = core::TimeNs(std::llround(double(f) / display.refresh_hz * 1e9));
-    const devices::GazeSample s = gaze_source->sample_at(t_ns);
-    for (int e = 0; e < 2; ++e) {
-      const devices::EyeGaze& eg = s.eye(core::Eye(e));
-      // Untracked samples keep the previous gaze (the distributions also guard bad input).
-      if (eg.tracked()) gaze[e] = eg.dir;
-      else if (s.combined.tracked()) gaze[e] = s.combined.dir;
-    }
+    const devices::FoveaGaze g = gaze_source.at_frame_time(t_ns);
+    for (int e = 0; e < 2; ++e) gaze[e] = g.eye(core::Eye(e)).dir;
     cpu_ms["gaze"].push_back(core::ns_to_ms(core::now_ns() - t0));
     const pipeline::FrameTimes t = pipeline.render(poses, gaze, std::uint32_t(f));
     for (const auto& [name, st] : {std::pair{"grid", t.grid}, {"trace", t.trace}, {"reconstruct", t.reconstruct},

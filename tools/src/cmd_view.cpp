@@ -19,7 +19,7 @@
 #include "fovea/core/eye_optics.hpp"
 #include "fovea/core/stereo_views.hpp"
 #include "fovea/core/image.hpp"
-#include "fovea/devices/gaze.hpp"
+#include "fovea/devices/foveation_gaze.hpp"
 #include "fovea/gpu/context.hpp"
 #include "fovea/pipeline/frame_pipeline.hpp"
 #include "fovea/renderer/gpu_scene.hpp"
@@ -36,8 +36,8 @@ Opens the mirror window (X11; e.g. under Xvfb with DISPLAY set): both eyes' pane
 by side as the headset shows them, through the lens distortion pass, with a gaze marker.
 With --scene every frame is path traced foveated at the current gaze (grid generation,
 path tracing, reconstruction, resolve; as fovea render, skipping the lens' hidden area),
-tone-mapped (Reinhard) and distorted for the panels. Without --scene each eye shows a grid of view directions (lines
-every 5 degrees), a picture of the optics.
+tone-mapped (Reinhard) and distorted for the panels. Without --scene each eye shows a grid
+of view directions (lines every 5 degrees), a picture of the optics.
 
   --display NAME|FILE   display preset (fove0, vive, modern, small, tiny) or JSON file [small]
   --scene S             cornell | furnace | glossy-spheres | stereo-occluders | default, or a
@@ -132,12 +132,12 @@ int run(std::vector<std::string> argv) {
   // The gaze: the mouse, a fixed direction, or a gaze source (recording, synthetic).
   const std::string gaze_arg = args.str("gaze", "");
   const bool mouse = gaze_arg == "mouse";
-  std::unique_ptr<devices::GazeSource> source;
+  std::unique_ptr<devices::FoveationGaze> source;
   std::array<glm::dvec3, 2> gaze{glm::dvec3(0, 0, -1), glm::dvec3(0, 0, -1)};
   if (!mouse && !gaze_arg.empty() && !args.has("gaze-dir") && !is_point(gaze_arg)) {
     devices::SourceOptions so;
     so.display = d;
-    source = devices::open_gaze_source(gaze_arg, so);
+    source = std::make_unique<devices::FoveationGaze>(gaze_arg, so);
   } else if (!mouse) {
     gaze[0] = gaze[1] = parse_gaze(args, optics[0].view());
   } else if (args.has("gaze-dir")) {
@@ -185,13 +185,8 @@ int run(std::vector<std::string> argv) {
       // (parallel eyes: vergence is ignored); off the panels the last gaze holds.
       if (const auto p = window.cursor()) gaze[0] = gaze[1] = core::gaze_direction(optics[int(p->eye)].lens(), p->uv);
     } else if (source) {
-      const devices::GazeSample s = source->sample_at(core::TimeNs(std::llround(double(frame) / d.refresh_hz * 1e9)));
-      for (int e = 0; e < 2; ++e) {
-        // Untracked samples keep the previous gaze.
-        const devices::EyeGaze& eg = s.eye(core::Eye(e));
-        if (eg.tracked()) gaze[size_t(e)] = eg.dir;
-        else if (s.combined.tracked()) gaze[size_t(e)] = s.combined.dir;
-      }
+      const devices::FoveaGaze g = source->at_frame_time(core::TimeNs(std::llround(double(frame) / d.refresh_hz * 1e9)));
+      for (int e = 0; e < 2; ++e) gaze[size_t(e)] = g.eye(core::Eye(e)).dir;
     }
     if (sr) {
       sr->pipeline->render(sr->poses, gaze, std::uint32_t(frame));

@@ -3,9 +3,9 @@
 // (alpha ignored):
 //   psnr            10·log10(peak² / MSE), MSE over R, G, B; peak 1 (linear radiance 1 = the
 //                   display's white), so HDR values above 1 count with their full error
-//   ssim            Wang et al. 2004 on luminance after the stated tone map (Reinhard
-//                   c / (1 + L), then sRGB encoding): 11×11 Gaussian window σ = 1.5,
-//                   K1 = 0.01, K2 = 0.03, L = 1, mean over the valid (fully covered) windows
+//   ssim            Wang et al. 2004 on the luma (Rec. 709 weights) of tonemap_srgb
+//                   (tonemap.hpp): 11×11 Gaussian window σ = 1.5, K1 = 0.01, K2 = 0.03,
+//                   L = 1, windows renormalised at the borders, mean of the index map
 //   band_psnr       PSNR per eccentricity band [k·w, (k+1)·w) around the gaze (w = 2°)
 //   fovea_psnr      PSNR over pixels with eccentricity <= 5.79° (the acuity plateau)
 //   foveated_psnr   PSNR after low-passing both images with an eccentricity-dependent Gaussian
@@ -13,6 +13,8 @@
 //   temporal_error  Schied et al. 2017: mean |Y_t − Y_{t−1}| of consecutive frames (Rec. 709
 //                   luminance, linear)
 // Results are finite: identical images give kPsnrIdentical dB.
+// The error maps further down (tone-mapped PSNR and SSIM, relMSE, LDR-/HDR-FLIP) pool per
+// 2° band and with acuity weights; docs/metrics.md has every formula.
 #include <vector>
 
 #include <glm/vec3.hpp>
@@ -53,5 +55,46 @@ double foveated_psnr(const Image& a, const Image& b, const View& view, glm::dvec
 // per pixel; the kernel at each output pixel uses that pixel's σ, weights renormalised at
 // the borders.
 Image variable_gaussian(const Image& img, const std::vector<float>& sigma_px);
+
+// SSIM index per pixel (the map ssim() averages).
+std::vector<float> ssim_map(const Image& a, const Image& b);
+
+// Per-pixel error maps of `test` against `reference` (linear HDR RGB, equal sizes).
+struct ErrorMaps {
+  std::vector<float> squared_error;  // tonemap_srgb at `exposure`, mean over R, G, B
+  std::vector<float> ssim;           // ssim_map
+  std::vector<float> rel_mse;        // linear: mean over R, G, B of (t − r)² / (r² + kRelMseEpsilon)
+  std::vector<float> ldr_flip;       // LDR-FLIP of tonemap_linear at `exposure`
+  std::vector<float> hdr_flip;       // HDR-FLIP (flip.hpp) of the linear images
+};
+constexpr double kRelMseEpsilon = 0.01;
+ErrorMaps error_maps(const Image& test, const Image& reference, double ppd, double exposure = 0.0);
+
+// Weighted means of the maps (weights ≥ 0, one per pixel; empty: all 1). PSNR comes from
+// the weighted MSE (peak 1, kPsnrIdentical when it vanishes), the others are means. A zero
+// total weight gives the scores of identical images with weight 0.
+struct Scores {
+  double psnr = kPsnrIdentical, ssim = 1, rel_mse = 0, ldr_flip = 0, hdr_flip = 0;
+  double weight = 0;  // Σ weights
+};
+Scores pool(const ErrorMaps& maps, const std::vector<float>& weights = {});
+double weighted_mean(const std::vector<float>& map, const std::vector<float>& weights = {});
+
+// Scores per eccentricity band [k·w, (k+1)·w) (empty bands skipped).
+struct BandScores {
+  double e_min = 0, e_max = 0;
+  long pixels = 0;
+  Scores scores;
+};
+std::vector<BandScores> band_scores(const ErrorMaps& maps, const std::vector<float>& ecc, double band_deg = 2.0);
+
+// Foveated pooling weights: the normalised acuity w(e) = m(e) (acuity.hpp, Koskela et al.
+// 2018 P4 Eq. 1): 1 within 5.79°, 0.075 at 30°: error counts as much as the eye resolves.
+std::vector<float> foveation_weights(const std::vector<float>& ecc);
+
+// Flicker of a static scene: per pixel, the standard deviation over the frames of the luma
+// of tonemap_srgb at `exposure` (needs ≥ 2 frames of equal size). Pool it with
+// weighted_mean, per band or foveated.
+std::vector<float> flicker_map(const std::vector<Image>& frames, double exposure = 0.0);
 
 }  // namespace fovea::core

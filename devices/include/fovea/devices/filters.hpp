@@ -4,11 +4,10 @@
 //               lost samples shorter than 75 ms are filled by interpolation (Olsen 2012).
 //  - "oneeuro": One Euro filter (Casiez, Roussel & Vogel, CHI 2012) per eye and axis on the
 //               gaze angles, reset after dropouts.
-//  - "hold":    blink/loss handling: untracked samples keep the last tracked direction for
-//               hold_ns, then ease to the view centre over ease_ns (flags stay blink/lost).
 // Prediction (GazePredictor) extrapolates to the display time at constant velocity during
 // fixation and pursuit, and never across a saccade onset (hold, or the landing estimate
-// from the main sequence once the peak velocity has passed).
+// from the main sequence once the peak velocity has passed). What the fovea does while the
+// eye is not tracked is the foveation gaze's policy (foveation_gaze.hpp), not a filter.
 #include <deque>
 #include <memory>
 #include <string_view>
@@ -38,16 +37,9 @@ class OneEuro {
   double x_ = 0, dx_ = 0;
 };
 
-struct HoldParams {
-  core::TimeNs hold_ns = 200'000'000;  // keep the last tracked gaze this long
-  core::TimeNs ease_ns = 300'000'000;  // then move to the view centre (smoothstep) over this
-};
-
 struct FilterParams {
   IvtParams ivt;
   OneEuroParams one_euro;
-  HoldParams hold;
-  glm::dvec3 centre{0, 0, -1};  // where "hold" eases to (the view centre)
 };
 
 // Wraps `inner` with the comma-separated stages of `spec` ("" = none). Throws InputError.
@@ -62,8 +54,14 @@ class GazePredictor {
  public:
   explicit GazePredictor(const PredictParams& p = {}) : p_(p) {}
   // The gaze at t ≥ newest sample time, at most `horizon_ns` ahead of it; `history` holds the
-  // recent samples in time order (the newest last).
-  GazeSample predict(const std::deque<GazeSample>& history, core::TimeNs t, core::TimeNs horizon_ns) const;
+  // recent samples in time order, of which the first `count` are used (the newest last).
+  // Only the directions move: the times stay those of the newest sample (it was measured
+  // then; the prediction is not a measurement).
+  GazeSample predict(const std::deque<GazeSample>& history, std::size_t count, core::TimeNs t,
+                     core::TimeNs horizon_ns) const;
+  GazeSample predict(const std::deque<GazeSample>& history, core::TimeNs t, core::TimeNs horizon_ns) const {
+    return predict(history, history.size(), t, horizon_ns);
+  }
 
  private:
   PredictParams p_;

@@ -34,6 +34,9 @@ struct EyeGaze {
 // Eye-movement class of a sample, set by the I-VT filter stage (filters.hpp); Unknown otherwise.
 enum class Motion : std::uint8_t { Unknown, Fixation, Saccade };
 
+// GazeSample::t_ns when no sample had been measured by the time asked for.
+inline constexpr core::TimeNs kNoSample = INT64_MIN;
+
 struct GazeSample {
   // On the source's timeline: replays and synthetic gaze count from their first sample
   // (t = 0); live devices use the host monotonic clock (device time mapped through the
@@ -71,11 +74,11 @@ struct SourceOptions {
   std::string format;   // replay: force a format instead of auto-detection
   double speed = 1.0;   // replay: timeline speed factor
   bool loop = false;    // replay: wrap around at the end
-  core::TimeNs horizon_ns = 20'000'000;   // prediction never goes further past the newest sample
-  core::TimeNs max_gap_ns = 100'000'000;  // no interpolation across larger gaps (result: lost)
+  core::TimeNs horizon_ns = 20'000'000;   // prediction never goes further past the newest sample (0: off)
+  core::TimeNs max_gap_ns = 100'000'000;  // a newest sample older than this is stale (result: lost)
   core::TimeNs window_ns = 2'000'000'000; // history kept for sample_at()
   double min_confidence = 0.6;            // formats with confidence: below this -> lost
-  // Filter stages applied to the stream, in order: "ivt", "oneeuro", "hold" (filters.hpp).
+  // Filter stages applied to the stream, in order: "ivt", "oneeuro" (filters.hpp).
   std::string filters;
   std::string raw_capture;  // HID sources: also write the raw device traffic here (docs/hid.md)
 
@@ -87,9 +90,15 @@ class GazeSource {
   virtual ~GazeSource() = default;
   // The newest sample available now; never blocks.
   virtual GazeSample latest() = 0;
-  // The gaze at time t on the source's timeline: interpolated between the samples around
-  // t, clamped to the first/last sample, predicted at most horizon_ns past the newest.
+  // The gaze at time t on the source's timeline from the samples measured at or before t
+  // (never a later one): the newest of them, its direction predicted to t (at most
+  // horizon_ns) when prediction is on. t_ns of the result is the newest real sample's time
+  // on the same timeline, never t; before the first sample t_ns is kNoSample and the
+  // result is lost. A newest sample older than max_gap_ns is stale: flagged lost.
   virtual GazeSample sample_at(core::TimeNs t) = 0;
+  // Live sources stamp samples with the host monotonic clock; recorded and synthetic ones
+  // count from their first sample. Set by the source kind, never guessed from its name.
+  virtual bool is_live() const = 0;
   virtual std::string describe() const = 0;
 };
 

@@ -1,9 +1,11 @@
 #pragma once
 // A GazeSource over any SampleStream: keeps a bounded window of recent samples and answers
-// sample_at() by interpolation. Recorded streams (replay, synthetic) are played on a
-// timeline starting at their first sample (t = 0), scaled by `speed`, optionally looped;
-// seeking backwards before the window re-reads the stream from its start. Live streams are
-// predicted past their newest sample (GazePredictor, at most horizon_ns).
+// sample_at() from the newest sample at or before the time asked for. Recorded streams
+// (replay, synthetic) are played on a timeline starting at their first sample (t = 0),
+// scaled by `speed`, optionally looped; seeking backwards before the window re-reads the
+// stream from its start; past the end of a recording its last sample stays. Between
+// samples the direction is predicted to the time asked for (GazePredictor, at most
+// horizon_ns; horizon_ns = 0 holds the newest sample).
 #include <deque>
 #include <memory>
 #include <mutex>
@@ -18,6 +20,7 @@ class TimelineSource final : public GazeSource {
   TimelineSource(std::unique_ptr<SampleStream> stream, const SourceOptions& opt);
   GazeSample latest() override;
   GazeSample sample_at(core::TimeNs t) override;
+  bool is_live() const override { return stream_->live(); }
   std::string describe() const override { return stream_->describe(); }
   // Samples currently held (bounded by window_ns); for tests of the memory bound.
   std::size_t window_size() const { return win_.size(); }
@@ -32,6 +35,7 @@ class TimelineSource final : public GazeSource {
   std::deque<GazeSample> win_;
   bool ended_ = false, trimmed_ = false;
   core::TimeNs period_ = -1;  // loop period once the end is known
+  core::TimeNs loop_base_ = 0;  // recording time of the current loop's start (k · period_)
   core::TimeNs opened_ns_ = 0;
   GazePredictor predictor_;
   std::mutex mutex_;

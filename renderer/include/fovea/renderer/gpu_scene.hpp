@@ -1,6 +1,7 @@
 #pragma once
 // A scene on the GPU: BVH nodes, triangles in BVH order, shading attributes, materials,
-// the emissive-triangle table for next-event estimation and the textures, uploaded once.
+// the emissive-triangle table for next-event estimation, the textures and the GGX albedo
+// table of the layered BSDF, uploaded once.
 #include <cstdint>
 
 #include "fovea/gpu/buffer.hpp"
@@ -29,12 +30,13 @@ class GpuScene {
   const gpu::Buffer& lights() const { return lights_; }          // >= 1 entry (a dummy when none)
   const gpu::Buffer& texture_table() const { return texture_table_; }
   const gpu::Buffer& texels() const { return texels_; }
+  const gpu::Buffer& ggx_albedo() const { return ggx_albedo_; }  // layered BSDF table (pt_scene.h)
   std::uint32_t light_count() const { return stats_.lights; }     // real emissive triangles
   glm::vec3 environment() const { return environment_; }
   const GpuSceneStats& stats() const { return stats_; }
 
  private:
-  gpu::Buffer nodes_, triangles_, shading_, materials_, lights_, texture_table_, texels_;
+  gpu::Buffer nodes_, triangles_, shading_, materials_, lights_, texture_table_, texels_, ggx_albedo_;
   glm::vec3 environment_{0};
   GpuSceneStats stats_;
 };

@@ -41,7 +41,8 @@ ReferenceResult render_reference(gpu::Context& ctx, const GpuScene& scene, const
 
 // OpenEXR, 32-bit float RGBA, written through a temporary file and renamed.
 void write_exr(const std::string& path, const core::Image& img);
-// Tone map for display: Reinhard on luminance (c / (1 + L)); write_png adds sRGB.
+// Tone map for display: core::tonemap_linear (exposure 0, the ACES fit the metrics use,
+// docs/metrics.md), alpha 1; write_png adds the sRGB OETF.
 core::Image tone_map(const core::Image& linear);
 
 }  // namespace fovea::renderer

@@ -21,8 +21,9 @@ struct Texture {
   std::vector<std::uint8_t> rgba;
 };
 
-// Lambert diffuse + GGX specular (Smith masking), glTF metallic-roughness semantics:
-// diffuse colour = base·(1−metallic); specular F0 = mix(specular, base, metallic).
+// GGX specular (Smith masking, multiple-scattering compensated) over an energy-compensated
+// Lambert base, glTF metallic-roughness semantics: diffuse colour = base·(1−metallic);
+// specular F0 = mix(specular, base, metallic). docs/renderer.md has the model.
 struct Material {
   std::string name;
   glm::vec3 base_color{0.8f};
@@ -30,7 +31,11 @@ struct Material {
   float metallic = 0.0f;
   float roughness = 1.0f;        // perceptual (GGX alpha = roughness²)
   float specular = 0.04f;        // dielectric F0; 0 makes a pure Lambert surface
-  glm::vec3 emission{0.0f};      // radiance emitted from the front face (linear)
+  glm::vec3 emission{0.0f};      // radiance emitted (linear)
+  // glTF `doubleSided`: back faces are shaded and emit with the normal reversed. Single-sided
+  // back faces neither reflect nor emit (black, still opaque). Built-in scenes and OBJ files
+  // (which cannot say) are double-sided except the built-in emitters.
+  bool double_sided = true;
 };
 
 struct Scene {

@@ -1,5 +1,7 @@
-// GLSL only: the counter-based random numbers and the BSDF (Lambert + GGX with Smith
-// masking, glTF metallic-roughness) of the path tracer.
+// GLSL only: the counter-based random numbers and the BSDF (GGX with Smith masking and a
+// multiple-scattering lobe over an energy-compensated Lambert base, glTF
+// metallic-roughness) of the path tracer. The includer
+// declares `vec4 ggx_albedo[]`, the table described with kPtGgxTableSize (pt_scene.h).
 #ifndef FOVEA_SHADERS_PT_SAMPLING_H
 #define FOVEA_SHADERS_PT_SAMPLING_H
 
@@ -68,13 +70,44 @@ vec3 pt_fresnel(vec3 f0, float c) {
   return f0 + (1.0 - f0) * (m * m * m * m * m);
 }
 
-// Probability of sampling the specular lobe, from the lobes' rough weights.
+// Table entry (A, B, A_avg, B_avg) at (μ, α), bilinear in (√μ, √α) between the nodes.
+vec4 pt_ggx_albedo(float mu, float alpha) {
+  const float n1 = float(kPtGgxTableSize - 1u);
+  const vec2 p = sqrt(clamp(vec2(mu, alpha), 0.0, 1.0)) * n1;
+  const uvec2 i0 = uvec2(min(p, vec2(n1 - 1.0)));
+  const vec2 f = p - vec2(i0);
+  const uint row = kPtGgxTableSize;
+  const uint k = i0.y * row + i0.x;
+  return mix(mix(ggx_albedo[k], ggx_albedo[k + 1u], f.x), mix(ggx_albedo[k + row], ggx_albedo[k + row + 1u], f.x), f.y);
+}
+
+// Multiple scattering of the specular layer (Kulla & Conty 2017, "Revisiting physically
+// based shading at Imageworks"): with E1 = A + B the single-scattering albedo for F = 1,
+//   f_ms = F_ms · (1 − E1(μo))(1 − E1(μi)) / (π(1 − E1_avg)),
+//   F_ms = F_avg²·E1_avg / (1 − F_avg(1 − E1_avg)), F_avg = F0 + (1 − F0)/21 (Schlick's
+// cosine-weighted mean), restores the energy masking removes: albedo F_ms(1 − E1(μo)), so a
+// white metal (F0 = 1, F_ms = 1) reflects exactly 1. Returns F_ms.
+vec3 pt_ms_scale(vec3 f0, float e1_avg) {
+  const vec3 fa = f0 + (1.0 - f0) / 21.0;
+  return fa * fa * e1_avg / (1.0 - fa * (1.0 - e1_avg));
+}
+
+// Albedo of the whole specular layer (single + multiple scattering) at μ from its table
+// entry t, and the same for the cosine-weighted hemispherical mean.
+vec3 pt_layer_albedo(vec3 f0, vec3 fms, vec4 t) { return f0 * t.x + t.y + fms * (1.0 - (t.x + t.y)); }
+vec3 pt_layer_albedo_avg(vec3 f0, vec3 fms, vec4 t) { return f0 * t.z + t.w + fms * (1.0 - (t.z + t.w)); }
+
+// Probability of sampling the GGX lobe (visible normals) rather than the cosine lobe, which
+// serves the diffuse base and the multiple-scattering lobe; from the lobes' rough weights.
 float pt_spec_prob(PtBsdf m, float cos_o) {
-  const float es = pt_luminance(pt_fresnel(m.f0, cos_o)) * float(pt_max3(m.f0) > 0.0);
+  if (pt_max3(m.f0) <= 0.0) return 0.0;
+  const float es = pt_luminance(pt_fresnel(m.f0, cos_o));
+  const vec4 t = pt_ggx_albedo(cos_o, m.alpha);
+  const float ems = pt_luminance(pt_ms_scale(m.f0, t.z + t.w)) * (1.0 - (t.x + t.y));
   const float ed = pt_luminance(m.diffuse);
-  if (es <= 0.0) return 0.0;
-  if (ed <= 0.0) return 1.0;
-  return clamp(es / (es + ed), 0.1, 0.9);
+  // Metals: unclamped, so mirrors keep (almost) all samples on the GGX lobe.
+  if (ed <= 0.0) return es / (es + ems);
+  return clamp(es / (es + ed + ems), 0.1, 0.9);
 }
 
 // f·cos split into the diffuse and specular lobes, and the sampling pdf (solid angle).
@@ -98,6 +131,17 @@ void pt_bsdf_eval(PtBsdf m, vec3 n, vec3 wo, vec3 wi, out vec3 f_diff, out vec3 
     f_spec = pt_fresnel(m.f0, hoo) * (D * G2 / (4.0 * co));
     // Visible-normal sampling pdf of wi: G1(wo)·D / (4 cos_o) (Heitz 2018, Eq. 17 with the Jacobian).
     pdf += ps * G1 * D / (4.0 * co);
+    const vec4 to = pt_ggx_albedo(co, m.alpha), ti = pt_ggx_albedo(ci, m.alpha);
+    const float e1_avg = to.z + to.w;
+    const vec3 fms = pt_ms_scale(m.f0, e1_avg);
+    f_spec += fms * ((1.0 - (to.x + to.y)) * (1.0 - (ti.x + ti.y)) * ci / (kPtPi * max(1.0 - e1_avg, 1e-4)));
+    // Energy-compensated layering (Kelemen & Szirmay-Kalos 2001; Kulla & Conty 2017):
+    // the diffuse base receives what the specular layer E does not reflect, reciprocally,
+    // f_d = ρ/π · (1 − E(μo))(1 − E(μi)) / (1 − E_avg); its albedo is then ρ(1 − E(μo)), so
+    // E(μo) + ρ(1 − E(μo)) ≤ 1 for every ρ ≤ 1 (the plain sum reached 1.33 at grazing).
+    const vec3 eo = pt_layer_albedo(m.f0, fms, to), ei = pt_layer_albedo(m.f0, fms, ti);
+    const vec3 eavg = pt_layer_albedo_avg(m.f0, fms, to);
+    f_diff *= clamp((1.0 - eo) * (1.0 - ei) / max(1.0 - eavg, vec3(1e-4)), 0.0, 1e4);
   }
 }
 

@@ -44,7 +44,9 @@ struct PtMaterial {
   FOVEA_INT texture;  // index into the texture table, -1 for none
   float emit_r, emit_g, emit_b;
   float metallic;
-  float roughness, specular, pad0, pad1;
+  float roughness, specular;
+  FOVEA_UINT double_sided;  // 1: back faces shade and emit with the normal reversed; 0: black
+  float pad;
 };
 
 // A texture in the shared texel buffer (RGBA8 sRGB words).
@@ -59,6 +61,13 @@ struct PtLight {
   float pmf;
   float area;
 };
+
+// Directional albedo of the GGX specular lobe (pt_bsdf_eval's f_spec with Schlick Fresnel,
+// which is linear in F0): E(μ, α, F0) = F0·A + B, and its cosine-weighted hemispherical
+// mean E_avg = 2∫E(μ)μ dμ = F0·A_avg + B_avg. A table of vec4 (A, B, A_avg, B_avg) with
+// kPtGgxTableSize² entries, index = r_index · size + μ_index, nodes √μ = i/(size−1) and
+// √α = j/(size−1), bilinear in (√μ, √α); built by renderer/src/ggx_albedo.cpp.
+FOVEA_CONST FOVEA_UINT kPtGgxTableSize = 32;
 
 #ifdef __cplusplus
 static_assert(sizeof(PtBvhNode) == 32 && sizeof(PtTriangle) == 48 && sizeof(PtShading) == 64);
