@@ -10,11 +10,13 @@
 #include <random>
 #include <vector>
 
-#include "fovea/compositor/bmfr.hpp"
-#include "fovea/compositor/reconstruct.hpp"
+#include <glm/vec3.hpp>
+#include <glm/geometric.hpp>
+
+#include "fovea/reconstruct/bmfr.hpp"
 #include "fovea/gpu/context.hpp"
 
-namespace fc = fovea::compositor;
+namespace fc = fovea::reconstruct;
 namespace fg = fovea::gpu;
 
 namespace {

@@ -12,7 +12,8 @@ layout(local_size_x = 8, local_size_y = 8) in;
 
 layout(std140, set = 0, binding = 0) uniform Params { GridParams P; };
 layout(std430, set = 0, binding = 1) readonly buffer Columns { GridColumn cols[]; };
-layout(std430, set = 0, binding = 2) readonly buffer Mask { uint hidden_mask[]; };  // 1 bit per display pixel
+// Hidden view pixels (core::ViewMask): row-major, each row padded to whole 32-bit words.
+layout(std430, set = 0, binding = 2) readonly buffer Mask { uint hidden_mask[]; };
 layout(std430, set = 0, binding = 3) writeonly buffer Samples { GridSample samples[]; };
 
 #include "fovea/shaders/grid_map.glsl"
@@ -22,9 +23,10 @@ void main() {
   if (cell.x >= P.padded_columns || cell.y >= P.padded_rows) return;
   GridSample s = gm_sample(cell.x, cell.y, vec2(P.jitter_u, P.jitter_v));
   if (s.flags == 0u && P.has_mask > 0.5) {
-    uvec2 p = uvec2(min(vec2(s.screen_x, s.screen_y), vec2(P.width - 1.0, P.height - 1.0)));
-    uint bit = p.y * uint(P.width) + p.x;
-    if ((hidden_mask[bit >> 5] & (1u << (bit & 31u))) != 0u) s.flags |= kCellHidden;
+    // The view pixel containing the sample, clamped into the raster (ViewMask::visible_at).
+    uvec2 p = uvec2(clamp(vec2(s.screen_x, s.screen_y), vec2(0.0), vec2(P.width - 1.0, P.height - 1.0)));
+    uint words_per_row = (uint(P.width) + 31u) >> 5;
+    if ((hidden_mask[p.y * words_per_row + (p.x >> 5)] & (1u << (p.x & 31u))) != 0u) s.flags |= kCellHidden;
   }
   samples[cell.y * P.padded_columns + cell.x] = s;
 }

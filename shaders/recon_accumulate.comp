@@ -9,28 +9,29 @@
 
 layout(local_size_x = 64) in;
 
+#include "fovea/shaders/recon_bindings.h"
 #include "fovea/shaders/grid.h"
 #include "fovea/shaders/pt_scene.h"
 #include "fovea/shaders/recon_grid.h"
 
-layout(std430, binding = 0) readonly buffer Maps { ReconGrid maps[]; };
-layout(std430, binding = 1) readonly buffer Tables { GridColumn tables[]; };
-layout(std430, binding = 2) readonly buffer Samples { GridSample samples[]; };
-layout(std430, binding = 3) readonly buffer Direct { vec4 direct[]; };
-layout(std430, binding = 4) readonly buffer Indirect { vec4 indirect[]; };
-layout(std430, binding = 5) readonly buffer NormalDepth { vec4 normal_depth[]; };
-layout(std430, binding = 6) readonly buffer PositionMaterial { vec4 position_material[]; };
-layout(std430, binding = 7) readonly buffer PrevDirect { vec4 prev_direct[]; };
-layout(std430, binding = 8) readonly buffer PrevIndirect { vec4 prev_indirect[]; };
-layout(std430, binding = 9) readonly buffer PrevPos { vec4 prev_pos[]; };
-layout(std430, binding = 10) readonly buffer PrevNrm { vec4 prev_nrm[]; };
-layout(std430, binding = 11) writeonly buffer AccDirect { vec4 acc_direct[]; };
-layout(std430, binding = 12) writeonly buffer AccIndirect { vec4 acc_indirect[]; };
-layout(std430, binding = 13) writeonly buffer Pos { vec4 vpos[]; };
-layout(std430, binding = 14) writeonly buffer Nrm { vec4 vnrm[]; };
-layout(std430, binding = 15) writeonly buffer TapIdx { uvec4 tap_idx[]; };
-layout(std430, binding = 16) writeonly buffer TapW { vec4 tap_w[]; };
-layout(std430, binding = 17) readonly buffer Materials { PtMaterial materials[]; };
+layout(std430, binding = RECON_MAPS) readonly buffer Maps { ReconGrid maps[]; };
+layout(std430, binding = RECON_TABLES) readonly buffer Tables { GridColumn tables[]; };
+layout(std430, binding = RECON_ACC_SAMPLES) readonly buffer Samples { GridSample samples[]; };
+layout(std430, binding = RECON_ACC_DIRECT) readonly buffer Direct { vec4 direct[]; };
+layout(std430, binding = RECON_ACC_INDIRECT) readonly buffer Indirect { vec4 indirect[]; };
+layout(std430, binding = RECON_ACC_NORMAL_DEPTH) readonly buffer NormalDepth { vec4 normal_depth[]; };
+layout(std430, binding = RECON_ACC_POSITION_MATERIAL) readonly buffer PositionMaterial { vec4 position_material[]; };
+layout(std430, binding = RECON_ACC_PREV_DIRECT) readonly buffer PrevDirect { vec4 prev_direct[]; };
+layout(std430, binding = RECON_ACC_PREV_INDIRECT) readonly buffer PrevIndirect { vec4 prev_indirect[]; };
+layout(std430, binding = RECON_ACC_PREV_POS) readonly buffer PrevPos { vec4 prev_pos[]; };
+layout(std430, binding = RECON_ACC_PREV_NRM) readonly buffer PrevNrm { vec4 prev_nrm[]; };
+layout(std430, binding = RECON_ACC_OUT_DIRECT) writeonly buffer AccDirect { vec4 acc_direct[]; };
+layout(std430, binding = RECON_ACC_OUT_INDIRECT) writeonly buffer AccIndirect { vec4 acc_indirect[]; };
+layout(std430, binding = RECON_ACC_OUT_POS) writeonly buffer Pos { vec4 vpos[]; };
+layout(std430, binding = RECON_ACC_OUT_NRM) writeonly buffer Nrm { vec4 vnrm[]; };
+layout(std430, binding = RECON_ACC_TAP_IDX) writeonly buffer TapIdx { uvec4 tap_idx[]; };
+layout(std430, binding = RECON_ACC_TAP_W) writeonly buffer TapW { vec4 tap_w[]; };
+layout(std430, binding = RECON_ACC_MATERIALS) readonly buffer Materials { PtMaterial materials[]; };
 
 #include "fovea/shaders/recon_map.h"
 

@@ -7,13 +7,14 @@
 
 layout(local_size_x = 8, local_size_y = 8) in;
 
+#include "fovea/shaders/recon_bindings.h"
 #include "fovea/shaders/grid.h"
 #include "fovea/shaders/recon_grid.h"
 
-layout(std430, binding = 0) readonly buffer Maps { ReconGrid maps[]; };
-layout(std430, binding = 1) readonly buffer Tables { GridColumn tables[]; };
-layout(std430, binding = 2) readonly buffer Src { vec4 src[]; };
-layout(std430, binding = 3) writeonly buffer Dst { vec4 dst[]; };
+layout(std430, binding = RECON_MAPS) readonly buffer Maps { ReconGrid maps[]; };
+layout(std430, binding = RECON_TABLES) readonly buffer Tables { GridColumn tables[]; };
+layout(std430, binding = RECON_BLUR_SRC) readonly buffer Src { vec4 src[]; };
+layout(std430, binding = RECON_BLUR_DST) writeonly buffer Dst { vec4 dst[]; };
 
 #include "fovea/shaders/recon_map.h"
 

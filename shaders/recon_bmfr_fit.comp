@@ -20,13 +20,14 @@ layout(local_size_x_id = 0) in;
 layout(constant_id = 0) const uint kGroup = 256u;  // invocations per block (divides 1024)
 layout(constant_id = 1) const bool kFp16 = false;
 
+#include "fovea/shaders/recon_bindings.h"
 #include "fovea/shaders/hash.h"
 #include "fovea/shaders/recon_grid.h"
 
-layout(std430, binding = 0) readonly buffer Pos { vec4 vpos[]; };
-layout(std430, binding = 1) readonly buffer Nrm { vec4 vnrm[]; };
-layout(std430, binding = 2) readonly buffer Z { vec4 z[]; };
-layout(std430, binding = 3) writeonly buffer Fitted { vec4 fitted[]; };
+layout(std430, binding = RECON_BMFR_POS) readonly buffer Pos { vec4 vpos[]; };
+layout(std430, binding = RECON_BMFR_NRM) readonly buffer Nrm { vec4 vnrm[]; };
+layout(std430, binding = RECON_BMFR_Z) readonly buffer Z { vec4 z[]; };
+layout(std430, binding = RECON_BMFR_FITTED) writeonly buffer Fitted { vec4 fitted[]; };
 
 layout(push_constant) uniform Push { ReconBmfrPush pc; };
 

@@ -8,13 +8,14 @@
 
 layout(local_size_x = 8, local_size_y = 8) in;
 
+#include "fovea/shaders/recon_bindings.h"
 #include "fovea/shaders/grid.h"
 #include "fovea/shaders/recon_grid.h"
 
-layout(std430, binding = 0) readonly buffer Maps { ReconGrid maps[]; };
-layout(std430, binding = 1) readonly buffer Tables { GridColumn tables[]; };
-layout(std430, binding = 2) readonly buffer Pos { vec4 vpos[]; };  // world position, .w material code
-layout(std430, binding = 3) writeonly buffer Depth { float depth[]; };
+layout(std430, binding = RECON_MAPS) readonly buffer Maps { ReconGrid maps[]; };
+layout(std430, binding = RECON_TABLES) readonly buffer Tables { GridColumn tables[]; };
+layout(std430, binding = RECON_DEPTH_POS) readonly buffer Pos { vec4 vpos[]; };  // world position, .w material code
+layout(std430, binding = RECON_DEPTH_OUT) writeonly buffer Depth { float depth[]; };
 
 #include "fovea/shaders/recon_map.h"
 

@@ -7,15 +7,16 @@
 
 layout(local_size_x = 64) in;
 
+#include "fovea/shaders/recon_bindings.h"
 #include "fovea/shaders/recon_grid.h"
 
-layout(std430, binding = 0) readonly buffer Pos { vec4 vpos[]; };
-layout(std430, binding = 1) readonly buffer TapIdx { uvec4 tap_idx[]; };
-layout(std430, binding = 2) readonly buffer TapW { vec4 tap_w[]; };
-layout(std430, binding = 3) readonly buffer Source { vec4 source[]; };  // fitted, or z without BMFR
-layout(std430, binding = 4) readonly buffer AccDirect { vec4 acc_direct[]; };  // .w: Phase I count
-layout(std430, binding = 5) readonly buffer PrevPost { vec4 prev_post[]; };
-layout(std430, binding = 6) writeonly buffer Post { vec4 post[]; };
+layout(std430, binding = RECON_POST_POS) readonly buffer Pos { vec4 vpos[]; };
+layout(std430, binding = RECON_POST_TAP_IDX) readonly buffer TapIdx { uvec4 tap_idx[]; };
+layout(std430, binding = RECON_POST_TAP_W) readonly buffer TapW { vec4 tap_w[]; };
+layout(std430, binding = RECON_POST_SOURCE) readonly buffer Source { vec4 source[]; };  // fitted, or z without BMFR
+layout(std430, binding = RECON_POST_ACC_DIRECT) readonly buffer AccDirect { vec4 acc_direct[]; };  // .w: Phase I count
+layout(std430, binding = RECON_POST_PREV) readonly buffer PrevPost { vec4 prev_post[]; };
+layout(std430, binding = RECON_POST_OUT) writeonly buffer Post { vec4 post[]; };
 
 layout(push_constant) uniform Push { ReconPostPush pc; };
 

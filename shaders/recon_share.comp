@@ -9,20 +9,21 @@
 
 layout(local_size_x = 64) in;
 
+#include "fovea/shaders/recon_bindings.h"
 #include "fovea/shaders/grid.h"
 #include "fovea/shaders/recon_grid.h"
 
-layout(std430, binding = 0) readonly buffer Maps { ReconGrid maps[]; };
-layout(std430, binding = 1) readonly buffer Tables { GridColumn tables[]; };
-layout(std430, binding = 2) readonly buffer Pos { vec4 vpos[]; };
-layout(std430, binding = 3) readonly buffer Nrm { vec4 vnrm[]; };
-layout(std430, binding = 4) readonly buffer AccDirect { vec4 acc_direct[]; };
-layout(std430, binding = 5) readonly buffer AccIndirect { vec4 acc_indirect[]; };
-layout(std430, binding = 6) readonly buffer OtherPos { vec4 other_pos[]; };
-layout(std430, binding = 7) readonly buffer OtherNrm { vec4 other_nrm[]; };
-layout(std430, binding = 8) readonly buffer OtherIndirect { vec4 other_indirect[]; };
-layout(std430, binding = 9) writeonly buffer Shared { vec4 shared_indirect[]; };
-layout(std430, binding = 10) writeonly buffer Z { vec4 z[]; };
+layout(std430, binding = RECON_MAPS) readonly buffer Maps { ReconGrid maps[]; };
+layout(std430, binding = RECON_TABLES) readonly buffer Tables { GridColumn tables[]; };
+layout(std430, binding = RECON_SHARE_POS) readonly buffer Pos { vec4 vpos[]; };
+layout(std430, binding = RECON_SHARE_NRM) readonly buffer Nrm { vec4 vnrm[]; };
+layout(std430, binding = RECON_SHARE_ACC_DIRECT) readonly buffer AccDirect { vec4 acc_direct[]; };
+layout(std430, binding = RECON_SHARE_ACC_INDIRECT) readonly buffer AccIndirect { vec4 acc_indirect[]; };
+layout(std430, binding = RECON_SHARE_OTHER_POS) readonly buffer OtherPos { vec4 other_pos[]; };
+layout(std430, binding = RECON_SHARE_OTHER_NRM) readonly buffer OtherNrm { vec4 other_nrm[]; };
+layout(std430, binding = RECON_SHARE_OTHER_INDIRECT) readonly buffer OtherIndirect { vec4 other_indirect[]; };
+layout(std430, binding = RECON_SHARE_SHARED) writeonly buffer Shared { vec4 shared_indirect[]; };
+layout(std430, binding = RECON_SHARE_Z) writeonly buffer Z { vec4 z[]; };
 
 #include "fovea/shaders/recon_map.h"
 

@@ -8,19 +8,20 @@
 
 layout(local_size_x = 64) in;
 
+#include "fovea/shaders/recon_bindings.h"
 #include "fovea/shaders/grid.h"
 #include "fovea/shaders/pt_trace.h"
 #include "fovea/shaders/recon_grid.h"
 
-layout(std430, binding = 0) readonly buffer Maps { ReconGrid maps[]; };
-layout(std430, binding = 1) readonly buffer Tables { GridColumn tables[]; };
-layout(std430, binding = 2) readonly buffer Pos { vec4 vpos[]; };
-layout(std430, binding = 3) readonly buffer TapIdx { uvec4 tap_idx[]; };
-layout(std430, binding = 4) readonly buffer TapW { vec4 tap_w[]; };
-layout(std430, binding = 5) readonly buffer Post { vec4 post[]; };
-layout(std430, binding = 6) readonly buffer Albedo { vec4 albedo[]; };
-layout(std430, binding = 7) readonly buffer PrevFinal { vec4 prev_final[]; };
-layout(std430, binding = 8) writeonly buffer Final { vec4 final_color[]; };
+layout(std430, binding = RECON_MAPS) readonly buffer Maps { ReconGrid maps[]; };
+layout(std430, binding = RECON_TABLES) readonly buffer Tables { GridColumn tables[]; };
+layout(std430, binding = RECON_TAA_POS) readonly buffer Pos { vec4 vpos[]; };
+layout(std430, binding = RECON_TAA_TAP_IDX) readonly buffer TapIdx { uvec4 tap_idx[]; };
+layout(std430, binding = RECON_TAA_TAP_W) readonly buffer TapW { vec4 tap_w[]; };
+layout(std430, binding = RECON_TAA_POST) readonly buffer Post { vec4 post[]; };
+layout(std430, binding = RECON_TAA_ALBEDO) readonly buffer Albedo { vec4 albedo[]; };
+layout(std430, binding = RECON_TAA_PREV_FINAL) readonly buffer PrevFinal { vec4 prev_final[]; };
+layout(std430, binding = RECON_TAA_FINAL) writeonly buffer Final { vec4 final_color[]; };
 
 #include "fovea/shaders/recon_map.h"
 

@@ -158,16 +158,4 @@ PanelImage MirrorWindow::screenshot() const { return impl_->last_frame; }
 void* MirrorWindow::x11_display() const { return glfwGetX11Display(); }
 unsigned long MirrorWindow::x11_window() const { return glfwGetX11Window(impl_->window); }
 
-glm::dvec3 gaze_direction(const core::Lens& lens, glm::dvec2 panel_uv) {
-  const glm::dvec2 t = lens.forward(panel_uv).tangent[1];
-  return glm::normalize(glm::dvec3(t, -1.0));
-}
-
-std::optional<glm::dvec2> gaze_panel_uv(const core::Lens& lens, glm::dvec3 dir) {
-  if (!(dir.z < 0)) return std::nullopt;
-  const auto uv = lens.inverse(1, {dir.x / -dir.z, dir.y / -dir.z});
-  if (!uv || uv->x < 0 || uv->y < 0 || uv->x > 1 || uv->y > 1) return std::nullopt;
-  return uv;
-}
-
 }  // namespace fovea::compositor

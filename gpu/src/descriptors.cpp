@@ -22,6 +22,8 @@ VkDescriptorType vk_type(Binding b) {
   return VK_DESCRIPTOR_TYPE_MAX_ENUM;
 }
 
+}  // namespace
+
 const char* binding_name(Binding b) {
   switch (b) {
     case Binding::StorageBuffer: return "storage buffer";
@@ -31,8 +33,6 @@ const char* binding_name(Binding b) {
   }
   return "?";
 }
-
-}  // namespace
 
 DescriptorSetLayout::DescriptorSetLayout(Context& ctx, std::vector<Binding> bindings) : bindings_(std::move(bindings)) {
   std::vector<VkDescriptorSetLayoutBinding> vk(bindings_.size());
@@ -85,6 +85,21 @@ DescriptorSet& DescriptorSet::bind(std::uint32_t binding, const Buffer& buffer, 
   expect(binding, uniform ? Binding::UniformBuffer : Binding::StorageBuffer);
   const VkDescriptorBufferInfo info{buffer.handle(), offset, range};
   write(binding, &info, nullptr);
+  return *this;
+}
+
+DescriptorSet& DescriptorSet::bind_all(std::span<const BufferSlot> slots) {
+  std::vector<bool> seen(bindings_.size(), false);
+  for (const BufferSlot& s : slots) {
+    const std::string which = "descriptor binding " + std::to_string(s.binding);
+    if (s.binding >= bindings_.size()) throw core::InputError(which + " is not in the layout");
+    if (seen[s.binding]) throw core::InputError(which + " is given twice");
+    if (!s.buffer) throw core::InputError(which + " has no buffer");
+    seen[s.binding] = true;
+  }
+  for (std::size_t b = 0; b < seen.size(); ++b)
+    if (!seen[b]) throw core::InputError("descriptor binding " + std::to_string(b) + " is not given");
+  for (const BufferSlot& s : slots) bind(s.binding, *s.buffer);
   return *this;
 }
 

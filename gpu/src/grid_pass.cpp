@@ -41,8 +41,8 @@ void GridPass::prepare(const core::SampleDistribution& d, std::span<const std::u
   }
   if (!table.empty()) columns_.upload(table);
   if (!hidden_mask.empty()) {
-    const VkDeviceSize need = (VkDeviceSize(d.view().width()) * d.view().height() + 31) / 32 * 4;
-    if (hidden_mask.size_bytes() < need) throw std::invalid_argument("hidden mask smaller than the display");
+    const VkDeviceSize need = VkDeviceSize(d.view().width() + 31) / 32 * 4 * VkDeviceSize(d.view().height());
+    if (hidden_mask.size_bytes() < need) throw std::invalid_argument("hidden mask smaller than the view raster");
     if (hidden_mask.size_bytes() > mask_.size()) {
       mask_ = host_buffer(*ctx_, hidden_mask.size_bytes(), BufferUsage::Storage, "hidden mask");
       set_.bind(2, mask_);

@@ -18,6 +18,32 @@ std::string known_shaders() {
   return s;
 }
 
+// The layout must match the shader's declarations binding for binding: Vulkan leaves a
+// mismatch undefined (validation reports only some), so a C++ list that drifted from the
+// GLSL fails here, at start-up, naming the binding.
+void check_bindings(const std::string& what, std::span<const std::uint32_t> words,
+                    const std::vector<std::vector<Binding>>& sets) {
+  const auto where = [](std::uint32_t set, std::uint32_t b) {
+    return "set " + std::to_string(set) + " binding " + std::to_string(b);
+  };
+  std::vector<std::vector<bool>> declared(sets.size());
+  for (std::size_t s = 0; s < sets.size(); ++s) declared[s].assign(sets[s].size(), false);
+  for (const spirv::DeclaredBinding& d : spirv::descriptor_bindings(words)) {
+    if (d.set >= sets.size() || d.binding >= sets[d.set].size())
+      throw core::InputError(what + ": the shader declares a " + binding_name(d.type) + " at " +
+                             where(d.set, d.binding) + ", which the layout does not have");
+    if (sets[d.set][d.binding] != d.type)
+      throw core::InputError(what + ": " + where(d.set, d.binding) + " is a " + binding_name(d.type) +
+                             " in the shader but a " + binding_name(sets[d.set][d.binding]) + " in the layout");
+    declared[d.set][d.binding] = true;
+  }
+  for (std::size_t s = 0; s < sets.size(); ++s)
+    for (std::size_t b = 0; b < sets[s].size(); ++b)
+      if (!declared[s][b])
+        throw core::InputError(what + ": the layout has a " + binding_name(sets[s][b]) + " at " +
+                               where(std::uint32_t(s), std::uint32_t(b)) + " that the shader does not declare");
+}
+
 }  // namespace
 
 ComputePipeline::ComputePipeline(Context& ctx, const ComputePipelineDesc& desc)
@@ -43,6 +69,8 @@ ComputePipeline::ComputePipeline(Context& ctx, const ComputePipelineDesc& desc)
   if (std::uint64_t(local_size_[0]) * local_size_[1] * local_size_[2] > ctx.limits().maxComputeWorkGroupInvocations)
     throw core::InputError(what + ": workgroup has more invocations than the device's " +
                            std::to_string(ctx.limits().maxComputeWorkGroupInvocations));
+
+  check_bindings(what, words, desc.sets);
 
   const VkDevice dev = ctx.device();
   VkShaderModuleCreateInfo mci{VK_STRUCTURE_TYPE_SHADER_MODULE_CREATE_INFO};

@@ -1,8 +1,10 @@
 #pragma once
-// Just enough SPIR-V parsing to learn a compute shader's workgroup size.
+// Just enough SPIR-V parsing to learn a compute shader's workgroup size and the descriptor
+// bindings it declares.
 #include <array>
 #include <cstdint>
 #include <span>
+#include <vector>
 
 #include "fovea/gpu/pipeline.hpp"
 
@@ -13,5 +15,14 @@ namespace fovea::gpu::spirv {
 // Throws core::InputError for malformed SPIR-V.
 std::array<std::uint32_t, 3> workgroup_size(std::span<const std::uint32_t> words,
                                             std::span<const SpecConstant> specialization);
+
+struct DeclaredBinding {
+  std::uint32_t set = 0, binding = 0;
+  Binding type = Binding::StorageBuffer;
+};
+// Every resource variable the module declares with a descriptor set and binding, ordered by
+// (set, binding). Throws core::InputError for malformed SPIR-V or a resource type the
+// pipelines do not bind (anything but buffers, storage images and combined samplers).
+std::vector<DeclaredBinding> descriptor_bindings(std::span<const std::uint32_t> words);
 
 }  // namespace fovea::gpu::spirv

@@ -33,7 +33,7 @@ struct Pixels8 {
   }
 };
 
-// Tone-mapped linear radiance (Reinhard, as `fovea render` shows it) encoded for `fmt`, alpha 1.
+// Tone-mapped linear radiance (the ACES fit `fovea render` shows, renderer::tone_map) encoded for `fmt`, alpha 1.
 Pixels8 encode_scene(const core::Image& linear, PixelFormat fmt);
 
 // The most frequent colour (first three bytes) among the border pixels: the application's

@@ -26,6 +26,7 @@ void FrameLog::write(const FrameTimes& t) {
                "\"begin_ns\":%lld,\"end_call_ns\":%lld,\"end_return_ns\":%lld,\"app_cpu_ms\":%.3f,"
                "\"end_frame_ms\":%.3f,\"layers\":%u,\"projection_views\":%u,\"replaced\":%s,\"render_ms\":%.3f,"
                "\"trace_ms\":%.3f,\"reconstruct_ms\":%.3f,\"resolve_ms\":%.3f,\"transfer_ms\":%.3f,"
+               "\"gaze_cpu_ms\":%.3f,\"grid_cpu_ms\":%.3f,\"submit_cpu_ms\":%.3f,\"readback_cpu_ms\":%.3f,"
                "\"gaze_sample_ns\":%lld,\"gaze_receive_ns\":%lld,\"gaze_read_ns\":%lld}\n",
                static_cast<long long>(t.frame), static_cast<long long>(t.display_time_ns),
                static_cast<long long>(t.wait_call_ns), static_cast<long long>(t.wait_return_ns),
@@ -33,8 +34,9 @@ void FrameLog::write(const FrameTimes& t) {
                static_cast<long long>(t.end_return_ns), double(t.end_call_ns - t.begin_ns) * 1e-6,
                double(t.end_return_ns - t.end_call_ns) * 1e-6, t.layers, t.projection_views,
                t.replaced ? "true" : "false", t.render.total, t.render.trace, t.render.reconstruct, t.render.resolve,
-               t.render.transfer, static_cast<long long>(t.render.gaze_sample_ns),
-               static_cast<long long>(t.render.gaze_receive_ns), static_cast<long long>(t.render.gaze_read_ns));
+               t.render.transfer, t.render.gaze_cpu, t.render.grid_cpu, t.render.submit_cpu, t.render.readback_cpu,
+               static_cast<long long>(t.render.gaze_sample_ns), static_cast<long long>(t.render.gaze_receive_ns),
+               static_cast<long long>(t.render.gaze_read_ns));
   std::fflush(file_);
 }
 

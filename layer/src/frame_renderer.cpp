@@ -17,9 +17,10 @@
 
 #include "app_device.hpp"
 #include "composite.hpp"
-#include "fovea/compositor/frame_pipeline.hpp"
 #include "fovea/core/display.hpp"
+#include "fovea/core/stereo_views.hpp"
 #include "fovea/gpu/context.hpp"
+#include "fovea/pipeline/frame_pipeline.hpp"
 #include "fovea/renderer/gpu_scene.hpp"
 #include "fovea/renderer/scene_io.hpp"
 #include "layer.hpp"
@@ -43,6 +44,18 @@ core::Pose to_pose(const XrPosef& p) {
 
 void xr_check(XrResult r, const char* what) {
   if (XR_FAILED(r)) throw std::runtime_error(std::string(what) + " failed below the layer: XrResult " + std::to_string(int(r)));
+}
+
+// The views the application submitted: FOV, raster from the imageRect, pose (its reference
+// space), IPD as the distance between the two view positions.
+core::StereoViews submitted_views(const std::vector<AppView>& v) {
+  core::StereoViews s;
+  for (int e = 0; e < 2; ++e) {
+    const AppView& a = v[std::size_t(e)];
+    s.eye[std::size_t(e)] = core::View(to_fov(a.fov), a.rect.extent.width, a.rect.extent.height, to_pose(a.pose));
+  }
+  s.ipd_m = glm::length(s.eye[1].pose().position - s.eye[0].pose().position);
+  return s;
 }
 
 // The application's window depths resampled into the scene's raster like its colour:
@@ -83,6 +96,7 @@ class PathTraceRenderer final : public FrameRenderer {
       if (v.rect.extent.width != r0.extent.width || v.rect.extent.height != r0.extent.height || v.format != format_)
         throw std::runtime_error("the application changed its projection views' size or format during the session");
 
+    const auto t_gaze = std::chrono::steady_clock::now();
     // Eye poses: the application's view poses (its reference space) placed at the scene's camera.
     std::array<core::Pose, 2> poses;
     std::array<glm::dvec3, 2> gaze;
@@ -102,10 +116,13 @@ class PathTraceRenderer final : public FrameRenderer {
       poses[std::size_t(e)].position = scene_.camera.position + scene_.camera.orientation * p.position;
       gaze[std::size_t(e)] = fg.eye(core::Eye(e)).dir;
     }
-    const compositor::FrameTimes gt = pipeline_->render(poses, gaze, std::uint32_t(in.frame));
-    times_.trace = gt.trace;
-    times_.reconstruct = gt.reconstruct;
-    times_.resolve = gt.resolve;
+    times_.gaze_cpu = ms_since(t_gaze);
+    const pipeline::FrameTimes gt = pipeline_->render(poses, gaze, std::uint32_t(in.frame));
+    times_.trace = gt.grid.gpu_ms + gt.trace.gpu_ms;
+    times_.reconstruct = gt.reconstruct.gpu_ms;
+    times_.resolve = gt.resolve.gpu_ms;
+    times_.grid_cpu = gt.grid.cpu_ms;
+    times_.submit_cpu = gt.submit_cpu_ms;
 
     const auto t1 = std::chrono::steady_clock::now();
     std::vector<AppDevice::Read> reads;
@@ -116,10 +133,13 @@ class PathTraceRenderer final : public FrameRenderer {
     std::vector<VkImage> targets;
     for (int e = 0; e < 2; ++e) {
       const auto ei = std::size_t(e);
-      out[ei] = encode_scene(pipeline_->image(core::Eye(e)), pixel_format(format_));
+      const auto r0 = std::chrono::steady_clock::now();
+      const core::Image rendered = pipeline_->image(core::Eye(e));
+      times_.readback_cpu += ms_since(r0);
+      out[ei] = encode_scene(rendered, pixel_format(format_));
       if (!app.empty()) {
         const core::View app_view(to_fov(in.app_views[ei].fov), app[ei].width, app[ei].height);
-        const core::View scene_view = display_.view(core::Eye(e));
+        const core::View& scene_view = views_in_[core::Eye(e)];
         const Pixels8 a = resample(app[ei], app_view, scene_view);
         if (!app_depth.empty()) {
           composite_depth(out[ei], pipeline_->depth(core::Eye(e)), a,
@@ -158,7 +178,7 @@ class PathTraceRenderer final : public FrameRenderer {
       views_[ei].pose = in.app_views[ei].pose;
       views_[ei].fov = in.app_views[ei].fov;
       views_[ei].subImage.swapchain = eyes_[ei].swapchain;
-      views_[ei].subImage.imageRect = {{0, 0}, {display_.width, display_.height}};
+      views_[ei].subImage.imageRect = {{0, 0}, {views_in_[core::Eye(e)].width(), views_in_[core::Eye(e)].height()}};
     }
     layers_.assign(in.app_frame->layers, in.app_frame->layers + in.app_frame->layerCount);
     layers_[in.projection_layer] = reinterpret_cast<const XrCompositionLayerBaseHeader*>(&projection_);
@@ -207,13 +227,16 @@ class PathTraceRenderer final : public FrameRenderer {
     const AppView& v0 = in.app_views[0];
     format_ = v0.format;
     pixel_format(format_);  // throws for formats the layer cannot composite
-    display_ = core::load_display("small");
+    views_in_ = submitted_views(in.app_views);
+    // The gaze source sees the submitted views as a display without a lens (nothing else of
+    // a preset applies to them).
     display_.name = "openxr-views";
     display_.description = "the application's projection views";
-    display_.width = v0.rect.extent.width;
-    display_.height = v0.rect.extent.height;
-    display_.fov_left = to_fov(in.app_views[0].fov);
-    display_.fov_right = to_fov(in.app_views[1].fov);
+    display_.width = views_in_[core::Eye::Left].width();
+    display_.height = views_in_[core::Eye::Left].height();
+    display_.fov_left = views_in_[core::Eye::Left].fov();
+    display_.fov_right = views_in_[core::Eye::Right].fov();
+    display_.ipd_m = views_in_.ipd_m;
     gaze_ = std::make_unique<LayerGaze>(config_.gaze, display_);
 
     for (Eye& e : eyes_) {
@@ -221,8 +244,8 @@ class PathTraceRenderer final : public FrameRenderer {
       ci.usageFlags = XR_SWAPCHAIN_USAGE_COLOR_ATTACHMENT_BIT | XR_SWAPCHAIN_USAGE_TRANSFER_DST_BIT;
       ci.format = format_;
       ci.sampleCount = 1;
-      ci.width = std::uint32_t(display_.width);
-      ci.height = std::uint32_t(display_.height);
+      ci.width = std::uint32_t(views_in_[core::Eye::Left].width());
+      ci.height = std::uint32_t(views_in_[core::Eye::Left].height());
       ci.faceCount = ci.arraySize = ci.mipCount = 1;
       xr_check(next_.xrCreateSwapchain(session_, &ci, &e.swapchain), "xrCreateSwapchain");
       std::uint32_t n = 0;
@@ -236,10 +259,10 @@ class PathTraceRenderer final : public FrameRenderer {
 
     ctx_ = std::make_unique<gpu::Context>();
     gpu_scene_ = std::make_unique<renderer::GpuScene>(*ctx_, scene_);
-    compositor::ReconSettings settings;
-    settings.share = compositor::StereoShare::Gather;
-    pipeline_ = std::make_unique<compositor::FramePipeline>(*ctx_, *gpu_scene_, display_, core::DistributionParams{},
-                                                            settings);
+    reconstruct::ReconSettings settings;
+    settings.share = reconstruct::StereoShare::Gather;
+    pipeline_ = std::make_unique<pipeline::FramePipeline>(*ctx_, *gpu_scene_, views_in_, core::DistributionParams{},
+                                                          settings);
     FOVEA_LAYER_INFO("rendering scene \"%s\" (from %s) at %dx%d per eye on %s, composite %s, gaze %s",
                      config_.scene.c_str(), config_.origin.c_str(), display_.width, display_.height,
                      ctx_->info().name.c_str(), composite_name(config_.composite), gaze_->describe().c_str());
@@ -250,6 +273,7 @@ class PathTraceRenderer final : public FrameRenderer {
   XrSession session_;
   renderer::Scene scene_;
   AppDevice app_;
+  core::StereoViews views_in_;  // the submitted views: FOV, raster (imageRect), pose, IPD
   core::DisplayPreset display_;
   VkFormat format_ = VK_FORMAT_UNDEFINED;
   std::unique_ptr<LayerGaze> gaze_;
@@ -257,7 +281,7 @@ class PathTraceRenderer final : public FrameRenderer {
   bool depth_noted_ = false;  // the depth decision was logged
   std::unique_ptr<gpu::Context> ctx_;
   std::unique_ptr<renderer::GpuScene> gpu_scene_;
-  std::unique_ptr<compositor::FramePipeline> pipeline_;
+  std::unique_ptr<pipeline::FramePipeline> pipeline_;
   std::array<Eye, 2> eyes_;
   RenderTimes times_;
   XrCompositionLayerProjection projection_{XR_TYPE_COMPOSITION_LAYER_PROJECTION};

@@ -123,17 +123,6 @@ TEST(MirrorWindow, CursorIsTheGaze) {
   EXPECT_FALSE(w.cursor().has_value());
 }
 
-TEST(MirrorWindow, GazeThroughTheLensRoundTrips) {
-  const core::Lens lens = core::Lens::for_eye(core::load_display("vive"), core::Eye::Left);
-  const glm::dvec3 dir = compositor::gaze_direction(lens, {0.3, 0.6});
-  EXPECT_NEAR(glm::length(dir), 1.0, 1e-12);
-  const auto uv = compositor::gaze_panel_uv(lens, dir);
-  ASSERT_TRUE(uv.has_value());
-  EXPECT_NEAR(uv->x, 0.3, 1e-9);
-  EXPECT_NEAR(uv->y, 0.6, 1e-9);
-  EXPECT_FALSE(compositor::gaze_panel_uv(lens, {0, 0, 1}).has_value());
-}
-
 using MirrorGpu = fovea::test::GpuTest;
 
 TEST_F(MirrorGpu, ShowsTheDistortedPanels) {

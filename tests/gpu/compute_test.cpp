@@ -113,6 +113,38 @@ TEST_F(Compute, MisuseIsReportedBeforeVulkanSeesIt) {
   });
 }
 
+// A layout that drifted from the shader's layout(binding = ...) declarations fails when the
+// pipeline is created, naming the binding; so do slots that miss or repeat a binding.
+TEST_F(Compute, BindingMismatchFailsAtStartUp) {
+  const auto message = [&](std::vector<gpu::Binding> set) -> std::string {
+    try {
+      gpu::ComputePipeline p(ctx(), {.shader = "test_gpu_fill.comp.spv", .sets = {std::move(set)},
+                                     .push_constant_bytes = sizeof(FillPush)});
+    } catch (const fovea::core::InputError& e) {
+      return e.what();
+    }
+    return "";
+  };
+  const auto S = gpu::Binding::StorageBuffer, U = gpu::Binding::UniformBuffer;
+  EXPECT_NE(message({S, U, S}).find("binding 2"), std::string::npos) << "a binding the shader lacks";
+  EXPECT_NE(message({S}).find("binding 1"), std::string::npos) << "a binding the layout lacks";
+  EXPECT_NE(message({S, S}).find("binding 1 is a uniform buffer in the shader"), std::string::npos) << "type";
+  EXPECT_EQ(message({S, U}), "");
+
+  gpu::ComputePipeline pipe(ctx(), fill_desc({}));
+  gpu::Buffer out(ctx(), {.size = 64 * 4});
+  gpu::Buffer params(ctx(), {.size = 4, .usage = gpu::BufferUsage::Uniform});
+  gpu::DescriptorSet set(ctx(), pipe.set_layout(0));
+  const gpu::BufferSlot missing[] = {{0, &out}};
+  const gpu::BufferSlot twice[] = {{0, &out}, {0, &out}, {1, &params}};
+  const gpu::BufferSlot beyond[] = {{0, &out}, {1, &params}, {2, &out}};
+  const gpu::BufferSlot all[] = {{1, &params}, {0, &out}};
+  EXPECT_THROW(set.bind_all(missing), fovea::core::InputError);
+  EXPECT_THROW(set.bind_all(twice), fovea::core::InputError);
+  EXPECT_THROW(set.bind_all(beyond), fovea::core::InputError);
+  EXPECT_NO_THROW(set.bind_all(all));
+}
+
 // Synchronization validation is on: a dispatch writing a buffer right after a transfer
 // wrote it, without a barrier, is reported. (This layer version does not flag
 // dispatch-after-dispatch write hazards, so compute_to_compute must not be forgotten.)

@@ -6,6 +6,7 @@
 
 #include "fovea/core/display.hpp"
 #include "fovea/core/distribution.hpp"
+#include "fovea/core/eye_optics.hpp"
 #include "fovea/gpu/buffer.hpp"
 #include "fovea/gpu/grid_pass.hpp"
 #include "gpu_fixture.hpp"
@@ -72,6 +73,42 @@ TEST_P(GridPassTest, MatchesCpuReference) {
   RecordProperty("worst_px", std::to_string(worst_px));
   std::printf("%s %s: worst |gpu - cpu| = %.2e px, %.2e in direction\n", c.display,
               core::distribution_name(c.kind), worst_px, worst_dir);
+}
+
+// With the lens' view mask (core::ViewMask, the layout the shader reads), the GPU grid hides
+// exactly the cells the CPU reference hides with the same mask (ViewMask::visible_at); only
+// cells within float rounding of a pixel edge may differ.
+TEST_F(GpuTest, GridPassMaskMatchesCpuReference) {
+  for (const char* name : {"tiny", "vive"}) {
+    const core::DisplayPreset display = core::load_display(name);
+    const core::EyeOptics optics(display, core::Eye::Right);
+    const core::ViewMask mask = optics.view_mask();
+    auto d = core::make_distribution(optics.view(), core::DistributionParams{});
+    d->set_visibility([&mask](glm::dvec2 px) { return mask.visible_at(px); });
+    gpu::GridPass pass(ctx());
+    gpu::Buffer out(ctx(), {.size = gpu::GridPass::samples_bytes(*d), .memory = gpu::Memory::HostVisible});
+    for (std::uint32_t f = 0; f < 2; ++f) {
+      d->set_frame(glm::normalize(glm::dvec3(0.15 * f, -0.1 * f, -1.0)), f);
+      pass.generate(*d, out, mask.words());
+      const auto got = out.download<shaders::GridSample>();
+      int hidden = 0, mismatch = 0;
+      for (int row = 0; row < d->padded_rows(); ++row)
+        for (int col = 0; col < d->padded_columns(); ++col) {
+          const auto& g = got[size_t(row) * d->padded_columns() + col];
+          const auto r = d->sample(col, row);
+          hidden += r.flags == shaders::kCellHidden ? 1 : 0;
+          if (g.flags == r.flags) continue;
+          const auto frac = [](double v) { return std::abs(v - std::round(v)); };
+          EXPECT_LT(std::min(frac(r.screen_x), frac(r.screen_y)), 1e-3)
+              << name << " cell " << col << "," << row << " gpu " << g.flags << " cpu " << r.flags;
+          ++mismatch;
+        }
+      EXPECT_GT(hidden, 0) << name;
+      EXPECT_LE(mismatch, hidden / 1000 + 2) << name;
+    }
+    // A mask smaller than the raster is refused before the GPU sees it.
+    EXPECT_THROW(pass.prepare(*d, mask.words().first(mask.words().size() / 2)), std::invalid_argument);
+  }
 }
 
 const Case kCases[] = {

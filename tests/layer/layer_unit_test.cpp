@@ -84,7 +84,7 @@ TEST(LayerComposite, AlphaBlendsStraightAlpha) {
 
 TEST(LayerComposite, EncodesSceneForTheSwapchainFormat) {
   core::Image img(2, 1);
-  img.at(0, 0) = {1.0f, 0.0f, 0.0f, 1.0f};  // Reinhard: 1 / (1 + L) keeps the hue
+  img.at(0, 0) = {1.0f, 0.0f, 0.0f, 1.0f};  // the tone map keeps the hue of a pure primary
   img.at(1, 0) = {NAN, 0.0f, 0.0f, 1.0f};
   const Pixels8 rgba = encode_scene(img, pixel_format(VK_FORMAT_R8G8B8A8_SRGB));
   const Pixels8 bgra = encode_scene(img, pixel_format(VK_FORMAT_B8G8R8A8_UNORM));

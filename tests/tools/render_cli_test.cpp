@@ -2,6 +2,7 @@
 // issue's fields (finite), per-frame PNGs and the last frame's EXRs; bad input -> exit 2.
 #include <cmath>
 #include <cstdlib>
+#include <cstdint>
 #include <filesystem>
 #include <fstream>
 
@@ -40,6 +41,11 @@ TEST(RenderCli, ReportFramesAndExrOnTheTinyDisplay) {
   // The Vulkan device and driver the timings come from.
   EXPECT_FALSE(j["device"]["name"].get<std::string>().empty());
   EXPECT_FALSE(j["device"]["driver"].get<std::string>().empty());
+  for (const char* k : {"gaze", "grid", "trace", "reconstruct", "resolve", "submit", "readback", "total"})
+    EXPECT_GE(j["cpu_ms"].value(k, -1.0), 0.0) << "cpu_ms." << k;
+  EXPECT_GT(j["cpu_ms"]["total"].get<double>(), 0.0);
+  // The tiny preset's lens hides the view's corners: those cells are not traced.
+  for (const char* eye : {"left", "right"}) EXPECT_GT(j["samples_hidden"][eye].get<double>(), 0) << eye;
   for (const char* eye : {"left", "right"}) {
     const auto& s = j["summary"][eye];
     for (const char* k : {"psnr", "fovea_psnr", "foveated_psnr", "ssim", "temporal_error", "band_psnr"})
@@ -53,6 +59,26 @@ TEST(RenderCli, ReportFramesAndExrOnTheTinyDisplay) {
     EXPECT_TRUE(fs::exists(dir + "/" + f)) << f;
   for (const auto& e : fs::directory_iterator(dir))
     EXPECT_EQ(e.path().string().find(".tmp"), std::string::npos) << "temporary file left: " << e.path();
+  fs::remove_all(dir);
+}
+
+// --no-cull traces the hidden area too: no cell is skipped for it, more cells are traced.
+TEST(RenderCli, NoCullTracesTheHiddenArea) {
+  namespace fs = std::filesystem;
+  const std::string dir = fovea::test::temp_dir("render-cull");
+  std::int64_t traced[2] = {0, 0};
+  for (int cull = 0; cull < 2; ++cull) {
+    const auto r = run_fovea(std::string("render --display tiny --scene cornell --gaze synthetic:3 --frames 1 --quiet ") +
+                             "--png-every 0 --denoiser none " + (cull ? "" : "--no-cull ") + "--out " + dir);
+    ASSERT_EQ(r.status, 0) << r.err;
+    std::ifstream in(dir + "/report.json");
+    const auto j = nlohmann::json::parse(in);
+    EXPECT_EQ(j["config"]["cull_hidden_area"].get<bool>(), cull == 1);
+    for (const char* eye : {"left", "right"})
+      EXPECT_EQ(j["samples_hidden"][eye].get<std::int64_t>() > 0, cull == 1) << eye;
+    traced[cull] = j["samples_traced_per_eye"].get<std::int64_t>();
+  }
+  EXPECT_LT(traced[1], traced[0]);
   fs::remove_all(dir);
 }
 

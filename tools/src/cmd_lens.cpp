@@ -16,6 +16,7 @@
 #include "fovea/core/display.hpp"
 #include "fovea/core/distribution.hpp"
 #include "fovea/core/error.hpp"
+#include "fovea/core/eye_optics.hpp"
 #include "fovea/core/hidden_area.hpp"
 #include "fovea/core/image.hpp"
 #include "fovea/core/lens.hpp"
@@ -35,13 +36,15 @@ in dark red.
   --grid                overlay the panel's own straight grid (every 1/16 of the panel)
   --out PNG             picture to write [lens-<display>.png]
   --json                print {"display", "eyes": {"left": {"hidden_fraction",
-                        "max_roundtrip_px", "samples_saved_fraction"}, "right": {...}}}
+                        "max_roundtrip_px", "samples_saved_fraction", "samples_hidden"},
+                        "right": {...}}}
   --help                this text
 
 hidden_fraction: display pixels no one sees. max_roundtrip_px: the largest distance between
 a visible display pixel and forward-then-inverse optics of it, over all channels.
-samples_saved_fraction: of the default Visual-Polar grid's on-screen samples (gaze straight
-ahead), the fraction the path tracer skips because the lens hides them.
+samples_saved_fraction, samples_hidden: of the default Visual-Polar grid's on-screen samples
+(gaze straight ahead), the fraction and the number of cells the path tracer skips because the
+lens hides them (the view mask fovea render culls with).
 
 Exit status: 0 on success, 2 on invalid arguments.
 )";
@@ -88,10 +91,17 @@ double max_roundtrip_px(const core::HiddenAreaMask& mask) {
   return *std::max_element(worst.begin(), worst.end());
 }
 
-double samples_saved_fraction(const core::HiddenAreaMask& mask) {
-  auto dist = core::make_distribution(mask.lens().view(), core::DistributionParams{});
+// The default Visual-Polar grid at centre gaze with the view mask `fovea render` culls with.
+struct SamplesHidden {
+  double fraction = 0;      // of the on-screen samples
+  std::int64_t count = 0;   // cells
+};
+
+SamplesHidden samples_hidden(const core::EyeOptics& optics) {
+  auto dist = core::make_distribution(optics.view(), core::DistributionParams{});
   dist->set_frame({0, 0, -1});
-  dist->set_visibility([&mask](glm::dvec2 px) { return mask.visible_view_px(px); });
+  const core::ViewMask mask = optics.view_mask();
+  dist->set_visibility([&mask](glm::dvec2 px) { return mask.visible_at(px); });
   std::size_t traced = 0, hidden = 0;
   for (int row = 0; row < dist->rows(); ++row)
     for (int col = 0; col < dist->columns(); ++col) {
@@ -100,7 +110,7 @@ double samples_saved_fraction(const core::HiddenAreaMask& mask) {
         continue;
       (f & shaders::kCellHidden ? hidden : traced) += 1;
     }
-  return traced + hidden ? double(hidden) / double(traced + hidden) : 0.0;
+  return {traced + hidden ? double(hidden) / double(traced + hidden) : 0.0, std::int64_t(hidden)};
 }
 
 int run(std::vector<std::string> argv) {
@@ -125,15 +135,19 @@ int run(std::vector<std::string> argv) {
   for (core::Eye eye : {core::Eye::Left, core::Eye::Right}) {
     const core::Lens lens = core::Lens::for_eye(d, eye);
     for (const auto& n : lens.notes()) std::cerr << "fovea lens: note: " << n << "\n";
-    const core::HiddenAreaMask mask(lens);
+    const core::EyeOptics optics(lens);
+    const core::HiddenAreaMask& mask = optics.hidden();
     const core::Image img = eye_picture(mask, select, args.has("grid"));
     const int x0 = eye == core::Eye::Left ? 0 : d.width;
     for (int y = 0; y < d.height; ++y)
       for (int x = 0; x < d.width; ++x) panel.at(x0 + x, y) = img.at(x, y);
-    if (args.has("json"))
+    if (args.has("json")) {
+      const SamplesHidden saved = samples_hidden(optics);
       eyes[core::eye_name(eye)] = {{"hidden_fraction", mask.hidden_fraction()},
                                    {"max_roundtrip_px", max_roundtrip_px(mask)},
-                                   {"samples_saved_fraction", samples_saved_fraction(mask)}};
+                                   {"samples_saved_fraction", saved.fraction},
+                                   {"samples_hidden", saved.count}};
+    }
   }
   core::write_png(out, panel);
   if (args.has("json")) {

@@ -8,6 +8,7 @@
 
 #include "command.hpp"
 #include "fovea/core/display.hpp"
+#include "fovea/core/stereo_views.hpp"
 #include "fovea/core/error.hpp"
 #include "fovea/core/image.hpp"
 #include "fovea/gpu/context.hpp"
@@ -82,9 +83,7 @@ int run(std::vector<std::string> argv) {
   const renderer::Scene scene = renderer::load_scene(args.str("scene", "default"));
   for (const auto& w : scene.warnings) std::cerr << "warning: " << w << "\n";
 
-  core::Pose pose = scene.camera;
-  pose.position += pose.orientation * glm::dvec3((eye == core::Eye::Left ? -0.5 : 0.5) * display.ipd_m, 0, 0);
-  const core::View view = display.view(eye, pose);
+  const core::View view = core::stereo_views(display, scene.camera)[eye];
 
   gpu::Context ctx;
   renderer::GpuScene gs(ctx, scene);

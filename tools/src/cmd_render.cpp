@@ -8,18 +8,22 @@
 #include <cstdlib>
 #include <filesystem>
 #include <iostream>
+#include <map>
 #include <optional>
 
 #include <nlohmann/json.hpp>
 
 #include "command.hpp"
-#include "fovea/compositor/frame_pipeline.hpp"
+#include "fovea/core/clock.hpp"
 #include "fovea/core/display.hpp"
+#include "fovea/core/eye_optics.hpp"
+#include "fovea/core/stereo_views.hpp"
 #include "fovea/core/error.hpp"
 #include "fovea/core/image.hpp"
 #include "fovea/core/metrics.hpp"
 #include "fovea/devices/foveation_gaze.hpp"
 #include "fovea/gpu/context.hpp"
+#include "fovea/pipeline/frame_pipeline.hpp"
 #include "fovea/renderer/reference.hpp"
 #include "fovea/renderer/scene_io.hpp"
 
@@ -34,10 +38,15 @@ Renders a stereo sequence: per frame and eye the sample grid follows the gaze, t
 path traced (1 sample per cell), reconstructed in grid space (temporal accumulation,
 optional stereo sharing of indirect diffuse, BMFR, TAA) and resolved to the display with
 the peripheral blur. Writes to --out:
-  frame_NNNN_left.png, frame_NNNN_right.png, frame_NNNN_sbs.png   tone-mapped (Reinhard)
+  frame_NNNN_left.png, frame_NNNN_right.png, frame_NNNN_sbs.png   tone-mapped (ACES fit, docs/metrics.md)
   last_left.exr, last_right.exr                                    linear, last frame
-  report.json   {"frames", "samples_traced_per_eye", "device": {name, driver}, "gpu_ms": {trace, reconstruct,
-                 resolve, total, bmfr_fit} (medians), "summary": {"left": {...}, "right": {...}}}
+  report.json   {"frames", "samples_traced_per_eye", "samples_hidden": {"left", "right"},
+                 "device": {name, driver},
+                 "gpu_ms": {grid, trace, reconstruct, resolve, total, bmfr_fit},
+                 "cpu_ms": {gaze, grid, trace, reconstruct, resolve, submit, readback, total}
+                 (medians per frame), "summary": {"left": {...}, "right": {...}}}
+Cells that the preset's lens hides (its hidden area, seen from the view) are neither traced
+nor reconstructed; samples_hidden counts them in the last frame.
 With --reference SPP each eye's summary compares the last frame with a converged
 Cartesian reference: psnr, fovea_psnr, foveated_psnr, ssim, band_psnr (2° bands), next to
 temporal_error (always). With no options: a short demo on the shipped scene and gaze.
@@ -55,6 +64,7 @@ temporal_error (always). With no options: a short demo on the shipped scene and 
   --bmfr-precision P    fp32 | fp16: storage of BMFR's regression matrix [fp32]
   --stereo-share M      off | gather | alternate [off]
   --no-blur             skip the peripheral blur
+  --no-cull             trace the lens' hidden area too
   --reference SPP       converged reference of the last frame with SPP samples per pixel
   --png-every N         write PNGs of every N-th frame (0: last frame only) [1]
   --no-marker           do not mark the gaze in the PNGs
@@ -112,14 +122,6 @@ void progress(int done, int total, double seconds) {
   std::fflush(stderr);
 }
 
-double mean_w(const std::vector<glm::vec4>& v) {
-  double s = 0;
-  long n = 0;
-  for (const auto& p : v)
-    if (p.w > 0) s += p.w, ++n;
-  return n ? s / double(n) : 0;
-}
-
 int run(std::vector<std::string> argv) {
   for (const auto& a : argv)
     if (a == "--help" || a == "-h") {
@@ -129,7 +131,7 @@ int run(std::vector<std::string> argv) {
   const Args args(argv,
                   {"scene", "display", "gaze", "frames", "distribution", "budget", "denoiser", "bmfr-precision", "stereo-share",
                    "reference", "png-every", "out"},
-                  {"no-blur", "no-marker", "quiet"});
+                  {"no-blur", "no-cull", "no-marker", "quiet"});
   const long frames = args.integer("frames", 24);
   if (frames < 1 || frames > 100000) throw core::InputError("--frames must be in 1..100000");
   const long ref_spp = args.integer("reference", 0);
@@ -141,13 +143,13 @@ int run(std::vector<std::string> argv) {
   dp.kind = core::parse_distribution(args.str("distribution", "visual-polar"));
   dp.budget = args.num("budget", dp.budget);
   dp.validate();
-  compositor::ReconSettings settings;
-  settings.denoiser = compositor::parse_denoiser(args.str("denoiser", "bmfr"));
-  settings.share = compositor::parse_stereo_share(args.str("stereo-share", "off"));
+  reconstruct::ReconSettings settings;
+  settings.denoiser = reconstruct::parse_denoiser(args.str("denoiser", "bmfr"));
+  settings.share = reconstruct::parse_stereo_share(args.str("stereo-share", "off"));
   const std::string precision = args.str("bmfr-precision", "fp32");
   if (precision != "fp32" && precision != "fp16")
     throw core::InputError("--bmfr-precision: expected fp32 or fp16, got \"" + precision + "\"");
-  settings.bmfr_precision = precision == "fp16" ? compositor::BmfrPrecision::Fp16 : compositor::BmfrPrecision::Fp32;
+  settings.bmfr_precision = precision == "fp16" ? reconstruct::BmfrPrecision::Fp16 : reconstruct::BmfrPrecision::Fp32;
   settings.blur = !args.has("no-blur");
   const fs::path out_dir(args.str("out", "out/render"));
 
@@ -170,32 +172,44 @@ int run(std::vector<std::string> argv) {
 
   gpu::Context ctx;
   renderer::GpuScene gpu_scene(ctx, scene);
-  compositor::FramePipeline pipeline(ctx, gpu_scene, display, dp, settings);
-
-  // A static head at the scene's camera; each eye ipd/2 beside it.
-  std::array<core::Pose, 2> poses;
-  for (int e = 0; e < 2; ++e) {
-    poses[e] = scene.camera;
-    poses[e].position += scene.camera.orientation * glm::dvec3((e == 0 ? -0.5 : 0.5) * display.ipd_m, 0, 0);
-  }
+  // A static head at the scene's camera.
+  const core::StereoViews views = core::stereo_views(display, scene.camera);
+  const std::array<core::Pose, 2> poses = views.poses();
+  pipeline::FramePipeline pipeline(ctx, gpu_scene, views, dp, settings);
+  const bool cull = !args.has("no-cull");
+  if (cull)
+    for (core::Eye e : {core::Eye::Left, core::Eye::Right})
+      pipeline.set_visibility(e, core::EyeOptics(display, e).view_mask());
 
   const bool bar = !args.has("quiet") && stderr_is_tty();
   const bool marker = !args.has("no-marker");
-  std::vector<double> t_trace, t_recon, t_resolve, t_total, t_fit;
+  // Per-frame times, milliseconds: GPU and CPU per stage (medians reported).
+  std::map<std::string, std::vector<double>> gpu_ms, cpu_ms;
   std::array<core::Image, 2> previous, last;
   std::array<double, 2> te_sum{0, 0};
   std::array<glm::dvec3, 2> gaze{glm::dvec3(0, 0, -1), glm::dvec3(0, 0, -1)};
   const auto start = std::chrono::steady_clock::now();
   for (long f = 0; f < frames; ++f) {
+    core::TimeNs t0 = core::now_ns();
     const auto t_ns = core::TimeNs(std::llround(double(f) / display.refresh_hz * 1e9));
     const devices::FoveaGaze g = gaze_source.at_frame_time(t_ns);
     for (int e = 0; e < 2; ++e) gaze[e] = g.eye(core::Eye(e)).dir;
-    const compositor::FrameTimes t = pipeline.render(poses, gaze, std::uint32_t(f));
-    t_trace.push_back(t.trace), t_recon.push_back(t.reconstruct), t_resolve.push_back(t.resolve);
-    t_total.push_back(t.total), t_fit.push_back(t.bmfr_fit);
+    cpu_ms["gaze"].push_back(core::ns_to_ms(core::now_ns() - t0));
+    const pipeline::FrameTimes t = pipeline.render(poses, gaze, std::uint32_t(f));
+    for (const auto& [name, st] : {std::pair{"grid", t.grid}, {"trace", t.trace}, {"reconstruct", t.reconstruct},
+                                   {"resolve", t.resolve}}) {
+      gpu_ms[name].push_back(st.gpu_ms);
+      cpu_ms[name].push_back(st.cpu_ms);
+    }
+    gpu_ms["total"].push_back(t.gpu_ms());
+    gpu_ms["bmfr_fit"].push_back(t.bmfr_fit_gpu_ms);
+    cpu_ms["submit"].push_back(t.submit_cpu_ms);
+    t0 = core::now_ns();
+    for (int e = 0; e < 2; ++e) last[e] = pipeline.image(core::Eye(e));
+    cpu_ms["readback"].push_back(core::ns_to_ms(core::now_ns() - t0));
+    cpu_ms["total"].push_back(cpu_ms["gaze"].back() + t.cpu_ms() + cpu_ms["readback"].back());
     std::array<core::Image, 2> ldr;
     for (int e = 0; e < 2; ++e) {
-      last[e] = pipeline.image(core::Eye(e));
       if (f > 0) te_sum[e] += core::temporal_error(previous[e], last[e]);
       previous[e] = last[e];
     }
@@ -225,6 +239,8 @@ int run(std::vector<std::string> argv) {
   j["frames"] = frames;
   const std::int64_t traced = (pipeline.traced_cells(core::Eye::Left) + pipeline.traced_cells(core::Eye::Right)) / 2;
   j["samples_traced_per_eye"] = traced;
+  j["samples_hidden"] = {{"left", pipeline.hidden_cells(core::Eye::Left)},
+                         {"right", pipeline.hidden_cells(core::Eye::Right)}};
   j["display_pixels_per_eye"] = std::int64_t(display.width) * display.height;
   j["config"] = {{"scene", args.str("scene", "default")},
                  {"display", display.name},
@@ -232,22 +248,21 @@ int run(std::vector<std::string> argv) {
                  {"distribution", core::distribution_name(dp.kind)},
                  {"budget", dp.budget},
                  {"grid", {pipeline.distribution(core::Eye::Left).columns(), pipeline.distribution(core::Eye::Left).rows()}},
-                 {"denoiser", compositor::denoiser_name(settings.denoiser)},
+                 {"denoiser", reconstruct::denoiser_name(settings.denoiser)},
                  {"bmfr_precision", precision},
-                 {"stereo_share", compositor::stereo_share_name(settings.share)},
-                 {"blur", settings.blur}};
+                 {"stereo_share", reconstruct::stereo_share_name(settings.share)},
+                 {"blur", settings.blur},
+                 {"cull_hidden_area", cull}};
+  for (const auto& [name, v] : gpu_ms) j["gpu_ms"][name] = median(v);
+  for (const auto& [name, v] : cpu_ms) j["cpu_ms"][name] = median(v);
   // Which Vulkan driver produced the timings (lavapipe 22.3 and 25 differ ~2x).
   j["device"] = {{"name", ctx.info().name}, {"driver", ctx.info().driver}};
-  j["gpu_ms"] = {{"trace", median(t_trace)},
-                 {"reconstruct", median(t_recon)},
-                 {"resolve", median(t_resolve)},
-                 {"total", median(t_total)},
-                 {"bmfr_fit", median(t_fit)}};
   // Effective indirect-diffuse samples per cell after sharing vs the eye's own.
   double own = 0, shared = 0;
   for (int e = 0; e < 2; ++e) {
-    own += mean_w(pipeline.grid_buffer(core::Eye(e), compositor::GridBuffer::AccIndirect));
-    shared += mean_w(pipeline.grid_buffer(core::Eye(e), compositor::GridBuffer::SharedIndirect));
+    const pipeline::IndirectSamples n = pipeline.indirect_samples(core::Eye(e));
+    own += n.own;
+    shared += n.effective;
   }
   j["stereo"] = {{"own_indirect_samples", own / 2}, {"effective_indirect_samples", shared / 2},
                  {"gain", own > 0 ? shared / own : 0.0}};
@@ -281,7 +296,7 @@ int run(std::vector<std::string> argv) {
     j["summary"][e == 0 ? "left" : "right"] = s;
   }
   core::write_file_atomic((out_dir / "report.json").string(), j.dump(2) + "\n");
-  std::cout << j["gpu_ms"].dump() << "\n";
+  std::cout << nlohmann::json{{"gpu_ms", j["gpu_ms"]}, {"cpu_ms", j["cpu_ms"]}}.dump() << "\n";
   return 0;
 }
 

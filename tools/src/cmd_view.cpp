@@ -13,14 +13,15 @@
 
 #include "command.hpp"
 #include "fovea/compositor/distortion.hpp"
-#include "fovea/compositor/frame_pipeline.hpp"
 #include "fovea/compositor/mirror_window.hpp"
 #include "fovea/core/display.hpp"
 #include "fovea/core/error.hpp"
-#include "fovea/core/hidden_area.hpp"
+#include "fovea/core/eye_optics.hpp"
+#include "fovea/core/stereo_views.hpp"
 #include "fovea/core/image.hpp"
 #include "fovea/devices/foveation_gaze.hpp"
 #include "fovea/gpu/context.hpp"
+#include "fovea/pipeline/frame_pipeline.hpp"
 #include "fovea/renderer/gpu_scene.hpp"
 #include "fovea/renderer/reference.hpp"
 #include "fovea/renderer/scene_io.hpp"
@@ -34,9 +35,9 @@ constexpr const char* kHelp = R"(usage: fovea view [options]
 Opens the mirror window (X11; e.g. under Xvfb with DISPLAY set): both eyes' panels side
 by side as the headset shows them, through the lens distortion pass, with a gaze marker.
 With --scene every frame is path traced foveated at the current gaze (grid generation,
-path tracing, reconstruction, resolve; as fovea render), tone-mapped (Reinhard) and
-distorted for the panels. Without --scene each eye shows a grid of view directions (lines
-every 5 degrees), a picture of the optics.
+path tracing, reconstruction, resolve; as fovea render, skipping the lens' hidden area),
+tone-mapped (ACES fit) and distorted for the panels. Without --scene each eye shows a grid
+of view directions (lines every 5 degrees), a picture of the optics.
 
   --display NAME|FILE   display preset (fove0, vive, modern, small, tiny) or JSON file [small]
   --scene S             cornell | furnace | glossy-spheres | stereo-occluders | default, or a
@@ -81,8 +82,8 @@ compositor::OpticsEval parse_optics(const std::string& s) {
 // What draws the resolved view images: the foveated pipeline on a scene.
 struct SceneRenderer {
   std::unique_ptr<renderer::GpuScene> gpu_scene;
-  std::unique_ptr<compositor::FramePipeline> pipeline;
-  std::array<core::Pose, 2> poses;  // a static head at the scene camera, eyes ipd/2 beside it
+  std::unique_ptr<pipeline::FramePipeline> pipeline;
+  std::array<core::Pose, 2> poses;  // a static head at the scene camera
 };
 
 std::pair<int, int> parse_size(const std::string& s) {
@@ -122,11 +123,11 @@ int run(std::vector<std::string> argv) {
   const core::DisplayPreset d = core::load_display(args.str("display", "small"));
   const long frames = args.integer("frames", 0);
   if (frames < 0) throw core::InputError("option --frames: must be 0 or more");
-  const compositor::OpticsEval optics = parse_optics(args.str("optics", "direct"));
+  const compositor::OpticsEval eval = parse_optics(args.str("optics", "direct"));
   core::DistributionParams dp;
   dp.budget = args.num("budget", dp.budget);
   dp.validate();
-  const core::Lens lenses[2] = {core::Lens::for_eye(d, core::Eye::Left), core::Lens::for_eye(d, core::Eye::Right)};
+  const core::EyeOptics optics[2] = {core::EyeOptics(d, core::Eye::Left), core::EyeOptics(d, core::Eye::Right)};
 
   // The gaze: the mouse, a fixed direction, or a gaze source (recording, synthetic).
   const std::string gaze_arg = args.str("gaze", "");
@@ -138,7 +139,7 @@ int run(std::vector<std::string> argv) {
     so.display = d;
     source = std::make_unique<devices::FoveationGaze>(gaze_arg, so);
   } else if (!mouse) {
-    gaze[0] = gaze[1] = parse_gaze(args, lenses[0].view());
+    gaze[0] = gaze[1] = parse_gaze(args, optics[0].view());
   } else if (args.has("gaze-dir")) {
     throw core::InputError("give either --gaze or --gaze-dir, not both");
   }
@@ -159,22 +160,20 @@ int run(std::vector<std::string> argv) {
   gpu::Context ctx;
   std::array<std::unique_ptr<compositor::DistortionPass>, 2> passes;
   for (int e = 0; e < 2; ++e)
-    passes[size_t(e)] = std::make_unique<compositor::DistortionPass>(ctx, core::HiddenAreaMask(lenses[e]),
-                                                                      compositor::ChannelSelect::All, optics);
+    passes[size_t(e)] = std::make_unique<compositor::DistortionPass>(ctx, optics[e].hidden(),
+                                                                      compositor::ChannelSelect::All, eval);
   compositor::PanelImage panels[2];
   std::optional<SceneRenderer> sr;
   if (scene) {
     sr.emplace();
     sr->gpu_scene = std::make_unique<renderer::GpuScene>(ctx, *scene);
-    sr->pipeline = std::make_unique<compositor::FramePipeline>(ctx, *sr->gpu_scene, d, dp, compositor::ReconSettings{});
-    for (int e = 0; e < 2; ++e) {
-      sr->poses[size_t(e)] = scene->camera;
-      sr->poses[size_t(e)].position +=
-          scene->camera.orientation * glm::dvec3((e == 0 ? -0.5 : 0.5) * d.ipd_m, 0, 0);
-    }
+    const core::StereoViews views = core::stereo_views(d, scene->camera);
+    sr->poses = views.poses();
+    sr->pipeline = std::make_unique<pipeline::FramePipeline>(ctx, *sr->gpu_scene, views, dp, reconstruct::ReconSettings{});
+    for (int e = 0; e < 2; ++e) sr->pipeline->set_visibility(core::Eye(e), optics[e].view_mask());
   } else {
     // The direction grid is static: distort it once.
-    for (int e = 0; e < 2; ++e) panels[e] = passes[size_t(e)]->run(compositor::direction_grid(lenses[e].view()));
+    for (int e = 0; e < 2; ++e) panels[e] = passes[size_t(e)]->run(compositor::direction_grid(optics[e].view()));
   }
 
   const auto period = std::chrono::microseconds(long(1e6 / d.refresh_hz));
@@ -184,7 +183,7 @@ int run(std::vector<std::string> argv) {
     if (mouse) {
       // Both eyes look along the direction seen through the lens under the cursor
       // (parallel eyes: vergence is ignored); off the panels the last gaze holds.
-      if (const auto p = window.cursor()) gaze[0] = gaze[1] = compositor::gaze_direction(lenses[int(p->eye)], p->uv);
+      if (const auto p = window.cursor()) gaze[0] = gaze[1] = core::gaze_direction(optics[int(p->eye)].lens(), p->uv);
     } else if (source) {
       const devices::FoveaGaze g = source->at_frame_time(core::TimeNs(std::llround(double(frame) / d.refresh_hz * 1e9)));
       for (int e = 0; e < 2; ++e) gaze[size_t(e)] = g.eye(core::Eye(e)).dir;
@@ -195,7 +194,7 @@ int run(std::vector<std::string> argv) {
         panels[e] = passes[size_t(e)]->run(renderer::tone_map(sr->pipeline->image(core::Eye(e))));
     }
     std::optional<glm::dvec2> marker[2];
-    for (int e = 0; e < 2; ++e) marker[e] = compositor::gaze_panel_uv(lenses[e], gaze[size_t(e)]);
+    for (int e = 0; e < 2; ++e) marker[e] = core::gaze_panel_uv(optics[e].lens(), gaze[size_t(e)]);
     window.show(panels[0], panels[1], marker[0], marker[1]);
     std::this_thread::sleep_until(frame_start + period);
   }

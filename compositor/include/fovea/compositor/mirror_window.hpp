@@ -58,11 +58,4 @@ class MirrorWindow {
   std::unique_ptr<Impl> impl_;
 };
 
-// The view direction an eye looks along when it looks at a panel position: the green
-// channel's forward optics (OpenXR view space, −Z forward).
-glm::dvec3 gaze_direction(const core::Lens& lens, glm::dvec2 panel_uv);
-// The panel position that shows a view direction (green channel's inverse optics), or
-// nullopt when it is not shown anywhere on the panel.
-std::optional<glm::dvec2> gaze_panel_uv(const core::Lens& lens, glm::dvec3 dir);
-
 }  // namespace fovea::compositor

@@ -3,6 +3,7 @@
 // one descriptor each) and descriptor sets, each with its own small pool. Sets are
 // created at setup time, updated with bind(), and bound by ComputePipeline.
 #include <cstdint>
+#include <span>
 #include <vector>
 
 #include "fovea/gpu/handle.hpp"
@@ -19,6 +20,14 @@ enum class Binding {
   UniformBuffer,  // uniform { ... }
   StorageImage,   // image2D / uimage2D with a format qualifier
   SampledImage,   // sampler2D (combined image sampler)
+};
+const char* binding_name(Binding b);  // "storage buffer", ... for messages
+
+// One buffer for one binding: typed binding structs list theirs (binding indices from the
+// constants the shader's layout(binding = ...) uses).
+struct BufferSlot {
+  std::uint32_t binding = 0;
+  const Buffer* buffer = nullptr;
 };
 
 class DescriptorSetLayout {
@@ -46,6 +55,9 @@ class DescriptorSet {
   DescriptorSet& bind(std::uint32_t binding, const Buffer& buffer, VkDeviceSize offset = 0,
                       VkDeviceSize range = VK_WHOLE_SIZE);
   DescriptorSet& bind(std::uint32_t binding, const Image2D& image);
+  // Binds every slot; throws core::InputError naming the binding unless the slots cover each
+  // binding of the layout exactly once with a buffer.
+  DescriptorSet& bind_all(std::span<const BufferSlot> slots);
   DescriptorSet& bind(std::uint32_t binding, const Image2D& image, const Sampler& sampler);
 
  private:

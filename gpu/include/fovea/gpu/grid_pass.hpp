@@ -24,7 +24,8 @@ class GridPass {
   static VkDeviceSize samples_bytes(const core::SampleDistribution& d);
 
   // Uploads the frame's parameters (call outside command recording, before record()).
-  // `hidden_mask`: optional bitmask of hidden display pixels (bit y*W + x), empty if none.
+  // `hidden_mask`: optional bitmask of hidden view pixels in core::ViewMask's layout (rows of
+  // ceil(W / 32) words, bit x & 31 of word y·ceil(W / 32) + x / 32), empty if none.
   void prepare(const core::SampleDistribution& d, std::span<const std::uint32_t> hidden_mask = {});
   // Records the dispatch writing into `samples` (at least samples_bytes(d) bytes).
   void record(VkCommandBuffer cmd, const Buffer& samples);

@@ -4,9 +4,10 @@
 
 #include "fovea/renderer/scene_io.hpp"
 #include "gpu_fixture.hpp"
-#include "reconstruct_helpers.hpp"
+#include "pipeline_helpers.hpp"
 
-namespace compositor = fovea::compositor;
+namespace pipeline = fovea::pipeline;
+namespace reconstruct = fovea::reconstruct;
 namespace core = fovea::core;
 namespace renderer = fovea::renderer;
 using fovea::test::GpuTest;
@@ -15,14 +16,14 @@ TEST_F(GpuTest, FramePipelineDepthIsTheNearestSamplesViewZ) {
   const renderer::Scene scene = renderer::load_scene("stereo-occluders");
   renderer::GpuScene gs(ctx(), scene);
   const core::DisplayPreset display = fovea::test::display_of_size(48, 54);
-  compositor::ReconSettings s;
+  reconstruct::ReconSettings s;
   s.blur = false;
-  compositor::FramePipeline p(ctx(), gs, display, {}, s);
-  const auto poses = fovea::test::eye_poses(scene, display.ipd_m);
+  pipeline::FramePipeline p(ctx(), gs, core::stereo_views(display), {}, s);
+  const auto poses = core::eye_poses(scene.camera, display.ipd_m);
   p.render(poses, {glm::dvec3(0.05, 0, -1), glm::dvec3(0.05, 0, -1)}, 3);
   for (core::Eye eye : {core::Eye::Left, core::Eye::Right}) {
     const std::vector<float> depth = p.depth(eye);
-    const auto pos = p.grid_buffer(eye, compositor::GridBuffer::Position);
+    const auto pos = pipeline::testing::grid_buffer(p, eye, pipeline::testing::GridBuffer::Position);
     const auto& d = p.distribution(eye);
     const core::View v = p.view(eye);
     ASSERT_EQ(depth.size(), std::size_t(v.width()) * std::size_t(v.height()));

@@ -5,9 +5,10 @@
 #include "fovea/core/metrics.hpp"
 #include "fovea/renderer/scene_io.hpp"
 #include "gpu_fixture.hpp"
-#include "reconstruct_helpers.hpp"
+#include "pipeline_helpers.hpp"
 
-namespace compositor = fovea::compositor;
+namespace pipeline = fovea::pipeline;
+namespace reconstruct = fovea::reconstruct;
 namespace core = fovea::core;
 namespace renderer = fovea::renderer;
 using fovea::test::GpuTest;
@@ -16,11 +17,11 @@ TEST_F(GpuTest, StereoGatherRaisesIndirectPsnrAndRespectsDisocclusions) {
   const renderer::Scene scene = renderer::load_scene("stereo-occluders");
   renderer::GpuScene gs(ctx(), scene);
   const core::DisplayPreset display = fovea::test::display_of_size(96, 108);
-  compositor::ReconSettings off, gather;
+  reconstruct::ReconSettings off, gather;
   off.blur = gather.blur = false;
-  gather.share = compositor::StereoShare::Gather;
-  compositor::FramePipeline a(ctx(), gs, display, {}, off), b(ctx(), gs, display, {}, gather);
-  const auto poses = fovea::test::eye_poses(scene, display.ipd_m);
+  gather.share = reconstruct::StereoShare::Gather;
+  pipeline::FramePipeline a(ctx(), gs, core::stereo_views(display), {}, off), b(ctx(), gs, core::stereo_views(display), {}, gather);
+  const auto poses = core::eye_poses(scene.camera, display.ipd_m);
   const std::array<glm::dvec3, 2> gaze{glm::dvec3(0, 0, -1), glm::dvec3(0, 0, -1)};
   for (std::uint32_t f = 0; f < 3; ++f) {
     a.render(poses, gaze, f);
@@ -29,11 +30,11 @@ TEST_F(GpuTest, StereoGatherRaisesIndirectPsnrAndRespectsDisocclusions) {
   const core::Eye L = core::Eye::Left;
   const auto samples = b.grid_samples(L);
   const auto ref = fovea::test::trace_reference(ctx(), gs, samples, b.view(L), L, 128);
-  const auto pos = b.grid_buffer(L, compositor::GridBuffer::Position);
+  const auto pos = pipeline::testing::grid_buffer(b, L, pipeline::testing::GridBuffer::Position);
   auto keep = [&](std::size_t i) { return samples[i].flags == 0 && pos[i].w >= 0; };
   const core::Image reference = fovea::test::cells_image(ref.indirect, keep);
-  const auto own = a.grid_buffer(L, compositor::GridBuffer::SharedIndirect);  // sharing off: own only
-  const auto shared = b.grid_buffer(L, compositor::GridBuffer::SharedIndirect);
+  const auto own = pipeline::testing::grid_buffer(a, L, pipeline::testing::GridBuffer::SharedIndirect);  // sharing off: own only
+  const auto shared = pipeline::testing::grid_buffer(b, L, pipeline::testing::GridBuffer::SharedIndirect);
   const double p_off = core::psnr(fovea::test::cells_image(own, keep), reference);
   const double p_gather = core::psnr(fovea::test::cells_image(shared, keep), reference);
   std::printf("indirect PSNR: own %.2f dB, gather %.2f dB\n", p_off, p_gather);
@@ -43,8 +44,8 @@ TEST_F(GpuTest, StereoGatherRaisesIndirectPsnrAndRespectsDisocclusions) {
   // another surface (a pillar in front) in the whole 3×3 neighbourhood of right-eye cells.
   const auto& dr = b.distribution(core::Eye::Right);
   const core::View vr = b.view(core::Eye::Right);
-  const auto rpos = b.grid_buffer(core::Eye::Right, compositor::GridBuffer::Position);
-  const auto own_b = b.grid_buffer(L, compositor::GridBuffer::AccIndirect);
+  const auto rpos = pipeline::testing::grid_buffer(b, core::Eye::Right, pipeline::testing::GridBuffer::Position);
+  const auto own_b = pipeline::testing::grid_buffer(b, L, pipeline::testing::GridBuffer::AccIndirect);
   const glm::dquat inv = glm::inverse(vr.pose().orientation);
   int occluded = 0;
   for (std::size_t i = 0; i < pos.size(); ++i) {
@@ -78,14 +79,14 @@ TEST_F(GpuTest, StereoAlternateFillsTheUntracedEyeFromTheOther) {
   const renderer::Scene scene = renderer::load_scene("stereo-occluders");
   renderer::GpuScene gs(ctx(), scene);
   const core::DisplayPreset display = fovea::test::display_of_size(64, 72);
-  compositor::ReconSettings s;
-  s.share = compositor::StereoShare::Alternate;
-  compositor::FramePipeline p(ctx(), gs, display, {}, s);
-  const auto poses = fovea::test::eye_poses(scene, display.ipd_m);
+  reconstruct::ReconSettings s;
+  s.share = reconstruct::StereoShare::Alternate;
+  pipeline::FramePipeline p(ctx(), gs, core::stereo_views(display), {}, s);
+  const auto poses = core::eye_poses(scene.camera, display.ipd_m);
   for (std::uint32_t f = 0; f < 4; ++f) p.render(poses, {glm::dvec3(0, 0, -1), glm::dvec3(0, 0, -1)}, f);
   for (core::Eye e : {core::Eye::Left, core::Eye::Right}) {
-    const auto own = p.grid_buffer(e, compositor::GridBuffer::AccIndirect);
-    const auto shared = p.grid_buffer(e, compositor::GridBuffer::SharedIndirect);
+    const auto own = pipeline::testing::grid_buffer(p, e, pipeline::testing::GridBuffer::AccIndirect);
+    const auto shared = pipeline::testing::grid_buffer(p, e, pipeline::testing::GridBuffer::SharedIndirect);
     ASSERT_TRUE(fovea::test::all_finite(shared));
     double n_own = 0, n_shared = 0;
     for (std::size_t i = 0; i < own.size(); ++i) n_own += own[i].w, n_shared += shared[i].w;

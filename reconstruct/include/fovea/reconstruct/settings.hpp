@@ -1,15 +1,10 @@
 #pragma once
-// Reconstruction in grid space (docs/reconstruction.md): settings, and the per-frame grid
-// mapping the reconstruction shaders use (shaders/include/fovea/shaders/recon_grid.h).
-#include <cstdint>
+// Reconstruction in grid space (docs/reconstruction.md): the settings every stage reads.
 #include <string_view>
 
-#include "fovea/compositor/bmfr.hpp"
-#include "fovea/core/distribution.hpp"
-#include "fovea/core/view.hpp"
-#include "fovea/shaders/recon_grid.h"
+#include "fovea/reconstruct/bmfr.hpp"
 
-namespace fovea::compositor {
+namespace fovea::reconstruct {
 
 enum class Denoiser { Bmfr, None };
 // Off: each eye alone. Gather: each eye also gathers the other eye's accumulated indirect
@@ -41,13 +36,4 @@ struct ReconSettings {
   double blur_max_sigma_px = 16;
 };
 
-// The grid mapping of `d`'s current frame seen from `eye_pose` (world), for the shaders;
-// its column table is expected at `table_offset` in the bound table buffer.
-shaders::ReconGrid recon_grid(const core::SampleDistribution& d, const core::Pose& eye_pose,
-                              std::uint32_t table_offset);
-
-// BMFR's 16 static block-grid displacements (cells, in [0, 32)²), uniformly spread over all
-// offsets: frame f uses entry f % 16.
-glm::ivec2 bmfr_block_offset(std::uint32_t frame);
-
-}  // namespace fovea::compositor
+}  // namespace fovea::reconstruct

@@ -3,9 +3,10 @@
 #include "fovea/core/metrics.hpp"
 #include "fovea/renderer/scene_io.hpp"
 #include "gpu_fixture.hpp"
-#include "reconstruct_helpers.hpp"
+#include "pipeline_helpers.hpp"
 
-namespace compositor = fovea::compositor;
+namespace pipeline = fovea::pipeline;
+namespace reconstruct = fovea::reconstruct;
 namespace core = fovea::core;
 namespace renderer = fovea::renderer;
 using fovea::test::GpuTest;
@@ -18,12 +19,12 @@ TEST_F(GpuTest, AccumulationKeepsAStaticSceneStableWhileTheGazeSweeps) {
 #else
   const core::DisplayPreset display = fovea::test::display_of_size(128, 144);
 #endif
-  compositor::ReconSettings s;
-  s.denoiser = compositor::Denoiser::None;
+  reconstruct::ReconSettings s;
+  s.denoiser = reconstruct::Denoiser::None;
   s.blur = false;
-  compositor::FramePipeline with(ctx(), gs, display, {}, s, {}, true);
-  compositor::FramePipeline without(ctx(), gs, display, {}, s, {}, true);
-  const auto poses = fovea::test::eye_poses(scene, display.ipd_m);
+  pipeline::FramePipeline with(ctx(), gs, core::stereo_views(display), {}, s, {}, true);
+  pipeline::FramePipeline without(ctx(), gs, core::stereo_views(display), {}, s, {}, true);
+  const auto poses = core::eye_poses(scene.camera, display.ipd_m);
   const int frames = 12;
   double te_with = 0, te_without = 0;
   core::Image prev_with, prev_without;
@@ -38,7 +39,7 @@ TEST_F(GpuTest, AccumulationKeepsAStaticSceneStableWhileTheGazeSweeps) {
     prev_with = iw, prev_without = io;
   }
   // History survived the moving grid: most samples hold many frames.
-  const auto acc = with.grid_buffer(core::Eye::Left, compositor::GridBuffer::AccDirect);
+  const auto acc = pipeline::testing::grid_buffer(with, core::Eye::Left, pipeline::testing::GridBuffer::AccDirect);
   const auto samples = with.grid_samples(core::Eye::Left);
   double count = 0;
   long n = 0;

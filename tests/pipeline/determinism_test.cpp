@@ -8,9 +8,10 @@
 
 #include "fovea/renderer/scene_io.hpp"
 #include "gpu_fixture.hpp"
-#include "reconstruct_helpers.hpp"
+#include "pipeline_helpers.hpp"
 
-namespace compositor = fovea::compositor;
+namespace pipeline = fovea::pipeline;
+namespace reconstruct = fovea::reconstruct;
 namespace core = fovea::core;
 namespace renderer = fovea::renderer;
 using fovea::test::GpuTest;
@@ -40,7 +41,7 @@ std::array<glm::dvec3, 2> gaze_of(std::uint32_t f) {
   return {g, g};
 }
 
-Snapshot render_sequence(compositor::FramePipeline& p, const std::array<core::Pose, 2>& poses) {
+Snapshot render_sequence(pipeline::FramePipeline& p, const std::array<core::Pose, 2>& poses) {
   for (std::uint32_t f = 0; f < kFrames; ++f) p.render(poses, gaze_of(f), 10 + f);
   Snapshot s;
   for (int e = 0; e < p.eyes(); ++e) {
@@ -49,15 +50,15 @@ Snapshot render_sequence(compositor::FramePipeline& p, const std::array<core::Po
     s.add(tag + "image", p.image(eye).pixels);
     s.add(tag + "depth", p.depth(eye));
     s.add(tag + "grid samples", p.grid_samples(eye));
-    const std::pair<compositor::GridBuffer, const char*> buffers[] = {
-        {compositor::GridBuffer::Radiance, "radiance"},   {compositor::GridBuffer::AccDirect, "acc direct"},
-        {compositor::GridBuffer::AccIndirect, "acc indirect"}, {compositor::GridBuffer::SharedIndirect, "shared"},
-        {compositor::GridBuffer::Fitted, "fitted"},       {compositor::GridBuffer::Final, "final"},
-        {compositor::GridBuffer::Albedo, "albedo"},       {compositor::GridBuffer::Position, "position"}};
+    const std::pair<pipeline::testing::GridBuffer, const char*> buffers[] = {
+        {pipeline::testing::GridBuffer::Radiance, "radiance"},   {pipeline::testing::GridBuffer::AccDirect, "acc direct"},
+        {pipeline::testing::GridBuffer::AccIndirect, "acc indirect"}, {pipeline::testing::GridBuffer::SharedIndirect, "shared"},
+        {pipeline::testing::GridBuffer::Fitted, "fitted"},       {pipeline::testing::GridBuffer::Final, "final"},
+        {pipeline::testing::GridBuffer::Albedo, "albedo"},       {pipeline::testing::GridBuffer::Position, "position"}};
     for (const auto& [which, name] : buffers)
       // Without BMFR nothing produces the fitted buffer: it keeps what it was filled with.
-      if (which != compositor::GridBuffer::Fitted || p.settings().denoiser == compositor::Denoiser::Bmfr)
-        s.add(tag + name, p.grid_buffer(eye, which));
+      if (which != pipeline::testing::GridBuffer::Fitted || p.settings().denoiser == reconstruct::Denoiser::Bmfr)
+        s.add(tag + name, pipeline::testing::grid_buffer(p, eye, which));
   }
   return s;
 }
@@ -77,14 +78,14 @@ void expect_identical(const Snapshot& a, const Snapshot& b, const char* what) {
   }
 }
 
-void check_determinism(fovea::gpu::Context& ctx, const char* scene_name, const compositor::ReconSettings& settings) {
+void check_determinism(fovea::gpu::Context& ctx, const char* scene_name, const reconstruct::ReconSettings& settings) {
   const renderer::Scene scene = renderer::load_scene(scene_name);
   renderer::GpuScene gs(ctx, scene);
   const core::DisplayPreset display = fovea::test::display_of_size(40, 44);
-  const auto poses = fovea::test::eye_poses(scene, display.ipd_m);
+  const auto poses = core::eye_poses(scene.camera, display.ipd_m);
   Snapshot first;
   {
-    compositor::FramePipeline p(ctx, gs, display, {}, settings);
+    pipeline::FramePipeline p(ctx, gs, core::stereo_views(display), {}, settings);
     first = render_sequence(p, poses);
   }
   for (const auto& v : first.words) {
@@ -92,28 +93,28 @@ void check_determinism(fovea::gpu::Context& ctx, const char* scene_name, const c
     for (std::uint32_t w : v) nan += (w & 0x7f800000u) == 0x7f800000u ? 1 : 0;
     ASSERT_EQ(nan, 0u) << "non-finite values in a fresh render";
   }
-  compositor::FramePipeline p(ctx, gs, display, {}, settings);
+  pipeline::FramePipeline p(ctx, gs, core::stereo_views(display), {}, settings);
   expect_identical(first, render_sequence(p, poses), "second fresh pipeline");
   // Other frames in between, then reset(): the history of those must not leak in.
   for (std::uint32_t f = 0; f < 3; ++f) p.render(poses, gaze_of(7 + f), 99 + f);
   p.reset();
   expect_identical(first, render_sequence(p, poses), "after reset()");
-  p.fill_buffers(kQuietNan);
+  pipeline::testing::fill_buffers(p, kQuietNan);
   expect_identical(first, render_sequence(p, poses), "after a NaN fill");
 }
 
 }  // namespace
 
 TEST_F(GpuTest, FramePipelineIsDeterministicWithBmfrGatherAndBlur) {
-  compositor::ReconSettings s;
-  s.share = compositor::StereoShare::Gather;
+  reconstruct::ReconSettings s;
+  s.share = reconstruct::StereoShare::Gather;
   check_determinism(ctx(), "default", s);
 }
 
 TEST_F(GpuTest, FramePipelineIsDeterministicWithoutDenoiserAlternating) {
-  compositor::ReconSettings s;
-  s.denoiser = compositor::Denoiser::None;
-  s.share = compositor::StereoShare::Alternate;
+  reconstruct::ReconSettings s;
+  s.denoiser = reconstruct::Denoiser::None;
+  s.share = reconstruct::StereoShare::Alternate;
   s.blur = false;
   check_determinism(ctx(), "stereo-occluders", s);
 }

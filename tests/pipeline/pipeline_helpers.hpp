@@ -1,5 +1,5 @@
 #pragma once
-// Helpers for the reconstruction tests: eye poses, small displays, grid-space references.
+// Helpers for the pipeline and reconstruction tests: small displays, grid-space references.
 #include <array>
 #include <cmath>
 #include <string>
@@ -7,7 +7,9 @@
 
 #include <glm/vec4.hpp>
 
-#include "fovea/compositor/frame_pipeline.hpp"
+#include "fovea/pipeline/frame_pipeline.hpp"
+#include "fovea/pipeline/testing.hpp"
+#include "fovea/core/stereo_views.hpp"
 #include "fovea/core/display.hpp"
 #include "fovea/core/image.hpp"
 #include "fovea/gpu/barriers.hpp"
@@ -16,13 +18,6 @@
 #include "pt_helpers.hpp"
 
 namespace fovea::test {
-
-inline std::array<core::Pose, 2> eye_poses(const renderer::Scene& s, double ipd) {
-  std::array<core::Pose, 2> p{s.camera, s.camera};
-  p[0].position += s.camera.orientation * glm::dvec3(-0.5 * ipd, 0, 0);
-  p[1].position += s.camera.orientation * glm::dvec3(0.5 * ipd, 0, 0);
-  return p;
-}
 
 // The tiny preset's optics at another raster size.
 inline core::DisplayPreset display_of_size(int w, int h) {

@@ -6,9 +6,10 @@
 #include "fovea/core/metrics.hpp"
 #include "fovea/renderer/scene_io.hpp"
 #include "gpu_fixture.hpp"
-#include "reconstruct_helpers.hpp"
+#include "pipeline_helpers.hpp"
 
-namespace compositor = fovea::compositor;
+namespace pipeline = fovea::pipeline;
+namespace reconstruct = fovea::reconstruct;
 namespace core = fovea::core;
 namespace renderer = fovea::renderer;
 using fovea::test::GpuTest;
@@ -56,21 +57,21 @@ std::vector<glm::vec4> grid_of(const core::SampleDistribution& d, double (*f)(gl
 
 TEST_F(Resolve, ConstantGridResolvesToTheConstantEverywhere) {
   const core::DisplayPreset display = fovea::test::display_of_size(96, 108);
-  compositor::ReconSettings s;
+  reconstruct::ReconSettings s;
   s.blur = false;
-  compositor::FramePipeline p(ctx(), *gs_, display, {}, s, {}, true);
+  pipeline::FramePipeline p(ctx(), *gs_, core::stereo_views(display), {}, s, {}, true);
   const auto& d = p.distribution(core::Eye::Left);
-  const core::Image img = p.resolve_grid(core::Eye::Left, grid_of(d, [](glm::dvec2, double) { return 0.75; }), false);
+  const core::Image img = pipeline::testing::resolve_grid(p, core::Eye::Left, grid_of(d, [](glm::dvec2, double) { return 0.75; }), false);
   for (const auto& px : img.pixels) ASSERT_NEAR(px.x, 0.75f, 1e-5f);
 }
 
 TEST_F(Resolve, RoundTripWithinHalfDecibelOfTheBudgetLimitedIdeal) {
   const core::DisplayPreset display = core::load_display("small");
-  compositor::ReconSettings s;
+  reconstruct::ReconSettings s;
   s.blur = false;
-  compositor::FramePipeline p(ctx(), *gs_, display, {}, s, {}, true);
+  pipeline::FramePipeline p(ctx(), *gs_, core::stereo_views(display), {}, s, {}, true);
   const auto& d = p.distribution(core::Eye::Left);
-  const core::Image img = p.resolve_grid(core::Eye::Left, grid_of(d, analytic), false);
+  const core::Image img = pipeline::testing::resolve_grid(p, core::Eye::Left, grid_of(d, analytic), false);
   // The ideal: the image low-passed at the grid's local sample spacing h (Gaussian σ = h/2),
   // i.e. what any reconstruction from samples that sparse can keep.
   core::Image truth(display.width, display.height), ideal = truth;
@@ -94,5 +95,5 @@ TEST_F(Resolve, BlurDefaultMatchesP5OnTheFove0Panel) {
   const glm::dvec3 d30 = glm::normalize(glm::dvec3(std::tan(30 * M_PI / 180), 0, -1));
   const glm::dvec2 px = *v.dir_to_pixel(d30);
   const double deg_per_px = core::angle_deg(v.pixel_to_dir(px), v.pixel_to_dir(px + glm::dvec2(1, 0)));
-  EXPECT_NEAR(compositor::kBlurSigmaDegAt30 / deg_per_px, 6.8, 0.1);
+  EXPECT_NEAR(reconstruct::kBlurSigmaDegAt30 / deg_per_px, 6.8, 0.1);
 }

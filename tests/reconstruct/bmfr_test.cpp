@@ -1,6 +1,6 @@
 // BMFR in grid space: no NaN/Inf on rank-deficient or hostile blocks, and the quality gain
 // on a static Cornell box.
-#include "fovea/compositor/bmfr.hpp"
+#include "fovea/reconstruct/bmfr.hpp"
 
 #include <map>
 #include <memory>
@@ -10,9 +10,10 @@
 #include "fovea/core/metrics.hpp"
 #include "fovea/renderer/scene_io.hpp"
 #include "gpu_fixture.hpp"
-#include "reconstruct_helpers.hpp"
+#include "pipeline_helpers.hpp"
 
-namespace compositor = fovea::compositor;
+namespace pipeline = fovea::pipeline;
+namespace reconstruct = fovea::reconstruct;
 namespace core = fovea::core;
 namespace renderer = fovea::renderer;
 using fovea::test::GpuTest;
@@ -52,15 +53,15 @@ double smooth_radiance(std::uint32_t x, std::uint32_t y) {
 class Bmfr : public GpuTest {
  protected:
   // One pipeline per configuration (lavapipe compiles the unrolled shader in ~1 s).
-  const compositor::BmfrFit& fitter(compositor::BmfrOptions o) {
+  const reconstruct::BmfrFit& fitter(reconstruct::BmfrOptions o) {
     auto& f = fits_[{int(o.precision), o.workgroup}];
-    if (!f) f = std::make_unique<compositor::BmfrFit>(ctx(), o);
+    if (!f) f = std::make_unique<reconstruct::BmfrFit>(ctx(), o);
     return *f;
   }
-  std::vector<glm::vec4> run(const Inputs& in, glm::ivec2 offset = {0, 0}, compositor::BmfrOptions o = {}) {
+  std::vector<glm::vec4> run(const Inputs& in, glm::ivec2 offset = {0, 0}, reconstruct::BmfrOptions o = {}) {
     return fitter(o).fit({kSide, kSide}, in.pos, in.nrm, in.z, 3, offset);
   }
-  std::map<std::pair<int, std::uint32_t>, std::unique_ptr<compositor::BmfrFit>> fits_;
+  std::map<std::pair<int, std::uint32_t>, std::unique_ptr<reconstruct::BmfrFit>> fits_;
   static void expect_sane(const std::vector<glm::vec4>& out) {
     ASSERT_TRUE(fovea::test::all_finite(out));
     for (const auto& p : out) {
@@ -105,11 +106,11 @@ TEST_F(Bmfr, FirefliesOfAMillionStayFinite) {
   Inputs in = flat_wall(0.3f, 4);
   for (std::size_t i = 0; i < in.z.size(); i += 97) in.z[i] = {1e6f, 1e6f, 1e6f, 1};
   expect_sane(run(in, {11, 2}));
-  expect_sane(run(in, {11, 2}, {.precision = compositor::BmfrPrecision::Fp16}));  // 1e6 > fp16 max
+  expect_sane(run(in, {11, 2}, {.precision = reconstruct::BmfrPrecision::Fp16}));  // 1e6 > fp16 max
 }
 
 TEST_F(Bmfr, PositionsAtTenToTheFiveUnitsStayFinite) {
-  for (auto precision : {compositor::BmfrPrecision::Fp32, compositor::BmfrPrecision::Fp16}) {
+  for (auto precision : {reconstruct::BmfrPrecision::Fp32, reconstruct::BmfrPrecision::Fp16}) {
     expect_sane(run(flat_wall(0.5f, 5, 1.0, {1e5, -1e5, 1e5}), {0, 0}, {.precision = precision}));
     // Blocks spanning 10⁵ units: w² would be 10¹⁰ unscaled, far beyond fp16.
     expect_sane(run(flat_wall(0.5f, 6, 1e3, {1e5, 1e5, 0}), {17, 23}, {.precision = precision}));
@@ -132,7 +133,7 @@ TEST_F(Bmfr, Fp16StorageAndWorkgroupSizesMatchFp32) {
   };
   const core::Image ref = as_image(truth);
   const auto fp32 = run(in, {7, 19});
-  const auto fp16 = run(in, {7, 19}, {.precision = compositor::BmfrPrecision::Fp16});
+  const auto fp16 = run(in, {7, 19}, {.precision = reconstruct::BmfrPrecision::Fp16});
   const double p_in = core::psnr(as_image(in.z), ref), p32 = core::psnr(as_image(fp32), ref),
                p16 = core::psnr(as_image(fp16), ref);
   std::printf("smooth ramp: input %.2f dB, fp32 fit %.2f dB, fp16 fit %.2f dB\n", p_in, p32, p16);
@@ -145,8 +146,8 @@ TEST_F(Bmfr, Fp16StorageAndWorkgroupSizesMatchFp32) {
 }
 
 TEST_F(Bmfr, WorkgroupMustDivideTheBlock) {
-  EXPECT_THROW(compositor::BmfrFit(ctx(), {.workgroup = 96}), core::InputError);
-  EXPECT_THROW(compositor::BmfrFit(ctx(), {.workgroup = 1024}), core::InputError);
+  EXPECT_THROW(reconstruct::BmfrFit(ctx(), {.workgroup = 96}), core::InputError);
+  EXPECT_THROW(reconstruct::BmfrFit(ctx(), {.workgroup = 1024}), core::InputError);
 }
 
 TEST_F(Bmfr, MaskedAndNearlyEmptyBlocksStayFinite) {
@@ -174,12 +175,12 @@ TEST_F(Bmfr, CornellAfter32FramesBeatsInputAndAccumulation) {
   const core::DisplayPreset display = fovea::test::display_of_size(size, size);
   core::DistributionParams dp;
   dp.kind = core::DistributionKind::Cartesian;
-  compositor::ReconSettings with, without;
+  reconstruct::ReconSettings with, without;
   with.blur = without.blur = false;
-  without.denoiser = compositor::Denoiser::None;
-  compositor::FramePipeline bmfr(ctx(), gs, display, dp, with, {}, true);
-  compositor::FramePipeline accum(ctx(), gs, display, dp, without, {}, true);
-  const auto poses = fovea::test::eye_poses(scene, display.ipd_m);
+  without.denoiser = reconstruct::Denoiser::None;
+  pipeline::FramePipeline bmfr(ctx(), gs, core::stereo_views(display), dp, with, {}, true);
+  pipeline::FramePipeline accum(ctx(), gs, core::stereo_views(display), dp, without, {}, true);
+  const auto poses = core::eye_poses(scene.camera, display.ipd_m);
   const std::array<glm::dvec3, 2> gaze{glm::dvec3(0, 0, -1), glm::dvec3(0, 0, -1)};
   for (std::uint32_t f = 0; f < frames; ++f) {
     bmfr.render(poses, gaze, f);
@@ -190,14 +191,14 @@ TEST_F(Bmfr, CornellAfter32FramesBeatsInputAndAccumulation) {
                                                 ref_frames);
   auto keep = [&](std::size_t i) { return samples[i].flags == 0; };
   const core::Image reference = fovea::test::cells_image(ref.radiance, keep);
-  const auto fitted = bmfr.grid_buffer(core::Eye::Left, compositor::GridBuffer::Final);
+  const auto fitted = pipeline::testing::grid_buffer(bmfr, core::Eye::Left, pipeline::testing::GridBuffer::Final);
   ASSERT_TRUE(fovea::test::all_finite(fitted));
   const double p_bmfr = core::psnr(fovea::test::cells_image(fitted, keep), reference);
   const double p_input =
-      core::psnr(fovea::test::cells_image(bmfr.grid_buffer(core::Eye::Left, compositor::GridBuffer::Radiance), keep),
+      core::psnr(fovea::test::cells_image(pipeline::testing::grid_buffer(bmfr, core::Eye::Left, pipeline::testing::GridBuffer::Radiance), keep),
                  reference);
   const double p_accum =
-      core::psnr(fovea::test::cells_image(accum.grid_buffer(core::Eye::Left, compositor::GridBuffer::Final), keep),
+      core::psnr(fovea::test::cells_image(pipeline::testing::grid_buffer(accum, core::Eye::Left, pipeline::testing::GridBuffer::Final), keep),
                  reference);
   std::printf("Cornell %dx%d after %u frames: 1 spp %.2f dB, accumulation %.2f dB, BMFR %.2f dB\n", size, size,
               frames, p_input, p_accum, p_bmfr);

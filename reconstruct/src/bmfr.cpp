@@ -1,12 +1,17 @@
-#include "fovea/compositor/bmfr.hpp"
+// BMFR Phase II (shaders/recon_bmfr_fit.comp): the fit on its own (BmfrFit) and as a stage.
+#include "fovea/reconstruct/bmfr.hpp"
 
 #include <string>
 
+#include "bindings.hpp"
+#include "buffers.hpp"
 #include "fovea/core/error.hpp"
+#include "fovea/gpu/barriers.hpp"
 #include "fovea/gpu/context.hpp"
+#include "fovea/reconstruct/stages.hpp"
 #include "fovea/shaders/recon_grid.h"
 
-namespace fovea::compositor {
+namespace fovea::reconstruct {
 
 namespace {
 
@@ -22,17 +27,14 @@ std::uint32_t checked_workgroup(const BmfrOptions& o) {
 BmfrFit::BmfrFit(gpu::Context& ctx, const BmfrOptions& options)
     : ctx_(&ctx),
       workgroup_(checked_workgroup(options)),
-      pipeline_(ctx, {.shader = "recon_bmfr_fit.comp.spv",
-                      .sets = {std::vector<gpu::Binding>(4, gpu::Binding::StorageBuffer)},
-                      .push_constant_bytes = sizeof(shaders::ReconBmfrPush),
-                      .specialization = {gpu::SpecConstant::u32(0, workgroup_),
-                                         gpu::SpecConstant::boolean(1, options.precision == BmfrPrecision::Fp16)}}) {}
+      pipeline_(kernel<BmfrBindings, shaders::ReconBmfrPush>(
+          ctx, "recon_bmfr_fit.comp.spv",
+          {gpu::SpecConstant::u32(0, workgroup_),
+           gpu::SpecConstant::boolean(1, options.precision == BmfrPrecision::Fp16)})) {}
 
 gpu::DescriptorSet BmfrFit::bind(const gpu::Buffer& vpos, const gpu::Buffer& vnrm, const gpu::Buffer& z,
                                  const gpu::Buffer& fitted) const {
-  gpu::DescriptorSet set(*ctx_, pipeline_.set_layout(0));
-  set.bind(0, vpos).bind(1, vnrm).bind(2, z).bind(3, fitted);
-  return set;
+  return make_set(*ctx_, pipeline_, BmfrBindings{&vpos, &vnrm, &z, &fitted});
 }
 
 void BmfrFit::record(VkCommandBuffer cmd, const gpu::DescriptorSet& set, BmfrGrid g, std::uint32_t frame,
@@ -64,4 +66,39 @@ std::vector<glm::vec4> BmfrFit::fit(BmfrGrid g, const std::vector<glm::vec4>& vp
   return out.download<glm::vec4>();
 }
 
-}  // namespace fovea::compositor
+glm::ivec2 bmfr_block_offset(std::uint32_t frame) {
+  // A 4×4 stratification of [0, 32)² (one offset per 8×8 stratum, visited in a shuffled
+  // order with fixed sub-stratum positions): uniform over all offsets and fixed.
+  static constexpr int kOrder[16] = {5, 14, 3, 8, 11, 0, 13, 6, 2, 9, 15, 4, 10, 7, 1, 12};
+  static constexpr int kJitter[16][2] = {{3, 5}, {6, 1}, {1, 6}, {4, 3}, {7, 7}, {2, 2}, {5, 4}, {0, 0},
+                                         {6, 5}, {3, 1}, {1, 3}, {5, 7}, {2, 6}, {7, 2}, {4, 0}, {0, 4}};
+  const int s = kOrder[frame % 16];
+  return {(s % 4) * 8 + kJitter[s][0], (s / 4) * 8 + kJitter[s][1]};
+}
+
+}  // namespace fovea::reconstruct
+
+namespace fovea::reconstruct {
+
+Bmfr::Bmfr(gpu::Context& ctx, std::span<const EyeGrid> eyes, const Accumulation& acc, const StereoGather& gather,
+           BmfrPrecision precision)
+    : fit_(ctx, {.precision = precision}), eyes_(eyes.size()) {
+  for (std::size_t i = 0; i < eyes.size(); ++i) {
+    Eye& e = eyes_[i];
+    e.grid = {eyes[i].padded_columns, eyes[i].padded_rows};
+    e.fitted = storage(ctx, VkDeviceSize(eyes[i].cells) * 16, "recon.fitted");
+    for (int p = 0; p < 2; ++p)
+      e.set[p] = fit_.bind(acc.position(int(i), p), acc.normal(int(i), p), gather.z(int(i)), e.fitted);
+  }
+}
+
+void Bmfr::record(VkCommandBuffer cmd, int parity, std::uint32_t frame, glm::ivec2 offset, float noise) const {
+  for (const Eye& e : eyes_) fit_.record(cmd, e.set[parity], e.grid, frame, offset, noise);
+  gpu::compute_to_compute(cmd);
+}
+
+void Bmfr::fill(VkCommandBuffer cmd, std::uint32_t word) const {
+  for (const Eye& e : eyes_) gpu::fill_buffer(cmd, e.fitted, word);
+}
+
+}  // namespace fovea::reconstruct

@@ -13,7 +13,7 @@
 #include "fovea/gpu/descriptors.hpp"
 #include "fovea/gpu/pipeline.hpp"
 
-namespace fovea::compositor {
+namespace fovea::reconstruct {
 
 struct BmfrGrid {
   std::uint32_t padded_columns = 0, padded_rows = 0;  // multiples of 32
@@ -50,4 +50,8 @@ class BmfrFit {
   gpu::ComputePipeline pipeline_;
 };
 
-}  // namespace fovea::compositor
+// BMFR's 16 static block-grid displacements (cells, in [0, 32)²), uniformly spread over all
+// offsets: frame f uses entry f % 16.
+glm::ivec2 bmfr_block_offset(std::uint32_t frame);
+
+}  // namespace fovea::reconstruct

@@ -1,0 +1,89 @@
+#pragma once
+// One stereo frame end to end on the GPU, in one submission: grid → trace → reconstruct →
+// resolve. Per eye the sample grid follows the gaze (gpu::GridPass, optionally skipping the
+// lens' hidden area), the path tracer traces it, the reconstruction stages
+// (reconstruct/stages.hpp) filter it in grid space, and the resolve brings it to the
+// display. Each stage reports its GPU and CPU time. Test access: pipeline/testing.hpp.
+#include <array>
+#include <cstdint>
+#include <memory>
+#include <vector>
+
+#include "fovea/core/distribution.hpp"
+#include "fovea/core/eye_optics.hpp"
+#include "fovea/core/image.hpp"
+#include "fovea/core/stereo_views.hpp"
+#include "fovea/gpu/context.hpp"
+#include "fovea/reconstruct/settings.hpp"
+#include "fovea/renderer/gpu_scene.hpp"
+#include "fovea/renderer/path_tracer.hpp"
+#include "fovea/shaders/grid.h"
+
+namespace fovea::pipeline {
+
+// Milliseconds one stage took on the GPU (timestamps; 0 without them) and on the CPU
+// (monotonic clock, the calling thread) for both eyes.
+struct StageTime {
+  double gpu_ms = 0;
+  double cpu_ms = 0;
+};
+
+struct FrameTimes {
+  StageTime grid;         // CPU: the distributions' per-frame update (gaze → grid) and upload; GPU: generation
+  StageTime trace;        // CPU: recording; GPU: path tracing
+  StageTime reconstruct;  // CPU: grid mappings and recording; GPU: accumulation, sharing, BMFR, post, TAA
+  StageTime resolve;      // CPU: recording; GPU: mips, resolve, depth, blur
+  double bmfr_fit_gpu_ms = 0;  // part of reconstruct: the regression alone
+  double submit_cpu_ms = 0;    // the submission until the GPU finished
+  double gpu_ms() const { return grid.gpu_ms + trace.gpu_ms + reconstruct.gpu_ms + resolve.gpu_ms; }
+  double cpu_ms() const { return grid.cpu_ms + trace.cpu_ms + reconstruct.cpu_ms + resolve.cpu_ms + submit_cpu_ms; }
+};
+
+// Mean indirect-diffuse samples per traced cell: the eye's own and after stereo sharing.
+struct IndirectSamples {
+  double own = 0, effective = 0;
+};
+
+class FramePipeline {
+ public:
+  // `views`: each eye's FOV and raster (their poses are the first frame's default);
+  // `mono` renders the left eye only (stereo sharing needs both).
+  FramePipeline(gpu::Context& ctx, const renderer::GpuScene& scene, const core::StereoViews& views,
+                const core::DistributionParams& distribution, const reconstruct::ReconSettings& settings,
+                const renderer::PathConfig& path = {}, bool mono = false);
+  ~FramePipeline();
+  FramePipeline(const FramePipeline&) = delete;
+  FramePipeline& operator=(const FramePipeline&) = delete;
+
+  // Skip the view pixels `mask` hides for eye `e` from the next frame on: those cells are
+  // neither traced nor reconstructed. The mask must have the eye's raster.
+  void set_visibility(core::Eye e, const core::ViewMask& mask);
+
+  // Renders one frame. `eye_pose`: world pose of each eye; `gaze`: each eye's view-space
+  // gaze. Frame indices key the noise; the history carries over from the previous call.
+  FrameTimes render(const std::array<core::Pose, 2>& eye_pose, const std::array<glm::dvec3, 2>& gaze,
+                    std::uint32_t frame);
+  // Forget the history (the next frame starts fresh).
+  void reset();
+
+  core::Image image(core::Eye e) const;  // the displayed image of the last frame
+  // The last frame's display-space linear depth, row-major like image(): per pixel the
+  // view-space distance along -Z (scene units) of the nearest grid sample's surface; 0 where
+  // that sample saw the sky or none exists. For depth compositing; the image ignores it.
+  std::vector<float> depth(core::Eye e) const;
+  std::vector<shaders::GridSample> grid_samples(core::Eye e) const;
+  std::int64_t traced_cells(core::Eye e) const;  // cells with a sample in the last frame
+  std::int64_t hidden_cells(core::Eye e) const;  // cells the visibility mask skipped in the last frame
+  IndirectSamples indirect_samples(core::Eye e) const;
+  const core::SampleDistribution& distribution(core::Eye e) const;
+  core::View view(core::Eye e) const;  // the eye's view with its last pose
+  int eyes() const;
+  const reconstruct::ReconSettings& settings() const;
+
+ private:
+  friend struct Access;  // pipeline/testing.hpp
+  struct Impl;
+  std::unique_ptr<Impl> impl_;
+};
+
+}  // namespace fovea::pipeline

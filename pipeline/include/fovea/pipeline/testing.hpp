@@ -1,0 +1,37 @@
+#pragma once
+// Test access to FramePipeline's internals: grid-space buffers, filling every buffer with a
+// pattern, resolving a given grid image. Not for tools: their numbers come from the public API.
+#include <cstdint>
+#include <vector>
+
+#include <glm/vec4.hpp>
+
+#include "fovea/pipeline/frame_pipeline.hpp"
+
+namespace fovea::pipeline::testing {
+
+// Grid-space buffers (padded grid layout) of the last frame.
+enum class GridBuffer {
+  Radiance,        // the path tracer's plain radiance (the "1 spp input")
+  AccDirect,       // Phase I direct+specular (demodulated, .w count)
+  AccIndirect,     // Phase I indirect diffuse (demodulated, .w count)
+  SharedIndirect,  // after stereo sharing (.w effective count)
+  Fitted,          // BMFR weighted sum (demodulated); only with the BMFR denoiser
+  Final,           // remodulated output in grid space (.w = 1 where a sample exists)
+  Albedo,
+  Position,        // validation data: world position (sky: direction), .w material (-2: no sample)
+};
+
+std::vector<glm::vec4> grid_buffer(const FramePipeline& p, core::Eye e, GridBuffer which);
+
+// Overwrites every device buffer the pipeline writes per frame (grid, the path tracer's
+// outputs, history, reconstruction and screen buffers; not BMFR's internal ones) with the
+// 32-bit `word`, and forgets the history: tests fill them with a NaN pattern to show that
+// no stage reads memory the frames since have not written.
+void fill_buffers(FramePipeline& p, std::uint32_t word);
+
+// Resolves a grid image given in the padded grid layout (premultiplied rgb, .w coverage)
+// with eye `e`'s current mapping, optionally blurred; for round-trip tests.
+core::Image resolve_grid(FramePipeline& p, core::Eye e, const std::vector<glm::vec4>& grid, bool blur);
+
+}  // namespace fovea::pipeline::testing

@@ -1,0 +1,261 @@
+#include "fovea/pipeline/frame_pipeline.hpp"
+
+#include <algorithm>
+#include <string>
+
+#include "fovea/core/clock.hpp"
+#include "fovea/core/error.hpp"
+#include "fovea/gpu/barriers.hpp"
+#include "frame_pipeline_impl.hpp"
+
+namespace fovea::pipeline {
+
+namespace {
+
+gpu::Buffer storage(gpu::Context& ctx, VkDeviceSize bytes, const char* name) {
+  return gpu::Buffer(ctx, {.size = std::max<VkDeviceSize>(bytes, 16), .usage = gpu::BufferUsage::Storage, .name = name});
+}
+
+// Milliseconds since `t0` on the monotonic clock, and restart it.
+double lap_ms(core::TimeNs& t0) {
+  const core::TimeNs t = core::now_ns();
+  const double ms = core::ns_to_ms(t - t0);
+  t0 = t;
+  return ms;
+}
+
+std::unique_ptr<EyeState> make_eye(gpu::Context& ctx, renderer::PathTracer& tracer, core::Eye eye,
+                                   const core::View& view, const core::DistributionParams& dp) {
+  auto e = std::make_unique<EyeState>();
+  e->eye = eye;
+  e->base_view = view;
+  e->pose = view.pose();
+  e->dist = core::make_distribution(core::View(view.fov(), view.width(), view.height()), dp);
+  if (!e->dist->invertible())
+    throw core::InputError(std::string("--distribution: ") + core::distribution_name(dp.kind) +
+                           " has no screen-to-grid mapping; the reconstruction needs one");
+  e->grid_pass = std::make_unique<gpu::GridPass>(ctx);
+  e->cells = std::uint32_t(e->dist->padded_columns() * e->dist->padded_rows());
+  e->grid = storage(ctx, gpu::GridPass::samples_bytes(*e->dist), "recon.grid");
+  e->trace = tracer.bind(e->grid, e->cells);
+  return e;
+}
+
+}  // namespace
+
+int FramePipeline::Impl::index(core::Eye e, const char* what) const {
+  for (std::size_t i = 0; i < eyes.size(); ++i)
+    if (eyes[i]->eye == e) return int(i);
+  throw core::InputError(std::string(what) + ": eye not rendered");
+}
+
+// Vulkan leaves new memory undefined (lavapipe hands out recycled heap memory), and a buffer
+// that a configuration never writes would otherwise read back differently from run to run.
+void FramePipeline::Impl::fill(std::uint32_t word) {
+  ctx.submit_and_wait([&](VkCommandBuffer cmd) {
+    for (auto& e : eyes) {
+      const renderer::TraceOutputs& t = e->trace;
+      for (const gpu::Buffer* b : {static_cast<const gpu::Buffer*>(&e->grid), &t.direct(), &t.indirect(), &t.albedo(), &t.normal_depth(),
+                                   &t.position_material(), &t.radiance()})
+        gpu::fill_buffer(cmd, *b, word);
+    }
+    accumulation->fill(cmd, word);
+    gather->fill(cmd, word);
+    if (bmfr) bmfr->fill(cmd, word);
+    post->fill(cmd, word);
+    resolve->fill(cmd, word);
+  });
+}
+
+FramePipeline::FramePipeline(gpu::Context& ctx, const renderer::GpuScene& scene, const core::StereoViews& views,
+                             const core::DistributionParams& distribution, const reconstruct::ReconSettings& settings,
+                             const renderer::PathConfig& path, bool mono)
+    : impl_(std::make_unique<Impl>(ctx, scene, path, settings)) {
+  if (mono && settings.share != reconstruct::StereoShare::Off)
+    throw core::InputError("--stereo-share: sharing needs both eyes");
+  Impl& m = *impl_;
+  for (int i = 0; i < (mono ? 1 : 2); ++i)
+    m.eyes.push_back(make_eye(ctx, m.tracer, core::Eye(i), views[core::Eye(i)], distribution));
+  std::vector<reconstruct::EyeGrid> grids;
+  for (auto& e : m.eyes) {
+    const EyeState* o = m.other(*e);
+    e->mapping = std::make_unique<reconstruct::GridMapping>(ctx, *e->dist, o ? o->dist.get() : nullptr);
+    const renderer::TraceOutputs& t = e->trace;
+    grids.push_back({.cells = e->cells,
+                     .padded_columns = std::uint32_t(e->dist->padded_columns()),
+                     .padded_rows = std::uint32_t(e->dist->padded_rows()),
+                     .polar = e->dist->gpu_params().family != shaders::kFamilyCartesian,
+                     .width = std::uint32_t(e->base_view.width()),
+                     .height = std::uint32_t(e->base_view.height()),
+                     .maps = &e->mapping->maps(),
+                     .tables = &e->mapping->tables(),
+                     .samples = &e->grid,
+                     .direct = &t.direct(),
+                     .indirect = &t.indirect(),
+                     .normal_depth = &t.normal_depth(),
+                     .position_material = &t.position_material(),
+                     .albedo = &t.albedo()});
+  }
+  m.accumulation = std::make_unique<reconstruct::Accumulation>(ctx, grids, m.tracer.scene().materials());
+  m.gather = std::make_unique<reconstruct::StereoGather>(ctx, grids, *m.accumulation);
+  if (settings.denoiser == reconstruct::Denoiser::Bmfr)
+    m.bmfr = std::make_unique<reconstruct::Bmfr>(ctx, grids, *m.accumulation, *m.gather, settings.bmfr_precision);
+  m.post = std::make_unique<reconstruct::PostTaa>(ctx, grids, *m.accumulation, *m.gather, m.bmfr.get());
+  m.resolve = std::make_unique<reconstruct::Resolve>(ctx, grids, *m.accumulation);
+  m.fill(0);
+}
+
+FramePipeline::~FramePipeline() = default;
+
+void FramePipeline::reset() { impl_->frames_done = 0; }
+
+void FramePipeline::set_visibility(core::Eye eye, const core::ViewMask& mask) {
+  EyeState& e = *impl_->eyes[std::size_t(impl_->index(eye, "set_visibility"))];
+  if (mask.width() != e.base_view.width() || mask.height() != e.base_view.height())
+    throw core::InputError("visibility mask: " + std::to_string(mask.width()) + "x" + std::to_string(mask.height()) +
+                           " differs from the eye's raster " + std::to_string(e.base_view.width()) + "x" +
+                           std::to_string(e.base_view.height()));
+  e.mask.assign(mask.words().begin(), mask.words().end());
+}
+
+FrameTimes FramePipeline::render(const std::array<core::Pose, 2>& eye_pose, const std::array<glm::dvec3, 2>& gaze,
+                                 std::uint32_t frame) {
+  Impl& m = *impl_;
+  FrameTimes t;
+  core::TimeNs t0 = core::now_ns();
+  const int p = m.frames_done == 0 ? 0 : 1 - m.parity;
+  const bool history = m.frames_done > 0;
+  for (auto& e : m.eyes) {
+    const int i = int(e->eye);
+    e->pose = eye_pose[i];
+    e->dist->set_frame(gaze[i], frame);
+    e->grid_pass->prepare(*e->dist, e->mask);
+  }
+  t.grid.cpu_ms = lap_ms(t0);
+  m.write_mappings();
+  t.reconstruct.cpu_ms = lap_ms(t0);
+  const bool stereo = m.eyes.size() == 2;
+  const bool alternate = stereo && m.settings.share == reconstruct::StereoShare::Alternate;
+  // Alternating sharing: only one eye traces indirect diffuse this frame.
+  bool fresh[2] = {true, true};
+  for (std::size_t i = 0; i < m.eyes.size(); ++i) fresh[i] = !alternate || int(m.eyes[i]->eye) == int(frame % 2);
+
+  double recording_ms = 0;  // inside submit_and_wait, counted to the stages
+  m.ctx.submit_and_wait([&](VkCommandBuffer cmd) {
+    const core::TimeNs start = core::now_ns();
+    core::TimeNs r0 = start;
+    m.timer.begin(cmd);
+    for (auto& e : m.eyes) e->grid_pass->record(cmd, e->grid);
+    gpu::compute_to_compute(cmd);
+    m.timer.stage(cmd, "grid");
+    t.grid.cpu_ms += lap_ms(r0);
+    for (std::size_t i = 0; i < m.eyes.size(); ++i) {
+      EyeState& e = *m.eyes[i];
+      renderer::PathConfig cfg = m.path;
+      if (!fresh[i]) cfg.max_bounces = 0;
+      m.tracer.record(cmd, e.trace, core::View(e.base_view.fov(), e.base_view.width(), e.base_view.height(), e.pose),
+                      e.eye, frame, cfg);
+    }
+    gpu::compute_to_compute(cmd);
+    m.timer.stage(cmd, "trace");
+    t.trace.cpu_ms = lap_ms(r0);
+    m.accumulation->record(cmd, p, history, std::span(fresh, m.eyes.size()), m.settings.alpha_min);
+    m.gather->record(cmd, p, stereo && m.settings.share != reconstruct::StereoShare::Off);
+    m.timer.stage(cmd, "accumulate");
+    if (m.bmfr)
+      m.bmfr->record(cmd, p, frame, m.settings.block_offsets ? reconstruct::bmfr_block_offset(frame) : glm::ivec2(0),
+                     m.settings.noise);
+    m.timer.stage(cmd, "bmfr_fit");
+    m.post->record(cmd, p, history, m.settings);
+    m.timer.stage(cmd, "post");
+    t.reconstruct.cpu_ms += lap_ms(r0);
+    std::vector<const gpu::Buffer*> finals;
+    for (std::size_t i = 0; i < m.eyes.size(); ++i) finals.push_back(&m.post->final_color(int(i), p));
+    m.resolve->record_copy(cmd, finals);
+    m.resolve->record_depth(cmd, p);
+    m.resolve->record_resolve(cmd, m.settings.blur, m.settings);
+    m.timer.stage(cmd, "resolve");
+    t.resolve.cpu_ms = lap_ms(r0);
+    recording_ms = core::ns_to_ms(r0 - start);
+  });
+  t.submit_cpu_ms = std::max(0.0, lap_ms(t0) - recording_ms);
+  for (auto& e : m.eyes) e->mapping->advance(e->pose);
+  m.parity = p;
+  ++m.frames_done;
+  t.reconstruct.cpu_ms += lap_ms(t0);
+
+  if (const auto stages = m.timer.read()) {
+    for (const gpu::StageTime& s : *stages) {
+      const double ms = double(s.duration_ns()) * 1e-6;
+      if (s.name == "grid") t.grid.gpu_ms += ms;
+      else if (s.name == "trace") t.trace.gpu_ms += ms;
+      else if (s.name == "resolve") t.resolve.gpu_ms += ms;
+      else t.reconstruct.gpu_ms += ms;
+      if (s.name == "bmfr_fit") t.bmfr_fit_gpu_ms = ms;
+    }
+  }
+  return t;
+}
+
+core::Image FramePipeline::image(core::Eye e) const {
+  const int i = impl_->index(e, "image");
+  const core::View& v = impl_->eyes[std::size_t(i)]->base_view;
+  core::Image img(v.width(), v.height());
+  img.pixels = impl_->resolve->screen(i).download<glm::vec4>();
+  img.pixels.resize(std::size_t(img.width) * img.height);
+  return img;
+}
+
+std::vector<float> FramePipeline::depth(core::Eye e) const {
+  const int i = impl_->index(e, "depth");
+  const core::View& v = impl_->eyes[std::size_t(i)]->base_view;
+  std::vector<float> d = impl_->resolve->depth(i).download<float>();
+  d.resize(std::size_t(v.width()) * std::size_t(v.height()));
+  return d;
+}
+
+std::vector<shaders::GridSample> FramePipeline::grid_samples(core::Eye eye) const {
+  const EyeState& e = *impl_->eyes[std::size_t(impl_->index(eye, "grid_samples"))];
+  std::vector<shaders::GridSample> v = e.grid.download<shaders::GridSample>();
+  v.resize(e.cells);
+  return v;
+}
+
+std::int64_t FramePipeline::traced_cells(core::Eye eye) const {
+  std::int64_t n = 0;
+  for (const auto& s : grid_samples(eye)) n += s.flags == 0 ? 1 : 0;
+  return n;
+}
+
+std::int64_t FramePipeline::hidden_cells(core::Eye eye) const {
+  std::int64_t n = 0;
+  for (const auto& s : grid_samples(eye)) n += s.flags == shaders::kCellHidden ? 1 : 0;
+  return n;
+}
+
+IndirectSamples FramePipeline::indirect_samples(core::Eye eye) const {
+  const int i = impl_->index(eye, "indirect_samples");
+  const auto mean_w = [](const std::vector<glm::vec4>& v) {
+    double s = 0;
+    long n = 0;
+    for (const auto& c : v)
+      if (c.w > 0) s += c.w, ++n;
+    return n ? s / double(n) : 0.0;
+  };
+  return {mean_w(impl_->accumulation->indirect(i, impl_->parity).download<glm::vec4>()),
+          mean_w(impl_->gather->shared(i).download<glm::vec4>())};
+}
+
+const core::SampleDistribution& FramePipeline::distribution(core::Eye eye) const {
+  return *impl_->eyes[std::size_t(impl_->index(eye, "distribution"))]->dist;
+}
+
+core::View FramePipeline::view(core::Eye eye) const {
+  const EyeState& e = *impl_->eyes[std::size_t(impl_->index(eye, "view"))];
+  return core::View(e.base_view.fov(), e.base_view.width(), e.base_view.height(), e.pose);
+}
+
+int FramePipeline::eyes() const { return int(impl_->eyes.size()); }
+const reconstruct::ReconSettings& FramePipeline::settings() const { return impl_->settings; }
+
+}  // namespace fovea::pipeline

@@ -1,0 +1,64 @@
+#pragma once
+// FramePipeline's state, shared by frame_pipeline.cpp and the test access (testing.cpp).
+#include <memory>
+#include <vector>
+
+#include "fovea/gpu/grid_pass.hpp"
+#include "fovea/gpu/timer.hpp"
+#include "fovea/pipeline/frame_pipeline.hpp"
+#include "fovea/reconstruct/grid_map.hpp"
+#include "fovea/reconstruct/stages.hpp"
+
+namespace fovea::pipeline {
+
+struct EyeState {
+  core::Eye eye = core::Eye::Left;
+  std::unique_ptr<core::SampleDistribution> dist;
+  core::View base_view;
+  core::Pose pose;
+  std::unique_ptr<gpu::GridPass> grid_pass;
+  gpu::Buffer grid;
+  renderer::TraceOutputs trace;
+  std::uint32_t cells = 0;
+  std::unique_ptr<reconstruct::GridMapping> mapping;
+  std::vector<std::uint32_t> mask;  // ViewMask words; empty: every cell is visible
+};
+
+struct FramePipeline::Impl {
+  gpu::Context& ctx;
+  reconstruct::ReconSettings settings;
+  renderer::PathConfig path;
+  renderer::PathTracer tracer;
+  std::vector<std::unique_ptr<EyeState>> eyes;
+  std::unique_ptr<reconstruct::Accumulation> accumulation;
+  std::unique_ptr<reconstruct::StereoGather> gather;
+  std::unique_ptr<reconstruct::Bmfr> bmfr;  // null without the BMFR denoiser
+  std::unique_ptr<reconstruct::PostTaa> post;
+  std::unique_ptr<reconstruct::Resolve> resolve;
+  gpu::GpuTimer timer;
+  std::uint32_t frames_done = 0;  // frames since the last reset
+  int parity = 0;                 // history buffers written by the last frame
+
+  Impl(gpu::Context& c, const renderer::GpuScene& scene, const renderer::PathConfig& p,
+       const reconstruct::ReconSettings& s)
+      : ctx(c), settings(s), path(p), tracer(c, scene), timer(c) {}
+
+  const EyeState* other(const EyeState& e) const {
+    if (eyes.size() < 2) return nullptr;
+    return eyes[0].get() == &e ? eyes[1].get() : eyes[0].get();
+  }
+  void write_mappings() {
+    for (auto& e : eyes) {
+      const EyeState* o = other(*e);
+      e->mapping->write(e->pose, o ? &o->pose : nullptr);
+    }
+  }
+  void fill(std::uint32_t word);
+  int index(core::Eye e, const char* what) const;  // throws InputError when `e` is not rendered
+};
+
+struct Access {
+  static FramePipeline::Impl& impl(const FramePipeline& p) { return *p.impl_; }
+};
+
+}  // namespace fovea::pipeline

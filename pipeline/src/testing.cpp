@@ -1,0 +1,49 @@
+#include "fovea/pipeline/testing.hpp"
+
+#include "fovea/core/error.hpp"
+#include "frame_pipeline_impl.hpp"
+
+namespace fovea::pipeline::testing {
+
+std::vector<glm::vec4> grid_buffer(const FramePipeline& pipeline, core::Eye eye, GridBuffer which) {
+  auto& m = Access::impl(pipeline);
+  const int i = m.index(eye, "grid_buffer");
+  const EyeState& e = *m.eyes[std::size_t(i)];
+  const int p = m.parity;
+  const gpu::Buffer* b = nullptr;
+  switch (which) {
+    case GridBuffer::Radiance: b = &e.trace.radiance(); break;
+    case GridBuffer::AccDirect: b = &m.accumulation->direct(i, p); break;
+    case GridBuffer::AccIndirect: b = &m.accumulation->indirect(i, p); break;
+    case GridBuffer::SharedIndirect: b = &m.gather->shared(i); break;
+    case GridBuffer::Fitted:
+      if (!m.bmfr) throw core::InputError("grid_buffer: no BMFR stage (denoiser none)");
+      b = &m.bmfr->fitted(i);
+      break;
+    case GridBuffer::Final: b = &m.post->final_color(i, p); break;
+    case GridBuffer::Albedo: b = &e.trace.albedo(); break;
+    case GridBuffer::Position: b = &m.accumulation->position(i, p); break;
+  }
+  std::vector<glm::vec4> v = b->download<glm::vec4>();
+  v.resize(e.cells);
+  return v;
+}
+
+void fill_buffers(FramePipeline& pipeline, std::uint32_t word) {
+  auto& m = Access::impl(pipeline);
+  m.fill(word);
+  m.frames_done = 0;
+}
+
+core::Image resolve_grid(FramePipeline& pipeline, core::Eye eye, const std::vector<glm::vec4>& grid, bool blur) {
+  auto& m = Access::impl(pipeline);
+  const int i = m.index(eye, "resolve_grid");
+  if (grid.size() != m.eyes[std::size_t(i)]->cells)
+    throw core::InputError("resolve_grid: grid size differs from the padded grid");
+  m.write_mappings();
+  m.resolve->level0(i).upload(grid);
+  m.ctx.submit_and_wait([&](VkCommandBuffer cmd) { m.resolve->record_resolve(cmd, blur, m.settings); });
+  return pipeline.image(eye);
+}
+
+}  // namespace fovea::pipeline::testing

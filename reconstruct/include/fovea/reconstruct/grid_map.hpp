@@ -1,0 +1,42 @@
+#pragma once
+// The per-frame grid mappings the reconstruction kernels read (shaders/include/fovea/shaders/
+// recon_grid.h): per eye, ReconGrid[3] = this frame, the previous frame (reprojection), the
+// other eye (stereo gather), and their column tables, in host-visible buffers.
+#include <cstdint>
+#include <vector>
+
+#include "fovea/core/distribution.hpp"
+#include "fovea/core/view.hpp"
+#include "fovea/gpu/buffer.hpp"
+#include "fovea/shaders/recon_grid.h"
+
+namespace fovea::reconstruct {
+
+// The grid mapping of `d`'s current frame seen from `eye_pose` (world), for the shaders;
+// its column table is expected at `table_offset` in the bound table buffer.
+shaders::ReconGrid recon_grid(const core::SampleDistribution& d, const core::Pose& eye_pose,
+                              std::uint32_t table_offset);
+
+class GridMapping {
+ public:
+  // `own` is the eye's distribution, `other` the other eye's (nullptr: one eye).
+  GridMapping(gpu::Context& ctx, const core::SampleDistribution& own, const core::SampleDistribution* other);
+
+  // Uploads this frame's mapping of both distributions (their current frame) with the poses.
+  void write(const core::Pose& own_pose, const core::Pose* other_pose);
+  // After a frame: this frame's mapping becomes the previous one.
+  void advance(const core::Pose& own_pose);
+
+  const gpu::Buffer& maps() const { return maps_; }
+  const gpu::Buffer& tables() const { return tables_; }
+
+ private:
+  const core::SampleDistribution* own_;
+  const core::SampleDistribution* other_;
+  std::uint32_t table_len_ = 1, other_table_len_ = 1;
+  shaders::ReconGrid prev_{};
+  std::vector<shaders::GridColumn> prev_table_;
+  gpu::Buffer maps_, tables_;
+};
+
+}  // namespace fovea::reconstruct

@@ -1,0 +1,146 @@
+#pragma once
+// The reconstruction stages (docs/reconstruction.md), one object each: it owns its kernels,
+// its per-eye buffers (ping-pong pairs where the stage keeps history) and descriptor sets,
+// and records both eyes' dispatches followed by the barrier its consumers need. Parity p is
+// the history slot a frame writes; it reads slot 1 − p.
+//   Accumulation (BMFR Phase I) → StereoGather → Bmfr (Phase II) → PostTaa (Phase III, TAA,
+//   albedo) → Resolve (φ-only mips, resolve to the display, depth, peripheral blur).
+#include <cstdint>
+#include <memory>
+#include <span>
+#include <vector>
+
+#include <vulkan/vulkan.h>
+
+#include "fovea/gpu/buffer.hpp"
+#include "fovea/gpu/descriptors.hpp"
+#include "fovea/gpu/pipeline.hpp"
+#include "fovea/reconstruct/bmfr.hpp"
+#include "fovea/reconstruct/settings.hpp"
+
+namespace fovea::reconstruct {
+
+// One eye's padded grid and the buffers every stage reads for it.
+struct EyeGrid {
+  std::uint32_t cells = 0, padded_columns = 0, padded_rows = 0;
+  bool polar = true;                   // φ-only mip chain (polar grids) or one level
+  std::uint32_t width = 0, height = 0;  // the display raster the grid resolves to
+  const gpu::Buffer* maps = nullptr;    // GridMapping::maps(), tables()
+  const gpu::Buffer* tables = nullptr;
+  // The path tracer's per-cell outputs (renderer::TraceOutputs) and the grid itself.
+  const gpu::Buffer *samples = nullptr, *direct = nullptr, *indirect = nullptr, *normal_depth = nullptr,
+                    *position_material = nullptr, *albedo = nullptr;
+};
+
+class Accumulation {
+ public:
+  Accumulation(gpu::Context& ctx, std::span<const EyeGrid> eyes, const gpu::Buffer& materials);
+  // `fresh[e]`: eye e traced new indirect diffuse this frame.
+  void record(VkCommandBuffer cmd, int parity, bool history, std::span<const bool> fresh, float alpha_min) const;
+  void fill(VkCommandBuffer cmd, std::uint32_t word) const;
+
+  const gpu::Buffer& direct(int eye, int parity) const { return eyes_[eye].direct[parity]; }
+  const gpu::Buffer& indirect(int eye, int parity) const { return eyes_[eye].indirect[parity]; }
+  const gpu::Buffer& position(int eye, int parity) const { return eyes_[eye].pos[parity]; }
+  const gpu::Buffer& normal(int eye, int parity) const { return eyes_[eye].nrm[parity]; }
+  const gpu::Buffer& tap_index(int eye) const { return eyes_[eye].tap_idx; }
+  const gpu::Buffer& tap_weight(int eye) const { return eyes_[eye].tap_w; }
+
+ private:
+  struct Eye {
+    std::uint32_t cells = 0;
+    gpu::Buffer direct[2], indirect[2], pos[2], nrm[2], tap_idx, tap_w;
+    gpu::DescriptorSet set[2];
+  };
+  gpu::ComputePipeline kernel_;
+  std::vector<Eye> eyes_;
+};
+
+class StereoGather {
+ public:
+  StereoGather(gpu::Context& ctx, std::span<const EyeGrid> eyes, const Accumulation& acc);
+  // `share`: gather the other eye's indirect diffuse (else z = own direct + indirect).
+  void record(VkCommandBuffer cmd, int parity, bool share) const;
+  void fill(VkCommandBuffer cmd, std::uint32_t word) const;
+
+  const gpu::Buffer& shared(int eye) const { return eyes_[eye].shared; }
+  const gpu::Buffer& z(int eye) const { return eyes_[eye].z; }
+
+ private:
+  struct Eye {
+    std::uint32_t cells = 0;
+    gpu::Buffer shared, z;
+    gpu::DescriptorSet set[2];
+  };
+  gpu::ComputePipeline kernel_;
+  std::vector<Eye> eyes_;
+};
+
+class Bmfr {
+ public:
+  Bmfr(gpu::Context& ctx, std::span<const EyeGrid> eyes, const Accumulation& acc, const StereoGather& gather,
+       BmfrPrecision precision);
+  void record(VkCommandBuffer cmd, int parity, std::uint32_t frame, glm::ivec2 offset, float noise) const;
+  void fill(VkCommandBuffer cmd, std::uint32_t word) const;
+
+  const gpu::Buffer& fitted(int eye) const { return eyes_[eye].fitted; }
+
+ private:
+  struct Eye {
+    BmfrGrid grid;
+    gpu::Buffer fitted;
+    gpu::DescriptorSet set[2];
+  };
+  BmfrFit fit_;
+  std::vector<Eye> eyes_;
+};
+
+class PostTaa {
+ public:
+  // `bmfr`: the fitted input, or nullptr when BMFR is off (Phase III then filters z).
+  PostTaa(gpu::Context& ctx, std::span<const EyeGrid> eyes, const Accumulation& acc, const StereoGather& gather,
+          const Bmfr* bmfr);
+  void record(VkCommandBuffer cmd, int parity, bool history, const ReconSettings& settings) const;
+  void fill(VkCommandBuffer cmd, std::uint32_t word) const;
+
+  // Remodulated output in grid space (.w = 1 where a sample exists).
+  const gpu::Buffer& final_color(int eye, int parity) const { return eyes_[eye].final_[parity]; }
+
+ private:
+  struct Eye {
+    std::uint32_t cells = 0;
+    gpu::Buffer post[2], final_[2];
+    gpu::DescriptorSet post_set[2], taa_set[2];
+  };
+  gpu::ComputePipeline post_, taa_;
+  std::vector<Eye> eyes_;
+};
+
+class Resolve {
+ public:
+  Resolve(gpu::Context& ctx, std::span<const EyeGrid> eyes, const Accumulation& acc);
+  // Copies a grid image into level 0 (transfer; the caller orders its writes before).
+  void record_copy(VkCommandBuffer cmd, std::span<const gpu::Buffer* const> grid_images) const;
+  // Depth of the nearest sample per display pixel from the positions of `parity`.
+  void record_depth(VkCommandBuffer cmd, int parity) const;
+  // Mips from level 0, resolve, optional blur: into the screen buffers.
+  void record_resolve(VkCommandBuffer cmd, bool blur, const ReconSettings& settings) const;
+  void fill(VkCommandBuffer cmd, std::uint32_t word) const;
+
+  gpu::Buffer& level0(int eye) { return eyes_[eye].mips; }  // for a given grid image
+  const gpu::Buffer& screen(int eye) const { return eyes_[eye].screen_a; }
+  const gpu::Buffer& depth(int eye) const { return eyes_[eye].depth; }
+
+ private:
+  struct Eye {
+    std::uint32_t cells = 0, width = 0, height = 0, padded_columns = 0, levels = 1;
+    std::vector<std::uint32_t> level_rows, level_offset;
+    gpu::Buffer mips, offsets, screen_a, screen_b, depth;
+    gpu::DescriptorSet mip_set, resolve_set, blur_h, blur_v, depth_set[2];
+  };
+  std::uint32_t max_levels() const;
+  gpu::ComputePipeline mip_, resolve_, blur_, depth_;
+  std::vector<Eye> eyes_;
+};
+
+}  // namespace fovea::reconstruct

@@ -1,0 +1,87 @@
+// BMFR Phase I and the stereo gather (shaders/recon_accumulate.comp, recon_share.comp).
+#include "bindings.hpp"
+#include "buffers.hpp"
+#include "fovea/gpu/barriers.hpp"
+#include "fovea/reconstruct/stages.hpp"
+#include "fovea/shaders/recon_grid.h"
+
+namespace fovea::reconstruct {
+
+Accumulation::Accumulation(gpu::Context& ctx, std::span<const EyeGrid> eyes, const gpu::Buffer& materials)
+    : kernel_(kernel<AccumulateBindings, shaders::ReconAccumulatePush>(ctx, "recon_accumulate.comp.spv")),
+      eyes_(eyes.size()) {
+  for (std::size_t i = 0; i < eyes.size(); ++i) {
+    const EyeGrid& g = eyes[i];
+    Eye& e = eyes_[i];
+    e.cells = g.cells;
+    const VkDeviceSize v4 = VkDeviceSize(g.cells) * 16;
+    for (int p = 0; p < 2; ++p) {
+      e.direct[p] = storage(ctx, v4, "recon.acc_direct");
+      e.indirect[p] = storage(ctx, v4, "recon.acc_indirect");
+      e.pos[p] = storage(ctx, v4, "recon.vpos");
+      e.nrm[p] = storage(ctx, v4, "recon.vnrm");
+    }
+    e.tap_idx = storage(ctx, v4, "recon.tap_idx");
+    e.tap_w = storage(ctx, v4, "recon.tap_w");
+    for (int p = 0; p < 2; ++p) {
+      const int q = 1 - p;  // history read by a frame writing p
+      e.set[p] = make_set(ctx, kernel_,
+                          AccumulateBindings{g.maps, g.tables, g.samples, g.direct, g.indirect, g.normal_depth,
+                                             g.position_material, &e.direct[q], &e.indirect[q], &e.pos[q], &e.nrm[q],
+                                             &e.direct[p], &e.indirect[p], &e.pos[p], &e.nrm[p], &e.tap_idx, &e.tap_w,
+                                             &materials});
+    }
+  }
+}
+
+void Accumulation::record(VkCommandBuffer cmd, int parity, bool history, std::span<const bool> fresh,
+                          float alpha_min) const {
+  for (std::size_t i = 0; i < eyes_.size(); ++i) {
+    const Eye& e = eyes_[i];
+    kernel_.run(cmd, {&e.set[parity]},
+                shaders::ReconAccumulatePush{e.cells, history ? 1u : 0u, fresh[i] ? 1u : 0u, 0, alpha_min, 0, 0, 0},
+                e.cells);
+  }
+  gpu::compute_to_compute(cmd);
+}
+
+void Accumulation::fill(VkCommandBuffer cmd, std::uint32_t word) const {
+  for (const Eye& e : eyes_) {
+    for (int p = 0; p < 2; ++p)
+      for (const gpu::Buffer* b : {&e.direct[p], &e.indirect[p], &e.pos[p], &e.nrm[p]}) gpu::fill_buffer(cmd, *b, word);
+    gpu::fill_buffer(cmd, e.tap_idx, word);
+    gpu::fill_buffer(cmd, e.tap_w, word);
+  }
+}
+
+StereoGather::StereoGather(gpu::Context& ctx, std::span<const EyeGrid> eyes, const Accumulation& acc)
+    : kernel_(kernel<ShareBindings, shaders::ReconSharePush>(ctx, "recon_share.comp.spv")), eyes_(eyes.size()) {
+  for (std::size_t i = 0; i < eyes.size(); ++i) {
+    const EyeGrid& g = eyes[i];
+    Eye& e = eyes_[i];
+    e.cells = g.cells;
+    e.shared = storage(ctx, VkDeviceSize(g.cells) * 16, "recon.shared_indirect");
+    e.z = storage(ctx, VkDeviceSize(g.cells) * 16, "recon.z");
+    const int me = int(i), other = eyes.size() == 2 ? 1 - me : me;  // one eye gathers from itself (unused)
+    for (int p = 0; p < 2; ++p)
+      e.set[p] = make_set(ctx, kernel_,
+                          ShareBindings{g.maps, g.tables, &acc.position(me, p), &acc.normal(me, p), &acc.direct(me, p),
+                                        &acc.indirect(me, p), &acc.position(other, p), &acc.normal(other, p),
+                                        &acc.indirect(other, p), &e.shared, &e.z});
+  }
+}
+
+void StereoGather::record(VkCommandBuffer cmd, int parity, bool share) const {
+  for (const Eye& e : eyes_)
+    kernel_.run(cmd, {&e.set[parity]}, shaders::ReconSharePush{e.cells, share ? 1u : 0u, 0, 0}, e.cells);
+  gpu::compute_to_compute(cmd);
+}
+
+void StereoGather::fill(VkCommandBuffer cmd, std::uint32_t word) const {
+  for (const Eye& e : eyes_) {
+    gpu::fill_buffer(cmd, e.shared, word);
+    gpu::fill_buffer(cmd, e.z, word);
+  }
+}
+
+}  // namespace fovea::reconstruct

@@ -1,0 +1,150 @@
+#pragma once
+// Typed binding structs of the reconstruction kernels: one named buffer per
+// `layout(binding = ...)`, indices from shaders/include/fovea/shaders/recon_bindings.h (the
+// constants the GLSL uses). A struct whose field count differs from the kernel's binding
+// count fails to compile; a slot list that misses or repeats a binding fails at start-up
+// (gpu::DescriptorSet::bind_all), and a layout that differs from the SPIR-V too
+// (gpu::ComputePipeline).
+#include <array>
+
+#include "fovea/gpu/descriptors.hpp"
+#include "fovea/shaders/recon_bindings.h"
+
+namespace fovea::reconstruct {
+
+using Buf = const gpu::Buffer*;
+
+#define FOVEA_BINDING_COUNT(count)           \
+  static constexpr std::uint32_t kCount = count; \
+  using Slots = std::array<gpu::BufferSlot, kCount>;
+
+struct AccumulateBindings {
+  FOVEA_BINDING_COUNT(RECON_ACC_COUNT)
+  Buf maps, tables, samples, direct, indirect, normal_depth, position_material, prev_direct, prev_indirect, prev_pos,
+      prev_nrm, out_direct, out_indirect, out_pos, out_nrm, tap_idx, tap_w, materials;
+  Slots slots() const {
+    return {{{RECON_MAPS, maps},
+             {RECON_TABLES, tables},
+             {RECON_ACC_SAMPLES, samples},
+             {RECON_ACC_DIRECT, direct},
+             {RECON_ACC_INDIRECT, indirect},
+             {RECON_ACC_NORMAL_DEPTH, normal_depth},
+             {RECON_ACC_POSITION_MATERIAL, position_material},
+             {RECON_ACC_PREV_DIRECT, prev_direct},
+             {RECON_ACC_PREV_INDIRECT, prev_indirect},
+             {RECON_ACC_PREV_POS, prev_pos},
+             {RECON_ACC_PREV_NRM, prev_nrm},
+             {RECON_ACC_OUT_DIRECT, out_direct},
+             {RECON_ACC_OUT_INDIRECT, out_indirect},
+             {RECON_ACC_OUT_POS, out_pos},
+             {RECON_ACC_OUT_NRM, out_nrm},
+             {RECON_ACC_TAP_IDX, tap_idx},
+             {RECON_ACC_TAP_W, tap_w},
+             {RECON_ACC_MATERIALS, materials}}};
+  }
+};
+
+struct ShareBindings {
+  FOVEA_BINDING_COUNT(RECON_SHARE_COUNT)
+  Buf maps, tables, pos, nrm, acc_direct, acc_indirect, other_pos, other_nrm, other_indirect, shared, z;
+  Slots slots() const {
+    return {{{RECON_MAPS, maps},
+             {RECON_TABLES, tables},
+             {RECON_SHARE_POS, pos},
+             {RECON_SHARE_NRM, nrm},
+             {RECON_SHARE_ACC_DIRECT, acc_direct},
+             {RECON_SHARE_ACC_INDIRECT, acc_indirect},
+             {RECON_SHARE_OTHER_POS, other_pos},
+             {RECON_SHARE_OTHER_NRM, other_nrm},
+             {RECON_SHARE_OTHER_INDIRECT, other_indirect},
+             {RECON_SHARE_SHARED, shared},
+             {RECON_SHARE_Z, z}}};
+  }
+};
+
+struct BmfrBindings {
+  FOVEA_BINDING_COUNT(RECON_BMFR_COUNT)
+  Buf pos, nrm, z, fitted;
+  Slots slots() const {
+    return {{{RECON_BMFR_POS, pos}, {RECON_BMFR_NRM, nrm}, {RECON_BMFR_Z, z}, {RECON_BMFR_FITTED, fitted}}};
+  }
+};
+
+struct PostBindings {
+  FOVEA_BINDING_COUNT(RECON_POST_COUNT)
+  Buf pos, tap_idx, tap_w, source, acc_direct, prev, out;
+  Slots slots() const {
+    return {{{RECON_POST_POS, pos},
+             {RECON_POST_TAP_IDX, tap_idx},
+             {RECON_POST_TAP_W, tap_w},
+             {RECON_POST_SOURCE, source},
+             {RECON_POST_ACC_DIRECT, acc_direct},
+             {RECON_POST_PREV, prev},
+             {RECON_POST_OUT, out}}};
+  }
+};
+
+struct TaaBindings {
+  FOVEA_BINDING_COUNT(RECON_TAA_COUNT)
+  Buf maps, tables, pos, tap_idx, tap_w, post, albedo, prev_final, final_color;
+  Slots slots() const {
+    return {{{RECON_MAPS, maps},
+             {RECON_TABLES, tables},
+             {RECON_TAA_POS, pos},
+             {RECON_TAA_TAP_IDX, tap_idx},
+             {RECON_TAA_TAP_W, tap_w},
+             {RECON_TAA_POST, post},
+             {RECON_TAA_ALBEDO, albedo},
+             {RECON_TAA_PREV_FINAL, prev_final},
+             {RECON_TAA_FINAL, final_color}}};
+  }
+};
+
+struct MipBindings {
+  FOVEA_BINDING_COUNT(RECON_MIP_COUNT)
+  Buf maps, tables, mips;
+  Slots slots() const { return {{{RECON_MAPS, maps}, {RECON_TABLES, tables}, {RECON_MIP_MIPS, mips}}}; }
+};
+
+struct ResolveBindings {
+  FOVEA_BINDING_COUNT(RECON_RESOLVE_COUNT)
+  Buf maps, tables, mips, offsets, screen;
+  Slots slots() const {
+    return {{{RECON_MAPS, maps},
+             {RECON_TABLES, tables},
+             {RECON_RESOLVE_MIPS, mips},
+             {RECON_RESOLVE_OFFSETS, offsets},
+             {RECON_RESOLVE_SCREEN, screen}}};
+  }
+};
+
+struct BlurBindings {
+  FOVEA_BINDING_COUNT(RECON_BLUR_COUNT)
+  Buf maps, tables, src, dst;
+  Slots slots() const {
+    return {{{RECON_MAPS, maps}, {RECON_TABLES, tables}, {RECON_BLUR_SRC, src}, {RECON_BLUR_DST, dst}}};
+  }
+};
+
+struct DepthBindings {
+  FOVEA_BINDING_COUNT(RECON_DEPTH_COUNT)
+  Buf maps, tables, pos, depth;
+  Slots slots() const {
+    return {{{RECON_MAPS, maps}, {RECON_TABLES, tables}, {RECON_DEPTH_POS, pos}, {RECON_DEPTH_OUT, depth}}};
+  }
+};
+
+#undef FOVEA_BINDING_COUNT
+
+// One pointer field per binding: a field added or dropped without the constant breaks here.
+static_assert(sizeof(AccumulateBindings) == AccumulateBindings::kCount * sizeof(Buf));
+static_assert(sizeof(ShareBindings) == ShareBindings::kCount * sizeof(Buf));
+static_assert(sizeof(BmfrBindings) == BmfrBindings::kCount * sizeof(Buf));
+static_assert(sizeof(PostBindings) == PostBindings::kCount * sizeof(Buf));
+static_assert(sizeof(TaaBindings) == TaaBindings::kCount * sizeof(Buf));
+static_assert(sizeof(MipBindings) == MipBindings::kCount * sizeof(Buf));
+static_assert(sizeof(ResolveBindings) == ResolveBindings::kCount * sizeof(Buf));
+static_assert(sizeof(BlurBindings) == BlurBindings::kCount * sizeof(Buf));
+static_assert(sizeof(DepthBindings) == DepthBindings::kCount * sizeof(Buf));
+
+}  // namespace fovea::reconstruct

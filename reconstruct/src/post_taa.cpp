@@ -1,0 +1,60 @@
+// BMFR Phase III, TAA and albedo re-modulation (shaders/recon_post.comp, recon_taa.comp).
+#include "bindings.hpp"
+#include "buffers.hpp"
+#include "fovea/gpu/barriers.hpp"
+#include "fovea/reconstruct/stages.hpp"
+#include "fovea/shaders/recon_grid.h"
+
+namespace fovea::reconstruct {
+
+PostTaa::PostTaa(gpu::Context& ctx, std::span<const EyeGrid> eyes, const Accumulation& acc,
+                 const StereoGather& gather, const Bmfr* bmfr)
+    : post_(kernel<PostBindings, shaders::ReconPostPush>(ctx, "recon_post.comp.spv")),
+      taa_(kernel<TaaBindings, shaders::ReconPostPush>(ctx, "recon_taa.comp.spv")),
+      eyes_(eyes.size()) {
+  for (std::size_t i = 0; i < eyes.size(); ++i) {
+    const EyeGrid& g = eyes[i];
+    Eye& e = eyes_[i];
+    const int me = int(i);
+    e.cells = g.cells;
+    for (int p = 0; p < 2; ++p) {
+      e.post[p] = storage(ctx, VkDeviceSize(g.cells) * 16, "recon.post");
+      e.final_[p] = storage(ctx, VkDeviceSize(g.cells) * 16, "recon.final");
+    }
+    const gpu::Buffer* source = bmfr ? &bmfr->fitted(me) : &gather.z(me);
+    for (int p = 0; p < 2; ++p) {
+      const int q = 1 - p;
+      e.post_set[p] = make_set(ctx, post_,
+                               PostBindings{&acc.position(me, p), &acc.tap_index(me), &acc.tap_weight(me), source,
+                                            &acc.direct(me, p), &e.post[q], &e.post[p]});
+      e.taa_set[p] = make_set(ctx, taa_,
+                              TaaBindings{g.maps, g.tables, &acc.position(me, p), &acc.tap_index(me),
+                                          &acc.tap_weight(me), &e.post[p], g.albedo, &e.final_[q], &e.final_[p]});
+    }
+  }
+}
+
+void PostTaa::record(VkCommandBuffer cmd, int parity, bool history, const ReconSettings& s) const {
+  const bool bmfr = s.denoiser == Denoiser::Bmfr;
+  shaders::ReconPostPush push{0, history ? 1u : 0u, bmfr ? 1u : 0u, 0, s.post_alpha_min, s.taa_alpha, 0, 0};
+  for (const Eye& e : eyes_) {
+    push.cells = e.cells;
+    post_.run(cmd, {&e.post_set[parity]}, push, e.cells);
+  }
+  gpu::compute_to_compute(cmd);
+  for (const Eye& e : eyes_) {
+    push.cells = e.cells;
+    taa_.run(cmd, {&e.taa_set[parity]}, push, e.cells);
+  }
+  gpu::compute_to_transfer(cmd);
+}
+
+void PostTaa::fill(VkCommandBuffer cmd, std::uint32_t word) const {
+  for (const Eye& e : eyes_)
+    for (int p = 0; p < 2; ++p) {
+      gpu::fill_buffer(cmd, e.post[p], word);
+      gpu::fill_buffer(cmd, e.final_[p], word);
+    }
+}
+
+}  // namespace fovea::reconstruct

@@ -1,0 +1,102 @@
+// Resolve to the display (shaders/recon_mip.comp, recon_resolve.comp, recon_blur.comp) and
+// the display-space depth (recon_depth.comp).
+#include <algorithm>
+
+#include "bindings.hpp"
+#include "buffers.hpp"
+#include "fovea/gpu/barriers.hpp"
+#include "fovea/reconstruct/stages.hpp"
+#include "fovea/shaders/recon_grid.h"
+
+namespace fovea::reconstruct {
+
+namespace {
+constexpr std::uint32_t kMaxMipLevels = 12;
+}
+
+Resolve::Resolve(gpu::Context& ctx, std::span<const EyeGrid> eyes, const Accumulation& acc)
+    : mip_(kernel<MipBindings, shaders::ReconMipPush>(ctx, "recon_mip.comp.spv")),
+      resolve_(kernel<ResolveBindings, shaders::ReconResolvePush>(ctx, "recon_resolve.comp.spv")),
+      blur_(kernel<BlurBindings, shaders::ReconBlurPush>(ctx, "recon_blur.comp.spv")),
+      depth_(kernel<DepthBindings, shaders::ReconResolvePush>(ctx, "recon_depth.comp.spv")),
+      eyes_(eyes.size()) {
+  for (std::size_t i = 0; i < eyes.size(); ++i) {
+    const EyeGrid& g = eyes[i];
+    Eye& e = eyes_[i];
+    e.cells = g.cells;
+    e.width = g.width;
+    e.height = g.height;
+    e.padded_columns = g.padded_columns;
+    // φ-only mip chain (polar grids): level l has ceil(rows / 2^l) rows.
+    std::uint32_t rows = g.padded_rows, offset = 0;
+    do {
+      e.level_rows.push_back(rows);
+      e.level_offset.push_back(offset);
+      offset += rows * g.padded_columns;
+      rows = (rows + 1) / 2;
+    } while (g.polar && e.level_rows.back() > 1 && e.level_rows.size() < kMaxMipLevels);
+    e.levels = std::uint32_t(e.level_rows.size());
+    e.mips = storage(ctx, VkDeviceSize(offset) * 16, "recon.mips");
+    e.offsets = storage(ctx, e.level_offset.size() * 4, "recon.mip_offsets");
+    e.offsets.upload(e.level_offset);
+    const VkDeviceSize screen = VkDeviceSize(g.width) * g.height * 16;
+    e.screen_a = storage(ctx, screen, "recon.screen");
+    e.screen_b = storage(ctx, screen, "recon.screen_tmp");
+    e.depth = storage(ctx, screen / 4, "recon.depth");
+    e.mip_set = make_set(ctx, mip_, MipBindings{g.maps, g.tables, &e.mips});
+    e.resolve_set = make_set(ctx, resolve_, ResolveBindings{g.maps, g.tables, &e.mips, &e.offsets, &e.screen_a});
+    e.blur_h = make_set(ctx, blur_, BlurBindings{g.maps, g.tables, &e.screen_a, &e.screen_b});
+    e.blur_v = make_set(ctx, blur_, BlurBindings{g.maps, g.tables, &e.screen_b, &e.screen_a});
+    for (int p = 0; p < 2; ++p)
+      e.depth_set[p] = make_set(ctx, depth_, DepthBindings{g.maps, g.tables, &acc.position(int(i), p), &e.depth});
+  }
+}
+
+std::uint32_t Resolve::max_levels() const {
+  std::uint32_t m = 1;
+  for (const Eye& e : eyes_) m = std::max(m, e.levels);
+  return m;
+}
+
+void Resolve::record_copy(VkCommandBuffer cmd, std::span<const gpu::Buffer* const> grid_images) const {
+  for (std::size_t i = 0; i < eyes_.size(); ++i)
+    gpu::copy_buffer(cmd, *grid_images[i], eyes_[i].mips, VkDeviceSize(eyes_[i].cells) * 16);
+  gpu::transfer_to_compute(cmd);
+}
+
+void Resolve::record_depth(VkCommandBuffer cmd, int parity) const {
+  for (const Eye& e : eyes_)
+    depth_.run(cmd, {&e.depth_set[parity]}, shaders::ReconResolvePush{e.width, e.height, 0, 0}, e.width, e.height);
+}
+
+void Resolve::record_resolve(VkCommandBuffer cmd, bool blur, const ReconSettings& s) const {
+  for (std::uint32_t l = 0; l + 1 < max_levels(); ++l) {
+    for (const Eye& e : eyes_) {
+      if (l + 1 >= e.levels) continue;
+      const shaders::ReconMipPush push{e.padded_columns, e.level_rows[l], e.level_rows[l + 1], l, e.level_offset[l],
+                                       e.level_offset[l + 1], 0, 0};
+      mip_.run(cmd, {&e.mip_set}, push, e.padded_columns, e.level_rows[l + 1]);
+    }
+    gpu::compute_to_compute(cmd);
+  }
+  for (const Eye& e : eyes_)
+    resolve_.run(cmd, {&e.resolve_set}, shaders::ReconResolvePush{e.width, e.height, e.levels, 0}, e.width, e.height);
+  gpu::compute_to_compute(cmd);
+  if (!blur) return;
+  for (int pass = 0; pass < 2; ++pass) {
+    for (const Eye& e : eyes_) {
+      const shaders::ReconBlurPush push{e.width, e.height, std::uint32_t(pass), 0, float(s.blur_fovea_deg),
+                                        float(s.blur_sigma_deg_at_30 / (30.0 - s.blur_fovea_deg)),
+                                        float(s.blur_max_sigma_px), 0};
+      blur_.run(cmd, {pass == 0 ? &e.blur_h : &e.blur_v}, push, e.width, e.height);
+    }
+    gpu::compute_to_compute(cmd);
+  }
+}
+
+void Resolve::fill(VkCommandBuffer cmd, std::uint32_t word) const {
+  for (const Eye& e : eyes_)
+    for (const gpu::Buffer* b : {&e.mips, &e.screen_a, &e.screen_b, &e.depth}) gpu::fill_buffer(cmd, *b, word);
+}
+
+}  // namespace fovea::reconstruct

@@ -1,0 +1,32 @@
+#include "fovea/reconstruct/settings.hpp"
+
+#include <string>
+
+#include "fovea/core/error.hpp"
+
+namespace fovea::reconstruct {
+
+Denoiser parse_denoiser(std::string_view s) {
+  if (s == "bmfr") return Denoiser::Bmfr;
+  if (s == "none") return Denoiser::None;
+  throw core::InputError("--denoiser: unknown \"" + std::string(s) + "\" (expected bmfr|none)");
+}
+
+StereoShare parse_stereo_share(std::string_view s) {
+  if (s == "off") return StereoShare::Off;
+  if (s == "gather") return StereoShare::Gather;
+  if (s == "alternate") return StereoShare::Alternate;
+  throw core::InputError("--stereo-share: unknown \"" + std::string(s) + "\" (expected off|gather|alternate)");
+}
+
+const char* denoiser_name(Denoiser d) { return d == Denoiser::Bmfr ? "bmfr" : "none"; }
+
+const char* stereo_share_name(StereoShare s) {
+  switch (s) {
+    case StereoShare::Gather: return "gather";
+    case StereoShare::Alternate: return "alternate";
+    default: return "off";
+  }
+}
+
+}  // namespace fovea::reconstruct

@@ -1,0 +1,91 @@
+// Descriptor binding indices of the reconstruction kernels (shaders/recon_*.comp), one
+// definition for the GLSL `layout(binding = ...)` and the C++ binding structs
+// (reconstruct/src/bindings.hpp). gpu::ComputePipeline checks the layout against the
+// SPIR-V at start-up, DescriptorSet::bind_all that every binding is given once.
+#ifndef FOVEA_SHADERS_RECON_BINDINGS_H
+#define FOVEA_SHADERS_RECON_BINDINGS_H
+
+// The grid mappings (ReconGrid[3]: this frame, previous frame, other eye) and their column
+// tables: the same two bindings in every kernel that maps between grid and display.
+#define RECON_MAPS 0
+#define RECON_TABLES 1
+
+// recon_accumulate.comp (BMFR Phase I)
+#define RECON_ACC_SAMPLES 2
+#define RECON_ACC_DIRECT 3
+#define RECON_ACC_INDIRECT 4
+#define RECON_ACC_NORMAL_DEPTH 5
+#define RECON_ACC_POSITION_MATERIAL 6
+#define RECON_ACC_PREV_DIRECT 7
+#define RECON_ACC_PREV_INDIRECT 8
+#define RECON_ACC_PREV_POS 9
+#define RECON_ACC_PREV_NRM 10
+#define RECON_ACC_OUT_DIRECT 11
+#define RECON_ACC_OUT_INDIRECT 12
+#define RECON_ACC_OUT_POS 13
+#define RECON_ACC_OUT_NRM 14
+#define RECON_ACC_TAP_IDX 15
+#define RECON_ACC_TAP_W 16
+#define RECON_ACC_MATERIALS 17
+#define RECON_ACC_COUNT 18
+
+// recon_share.comp (stereo gather of indirect diffuse)
+#define RECON_SHARE_POS 2
+#define RECON_SHARE_NRM 3
+#define RECON_SHARE_ACC_DIRECT 4
+#define RECON_SHARE_ACC_INDIRECT 5
+#define RECON_SHARE_OTHER_POS 6
+#define RECON_SHARE_OTHER_NRM 7
+#define RECON_SHARE_OTHER_INDIRECT 8
+#define RECON_SHARE_SHARED 9
+#define RECON_SHARE_Z 10
+#define RECON_SHARE_COUNT 11
+
+// recon_bmfr_fit.comp (BMFR Phase II)
+#define RECON_BMFR_POS 0
+#define RECON_BMFR_NRM 1
+#define RECON_BMFR_Z 2
+#define RECON_BMFR_FITTED 3
+#define RECON_BMFR_COUNT 4
+
+// recon_post.comp (BMFR Phase III)
+#define RECON_POST_POS 0
+#define RECON_POST_TAP_IDX 1
+#define RECON_POST_TAP_W 2
+#define RECON_POST_SOURCE 3
+#define RECON_POST_ACC_DIRECT 4
+#define RECON_POST_PREV 5
+#define RECON_POST_OUT 6
+#define RECON_POST_COUNT 7
+
+// recon_taa.comp
+#define RECON_TAA_POS 2
+#define RECON_TAA_TAP_IDX 3
+#define RECON_TAA_TAP_W 4
+#define RECON_TAA_POST 5
+#define RECON_TAA_ALBEDO 6
+#define RECON_TAA_PREV_FINAL 7
+#define RECON_TAA_FINAL 8
+#define RECON_TAA_COUNT 9
+
+// recon_mip.comp
+#define RECON_MIP_MIPS 2
+#define RECON_MIP_COUNT 3
+
+// recon_resolve.comp
+#define RECON_RESOLVE_MIPS 2
+#define RECON_RESOLVE_OFFSETS 3
+#define RECON_RESOLVE_SCREEN 4
+#define RECON_RESOLVE_COUNT 5
+
+// recon_blur.comp
+#define RECON_BLUR_SRC 2
+#define RECON_BLUR_DST 3
+#define RECON_BLUR_COUNT 4
+
+// recon_depth.comp
+#define RECON_DEPTH_POS 2
+#define RECON_DEPTH_OUT 3
+#define RECON_DEPTH_COUNT 4
+
+#endif

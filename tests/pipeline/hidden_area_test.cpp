@@ -1,0 +1,66 @@
+// Hidden-area culling: with the lens' view mask set, the cells it hides are neither traced
+// nor reconstructed, and the cells it leaves visible render as without the mask.
+#include <cmath>
+
+#include "fovea/core/error.hpp"
+#include "fovea/core/eye_optics.hpp"
+#include "fovea/renderer/scene_io.hpp"
+#include "gpu_fixture.hpp"
+#include "pipeline_helpers.hpp"
+
+namespace pipeline = fovea::pipeline;
+namespace reconstruct = fovea::reconstruct;
+namespace core = fovea::core;
+namespace renderer = fovea::renderer;
+namespace shaders = fovea::shaders;
+using fovea::test::GpuTest;
+using pipeline::testing::GridBuffer;
+
+TEST_F(GpuTest, FramePipelineNeverTracesHiddenCells) {
+  const renderer::Scene scene = renderer::load_scene("cornell");
+  renderer::GpuScene gs(ctx(), scene);
+  const core::DisplayPreset display = core::load_display("tiny");
+  reconstruct::ReconSettings s;
+  s.denoiser = reconstruct::Denoiser::None;
+  pipeline::FramePipeline culled(ctx(), gs, core::stereo_views(display), {}, s, {}, true);
+  pipeline::FramePipeline full(ctx(), gs, core::stereo_views(display), {}, s, {}, true);
+  const core::ViewMask mask = core::EyeOptics(display, core::Eye::Left).view_mask();
+  culled.set_visibility(core::Eye::Left, mask);
+  // A NaN pattern everywhere first: whatever a hidden cell reads back was written this frame.
+  pipeline::testing::fill_buffers(culled, 0x7fc00001u);
+  const auto poses = core::eye_poses(scene.camera, display.ipd_m);
+  const std::array<glm::dvec3, 2> gaze{glm::normalize(glm::dvec3(0.1, 0.05, -1)), glm::dvec3(0, 0, -1)};
+  for (std::uint32_t f = 0; f < 2; ++f) {
+    culled.render(poses, gaze, f);
+    full.render(poses, gaze, f);
+  }
+  const auto samples = culled.grid_samples(core::Eye::Left);
+  const auto unmasked = full.grid_samples(core::Eye::Left);
+  const auto radiance = pipeline::testing::grid_buffer(culled, core::Eye::Left, GridBuffer::Radiance);
+  const auto position = pipeline::testing::grid_buffer(culled, core::Eye::Left, GridBuffer::Position);
+  const auto final_color = pipeline::testing::grid_buffer(culled, core::Eye::Left, GridBuffer::Final);
+  const auto full_position = pipeline::testing::grid_buffer(full, core::Eye::Left, GridBuffer::Position);
+  std::int64_t hidden = 0;
+  for (std::size_t i = 0; i < samples.size(); ++i) {
+    if (samples[i].flags != shaders::kCellHidden) {
+      EXPECT_EQ(samples[i].flags, unmasked[i].flags) << "cell " << i << ": only the mask differs";
+      continue;
+    }
+    ++hidden;
+    ASSERT_EQ(unmasked[i].flags, 0u) << "cell " << i << " is traced without the mask";
+    EXPECT_FALSE(mask.visible_at({samples[i].screen_x, samples[i].screen_y})) << "cell " << i;
+    // Not traced: the tracer's skip values; not reconstructed: Phase I's "no sample", black.
+    EXPECT_EQ(radiance[i], glm::vec4(0.0f)) << "cell " << i;
+    EXPECT_EQ(position[i].w, -2.0f) << "cell " << i;
+    EXPECT_NE(full_position[i].w, -2.0f) << "cell " << i << " has a sample without the mask";
+    EXPECT_EQ(final_color[i], glm::vec4(0.0f)) << "cell " << i;
+  }
+  EXPECT_GT(hidden, 0) << "the tiny preset's lens hides the view's corners";
+  EXPECT_EQ(culled.hidden_cells(core::Eye::Left), hidden);
+  EXPECT_EQ(full.hidden_cells(core::Eye::Left), 0);
+  EXPECT_EQ(culled.traced_cells(core::Eye::Left) + hidden, full.traced_cells(core::Eye::Left));
+  EXPECT_TRUE(fovea::test::all_finite(final_color));
+  // A mask of another raster is refused.
+  const core::ViewMask other = core::EyeOptics(core::load_display("small"), core::Eye::Left).view_mask();
+  EXPECT_THROW(culled.set_visibility(core::Eye::Left, other), core::InputError);
+}
