@@ -130,7 +130,8 @@ class PathTraceRenderer final : public FrameRenderer {
                                                             std::uint8_t((*config_.app_background)[1]),
                                                             std::uint8_t((*config_.app_background)[2])}
                               : border_colour(app[ei]);
-          composite(out[ei], a, config_.composite, bg);
+          composite(out[ei], a, config_.composite, bg,
+                    layer_blend(in.app_frame->layers[in.projection_layer]->layerFlags, pixel_format(format_)));
         }
       }
       Eye& eye = eyes_[ei];

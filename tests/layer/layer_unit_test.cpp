@@ -61,25 +61,75 @@ TEST(LayerComposite, AppOnTopKeysTheBackground) {
   const auto bg = border_colour(app);
   EXPECT_EQ(bg, (std::array<std::uint8_t, 3>{47, 79, 79}));
   Pixels8 scene = filled(8, 6, {200, 100, 50, 255});
-  EXPECT_EQ(composite(scene, app, Composite::AppOnTop, bg), 1);
+  EXPECT_EQ(composite(scene, app, Composite::AppOnTop, bg, LayerBlend{}), 1);
   EXPECT_EQ(scene.at(3, 2)[2], 255);
   EXPECT_EQ(scene.at(5, 2)[0], 200);
   EXPECT_EQ(scene.at(0, 0)[0], 200);
   Pixels8 only = filled(8, 6, {200, 100, 50, 255});
-  EXPECT_EQ(composite(only, app, Composite::SceneOnly, bg), 0);
+  EXPECT_EQ(composite(only, app, Composite::SceneOnly, bg, LayerBlend{}), 0);
   EXPECT_EQ(only.data, filled(8, 6, {200, 100, 50, 255}).data);
 }
 
-TEST(LayerComposite, AlphaBlendsStraightAlpha) {
-  Pixels8 app = filled(2, 2, {255, 0, 0, 0});
+// OpenXR layers are premultiplied unless XR_COMPOSITION_LAYER_UNPREMULTIPLIED_ALPHA_BIT is set.
+TEST(LayerComposite, AlphaBlendsPremultipliedByDefault) {
+  const XrCompositionLayerFlags flags = XR_COMPOSITION_LAYER_BLEND_TEXTURE_SOURCE_ALPHA_BIT;
+  const LayerBlend blend = layer_blend(flags, pixel_format(VK_FORMAT_R8G8B8A8_UNORM));
+  EXPECT_TRUE(blend.premultiplied);
+  Pixels8 app = filled(2, 2, {0, 0, 0, 0});
   std::copy_n(std::array<std::uint8_t, 4>{255, 0, 0, 255}.data(), 4, app.at(0, 0));
-  std::copy_n(std::array<std::uint8_t, 4>{255, 0, 0, 128}.data(), 4, app.at(1, 0));
+  std::copy_n(std::array<std::uint8_t, 4>{128, 0, 0, 128}.data(), 4, app.at(1, 0));  // red at half coverage
+  std::copy_n(std::array<std::uint8_t, 4>{0, 60, 0, 0}.data(), 4, app.at(1, 1));     // additive light
   Pixels8 scene = filled(2, 2, {0, 0, 200, 255});
-  EXPECT_EQ(composite(scene, app, Composite::Alpha, {0, 0, 0}), 2);
+  EXPECT_EQ(composite(scene, app, Composite::Alpha, {0, 0, 0}, blend), 3);
   EXPECT_EQ(scene.at(0, 0)[0], 255);
+  EXPECT_EQ(scene.at(1, 0)[0], 128);  // not 128 * 128 / 255 as straight alpha would give
+  EXPECT_EQ(scene.at(1, 0)[2], 100);
+  EXPECT_EQ(scene.at(1, 1)[1], 60);
+  EXPECT_EQ(scene.at(1, 1)[2], 200);
+  EXPECT_EQ(scene.at(0, 1)[2], 200);
+}
+
+TEST(LayerComposite, AlphaBlendsStraightAlphaWhenUnpremultiplied) {
+  const LayerBlend blend =
+      layer_blend(XR_COMPOSITION_LAYER_BLEND_TEXTURE_SOURCE_ALPHA_BIT | XR_COMPOSITION_LAYER_UNPREMULTIPLIED_ALPHA_BIT,
+                  pixel_format(VK_FORMAT_B8G8R8A8_UNORM));
+  EXPECT_FALSE(blend.premultiplied);
+  Pixels8 app = filled(2, 1, {255, 0, 0, 0});
+  std::copy_n(std::array<std::uint8_t, 4>{255, 0, 0, 128}.data(), 4, app.at(1, 0));
+  Pixels8 scene = filled(2, 1, {0, 0, 200, 255});
+  EXPECT_EQ(composite(scene, app, Composite::Alpha, {0, 0, 0}, blend), 1);
+  EXPECT_EQ(scene.at(0, 0)[0], 0);  // alpha 0: the scene
   EXPECT_EQ(scene.at(1, 0)[0], 128);
   EXPECT_EQ(scene.at(1, 0)[2], 100);
-  EXPECT_EQ(scene.at(0, 1)[2], 200);
+}
+
+// Without XR_COMPOSITION_LAYER_BLEND_TEXTURE_SOURCE_ALPHA_BIT the layer is opaque.
+TEST(LayerComposite, AlphaIgnoredWithoutSourceAlphaBit) {
+  const LayerBlend blend = layer_blend(0, pixel_format(VK_FORMAT_R8G8B8A8_SRGB));
+  EXPECT_FALSE(blend.source_alpha);
+  Pixels8 app = filled(1, 1, {10, 20, 30, 0});
+  Pixels8 scene = filled(1, 1, {0, 0, 200, 255});
+  EXPECT_EQ(composite(scene, app, Composite::Alpha, {0, 0, 0}, blend), 1);
+  EXPECT_EQ(scene.data, (std::vector<std::uint8_t>{10, 20, 30, 255}));
+}
+
+// sRGB swapchains blend in linear light: half coverage of white over black is linear 0.5,
+// sRGB-encoded 188, not the 128 of blending the encoded bytes.
+TEST(LayerComposite, AlphaBlendsInLinearLight) {
+  const LayerBlend blend = layer_blend(XR_COMPOSITION_LAYER_BLEND_TEXTURE_SOURCE_ALPHA_BIT |
+                                           XR_COMPOSITION_LAYER_UNPREMULTIPLIED_ALPHA_BIT,
+                                       pixel_format(VK_FORMAT_R8G8B8A8_SRGB));
+  Pixels8 app = filled(1, 1, {255, 255, 255, 128});
+  Pixels8 scene = filled(1, 1, {0, 0, 0, 255});
+  EXPECT_EQ(composite(scene, app, Composite::Alpha, {0, 0, 0}, blend), 1);
+  const int expected = int(std::lround(core::srgb_encode(128.0f / 255.0f) * 255.0f));
+  EXPECT_EQ(expected, 188);
+  EXPECT_EQ(scene.at(0, 0)[0], expected);
+  // A pixel over itself is unchanged whatever the coverage (no drift from re-encoding).
+  Pixels8 same = filled(1, 1, {90, 140, 200, 255});
+  const Pixels8 over = filled(1, 1, {90, 140, 200, 77});
+  composite(same, over, Composite::Alpha, {0, 0, 0}, blend);
+  EXPECT_EQ(same.data, (std::vector<std::uint8_t>{90, 140, 200, 255}));
 }
 
 TEST(LayerComposite, EncodesSceneForTheSwapchainFormat) {
