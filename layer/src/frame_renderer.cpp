@@ -63,7 +63,6 @@ class PathTraceRenderer final : public FrameRenderer {
   PathTraceRenderer(const LayerConfig& config, const VulkanBinding& vk, const Dispatch& next, XrSession session)
       : config_(config), next_(next), session_(session), scene_(renderer::load_scene(config.scene)), app_(vk) {
     for (const auto& w : scene_.warnings) FOVEA_LAYER_WARN("scene %s: %s", config.scene.c_str(), w.c_str());
-    if (config_.gaze.empty()) config_.gaze = "synthetic:1";
   }
 
   ~PathTraceRenderer() override {

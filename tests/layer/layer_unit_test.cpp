@@ -214,6 +214,28 @@ TEST(LayerGaze, TheActionGoesThroughTheSamePolicyWithItsSampleTime) {
   EXPECT_LT(core::angle_deg(rest.left.dir, glm::dvec3(0, 0, -1)), 1e-9);
 }
 
+// No gaze source configured: fixed foveation at the view centre, said in a warning, never a
+// synthetic scanpath.
+TEST(LayerGaze, WithoutASourceTheFoveaStaysAtTheViewCentre) {
+  testing::internal::CaptureStderr();
+  LayerGaze gaze("", core::load_display("small"));
+  const std::string err = testing::internal::GetCapturedStderr();
+  EXPECT_NE(err.find("warn: no gaze source configured"), std::string::npos) << err;
+  const std::int64_t t0 = 5'000'000'000;
+  for (int frame = 0; frame < 300; ++frame) {  // 3.3 s at 90 Hz
+    const devices::FoveaGaze g = gaze.frame(t0 + std::int64_t(frame) * 11'111'111, nullptr);
+    ASSERT_FALSE(g.has_sample);
+    for (core::Eye e : {core::Eye::Left, core::Eye::Right}) {
+      ASSERT_EQ(g.eye(e).state, devices::FoveaState::Resting) << frame;
+      ASSERT_LT(core::angle_deg(g.eye(e).dir, glm::dvec3(0, 0, -1)), 1e-9) << frame;
+    }
+  }
+  // The runtime's eye-gaze action still steers it when present.
+  const glm::dvec3 up = glm::normalize(glm::dvec3(0, 0.3, -1));
+  const ActionGaze a{up, t0 + 4'000'000'000};
+  EXPECT_LT(core::angle_deg(gaze.frame(t0 + 4'000'000'000, &a).left.dir, up), 1e-9);
+}
+
 // The window depth an application stores for view distance z (the inverse of view_distance).
 float window_depth(double z, const DepthRange& r) {
   const auto inverse = [](double v) { return std::isinf(v) ? 0.0 : 1.0 / v; };
