@@ -24,6 +24,7 @@
 #include "fovea/renderer/scene_io.hpp"
 #include "layer.hpp"
 #include "log.hpp"
+#include "next_chain.hpp"
 
 namespace fovea::layer {
 namespace {
@@ -148,13 +149,20 @@ class PathTraceRenderer final : public FrameRenderer {
 
     // The application's frame with its stereo projection layer replaced by the layer's.
     const auto* app_proj = reinterpret_cast<const XrCompositionLayerProjection*>(in.app_frame->layers[in.projection_layer]);
-    projection_ = *app_proj;
-    projection_.next = nullptr;  // the depth it may chain describes the application's image, not this one
+    projection_ = *app_proj;  // its next chain too
     projection_.viewCount = 2;
+    chains_.clear();
     projection_.views = views_.data();
     for (int e = 0; e < 2; ++e) {
       const auto ei = std::size_t(e);
       views_[ei] = {XR_TYPE_COMPOSITION_LAYER_PROJECTION_VIEW};
+      // Every structure the application chained, but the depth: it describes its image, not this one.
+      std::size_t lost = 0;
+      views_[ei].next = chains_.without(app_proj->views[ei].next, XR_TYPE_COMPOSITION_LAYER_DEPTH_INFO_KHR, &lost);
+      if (lost && !chain_noted_)
+        FOVEA_LAYER_WARN("%zu structure(s) of a type the layer does not know precede the depth chained to a "
+                         "projection view: they are not passed on", lost);
+      chain_noted_ |= lost > 0;
       views_[ei].pose = in.app_views[ei].pose;
       views_[ei].fov = in.app_views[ei].fov;
       views_[ei].subImage.swapchain = eyes_[ei].swapchain;
@@ -255,6 +263,8 @@ class PathTraceRenderer final : public FrameRenderer {
   std::unique_ptr<LayerGaze> gaze_;
   bool gaze_from_action_ = false;
   bool depth_noted_ = false;  // the depth decision was logged
+  bool chain_noted_ = false;  // a view's next chain could not be kept whole (logged once)
+  ChainCopies chains_;        // the views' next chains, this frame
   std::unique_ptr<gpu::Context> ctx_;
   std::unique_ptr<renderer::GpuScene> gpu_scene_;
   std::unique_ptr<compositor::FramePipeline> pipeline_;

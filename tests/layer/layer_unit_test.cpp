@@ -13,6 +13,7 @@
 #include "fovea/core/clock.hpp"
 #include "fovea/devices/hid_stream.hpp"
 #include "gaze_input.hpp"
+#include "next_chain.hpp"
 
 namespace fovea::layer {
 namespace {
@@ -283,6 +284,45 @@ TEST(LayerDepth, KeepsTheNearerSurfaceForEveryDepthConvention) {
   }
   Pixels8 scene = filled(2, 1, {0, 0, 0, 255});
   EXPECT_THROW(composite_depth(scene, {1}, filled(2, 1, {0, 0, 0, 255}), {0, 0}, DepthRange{}), std::logic_error);
+}
+
+// The replaced projection view keeps every structure the application chained but its depth.
+TEST(LayerNextChain, DropsOnlyTheDepth) {
+  XrCompositionLayerColorScaleBiasKHR after{XR_TYPE_COMPOSITION_LAYER_COLOR_SCALE_BIAS_KHR};
+  XrCompositionLayerDepthInfoKHR depth{XR_TYPE_COMPOSITION_LAYER_DEPTH_INFO_KHR, &after};
+  XrCompositionLayerColorScaleBiasKHR before{XR_TYPE_COMPOSITION_LAYER_COLOR_SCALE_BIAS_KHR, &depth};
+  before.colorScale = {0.5f, 0.25f, 1, 1};
+  ChainCopies copies;
+  std::size_t lost = 7;
+  const auto* head = static_cast<const XrCompositionLayerColorScaleBiasKHR*>(
+      copies.without(&before, XR_TYPE_COMPOSITION_LAYER_DEPTH_INFO_KHR, &lost));
+  EXPECT_EQ(lost, 0u);
+  ASSERT_NE(head, nullptr);
+  EXPECT_NE(head, &before);  // a copy: the application's chain is left untouched
+  EXPECT_EQ(before.next, &depth);
+  EXPECT_EQ(head->type, XR_TYPE_COMPOSITION_LAYER_COLOR_SCALE_BIAS_KHR);
+  EXPECT_EQ(head->colorScale.g, 0.25f);
+  EXPECT_EQ(head->next, &after);  // after the depth: shared
+  // Depth first or alone, or no depth at all: no copies needed.
+  EXPECT_EQ(copies.without(&depth, XR_TYPE_COMPOSITION_LAYER_DEPTH_INFO_KHR), &after);
+  EXPECT_EQ(copies.without(&after, XR_TYPE_COMPOSITION_LAYER_DEPTH_INFO_KHR), &after);
+  EXPECT_EQ(copies.without(nullptr, XR_TYPE_COMPOSITION_LAYER_DEPTH_INFO_KHR), nullptr);
+}
+
+TEST(LayerNextChain, AnUnknownStructureBeforeTheDepthIsCounted) {
+  XrCompositionLayerDepthInfoKHR depth{XR_TYPE_COMPOSITION_LAYER_DEPTH_INFO_KHR};
+  XrCompositionLayerColorScaleBiasKHR known{XR_TYPE_COMPOSITION_LAYER_COLOR_SCALE_BIAS_KHR, &depth};
+  const XrBaseInStructure unknown{XrStructureType(1000999999), reinterpret_cast<const XrBaseInStructure*>(&known)};
+  EXPECT_EQ(structure_size(unknown.type), 0u);
+  EXPECT_EQ(structure_size(XR_TYPE_COMPOSITION_LAYER_COLOR_SCALE_BIAS_KHR), sizeof(known));
+  ChainCopies copies;
+  std::size_t lost = 0;
+  const auto* head = static_cast<const XrBaseInStructure*>(
+      copies.without(&unknown, XR_TYPE_COMPOSITION_LAYER_DEPTH_INFO_KHR, &lost));
+  EXPECT_EQ(lost, 1u);
+  ASSERT_NE(head, nullptr);
+  EXPECT_EQ(head->type, XR_TYPE_COMPOSITION_LAYER_COLOR_SCALE_BIAS_KHR);
+  EXPECT_EQ(head->next, nullptr);
 }
 
 }  // namespace
