@@ -73,12 +73,35 @@ Pixels8 resample(const Pixels8& app, const core::View& app_view, const core::Vie
   return out;
 }
 
+LayerBlend layer_blend(XrCompositionLayerFlags flags, PixelFormat fmt) {
+  return {(flags & XR_COMPOSITION_LAYER_BLEND_TEXTURE_SOURCE_ALPHA_BIT) != 0,
+          (flags & XR_COMPOSITION_LAYER_UNPREMULTIPLIED_ALPHA_BIT) == 0, fmt.srgb};
+}
+
+namespace {
+
+// One 8-bit colour channel to linear [0, 1] and back (alpha is linear in every format).
+struct ChannelCodec {
+  std::array<float, 256> decode{};
+  bool srgb;
+  explicit ChannelCodec(bool srgb_) : srgb(srgb_) {
+    for (int i = 0; i < 256; ++i) decode[std::size_t(i)] = srgb ? core::srgb_decode(float(i) / 255.0f) : float(i) / 255.0f;
+  }
+  std::uint8_t encode(float v) const {
+    v = std::clamp(v, 0.0f, 1.0f);
+    return std::uint8_t(std::lround((srgb ? core::srgb_encode(v) : v) * 255.0f));
+  }
+};
+
+}  // namespace
+
 std::int64_t composite(Pixels8& scene, const Pixels8& app, Composite mode, std::array<std::uint8_t, 3> background,
-                       int tolerance) {
+                       const LayerBlend& blend, int tolerance) {
   if (app.width != scene.width || app.height != scene.height)
     throw std::logic_error("composite: the application's image and the scene differ in size");
   std::int64_t shown = 0;
   if (mode == Composite::SceneOnly) return 0;
+  const ChannelCodec codec(blend.srgb);
   for (int y = 0; y < scene.height; ++y)
     for (int x = 0; x < scene.width; ++x) {
       const std::uint8_t* a = app.at(x, y);
@@ -90,13 +113,27 @@ std::int64_t composite(Pixels8& scene, const Pixels8& app, Composite mode, std::
         if (!differs) continue;
         std::copy_n(a, 4, s);
         ++shown;
-      } else {
-        const int alpha = a[3];
-        if (alpha == 0) continue;
-        for (int c = 0; c < 3; ++c) s[c] = std::uint8_t((a[c] * alpha + s[c] * (255 - alpha) + 127) / 255);
+        continue;
+      }
+      // An opaque layer covers the scene: its pixels pass through unchanged.
+      const int alpha = blend.source_alpha ? a[3] : 255;
+      if (alpha == 255) {
+        std::copy_n(a, 3, s);
         s[3] = 255;
         ++shown;
+        continue;
       }
+      // Premultiplied: out = src + (1 - a) dst; straight: out = a src + (1 - a) dst. A fully
+      // transparent premultiplied pixel may still add light (additive content).
+      const float fa = float(alpha) / 255.0f;
+      const float src_weight = blend.premultiplied ? 1.0f : fa;
+      bool adds = false;
+      for (int c = 0; c < 3; ++c) adds |= a[c] != 0;
+      if (alpha == 0 && !(blend.premultiplied && adds)) continue;
+      for (int c = 0; c < 3; ++c)
+        s[c] = codec.encode(src_weight * codec.decode[a[c]] + (1.0f - fa) * codec.decode[s[c]]);
+      s[3] = 255;
+      ++shown;
     }
   return shown;
 }

@@ -1,13 +1,14 @@
 #pragma once
-// Combining the path-traced scene with the application's own pixels, on the host, in the
-// 8-bit encoding of the application's swapchain (so the application's pixels pass through
-// bit-exact wherever they are kept).
+// Combining the path-traced scene with the application's own pixels, on the host. Pixels are
+// kept in the 8-bit encoding of the application's swapchain (so the application's pixels pass
+// through bit-exact wherever they are kept); blending decodes to linear and re-encodes.
 #include <array>
 #include <cstdint>
 #include <optional>
 #include <vector>
 
 #include <vulkan/vulkan.h>
+#include <openxr/openxr.h>
 
 #include "config.hpp"
 #include "fovea/core/image.hpp"
@@ -45,12 +46,23 @@ std::array<std::uint8_t, 3> border_colour(const Pixels8& img);
 // did not cover get alpha 0.
 Pixels8 resample(const Pixels8& app, const core::View& app_view, const core::View& scene_view);
 
+// How the application's projection layer blends over what lies below it, from its
+// XrCompositionLayerFlags (OpenXR 1.0 "Composition Layer Blending"): without
+// XR_COMPOSITION_LAYER_BLEND_TEXTURE_SOURCE_ALPHA_BIT the layer is opaque; with it, colour is
+// premultiplied by alpha unless XR_COMPOSITION_LAYER_UNPREMULTIPLIED_ALPHA_BIT is set.
+struct LayerBlend {
+  bool source_alpha = false;
+  bool premultiplied = true;
+  bool srgb = false;  // the swapchain stores sRGB-encoded colour: blend after decoding
+};
+LayerBlend layer_blend(XrCompositionLayerFlags flags, PixelFormat fmt);
+
 // Composites `app` (same raster as `scene`) into `scene` by `mode`. AppOnTop keeps the
 // application's pixel where any channel differs from `background` by more than `tolerance`
-// (8-bit units); Alpha blends by the application's (straight) alpha in the stored encoding.
-// Returns how many pixels show the application.
+// (8-bit units); Alpha blends the application's layer over the scene as `blend` says, in
+// linear colour. Returns how many pixels show the application.
 std::int64_t composite(Pixels8& scene, const Pixels8& app, Composite mode, std::array<std::uint8_t, 3> background,
-                       int tolerance = 2);
+                       const LayerBlend& blend, int tolerance = 2);
 
 // The mapping of the application's depth values (XrCompositionLayerDepthInfoKHR): window
 // depth min_depth lies at view distance near_z, max_depth at far_z. near_z > far_z is

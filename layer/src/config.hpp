@@ -24,7 +24,7 @@ struct LayerConfig {
   // AppOnTop's background colour (8-bit, as stored in the application's image); unset: the
   // most frequent colour on the image border, per frame.
   std::optional<std::array<int, 3>> app_background;
-  std::string gaze;  // devices::open_gaze_source URI; empty: synthetic:1
+  std::string gaze;  // devices::open_gaze_source URI; empty: none (fixed foveation, gaze_input.hpp)
   std::string origin;  // where the scene setting came from, for the log
 };
 

@@ -144,17 +144,31 @@ const Dispatch* next_for_session(XrSession session) {
 XrResult intercept::xrDestroyInstance(XrInstance instance) {
   PFN_xrDestroyInstance next = nullptr;
   {
+    // What the layer created on the instance's handles goes first, while they are alive: the
+    // sessions' renderers (swapchains, frees on the application's device), eye-gaze spaces
+    // and the eye-gaze action set. The instance's table stays until the call down returns.
     std::lock_guard lock(layer().mutex);
     auto it = layer().instances.find(instance);
     if (it == layer().instances.end()) return XR_ERROR_HANDLE_INVALID;
-    next = it->second.next.xrDestroyInstance;
+    const Dispatch& d = it->second.next;
+    for (auto& [handle, session] : layer().sessions)
+      if (session.instance == instance) release_session(session, d);
+    destroy_eye_gaze_actions(d, it->second.gaze);
+    next = d.xrDestroyInstance;
   }
   const XrResult r = next(instance);
   if (XR_SUCCEEDED(r)) {
     std::lock_guard lock(layer().mutex);
     Layer& l = layer();
-    for (auto it = l.sessions.begin(); it != l.sessions.end();)
-      it = it->second.instance == instance ? l.sessions.erase(it) : std::next(it);
+    for (auto it = l.sessions.begin(); it != l.sessions.end();) {
+      if (it->second.instance != instance) {
+        ++it;
+        continue;
+      }
+      for (auto sc = l.swapchains.begin(); sc != l.swapchains.end();)
+        sc = sc->second.session == it->first ? l.swapchains.erase(sc) : std::next(sc);
+      it = l.sessions.erase(it);
+    }
     l.instances.erase(instance);
     if (l.last_instance == instance) l.last_instance = l.instances.empty() ? XR_NULL_HANDLE : l.instances.rbegin()->first;
   }

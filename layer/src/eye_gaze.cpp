@@ -39,6 +39,14 @@ EyeGazeActions create_eye_gaze_actions(const Dispatch& next, XrInstance instance
   std::strcpy(si.actionSetName, "xr_apilayer_fovea_gaze");
   std::strcpy(si.localizedActionSetName, "Fovea layer eye gaze");
   check(next.xrCreateActionSet(instance, &si, &a.set), "xrCreateActionSet");
+  // A later step's failure must not leave the set (and its action) behind in the runtime.
+  struct SetGuard {
+    const Dispatch& next;
+    XrActionSet set;
+    ~SetGuard() {
+      if (set != XR_NULL_HANDLE) next.xrDestroyActionSet(set);
+    }
+  } guard{next, a.set};
   XrActionCreateInfo ai{XR_TYPE_ACTION_CREATE_INFO};
   ai.actionType = XR_ACTION_TYPE_POSE_INPUT;
   std::strcpy(ai.actionName, "gaze");
@@ -52,7 +60,19 @@ EyeGazeActions create_eye_gaze_actions(const Dispatch& next, XrInstance instance
   sb.countSuggestedBindings = 1;
   sb.suggestedBindings = &b;
   check(next.xrSuggestInteractionProfileBindings(instance, &sb), "xrSuggestInteractionProfileBindings");
+  guard.set = XR_NULL_HANDLE;
   return a;
+}
+
+void destroy_eye_gaze_actions(const Dispatch& next, EyeGazeActions& a) {
+  if (a.set != XR_NULL_HANDLE) next.xrDestroyActionSet(a.set);  // its action goes with it
+  a = {};
+}
+
+void destroy_eye_gaze_session(const Dispatch& next, EyeGazeSession& s) {
+  for (XrSpace space : {s.gaze, s.view})
+    if (space != XR_NULL_HANDLE) next.xrDestroySpace(space);
+  s = {};
 }
 
 EyeGazeSession create_eye_gaze_session(const Dispatch& next, const EyeGazeActions& a, XrSession session) {

@@ -36,10 +36,13 @@ struct EyeGazeSession {
 
 // Whether the runtime (below the layer) offers the extension; false when it cannot be asked.
 bool runtime_has_eye_gaze(PFN_xrGetInstanceProcAddr next_gipa);
-// Creates the action set and action and suggests the binding; throws std::runtime_error.
+// Creates the action set and action and suggests the binding; throws std::runtime_error
+// after destroying whatever it had created.
 EyeGazeActions create_eye_gaze_actions(const Dispatch& next, XrInstance instance);
+void destroy_eye_gaze_actions(const Dispatch& next, EyeGazeActions& a);
 // The spaces for a session whose attach included the set; throws std::runtime_error.
 EyeGazeSession create_eye_gaze_session(const Dispatch& next, const EyeGazeActions& a, XrSession session);
+void destroy_eye_gaze_session(const Dispatch& next, EyeGazeSession& s);
 // The gaze direction in VIEW space at `time` (nullopt when not tracked) and the time of the
 // tracker sample behind it.
 ActionGaze locate_eye_gaze(const Dispatch& next, const EyeGazeSession& s, XrTime time);

@@ -2,6 +2,11 @@
 
 #include <time.h>
 
+#include <cerrno>
+#include <cstring>
+
+#include "log.hpp"
+
 namespace fovea::layer {
 
 std::int64_t now_ns() {
@@ -16,7 +21,14 @@ FrameLog::~FrameLog() {
 
 void FrameLog::open(const std::string& dir) {
   if (file_) std::fclose(file_);
-  file_ = dir.empty() ? nullptr : std::fopen((dir + "/layer_timing.jsonl").c_str(), "w");
+  file_ = nullptr;
+  if (dir.empty()) return;
+  const std::string path = dir + "/layer_timing.jsonl";
+  file_ = std::fopen(path.c_str(), "w");
+  // Reported, not fatal: the session works, its frames are just not logged.
+  if (!file_)
+    FOVEA_LAYER_WARN("cannot write the timing log \"%s\" (FOVEA_LAYER_OUT): %s; frames are not logged", path.c_str(),
+                     std::strerror(errno));
 }
 
 void FrameLog::write(const FrameTimes& t) {

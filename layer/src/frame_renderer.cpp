@@ -25,6 +25,7 @@
 #include "fovea/renderer/scene_io.hpp"
 #include "layer.hpp"
 #include "log.hpp"
+#include "next_chain.hpp"
 
 namespace fovea::layer {
 namespace {
@@ -76,7 +77,6 @@ class PathTraceRenderer final : public FrameRenderer {
   PathTraceRenderer(const LayerConfig& config, const VulkanBinding& vk, const Dispatch& next, XrSession session)
       : config_(config), next_(next), session_(session), scene_(renderer::load_scene(config.scene)), app_(vk) {
     for (const auto& w : scene_.warnings) FOVEA_LAYER_WARN("scene %s: %s", config.scene.c_str(), w.c_str());
-    if (config_.gaze.empty()) config_.gaze = "synthetic:1";
   }
 
   ~PathTraceRenderer() override {
@@ -150,7 +150,8 @@ class PathTraceRenderer final : public FrameRenderer {
                                                             std::uint8_t((*config_.app_background)[1]),
                                                             std::uint8_t((*config_.app_background)[2])}
                               : border_colour(app[ei]);
-          composite(out[ei], a, config_.composite, bg);
+          composite(out[ei], a, config_.composite, bg,
+                    layer_blend(in.app_frame->layers[in.projection_layer]->layerFlags, pixel_format(format_)));
         }
       }
       Eye& eye = eyes_[ei];
@@ -168,13 +169,20 @@ class PathTraceRenderer final : public FrameRenderer {
 
     // The application's frame with its stereo projection layer replaced by the layer's.
     const auto* app_proj = reinterpret_cast<const XrCompositionLayerProjection*>(in.app_frame->layers[in.projection_layer]);
-    projection_ = *app_proj;
-    projection_.next = nullptr;  // the depth it may chain describes the application's image, not this one
+    projection_ = *app_proj;  // its next chain too
     projection_.viewCount = 2;
+    chains_.clear();
     projection_.views = views_.data();
     for (int e = 0; e < 2; ++e) {
       const auto ei = std::size_t(e);
       views_[ei] = {XR_TYPE_COMPOSITION_LAYER_PROJECTION_VIEW};
+      // Every structure the application chained, but the depth: it describes its image, not this one.
+      std::size_t lost = 0;
+      views_[ei].next = chains_.without(app_proj->views[ei].next, XR_TYPE_COMPOSITION_LAYER_DEPTH_INFO_KHR, &lost);
+      if (lost && !chain_noted_)
+        FOVEA_LAYER_WARN("%zu structure(s) of a type the layer does not know precede the depth chained to a "
+                         "projection view: they are not passed on", lost);
+      chain_noted_ |= lost > 0;
       views_[ei].pose = in.app_views[ei].pose;
       views_[ei].fov = in.app_views[ei].fov;
       views_[ei].subImage.swapchain = eyes_[ei].swapchain;
@@ -279,6 +287,8 @@ class PathTraceRenderer final : public FrameRenderer {
   std::unique_ptr<LayerGaze> gaze_;
   bool gaze_from_action_ = false;
   bool depth_noted_ = false;  // the depth decision was logged
+  bool chain_noted_ = false;  // a view's next chain could not be kept whole (logged once)
+  ChainCopies chains_;        // the views' next chains, this frame
   std::unique_ptr<gpu::Context> ctx_;
   std::unique_ptr<renderer::GpuScene> gpu_scene_;
   std::unique_ptr<pipeline::FramePipeline> pipeline_;

@@ -23,7 +23,8 @@ struct ActionGaze {
 
 class LayerGaze {
  public:
-  // Opens the source for the application's views; throws core::InputError.
+  // Opens the source for the application's views; throws core::InputError. An empty URI:
+  // no tracker, the fovea rests at the view centre (logged as a warning).
   LayerGaze(const std::string& uri, const core::DisplayPreset& display);
   // The fovea for the frame displayed at `display_time_ns` (XrTime: CLOCK_MONOTONIC), from
   // the action when given, else from the source (recordings start at the first frame).

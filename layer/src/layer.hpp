@@ -47,6 +47,7 @@ constexpr std::uint32_t kLayerExtensionVersion = 1;
   X(xrBeginFrame)           \
   X(xrEndFrame)              \
   X(xrCreateActionSet)       \
+  X(xrDestroyActionSet)      \
   X(xrCreateAction)          \
   X(xrStringToPath)          \
   X(xrSuggestInteractionProfileBindings) \
@@ -101,6 +102,11 @@ Layer& layer();
 // The next layer's table for the instance owning `session`; for an unknown session (the
 // application's mistake) the most recent instance's, so the runtime reports the error.
 const Dispatch* next_for_session(XrSession session);
+
+// Destroys what the layer created on a session's handles (the renderer's swapchains and its
+// frees on the application's device, the eye-gaze spaces); called before the session, or
+// its instance, is destroyed below the layer. The session passes through from then on.
+void release_session(SessionState& s, const Dispatch& next);
 
 // Intercepted commands (hidden; reached through the layer's xrGetInstanceProcAddr).
 namespace intercept {

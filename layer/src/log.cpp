@@ -1,5 +1,6 @@
 #include "log.hpp"
 
+#include <cerrno>
 #include <cstdarg>
 #include <cstdio>
 #include <cstdlib>
@@ -30,7 +31,13 @@ void write(Level level, const char* fmt, ...) {
   static const Level max_level = configured_level();
   static FILE* file = [] {
     const char* path = std::getenv("FOVEA_LAYER_LOG_FILE");
-    return path && *path ? std::fopen(path, "a") : nullptr;
+    if (!path || !*path) return static_cast<FILE*>(nullptr);
+    FILE* f = std::fopen(path, "a");
+    // The layer keeps working; the messages still reach stderr from warn up.
+    if (!f)
+      std::fprintf(stderr, "[fovea-layer] warn: cannot open FOVEA_LAYER_LOG_FILE \"%s\": %s; logging to stderr only\n",
+                   path, std::strerror(errno));
+    return f;
   }();
   if (level > max_level) return;
   char buf[2048];

@@ -52,6 +52,12 @@ XrResult intercept::xrCreateSession(XrInstance instance, const XrSessionCreateIn
   return r;
 }
 
+void release_session(SessionState& s, const Dispatch& next) {
+  s.renderer.reset();
+  destroy_eye_gaze_session(next, s.gaze);
+  s.disabled = true;
+}
+
 XrResult intercept::xrDestroySession(XrSession session) {
   PFN_xrDestroySession next = nullptr;
   {
@@ -59,9 +65,8 @@ XrResult intercept::xrDestroySession(XrSession session) {
     const Dispatch* d = next_for_session(session);
     if (!d) return XR_ERROR_HANDLE_INVALID;
     next = d->xrDestroySession;
-    // The renderer's swapchains and transfer buffers go before the session they belong to.
     auto it = layer().sessions.find(session);
-    if (it != layer().sessions.end()) it->second.renderer.reset();
+    if (it != layer().sessions.end()) release_session(it->second, *d);
   }
   const XrResult r = next(session);
   if (XR_SUCCEEDED(r)) {

@@ -4,6 +4,9 @@
 // behind the box's back wall, 0.8 m away). With the layer path tracing the Cornell box, the
 // runtime's panels (lens off) must show magenta on the left and the scene on the right.
 // Variants: D32_SFLOAT and D16_UNORM with the usual mapping, D32_SFLOAT with reversed Z.
+// A recording layer below the Fovea layer checks what goes down: the application's other
+// next-chain structures kept, its depth dropped, and (reversed-Z variant, which destroys the
+// instance with its session alive) the layer's swapchains destroyed before the instance.
 #include <algorithm>
 #include <cmath>
 #include <cstdlib>
@@ -35,7 +38,7 @@ constexpr int kFrames = 3;
 constexpr const char* kVariables[] = {"XR_API_LAYER_PATH", "XR_ENABLE_API_LAYERS", "FOVEA_LAYER_OUT",
                                       "FOVEA_LAYER_LOG_FILE", "FOVEA_SCENE", "FOVEA_LAYER_SCENE",
                                       "XDG_CONFIG_HOME", "FOVEA_RUNTIME_OUT", "FOVEA_RUNTIME_PNG_EVERY",
-                                      "FOVEA_RUNTIME_LENS"};
+                                      "FOVEA_RUNTIME_LENS", "FOVEA_TEST_RECORD"};
 
 // Occurrences of `what` in `text`.
 int count(const std::string& text, const std::string& what) {
@@ -58,8 +61,9 @@ class DepthApp : public XrTest, public ::testing::WithParamInterface<DepthVarian
     setenv("FOVEA_RUNTIME_PNG_EVERY", "1", 1);
     setenv("FOVEA_RUNTIME_LENS", "off", 1);  // panels in the views' raster
     setenv("XDG_CONFIG_HOME", (out_->path() + "/no-config").c_str(), 1);
-    setenv("XR_API_LAYER_PATH", FOVEA_LAYER_EXPLICIT_DIR, 1);
-    setenv("XR_ENABLE_API_LAYERS", "XR_APILAYER_FOVEA_path_tracing", 1);
+    setenv("XR_API_LAYER_PATH", FOVEA_LAYER_EXPLICIT_DIR ":" FOVEA_TEST_RECORDER_DIR, 1);
+    setenv("XR_ENABLE_API_LAYERS", "XR_APILAYER_FOVEA_path_tracing:XR_APILAYER_FOVEA_test_recorder", 1);
+    setenv("FOVEA_TEST_RECORD", (out_->path() + "/record.txt").c_str(), 1);
     setenv("FOVEA_LAYER_OUT", out_->path().c_str(), 1);
     setenv("FOVEA_LAYER_LOG_FILE", log_path().c_str(), 1);
     setenv("FOVEA_SCENE", "cornell", 1);
@@ -242,6 +246,13 @@ TEST_P(DepthApp, NearHalfShowsTheAppFarHalfShowsTheScene) {
 
   XrCompositionLayerDepthInfoKHR depth[2];
   XrCompositionLayerProjectionView views[2];
+  // Identity colour scale and bias (XR_KHR_composition_layer_color_scale_bias, not enabled: a
+  // runtime ignores it) chained on the layer and before each view's depth.
+  XrCompositionLayerColorScaleBiasKHR bias[3];
+  for (auto& b : bias) {
+    b = {XR_TYPE_COMPOSITION_LAYER_COLOR_SCALE_BIAS_KHR};
+    b.colorScale = {1, 1, 1, 1};
+  }
   for (int f = 0; f < kFrames; ++f) {
     XrFrameState fs{XR_TYPE_FRAME_STATE};
     ASSERT_EQ(xrWaitFrame(session_, nullptr, &fs), XR_SUCCESS);
@@ -263,12 +274,13 @@ TEST_P(DepthApp, NearHalfShowsTheAppFarHalfShowsTheScene) {
       depth[e].maxDepth = 1;
       depth[e].nearZ = GetParam().reversed ? kFar : kNear;
       depth[e].farZ = GetParam().reversed ? kNear : kFar;
-      views[e] = {XR_TYPE_COMPOSITION_LAYER_PROJECTION_VIEW, &depth[e]};
+      bias[e].next = &depth[e];
+      views[e] = {XR_TYPE_COMPOSITION_LAYER_PROJECTION_VIEW, &bias[e]};
       views[e].pose = located[e].pose;
       views[e].fov = located[e].fov;
       views[e].subImage = {colour_[e], rect, 0};
     }
-    XrCompositionLayerProjection proj{XR_TYPE_COMPOSITION_LAYER_PROJECTION};
+    XrCompositionLayerProjection proj{XR_TYPE_COMPOSITION_LAYER_PROJECTION, &bias[2]};
     proj.space = local;
     proj.viewCount = 2;
     proj.views = views;
@@ -288,6 +300,27 @@ TEST_P(DepthApp, NearHalfShowsTheAppFarHalfShowsTheScene) {
   std::string line, last;
   while (std::getline(timing, line)) last = line;
   EXPECT_NE(last.find("\"replaced\":true"), std::string::npos) << last;
+
+  // Below the layer: the replaced frame keeps the application's chains but the depth.
+  const std::string bias_type = std::to_string(int(XR_TYPE_COMPOSITION_LAYER_COLOR_SCALE_BIAS_KHR));
+  std::string record = read_text(out_->path() + "/record.txt");
+  const auto last_end = record.rfind("end_frame");
+  ASSERT_NE(last_end, std::string::npos) << record;
+  EXPECT_EQ(record.substr(last_end, record.find('\n', last_end) - last_end),
+            "end_frame projection=" + bias_type + " view=" + bias_type + " view=" + bias_type)
+      << record;
+  if (GetParam().reversed) {
+    // The instance destroyed with its session and swapchains alive: the layer destroys its two
+    // swapchains before the instance goes down, and nothing after it.
+    const std::size_t before = record.size();
+    ASSERT_EQ(xrDestroyInstance(instance_), XR_SUCCESS);
+    instance_ = XR_NULL_HANDLE;
+    session_ = XR_NULL_HANDLE;
+    colour_[0] = colour_[1] = depth_[0] = depth_[1] = XR_NULL_HANDLE;
+    record = read_text(out_->path() + "/record.txt").substr(before);
+    EXPECT_EQ(count(record, "destroy_swapchain"), 2) << record;
+    EXPECT_EQ(record.find("destroy_instance"), record.rfind('\n', record.size() - 2) + 1) << record;
+  }
 
   // The last frame's panels: a block left of centre (the application's near half) and one
   // right of centre (its far half), both inside the lens's visible area.

@@ -13,6 +13,7 @@
 #include "fovea/core/clock.hpp"
 #include "fovea/devices/hid_stream.hpp"
 #include "gaze_input.hpp"
+#include "next_chain.hpp"
 
 namespace fovea::layer {
 namespace {
@@ -61,25 +62,75 @@ TEST(LayerComposite, AppOnTopKeysTheBackground) {
   const auto bg = border_colour(app);
   EXPECT_EQ(bg, (std::array<std::uint8_t, 3>{47, 79, 79}));
   Pixels8 scene = filled(8, 6, {200, 100, 50, 255});
-  EXPECT_EQ(composite(scene, app, Composite::AppOnTop, bg), 1);
+  EXPECT_EQ(composite(scene, app, Composite::AppOnTop, bg, LayerBlend{}), 1);
   EXPECT_EQ(scene.at(3, 2)[2], 255);
   EXPECT_EQ(scene.at(5, 2)[0], 200);
   EXPECT_EQ(scene.at(0, 0)[0], 200);
   Pixels8 only = filled(8, 6, {200, 100, 50, 255});
-  EXPECT_EQ(composite(only, app, Composite::SceneOnly, bg), 0);
+  EXPECT_EQ(composite(only, app, Composite::SceneOnly, bg, LayerBlend{}), 0);
   EXPECT_EQ(only.data, filled(8, 6, {200, 100, 50, 255}).data);
 }
 
-TEST(LayerComposite, AlphaBlendsStraightAlpha) {
-  Pixels8 app = filled(2, 2, {255, 0, 0, 0});
+// OpenXR layers are premultiplied unless XR_COMPOSITION_LAYER_UNPREMULTIPLIED_ALPHA_BIT is set.
+TEST(LayerComposite, AlphaBlendsPremultipliedByDefault) {
+  const XrCompositionLayerFlags flags = XR_COMPOSITION_LAYER_BLEND_TEXTURE_SOURCE_ALPHA_BIT;
+  const LayerBlend blend = layer_blend(flags, pixel_format(VK_FORMAT_R8G8B8A8_UNORM));
+  EXPECT_TRUE(blend.premultiplied);
+  Pixels8 app = filled(2, 2, {0, 0, 0, 0});
   std::copy_n(std::array<std::uint8_t, 4>{255, 0, 0, 255}.data(), 4, app.at(0, 0));
-  std::copy_n(std::array<std::uint8_t, 4>{255, 0, 0, 128}.data(), 4, app.at(1, 0));
+  std::copy_n(std::array<std::uint8_t, 4>{128, 0, 0, 128}.data(), 4, app.at(1, 0));  // red at half coverage
+  std::copy_n(std::array<std::uint8_t, 4>{0, 60, 0, 0}.data(), 4, app.at(1, 1));     // additive light
   Pixels8 scene = filled(2, 2, {0, 0, 200, 255});
-  EXPECT_EQ(composite(scene, app, Composite::Alpha, {0, 0, 0}), 2);
+  EXPECT_EQ(composite(scene, app, Composite::Alpha, {0, 0, 0}, blend), 3);
   EXPECT_EQ(scene.at(0, 0)[0], 255);
+  EXPECT_EQ(scene.at(1, 0)[0], 128);  // not 128 * 128 / 255 as straight alpha would give
+  EXPECT_EQ(scene.at(1, 0)[2], 100);
+  EXPECT_EQ(scene.at(1, 1)[1], 60);
+  EXPECT_EQ(scene.at(1, 1)[2], 200);
+  EXPECT_EQ(scene.at(0, 1)[2], 200);
+}
+
+TEST(LayerComposite, AlphaBlendsStraightAlphaWhenUnpremultiplied) {
+  const LayerBlend blend =
+      layer_blend(XR_COMPOSITION_LAYER_BLEND_TEXTURE_SOURCE_ALPHA_BIT | XR_COMPOSITION_LAYER_UNPREMULTIPLIED_ALPHA_BIT,
+                  pixel_format(VK_FORMAT_B8G8R8A8_UNORM));
+  EXPECT_FALSE(blend.premultiplied);
+  Pixels8 app = filled(2, 1, {255, 0, 0, 0});
+  std::copy_n(std::array<std::uint8_t, 4>{255, 0, 0, 128}.data(), 4, app.at(1, 0));
+  Pixels8 scene = filled(2, 1, {0, 0, 200, 255});
+  EXPECT_EQ(composite(scene, app, Composite::Alpha, {0, 0, 0}, blend), 1);
+  EXPECT_EQ(scene.at(0, 0)[0], 0);  // alpha 0: the scene
   EXPECT_EQ(scene.at(1, 0)[0], 128);
   EXPECT_EQ(scene.at(1, 0)[2], 100);
-  EXPECT_EQ(scene.at(0, 1)[2], 200);
+}
+
+// Without XR_COMPOSITION_LAYER_BLEND_TEXTURE_SOURCE_ALPHA_BIT the layer is opaque.
+TEST(LayerComposite, AlphaIgnoredWithoutSourceAlphaBit) {
+  const LayerBlend blend = layer_blend(0, pixel_format(VK_FORMAT_R8G8B8A8_SRGB));
+  EXPECT_FALSE(blend.source_alpha);
+  Pixels8 app = filled(1, 1, {10, 20, 30, 0});
+  Pixels8 scene = filled(1, 1, {0, 0, 200, 255});
+  EXPECT_EQ(composite(scene, app, Composite::Alpha, {0, 0, 0}, blend), 1);
+  EXPECT_EQ(scene.data, (std::vector<std::uint8_t>{10, 20, 30, 255}));
+}
+
+// sRGB swapchains blend in linear light: half coverage of white over black is linear 0.5,
+// sRGB-encoded 188, not the 128 of blending the encoded bytes.
+TEST(LayerComposite, AlphaBlendsInLinearLight) {
+  const LayerBlend blend = layer_blend(XR_COMPOSITION_LAYER_BLEND_TEXTURE_SOURCE_ALPHA_BIT |
+                                           XR_COMPOSITION_LAYER_UNPREMULTIPLIED_ALPHA_BIT,
+                                       pixel_format(VK_FORMAT_R8G8B8A8_SRGB));
+  Pixels8 app = filled(1, 1, {255, 255, 255, 128});
+  Pixels8 scene = filled(1, 1, {0, 0, 0, 255});
+  EXPECT_EQ(composite(scene, app, Composite::Alpha, {0, 0, 0}, blend), 1);
+  const int expected = int(std::lround(core::srgb_encode(128.0f / 255.0f) * 255.0f));
+  EXPECT_EQ(expected, 188);
+  EXPECT_EQ(scene.at(0, 0)[0], expected);
+  // A pixel over itself is unchanged whatever the coverage (no drift from re-encoding).
+  Pixels8 same = filled(1, 1, {90, 140, 200, 255});
+  const Pixels8 over = filled(1, 1, {90, 140, 200, 77});
+  composite(same, over, Composite::Alpha, {0, 0, 0}, blend);
+  EXPECT_EQ(same.data, (std::vector<std::uint8_t>{90, 140, 200, 255}));
 }
 
 TEST(LayerComposite, EncodesSceneForTheSwapchainFormat) {
@@ -164,6 +215,28 @@ TEST(LayerGaze, TheActionGoesThroughTheSamePolicyWithItsSampleTime) {
   EXPECT_LT(core::angle_deg(rest.left.dir, glm::dvec3(0, 0, -1)), 1e-9);
 }
 
+// No gaze source configured: fixed foveation at the view centre, said in a warning, never a
+// synthetic scanpath.
+TEST(LayerGaze, WithoutASourceTheFoveaStaysAtTheViewCentre) {
+  testing::internal::CaptureStderr();
+  LayerGaze gaze("", core::load_display("small"));
+  const std::string err = testing::internal::GetCapturedStderr();
+  EXPECT_NE(err.find("warn: no gaze source configured"), std::string::npos) << err;
+  const std::int64_t t0 = 5'000'000'000;
+  for (int frame = 0; frame < 300; ++frame) {  // 3.3 s at 90 Hz
+    const devices::FoveaGaze g = gaze.frame(t0 + std::int64_t(frame) * 11'111'111, nullptr);
+    ASSERT_FALSE(g.has_sample);
+    for (core::Eye e : {core::Eye::Left, core::Eye::Right}) {
+      ASSERT_EQ(g.eye(e).state, devices::FoveaState::Resting) << frame;
+      ASSERT_LT(core::angle_deg(g.eye(e).dir, glm::dvec3(0, 0, -1)), 1e-9) << frame;
+    }
+  }
+  // The runtime's eye-gaze action still steers it when present.
+  const glm::dvec3 up = glm::normalize(glm::dvec3(0, 0.3, -1));
+  const ActionGaze a{up, t0 + 4'000'000'000};
+  EXPECT_LT(core::angle_deg(gaze.frame(t0 + 4'000'000'000, &a).left.dir, up), 1e-9);
+}
+
 // The window depth an application stores for view distance z (the inverse of view_distance).
 float window_depth(double z, const DepthRange& r) {
   const auto inverse = [](double v) { return std::isinf(v) ? 0.0 : 1.0 / v; };
@@ -211,6 +284,45 @@ TEST(LayerDepth, KeepsTheNearerSurfaceForEveryDepthConvention) {
   }
   Pixels8 scene = filled(2, 1, {0, 0, 0, 255});
   EXPECT_THROW(composite_depth(scene, {1}, filled(2, 1, {0, 0, 0, 255}), {0, 0}, DepthRange{}), std::logic_error);
+}
+
+// The replaced projection view keeps every structure the application chained but its depth.
+TEST(LayerNextChain, DropsOnlyTheDepth) {
+  XrCompositionLayerColorScaleBiasKHR after{XR_TYPE_COMPOSITION_LAYER_COLOR_SCALE_BIAS_KHR};
+  XrCompositionLayerDepthInfoKHR depth{XR_TYPE_COMPOSITION_LAYER_DEPTH_INFO_KHR, &after};
+  XrCompositionLayerColorScaleBiasKHR before{XR_TYPE_COMPOSITION_LAYER_COLOR_SCALE_BIAS_KHR, &depth};
+  before.colorScale = {0.5f, 0.25f, 1, 1};
+  ChainCopies copies;
+  std::size_t lost = 7;
+  const auto* head = static_cast<const XrCompositionLayerColorScaleBiasKHR*>(
+      copies.without(&before, XR_TYPE_COMPOSITION_LAYER_DEPTH_INFO_KHR, &lost));
+  EXPECT_EQ(lost, 0u);
+  ASSERT_NE(head, nullptr);
+  EXPECT_NE(head, &before);  // a copy: the application's chain is left untouched
+  EXPECT_EQ(before.next, &depth);
+  EXPECT_EQ(head->type, XR_TYPE_COMPOSITION_LAYER_COLOR_SCALE_BIAS_KHR);
+  EXPECT_EQ(head->colorScale.g, 0.25f);
+  EXPECT_EQ(head->next, &after);  // after the depth: shared
+  // Depth first or alone, or no depth at all: no copies needed.
+  EXPECT_EQ(copies.without(&depth, XR_TYPE_COMPOSITION_LAYER_DEPTH_INFO_KHR), &after);
+  EXPECT_EQ(copies.without(&after, XR_TYPE_COMPOSITION_LAYER_DEPTH_INFO_KHR), &after);
+  EXPECT_EQ(copies.without(nullptr, XR_TYPE_COMPOSITION_LAYER_DEPTH_INFO_KHR), nullptr);
+}
+
+TEST(LayerNextChain, AnUnknownStructureBeforeTheDepthIsCounted) {
+  XrCompositionLayerDepthInfoKHR depth{XR_TYPE_COMPOSITION_LAYER_DEPTH_INFO_KHR};
+  XrCompositionLayerColorScaleBiasKHR known{XR_TYPE_COMPOSITION_LAYER_COLOR_SCALE_BIAS_KHR, &depth};
+  const XrBaseInStructure unknown{XrStructureType(1000999999), reinterpret_cast<const XrBaseInStructure*>(&known)};
+  EXPECT_EQ(structure_size(unknown.type), 0u);
+  EXPECT_EQ(structure_size(XR_TYPE_COMPOSITION_LAYER_COLOR_SCALE_BIAS_KHR), sizeof(known));
+  ChainCopies copies;
+  std::size_t lost = 0;
+  const auto* head = static_cast<const XrBaseInStructure*>(
+      copies.without(&unknown, XR_TYPE_COMPOSITION_LAYER_DEPTH_INFO_KHR, &lost));
+  EXPECT_EQ(lost, 1u);
+  ASSERT_NE(head, nullptr);
+  EXPECT_EQ(head->type, XR_TYPE_COMPOSITION_LAYER_COLOR_SCALE_BIAS_KHR);
+  EXPECT_EQ(head->next, nullptr);
 }
 
 }  // namespace

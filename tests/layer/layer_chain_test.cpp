@@ -1,0 +1,249 @@
+// The layer library on a fake next layer (in place of the runtime) that records every call
+// the layer makes down the chain and can fail the Nth call of a command: teardown order,
+// cleanup after partial failure, and reported (not fatal) output failures.
+#include <dlfcn.h>
+
+#include <algorithm>
+#include <cstdlib>
+#include <cstring>
+#include <map>
+#include <string>
+#include <vector>
+
+#include <gtest/gtest.h>
+
+#include <openxr/openxr.h>
+
+#include "fovea/runtime/loader_interface.hpp"
+
+namespace {
+
+// Set before the layer first logs (its log file is opened once per process).
+const bool kLogFileSet = [] {
+  setenv("FOVEA_LAYER_LOG_FILE", "/nonexistent-fovea-dir/layer.log", 1);
+  setenv("FOVEA_LAYER_LOG_LEVEL", "info", 1);
+  return true;
+}();
+
+constexpr const char* kLayerName = "XR_APILAYER_FOVEA_path_tracing";
+
+// The fake next layer's state: the calls in order ("command handle"), failures to inject.
+struct Fake {
+  std::vector<std::string> calls;
+  std::map<std::string, int> count;
+  std::map<std::string, int> fail_at;  // command -> the call (1-based) that fails
+  std::uint64_t next_handle = 0x1000;
+  bool eye_gaze = true;
+} g;
+
+// Records a call; true when it is the one to fail.
+bool record(const char* name, std::uint64_t handle) {
+  g.calls.push_back(std::string(name) + " " + std::to_string(handle));
+  const int n = ++g.count[name];
+  const auto f = g.fail_at.find(name);
+  return f != g.fail_at.end() && f->second == n;
+}
+
+template <class H>
+std::uint64_t id(H h) {
+  return reinterpret_cast<std::uint64_t>(h);
+}
+
+template <class H>
+XrResult create(const char* name, std::uint64_t parent, H* out) {
+  if (record(name, parent)) return XR_ERROR_RUNTIME_FAILURE;
+  *out = reinterpret_cast<H>(g.next_handle++);
+  g.calls.back() += " -> " + std::to_string(id(*out));
+  return XR_SUCCESS;
+}
+
+XrResult XRAPI_CALL fake_enumerate_extensions(const char*, uint32_t capacity, uint32_t* count, XrExtensionProperties* p) {
+  *count = g.eye_gaze ? 1 : 0;
+  if (capacity && g.eye_gaze) std::strcpy(p[0].extensionName, "XR_EXT_eye_gaze_interaction");
+  return XR_SUCCESS;
+}
+
+XrResult XRAPI_CALL fake_gipa(XrInstance instance, const char* name, PFN_xrVoidFunction* fn);
+
+XrResult XRAPI_CALL fake_create_instance(const XrInstanceCreateInfo*, const XrApiLayerCreateInfo*, XrInstance* out) {
+  return create("xrCreateInstance", 0, out);
+}
+
+#define FAKE(name, ...)                                           \
+  if (!std::strcmp(n, #name)) {                                   \
+    PFN_##name p = __VA_ARGS__;                                   \
+    *fn = reinterpret_cast<PFN_xrVoidFunction>(p);                \
+    return XR_SUCCESS;                                            \
+  }
+// A command that only succeeds or fails; its first argument is the handle it acts on.
+#define FAKE_PLAIN(name) \
+  FAKE(name, [](auto h, auto...) -> XrResult { return record(#name, id(h)) ? XR_ERROR_RUNTIME_FAILURE : XR_SUCCESS; })
+#define FAKE_CREATE(name) \
+  FAKE(name, [](auto parent, auto, auto* out) -> XrResult { return create(#name, id(parent), out); })
+
+XrResult XRAPI_CALL fake_gipa(XrInstance, const char* n, PFN_xrVoidFunction* fn) {
+  FAKE(xrGetInstanceProcAddr, &fake_gipa)
+  FAKE(xrEnumerateInstanceExtensionProperties, &fake_enumerate_extensions)
+  FAKE_CREATE(xrCreateSession)
+  FAKE_CREATE(xrCreateSwapchain)
+  FAKE_CREATE(xrCreateActionSet)
+  FAKE_CREATE(xrCreateAction)
+  FAKE_CREATE(xrStringToPath)
+  FAKE_CREATE(xrCreateActionSpace)
+  FAKE_CREATE(xrCreateReferenceSpace)
+  FAKE_PLAIN(xrDestroyInstance)
+  FAKE_PLAIN(xrDestroySession)
+  FAKE_PLAIN(xrDestroySwapchain)
+  FAKE_PLAIN(xrDestroyActionSet)
+  FAKE_PLAIN(xrDestroySpace)
+  FAKE_PLAIN(xrEnumerateSwapchainImages)
+  FAKE_PLAIN(xrAcquireSwapchainImage)
+  FAKE_PLAIN(xrWaitSwapchainImage)
+  FAKE_PLAIN(xrReleaseSwapchainImage)
+  FAKE_PLAIN(xrWaitFrame)
+  FAKE_PLAIN(xrBeginFrame)
+  FAKE_PLAIN(xrEndFrame)
+  FAKE_PLAIN(xrSuggestInteractionProfileBindings)
+  FAKE_PLAIN(xrAttachSessionActionSets)
+  FAKE_PLAIN(xrSyncActions)
+  FAKE_PLAIN(xrLocateSpace)
+  *fn = nullptr;
+  return XR_ERROR_FUNCTION_UNSUPPORTED;
+}
+
+// The layer library, negotiated as the loader would.
+struct LayerLib {
+  void* lib = nullptr;
+  XrNegotiateApiLayerRequest request{};
+  LayerLib() {
+    lib = dlopen(FOVEA_LAYER_LIBRARY, RTLD_NOW | RTLD_LOCAL);
+    if (!lib) return;
+    auto negotiate = reinterpret_cast<PFN_xrNegotiateLoaderApiLayerInterface>(
+        dlsym(lib, "xrNegotiateLoaderApiLayerInterface"));
+    XrNegotiateLoaderInfo info{XR_LOADER_INTERFACE_STRUCT_LOADER_INFO, XR_LOADER_INFO_STRUCT_VERSION,
+                               sizeof(XrNegotiateLoaderInfo), 1, 1, XR_MAKE_VERSION(1, 0, 0), XR_CURRENT_API_VERSION};
+    request = {XR_LOADER_INTERFACE_STRUCT_API_LAYER_REQUEST, XR_API_LAYER_INFO_STRUCT_VERSION,
+               sizeof(XrNegotiateApiLayerRequest), 0, 0, nullptr, nullptr};
+    if (!negotiate || XR_FAILED(negotiate(&info, kLayerName, &request))) request.getInstanceProcAddr = nullptr;
+  }
+  ~LayerLib() {
+    if (lib) dlclose(lib);
+  }
+
+  XrInstance create_instance() {
+    XrApiLayerNextInfo next{XR_LOADER_INTERFACE_STRUCT_API_LAYER_NEXT_INFO, XR_API_LAYER_NEXT_INFO_STRUCT_VERSION,
+                            sizeof(XrApiLayerNextInfo), {}, &fake_gipa, &fake_create_instance, nullptr};
+    std::strcpy(next.layerName, kLayerName);
+    XrApiLayerCreateInfo layer_info{XR_LOADER_INTERFACE_STRUCT_API_LAYER_CREATE_INFO,
+                                    XR_API_LAYER_CREATE_INFO_STRUCT_VERSION, sizeof(XrApiLayerCreateInfo), nullptr,
+                                    {}, &next};
+    XrInstanceCreateInfo ci{XR_TYPE_INSTANCE_CREATE_INFO};
+    std::strcpy(ci.applicationInfo.applicationName, "fovea_layer_chain_test");
+    ci.applicationInfo.apiVersion = XR_MAKE_VERSION(1, 0, 0);
+    XrInstance instance = XR_NULL_HANDLE;
+    EXPECT_EQ(request.createApiLayerInstance(&ci, &layer_info, &instance), XR_SUCCESS);
+    return instance;
+  }
+
+  template <class PFN>
+  PFN get(XrInstance instance, const char* name) {
+    PFN_xrVoidFunction fn = nullptr;
+    EXPECT_EQ(request.getInstanceProcAddr(instance, name, &fn), XR_SUCCESS) << name;
+    return reinterpret_cast<PFN>(fn);
+  }
+};
+
+class LayerChain : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    ASSERT_TRUE(kLogFileSet);
+    g = Fake{};
+    // No configuration file; a scene makes the layer set up its eye-gaze input.
+    setenv("XDG_CONFIG_HOME", "/nonexistent-fovea-config", 1);
+    setenv("FOVEA_SCENE", "cornell", 1);
+    unsetenv("FOVEA_LAYER_SCENE");
+    unsetenv("FOVEA_LAYER_OUT");
+    ASSERT_NE(layer_.lib, nullptr) << dlerror();
+    ASSERT_NE(layer_.request.getInstanceProcAddr, nullptr);
+  }
+  void TearDown() override { unsetenv("FOVEA_SCENE"); }
+
+  // Index of the first recorded call starting with `prefix` (calls.size() when none).
+  static std::size_t find(const std::string& prefix) {
+    return std::size_t(std::find_if(g.calls.begin(), g.calls.end(),
+                                    [&](const std::string& c) { return c.rfind(prefix, 0) == 0; }) -
+                       g.calls.begin());
+  }
+  static std::uint64_t created(const char* command) {
+    const std::string& c = g.calls.at(find(command));
+    return std::stoull(c.substr(c.find("-> ") + 3));
+  }
+
+  LayerLib layer_;
+};
+
+// First: the log file is opened at the process's first log line. An unwritable log file or output directory is reported and the layer keeps working.
+TEST_F(LayerChain, OutputFailuresAreReportedNotFatal) {
+  unsetenv("FOVEA_SCENE");
+  setenv("FOVEA_LAYER_OUT", "/nonexistent-fovea-dir/out", 1);
+  testing::internal::CaptureStderr();
+  const XrInstance instance = layer_.create_instance();
+  XrSessionCreateInfo si{XR_TYPE_SESSION_CREATE_INFO};
+  XrSession session = XR_NULL_HANDLE;
+  const XrResult r = layer_.get<PFN_xrCreateSession>(instance, "xrCreateSession")(instance, &si, &session);
+  const XrFrameEndInfo end{XR_TYPE_FRAME_END_INFO};
+  const XrResult e = layer_.get<PFN_xrEndFrame>(instance, "xrEndFrame")(session, &end);
+  const std::string err = testing::internal::GetCapturedStderr();
+  EXPECT_EQ(r, XR_SUCCESS);
+  EXPECT_EQ(e, XR_SUCCESS);
+  EXPECT_EQ(find("xrEndFrame"), g.calls.size() - 1);  // the frame went down
+  EXPECT_NE(err.find("FOVEA_LAYER_LOG_FILE \"/nonexistent-fovea-dir/layer.log\""), std::string::npos) << err;
+  EXPECT_NE(err.find("/nonexistent-fovea-dir/out/layer_timing.jsonl"), std::string::npos) << err;
+  ASSERT_EQ(layer_.get<PFN_xrDestroyInstance>(instance, "xrDestroyInstance")(instance), XR_SUCCESS);
+}
+
+TEST_F(LayerChain, DestroyInstanceReleasesTheLayersObjectsBeforeCallingDown) {
+  const XrInstance instance = layer_.create_instance();
+  const std::uint64_t set = created("xrCreateActionSet");
+  auto destroy = layer_.get<PFN_xrDestroyInstance>(instance, "xrDestroyInstance");
+  ASSERT_EQ(destroy(instance), XR_SUCCESS);
+  const std::size_t destroy_set = find("xrDestroyActionSet " + std::to_string(set));
+  const std::size_t destroy_instance = find("xrDestroyInstance");
+  ASSERT_LT(destroy_set, g.calls.size()) << "the layer's action set was never destroyed";
+  EXPECT_LT(destroy_set, destroy_instance);
+  EXPECT_EQ(destroy_instance, g.calls.size() - 1);  // nothing on dead handles afterwards
+}
+
+// Each creation step of the eye-gaze input failing in turn: the instance still works and
+// nothing the layer created is left behind.
+TEST_F(LayerChain, EyeGazeSetupFailureLeavesNothingBehind) {
+  for (const char* step : {"xrCreateAction", "xrStringToPath", "xrSuggestInteractionProfileBindings"}) {
+    SCOPED_TRACE(step);
+    g = Fake{};
+    g.fail_at[step] = 1;
+    const XrInstance instance = layer_.create_instance();
+    ASSERT_NE(instance, XR_NULL_HANDLE);
+    const std::uint64_t set = created("xrCreateActionSet");
+    const std::size_t destroyed = find("xrDestroyActionSet " + std::to_string(set));
+    ASSERT_LT(destroyed, g.calls.size()) << "the action set leaked";
+    EXPECT_LT(find(step), destroyed);
+    g.calls.clear();
+    ASSERT_EQ(layer_.get<PFN_xrDestroyInstance>(instance, "xrDestroyInstance")(instance), XR_SUCCESS);
+    EXPECT_EQ(g.calls, std::vector<std::string>{"xrDestroyInstance " + std::to_string(id(instance))});
+  }
+}
+
+// Without a scene the layer creates nothing of its own: only the application's call goes down.
+TEST_F(LayerChain, PassThroughDestroyInstanceOnlyCallsDown) {
+  unsetenv("FOVEA_SCENE");  // pass-through: the session has nothing of the layer's
+  const XrInstance instance = layer_.create_instance();
+  EXPECT_EQ(find("xrCreateActionSet"), g.calls.size());
+  XrSessionCreateInfo si{XR_TYPE_SESSION_CREATE_INFO};
+  XrSession session = XR_NULL_HANDLE;
+  ASSERT_EQ(layer_.get<PFN_xrCreateSession>(instance, "xrCreateSession")(instance, &si, &session), XR_SUCCESS);
+  g.calls.clear();
+  ASSERT_EQ(layer_.get<PFN_xrDestroyInstance>(instance, "xrDestroyInstance")(instance), XR_SUCCESS);
+  EXPECT_EQ(g.calls, std::vector<std::string>{"xrDestroyInstance " + std::to_string(id(instance))});
+}
+
+}  // namespace
