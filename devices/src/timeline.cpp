@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 
 namespace fovea::devices {
 
@@ -37,7 +38,9 @@ GazeSample TimelineSource::at_recording_time(core::TimeNs tt) {
     if (opt_.loop && ended_ && !win_.empty() && tt > win_.back().t_ns) {
       if (period_ < 0) {  // one nominal sample period after the last sample
         const core::TimeNs dt = win_.size() > 1 ? win_.back().t_ns - win_[win_.size() - 2].t_ns : 0;
-        period_ = win_.back().t_ns + std::max<core::TimeNs>(dt, 1);
+        // Saturating: a recording spanning ~int64 ns must not wrap to a negative period.
+        if (__builtin_add_overflow(win_.back().t_ns, std::max<core::TimeNs>(dt, 1), &period_))
+          period_ = std::numeric_limits<core::TimeNs>::max();
       }
       tt %= period_;
       if (win_.empty() || tt < win_.front().t_ns) restart();
@@ -73,7 +76,8 @@ GazeSample TimelineSource::at_recording_time(core::TimeNs tt) {
 
 GazeSample TimelineSource::sample_at(core::TimeNs t) {
   std::lock_guard lock(mutex_);
-  const core::TimeNs tt = stream_->live() ? t : std::llround(static_cast<double>(t) * opt_.speed);
+  const core::TimeNs tt =
+      stream_->live() ? t : std::llround(std::clamp(static_cast<double>(t) * opt_.speed, -9.2e18, 9.2e18));
   GazeSample s = at_recording_time(tt);
   s.t_ns = t;
   return s;

@@ -19,6 +19,7 @@
 #include "fovea/core/image.hpp"
 #include "fovea/core/metrics.hpp"
 #include "fovea/devices/gaze.hpp"
+#include "fovea/devices/screen.hpp"
 #include "fovea/gpu/context.hpp"
 #include "fovea/renderer/reference.hpp"
 #include "fovea/renderer/scene_io.hpp"
@@ -47,6 +48,8 @@ temporal_error (always). With no options: a short demo on the shipped scene and 
   --display NAME|FILE   display preset (fove0, vive, modern, small, tiny) or JSON [small]
   --gaze URI            recording, or synthetic:<seed>[?...] (docs/gaze.md)
                         [the shipped recording data/gaze/default.csv]
+  --screen GEOMETRY     what 2-D gaze coordinates refer to: WxH@HFOVxVFOV or
+                        WxH@SWxSHmm@Dmm (as the URI key screen=; docs/gaze.md)
   --frames N            frames to render [24]
   --distribution D      visual-polar | paper-visual-polar | cartesian | cartesian-uniform |
                         log-polar [visual-polar]
@@ -128,7 +131,7 @@ int run(std::vector<std::string> argv) {
     }
   const Args args(argv,
                   {"scene", "display", "gaze", "frames", "distribution", "budget", "denoiser", "bmfr-precision", "stereo-share",
-                   "reference", "png-every", "out"},
+                   "reference", "png-every", "out", "screen"},
                   {"no-blur", "no-marker", "quiet"});
   const long frames = args.integer("frames", 24);
   if (frames < 1 || frames > 100000) throw core::InputError("--frames must be in 1..100000");
@@ -162,6 +165,7 @@ int run(std::vector<std::string> argv) {
   }
   devices::SourceOptions so;
   so.display = display;
+  if (auto sc = args.opt("screen")) so.screen = devices::parse_screen(*sc, "--screen");
   const auto gaze_source = devices::open_gaze_source(gaze_uri, so);
 
   const renderer::Scene scene = renderer::load_scene(args.str("scene", "default"));
