@@ -37,6 +37,7 @@ void EventSegmenter::close_motion(core::TimeNs end) {
 }
 
 void EventSegmenter::add(const GazeSample& s) {
+  last_seen_ = s.t_ns;
   if (!s.tracked()) {
     if (!gap_) {
       gap_ = true;
@@ -103,7 +104,7 @@ void EventSegmenter::finish() {
     GazeEvent b;
     b.kind = Kind::Blink;
     b.start_ns = gap_start_;
-    b.end_ns = last_t_;
+    b.end_ns = last_seen_;  // the recording ends inside the blink
     b.start_dir = b.end_dir = gap_dir_;
     cb_(b);
   }

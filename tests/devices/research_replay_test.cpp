@@ -8,6 +8,7 @@
 #include <fstream>
 #include <random>
 #include <sstream>
+#include <thread>
 
 #include <glm/geometric.hpp>
 #include <gtest/gtest.h>
@@ -388,4 +389,34 @@ TEST(FuzzRegression, HidTimestampOfTwoToTheSixtyTwoMicroseconds) {
   EXPECT_EQ(c.stats().dropped.at("time_overflow"), 1u);
   ASSERT_GT(v.size(), 10u);
   for (const auto& s : v) ASSERT_GE(s.t_ns, 0);
+}
+
+// The emulated device in real time on its own thread: reports arrive when due on the host
+// clock (never earlier), with the faults the URI names.
+TEST(EmulatedHidRealtime, PacedOnTheHostClockWithFaultsFromTheUri) {
+  SourceOptions o;
+  auto s = open_sample_stream("hid-emulated:ms?rate=120&seconds=0.5&realtime=1", o);
+  auto* hid = dynamic_cast<hid::HidGazeStream*>(s.get());
+  ASSERT_NE(hid, nullptr);
+  std::vector<GazeSample> v;
+  GazeSample g;
+  while (!hid->finished() || s->next(g)) {
+    if (s->next(g)) v.push_back(g);
+    else std::this_thread::sleep_for(std::chrono::milliseconds(2));
+  }
+  while (s->next(g)) v.push_back(g);
+  ASSERT_GT(v.size(), 55u);
+  // Device times span ~0.5 s; the receive times cannot span less (a lower bound only).
+  EXPECT_GE(v.back().host_time_ns - v.front().host_time_ns,
+            v.back().device_time_ns - v.front().device_time_ns - 5'000'000);
+
+  auto f = open_sample_stream("hid-emulated:compact?rate=120&seconds=2&realtime=1&unplug_after=20&garbage_every=5", o);
+  auto* fh = dynamic_cast<hid::HidGazeStream*>(f.get());
+  while (!fh->finished()) std::this_thread::sleep_for(std::chrono::milliseconds(5));
+  const auto st = fh->stats();
+  EXPECT_TRUE(st.disconnected);
+  EXPECT_LT(st.samples, 20u);
+  EXPECT_GE(st.reports, 19u);
+  EXPECT_THROW(open_sample_stream("hid-emulated:ms?realtime=2", o), InputError);
+  EXPECT_THROW(open_sample_stream("hid-emulated:ms?stall_every=-1", o), InputError);
 }

@@ -75,7 +75,7 @@ class EventSegmenter {
   // Fixation precision accumulators: sums of angles, squared angles, squared S2S steps.
   double sx_ = 0, sy_ = 0, sxx_ = 0, syy_ = 0, s2s_ = 0;
   std::uint64_t steps_ = 0;
-  core::TimeNs last_t_ = 0;
+  core::TimeNs last_t_ = 0, last_seen_ = 0;  // last classified / last sample
   glm::dvec3 last_dir_{0, 0, -1};
   bool have_dir_ = false;
   bool gap_ = false, gap_blink_ = false;
