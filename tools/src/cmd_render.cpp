@@ -20,6 +20,7 @@
 #include "fovea/core/metrics.hpp"
 #include "fovea/devices/gaze.hpp"
 #include "fovea/devices/screen.hpp"
+#include "frame_log.hpp"
 #include "fovea/gpu/context.hpp"
 #include "fovea/renderer/reference.hpp"
 #include "fovea/renderer/scene_io.hpp"
@@ -37,6 +38,9 @@ optional stereo sharing of indirect diffuse, BMFR, TAA) and resolved to the disp
 the peripheral blur. Writes to --out:
   frame_NNNN_left.png, frame_NNNN_right.png, frame_NNNN_sbs.png   tone-mapped (Reinhard)
   last_left.exr, last_right.exr                                    linear, last frame
+  frames.jsonl  per frame: gaze sample used (its times, flags), the gaze each eye used, eye
+                poses, grid size, "timings_ms" per stage (the only non-deterministic field);
+                compare two runs with `fovea replay-diff A B`
   report.json   {"frames", "samples_traced_per_eye", "gpu_ms": {trace, reconstruct,
                  resolve, total, bmfr_fit} (medians), "summary": {"left": {...}, "right": {...}}}
 With --reference SPP each eye's summary compares the last frame with a converged
@@ -189,6 +193,7 @@ int run(std::vector<std::string> argv) {
   std::array<core::Image, 2> previous, last;
   std::array<double, 2> te_sum{0, 0};
   std::array<glm::dvec3, 2> gaze{glm::dvec3(0, 0, -1), glm::dvec3(0, 0, -1)};
+  FrameLog frame_log((out_dir / "frames.jsonl").string());
   const auto start = std::chrono::steady_clock::now();
   for (long f = 0; f < frames; ++f) {
     const auto t_ns = core::TimeNs(std::llround(double(f) / display.refresh_hz * 1e9));
@@ -202,6 +207,10 @@ int run(std::vector<std::string> argv) {
     const compositor::FrameTimes t = pipeline.render(poses, gaze, std::uint32_t(f));
     t_trace.push_back(t.trace), t_recon.push_back(t.reconstruct), t_resolve.push_back(t.resolve);
     t_total.push_back(t.total), t_fit.push_back(t.bmfr_fit);
+    const auto& dist = pipeline.distribution(core::Eye::Left);
+    frame_log.add({f, t_ns, s, gaze, poses, dist.columns(), dist.rows(),
+                   {{"trace", t.trace}, {"reconstruct", t.reconstruct}, {"resolve", t.resolve}, {"total", t.total},
+                    {"bmfr_fit", t.bmfr_fit}}});
     std::array<core::Image, 2> ldr;
     for (int e = 0; e < 2; ++e) {
       last[e] = pipeline.image(core::Eye(e));
@@ -227,6 +236,7 @@ int run(std::vector<std::string> argv) {
                std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count());
   }
   if (bar) std::fprintf(stderr, "\n");
+  frame_log.finish();
   renderer::write_exr((out_dir / "last_left.exr").string(), last[0]);
   renderer::write_exr((out_dir / "last_right.exr").string(), last[1]);
 

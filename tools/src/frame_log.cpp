@@ -1,0 +1,74 @@
+#include "frame_log.hpp"
+
+#include <unistd.h>
+
+#include <cmath>
+#include <filesystem>
+#include <stdexcept>
+
+#include <nlohmann/json.hpp>
+
+namespace fovea::tools {
+
+namespace {
+nlohmann::json vec(const glm::dvec3& v) {
+  // Outputs never hold NaN/Inf: a non-finite direction is written as null.
+  if (!std::isfinite(v.x + v.y + v.z)) return nullptr;
+  return {v.x, v.y, v.z};
+}
+nlohmann::json eye(const devices::EyeGaze& g) {
+  return {{"dir", vec(g.dir)}, {"flags", g.flags}, {"confidence", std::isfinite(g.confidence) ? g.confidence : 0.0}};
+}
+}  // namespace
+
+FrameLog::FrameLog(std::string path) : path_(std::move(path)), tmp_(path_ + ".tmp." + std::to_string(::getpid())) {
+  f_ = std::fopen(tmp_.c_str(), "wb");
+  if (!f_) throw std::runtime_error(path_ + ": cannot open for writing");
+}
+
+FrameLog::~FrameLog() {
+  if (f_) {
+    std::fclose(f_);
+    std::remove(tmp_.c_str());
+  }
+}
+
+void FrameLog::add(const FrameRecord& r) {
+  const devices::GazeSample& s = r.sample;
+  nlohmann::json j;
+  j["frame"] = r.frame;
+  j["t_ns"] = r.t_ns;
+  j["gaze"] = {{"t_ns", s.t_ns},
+               {"device_time_ns", s.device_time_ns},
+               {"host_time_ns", s.host_time_ns},
+               {"combined", eye(s.combined)},
+               {"left", eye(s.left)},
+               {"right", eye(s.right)}};
+  j["used_gaze"] = {{"left", vec(r.used[0])}, {"right", vec(r.used[1])}};
+  nlohmann::json poses = nlohmann::json::array();
+  for (const core::Pose& p : r.poses) {
+    const glm::dquat& q = p.orientation;
+    poses.push_back({{"position", vec(p.position)}, {"orientation_wxyz", {q.w, q.x, q.y, q.z}}});
+  }
+  j["eye_poses"] = poses;
+  j["grid"] = {r.grid_columns, r.grid_rows};
+  nlohmann::json t = nlohmann::json::object();
+  for (const auto& [k, v] : r.timings_ms) t[k] = std::isfinite(v) ? v : 0.0;
+  j["timings_ms"] = t;  // the only field that differs between identical runs
+  std::fprintf(f_, "%s\n", j.dump().c_str());
+}
+
+void FrameLog::finish() {
+  const bool ok = !std::ferror(f_);
+  const bool closed = std::fclose(f_) == 0;
+  f_ = nullptr;
+  if (!ok || !closed) {
+    std::remove(tmp_.c_str());
+    throw std::runtime_error(path_ + ": write failed");
+  }
+  std::error_code ec;
+  std::filesystem::rename(tmp_, path_, ec);
+  if (ec) throw std::runtime_error(path_ + ": rename failed: " + ec.message());
+}
+
+}  // namespace fovea::tools
