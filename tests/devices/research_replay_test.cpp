@@ -6,6 +6,7 @@
 #include <cmath>
 #include <filesystem>
 #include <fstream>
+#include <limits>
 #include <random>
 #include <sstream>
 #include <thread>
@@ -419,4 +420,44 @@ TEST(EmulatedHidRealtime, PacedOnTheHostClockWithFaultsFromTheUri) {
   EXPECT_GE(st.reports, 19u);
   EXPECT_THROW(open_sample_stream("hid-emulated:ms?realtime=2", o), InputError);
   EXPECT_THROW(open_sample_stream("hid-emulated:ms?stall_every=-1", o), InputError);
+}
+
+// A hand-written descriptor: a 62-bit µs Sensor Timestamp (2 padding bits), a 16-bit gaze
+// point, and a Status feature with a 32-bit Configuration Status of logical maximum
+// 0xFFFFFFFF beside 32-bit calibrated screen sizes (fuzz findings 8 and 9).
+TEST(FuzzRegression, HidWideFieldsSaturateAndStampsStayInInt64) {
+  const std::vector<std::uint8_t> desc = {
+      0x05, 0x12, 0x09, 0x01, 0xa1, 0x01,                                            // page 0x12, Eye Tracker, application
+      0x85, 0x10, 0x09, 0x10, 0xa1, 0x00,                                            // report 0x10, Tracking Data
+      0x09, 0x20, 0x15, 0x00, 0x27, 0xff, 0xff, 0xff, 0x7f, 0x75, 0x3e, 0x95, 0x01, 0x81, 0x02,  // timestamp, 62 bits
+      0x75, 0x02, 0x95, 0x01, 0x81, 0x03,                                            // 2 padding bits
+      0x09, 0x24, 0xa1, 0x00, 0x09, 0x21, 0x09, 0x22, 0x15, 0x00, 0x26, 0xff, 0x7f,  // Gaze Point X, Y
+      0x75, 0x10, 0x95, 0x02, 0x81, 0x02, 0xc0, 0xc0,
+      0x85, 0x13, 0x0a, 0x01, 0x03, 0x15, 0x00, 0x27, 0xff, 0xff, 0xff, 0xff,        // report 0x13: Configuration Status
+      0x75, 0x20, 0x95, 0x01, 0xb1, 0x02,
+      0x0a, 0x04, 0x02, 0x0a, 0x05, 0x02, 0x15, 0x00, 0x27, 0xff, 0xff, 0xff, 0x7f,  // Calibrated Screen Width, Height
+      0x75, 0x20, 0x95, 0x02, 0xb1, 0x02, 0xc0};
+  const hid::EyeTrackerCodec codec(desc);
+  const std::vector<std::uint8_t> feature = {0x13, 0xff, 0xff, 0xff, 0xff, 0x20, 0xa1, 0x07, 0x00, 0x20, 0xa1, 0x07, 0x00};
+  hid::DeviceConfig cfg;
+  ASSERT_TRUE(codec.decode_feature(feature, cfg));
+  EXPECT_EQ(cfg.configuration_status, std::numeric_limits<int>::max());
+  EXPECT_NEAR(cfg.screen_w_m, 0.5, 1e-12);
+
+  hid::GazeMapper m(codec, parse_screen("1000x1000@90x90", "test"));
+  m.feature(feature);
+  auto report = [](std::uint64_t ts) {
+    std::vector<std::uint8_t> r(13, 0);
+    r[0] = 0x10;
+    for (int i = 0; i < 8; ++i) r[1 + i] = static_cast<std::uint8_t>(ts >> (8 * i));
+    r[9] = r[11] = 100;
+    return r;
+  };
+  GazeSample s;
+  std::string why;
+  EXPECT_TRUE(m.map(report(1000), s, why)) << why;
+  EXPECT_FALSE(m.map(report((std::uint64_t(1) << 62) - 5), s, why));  // ~4.6e21 ns: beyond int64
+  EXPECT_EQ(why, "time_overflow");
+  ASSERT_TRUE(m.map(report(2000), s, why)) << why;
+  EXPECT_EQ(s.device_time_ns, 2'000'000);
 }

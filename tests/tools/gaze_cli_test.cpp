@@ -121,6 +121,13 @@ TEST(GazeCli, FuzzFindingsGiveExitTwoOrSaneOutput) {
   ASSERT_EQ(c.status, 0) << c.err;
   EXPECT_NE(c.err.find("time_overflow: 1"), std::string::npos) << c.err;
   EXPECT_EQ(slurp(dir + "/cap.csv").find("\n-"), std::string::npos);
+  // A bad geometry is named wherever it is given.
+  const auto sc = run_fovea("render --display tiny --frames 1 --screen 12 --out " + dir + "/r");
+  EXPECT_EQ(sc.status, 2);
+  EXPECT_NE(sc.err.find("--screen"), std::string::npos) << sc.err;
+  const auto su = run_fovea("gaze info '" + shipped("default.csv") + "?screen=1x1@200x1'");
+  EXPECT_EQ(su.status, 2);
+  EXPECT_NE(su.err.find("screen"), std::string::npos) << su.err;
   // An unrelated JSON file is not read as Tobii gaze.
   const auto j = run_fovea("gaze info " + write(dir + "/package.json", "{\"name\": \"x\"}\n"));
   EXPECT_EQ(j.status, 2);
