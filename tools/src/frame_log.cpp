@@ -1,12 +1,10 @@
 #include "frame_log.hpp"
 
-#include <unistd.h>
-
 #include <cmath>
-#include <filesystem>
-#include <stdexcept>
 
 #include <nlohmann/json.hpp>
+
+#include "fovea/core/image.hpp"
 
 namespace fovea::tools {
 
@@ -20,18 +18,6 @@ nlohmann::json eye(const devices::EyeGaze& g) {
   return {{"dir", vec(g.dir)}, {"flags", g.flags}, {"confidence", std::isfinite(g.confidence) ? g.confidence : 0.0}};
 }
 }  // namespace
-
-FrameLog::FrameLog(std::string path) : path_(std::move(path)), tmp_(path_ + ".tmp." + std::to_string(::getpid())) {
-  f_ = std::fopen(tmp_.c_str(), "wb");
-  if (!f_) throw std::runtime_error(path_ + ": cannot open for writing");
-}
-
-FrameLog::~FrameLog() {
-  if (f_) {
-    std::fclose(f_);
-    std::remove(tmp_.c_str());
-  }
-}
 
 void FrameLog::add(const FrameRecord& r) {
   const devices::GazeSample& s = r.sample;
@@ -55,20 +41,9 @@ void FrameLog::add(const FrameRecord& r) {
   nlohmann::json t = nlohmann::json::object();
   for (const auto& [k, v] : r.timings_ms) t[k] = std::isfinite(v) ? v : 0.0;
   j["timings_ms"] = t;  // the only field that differs between identical runs
-  std::fprintf(f_, "%s\n", j.dump().c_str());
+  text_ += j.dump() + "\n";
 }
 
-void FrameLog::finish() {
-  const bool ok = !std::ferror(f_);
-  const bool closed = std::fclose(f_) == 0;
-  f_ = nullptr;
-  if (!ok || !closed) {
-    std::remove(tmp_.c_str());
-    throw std::runtime_error(path_ + ": write failed");
-  }
-  std::error_code ec;
-  std::filesystem::rename(tmp_, path_, ec);
-  if (ec) throw std::runtime_error(path_ + ": rename failed: " + ec.message());
-}
+void FrameLog::finish() const { core::write_file_atomic(path_, text_); }
 
 }  // namespace fovea::tools

@@ -3,7 +3,6 @@
 // Every field but "timings_ms" is a deterministic function of the inputs, so two runs are
 // compared field for field (`fovea replay-diff`); timings are kept under their own key.
 #include <array>
-#include <cstdio>
 #include <string>
 #include <utility>
 #include <vector>
@@ -25,19 +24,16 @@ struct FrameRecord {
   std::vector<std::pair<const char*, double>> timings_ms;  // per stage
 };
 
-// Written to a temporary name and renamed by finish(), like every output.
+// Held in memory (a few hundred bytes per frame) and written by finish() through a
+// temporary name and a rename, like every output.
 class FrameLog {
  public:
-  explicit FrameLog(std::string path);
-  ~FrameLog();
-  FrameLog(const FrameLog&) = delete;
-  FrameLog& operator=(const FrameLog&) = delete;
+  explicit FrameLog(std::string path) : path_(std::move(path)) {}
   void add(const FrameRecord& r);
-  void finish();
+  void finish() const;
 
  private:
-  std::string path_, tmp_;
-  std::FILE* f_ = nullptr;
+  std::string path_, text_;
 };
 
 }  // namespace fovea::tools
