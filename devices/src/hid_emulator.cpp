@@ -204,7 +204,10 @@ EmulatedTransport::EmulatedTransport(std::unique_ptr<SampleStream> gaze, std::st
 }
 
 EmulatedTransport::~EmulatedTransport() {
-  stop_ = true;
+  {
+    std::lock_guard lock(mutex_);  // under the lock: the device thread cannot miss the wake-up
+    stop_ = true;
+  }
   cv_.notify_all();
   if (thread_.joinable()) thread_.join();
 }
