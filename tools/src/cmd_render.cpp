@@ -39,8 +39,9 @@ the peripheral blur. Writes to --out:
   frame_NNNN_left.png, frame_NNNN_right.png, frame_NNNN_sbs.png   tone-mapped (Reinhard)
   last_left.exr, last_right.exr                                    linear, last frame
   frames.jsonl  per frame: gaze sample used (its times, flags), the gaze each eye used, eye
-                poses, grid size, "timings_ms" per stage (the only non-deterministic field);
+                poses, grid size — deterministic: identical runs write identical bytes;
                 compare two runs with `fovea replay-diff A B`
+  frame_times.jsonl  per frame: GPU ms per stage (trace, reconstruct, resolve, total, bmfr_fit)
   report.json   {"frames", "samples_traced_per_eye", "gpu_ms": {trace, reconstruct,
                  resolve, total, bmfr_fit} (medians), "summary": {"left": {...}, "right": {...}}}
 With --reference SPP each eye's summary compares the last frame with a converged
@@ -193,7 +194,7 @@ int run(std::vector<std::string> argv) {
   std::array<core::Image, 2> previous, last;
   std::array<double, 2> te_sum{0, 0};
   std::array<glm::dvec3, 2> gaze{glm::dvec3(0, 0, -1), glm::dvec3(0, 0, -1)};
-  FrameLog frame_log((out_dir / "frames.jsonl").string());
+  FrameLog frame_log((out_dir / "frames.jsonl").string(), (out_dir / "frame_times.jsonl").string());
   const auto start = std::chrono::steady_clock::now();
   for (long f = 0; f < frames; ++f) {
     const auto t_ns = core::TimeNs(std::llround(double(f) / display.refresh_hz * 1e9));

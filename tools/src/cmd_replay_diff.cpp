@@ -1,6 +1,6 @@
 // fovea replay-diff A B: compares two `fovea render` output directories — per frame the gaze
-// sample used, the gaze each eye was rendered with, eye poses and grid size (frames.jsonl,
-// timings ignored), and the images both runs wrote — with tolerances. Exit 0 when they
+// sample used, the gaze each eye was rendered with, eye poses and grid size (frames.jsonl;
+// timings live apart in frame_times.jsonl), and the images both runs wrote — with tolerances. Exit 0 when they
 // agree, 1 on a difference, 2 on unusable input: the regression check to run in CI.
 #include <cmath>
 #include <filesystem>
@@ -25,7 +25,7 @@ const char* kHelp = R"(usage: fovea replay-diff A B [--gaze-tol-deg D] [--pose-t
 Compares two `fovea render --out` directories:
   frames.jsonl  same frames; per frame equal times, flags and grid size; gaze directions
                 (sample and used) within --gaze-tol-deg [1e-6]; eye poses within --pose-tol
-                (m, quaternion components) [1e-9]; "timings_ms" is ignored
+                (m, quaternion components) [1e-9] (timings are in frame_times.jsonl, not compared)
   *.png         every image present in both (frames, sbs): PSNR >= --psnr-min dB [60]
                 (identical images: infinite); an image only in one run is a difference
 Exit status: 0 equal within the tolerances, 1 different, 2 unusable input.
@@ -71,7 +71,7 @@ struct Diff {
 };
 
 // Walks two frame records: numbers under a "dir"/"used_gaze" key by angle, pose numbers by
-// absolute difference, everything else exactly; "timings_ms" skipped.
+// absolute difference, everything else exactly.
 void compare(const nlohmann::json& a, const nlohmann::json& b, const std::string& where, bool direction, double gaze_tol,
              double pose_tol, Diff& d) {
   if (direction && (a.is_array() || a.is_null() || b.is_array() || b.is_null())) {
@@ -88,7 +88,6 @@ void compare(const nlohmann::json& a, const nlohmann::json& b, const std::string
   }
   if (a.is_object()) {
     for (auto it = a.begin(); it != a.end(); ++it) {
-      if (it.key() == "timings_ms") continue;
       if (!b.contains(it.key())) {
         d.add(where + "." + it.key() + ": only in A");
         continue;
@@ -97,7 +96,7 @@ void compare(const nlohmann::json& a, const nlohmann::json& b, const std::string
       compare(it.value(), b[it.key()], where + "." + it.key(), dir, gaze_tol, pose_tol, d);
     }
     for (auto it = b.begin(); it != b.end(); ++it)
-      if (it.key() != "timings_ms" && !a.contains(it.key())) d.add(where + "." + it.key() + ": only in B");
+      if (!a.contains(it.key())) d.add(where + "." + it.key() + ": only in B");
   } else if (a.is_array()) {
     if (a.size() != b.size()) {
       d.add(where + ": " + std::to_string(a.size()) + " vs " + std::to_string(b.size()) + " entries");

@@ -38,12 +38,15 @@ void FrameLog::add(const FrameRecord& r) {
   }
   j["eye_poses"] = poses;
   j["grid"] = {r.grid_columns, r.grid_rows};
-  nlohmann::json t = nlohmann::json::object();
-  for (const auto& [k, v] : r.timings_ms) t[k] = std::isfinite(v) ? v : 0.0;
-  j["timings_ms"] = t;  // the only field that differs between identical runs
   text_ += j.dump() + "\n";
+  nlohmann::json t = {{"frame", r.frame}};
+  for (const auto& [k, v] : r.timings_ms) t[k] = std::isfinite(v) ? v : 0.0;
+  times_ += t.dump() + "\n";
 }
 
-void FrameLog::finish() const { core::write_file_atomic(path_, text_); }
+void FrameLog::finish() const {
+  core::write_file_atomic(path_, text_);
+  core::write_file_atomic(times_path_, times_);
+}
 
 }  // namespace fovea::tools

@@ -1,7 +1,8 @@
 #pragma once
 // frames.jsonl of `fovea render`: one JSON object per frame, the test oracle of a replay.
-// Every field but "timings_ms" is a deterministic function of the inputs, so two runs are
-// compared field for field (`fovea replay-diff`); timings are kept under their own key.
+// Every field is a deterministic function of the inputs, so two identical runs write the
+// same bytes (`fovea replay-diff` compares with tolerances); the per-stage timings of each
+// frame go to frame_times.jsonl beside it.
 #include <array>
 #include <string>
 #include <utility>
@@ -28,12 +29,13 @@ struct FrameRecord {
 // temporary name and a rename, like every output.
 class FrameLog {
  public:
-  explicit FrameLog(std::string path) : path_(std::move(path)) {}
+  // `frames_path` (deterministic) and `times_path` (timings), one line per frame each.
+  FrameLog(std::string frames_path, std::string times_path) : path_(std::move(frames_path)), times_path_(std::move(times_path)) {}
   void add(const FrameRecord& r);
   void finish() const;
 
  private:
-  std::string path_, text_;
+  std::string path_, times_path_, text_, times_;
 };
 
 }  // namespace fovea::tools
