@@ -122,6 +122,16 @@ double SourceUri::take_number(const std::string& key, double fallback, double lo
   return d;
 }
 
+std::string SourceUri::rebuilt() const {
+  std::string out = scheme + ":" + body;
+  char sep = '?';
+  for (const auto& [k, v] : query) {
+    out += sep + k + "=" + v;
+    sep = '&';
+  }
+  return out;
+}
+
 void SourceUri::finish() const {
   if (!query.empty())
     throw core::InputError("gaze source \"" + text + "\": unknown option \"" + query.begin()->first + "\"");
@@ -167,6 +177,19 @@ Recording open_recording(std::string_view uri, const SourceOptions& base) {
   r.reader = reader.get();
   r.stream = with_filters(std::move(reader), r.options);
   return r;
+}
+
+std::vector<std::string> recording_notes(std::string_view uri, const SourceOptions& opt) {
+  SourceUri u = parse_source_uri(uri);
+  if (u.scheme != "replay") return {};
+  // Only the keys a recording walk takes; timeline keys (speed, loop) do not change notes.
+  u.take("speed");
+  u.take("loop");
+  Recording r = open_recording(u.rebuilt(), opt);
+  GazeSample s;
+  while (r.reader->next(s)) {
+  }
+  return r.reader->stats().notes;
 }
 
 namespace {
@@ -215,13 +238,7 @@ std::unique_ptr<GazeSource> open_gaze_source(std::string_view uri, const SourceO
     opt.loop = loop == "1";
   }
   // The remaining options are validated by the stream itself.
-  std::string rebuilt = u.scheme + ":" + u.body;
-  char sep = '?';
-  for (const auto& [k, v] : u.query) {
-    rebuilt += sep + k + "=" + v;
-    sep = '&';
-  }
-  return std::make_unique<TimelineSource>(open_sample_stream(rebuilt, opt), opt);
+  return std::make_unique<TimelineSource>(open_sample_stream(u.rebuilt(), opt), opt);
 }
 
 }  // namespace fovea::devices

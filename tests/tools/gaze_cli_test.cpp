@@ -144,3 +144,16 @@ TEST(XrInfoCli, ExitsNonZeroWhenNoRuntimeLoads) {
   EXPECT_NE(r.err.find("no OpenXR runtime loads"), std::string::npos) << r.err;
   std::filesystem::remove_all(dir);
 }
+
+// `fovea render` replays through a GazeSource; the reader's notes still reach the user.
+TEST(GazeCli, RenderWarnsAboutGazeOffTheDisplay) {
+  const std::string dir = temp_dir("gaze-render");
+  const std::string asc = write(dir + "/off.asc", "** x\nMSG\t999 GAZE_COORDS 0.00 0.00 1919.00 1079.00\n"
+                                                  "SAMPLES\tGAZE\tLEFT\tRATE\t500.00\n1000\t2500.0\t540.0\t1000.0\n"
+                                                  "1002\t961.0\t540.0\t1000.0\n");
+  const auto r = run_fovea("render --display tiny --scene cornell --frames 1 --png-every 0 --quiet --gaze '" + asc +
+                           "?screen=1920x1080@95x63' --out " + dir + "/out");
+  ASSERT_EQ(r.status, 0) << r.err;
+  EXPECT_NE(r.err.find("warning: " + asc + ": 1 of 2 samples lie outside the display (1920x1080 px)"), std::string::npos) << r.err;
+  std::filesystem::remove_all(dir);
+}

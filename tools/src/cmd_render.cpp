@@ -19,6 +19,7 @@
 #include "fovea/core/image.hpp"
 #include "fovea/core/metrics.hpp"
 #include "fovea/devices/gaze.hpp"
+#include "fovea/devices/readers.hpp"
 #include "fovea/devices/screen.hpp"
 #include "frame_log.hpp"
 #include "fovea/gpu/context.hpp"
@@ -172,6 +173,7 @@ int run(std::vector<std::string> argv) {
   so.display = display;
   if (auto sc = args.opt("screen")) so.screen = devices::parse_screen(*sc, "--screen");
   const auto gaze_source = devices::open_gaze_source(gaze_uri, so);
+  for (const auto& n : devices::recording_notes(gaze_uri, so)) std::cerr << "warning: " << n << "\n";
 
   const renderer::Scene scene = renderer::load_scene(args.str("scene", "default"));
   for (const auto& w : scene.warnings) std::cerr << "warning: " << w << "\n";

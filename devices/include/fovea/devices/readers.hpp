@@ -74,6 +74,10 @@ struct Recording {
   SourceOptions options;         // after the URI's keys
 };
 Recording open_recording(std::string_view uri, const SourceOptions& opt);
+// The reader's notes on a recording (gaze outside the display, a truncated file, a missing
+// raster) from one streaming pass, for tools that replay through a GazeSource and would not
+// see them; empty for sources that are not recordings.
+std::vector<std::string> recording_notes(std::string_view uri, const SourceOptions& opt);
 
 // Writes the project's format: CSV `t_ns,eye,dir_x,dir_y,dir_z,confidence,flags` (one row
 // per eye: combined, left, right) and the sidecar FILE.json. Both appear atomically at
