@@ -1,5 +1,7 @@
 // Device-backed streams: hid:, usb:, hid-capture:, hid-emulated:. The mirror window's
 // `mouse` and the OpenXR layer's `openxr` sources live in those modules.
+#include <cmath>
+
 #include "fovea/core/error.hpp"
 #include "fovea/devices/hid_emulator.hpp"
 #include "fovea/devices/hid_stream.hpp"
@@ -25,9 +27,26 @@ std::unique_ptr<SampleStream> open_device_stream(SourceUri& u, const SourceOptio
     p.rate_hz = u.take_number("rate", p.rate_hz, 60, 1000);
     p.seconds = u.take_number("seconds", 0, 0, 1e6);
     p.ipd_m = opt.display.ipd_m;
+    // Faults and pacing, so a layer or runtime can be tested against a live-timed device
+    // that misbehaves (counts are in reports read by the host).
+    hid::Faults f;
+    auto flag = [&](const char* key) {
+      const std::string v = u.take(key);
+      if (!v.empty() && v != "0" && v != "1")
+        throw core::InputError("gaze source \"" + u.text + "\": " + key + " must be 0 or 1");
+      return v == "1";
+    };
+    f.realtime = flag("realtime");
+    f.feature_stall = flag("feature_stall");
+    f.garbage_every = static_cast<int>(u.take_number("garbage_every", 0, 0, 1e9));
+    f.short_every = static_cast<int>(u.take_number("short_every", 0, 0, 1e9));
+    f.stall_every = static_cast<int>(u.take_number("stall_every", 0, 0, 1e9));
+    f.stall_ns = std::llround(u.take_number("stall_ms", 0, 0, 60000) * 1e6);
+    f.unplug_after = static_cast<int>(u.take_number("unplug_after", -1, -1, 1e9));
+    f.seed = static_cast<std::uint64_t>(u.take_number("fault_seed", 1, 0, 9e15));
     u.finish();
     auto t = std::make_unique<hid::EmulatedTransport>(std::make_unique<SyntheticStream>(p), u.body.empty() ? "ms" : u.body,
-                                                      opt.screen_view());
+                                                      opt.screen_view(), f);
     return std::make_unique<hid::HidGazeStream>(std::move(t), opt, opt.raw_capture);
   }
   if (u.scheme == "hid" || u.scheme == "usb") {

@@ -11,6 +11,7 @@
 #include "fovea/core/error.hpp"
 #include "fovea/devices/filters.hpp"
 #include "fovea/devices/readers.hpp"
+#include "fovea/devices/screen.hpp"
 #include "fovea/devices/synthetic.hpp"
 #include "fovea/devices/timeline.hpp"
 #include "source_uri.hpp"
@@ -121,6 +122,16 @@ double SourceUri::take_number(const std::string& key, double fallback, double lo
   return d;
 }
 
+std::string SourceUri::rebuilt() const {
+  std::string out = scheme + ":" + body;
+  char sep = '?';
+  for (const auto& [k, v] : query) {
+    out += sep + k + "=" + v;
+    sep = '&';
+  }
+  return out;
+}
+
 void SourceUri::finish() const {
   if (!query.empty())
     throw core::InputError("gaze source \"" + text + "\": unknown option \"" + query.begin()->first + "\"");
@@ -130,19 +141,55 @@ void apply_common_options(SourceUri& u, SourceOptions& opt) {
   opt.horizon_ns = std::llround(u.take_number("horizon_ms", static_cast<double>(opt.horizon_ns) * 1e-6, 0, 1000) * 1e6);
   opt.min_confidence = u.take_number("min_confidence", opt.min_confidence, 0, 1);
   if (auto f = u.take("filters"); !f.empty()) opt.filters = f;
+  // The 2-D gaze geometry: the one place a URI sets it, so the layer's config and the
+  // runtime's environment variable (both a URI) carry it too.
+  if (auto sc = u.take("screen"); !sc.empty()) opt.screen = parse_screen(sc, "gaze source \"" + u.text + "\": screen");
 }
 
 namespace {
 std::unique_ptr<SampleStream> open_raw_stream(SourceUri& u, const SourceOptions& opt);
+
+std::unique_ptr<SampleStream> with_filters(std::unique_ptr<SampleStream> s, const SourceOptions& opt) {
+  if (opt.filters.empty()) return s;
+  FilterParams fp;
+  fp.centre = opt.screen_view().centre_dir();
+  return apply_filters(std::move(s), opt.filters, fp);
 }
+}  // namespace
 
 std::unique_ptr<SampleStream> open_sample_stream(std::string_view uri, const SourceOptions& base) {
   SourceUri u = parse_source_uri(uri);
   SourceOptions opt = base;
   apply_common_options(u, opt);
-  auto s = open_raw_stream(u, opt);
-  if (opt.filters.empty()) return s;
-  return apply_filters(std::move(s), opt.filters, FilterParams{});
+  return with_filters(open_raw_stream(u, opt), opt);
+}
+
+Recording open_recording(std::string_view uri, const SourceOptions& base) {
+  SourceUri u = parse_source_uri(uri);
+  if (u.scheme != "replay") throw core::InputError("\"" + u.text + "\": not a recording (replay:FILE or a file name)");
+  if (u.body.empty()) throw core::InputError("gaze source \"" + u.text + "\": missing file name");
+  Recording r;
+  r.options = base;
+  apply_common_options(u, r.options);
+  if (auto f = u.take("format"); !f.empty()) r.options.format = f;
+  u.finish();
+  auto reader = open_reader(u.body, r.options);
+  r.reader = reader.get();
+  r.stream = with_filters(std::move(reader), r.options);
+  return r;
+}
+
+std::vector<std::string> recording_notes(std::string_view uri, const SourceOptions& opt) {
+  SourceUri u = parse_source_uri(uri);
+  if (u.scheme != "replay") return {};
+  // Only the keys a recording walk takes; timeline keys (speed, loop) do not change notes.
+  u.take("speed");
+  u.take("loop");
+  Recording r = open_recording(u.rebuilt(), opt);
+  GazeSample s;
+  while (r.reader->next(s)) {
+  }
+  return r.reader->stats().notes;
 }
 
 namespace {
@@ -191,13 +238,7 @@ std::unique_ptr<GazeSource> open_gaze_source(std::string_view uri, const SourceO
     opt.loop = loop == "1";
   }
   // The remaining options are validated by the stream itself.
-  std::string rebuilt = u.scheme + ":" + u.body;
-  char sep = '?';
-  for (const auto& [k, v] : u.query) {
-    rebuilt += sep + k + "=" + v;
-    sep = '&';
-  }
-  return std::make_unique<TimelineSource>(open_sample_stream(rebuilt, opt), opt);
+  return std::make_unique<TimelineSource>(open_sample_stream(u.rebuilt(), opt), opt);
 }
 
 }  // namespace fovea::devices

@@ -1,5 +1,6 @@
 #include "fovea/devices/hid_emulator.hpp"
 
+#include <chrono>
 #include <cmath>
 #include <cstring>
 
@@ -198,7 +199,23 @@ EmulatedTransport::EmulatedTransport(std::unique_ptr<SampleStream> gaze, std::st
       device_(reference_descriptor(layout), emulated_config(screen), screen),
       faults_(faults),
       layout_(layout),
-      rng_(faults.seed) {}
+      rng_(faults.seed) {
+  if (faults_.realtime) thread_ = std::thread([this] { device_thread(); });
+}
+
+EmulatedTransport::~EmulatedTransport() {
+  {
+    std::lock_guard lock(mutex_);  // under the lock: the device thread cannot miss the wake-up
+    stop_ = true;
+  }
+  cv_.notify_all();
+  if (thread_.joinable()) thread_.join();
+}
+
+core::TimeNs EmulatedTransport::now() const {
+  if (faults_.realtime) return core::now_ns();
+  return last_host_ + faults_.clock_offset_ns * (last_host_ == 0);
+}
 
 DeviceInfo EmulatedTransport::info() const {
   DeviceInfo i;
@@ -215,35 +232,90 @@ DeviceInfo EmulatedTransport::info() const {
 
 std::vector<std::uint8_t> EmulatedTransport::report_descriptor() { return device_.codec().descriptor_bytes(); }
 
-InputReport EmulatedTransport::read_input(std::span<std::uint8_t> buf, int) {
+bool EmulatedTransport::produce(Pending& out) {
+  out = Pending{};
+  if (!status_sent_ && !device_.codec().encode_status_input(device_.config()).empty()) {
+    out.bytes = device_.codec().encode_status_input(device_.config());
+    status_sent_ = true;
+    return true;
+  }
+  GazeSample s;
+  if (!gaze_->next(s)) return false;
+  out.bytes = device_.input_report(s);
+  out.gaze = true;
+  out.device_ns = s.device_time_ns;
+  return true;
+}
+
+void EmulatedTransport::device_thread() {
+  std::unique_lock lock(mutex_);
+  cv_.wait(lock, [&] { return enabled_ || stop_; });  // the stream is off until the host enables it
+  const core::TimeNs start = core::now_ns();
+  bool have_first = false;
+  core::TimeNs first = 0;
+  Pending p;
+  while (!stop_) {
+    lock.unlock();
+    const bool more = produce(p);
+    lock.lock();
+    if (!more) break;
+    if (!have_first && p.gaze) {
+      have_first = true;
+      first = p.device_ns;
+    }
+    // Due on the host clock at the sample's offset from the first sample.
+    const core::TimeNs due = start + (have_first ? p.device_ns - first : 0);
+    cv_.wait_for(lock, std::chrono::nanoseconds(std::max<core::TimeNs>(0, due - core::now_ns())), [&] { return stop_.load(); });
+    if (stop_) break;
+    p.host_ns = core::now_ns();
+    if (p.host_ns < silent_until_) continue;  // stalled: the report is lost
+    constexpr std::size_t kDeviceBuffer = 4096;  // a host that does not read loses the oldest
+    if (queue_.size() >= kDeviceBuffer) queue_.pop_front();
+    queue_.push_back(std::move(p));
+    cv_.notify_all();
+  }
+  produced_all_ = true;
+  cv_.notify_all();
+}
+
+InputReport EmulatedTransport::read_input(std::span<std::uint8_t> buf, int timeout_ms) {
   ++reads_;
   if (faults_.unplug_after >= 0 && reads_ > static_cast<std::uint64_t>(faults_.unplug_after))
     throw TransportError("emulated device: unplugged", true);
-  if (faults_.stall_every > 0 && reads_ % faults_.stall_every == 0) throw TransportError("emulated device: endpoint stalled", false);
-  if (!(device_.mode() & kModeGazePoint)) return {};  // the stream is off until the host enables it
-  std::vector<std::uint8_t> r;
-  core::TimeNs device_ns = 0;
-  if (!status_sent_ && !device_.codec().encode_status_input(device_.config()).empty()) {
-    r = device_.codec().encode_status_input(device_.config());
-    status_sent_ = true;
+  if (faults_.stall_every > 0 && reads_ % faults_.stall_every == 0) {
+    if (faults_.realtime) {
+      std::lock_guard lock(mutex_);
+      silent_until_ = core::now_ns() + faults_.stall_ns;
+    }
+    throw TransportError("emulated device: endpoint stalled", false);
+  }
+  Pending p;
+  if (faults_.realtime) {
+    std::unique_lock lock(mutex_);
+    cv_.wait_for(lock, std::chrono::milliseconds(std::max(0, timeout_ms)), [&] { return !queue_.empty() || produced_all_; });
+    if (queue_.empty()) {
+      if (produced_all_) exhausted_ = true;
+      return {};
+    }
+    p = std::move(queue_.front());
+    queue_.pop_front();
   } else {
-    GazeSample s;
-    if (!gaze_->next(s)) {
+    if (!enabled_) return {};  // the stream is off until the host enables it
+    if (!produce(p)) {
       exhausted_ = true;
       return {};
     }
-    r = device_.input_report(s);
-    device_ns = s.device_time_ns;
   }
   if (faults_.garbage_every > 0 && reads_ % faults_.garbage_every == 0)
-    for (auto& x : r) x = static_cast<std::uint8_t>(splitmix(rng_));
-  std::size_t n = std::min(r.size(), buf.size());
+    for (auto& x : p.bytes) x = static_cast<std::uint8_t>(splitmix(rng_));
+  std::size_t n = std::min(p.bytes.size(), buf.size());
   if (faults_.short_every > 0 && reads_ % faults_.short_every == 0) n = n / 2;
-  std::memcpy(buf.data(), r.data(), n);
+  std::memcpy(buf.data(), p.bytes.data(), n);
+  if (faults_.realtime) return {n, p.host_ns};
   // Host receive time: device clock with offset and drift, plus an exponential delay.
   const double u = (static_cast<double>(splitmix(rng_) >> 11) + 0.5) * 0x1.0p-53;
   const core::TimeNs delay = std::llround(-std::log(u) * static_cast<double>(faults_.delay_ns));
-  core::TimeNs host = device_ns + faults_.clock_offset_ns + std::llround(static_cast<double>(device_ns) * faults_.drift_ppm * 1e-6) + delay;
+  core::TimeNs host = p.device_ns + faults_.clock_offset_ns + std::llround(static_cast<double>(p.device_ns) * faults_.drift_ppm * 1e-6) + delay;
   host = std::max(host, last_host_);  // a host clock never runs backwards
   last_host_ = host;
   return {n, host};
@@ -259,6 +331,11 @@ std::vector<std::uint8_t> EmulatedTransport::get_feature(std::uint8_t id, std::s
 void EmulatedTransport::set_feature(std::span<const std::uint8_t> report) {
   if (faults_.feature_stall) throw TransportError("emulated device: SET_REPORT stalled", false);
   if (!device_.set_feature(report)) throw TransportError("emulated device: SET_REPORT rejected", false);
+  {
+    std::lock_guard lock(mutex_);
+    enabled_ = (device_.mode() & kModeGazePoint) != 0;
+  }
+  cv_.notify_all();
 }
 
 }  // namespace fovea::devices::hid

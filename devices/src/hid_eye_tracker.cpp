@@ -17,6 +17,14 @@ std::string hex32(std::uint32_t v) {
   return b;
 }
 
+// Device values are declared up to 32 bits unsigned (e.g. logical max 0xFFFFFFFF): a plain
+// cast of such a value to int is undefined, so it saturates instead.
+int saturate_int(double v) {
+  if (!(v == v)) return 0;
+  return static_cast<int>(std::clamp(v, static_cast<double>(std::numeric_limits<int>::min()),
+                                     static_cast<double>(std::numeric_limits<int>::max())));
+}
+
 int nibble(std::uint32_t unit, int i) {
   const int v = (unit >> (4 * i)) & 0xF;
   return v >= 8 ? v - 16 : v;
@@ -221,7 +229,7 @@ bool EyeTrackerCodec::decode_input(std::span<const std::uint8_t> rep, HidGaze& o
   std::int64_t raw = 0;
   if (id != L.tracking_report_id) {
     if (L.status_input_config.found && L.status_input_config.report_id == id && read_value(rep, L.status_input_config, ids, raw))
-      cfg.configuration_status = static_cast<int>(raw);
+      cfg.configuration_status = saturate_int(static_cast<double>(raw));
     if (L.status_input_frequency.found && L.status_input_frequency.report_id == id && read_value(rep, L.status_input_frequency, ids, raw))
       cfg.sampling_hz = L.status_input_frequency.to_si(raw);
     reason.clear();
@@ -264,8 +272,8 @@ bool EyeTrackerCodec::decode_feature(std::span<const std::uint8_t> rep, DeviceCo
   get(L.max_screen_w, [&](double s) { if (cfg.screen_w_m <= 0) cfg.screen_w_m = s; });
   get(L.max_screen_h, [&](double s) { if (cfg.screen_h_m <= 0) cfg.screen_h_m = s; });
   get(L.sampling_frequency, [&](double s) { cfg.sampling_hz = s; });
-  get(L.configuration_status, [&](double s) { cfg.configuration_status = static_cast<int>(s); });
-  get(L.tracker_quality, [&](double s) { cfg.tracker_quality = static_cast<int>(s); });
+  get(L.configuration_status, [&](double s) { cfg.configuration_status = saturate_int(s); });
+  get(L.tracker_quality, [&](double s) { cfg.tracker_quality = saturate_int(s); });
   get(L.min_distance, [&](double s) { cfg.min_distance_m = s; });
   get(L.optimum_distance, [&](double s) { cfg.optimum_distance_m = s; });
   get(L.max_distance, [&](double s) { cfg.max_distance_m = s; });

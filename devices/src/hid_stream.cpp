@@ -21,15 +21,29 @@ bool GazeMapper::map(std::span<const std::uint8_t> report, GazeSample& out, std:
   if (!(cfg_.screen_w_m > 0 && cfg_.screen_h_m > 0))
     throw core::InputError("HID eye tracker: no Calibrated Screen Width/Height (or Maximum Screen Plane size) known; "
                            "cannot map the gaze point");
-  // Timestamps narrower than 64 bits wrap: unwrap by the value's width.
+  // Timestamps narrower than 64 bits wrap: unwrap by the value's width. The unwrapped count
+  // and its value in ns must stay within int64; a report past that is dropped, not wrapped.
   const Value& ts = codec_.layout().timestamp;
   std::int64_t raw = g.timestamp_raw;
-  if (ts.bits < 64) {
+  if (ts.bits < 63) {
     const std::int64_t span = std::int64_t(1) << ts.bits;
-    if (have_last_ && raw + wraps_ < last_raw_ - span / 2) wraps_ += span;
-    raw += wraps_;
+    std::int64_t wraps = wraps_, unwrapped = 0;
+    bool overflow = __builtin_add_overflow(raw, wraps, &unwrapped);
+    if (!overflow && have_last_ && unwrapped < last_raw_ - span / 2)
+      overflow = __builtin_add_overflow(wraps, span, &wraps) || __builtin_add_overflow(raw, wraps, &unwrapped);
+    if (overflow) {
+      reason = "time_overflow";
+      return false;
+    }
+    wraps_ = wraps;
+    raw = unwrapped;
   }
-  const core::TimeNs device = std::llround(static_cast<double>(raw) * ts.si_per_unit * 1e9);
+  const double device_d = static_cast<double>(raw) * ts.si_per_unit * 1e9;
+  if (!(std::abs(device_d) < 9.2e18)) {  // e.g. a 2^62 µs stamp: not representable in int64 ns
+    reason = "time_overflow";
+    return false;
+  }
+  const core::TimeNs device = std::llround(device_d);
   if (have_last_ && device <= last_device_) {
     reason = device == last_device_ ? "duplicate_time" : "non_monotonic_time";
     return false;
@@ -312,7 +326,10 @@ bool HidCaptureStream::next(GazeSample& out) {
       have_first_ = true;
       first_ = out.device_time_ns;
     }
-    out.t_ns = out.device_time_ns - first_;
+    if (__builtin_sub_overflow(out.device_time_ns, first_, &out.t_ns)) {
+      drop("time_overflow");
+      continue;
+    }
     out.host_time_ns = host;
     ++stats_.samples;
     if (out.tracked()) ++stats_.tracked;

@@ -23,7 +23,7 @@ void LineReader::rewind() {
   if (gzrewind(static_cast<gzFile>(gz_)) != 0) throw core::InputError(path_ + ": cannot rewind");
   begin_ = end_ = 0;
   number_ = 0;
-  eof_ = false;
+  eof_ = truncated_ = false;
 }
 
 bool LineReader::fill() {
@@ -44,6 +44,9 @@ bool LineReader::fill() {
     throw core::InputError(path_ + ": read error (" + gzerror(static_cast<gzFile>(gz_), &err) + ")");
   }
   if (n == 0) {
+    int err = Z_OK;
+    gzerror(static_cast<gzFile>(gz_), &err);
+    truncated_ = err == Z_BUF_ERROR;  // zlib: "unexpected end of file" inside a gzip member
     eof_ = true;
     return false;
   }

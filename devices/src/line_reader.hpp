@@ -31,6 +31,9 @@ class LineReader {
   const std::string& path() const { return path_; }
   // Bytes held by the reader (buffer capacity), the figure behind the memory bound.
   std::size_t peak_bytes() const { return peak_; }
+  // After the last line: the gzip stream ended before its trailer (a cut file). The lines
+  // read are what the file holds; the caller decides how to report it.
+  bool truncated() const { return truncated_; }
 
  private:
   bool fill();  // appends one chunk; false at end of file
@@ -39,7 +42,7 @@ class LineReader {
   std::vector<char> buf_;
   std::size_t begin_ = 0, end_ = 0;
   std::uint64_t number_ = 0;
-  bool eof_ = false;
+  bool eof_ = false, truncated_ = false;
   std::size_t peak_ = 0;
 };
 

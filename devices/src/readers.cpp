@@ -9,7 +9,6 @@
 #include <filesystem>
 #include <fstream>
 #include <numbers>
-#include <sstream>
 #include <unistd.h>
 
 #include <glm/geometric.hpp>
@@ -42,6 +41,17 @@ const char* format_name(Format f) {
   return "?";
 }
 
+const char* device_clock_name(Format f) {
+  switch (f) {
+    case Format::Fovea: return "t_ns of the source recording";
+    case Format::PupilCore: return "Pupil time (gaze_timestamp, s, arbitrary epoch)";
+    case Format::Neon: return "UTC (timestamp [ns] since 1970)";
+    case Format::TobiiG3: return "s since the Glasses 3 recording start";
+    case Format::EyelinkAsc: return "EyeLink tracker clock (ms)";
+  }
+  return "?";
+}
+
 Format parse_format(std::string_view n) {
   for (Format f : {Format::Fovea, Format::PupilCore, Format::Neon, Format::TobiiG3, Format::EyelinkAsc})
     if (n == format_name(f)) return f;
@@ -59,7 +69,15 @@ Format detect_format(const std::string& path) {
   if (head.rfind("\xEF\xBB\xBF", 0) == 0) head.erase(0, 3);
   const std::string first = head.substr(0, head.find('\n'));
   std::size_t p = head.find_first_not_of(" \t\r\n");
-  if (p != std::string::npos && head[p] == '{') return Format::TobiiG3;
+  if (p != std::string::npos && head[p] == '{') {
+    // Glasses 3 gazedata: one JSON object per line with "type" and "timestamp" (any other
+    // JSON file is not silently read as gaze).
+    const std::string line = head.substr(p, head.find('\n', p) - p);
+    if (line.find("\"timestamp\"") != std::string::npos && line.find("\"type\"") != std::string::npos)
+      return Format::TobiiG3;
+    throw core::InputError(path + ": a JSON file, but its first line is not Tobii Glasses 3 gazedata "
+                           "(an object with \"type\" and \"timestamp\")");
+  }
   if (first.find("t_ns") != std::string::npos && first.find("dir_x") != std::string::npos) return Format::Fovea;
   if (first.find("gaze_timestamp") != std::string::npos && first.find("norm_pos_x") != std::string::npos)
     return Format::PupilCore;
@@ -98,6 +116,10 @@ class ReaderBase : public GazeReader {
       } else {
         current_unterminated_ = false;
         stats_.peak_buffer_bytes = lines_.peak_bytes();
+        if (lines_.truncated() && !truncated_noted_) {
+          truncated_noted_ = true;
+          note(lines_.path() + ": the gzip stream ends early (truncated file); the samples up to the cut were read");
+        }
         if (!flush(out)) return false;
         have = true;
       }
@@ -109,6 +131,7 @@ class ReaderBase : public GazeReader {
     lines_.rewind();
     stats_ = ReadStats{};
     have_last_ = false;
+    truncated_noted_ = false;
     reset();
   }
   std::string describe() const override { return std::string("replay:") + lines_.path() + " (" + format_name(format_) + ")"; }
@@ -119,6 +142,7 @@ class ReaderBase : public GazeReader {
   Format format() const override { return format_; }
   bool reports_blinks() const override { return false; }
   std::string metadata_json() const override { return "{}"; }
+  core::TimeNs time_origin_ns() const override { return first_device_; }
 
  protected:
   // Parses one non-empty line; true if `out` holds a sample (device_time_ns set).
@@ -128,6 +152,12 @@ class ReaderBase : public GazeReader {
   virtual void reset() {}
 
   void drop(const char* reason) { ++stats_.dropped[current_unterminated_ ? "truncated_last_line" : reason]; }
+  void note(const std::string& what) {
+    if (stats_.notes.size() < ReadStats::kMaxNotes) stats_.notes.push_back(what);
+  }
+  void message(core::TimeNs device_ns, const char* kind, std::string_view text) {
+    if (sink_) sink_(RecordingMessage{device_ns, kind, std::string(text)});
+  }
   [[noreturn]] void fail(const Line& l, const std::string& what) const {
     throw core::InputError(lines_.path() + ":" + std::to_string(l.number) + ": " + what);
   }
@@ -153,6 +183,16 @@ class ReaderBase : public GazeReader {
 
  private:
   bool accept(GazeSample& s) {
+    for (const EyeGaze* g : {&s.combined, &s.left, &s.right})
+      if (!std::isfinite(g->dir.x + g->dir.y + g->dir.z)) {  // e.g. a coordinate of 1e300
+        drop("bad_value");
+        return false;
+      }
+    core::TimeNs rebased = 0;
+    if (have_last_ && __builtin_sub_overflow(s.device_time_ns, first_device_, &rebased)) {
+      drop("time_overflow");  // further from the first sample than int64 ns can express
+      return false;
+    }
     if (have_last_ && s.device_time_ns == last_device_) {
       drop("duplicate_time");
       return false;
@@ -164,13 +204,13 @@ class ReaderBase : public GazeReader {
     if (!have_last_) first_device_ = s.device_time_ns;
     have_last_ = true;
     last_device_ = s.device_time_ns;
-    s.t_ns = s.device_time_ns - first_device_;
+    s.t_ns = rebased;
     s.host_time_ns = s.t_ns;
     ++stats_.samples;
     if (s.tracked()) ++stats_.tracked;
     return true;
   }
-  bool current_unterminated_ = false;
+  bool current_unterminated_ = false, truncated_noted_ = false;
   bool have_last_ = false;
   core::TimeNs first_device_ = 0, last_device_ = 0;
 };
@@ -186,12 +226,23 @@ bool unit_dir(double x, double y, double z, glm::dvec3& out) {
 class FoveaReader final : public ReaderBase {
  public:
   FoveaReader(const std::string& path, const SourceOptions& opt) : ReaderBase(path, opt, Format::Fovea) {
-    std::ifstream side(path + ".json");
+    const std::string side_path = path + ".json";
+    std::ifstream side(side_path, std::ios::binary);
     if (side) {
-      std::stringstream ss;
-      ss << side.rdbuf();
+      // A sidecar holds a few fields: bound its size and nesting before parsing, so a hostile
+      // file can neither exhaust memory nor the stack (parsing and dumping recurse per level).
+      constexpr std::size_t kMaxSidecar = 1 << 20;
+      constexpr int kMaxDepth = 64;
+      std::error_code ec;
+      const auto size = std::filesystem::file_size(side_path, ec);
+      if (ec || size > kMaxSidecar)
+        throw core::InputError(side_path + ": sidecar larger than 1 MiB (or unreadable); not a gaze sidecar");
+      std::string text(static_cast<std::size_t>(size), '\0');
+      side.read(text.data(), static_cast<std::streamsize>(text.size()));
+      if (detail::json_depth(text) > kMaxDepth)
+        throw core::InputError(side_path + ": sidecar JSON nested deeper than " + std::to_string(kMaxDepth) + " levels");
       try {
-        meta_ = nlohmann::json::parse(ss.str()).dump();
+        meta_ = nlohmann::json::parse(text).dump();
       } catch (const nlohmann::json::exception& e) {
         throw core::InputError(path + ".json: invalid JSON sidecar: " + e.what());
       }
@@ -362,6 +413,7 @@ class NeonReader final : public ReaderBase {
  public:
   NeonReader(const std::string& path, const SourceOptions& opt)
       : ReaderBase(path, opt, Format::Neon), view_(opt.screen ? *opt.screen : neon_scene_camera()) {}
+  bool reports_blinks() const override { return true; }
 
  protected:
   void reset() override { header_ = false; }
@@ -373,10 +425,12 @@ class NeonReader final : public ReaderBase {
       x_ = column(h, "gaze x [px]");
       y_ = column(h, "gaze y [px]");
       w_ = column(h, "worn");
+      b_ = column(h, "blink id");
       az_ = column(h, "azimuth [deg]");
       el_ = column(h, "elevation [deg]");
       if (t_ < 0 || x_ < 0 || y_ < 0) fail(l, "header needs \"timestamp [ns]\", \"gaze x [px]\", \"gaze y [px]\"");
       header_ = true;
+      read_events();
       return false;
     }
     if (static_cast<int>(fields_.size()) <= std::max({t_, x_, y_})) {
@@ -417,14 +471,48 @@ class NeonReader final : public ReaderBase {
       out.combined.confidence = worn > 0.5 ? 1.0 : 0.0;
       out.combined.flags = worn > 0.5 ? kTracked : kLost;
     }
+    // A sample inside a blink (non-empty "blink id"): the eye is closed and the gaze drifts
+    // with the lid, so the direction is no measurement.
+    if (b_ >= 0 && b_ < static_cast<int>(fields_.size()) && !fields_[b_].empty() && out.combined.tracked()) {
+      out.combined.flags = kBlink;
+      out.combined.confidence = 0;
+    }
     out.left = out.right = out.combined;
     return true;
   }
 
  private:
+  // Neon / Pupil Cloud exports put events (recording.begin, user events) in events.csv next
+  // to gaze.csv: passed on as messages when the gaze header has been read.
+  void read_events() {
+    if (!sink_) return;
+    const auto ev = std::filesystem::path(lines_.path()).parent_path() / "events.csv";
+    if (!std::filesystem::is_regular_file(ev)) return;
+    detail::LineReader r(ev.string());
+    detail::Line l;
+    std::vector<std::string_view> f;
+    int t = -1, name = -1, type = -1;
+    constexpr std::uint64_t kMaxEvents = 1'000'000;
+    while (r.next(l) && l.number <= kMaxEvents) {
+      detail::split_fields(l.text, ',', f);
+      if (l.number == 1) {
+        const std::vector<std::string> h(f.begin(), f.end());
+        t = column(h, "timestamp [ns]");
+        name = column(h, "name");
+        type = column(h, "type");
+        if (t < 0 || name < 0) return;
+        continue;
+      }
+      std::int64_t ns = 0;
+      if (static_cast<int>(f.size()) <= std::max(t, name) || detail::parse_int64(f[t], ns) != Num::Ok) continue;
+      std::string text(f[name]);
+      if (type >= 0 && type < static_cast<int>(f.size()) && !f[type].empty()) text += " (" + std::string(f[type]) + ")";
+      message(ns, "event", text);
+    }
+  }
   core::View view_;
   bool header_ = false;
-  int t_ = -1, x_ = -1, y_ = -1, w_ = -1, az_ = -1, el_ = -1;
+  int t_ = -1, x_ = -1, y_ = -1, w_ = -1, b_ = -1, az_ = -1, el_ = -1;
 };
 
 // ---- Tobii Pro Glasses 3 gazedata(.gz) -----------------------------------------------
@@ -511,8 +599,10 @@ class EyelinkReader final : public ReaderBase {
     binocular_ = false;
     mono_right_ = false;
     blink_[0] = blink_[1] = false;
+    coords_ = Coords::None;
     disp_w_ = view_.width();
     disp_h_ = view_.height();
+    outside_ = samples_ = 0;
   }
   bool parse(const Line& l, GazeSample& out) override {
     detail::split_blank(l.text, fields_);
@@ -536,6 +626,7 @@ class EyelinkReader final : public ReaderBase {
     out = GazeSample{};
     out.device_time_ns = std::llround(tms * 1e6);
     const int eyes = binocular_ ? 2 : 1;
+    bool outside = false;
     for (int i = 0; i < eyes; ++i) {
       const int eye = binocular_ ? i : (mono_right_ ? 1 : 0);  // 0 = left, 1 = right
       const std::string_view xs = fields_[1 + 3 * i], ys = fields_[2 + 3 * i];
@@ -550,6 +641,7 @@ class EyelinkReader final : public ReaderBase {
           drop(detail::num_reason(n));
           return false;
         }
+        outside = outside || x < 0 || y < 0 || x > disp_w_ || y > disp_h_;
         // Display pixels (top-left, y down) scaled from DISPLAY_COORDS to the view raster.
         g = from_screen(view_, x * view_.width() / disp_w_, y * view_.height() / disp_h_, 1.0);
       }
@@ -559,10 +651,25 @@ class EyelinkReader final : public ReaderBase {
     if (!binocular_) (mono_right_ ? out.left : out.right) = (mono_right_ ? out.right : out.left);
     out.combined = combine_eyes(out.left, out.right);
     if (!out.combined.tracked()) out.combined.flags = (out.left.flags | out.right.flags) & kBlink ? kBlink : kLost;
+    ++samples_;
+    if (outside) ++outside_;
     return true;
+  }
+  bool flush(GazeSample&) override {
+    if (coords_ == Coords::None && samples_ > 0)
+      note(lines_.path() + ": no DISPLAY_COORDS or GAZE_COORDS message; gaze pixels were taken as the screen raster (" +
+           std::to_string(view_.width()) + "x" + std::to_string(view_.height()) + ")");
+    if (outside_ > 0)
+      note(lines_.path() + ": " + std::to_string(outside_) + " of " + std::to_string(samples_) +
+           " samples lie outside the display (" + std::to_string(std::lround(disp_w_)) + "x" +
+           std::to_string(std::lround(disp_h_)) + " px); check the screen geometry");
+    samples_ = outside_ = 0;
+    return false;
   }
 
  private:
+  // Where the pixel raster of the gaze samples comes from, by priority.
+  enum class Coords { None, Gaze, Display };
   void control(const Line& l) {
     const std::string_view k = fields_[0];
     auto has = [&](std::string_view w) { return std::find(fields_.begin(), fields_.end(), w) != fields_.end(); };
@@ -574,21 +681,38 @@ class EyelinkReader final : public ReaderBase {
     } else if (k == "SBLINK" || k == "EBLINK") {
       const bool on = k == "SBLINK";
       if (fields_.size() > 1) blink_[fields_[1] == "R" ? 1 : 0] = on;
-    } else if (k == "MSG" && fields_.size() >= 7 && fields_[2] == "DISPLAY_COORDS") {
-      double x0 = 0, y0 = 0, x1 = 0, y1 = 0;
-      if (detail::parse_double(fields_[3], x0) == Num::Ok && detail::parse_double(fields_[4], y0) == Num::Ok &&
-          detail::parse_double(fields_[5], x1) == Num::Ok && detail::parse_double(fields_[6], y1) == Num::Ok &&
-          x1 > x0 && y1 > y0) {
-        disp_w_ = x1 - x0 + 1;
-        disp_h_ = y1 - y0 + 1;
-      } else {
-        drop("bad_value");
-      }
+    } else if ((k == "MSG" || k == "INPUT" || k == "BUTTON") && fields_.size() >= 2) {
+      double tms = 0;
+      const bool timed = detail::parse_double(fields_[1], tms) == Num::Ok && std::abs(tms) <= 9.2e9;
+      // The message text: everything after the time stamp, as written.
+      const std::size_t at = fields_[1].data() + fields_[1].size() - l.text.data();
+      if (timed) message(std::llround(tms * 1e6), k == "MSG" ? "msg" : k == "INPUT" ? "input" : "button", detail::trim(l.text.substr(at)));
+      if (k == "MSG" && fields_.size() >= 7 && (fields_[2] == "DISPLAY_COORDS" || fields_[2] == "GAZE_COORDS"))
+        coords(fields_[2] == "DISPLAY_COORDS" ? Coords::Display : Coords::Gaze, 3);
+    } else if (k == "DISPLAY_COORDS" || k == "GAZE_COORDS") {  // also written without MSG
+      coords(k == "DISPLAY_COORDS" ? Coords::Display : Coords::Gaze, 1);
+    }
+  }
+  // DISPLAY_COORDS left top right bottom; GAZE_COORDS (the tracker's gaze raster) is used
+  // only when the file has no DISPLAY_COORDS.
+  void coords(Coords kind, std::size_t first) {
+    if (kind < coords_ || fields_.size() < first + 4) return;
+    double x0 = 0, y0 = 0, x1 = 0, y1 = 0;
+    if (detail::parse_double(fields_[first], x0) == Num::Ok && detail::parse_double(fields_[first + 1], y0) == Num::Ok &&
+        detail::parse_double(fields_[first + 2], x1) == Num::Ok && detail::parse_double(fields_[first + 3], y1) == Num::Ok &&
+        x1 > x0 && y1 > y0 && x1 - x0 < 1e6 && y1 - y0 < 1e6) {
+      disp_w_ = x1 - x0 + 1;
+      disp_h_ = y1 - y0 + 1;
+      coords_ = kind;
+    } else {
+      drop("bad_value");
     }
   }
   core::View view_;
   bool binocular_ = false, mono_right_ = false, blink_[2] = {};
+  Coords coords_ = Coords::None;
   double disp_w_ = view_.width(), disp_h_ = view_.height();
+  std::uint64_t outside_ = 0, samples_ = 0;
 };
 
 }  // namespace
@@ -609,6 +733,13 @@ std::unique_ptr<GazeReader> open_reader(const std::string& path, const SourceOpt
 // ---- Writer --------------------------------------------------------------------------
 FoveaCsvWriter::FoveaCsvWriter(const std::string& path, const std::string& metadata_json, bool per_eye)
     : path_(path), tmp_(path + ".tmp." + std::to_string(::getpid())), per_eye_(per_eye) {
+  set_metadata(metadata_json);
+  file_ = std::fopen(tmp_.c_str(), "wb");
+  if (!file_) throw std::runtime_error(path + ": cannot open for writing");
+  std::fputs("t_ns,eye,dir_x,dir_y,dir_z,confidence,flags\n", static_cast<std::FILE*>(file_));
+}
+
+void FoveaCsvWriter::set_metadata(const std::string& metadata_json) {
   nlohmann::json meta;
   try {
     meta = nlohmann::json::parse(metadata_json.empty() ? "{}" : metadata_json);
@@ -618,9 +749,6 @@ FoveaCsvWriter::FoveaCsvWriter(const std::string& path, const std::string& metad
   nlohmann::json side = {{"format", "fovea-gaze-csv"}, {"version", 1}};
   side.update(meta);
   meta_ = side.dump(2) + "\n";
-  file_ = std::fopen(tmp_.c_str(), "wb");
-  if (!file_) throw std::runtime_error(path + ": cannot open for writing");
-  std::fputs("t_ns,eye,dir_x,dir_y,dir_z,confidence,flags\n", static_cast<std::FILE*>(file_));
 }
 
 FoveaCsvWriter::~FoveaCsvWriter() {

@@ -15,6 +15,7 @@ struct SourceUri {
   std::string take(const std::string& key);  // "" if absent; removes the key
   double take_number(const std::string& key, double fallback, double lo, double hi);
   void finish() const;  // throws for any key nobody took
+  std::string rebuilt() const;  // "scheme:body?k=v&..." with the keys not yet taken
 };
 
 SourceUri parse_source_uri(std::string_view uri);

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 
 namespace fovea::devices {
 
@@ -38,7 +39,9 @@ GazeSample TimelineSource::at_recording_time(core::TimeNs tt) {
     if (opt_.loop && ended_ && !win_.empty() && tt > win_.back().t_ns) {
       if (period_ < 0) {  // one nominal sample period after the last sample
         const core::TimeNs dt = win_.size() > 1 ? win_.back().t_ns - win_[win_.size() - 2].t_ns : 0;
-        period_ = win_.back().t_ns + std::max<core::TimeNs>(dt, 1);
+        // Saturating: a recording spanning ~int64 ns must not wrap to a negative period.
+        if (__builtin_add_overflow(win_.back().t_ns, std::max<core::TimeNs>(dt, 1), &period_))
+          period_ = std::numeric_limits<core::TimeNs>::max();
       }
       loop_base_ = tt - tt % period_;
       tt %= period_;
@@ -72,7 +75,8 @@ GazeSample TimelineSource::at_recording_time(core::TimeNs tt) {
 GazeSample TimelineSource::sample_at(core::TimeNs t) {
   std::lock_guard lock(mutex_);
   const bool live = stream_->live();
-  GazeSample s = at_recording_time(live ? t : std::llround(static_cast<double>(t) * opt_.speed));
+  GazeSample s = at_recording_time(
+      live ? t : std::llround(std::clamp(static_cast<double>(t) * opt_.speed, -9.2e18, 9.2e18)));
   // Back from recording time to the caller's timeline: the sample's own time, not t.
   if (!live && s.t_ns != kNoSample)
     s.t_ns = std::min<core::TimeNs>(t, std::llround(static_cast<double>(s.t_ns + loop_base_) / opt_.speed));

@@ -223,7 +223,7 @@ TEST(Replay, TenMillionSamplesStreamInBoundedMemory) {
     std::fwrite(buf.data(), 1, buf.size(), f);
     std::fclose(f);
   }
-  const auto file_size = std::filesystem::file_size(path);
+  [[maybe_unused]] const auto file_size = std::filesystem::file_size(path);  // read below unless sanitized
   auto r = open_reader(path, SourceOptions{});
   SummaryParams sp;
   const GazeSummary s = summarize(*r, sp);

@@ -6,8 +6,8 @@
 
 #include <nlohmann/json.hpp>
 
-#include "canvas.hpp"
 #include "command.hpp"
+#include "plot_canvas.hpp"
 #include "fovea/core/error.hpp"
 #include <chrono>
 #include <filesystem>
@@ -18,6 +18,7 @@
 #include "fovea/devices/analysis.hpp"
 #include "fovea/devices/hid_stream.hpp"
 #include "fovea/devices/readers.hpp"
+#include "fovea/devices/screen.hpp"
 #include "fovea/devices/synthetic.hpp"
 
 namespace fovea::tools {
@@ -28,37 +29,32 @@ namespace {
 
 const char* kHelp =
     "usage: fovea gaze <subcommand> ...\n"
-    "  info FILE [--format F]          JSON summary: samples, validity, rate, events, dropped rows\n"
+    "  info FILE [--format F] [--events]\n"
+    "                                  JSON summary: samples, validity, rate, events, dropped rows,\n"
+    "                                  data quality (RMS-S2S, STD, data loss); --events lists each\n"
+    "                                  fixation, saccade and blink with its times\n"
     "                                  (FILE: any replay format, a raw HID capture, or synthetic:SEED?seconds=S)\n"
     "  convert IN OUT [--format F]     any supported format -> the project's CSV (+ OUT.json)\n"
     "  synth --task T --seconds S OUT  synthetic gaze (--seed N --rate HZ --noise DEG --color C\n"
     "                                  --dropouts PER_S); tasks: reading search pursuit fixation-grid\n"
-    "  plot FILE OUT.png               gaze over time and on the display, saccades marked\n"
+    "  plot FILE OUT.png [--from S --to S --width PX]\n"
+    "                                  gaze angles against time (numbered axes, legend) and the\n"
+    "                                  scanpath on the screen; --from/--to: a time window (s)\n"
     "  record --source URI --seconds S OUT [--raw CAPTURE] [--timeout S]\n"
     "                                  record any source (hid:, usb:, hid-emulated:LAYOUT, synthetic:,\n"
     "                                  replay); --raw writes the raw HID traffic (docs/hid.md)\n"
-    "geometry for 2D formats: --display NAME|FILE (default small), --screen WxH@HFOVxVFOV\n"
+    "geometry for 2D formats: --display NAME|FILE (default small), --screen WxH@HFOVxVFOV or\n"
+    "  WxH@SWxSHmm@Dmm (screen size and eye distance; also the URI key screen=)\n"
     "  (e.g. 1920x1080@95x63: the raster and symmetric field of view the gaze coordinates refer to)\n"
     "--min-confidence C (default 0.6): samples below are marked lost\n"
     "formats: fovea pupil-core neon tobii-g3 eyelink-asc (auto-detected; see docs/gaze.md)\n";
 
 const std::vector<std::string> kGeometryOpts = {"format", "display", "screen", "min-confidence"};
 
-// "WxH@HFOVxVFOV" -> a View with a symmetric field of view.
-core::View parse_screen(const std::string& s) {
-  int w = 0, h = 0;
-  double hf = 0, vf = 0;
-  char tail = 0;
-  if (std::sscanf(s.c_str(), "%dx%d@%lfx%lf%c", &w, &h, &hf, &vf, &tail) != 4 || w < 1 || h < 1 || w > 65536 ||
-      h > 65536 || !(hf > 0 && hf < 179) || !(vf > 0 && vf < 179))
-    throw core::InputError("--screen: expected WxH@HFOVxVFOV (pixels, degrees), e.g. 1920x1080@95x63; got \"" + s + "\"");
-  return core::View(core::Fov::from_degrees(-hf / 2, hf / 2, vf / 2, -vf / 2), w, h);
-}
-
 dv::SourceOptions gaze_source_options(const Args& a) {
   dv::SourceOptions opt;
   opt.display = core::load_display(a.str("display", "small"));
-  if (auto s = a.opt("screen")) opt.screen = parse_screen(*s);
+  if (auto s = a.opt("screen")) opt.screen = dv::parse_screen(*s, "--screen");
   opt.format = a.str("format", "");
   opt.min_confidence = a.num("min-confidence", opt.min_confidence);
   if (!(opt.min_confidence >= 0 && opt.min_confidence <= 1)) throw core::InputError("--min-confidence must be in [0, 1]");
@@ -70,12 +66,15 @@ dv::SourceOptions gaze_source_options(const Args& a) {
 struct Input {
   std::unique_ptr<dv::SampleStream> stream;
   std::function<const dv::ReadStats*()> stats = [] { return nullptr; };
+  dv::GazeReader* reader = nullptr;  // replay formats: messages, time origin
+  dv::SourceOptions options;         // after the URI's own keys (screen=, ...)
   std::string format;
   bool reports_blinks = true;
 };
 
 Input open_input(const std::string& arg, const dv::SourceOptions& opt) {
   Input in;
+  in.options = opt;
   std::string uri = arg;
   if (uri.find(':') == std::string::npos) {
     std::FILE* f = std::fopen(arg.c_str(), "rb");
@@ -101,71 +100,169 @@ Input open_input(const std::string& arg, const dv::SourceOptions& opt) {
     in.format = "synthetic";
     return in;
   }
-  if (uri.rfind("replay:", 0) == 0) uri = uri.substr(7);
-  if (uri.find(':') != std::string::npos && !std::filesystem::exists(uri))
+  const std::string file = uri.rfind("replay:", 0) == 0 ? uri.substr(7) : uri;
+  const std::string path = file.substr(0, file.find('?'));
+  if (path.find(':') != std::string::npos && !std::filesystem::exists(path))
     throw core::InputError(arg + ": not a recording (live sources: use `fovea gaze record`)");
-  auto reader = dv::open_reader(uri, opt);
-  auto* raw = reader.get();
+  dv::Recording rec = dv::open_recording("replay:" + file, opt);
+  auto* raw = rec.reader;
   in.stats = [raw] { return &raw->stats(); };
-  in.format = dv::format_name(reader->format());
-  in.reports_blinks = reader->reports_blinks();
-  in.stream = std::move(reader);
+  in.reader = raw;
+  in.options = rec.options;
+  in.format = dv::format_name(raw->format());
+  in.reports_blinks = raw->reports_blinks();
+  in.stream = std::move(rec.stream);
   return in;
 }
 
+// What the reader noticed about the data (truncated gzip, gaze off the display, ...).
+void print_notes(const Input& in) {
+  if (const dv::ReadStats* st = in.stats())
+    for (const auto& n : st->notes) std::cerr << "warning: " << n << "\n";
+}
+
+// Rounded to `decimals` places (dividing by a power of ten prints cleanly; multiplying by
+// 1e-5 would not).
+double round_to(double v, int decimals) {
+  const double p = std::pow(10.0, decimals);
+  return std::round(v * p) / p;
+}
+
 int cmd_info(const std::vector<std::string>& argv) {
-  Args a(argv, kGeometryOpts, {}, 1);
+  Args a(argv, kGeometryOpts, {"events"}, 1);
   if (a.positional().size() != 1) throw core::InputError("gaze info needs FILE (see --help)");
   const dv::SourceOptions opt = gaze_source_options(a);
   Input in = open_input(a.positional()[0], opt);
   dv::SummaryParams sp;
   sp.infer_blinks = !in.reports_blinks;
-  const dv::GazeSummary s = dv::summarize(*in.stream, sp);
+  nlohmann::json events = nlohmann::json::array();
+  dv::EventSegmenter::Callback on_event;
+  if (a.has("events"))
+    on_event = [&](const dv::GazeEvent& e) {
+      nlohmann::json o = {{"type", dv::event_kind_name(e.kind)},
+                          {"start_ns", e.start_ns},
+                          {"end_ns", e.end_ns},
+                          {"duration_ms", round_to(static_cast<double>(e.end_ns - e.start_ns) * 1e-6, 3)}};
+      if (e.kind != dv::GazeEvent::Kind::Fixation) o["amplitude_deg"] = round_to(e.amplitude_deg, 3);
+      if (e.kind == dv::GazeEvent::Kind::Fixation) {
+        o["rms_s2s_deg"] = round_to(e.rms_s2s_deg, 5);
+        o["std_deg"] = round_to(e.std_deg, 5);
+      }
+      events.push_back(std::move(o));
+    };
+  const dv::GazeSummary s = dv::summarize(*in.stream, sp, on_event);
   const dv::ReadStats* st = in.stats();
+  print_notes(in);
   if (s.tracked == 0)
     throw core::InputError(a.positional()[0] + ": no usable sample (" + std::to_string(s.samples) + " kept, " +
                            std::to_string(st ? st->dropped_total() : 0) + " dropped)");
   nlohmann::json j;
   j["format"] = in.format;
   j["samples"] = s.samples;
-  j["valid_fraction"] = std::round(s.valid_fraction() * 1e6) / 1e6;
-  j["rate_hz"] = std::round(s.rate_hz * 1e3) / 1e3;
-  j["duration_s"] = std::round(s.duration_s * 1e6) / 1e6;
+  j["valid_fraction"] = round_to(s.valid_fraction(), 6);
+  j["rate_hz"] = round_to(s.rate_hz, 3);
+  j["duration_s"] = round_to(s.duration_s, 6);
   j["dropped"] = nlohmann::json::object();
   if (st)
     for (const auto& [k, v] : st->dropped) j["dropped"][k] = v;
   j["fixations"] = s.fixations;
   j["saccades"] = s.saccades;
   j["blinks"] = s.blinks;
+  const dv::DataQuality& q = s.quality;
+  j["data_quality"] = {{"rms_s2s_deg", round_to(q.rms_s2s_deg, 5)},
+                       {"std_deg", round_to(q.std_deg, 5)},
+                       {"fixations_measured", q.fixations_measured},
+                       {"data_loss", round_to(q.data_loss, 6)},
+                       {"data_loss_excluding_blinks", round_to(q.data_loss_excluding_blinks, 6)}};
+  if (st && !st->notes.empty()) j["notes"] = st->notes;
+  if (a.has("events")) j["events"] = std::move(events);
   std::cout << j.dump(2) << "\n";
   return 0;
 }
+
+// Messages of a recording (EyeLink MSG, Neon events) collected while it is read, written
+// next to the converted file as OUT.events.csv on the output's timeline.
+class MessageLog {
+ public:
+  explicit MessageLog(dv::GazeReader* reader) {
+    if (reader) reader->set_message_sink([this](const dv::RecordingMessage& m) { add(m); });
+  }
+  std::size_t size() const { return messages_.size(); }
+  // t_ns = device time - origin (negative for messages before the first sample).
+  void write(const std::string& path, core::TimeNs origin) const {
+    std::string csv = "t_ns,device_time_ns,kind,text\n";
+    for (const auto& m : messages_) {
+      std::string text;  // CSV quoting: the text may hold commas and quotes
+      for (char c : m.text) text += c == '"' ? std::string("\"\"") : std::string(1, c);
+      core::TimeNs t = 0;
+      if (__builtin_sub_overflow(m.device_time_ns, origin, &t)) continue;
+      csv += std::to_string(t) + "," + std::to_string(m.device_time_ns) + "," + m.kind + ",\"" + text + "\"\n";
+    }
+    core::write_file_atomic(path, csv);
+  }
+  std::uint64_t skipped() const { return skipped_; }
+
+ private:
+  void add(const dv::RecordingMessage& m) {
+    constexpr std::size_t kMaxBytes = 64 << 20;  // messages are few; a hostile file must not fill memory
+    if (bytes_ + m.text.size() > kMaxBytes) {
+      ++skipped_;
+      return;
+    }
+    bytes_ += m.text.size();
+    messages_.push_back(m);
+  }
+  std::vector<dv::RecordingMessage> messages_;
+  std::size_t bytes_ = 0;
+  std::uint64_t skipped_ = 0;
+};
 
 int cmd_convert(const std::vector<std::string>& argv) {
   Args a(argv, kGeometryOpts, {}, 2);
   if (a.positional().size() != 2) throw core::InputError("gaze convert needs IN and OUT (see --help)");
   const dv::SourceOptions opt = gaze_source_options(a);
   const std::string& in_path = a.positional()[0];
+  const std::string& out_path = a.positional()[1];
   Input in = open_input(in_path, opt);
-  nlohmann::json meta = {{"source", in_path}, {"source_format", in.format}, {"display", opt.display.name}};
-  const core::View sv = opt.screen_view();
-  meta["screen"] = {{"width", sv.width()}, {"height", sv.height()}};
-  dv::FoveaCsvWriter w(a.positional()[1], meta.dump());
+  MessageLog log(in.reader);
+  nlohmann::json meta = {{"source", in_path}, {"source_format", in.format}, {"display", in.options.display.name}};
+  const core::View sv = in.options.screen_view();
+  meta["screen"] = {{"width", sv.width()},
+                    {"height", sv.height()},
+                    {"hfov_deg", round_to((sv.fov().angle_right - sv.fov().angle_left) * 180 / M_PI, 6)},
+                    {"vfov_deg", round_to((sv.fov().angle_up - sv.fov().angle_down) * 180 / M_PI, 6)}};
   dv::GazeSample s;
   std::uint64_t tracked = 0;
+  bool have_first = false;
+  core::TimeNs first_device = 0;
+  auto w = std::make_unique<dv::FoveaCsvWriter>(out_path, meta.dump());
   while (in.stream->next(s)) {
-    w.write(s);
+    if (!have_first) {
+      have_first = true;
+      first_device = s.device_time_ns;
+    }
+    w->write(s);
     tracked += s.tracked();
   }
+  print_notes(in);
   if (tracked == 0) throw core::InputError(in_path + ": no usable sample; nothing written");
-  w.finish();
-  std::cerr << "converted " << w.samples() << " samples";
+  // The original time base: t_ns = device time - t0, on the source's clock.
+  const core::TimeNs origin = in.reader ? in.reader->time_origin_ns() : first_device;
+  meta["time_base"] = {{"t0_device_time_ns", origin},
+                       {"device_clock", in.reader ? dv::device_clock_name(in.reader->format()) : in.format}};
+  if (in.reader) meta["events_file"] = std::filesystem::path(out_path + ".events.csv").filename().string();
+  w->set_metadata(meta.dump());
+  w->finish();
+  if (in.reader) log.write(out_path + ".events.csv", origin);
+  std::cerr << "converted " << w->samples() << " samples";
   if (const dv::ReadStats* st = in.stats()) {
     std::cerr << " (" << st->dropped_total() << " rows dropped";
     for (const auto& [k, v] : st->dropped) std::cerr << ", " << k << ": " << v;
     std::cerr << ")";
   }
-  std::cerr << " -> " << a.positional()[1] << "\n";
+  if (in.reader) std::cerr << ", " << log.size() << " messages";
+  if (log.skipped()) std::cerr << " (" << log.skipped() << " skipped: over 64 MiB of text)";
+  std::cerr << " -> " << out_path << "\n";
   return 0;
 }
 
@@ -207,72 +304,148 @@ int cmd_synth(const std::vector<std::string>& argv) {
   return 0;
 }
 
-// Two panels: gaze angles over time (horizontal blue, vertical green; saccades shaded red,
-// untracked time grey; grid every second and every 10°), and the gaze on the display
-// (fixation samples dark, saccade samples red). Two streaming passes, bounded memory.
+// ---- plot ------------------------------------------------------------------------------
+// Three panels, each with numbered axes in their units: horizontal and vertical gaze angle
+// (degrees; + right, + up) against time (s), with I-VT saccades shaded red and untracked
+// time grey; below, the scanpath on the screen raster (px): fixation samples dark, saccade
+// paths red. A legend names every colour. Two streaming passes, bounded memory; the number
+// of grid lines is bounded whatever the time span.
 int cmd_plot(const std::vector<std::string>& argv) {
-  Args a(argv, {"format", "display", "screen", "min-confidence", "width"}, {}, 2);
+  Args a(argv, {"format", "display", "screen", "min-confidence", "width", "from", "to"}, {}, 2);
   if (a.positional().size() != 2) throw core::InputError("gaze plot needs FILE and OUT.png (see --help)");
   const dv::SourceOptions opt = gaze_source_options(a);
+  const double from_s = a.num("from", 0), to_s = a.num("to", 9.2e9);
+  if (!(from_s >= 0 && to_s > from_s && to_s <= 9.2e9))
+    throw core::InputError("--from/--to: need 0 <= FROM < TO (seconds from the first sample)");
+  const auto from_ns = static_cast<core::TimeNs>(from_s * 1e9), to_ns = static_cast<core::TimeNs>(to_s * 1e9);
   Input in = open_input(a.positional()[0], opt);
   dv::SampleStream* reader = in.stream.get();
   dv::GazeSample s;
-  core::TimeNs t_end = 0;
+  core::TimeNs t_lo = -1, t_hi = 0;
   double max_angle = 10;
   std::uint64_t tracked = 0;
   auto angles = [](const glm::dvec3& d) {
     return glm::dvec2(std::atan2(d.x, -d.z), std::atan2(d.y, std::hypot(d.x, d.z))) * (180.0 / M_PI);
   };
+  auto in_window = [&](core::TimeNs t) { return t >= from_ns && t <= to_ns; };
   while (reader->next(s)) {
-    t_end = s.t_ns;
+    if (!in_window(s.t_ns)) continue;
+    if (t_lo < 0) t_lo = s.t_ns;
+    t_hi = s.t_ns;
     if (s.tracked()) {
       ++tracked;
       const glm::dvec2 g = angles(s.combined.dir);
       max_angle = std::max({max_angle, std::abs(g.x), std::abs(g.y)});
     }
   }
-  if (tracked == 0) throw core::InputError(a.positional()[0] + ": no usable sample to plot");
+  print_notes(in);
+  if (tracked == 0) throw core::InputError(a.positional()[0] + ": no usable sample to plot" + (a.has("from") || a.has("to") ? " in --from/--to" : ""));
   max_angle = std::min(90.0, std::ceil(max_angle / 10) * 10);
   const int W = static_cast<int>(std::clamp(a.integer("width", 1200), 400L, 4000L));
-  const int top = W * 3 / 10, margin = 20;
-  const core::View view = opt.screen_view();
-  const int disp_h = std::min(W * 6 / 10, static_cast<int>(double(W - 2 * margin) * view.height() / view.width()));
+  const int fs = W >= 1000 ? 2 : 1;  // font scale
+  const int th = Canvas::text_height(fs), gap = th;
+  const int ml = Canvas::text_width("-90", fs) + 3 * gap, mr = 2 * gap;
+  const int pw = W - ml - mr, ph = W * 2 / 10;
+  const core::View view = in.options.screen_view();
+  const int disp_h = std::min(W * 5 / 10, static_cast<int>(double(pw) * view.height() / view.width()));
   const int disp_w = static_cast<int>(double(disp_h) * view.width() / view.height());
-  Canvas c(W, top + disp_h + 3 * margin);
-  const int px0 = margin, px1 = W - margin, py0 = margin, py1 = top;
-  const double span = std::max<double>(static_cast<double>(t_end), 1.0);
-  auto tx = [&](core::TimeNs t) { return px0 + (px1 - px0 - 1) * static_cast<double>(t) / span; };
-  auto ay = [&](double deg) { return py0 + (py1 - py0 - 1) * (0.5 - 0.5 * deg / max_angle); };
-  for (double t = 0; t <= span * 1e-9; t += 1.0) c.line(tx(core::TimeNs(t * 1e9)), py0, tx(core::TimeNs(t * 1e9)), py1 - 1, {0, 0, 0, 0.12f});
-  for (double d = -max_angle; d <= max_angle; d += 10) c.line(px0, ay(d), px1 - 1, ay(d), {0, 0, 0, d == 0 ? 0.4f : 0.12f});
-  c.frame(px0, py0, px1, py1, {0, 0, 0, 1});
-  const int dx0 = (W - disp_w) / 2, dy0 = top + 2 * margin;
-  c.rect(dx0, dy0, dx0 + disp_w, dy0 + disp_h, {0.93f, 0.93f, 0.93f, 1});
-  c.frame(dx0, dy0, dx0 + disp_w, dy0 + disp_h, {0, 0, 0, 1});
+  // Rows: legend, panel title, panel, tick labels, panel title, panel, tick labels + axis
+  // title, scanpath title, scanpath, tick labels.
+  const int legend_y = gap, p1 = legend_y + 2 * th + 2 * gap, p2 = p1 + ph + 3 * th + gap;
+  const int sp_y = p2 + ph + 6 * th + 2 * gap;
+  Canvas c(W, sp_y + disp_h + 3 * th + gap);
+  const glm::vec4 ink{0, 0, 0, 1}, grid{0, 0, 0, 0.12f}, blue{0.1f, 0.3f, 0.9f, 0.9f}, green{0.1f, 0.6f, 0.2f, 0.9f},
+      red{0.9f, 0.1f, 0.1f, 0.25f}, grey{0.5f, 0.5f, 0.5f, 0.3f};
+  // Legend.
+  int lx = ml;
+  auto legend = [&](const char* label, glm::vec4 col) {
+    c.rect(lx, legend_y, lx + 3 * th, legend_y + th, glm::vec4(glm::vec3(col), std::max(col.w, 0.5f)));
+    c.text(lx + 3 * th + th / 2, legend_y, label, fs, ink);
+    lx += 3 * th + th + Canvas::text_width(label, fs) + 2 * th;
+  };
+  legend("horizontal", blue);
+  legend("vertical", green);
+  legend("saccade (i-vt)", red);
+  legend("untracked", grey);
+  legend("fixation sample", glm::vec4(0.1f, 0.1f, 0.4f, 0.6f));
+  // Time axis: seconds from the first sample; a bounded number of labelled ticks.
+  const double t0_s = static_cast<double>(t_lo) * 1e-9, t1_s = std::max(static_cast<double>(t_hi) * 1e-9, t0_s + 1e-3);
+  auto tx = [&](core::TimeNs t) { return ml + (pw - 1) * (static_cast<double>(t) * 1e-9 - t0_s) / (t1_s - t0_s); };
+  const int max_time_ticks = std::max(2, pw / Canvas::text_width("0000000000", fs));
+  const auto tt = nice_ticks(t0_s, t1_s, max_time_ticks);
+  const double t_step = tt.size() > 1 ? tt[1] - tt[0] : t1_s - t0_s;
+  const auto at = nice_ticks(-max_angle, max_angle, std::max(3, ph / (3 * th)));
+  const double a_step = at.size() > 1 ? at[1] - at[0] : max_angle;
+  for (const auto& [y0, title] : {std::pair{p1, "horizontal gaze angle (deg, + right)"},
+                                  std::pair{p2, "vertical gaze angle (deg, + up)"}}) {
+    c.text(ml, y0 - th - gap / 2, title, fs, ink);
+    for (double t : tt) {
+      c.line(tx(core::TimeNs(t * 1e9)), y0, tx(core::TimeNs(t * 1e9)), y0 + ph - 1, grid);
+      const std::string l = tick_label(t, t_step);
+      c.text(static_cast<int>(tx(core::TimeNs(t * 1e9))) - Canvas::text_width(l, fs) / 2, y0 + ph + gap / 2, l, fs, ink);
+    }
+    for (double d : at) {
+      const double y = y0 + (ph - 1) * (0.5 - 0.5 * d / max_angle);
+      c.line(ml, y, ml + pw - 1, y, {0, 0, 0, d == 0 ? 0.4f : 0.12f});
+      const std::string l = tick_label(d, a_step);
+      c.text(ml - gap / 2 - Canvas::text_width(l, fs), static_cast<int>(y) - th / 2, l, fs, ink);
+    }
+    c.frame(ml, y0, ml + pw, y0 + ph, ink);
+  }
+  const std::string t_title = "time (s)";
+  c.text(ml + pw / 2 - Canvas::text_width(t_title, fs) / 2, p2 + ph + 2 * th, t_title, fs, ink);
+  auto ay = [&](int y0, double deg) { return y0 + (ph - 1) * (0.5 - 0.5 * deg / max_angle); };
+  // Scanpath panel with pixel axes.
+  const int dx0 = ml + (pw - disp_w) / 2, dy0 = sp_y;
+  char sp_title[160];
+  std::snprintf(sp_title, sizeof sp_title, "scanpath on the screen (px), %dx%d, %.1fx%.1f deg", view.width(), view.height(),
+                (view.fov().angle_right - view.fov().angle_left) * 180 / M_PI, (view.fov().angle_up - view.fov().angle_down) * 180 / M_PI);
+  c.text(ml, dy0 - 2 * th - gap / 2, sp_title, fs, ink);
+  c.rect(dx0, dy0, dx0 + disp_w, dy0 + disp_h, {0.95f, 0.95f, 0.95f, 1});
+  const auto xt = nice_ticks(0, view.width(), std::max(2, disp_w / Canvas::text_width("00000", fs)));
+  const auto yt = nice_ticks(0, view.height(), std::max(2, disp_h / (3 * th)));
+  for (double x : xt) {
+    const double px = dx0 + x / view.width() * (disp_w - 1);
+    c.line(px, dy0, px, dy0 + disp_h - 1, grid);
+    const std::string l = tick_label(x, 1);
+    c.text(static_cast<int>(px) - Canvas::text_width(l, fs) / 2, dy0 + disp_h + gap / 2, l, fs, ink);
+  }
+  for (double y : yt) {
+    const double py = dy0 + y / view.height() * (disp_h - 1);
+    c.line(dx0, py, dx0 + disp_w - 1, py, grid);
+    const std::string l = tick_label(y, 1);
+    c.text(dx0 - gap / 2 - Canvas::text_width(l, fs), static_cast<int>(py) - th / 2, l, fs, ink);
+  }
+  c.frame(dx0, dy0, dx0 + disp_w, dy0 + disp_h, ink);
   // Pass 2: events (shading) and traces.
   reader->rewind();
   dv::SummaryParams sp;
   sp.infer_blinks = !in.reports_blinks;
-  dv::EventSegmenter seg(sp, [&](dv::EventSegmenter::Kind k, core::TimeNs t0, core::TimeNs t1) {
-    if (k == dv::EventSegmenter::Kind::Saccade)
-      c.rect(static_cast<int>(tx(t0)), py0 + 1, static_cast<int>(std::ceil(tx(t1))) + 1, py1 - 1, {0.9f, 0.1f, 0.1f, 0.25f});
+  dv::EventSegmenter seg(sp, [&](const dv::GazeEvent& e) {
+    if (e.kind == dv::GazeEvent::Kind::Saccade)
+      for (int y0 : {p1, p2}) c.rect(static_cast<int>(tx(e.start_ns)), y0 + 1, static_cast<int>(std::ceil(tx(e.end_ns))) + 1, y0 + ph - 1, red);
   });
   bool have_prev = false;
   dv::GazeSample prev;
   glm::dvec2 prev_px{};
   bool prev_on = false;
+  int last_grey = -1;  // one grey column per pixel, however many samples fall on it
   while (reader->next(s)) {
+    if (!in_window(s.t_ns)) continue;
     seg.add(s);
     if (!s.tracked()) {
-      c.rect(static_cast<int>(tx(s.t_ns)), py0 + 1, static_cast<int>(tx(s.t_ns)) + 1, py1 - 1, {0.5f, 0.5f, 0.5f, 0.3f});
+      const int x = static_cast<int>(tx(s.t_ns));
+      if (x != last_grey)
+        for (int y0 : {p1, p2}) c.rect(x, y0 + 1, x + 1, y0 + ph - 1, grey);
+      last_grey = x;
       have_prev = false;
       continue;
     }
     const glm::dvec2 g = angles(s.combined.dir);
     if (have_prev) {
       const glm::dvec2 p = angles(prev.combined.dir);
-      c.line(tx(prev.t_ns), ay(p.x), tx(s.t_ns), ay(g.x), {0.1f, 0.3f, 0.9f, 0.9f});
-      c.line(tx(prev.t_ns), ay(p.y), tx(s.t_ns), ay(g.y), {0.1f, 0.6f, 0.2f, 0.9f});
+      c.line(tx(prev.t_ns), ay(p1, p.x), tx(s.t_ns), ay(p1, g.x), blue);
+      c.line(tx(prev.t_ns), ay(p2, p.y), tx(s.t_ns), ay(p2, g.y), green);
     }
     const auto pix = view.dir_to_pixel(s.combined.dir);
     const bool on = pix.has_value();
@@ -304,7 +477,7 @@ int cmd_record(const std::vector<std::string>& argv) {
   const double timeout = a.num("timeout", seconds + 5);  // wall clock, for live devices
   auto stream = dv::open_sample_stream(a.str("source", ""), opt);
   auto* hid = dynamic_cast<dv::hid::HidGazeStream*>(stream.get());
-  const nlohmann::json meta = {{"display", opt.display.name}, {"source", stream->describe()}};
+  nlohmann::json meta = {{"display", opt.display.name}, {"source", stream->describe()}};
   dv::FoveaCsvWriter w(a.positional()[0], meta.dump());
   const auto start = std::chrono::steady_clock::now();
   const auto limit = static_cast<core::TimeNs>(seconds * 1e9);
@@ -322,6 +495,10 @@ int cmd_record(const std::vector<std::string>& argv) {
     if (!have_first) {
       have_first = true;
       first = s.t_ns;
+      // The original time base: the first sample's time on the source's timeline (live
+      // devices: host monotonic clock), its device and its host receive time.
+      meta["time_base"] = {{"t0_source_ns", s.t_ns}, {"t0_device_time_ns", s.device_time_ns}, {"t0_host_time_ns", s.host_time_ns}};
+      w.set_metadata(meta.dump());
     }
     s.t_ns -= first;
     if (s.t_ns >= limit) break;

@@ -22,6 +22,9 @@
 #include "fovea/core/image.hpp"
 #include "fovea/core/metrics.hpp"
 #include "fovea/devices/foveation_gaze.hpp"
+#include "fovea/devices/readers.hpp"
+#include "fovea/devices/screen.hpp"
+#include "frame_log.hpp"
 #include "fovea/gpu/context.hpp"
 #include "fovea/pipeline/frame_pipeline.hpp"
 #include "fovea/renderer/reference.hpp"
@@ -40,6 +43,10 @@ optional stereo sharing of indirect diffuse, BMFR, TAA) and resolved to the disp
 the peripheral blur. Writes to --out:
   frame_NNNN_left.png, frame_NNNN_right.png, frame_NNNN_sbs.png   tone-mapped (ACES fit, docs/metrics.md)
   last_left.exr, last_right.exr                                    linear, last frame
+  frames.jsonl  per frame: the gaze sample used (its times, flags), the gaze each eye used,
+                eye poses, grid size — deterministic: identical runs write identical bytes;
+                compare two runs with `fovea replay-diff A B`
+  frame_times.jsonl  per frame: GPU and CPU ms per stage, the host time the gaze was read
   report.json   {"frames", "samples_traced_per_eye", "samples_hidden": {"left", "right"},
                  "device": {name, driver},
                  "gpu_ms": {grid, trace, reconstruct, resolve, total, bmfr_fit},
@@ -56,6 +63,8 @@ temporal_error (always). With no options: a short demo on the shipped scene and 
   --display NAME|FILE   display preset (fove0, vive, modern, small, tiny) or JSON [small]
   --gaze URI            recording, or synthetic:<seed>[?...] (docs/gaze.md)
                         [the shipped recording data/gaze/default.csv]
+  --screen GEOMETRY     what 2-D gaze coordinates refer to: WxH@HFOVxVFOV or
+                        WxH@SWxSHmm@Dmm (as the URI key screen=; docs/gaze.md)
   --frames N            frames to render [24]
   --distribution D      visual-polar | paper-visual-polar | cartesian | cartesian-uniform |
                         log-polar [visual-polar]
@@ -130,7 +139,7 @@ int run(std::vector<std::string> argv) {
     }
   const Args args(argv,
                   {"scene", "display", "gaze", "frames", "distribution", "budget", "denoiser", "bmfr-precision", "stereo-share",
-                   "reference", "png-every", "out"},
+                   "reference", "png-every", "out", "screen"},
                   {"no-blur", "no-cull", "no-marker", "quiet"});
   const long frames = args.integer("frames", 24);
   if (frames < 1 || frames > 100000) throw core::InputError("--frames must be in 1..100000");
@@ -164,7 +173,9 @@ int run(std::vector<std::string> argv) {
   }
   devices::SourceOptions so;
   so.display = display;
+  if (auto sc = args.opt("screen")) so.screen = devices::parse_screen(*sc, "--screen");
   devices::FoveationGaze gaze_source(gaze_uri, so);
+  for (const auto& n : devices::recording_notes(gaze_uri, so)) std::cerr << "warning: " << n << "\n";
 
   const renderer::Scene scene = renderer::load_scene(args.str("scene", "default"));
   for (const auto& w : scene.warnings) std::cerr << "warning: " << w << "\n";
@@ -188,6 +199,7 @@ int run(std::vector<std::string> argv) {
   std::array<core::Image, 2> previous, last;
   std::array<double, 2> te_sum{0, 0};
   std::array<glm::dvec3, 2> gaze{glm::dvec3(0, 0, -1), glm::dvec3(0, 0, -1)};
+  FrameLog frame_log((out_dir / "frames.jsonl").string(), (out_dir / "frame_times.jsonl").string());
   const auto start = std::chrono::steady_clock::now();
   for (long f = 0; f < frames; ++f) {
     core::TimeNs t0 = core::now_ns();
@@ -208,6 +220,11 @@ int run(std::vector<std::string> argv) {
     for (int e = 0; e < 2; ++e) last[e] = pipeline.image(core::Eye(e));
     cpu_ms["readback"].push_back(core::ns_to_ms(core::now_ns() - t0));
     cpu_ms["total"].push_back(cpu_ms["gaze"].back() + t.cpu_ms() + cpu_ms["readback"].back());
+    const auto& dist = pipeline.distribution(core::Eye::Left);
+    std::vector<std::pair<std::string, double>> timings;
+    for (const auto& [name, v] : gpu_ms) timings.emplace_back("gpu_" + name, v.back());
+    for (const auto& [name, v] : cpu_ms) timings.emplace_back("cpu_" + name, v.back());
+    frame_log.add({f, t_ns, g, gaze, poses, dist.columns(), dist.rows(), std::move(timings)});
     std::array<core::Image, 2> ldr;
     for (int e = 0; e < 2; ++e) {
       if (f > 0) te_sum[e] += core::temporal_error(previous[e], last[e]);
@@ -232,6 +249,7 @@ int run(std::vector<std::string> argv) {
                std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count());
   }
   if (bar) std::fprintf(stderr, "\n");
+  frame_log.finish();
   renderer::write_exr((out_dir / "last_left.exr").string(), last[0]);
   renderer::write_exr((out_dir / "last_right.exr").string(), last[1]);
 

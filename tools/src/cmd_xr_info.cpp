@@ -160,7 +160,9 @@ int run(std::vector<std::string> argv) {
                  "  the runtime and the Fovea layer (" << kFoveaLayer << ") load.\n"
                  "  --runtime-json FILE  use this runtime manifest (as XR_RUNTIME_JSON)\n"
                  "  --layer-path DIR     search explicit layer manifests here (as XR_API_LAYER_PATH)\n"
-                 "  --json               machine-readable output\n";
+                 "  --json               machine-readable output\n"
+                 "  Exit status: 0 when the runtime loads, 1 when no runtime loads (or no loader), 2 on\n"
+                 "  invalid arguments.\n";
     return 0;
   }
   if (auto p = args.opt("runtime-json")) {
@@ -215,6 +217,11 @@ int run(std::vector<std::string> argv) {
     std::cout << j.dump(2) << "\n";
   else
     print_text(j);
+  // Scripts (and CI) check the exit status: no runtime is a failure, whatever the format.
+  if (!j["runtime"]["loads"].get<bool>()) {
+    std::cerr << "fovea xr-info: no OpenXR runtime loads (" << j["runtime"]["result"].get<std::string>() << ")\n";
+    return 1;
+  }
   return 0;
 }
 

@@ -5,7 +5,7 @@
 #include <cstdio>
 #include <limits>
 
-#include "canvas.hpp"
+#include "plot_canvas.hpp"
 
 #if defined(__GNUC__)
 #pragma GCC diagnostic push

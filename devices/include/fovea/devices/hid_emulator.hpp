@@ -6,10 +6,14 @@
 // fields, 10 µs / 0.1 mm / 1 mm unit exponents, vendor items interleaved, push/pop,
 // usage ranges, an extended usage, Y before X). The emulated transport can inject faults,
 // which is how the transports' error paths are tested at the byte level.
+#include <atomic>
+#include <condition_variable>
 #include <deque>
 #include <functional>
 #include <memory>
+#include <mutex>
 #include <string_view>
+#include <thread>
 
 #include "fovea/core/view.hpp"
 #include "fovea/devices/gaze.hpp"
@@ -38,7 +42,9 @@ class EmulatedEyeTracker {
   std::uint8_t mode_ = 0;
 };
 
-// Faults injected by the emulated transport, counted in samples read.
+// Faults injected by the emulated transport, counted in reports read. From a URI:
+// hid-emulated:LAYOUT?realtime=1&garbage_every=N&short_every=N&stall_every=N&stall_ms=M&
+// unplug_after=N&feature_stall=1&fault_seed=S (docs/hid.md).
 struct Faults {
   int garbage_every = 0;       // every Nth read returns random bytes
   int short_every = 0;         // every Nth read returns a truncated report
@@ -49,32 +55,56 @@ struct Faults {
   double drift_ppm = 50;
   core::TimeNs delay_ns = 2'000'000;             // mean extra transport delay (exponential)
   std::uint64_t seed = 1;
+  // Real time: the device emits each report on its own thread when the sample is due on the
+  // host monotonic clock, stamped with the real receive time; a stall also silences the
+  // device for stall_ns (the reports of that time are lost, as in a full device buffer).
+  bool realtime = false;
+  core::TimeNs stall_ns = 0;
 };
 
-// Plays a gaze stream as the device's input reports; host receive times are simulated
-// (device time + offset + drift + random delay), so it runs as fast as it is read.
+// Plays a gaze stream as the device's input reports. By default host receive times are
+// simulated (device time + offset + drift + random delay), so it runs as fast as it is
+// read; with Faults::realtime a device thread paces the reports on the host clock.
 class EmulatedTransport final : public Transport {
  public:
   EmulatedTransport(std::unique_ptr<SampleStream> gaze, std::string_view layout, const core::View& screen,
                     const Faults& faults = {});
+  ~EmulatedTransport() override;
   DeviceInfo info() const override;
   std::vector<std::uint8_t> report_descriptor() override;
   InputReport read_input(std::span<std::uint8_t> buf, int timeout_ms) override;
   std::vector<std::uint8_t> get_feature(std::uint8_t id, std::size_t length) override;
   void set_feature(std::span<const std::uint8_t> report) override;
   bool exhausted() const override { return exhausted_; }
-  core::TimeNs now() const override { return last_host_ + faults_.clock_offset_ns * (last_host_ == 0); }
+  core::TimeNs now() const override;
   const EmulatedEyeTracker& device() const { return device_; }
   std::uint64_t reads() const { return reads_; }
 
  private:
+  struct Pending {
+    std::vector<std::uint8_t> bytes;
+    bool gaze = false;  // a tracking-data report (else the status report)
+    core::TimeNs device_ns = 0, host_ns = 0;
+  };
+  // The device's next report (the status report first, then one per gaze sample); false
+  // when the gaze stream has ended.
+  bool produce(Pending& out);
+  void device_thread();  // realtime: produce() when due, queue with the receive time
   std::unique_ptr<SampleStream> gaze_;
   EmulatedEyeTracker device_;
   Faults faults_;
   std::string layout_;
   std::uint64_t reads_ = 0, rng_;
   core::TimeNs last_host_ = 0;
-  bool status_sent_ = false, exhausted_ = false;
+  bool status_sent_ = false;
+  std::atomic<bool> exhausted_{false}, enabled_{false}, stop_{false};
+  // Realtime only.
+  std::mutex mutex_;
+  std::condition_variable cv_;
+  std::deque<Pending> queue_;
+  bool produced_all_ = false;
+  core::TimeNs silent_until_ = 0;
+  std::thread thread_;
 };
 
 }  // namespace fovea::devices::hid
