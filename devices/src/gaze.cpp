@@ -13,6 +13,7 @@
 #include "fovea/devices/readers.hpp"
 #include "fovea/devices/synthetic.hpp"
 #include "fovea/devices/timeline.hpp"
+#include "fovea/devices/tracker_model.hpp"
 #include "source_uri.hpp"
 
 namespace fovea::devices {
@@ -190,6 +191,10 @@ std::unique_ptr<GazeSource> open_gaze_source(std::string_view uri, const SourceO
       throw core::InputError("gaze source \"" + u.text + "\": loop must be 0 or 1");
     opt.loop = loop == "1";
   }
+  TrackerParams tracker;
+  const bool modelled = take_tracker_options(u, tracker);
+  if (modelled && !opt.filters.empty())
+    throw core::InputError("gaze source \"" + u.text + "\": filters cannot follow a tracker model");
   // The remaining options are validated by the stream itself.
   std::string rebuilt = u.scheme + ":" + u.body;
   char sep = '?';
@@ -197,7 +202,11 @@ std::unique_ptr<GazeSource> open_gaze_source(std::string_view uri, const SourceO
     rebuilt += sep + k + "=" + v;
     sep = '&';
   }
-  return std::make_unique<TimelineSource>(open_sample_stream(rebuilt, opt), opt);
+  if (!modelled) return std::make_unique<TimelineSource>(open_sample_stream(rebuilt, opt), opt);
+  // The URI's gaze is the true eye, read as it is; prediction applies to what the tracker delivers.
+  SourceOptions truth = opt;
+  truth.horizon_ns = 0;
+  return std::make_unique<TrackerModel>(std::make_unique<TimelineSource>(open_sample_stream(rebuilt, truth), truth), tracker, opt);
 }
 
 }  // namespace fovea::devices
