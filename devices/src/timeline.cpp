@@ -74,8 +74,9 @@ GazeSample TimelineSource::sample_at(core::TimeNs t) {
   const bool live = stream_->live();
   GazeSample s = at_recording_time(live ? t : std::llround(static_cast<double>(t) * opt_.speed));
   // Back from recording time to the caller's timeline: the sample's own time, not t.
+  // A recording carries no receive delay (a captured host clock is not this timeline).
   if (!live && s.t_ns != kNoSample)
-    s.t_ns = std::min<core::TimeNs>(t, std::llround(static_cast<double>(s.t_ns + loop_base_) / opt_.speed));
+    s.t_ns = s.host_time_ns = std::min<core::TimeNs>(t, std::llround(static_cast<double>(s.t_ns + loop_base_) / opt_.speed));
   return s;
 }
 

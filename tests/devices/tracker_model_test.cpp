@@ -214,6 +214,20 @@ TEST(TrackerModel, SlowIsNotStale) {
   EXPECT_EQ(s.host_time_ns - s.t_ns, 150 * kMs);
 }
 
+TEST(TrackerModel, FoveationGazeReportsMeasurementAndDelivery) {
+  const TimeNs epoch = 5'000'000'000'000, delay = 12 * kMs;
+  FoveationGaze g(model(true_eye(4), clean(250, delay)));
+  EXPECT_FALSE(g.live());
+  g.set_epoch(epoch);
+  for (const TimeNs q : {TimeNs(100 * kMs), TimeNs(1'234'567'891)}) {
+    const FoveaGaze f = g.at(epoch + q);
+    ASSERT_TRUE(f.has_sample);
+    EXPECT_EQ(f.sample_ns, epoch + (q - delay) / (4 * kMs) * (4 * kMs));  // the newest 250 Hz instant ≤ q − D
+    EXPECT_EQ(f.device_ns, f.sample_ns - epoch);
+    EXPECT_EQ(f.receive_ns - f.sample_ns, delay);
+  }
+}
+
 TEST(TrackerModel, GroundTruthMustNotBeLive) {
   SourceOptions o;
   auto live = std::make_unique<TimelineSource>(std::make_unique<VectorStream>(std::vector<GazeSample>{}, true), o);
