@@ -141,6 +141,10 @@ std::unique_ptr<SampleStream> open_sample_stream(std::string_view uri, const Sou
   SourceUri u = parse_source_uri(uri);
   SourceOptions opt = base;
   apply_common_options(u, opt);
+  if (TrackerParams tracker; take_tracker_options(u, tracker))
+    throw core::InputError("gaze source \"" + u.text +
+                           "\": a tracker model delivers samples over time; it applies where gaze is read at a time "
+                           "(render, view, the runtime, the layer), not to tools that walk every sample");
   auto s = open_raw_stream(u, opt);
   if (opt.filters.empty()) return s;
   return apply_filters(std::move(s), opt.filters, FilterParams{});

@@ -304,6 +304,7 @@ TEST(TrackerModel, OpenedFromUriKeys) {
                           "synthetic:1?tracker_rate=5", "synthetic:1?tracker_clock=wall", "synthetic:1?tracker_dropout=1",
                           "synthetic:1?tracker=fove0&filters=ivt"})
     EXPECT_THROW(open_gaze_source(bad, o), InputError) << bad;
+  EXPECT_THROW(open_sample_stream("synthetic:1?tracker=fove0", o), InputError);
 }
 
 TEST(Duration, UnitsAndBareMilliseconds) {
