@@ -66,7 +66,7 @@ FoveaEye FoveationGaze::follow(Track& track, const EyeGaze& m, core::TimeNs samp
   return e;
 }
 
-FoveaGaze FoveationGaze::apply(core::TimeNs t, const GazeSample& s, core::TimeNs offset, bool live_times) {
+FoveaGaze FoveationGaze::apply(core::TimeNs t, const GazeSample& s, core::TimeNs offset) {
   FoveaGaze g;
   g.query_ns = t;
   g.motion = s.motion;
@@ -74,7 +74,8 @@ FoveaGaze FoveationGaze::apply(core::TimeNs t, const GazeSample& s, core::TimeNs
   if (g.has_sample) {
     g.sample_ns = s.t_ns + offset;
     g.device_ns = s.device_time_ns;
-    g.receive_ns = live_times ? s.host_time_ns : g.sample_ns;
+    // Recordings report receipt at measurement; a modelled tracker its delivery time.
+    g.receive_ns = s.host_time_ns + offset;
   }
   const core::TimeNs sample_ns = g.has_sample ? g.sample_ns : t;
   g.combined = follow(tracks_[0], s.combined, sample_ns, t);
@@ -90,12 +91,12 @@ FoveaGaze FoveationGaze::at(core::TimeNs t) {
   const bool is_live = live();
   if (!is_live && !epoch_) epoch_ = t;
   const core::TimeNs offset = is_live ? 0 : *epoch_;
-  return apply(t, source_->sample_at(t - offset), offset, is_live);
+  return apply(t, source_->sample_at(t - offset), offset);
 }
 
 FoveaGaze FoveationGaze::use(core::TimeNs t, const GazeSample& s) {
   std::lock_guard lock(mutex_);
-  return apply(t, s, 0, true);
+  return apply(t, s, 0);
 }
 
 }  // namespace fovea::devices

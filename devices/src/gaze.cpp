@@ -14,6 +14,7 @@
 #include "fovea/devices/screen.hpp"
 #include "fovea/devices/synthetic.hpp"
 #include "fovea/devices/timeline.hpp"
+#include "fovea/devices/tracker_model.hpp"
 #include "source_uri.hpp"
 
 namespace fovea::devices {
@@ -161,6 +162,10 @@ std::unique_ptr<SampleStream> open_sample_stream(std::string_view uri, const Sou
   SourceUri u = parse_source_uri(uri);
   SourceOptions opt = base;
   apply_common_options(u, opt);
+  if (TrackerParams tracker; take_tracker_options(u, tracker))
+    throw core::InputError("gaze source \"" + u.text +
+                           "\": a tracker model delivers samples over time; it applies where gaze is read at a time "
+                           "(render, view, the runtime, the layer), not to tools that walk every sample");
   return with_filters(open_raw_stream(u, opt), opt);
 }
 
@@ -237,8 +242,17 @@ std::unique_ptr<GazeSource> open_gaze_source(std::string_view uri, const SourceO
       throw core::InputError("gaze source \"" + u.text + "\": loop must be 0 or 1");
     opt.loop = loop == "1";
   }
+  TrackerParams tracker;
+  const bool modelled = take_tracker_options(u, tracker);
+  if (modelled && !opt.filters.empty())
+    throw core::InputError("gaze source \"" + u.text + "\": filters cannot follow a tracker model");
   // The remaining options are validated by the stream itself.
-  return std::make_unique<TimelineSource>(open_sample_stream(u.rebuilt(), opt), opt);
+  const std::string rebuilt = u.rebuilt();
+  if (!modelled) return std::make_unique<TimelineSource>(open_sample_stream(rebuilt, opt), opt);
+  // The URI's gaze is the true eye, read as it is; prediction applies to what the tracker delivers.
+  SourceOptions truth = opt;
+  truth.horizon_ns = 0;
+  return std::make_unique<TrackerModel>(std::make_unique<TimelineSource>(open_sample_stream(rebuilt, truth), truth), tracker, opt);
 }
 
 }  // namespace fovea::devices

@@ -21,5 +21,8 @@ struct SourceUri {
 SourceUri parse_source_uri(std::string_view uri);
 // hid:, usb:, hid-capture:, mouse, openxr (devices' own translation units).
 std::unique_ptr<SampleStream> open_device_stream(SourceUri& u, const SourceOptions& opt);
+// tracker=PRESET and the tracker_* keys (tracker_model.cpp); false when none is given.
+struct TrackerParams;
+bool take_tracker_options(SourceUri& u, TrackerParams& p);
 
 }  // namespace fovea::devices

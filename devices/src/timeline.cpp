@@ -78,8 +78,9 @@ GazeSample TimelineSource::sample_at(core::TimeNs t) {
   GazeSample s = at_recording_time(
       live ? t : std::llround(std::clamp(static_cast<double>(t) * opt_.speed, -9.2e18, 9.2e18)));
   // Back from recording time to the caller's timeline: the sample's own time, not t.
+  // A recording carries no receive delay (a captured host clock is not this timeline).
   if (!live && s.t_ns != kNoSample)
-    s.t_ns = std::min<core::TimeNs>(t, std::llround(static_cast<double>(s.t_ns + loop_base_) / opt_.speed));
+    s.t_ns = s.host_time_ns = std::min<core::TimeNs>(t, std::llround(static_cast<double>(s.t_ns + loop_base_) / opt_.speed));
   return s;
 }
 

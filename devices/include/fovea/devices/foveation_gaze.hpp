@@ -51,7 +51,7 @@ struct FoveaGaze {
   core::TimeNs query_ns = 0;    // the time asked for (e.g. the frame's display time)
   core::TimeNs sample_ns = 0;   // when the newest real sample used was measured (≤ query_ns)
   core::TimeNs device_ns = 0;   // that sample's own stamp (tracker clock or recording file)
-  core::TimeNs receive_ns = 0;  // when the host received it (recordings: = sample_ns)
+  core::TimeNs receive_ns = 0;  // when the host received it (recordings: = sample_ns; a tracker model: its delivery)
   core::TimeNs read_ns = 0;     // host monotonic time at which this use read the source
 
   const FoveaEye& eye(core::Eye e) const { return e == core::Eye::Left ? left : right; }
@@ -90,7 +90,7 @@ class FoveationGaze {
     bool seen = false;
   };
   FoveaEye follow(Track& track, const EyeGaze& m, core::TimeNs sample_ns, core::TimeNs t) const;
-  FoveaGaze apply(core::TimeNs t, const GazeSample& s, core::TimeNs offset, bool live_times);
+  FoveaGaze apply(core::TimeNs t, const GazeSample& s, core::TimeNs offset);
 
   std::unique_ptr<GazeSource> source_;
   LossPolicy policy_;

@@ -104,7 +104,8 @@ class GazeSource {
 
 // "replay:FILE[?format=F&speed=S&loop=1]", "synthetic:SEED[?task=T&rate=HZ&seconds=S&...]",
 // "hid:[VID:PID|path]", "usb:[VID:PID]", "hid-capture:FILE". A plain path is a replay.
-// Query keys common to all: filters=..., horizon_ms=..., min_confidence=...
+// Query keys common to all: filters=..., horizon_ms=..., min_confidence=...; recordings and
+// synthetic gaze also take a tracker model: tracker=PRESET, tracker_*=... (tracker_model.hpp).
 // Throws core::InputError for a malformed URI, an unknown scheme or an unusable input.
 std::unique_ptr<GazeSource> open_gaze_source(std::string_view uri, const SourceOptions& opt);
 
