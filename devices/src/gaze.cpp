@@ -152,9 +152,7 @@ std::unique_ptr<SampleStream> open_raw_stream(SourceUri& u, const SourceOptions&
 
 std::unique_ptr<SampleStream> with_filters(std::unique_ptr<SampleStream> s, const SourceOptions& opt) {
   if (opt.filters.empty()) return s;
-  FilterParams fp;
-  fp.centre = opt.screen_view().centre_dir();
-  return apply_filters(std::move(s), opt.filters, fp);
+  return apply_filters(std::move(s), opt.filters, FilterParams{});
 }
 }  // namespace
 
