@@ -94,10 +94,14 @@ std::string read_material_libraries(const std::string& obj, const std::string& d
         warnings.push_back(origin + ": material library \"" + name + "\" missing, ignored");
         continue;
       }
-      const std::string text = core::read_file_bounded(path, budget);
-      budget -= text.size();
-      check_exponents(text, path);
-      out += text;
+      try {
+        const std::string text = core::read_file_bounded(path, budget);
+        budget -= text.size();
+        check_exponents(text, path);
+        out += text;
+      } catch (const core::InputError& e) {
+        throw core::InputError(origin + ": mtllib " + e.what());
+      }
       out += '\n';
     }
   }
