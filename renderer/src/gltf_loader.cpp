@@ -17,12 +17,12 @@
 #include <glm/gtc/type_ptr.hpp>
 #include <glm/mat3x3.hpp>
 #include <glm/mat4x4.hpp>
-#include <stb/stb_image.h>
 #include <tiny_gltf.h>
 
 #include "fovea/core/error.hpp"
 #include "fovea/core/input_limits.hpp"
 #include "fovea/renderer/scene_io.hpp"
+#include "texture_decode.hpp"
 
 namespace fovea::renderer {
 
@@ -181,38 +181,6 @@ std::span<const unsigned char> encoded_image(const Model& m, const EncodedImages
   return {};
 }
 
-// Decodes one image to RGBA8 within what is left of the decoded-bytes budget. Returns
-// false with `why` for images that are missing or undecodable (the caller substitutes
-// white); a budget overrun throws.
-bool decode_texture(Ctx& c, std::span<const unsigned char> bytes, Texture& t, std::size_t& decoded, std::string& why) {
-  int w = 0, h = 0, n = 0;
-  if (bytes.size() > std::size_t(std::numeric_limits<int>::max()) ||
-      !stbi_info_from_memory(bytes.data(), int(bytes.size()), &w, &h, &n) || w < 1 || h < 1) {
-    why = "undecodable";
-    return false;
-  }
-  if (w > c.limits.max_texture_size || h > c.limits.max_texture_size) {
-    why = std::to_string(w) + "x" + std::to_string(h) + " is larger than " + std::to_string(c.limits.max_texture_size) +
-          " pixels a side";
-    return false;
-  }
-  const std::size_t need = std::size_t(w) * std::size_t(h) * 4;
-  if (need > c.limits.max_texture_bytes - decoded)
-    throw core::InputError(c.origin + ": textures need more than " + std::to_string(c.limits.max_texture_bytes >> 20) +
-                           " MiB decoded, refused");
-  unsigned char* px = stbi_load_from_memory(bytes.data(), int(bytes.size()), &w, &h, &n, 4);
-  if (!px) {
-    why = "undecodable";
-    return false;
-  }
-  decoded += need;
-  t.width = w;
-  t.height = h;
-  t.rgba.assign(px, px + need);
-  stbi_image_free(px);
-  return true;
-}
-
 // One scene texture per glTF texture (material indices stay valid); only the textures a
 // material uses are decoded, the others stay 1x1 white.
 void load_textures(Ctx& c, const EncodedImages& enc) {
@@ -230,7 +198,8 @@ void load_textures(Ctx& c, const EncodedImages& enc) {
       const auto bytes = encoded_image(c.m, enc, c.m.textures[i].source, why);
       if (!bytes.empty()) {
         const auto& img = c.m.images[std::size_t(c.m.textures[i].source)];
-        if (!decode_texture(c, bytes, t, decoded, why)) why = "image \"" + img.uri.substr(0, 64) + "\" " + why;
+        if (!detail::decode_texture(bytes, c.limits, c.origin, decoded, t, why))
+          why = "image \"" + img.uri.substr(0, 64) + "\" " + why;
       }
       if (t.width == 0) c.warn(why + ", replaced by white");
     }

@@ -10,37 +10,28 @@
 #include <set>
 #include <sstream>
 
-#include <stb/stb_image.h>
 #include <tiny_obj_loader.h>
 
 #include "fovea/core/error.hpp"
 #include "fovea/core/input_limits.hpp"
 #include "fovea/renderer/scene_io.hpp"
+#include "texture_decode.hpp"
 
 namespace fovea::renderer {
 
 namespace {
 
-// Decodes an image file into an RGBA8 texture within what is left of the decoded-bytes
-// budget (`decoded` so far); false if missing or undecodable, throws beyond the budget.
-bool load_texture_file(const std::string& path, const SceneLimits& limits, std::size_t& decoded, Texture& t) {
-  int w = 0, h = 0, n = 0;
+// Decodes an image file into an RGBA8 texture, reading it within the byte budget; false
+// if missing or undecodable, throws beyond the budgets.
+bool load_texture_file(const std::string& path, const SceneLimits& limits, const std::string& origin,
+                       std::size_t& budget, std::size_t& decoded, Texture& t) {
   std::error_code ec;
-  if (!std::filesystem::is_regular_file(path, ec) || !stbi_info(path.c_str(), &w, &h, &n) || w < 1 || h < 1 ||
-      w > limits.max_texture_size || h > limits.max_texture_size)
-    return false;
-  const std::size_t need = std::size_t(w) * std::size_t(h) * 4;
-  if (need > limits.max_texture_bytes - decoded)
-    throw core::InputError(path + ": textures need more than " + std::to_string(limits.max_texture_bytes >> 20) +
-                           " MiB decoded, refused");
-  unsigned char* px = stbi_load(path.c_str(), &w, &h, &n, 4);
-  if (!px) return false;
-  decoded += need;
-  t.width = w;
-  t.height = h;
-  t.rgba.assign(px, px + need);
-  stbi_image_free(px);
-  return true;
+  if (!std::filesystem::is_regular_file(path, ec)) return false;
+  const std::string bytes = core::read_file_bounded(path, budget);
+  budget -= bytes.size();
+  std::string why;
+  return detail::decode_texture({reinterpret_cast<const unsigned char*>(bytes.data()), bytes.size()}, limits, origin,
+                                decoded, t, why);
 }
 
 // tinyobjloader accumulates a number's exponent in an int without a bound ("1e9999999999"
@@ -160,7 +151,7 @@ Scene load_obj(const std::string& path, const SceneLimits& limits) {
         t.name = om.diffuse_texname;
         const std::string tp = (std::filesystem::path(dir) / om.diffuse_texname).string();
         int id = -1;
-        if (load_texture_file(tp, limits, decoded, t)) {
+        if (load_texture_file(tp, limits, path, budget, decoded, t)) {
           id = int(s.textures.size());
           s.textures.push_back(std::move(t));
         } else {
