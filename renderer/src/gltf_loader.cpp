@@ -196,11 +196,8 @@ void load_textures(Ctx& c, const EncodedImages& enc) {
     if (used[i]) {
       std::string why;
       const auto bytes = encoded_image(c.m, enc, c.m.textures[i].source, why);
-      if (!bytes.empty()) {
-        const auto& img = c.m.images[std::size_t(c.m.textures[i].source)];
-        if (!detail::decode_texture(bytes, c.limits, c.origin, decoded, t, why))
-          why = "image \"" + img.uri.substr(0, 64) + "\" " + why;
-      }
+      if (why.empty() && !detail::decode_texture(bytes, c.limits, c.origin, decoded, t, why))
+        why = "image \"" + c.m.images[std::size_t(c.m.textures[i].source)].uri.substr(0, 64) + "\" " + why;
       if (t.width == 0) c.warn(why + ", replaced by white");
     }
     if (t.width == 0) {
