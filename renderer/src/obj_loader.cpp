@@ -71,10 +71,12 @@ std::string read_material_libraries(const std::string& obj, const std::string& d
                                     std::vector<std::string>& warnings, const std::string& origin) {
   std::string out;
   std::set<std::string> seen;
-  std::istringstream lines(obj);
-  std::string line;
-  while (std::getline(lines, line)) {
-    std::istringstream words(line);
+  for (std::size_t at = 0; at < obj.size();) {
+    const std::size_t end = std::min(obj.find('\n', at), obj.size());
+    const std::string_view line(obj.data() + at, end - at);
+    at = end + 1;
+    if (line.find("mtllib") == std::string_view::npos) continue;  // no copy of the other lines
+    std::istringstream words{std::string(line)};
     std::string keyword, name;
     if (!(words >> keyword) || keyword != "mtllib") continue;
     while (words >> name) {
