@@ -2,12 +2,12 @@
 
 #include <cmath>
 #include <filesystem>
-#include <fstream>
-#include <sstream>
 
 #include <nlohmann/json.hpp>
 
 #include "fovea/core/error.hpp"
+#include "fovea/core/input_limits.hpp"
+#include "json_input.hpp"
 
 namespace fovea::core {
 
@@ -31,6 +31,13 @@ double number(const json& j, const char* key, std::string_view origin, const std
   return v;
 }
 
+// An optional string member; anything but a string is an error naming the key.
+std::string string_member(const json& j, const char* key, std::string_view origin) {
+  if (!j.contains(key)) return {};
+  if (!j[key].is_string()) fail(origin, "\"" + std::string(key) + "\" must be a string");
+  return j[key].get<std::string>();
+}
+
 Fov read_fov(const json& j, std::string_view origin, const std::string& path) {
   if (!j.is_object()) fail(origin, "\"" + path + "\" must be an object");
   const std::string p = path + ".";
@@ -41,18 +48,13 @@ Fov read_fov(const json& j, std::string_view origin, const std::string& path) {
 }  // namespace
 
 DisplayPreset parse_display(std::string_view text, std::string_view origin) {
-  json j;
-  try {
-    j = json::parse(text);
-  } catch (const json::parse_error& e) {
-    fail(origin, std::string("invalid JSON: ") + e.what());
-  }
+  const json j = detail::parse_json_input(text, origin);
   if (!j.is_object()) fail(origin, "top level must be an object");
   DisplayPreset d;
   d.json = std::string(text);
-  d.name = j.value("name", std::string());
+  d.name = string_member(j, "name", origin);
   if (d.name.empty()) fail(origin, "missing \"name\"");
-  d.description = j.value("description", std::string());
+  d.description = string_member(j, "description", origin);
   const double w = number(j, "width", origin, ""), h = number(j, "height", origin, "");
   if (w < 1 || h < 1 || w > 65536 || h > 65536 || w != std::floor(w) || h != std::floor(h))
     fail(origin, "\"width\"/\"height\" must be whole numbers in 1..65536");
@@ -81,16 +83,15 @@ DisplayPreset load_display(std::string_view name_or_path) {
     return parse_display(std::string_view(reinterpret_cast<const char*>(bytes.data()), bytes.size()),
                          name_or_path);
   const std::filesystem::path path(name_or_path);
-  std::ifstream in(path, std::ios::binary);
-  if (!in) {
+  std::error_code ec;
+  if (!std::filesystem::is_regular_file(path, ec)) {
     std::string names;
     for (const auto& n : display_preset_names()) names += (names.empty() ? "" : ", ") + n;
     throw InputError("display \"" + std::string(name_or_path) +
                      "\": neither a preset name (" + names + ") nor a readable file");
   }
-  std::ostringstream ss;
-  ss << in.rdbuf();
-  return parse_display(ss.str(), path.string());
+  // A preset is a few hundred bytes; the bound keeps a wrong path (a log, a device) harmless.
+  return parse_display(read_file_bounded(path.string(), 1 << 20), path.string());
 }
 
 std::vector<std::string> display_preset_names() {

@@ -5,6 +5,7 @@
 #include <nlohmann/json.hpp>
 
 #include "fovea/core/error.hpp"
+#include "json_input.hpp"
 
 namespace fovea::core {
 
@@ -76,19 +77,17 @@ const char* lens_model_name(LensModelKind k) {
 
 LensParams parse_lens_params(std::string_view text, std::string_view origin) {
   LensParams p;
-  json j;
-  try {
-    j = json::parse(text);
-  } catch (const json::parse_error& e) {
-    throw InputError(std::string(origin) + ": invalid JSON: " + e.what());
-  }
+  const json j = detail::parse_json_input(text, origin);
   if (!j.is_object() || !j.contains("lens")) return p;
   const Reader r(origin);
   const json& lens = j["lens"];
   if (!lens.is_object()) r.fail("", "must be an object");
   if (!lens.contains("model") || !lens["model"].is_string()) r.fail("model", "missing (\"vive\" or \"panotools\")");
   const std::string model = lens["model"].get<std::string>();
-  p.source = lens.value("source", std::string());
+  if (lens.contains("source")) {
+    if (!lens["source"].is_string()) r.fail("source", "must be a string");
+    p.source = lens["source"].get<std::string>();
+  }
 
   if (model == "vive") {
     p.kind = LensModelKind::Vive;

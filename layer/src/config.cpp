@@ -1,13 +1,13 @@
 #include "config.hpp"
 
+#include <cstdint>
 #include <cstdlib>
 #include <filesystem>
-#include <fstream>
-#include <sstream>
 
 #include <nlohmann/json.hpp>
 
 #include "fovea/core/error.hpp"
+#include "fovea/core/input_limits.hpp"
 
 namespace fovea::layer {
 namespace {
@@ -39,9 +39,14 @@ void apply_section(const nlohmann::json& s, const std::string& where, LayerConfi
       if (!v.is_array() || v.size() != 3) throw core::InputError(field + ": must be \"auto\" or [r, g, b] (0..255)");
       std::array<int, 3> rgb{};
       for (int i = 0; i < 3; ++i) {
-        if (!v[i].is_number_integer() || v[i].get<int>() < 0 || v[i].get<int>() > 255)
-          throw core::InputError(field + ": must be \"auto\" or [r, g, b] (0..255)");
-        rgb[i] = v[i].get<int>();
+        // Range-checked in 64 bits: get<int>() would wrap 4294967297 to 1.
+        const bool in_range = v[i].is_number_unsigned() ? v[i].get<std::uint64_t>() <= 255
+                              : v[i].is_number_integer() ? v[i].get<std::int64_t>() >= 0 && v[i].get<std::int64_t>() <= 255
+                                                         : false;
+        if (!in_range)
+          throw core::InputError(field + "[" + std::to_string(i) + "]: " + v[i].dump() +
+                                 " is not a whole number in 0..255 (expected \"auto\" or [r, g, b])");
+        rgb[i] = static_cast<int>(v[i].get<std::int64_t>());
       }
       c.app_background = rgb;
     } else {
@@ -90,10 +95,7 @@ LayerConfig load_config(const std::string& application) {
   const fs::path file = dir / "fovea" / "layer.json";
   std::error_code ec;
   if (!dir.empty() && fs::is_regular_file(file, ec)) {
-    std::ifstream in(file);
-    std::stringstream ss;
-    ss << in.rdbuf();
-    c = parse_config(ss.str(), file.string(), application);
+    c = parse_config(core::read_file_bounded(file.string(), 1 << 20), file.string(), application);
   }
   for (const char* name : {"FOVEA_LAYER_SCENE", "FOVEA_SCENE"})
     if (!env(name).empty()) {

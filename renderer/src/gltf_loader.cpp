@@ -1,11 +1,15 @@
-// glTF 2.0 through tinygltf (the Debian library). tinygltf parses the JSON and decodes
-// images; everything it hands back is treated as untrusted: every index, offset, stride
-// and count is checked here before use.
+// glTF 2.0 through tinygltf (the Debian library). tinygltf parses the JSON; images are
+// decoded here (stb_image), only those a material uses. Before tinygltf sees the text its
+// JSON nesting is bounded (tinygltf converts `extras` recursively), files it reads go
+// through a size budget, and everything it hands back is treated as untrusted: every
+// index, offset, stride and count is checked here before use.
 #include <algorithm>
 #include <cmath>
 #include <cstring>
 #include <filesystem>
+#include <limits>
 #include <set>
+#include <span>
 
 #include <glm/geometric.hpp>
 #include <glm/gtc/matrix_transform.hpp>
@@ -16,7 +20,9 @@
 #include <tiny_gltf.h>
 
 #include "fovea/core/error.hpp"
+#include "fovea/core/input_limits.hpp"
 #include "fovea/renderer/scene_io.hpp"
+#include "texture_decode.hpp"
 
 namespace fovea::renderer {
 
@@ -33,6 +39,7 @@ struct Ctx {
   std::uint32_t default_material = 0;
   bool have_camera = false;
   std::size_t triangles_seen = 0;  // triangles instantiated so far (DAGs can explode)
+  std::size_t node_instances = 0;  // nodes visited so far, for the same reason
 
   void warn(const std::string& w) {
     if (std::find(s.warnings.begin(), s.warnings.end(), origin + ": " + w) == s.warnings.end())
@@ -133,37 +140,65 @@ int find_attribute(const tinygltf::Primitive& p, const char* name) {
   return it == p.attributes.end() ? -1 : it->second;
 }
 
-void load_textures(Ctx& c) {
-  for (const auto& tex : c.m.textures) {
+// Images as tinygltf found them, still encoded, by image index (empty: the image lives in
+// a buffer view, or its URI could not be read).
+struct EncodedImages {
+  std::vector<std::vector<unsigned char>> bytes;
+};
+
+// tinygltf's image callback: keeps the encoded bytes for load_textures. For images in a
+// buffer view tinygltf passes a pointer it has not range-checked against the buffer (a
+// view past the end crashed the decoder); those are read later through a checked view.
+bool keep_encoded(tinygltf::Image* img, int index, std::string*, std::string*, int, int,
+                  const unsigned char* bytes, int size, void* user) {
+  if (img->bufferView >= 0 || index < 0 || size <= 0) return true;
+  auto& store = static_cast<EncodedImages*>(user)->bytes;
+  if (store.size() <= std::size_t(index)) store.resize(std::size_t(index) + 1);
+  store[std::size_t(index)].assign(bytes, bytes + size);
+  return true;
+}
+
+// The encoded bytes of image `src`; empty with `why` set if there are none.
+std::span<const unsigned char> encoded_image(const Model& m, const EncodedImages& enc, int src, std::string& why) {
+  if (src < 0 || std::size_t(src) >= m.images.size()) {
+    why = "texture without a valid image";
+    return {};
+  }
+  const auto& img = m.images[std::size_t(src)];
+  if (img.bufferView >= 0) {
+    const auto bvi = std::size_t(img.bufferView);
+    const auto* bv = bvi < m.bufferViews.size() ? &m.bufferViews[bvi] : nullptr;
+    const auto* buf = bv && bv->buffer >= 0 && std::size_t(bv->buffer) < m.buffers.size()
+                          ? &m.buffers[std::size_t(bv->buffer)].data : nullptr;
+    if (!buf || bv->byteOffset > buf->size() || bv->byteLength > buf->size() - bv->byteOffset) {
+      why = "image " + std::to_string(src) + ": bufferView " + std::to_string(img.bufferView) + " lies outside its buffer";
+      return {};
+    }
+    return {buf->data() + bv->byteOffset, bv->byteLength};
+  }
+  if (std::size_t(src) < enc.bytes.size() && !enc.bytes[std::size_t(src)].empty()) return enc.bytes[std::size_t(src)];
+  why = "image \"" + img.uri.substr(0, 64) + "\" missing";
+  return {};
+}
+
+// One scene texture per glTF texture (material indices stay valid); only the textures a
+// material uses are decoded, the others stay 1x1 white.
+void load_textures(Ctx& c, const EncodedImages& enc) {
+  std::vector<bool> used(c.m.textures.size(), false);
+  for (const auto& gm : c.m.materials) {
+    const int ti = gm.pbrMetallicRoughness.baseColorTexture.index;
+    if (ti >= 0 && std::size_t(ti) < used.size()) used[std::size_t(ti)] = true;
+  }
+  std::size_t decoded = 0;
+  for (std::size_t i = 0; i < c.m.textures.size(); ++i) {
     Texture t;
-    t.name = tex.name;
-    const int src = tex.source;
-    if (src < 0 || std::size_t(src) >= c.m.images.size()) {
-      c.warn("texture without a valid image, replaced by white");
-    } else {
-      const auto& img = c.m.images[std::size_t(src)];
-      const int comp = img.component;
-      const std::size_t bpc = img.bits == 16 ? 2 : img.bits == 8 ? 1 : 0;
-      const bool ok = img.width > 0 && img.height > 0 && img.width <= c.limits.max_texture_size &&
-                      img.height <= c.limits.max_texture_size && comp >= 1 && comp <= 4 && bpc != 0 &&
-                      img.image.size() == std::size_t(img.width) * img.height * comp * bpc;
-      if (!ok) {
-        c.warn("image \"" + img.uri.substr(0, 64) + "\" missing or undecodable, replaced by white");
-      } else {
-        t.width = img.width;
-        t.height = img.height;
-        t.rgba.resize(std::size_t(t.width) * t.height * 4);
-        for (std::size_t i = 0; i < std::size_t(t.width) * t.height; ++i) {
-          std::uint8_t px[4] = {0, 0, 0, 255};
-          for (int k = 0; k < comp; ++k)  // 16-bit: keep the high byte (little endian)
-            px[k] = img.image[(i * comp + k) * bpc + (bpc - 1)];
-          if (comp <= 2) {  // grey (+ alpha)
-            px[3] = comp == 2 ? px[1] : 255;
-            px[1] = px[2] = px[0];
-          }
-          std::memcpy(&t.rgba[i * 4], px, 4);
-        }
-      }
+    t.name = c.m.textures[i].name;
+    if (used[i]) {
+      std::string why;
+      const auto bytes = encoded_image(c.m, enc, c.m.textures[i].source, why);
+      if (why.empty() && !detail::decode_texture(bytes, c.limits, c.origin, decoded, t, why))
+        why = "image \"" + c.m.images[std::size_t(c.m.textures[i].source)].uri.substr(0, 64) + "\" " + why;
+      if (t.width == 0) c.warn(why + ", replaced by white");
     }
     if (t.width == 0) {
       t.width = t.height = 1;
@@ -304,6 +339,9 @@ void visit(Ctx& c, int node, const glm::dmat4& parent, std::vector<int>& path) {
     c.warn("node hierarchy deeper than 256 levels, truncated");
     return;
   }
+  if (++c.node_instances > c.limits.max_node_instances)
+    throw core::InputError(c.origin + ": more than " + std::to_string(c.limits.max_node_instances) +
+                           " node instances after instancing the node graph");
   const auto& n = c.m.nodes[std::size_t(node)];
   const glm::dmat4 world = parent * local_transform(n);
   if (!finite_matrix(world)) {
@@ -334,11 +372,11 @@ void visit(Ctx& c, int node, const glm::dmat4& parent, std::vector<int>& path) {
   path.pop_back();
 }
 
-Scene from_model(const Model& m, const std::string& origin, const SceneLimits& limits) {
+Scene from_model(const Model& m, const EncodedImages& enc, const std::string& origin, const SceneLimits& limits) {
   Scene s;
   s.name = std::filesystem::path(origin).stem().string();
   Ctx c{m, s, origin, limits};
-  load_textures(c);
+  load_textures(c, enc);
   load_materials(c);
   std::vector<int> roots;
   if (!m.scenes.empty()) {
@@ -374,44 +412,93 @@ void collect_warnings(Scene& s, const std::string& origin, const std::string& wa
   }
 }
 
-}  // namespace
+// Files tinygltf reads (external buffers and images) share the scene's byte budget; text
+// loaded from memory without a base directory may use data URIs only.
+struct FileBudget {
+  std::size_t left;
+  bool allow_files;
+};
 
-Scene load_gltf(const std::string& path, const SceneLimits& limits) {
+bool file_exists(const std::string& path, void* user) {
   std::error_code ec;
-  if (!std::filesystem::is_regular_file(path, ec))
-    throw core::InputError(path + ": not a readable file");
+  return static_cast<FileBudget*>(user)->allow_files && std::filesystem::is_regular_file(path, ec);
+}
+
+// tinygltf's own expansion runs wordexp() on URIs from the file; paths are taken as written.
+std::string path_as_is(const std::string& path, void*) { return path; }
+
+bool read_within_budget(std::vector<unsigned char>* out, std::string* err, const std::string& path, void* user) {
+  auto& budget = *static_cast<FileBudget*>(user);
+  if (!budget.allow_files) {
+    if (err) *err += path + ": external files are not allowed here\n";
+    return false;
+  }
+  try {
+    const std::string bytes = core::read_file_bounded(path, budget.left);
+    budget.left -= bytes.size();
+    out->assign(bytes.begin(), bytes.end());
+    return true;
+  } catch (const core::InputError& e) {
+    if (err) *err += std::string(e.what()) + " (the scene's file budget)\n";
+    return false;
+  }
+}
+
+bool refuse_write(std::string* err, const std::string&, const std::vector<unsigned char>&, void*) {
+  if (err) *err += "writing is not supported\n";
+  return false;
+}
+
+// tinygltf converts `extras` and `extensions` to its Value type recursively.
+constexpr std::size_t kMaxJsonDepth = 128;
+
+// The JSON chunk of a GLB container (header: magic, version, length; then chunk length
+// and type), or the whole text when it is not one; tinygltf reports malformed containers.
+std::string_view glb_json(std::string_view bytes) {
+  if (bytes.size() < 20) return {};
+  std::uint32_t len = 0;
+  std::memcpy(&len, bytes.data() + 12, 4);
+  return bytes.substr(20, std::min<std::size_t>(len, bytes.size() - 20));
+}
+
+Scene load(std::string_view bytes, bool binary, const std::string& origin, const std::string& base_dir,
+           const SceneLimits& limits) {
+  if (bytes.size() > limits.max_file_bytes || bytes.size() > std::numeric_limits<unsigned>::max())
+    throw core::InputError(origin + ": larger than " + std::to_string(limits.max_file_bytes) + " bytes, refused");
+  core::check_json_nesting(binary ? glb_json(bytes) : bytes, origin, kMaxJsonDepth);
   tinygltf::TinyGLTF loader;
+  EncodedImages images;
+  FileBudget budget{limits.max_file_bytes - bytes.size(), !base_dir.empty()};
+  loader.SetImageLoader(&keep_encoded, &images);
+  loader.SetFsCallbacks({&file_exists, &path_as_is, &read_within_budget, &refuse_write, &budget});
   Model m;
   std::string err, warn;
-  const bool binary = path.ends_with(".glb") || path.ends_with(".GLB");
   bool ok = false;
   try {
-    ok = binary ? loader.LoadBinaryFromFile(&m, &err, &warn, path)
-                : loader.LoadASCIIFromFile(&m, &err, &warn, path);
+    ok = binary ? loader.LoadBinaryFromMemory(&m, &err, &warn, reinterpret_cast<const unsigned char*>(bytes.data()),
+                                              static_cast<unsigned>(bytes.size()), base_dir)
+                : loader.LoadASCIIFromString(&m, &err, &warn, bytes.data(), static_cast<unsigned>(bytes.size()), base_dir);
   } catch (const std::exception& e) {  // e.g. JSON type errors thrown from inside the parser
     err = e.what();
   }
-  if (!ok) throw core::InputError(path + ": not a valid glTF 2.0 file: " + first_line(err.empty() ? warn : err));
-  Scene s = from_model(m, path, limits);
-  collect_warnings(s, path, warn);
+  if (!ok) throw core::InputError(origin + ": not a valid glTF 2.0 file: " + first_line(err.empty() ? warn : err));
+  Scene s = from_model(m, images, origin, limits);
+  collect_warnings(s, origin, warn);
   return s;
+}
+
+}  // namespace
+
+Scene load_gltf(const std::string& path, const SceneLimits& limits) {
+  const std::string bytes = core::read_file_bounded(path, limits.max_file_bytes);
+  const bool binary = path.ends_with(".glb") || path.ends_with(".GLB");
+  const std::string dir = std::filesystem::path(path).parent_path().string();
+  return load(bytes, binary, path, dir.empty() ? "." : dir, limits);
 }
 
 Scene load_gltf_text(std::string_view text, const std::string& origin, const std::string& base_dir,
                      const SceneLimits& limits) {
-  tinygltf::TinyGLTF loader;
-  Model m;
-  std::string err, warn;
-  bool ok = false;
-  try {
-    ok = loader.LoadASCIIFromString(&m, &err, &warn, text.data(), static_cast<unsigned>(text.size()), base_dir);
-  } catch (const std::exception& e) {
-    err = e.what();
-  }
-  if (!ok) throw core::InputError(origin + ": not a valid glTF 2.0 file: " + first_line(err.empty() ? warn : err));
-  Scene s = from_model(m, origin, limits);
-  collect_warnings(s, origin, warn);
-  return s;
+  return load(text, false, origin, base_dir, limits);
 }
 
 }  // namespace fovea::renderer

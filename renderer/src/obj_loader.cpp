@@ -1,31 +1,104 @@
 // Wavefront OBJ/MTL through tinyobjloader (the Debian library); indices and material
-// ids it returns are range-checked here, textures decoded with stb_image.
+// ids it returns are range-checked here, textures decoded with stb_image. The OBJ file and
+// the material libraries it names are read here with a size bound (tinyobjloader reads
+// an endless file until memory runs out) and their numbers screened before parsing.
 #include <algorithm>
+#include <cctype>
 #include <cmath>
 #include <filesystem>
 #include <map>
+#include <set>
+#include <sstream>
 
-#include <stb/stb_image.h>
 #include <tiny_obj_loader.h>
 
 #include "fovea/core/error.hpp"
+#include "fovea/core/input_limits.hpp"
 #include "fovea/renderer/scene_io.hpp"
+#include "texture_decode.hpp"
 
 namespace fovea::renderer {
 
 namespace {
 
-// Decodes an image file into an RGBA8 texture; empty optional-like result on failure.
-bool load_texture_file(const std::string& path, int max_size, Texture& t) {
-  int w = 0, h = 0, n = 0;
-  if (!stbi_info(path.c_str(), &w, &h, &n) || w < 1 || h < 1 || w > max_size || h > max_size) return false;
-  unsigned char* px = stbi_load(path.c_str(), &w, &h, &n, 4);
-  if (!px) return false;
-  t.width = w;
-  t.height = h;
-  t.rgba.assign(px, px + std::size_t(w) * h * 4);
-  stbi_image_free(px);
-  return true;
+// Decodes an image file into an RGBA8 texture, reading it within the byte budget; false
+// if missing or undecodable, throws beyond the budgets.
+bool load_texture_file(const std::string& path, const SceneLimits& limits, const std::string& origin,
+                       std::size_t& budget, std::size_t& decoded, Texture& t) {
+  std::error_code ec;
+  if (!std::filesystem::is_regular_file(path, ec)) return false;
+  const std::string bytes = core::read_file_bounded(path, budget);
+  budget -= bytes.size();
+  std::string why;
+  return detail::decode_texture({reinterpret_cast<const unsigned char*>(bytes.data()), bytes.size()}, limits, origin,
+                                decoded, t, why);
+}
+
+// tinyobjloader accumulates a number's exponent in an int without a bound ("1e9999999999"
+// overflows it: undefined behaviour). Numeric tokens whose exponent has more than four
+// significant digits are refused first, naming the line; no float needs more than three.
+void check_exponents(std::string_view text, const std::string& origin) {
+  std::size_t line = 1, i = 0;
+  const auto digit = [&](std::size_t k) { return k < text.size() && text[k] >= '0' && text[k] <= '9'; };
+  while (i < text.size()) {
+    const char ch = text[i];
+    if (ch == '\n') ++line;
+    // A token starts after whitespace or '/' (face indices) with a sign, digit or point.
+    const bool starts = (i == 0 || std::isspace(static_cast<unsigned char>(text[i - 1])) || text[i - 1] == '/') &&
+                        (digit(i) || ch == '+' || ch == '-' || ch == '.');
+    if (!starts) {
+      ++i;
+      continue;
+    }
+    std::size_t k = i + (ch == '+' || ch == '-');
+    while (digit(k) || (k < text.size() && text[k] == '.')) ++k;
+    if (k < text.size() && (text[k] == 'e' || text[k] == 'E')) {
+      ++k;
+      if (k < text.size() && (text[k] == '+' || text[k] == '-')) ++k;
+      while (k < text.size() && text[k] == '0') ++k;
+      std::size_t significant = 0;
+      while (digit(k)) ++k, ++significant;
+      if (significant > 4)
+        throw core::InputError(origin + ":" + std::to_string(line) + ": number with an exponent out of range");
+    }
+    i = std::max(k, i + 1);
+  }
+}
+
+// The material libraries named by `mtllib` lines, concatenated (tinyobjloader takes one
+// material stream for all of them), each read with what is left of the byte budget.
+std::string read_material_libraries(const std::string& obj, const std::string& dir, std::size_t& budget,
+                                    std::vector<std::string>& warnings, const std::string& origin) {
+  std::string out;
+  std::set<std::string> seen;
+  for (std::size_t at = 0; at < obj.size();) {
+    const std::size_t end = std::min(obj.find('\n', at), obj.size());
+    const std::string_view line(obj.data() + at, end - at);
+    at = end + 1;
+    if (line.find("mtllib") == std::string_view::npos) continue;  // no copy of the other lines
+    std::istringstream words{std::string(line)};
+    std::string keyword, name;
+    if (!(words >> keyword) || keyword != "mtllib") continue;
+    while (words >> name) {
+      if (!seen.insert(name).second) continue;
+      const std::string path = (std::filesystem::path(dir) / name).string();
+      std::error_code ec;
+      if (!std::filesystem::is_regular_file(path, ec)) {
+        warnings.push_back(origin + ": material library \"" + name + "\" missing, ignored");
+        continue;
+      }
+      try {
+        const std::string text = core::read_file_bounded(path, budget);
+        budget -= text.size();
+        check_exponents(text, path);
+        out += text;
+      } catch (const core::InputError& e) {
+        throw core::InputError(origin + ": mtllib " + e.what());
+      }
+      out += '\n';
+    }
+  }
+  return out;
 }
 
 // Blinn-Phong exponent -> GGX: alpha = sqrt(2 / (Ns + 2)) (Walter et al. 2007, §5.2),
@@ -38,20 +111,22 @@ float ns_to_roughness(float ns) {
 }  // namespace
 
 Scene load_obj(const std::string& path, const SceneLimits& limits) {
-  std::error_code ec;
-  if (!std::filesystem::is_regular_file(path, ec)) throw core::InputError(path + ": not a readable file");
+  const std::string obj = core::read_file_bounded(path, limits.max_file_bytes);
+  check_exponents(obj, path);
+  Scene s;
+  const std::string dir = std::filesystem::path(path).parent_path().string();
+  std::size_t budget = limits.max_file_bytes - obj.size();
+  const std::string mtl = read_material_libraries(obj, dir, budget, s.warnings, path);
   tinyobj::ObjReaderConfig cfg;
   cfg.triangulate = true;
   cfg.vertex_color = false;
   tinyobj::ObjReader reader;
-  if (!reader.ParseFromFile(path, cfg)) {
+  if (!reader.ParseFromString(obj, mtl, cfg)) {
     std::string e = reader.Error();
     if (const auto nl = e.find('\n'); nl != std::string::npos) e.resize(nl);
     throw core::InputError(path + ": not a valid OBJ file: " + (e.empty() ? "parse error" : e));
   }
-  Scene s;
   s.name = std::filesystem::path(path).stem().string();
-  const std::string dir = std::filesystem::path(path).parent_path().string();
   if (!reader.Warning().empty()) {
     std::string w = reader.Warning();
     if (const auto nl = w.find('\n'); nl != std::string::npos) w.resize(nl);
@@ -62,6 +137,7 @@ Scene load_obj(const std::string& path, const SceneLimits& limits) {
   def.name = "obj-default";
   const std::uint32_t def_id = s.add_material(def);
   std::map<std::string, int> texture_ids;
+  std::size_t decoded = 0;
   std::vector<std::uint32_t> mat_map;
   for (const auto& om : reader.GetMaterials()) {
     Material m;
@@ -77,7 +153,7 @@ Scene load_obj(const std::string& path, const SceneLimits& limits) {
         t.name = om.diffuse_texname;
         const std::string tp = (std::filesystem::path(dir) / om.diffuse_texname).string();
         int id = -1;
-        if (load_texture_file(tp, limits.max_texture_size, t)) {
+        if (load_texture_file(tp, limits, path, budget, decoded, t)) {
           id = int(s.textures.size());
           s.textures.push_back(std::move(t));
         } else {

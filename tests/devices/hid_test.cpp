@@ -1,3 +1,4 @@
+#include <algorithm>
 #include <random>
 
 #include <glm/geometric.hpp>
@@ -87,6 +88,267 @@ TEST(HidDescriptor, MicrosoftReferenceLayout) {
   EXPECT_NEAR(L.sampling_frequency.si_per_unit, 1.0, 1e-12);  // Hz
   EXPECT_EQ(L.device_mode.report_id, 0x14);
   EXPECT_EQ(c.mode_request(kModeGazePoint), bytes({0x14, 0x01}));
+}
+
+// A descriptor from outside the project: Microsoft's virtual eye-gaze device in the Driver
+// Module Framework (MIT licence), g_VirtualEyeGaze_HidReportDescriptor in
+// https://github.com/microsoft/DMF/blob/0dc1b70d2604e6ac4c0cb88d36476a8b2c17e9c5/Dmf/Modules.Library/Dmf_VirtualEyeGaze.c
+// The source spells it with macros; each line below is the HID 1.11 §6.2.2.2 short-item
+// encoding (prefix byte, little-endian data) of the macro named in its comment, in order.
+const std::vector<std::uint8_t> kDmfVirtualEyeGaze = {
+    0x05, 0x12,                    // HID_USAGE_PAGE(HID_USAGE_PAGE_EYE_HEAD_TRACKER)
+    0x09, 0x01,                    // HID_USAGE(HID_USAGE_EYE_TRACKER)
+    0xA1, 0x01,                    // HID_BEGIN_APPLICATION_COLLECTION()
+    0x09, 0x10,                    //   HID_USAGE(HID_USAGE_TRACKING_DATA)
+    0xA1, 0x02,                    //   HID_BEGIN_LOGICAL_COLLECTION()
+    0x85, 0x10,                    //     HID_REPORT_ID(HID_USAGE_TRACKING_DATA)
+    0x15, 0x00,                    //     HID_LOGICAL_MINIMUM_BYTE(0x00)
+    0x26, 0xFF, 0x00,              //     HID_LOGICAL_MAXIMUM_WORD(0x00FF)
+    0x75, 0x08,                    //     HID_REPORT_SIZE_UINT8()
+    0x09, 0x20,                    //     HID_USAGE(HID_USAGE_TIMESTAMP)
+    0x66, 0x01, 0x10,              //     HID_UNIT_WORD(0x1001)
+    0x55, 0x0A,                    //     HID_UNIT_EXPONENT_BYTE(0x0A)
+    0x95, 0x08,                    //     HID_REPORT_COUNT(8)
+    0x81, 0x02,                    //     HID_INPUT_DYNAMIC_VALUE()
+    0x95, 0x01,                    //     HID_REPORT_COUNT(1)
+    0x75, 0x20,                    //     HID_REPORT_SIZE_UINT32()
+    0x65, 0x11,                    //     HID_UNIT_BYTE(0x11)
+    0x55, 0x0C,                    //     HID_UNIT_EXPONENT_BYTE(0x0C)
+    0x17, 0x80, 0x7B, 0xE1, 0xFF,  //     HID_LOGICAL_MINIMUM_DWORD(0xFFE17B80)
+    0x27, 0x80, 0x84, 0x1E, 0x00,  //     HID_LOGICAL_MAXIMUM_DWORD(0x001E8480)
+    0x09, 0x24,                    //     HID_USAGE(HID_USAGE_GAZE_LOCATION)
+    0xA1, 0x00,                    //     HID_BEGIN_PHYSICAL_COLLECTION()
+    0x95, 0x02,                    //       HID_REPORT_COUNT(2)
+    0x09, 0x21, 0x09, 0x22,        //       HID_USAGE(HID_USAGE_POSITION_X), HID_USAGE(HID_USAGE_POSITION_Y)
+    0x81, 0x03,                    //       HID_INPUT_STATIC_VALUE()
+    0xC0,                          //     HID_END_COLLECTION_EX()
+    0x09, 0x25,                    //     HID_USAGE(HID_USAGE_LEFT_EYE_POSITION)
+    0xA1, 0x00,                    //     HID_BEGIN_PHYSICAL_COLLECTION()
+    0x95, 0x03,                    //       HID_REPORT_COUNT(3)
+    0x09, 0x21, 0x09, 0x22, 0x09, 0x23,  // HID_USAGE(HID_USAGE_POSITION_X/_Y/_Z)
+    0x81, 0x03,                    //       HID_INPUT_STATIC_VALUE()
+    0xC0,                          //     HID_END_COLLECTION_EX()
+    0x09, 0x26,                    //     HID_USAGE(HID_USAGE_RIGHT_EYE_POSITION)
+    0xA1, 0x00,                    //     HID_BEGIN_PHYSICAL_COLLECTION()
+    0x95, 0x03,                    //       HID_REPORT_COUNT(3)
+    0x09, 0x21, 0x09, 0x22, 0x09, 0x23,  // HID_USAGE(HID_USAGE_POSITION_X/_Y/_Z)
+    0x81, 0x03,                    //       HID_INPUT_STATIC_VALUE()
+    0xC0,                          //     HID_END_COLLECTION_EX()
+    0x09, 0x27,                    //     HID_USAGE(HID_USAGE_HEAD_POSITION)
+    0xA1, 0x00,                    //     HID_BEGIN_PHYSICAL_COLLECTION()
+    0x95, 0x03,                    //       HID_REPORT_COUNT(3)
+    0x09, 0x21, 0x09, 0x22, 0x09, 0x23,  // HID_USAGE(HID_USAGE_POSITION_X/_Y/_Z)
+    0x81, 0x03,                    //       HID_INPUT_STATIC_VALUE()
+    0xC0,                          //     HID_END_COLLECTION_EX()
+    0x09, 0x28,                    //     HID_USAGE(HID_USAGE_HEAD_DIRECTION)
+    0xA1, 0x00,                    //     HID_BEGIN_PHYSICAL_COLLECTION()
+    0x95, 0x03,                    //       HID_REPORT_COUNT(3)
+    0x09, 0x29, 0x09, 0x2A, 0x09, 0x2B,  // HID_USAGE(HID_USAGE_ROTATION_ABOUT_X/_Y/_Z_AXIS)
+    0x81, 0x03,                    //       HID_INPUT_STATIC_VALUE()
+    0xC0,                          //     HID_END_COLLECTION_EX()
+    0xC0,                          //   HID_END_COLLECTION_EX()
+    0x09, 0x11,                    //   HID_USAGE(HID_USAGE_CAPABILITIES)
+    0xA1, 0x02,                    //   HID_BEGIN_LOGICAL_COLLECTION()
+    0x85, 0x11,                    //     HID_REPORT_ID(HID_USAGE_CAPABILITIES)
+    0x75, 0x08,                    //     HID_REPORT_SIZE_UINT8()
+    0x95, 0x01,                    //     HID_REPORT_COUNT(1)
+    0x0A, 0x00, 0x01,              //     HID_USAGE_WORD(HID_USAGE_TRACKER_QUALITY)
+    0x15, 0x00,                    //     HID_LOGICAL_MINIMUM_BYTE(0x00)
+    0x25, 0x01,                    //     HID_LOGICAL_MAXIMUM_BYTE(0x01)
+    0x65, 0x00,                    //     HID_UNIT_BYTE(0x00)
+    0x55, 0x00,                    //     HID_UNIT_EXPONENT_BYTE(0x00)
+    0xB1, 0x03,                    //     HID_FEATURE_STATIC_VALUE()
+    0xA1, 0x00,                    //     HID_BEGIN_PHYSICAL_COLLECTION()
+    0x95, 0x05,                    //       HID_REPORT_COUNT(5)
+    0x75, 0x20,                    //       HID_REPORT_SIZE_UINT32()
+    0x17, 0x80, 0x7B, 0xE1, 0xFF,  //       HID_LOGICAL_MINIMUM_DWORD(0xFFE17B80)
+    0x27, 0x80, 0x84, 0x1E, 0x00,  //       HID_LOGICAL_MAXIMUM_DWORD(0x001E8480)
+    0x65, 0x11,                    //       HID_UNIT_BYTE(0x11)
+    0x55, 0x0C,                    //       HID_UNIT_EXPONENT_BYTE(0x0C)
+    0x0A, 0x01, 0x01,              //       HID_USAGE_WORD(HID_USAGE_MINIMUM_TRACKING_DISTANCE)
+    0x0A, 0x02, 0x01,              //       HID_USAGE_WORD(HID_USAGE_OPTIMUM_TRACKING_DISTANCE)
+    0x0A, 0x03, 0x01,              //       HID_USAGE_WORD(HID_USAGE_MAXIMUM_TRACKING_DISTANCE)
+    0x0A, 0x04, 0x01,              //       HID_USAGE_WORD(HID_USAGE_MAXIMUM_SCREEN_PLANE_WIDTH)
+    0x0A, 0x05, 0x01,              //       HID_USAGE_WORD(HID_USAGE_MAXIMUM_SCREEN_PLANE_HEIGHT)
+    0xB1, 0x03,                    //       HID_FEATURE_STATIC_VALUE()
+    0xC0,                          //     HID_END_COLLECTION_EX()
+    0xC0,                          //   HID_END_COLLECTION_EX()
+    0x09, 0x12,                    //   HID_USAGE(HID_USAGE_CONFIGURATION)
+    0xA1, 0x02,                    //   HID_BEGIN_LOGICAL_COLLECTION()
+    0x85, 0x12,                    //     HID_REPORT_ID(HID_USAGE_CONFIGURATION)
+    0x75, 0x08,                    //     HID_REPORT_SIZE_UINT8()
+    0x15, 0x00,                    //     HID_LOGICAL_MINIMUM_BYTE(0x00)
+    0x26, 0xFF, 0x00,              //     HID_LOGICAL_MAXIMUM_WORD(0x00FF)
+    0x95, 0x01,                    //     HID_REPORT_COUNT(1)
+    0x75, 0x10,                    //     HID_REPORT_SIZE_UINT16()
+    0x27, 0xFF, 0xFF, 0x00, 0x00,  //     HID_LOGICAL_MAXIMUM_DWORD(0x0000FFFF)
+    0x65, 0x00,                    //     HID_UNIT_BYTE(0x00)
+    0x55, 0x00,                    //     HID_UNIT_EXPONENT_BYTE(0x00)
+    0x0A, 0x00, 0x02,              //     HID_USAGE_WORD(HID_USAGE_DISPLAY_MANUFACTURER_ID)
+    0xB1, 0x03,                    //     HID_FEATURE_STATIC_VALUE()
+    0x0A, 0x01, 0x02,              //     HID_USAGE_WORD(HID_USAGE_DISPLAY_PRODUCT_ID)
+    0xB1, 0x03,                    //     HID_FEATURE_STATIC_VALUE()
+    0x75, 0x20,                    //     HID_REPORT_SIZE_UINT32()
+    0x27, 0xFF, 0xFF, 0xFF, 0x7F,  //     HID_LOGICAL_MAXIMUM_DWORD(0x7FFFFFFF)
+    0x0A, 0x02, 0x02,              //     HID_USAGE_WORD(HID_USAGE_DISPLAY_SERIAL_NUMBER)
+    0xB1, 0x03,                    //     HID_FEATURE_STATIC_VALUE()
+    0x75, 0x10,                    //     HID_REPORT_SIZE_UINT16()
+    0x15, 0x00,                    //     HID_LOGICAL_MINIMUM_BYTE(0x00)
+    0x27, 0xFF, 0xFF, 0x00, 0x00,  //     HID_LOGICAL_MAXIMUM_DWORD(0x0000FFFF)
+    0x0A, 0x03, 0x02,              //     HID_USAGE_WORD(HID_USAGE_DISPLAY_MANUFACTURER_DATE)
+    0xB1, 0x03,                    //     HID_FEATURE_STATIC_VALUE()
+    0xA1, 0x00,                    //     HID_BEGIN_PHYSICAL_COLLECTION()
+    0x65, 0x11,                    //       HID_UNIT_BYTE(0x11)
+    0x55, 0x0C,                    //       HID_UNIT_EXPONENT_BYTE(0x0C)
+    0x27, 0xFF, 0xFF, 0xFF, 0x7F,  //       HID_LOGICAL_MAXIMUM_DWORD(0x7FFFFFFF)
+    0x75, 0x20,                    //       HID_REPORT_SIZE_UINT32()
+    0x0A, 0x04, 0x02,              //       HID_USAGE_WORD(HID_USAGE_CALIBRATED_SCREEN_WIDTH)
+    0xB1, 0x03,                    //       HID_FEATURE_STATIC_VALUE()
+    0x0A, 0x05, 0x02,              //       HID_USAGE_WORD(HID_USAGE_CALIBRATED_SCREEN_HEIGHT)
+    0xB1, 0x03,                    //       HID_FEATURE_STATIC_VALUE()
+    0xC0,                          //     HID_END_COLLECTION_EX()
+    0xC0,                          //   HID_END_COLLECTION_EX()
+    0x09, 0x13,                    //   HID_USAGE(HID_USAGE_TRACKER_STATUS)
+    0xA1, 0x02,                    //   HID_BEGIN_LOGICAL_COLLECTION()
+    0x85, 0x13,                    //     HID_REPORT_ID(HID_USAGE_TRACKER_STATUS)
+    0x75, 0x08,                    //     HID_REPORT_SIZE_UINT8()
+    0x65, 0x00,                    //     HID_UNIT_BYTE(0x00)
+    0x55, 0x00,                    //     HID_UNIT_EXPONENT_BYTE(0x00)
+    0x25, 0x04,                    //     HID_LOGICAL_MAXIMUM_BYTE(0x04)
+    0x0A, 0x01, 0x03,              //     HID_USAGE_WORD(HID_USAGE_CONFIGURATION_STATUS)
+    0xB1, 0x02,                    //     HID_FEATURE_DYNAMIC_VALUE()
+    0x75, 0x10,                    //     HID_REPORT_SIZE_UINT16()
+    0x27, 0xFF, 0xFF, 0x00, 0x00,  //     HID_LOGICAL_MAXIMUM_DWORD(0x0000FFFF)
+    0x66, 0x01, 0xF0,              //     HID_UNIT_WORD(0xF001)
+    0x55, 0x00,                    //     HID_UNIT_EXPONENT_BYTE(0x00)
+    0x0A, 0x00, 0x03,              //     HID_USAGE_WORD(HID_USAGE_SAMPLING_FREQUENCY)
+    0xB1, 0x02,                    //     HID_FEATURE_DYNAMIC_VALUE()
+    0xC0,                          //   HID_END_COLLECTION_EX()
+    0x09, 0x13,                    //   HID_USAGE(HID_USAGE_TRACKER_STATUS)
+    0xA1, 0x02,                    //   HID_BEGIN_LOGICAL_COLLECTION()
+    0x85, 0x13,                    //     HID_REPORT_ID(HID_USAGE_TRACKER_STATUS)
+    0x75, 0x08,                    //     HID_REPORT_SIZE_UINT8()
+    0x65, 0x00,                    //     HID_UNIT_BYTE(0x00)
+    0x55, 0x00,                    //     HID_UNIT_EXPONENT_BYTE(0x00)
+    0x25, 0x04,                    //     HID_LOGICAL_MAXIMUM_BYTE(0x04)
+    0x0A, 0x01, 0x03,              //     HID_USAGE_WORD(HID_USAGE_CONFIGURATION_STATUS)
+    0x81, 0x02,                    //     HID_INPUT_DYNAMIC_VALUE()
+    0x75, 0x10,                    //     HID_REPORT_SIZE_UINT16()
+    0x27, 0xFF, 0xFF, 0x00, 0x00,  //     HID_LOGICAL_MAXIMUM_DWORD(0x0000FFFF)
+    0x66, 0x01, 0xF0,              //     HID_UNIT_WORD(0xF001)
+    0x55, 0x00,                    //     HID_UNIT_EXPONENT_BYTE(0x00)
+    0x0A, 0x00, 0x03,              //     HID_USAGE_WORD(HID_USAGE_SAMPLING_FREQUENCY)
+    0x81, 0x02,                    //     HID_INPUT_DYNAMIC_VALUE()
+    0xC0,                          //   HID_END_COLLECTION_EX()
+    0x09, 0x14,                    //   HID_USAGE(HID_USAGE_TRACKER_CONTROL)
+    0xA1, 0x02,                    //   HID_BEGIN_LOGICAL_COLLECTION()
+    0x85, 0x14,                    //     HID_REPORT_ID(HID_USAGE_TRACKER_CONTROL)
+    0x75, 0x08,                    //     HID_REPORT_SIZE_UINT8()
+    0x25, 0x07,                    //     HID_LOGICAL_MAXIMUM_BYTE(0x07)
+    0x65, 0x00,                    //     HID_UNIT_BYTE(0x00)
+    0x55, 0x00,                    //     HID_UNIT_EXPONENT_BYTE(0x00)
+    0x0A, 0x00, 0x04,              //     HID_USAGE_WORD(HID_USAGE_MODE_REQUEST)
+    0xB1, 0x02,                    //     HID_FEATURE_DYNAMIC_VALUE()
+    0xC0,                          //   HID_END_COLLECTION_EX()
+    0xC0,                          // HID_END_COLLECTION_EX()
+};
+
+TEST(HidDescriptor, PublishedMicrosoftVirtualEyeGazeDescriptor) {
+  const Descriptor d = parse_descriptor(kDmfVirtualEyeGaze);
+  EXPECT_TRUE(d.uses_report_ids);
+  EXPECT_EQ(d.long_items, 0u);
+  // The packed report structs of the same driver: GAZE_REPORT is the ID byte and GAZE_DATA
+  // (Dmf_EyeGazeIoctl_Public.h: 8-byte timestamp, 2-D gaze point, four 3-D points, 64 bytes),
+  // CONFIGURATION_REPORT the ID and 18 bytes, TRACKER_STATUS_REPORT {ReportId,
+  // ConfigurationStatus, SamplingFrequency}, TRACKER_CONTROL_REPORT {ReportId, ModeRequest}.
+  EXPECT_EQ(d.report_bytes(ReportType::Input, 0x10), 65u);
+  EXPECT_EQ(d.report_bytes(ReportType::Feature, 0x11), 1u + 1 + 5 * 4);
+  EXPECT_EQ(d.report_bytes(ReportType::Feature, 0x12), 1u + 2 + 2 + 4 + 2 + 4 + 4);
+  EXPECT_EQ(d.report_bytes(ReportType::Feature, 0x13), 4u);
+  EXPECT_EQ(d.report_bytes(ReportType::Input, 0x13), 4u);
+  EXPECT_EQ(d.report_bytes(ReportType::Feature, 0x14), 2u);
+  EXPECT_EQ(d.report_ids(ReportType::Input), bytes({0x10, 0x13}));
+  EXPECT_EQ(d.report_ids(ReportType::Feature), bytes({0x11, 0x12, 0x13, 0x14}));
+
+  // The head-direction field: three 32-bit rotations inside Eye Tracker > Tracking Data >
+  // Head Direction Point, constant (Cnst,Var,Abs) as declared.
+  const auto head_dir = std::find_if(d.fields.begin(), d.fields.end(), [](const Field& f) {
+    return f.type == ReportType::Input && f.usage_of(0) == 0x120029u;
+  });
+  ASSERT_NE(head_dir, d.fields.end());
+  EXPECT_EQ(head_dir->report_id, 0x10);
+  EXPECT_EQ(head_dir->bit_offset, 64u + 11 * 32);  // after gaze (2), both eyes (6), head position (3)
+  EXPECT_EQ(head_dir->count, 3u);
+  EXPECT_EQ(head_dir->bit_size, 32u);
+  EXPECT_EQ(head_dir->usage_of(2), 0x12002Bu);
+  EXPECT_EQ(head_dir->flags, std::uint32_t(kConstant | kVariable));
+  EXPECT_EQ(head_dir->collections, (std::vector<std::uint32_t>{0x120001, 0x120010, 0x120028}));
+  EXPECT_EQ(head_dir->logical_min, -2000000);
+  EXPECT_EQ(head_dir->logical_max, 2000000);
+  EXPECT_EQ(head_dir->unit, 0x11u);
+  EXPECT_EQ(head_dir->unit_exponent, -4);
+
+  const EyeTrackerCodec c(kDmfVirtualEyeGaze);
+  const EyeTrackerLayout& L = c.layout();
+  EXPECT_EQ(L.tracking_report_id, 0x10);
+  EXPECT_EQ(L.timestamp.bit_offset, 0u);
+  EXPECT_EQ(L.timestamp.bits, 64u);
+  EXPECT_FALSE(L.timestamp.constant);  // HID_INPUT_DYNAMIC_VALUE here
+  EXPECT_DOUBLE_EQ(L.timestamp.si_per_unit, 1e-6);
+  EXPECT_EQ(L.gaze_x.bit_offset, 64u);
+  EXPECT_EQ(L.gaze_y.bit_offset, 96u);
+  EXPECT_NEAR(L.gaze_x.si_per_unit, 1e-6, 1e-18);
+  EXPECT_EQ(L.eye[0][0].bit_offset, 128u);
+  EXPECT_EQ(L.eye[1][2].bit_offset, 128u + 5 * 32);
+  EXPECT_EQ(L.head[0].bit_offset, 64u + 8 * 32);
+  EXPECT_EQ(L.calibrated_w.report_id, 0x12);
+  EXPECT_EQ(L.calibrated_w.bit_offset, 16u + 16 + 32 + 16);
+  EXPECT_EQ(L.calibrated_h.bit_offset, 16u + 16 + 32 + 16 + 32);
+  EXPECT_EQ(L.configuration_status.report_id, 0x13);
+  EXPECT_EQ(L.sampling_frequency.bit_offset, 8u);
+  EXPECT_NEAR(L.sampling_frequency.si_per_unit, 1.0, 1e-12);  // SI, time^-1: Hz
+  EXPECT_TRUE(L.status_input_config.found);
+  EXPECT_EQ(c.mode_request(kModeGazePoint), bytes({0x14, 0x01}));  // MODE_REQUEST_ENABLE_GAZE_POINT
+
+  // Reports with the defaults the driver sets in DMF_VirtualEyeGaze_Open: tracker quality
+  // 1 (fine gaze), tracking distances 50000/65000/90000 µm, status 3 (screen setup
+  // needed) at 100 Hz.
+  DeviceConfig cfg;
+  std::vector<std::uint8_t> caps = {0x11, 0x01};
+  for (const std::uint32_t um : {50000u, 65000u, 90000u, 0u, 0u})
+    for (int b = 0; b < 4; ++b) caps.push_back(std::uint8_t(um >> (8 * b)));
+  ASSERT_TRUE(c.decode_feature(caps, cfg));
+  EXPECT_EQ(cfg.tracker_quality, 1);
+  EXPECT_NEAR(cfg.min_distance_m, 0.05, 1e-12);
+  EXPECT_NEAR(cfg.optimum_distance_m, 0.065, 1e-12);
+  EXPECT_NEAR(cfg.max_distance_m, 0.09, 1e-12);
+  ASSERT_TRUE(c.decode_feature(bytes({0x13, 0x03, 0x64, 0x00}), cfg));
+  EXPECT_EQ(cfg.configuration_status, 3);
+  EXPECT_DOUBLE_EQ(cfg.sampling_hz, 100.0);
+  // A calibrated 527040 x 296460 µm screen, then a gaze report: 1.5 s, (-1000, 250000) µm.
+  std::vector<std::uint8_t> conf(19, 0);
+  conf[0] = 0x12;
+  for (int b = 0; b < 4; ++b) {
+    conf[11 + b] = std::uint8_t(527040u >> (8 * b));
+    conf[15 + b] = std::uint8_t(296460u >> (8 * b));
+  }
+  ASSERT_TRUE(c.decode_feature(conf, cfg));
+  EXPECT_NEAR(cfg.screen_w_m, 0.52704, 1e-12);
+  EXPECT_NEAR(cfg.screen_h_m, 0.29646, 1e-12);
+  std::vector<std::uint8_t> gaze(65, 0);
+  gaze[0] = 0x10;
+  for (int b = 0; b < 8; ++b) gaze[1 + b] = std::uint8_t(std::uint64_t(1500000) >> (8 * b));
+  for (int b = 0; b < 4; ++b) {
+    gaze[9 + b] = std::uint8_t(std::uint32_t(-1000) >> (8 * b));
+    gaze[13 + b] = std::uint8_t(250000u >> (8 * b));
+  }
+  HidGaze g;
+  std::string reason;
+  ASSERT_TRUE(c.decode_input(gaze, g, cfg, reason)) << reason;
+  EXPECT_DOUBLE_EQ(g.timestamp_s, 1.5);
+  EXPECT_TRUE(g.gaze_valid);
+  EXPECT_NEAR(g.gaze_x_m, -0.001, 1e-12);
+  EXPECT_NEAR(g.gaze_y_m, 0.25, 1e-12);
 }
 
 TEST(HidDescriptor, CompactInterleavedLayout) {

@@ -49,6 +49,23 @@ TEST(LayerConfig, ErrorsNameFileAndField) {
   EXPECT_NE(message(R"({"defaults": {}})").find("unknown key"), std::string::npos);
 }
 
+// Fuzz finding: 4294967297 used to wrap to 1 through get<int>().
+TEST(LayerConfig, BackgroundComponentsAreRangeCheckedInSixtyFourBits) {
+  for (const char* bad : {"[4294967297, 0, 0]", "[0, -4294967295, 0]", "[0, 0, 18446744073709551615]",
+                          "[0, 0, 1.5]", "[0, 0, 1e400]"}) {
+    const std::string text = std::string(R"({"default": {"app_background": )") + bad + "}}";
+    try {
+      parse_config(text, "cfg.json", "App");
+      ADD_FAILURE() << bad << " accepted";
+    } catch (const core::InputError& e) {
+      EXPECT_NE(std::string(e.what()).find("cfg.json"), std::string::npos) << e.what();
+    }
+  }
+  const auto c = parse_config(R"({"default": {"app_background": [0, 128, 255]}})", "cfg.json", "App");
+  ASSERT_TRUE(c.app_background.has_value());
+  EXPECT_EQ(*c.app_background, (std::array<int, 3>{0, 128, 255}));
+}
+
 Pixels8 filled(int w, int h, std::array<std::uint8_t, 4> c) {
   Pixels8 p{w, h, {}};
   for (int i = 0; i < w * h; ++i) p.data.insert(p.data.end(), c.begin(), c.end());

@@ -191,6 +191,120 @@ TEST_F(Hostile, ObjWithBadIndicesAndNansLoadsTheRest) {
   EXPECT_FALSE(s.warnings.empty());
 }
 
+// Fuzz findings: each input refused with a message naming the file, or loaded with the
+// bad part dropped; none may crash, hang or allocate without bound.
+
+// The message a refused scene gives ("accepted" if it loads).
+std::string refusal(const std::string& path, const fr::SceneLimits& limits = {}) {
+  try {
+    fr::load_scene(path, limits);
+  } catch (const fovea::core::InputError& e) {
+    return e.what();
+  }
+  return "accepted";
+}
+
+// A binary PPM (stb_image decodes PNM): the smallest image to put in a data URI.
+std::string ppm_data_uri(int w, int h) {
+  const std::string header = "P6\n" + std::to_string(w) + " " + std::to_string(h) + "\n255\n";
+  std::vector<std::uint8_t> bytes(header.begin(), header.end());
+  bytes.resize(bytes.size() + std::size_t(w) * h * 3, 200);
+  return "data:application/octet-stream;base64," + base64(bytes);
+}
+
+// A one-material scene whose base colour uses texture 0 -> image 0.
+json textured(const json& image) {
+  json j = make_gltf(kTwoTris, kTwoIdx);
+  j["images"] = json::array({image});
+  j["textures"] = json::array({{{"source", 0}}});
+  j["materials"] = json::array({{{"pbrMetallicRoughness", {{"baseColorTexture", {{"index", 0}}}}}}});
+  j["meshes"][0]["primitives"][0]["material"] = 0;
+  return j;
+}
+
+TEST_F(Hostile, ImageBufferViewPastItsBufferIsNotDecoded) {
+  json j = textured({{"bufferView", 2}, {"mimeType", "image/png"}});
+  j["bufferViews"].push_back({{"buffer", 0}, {"byteOffset", 40}, {"byteLength", 1000000}});
+  const fr::Scene s = fr::load_scene(write("a.gltf", j));
+  ASSERT_EQ(s.textures.size(), 1u);
+  EXPECT_EQ(s.textures[0].width, 1);
+  EXPECT_TRUE(has_warning(s, "outside its buffer"));
+  j["bufferViews"][2] = {{"buffer", 0}, {"byteOffset", 1u << 31}, {"byteLength", 16}};
+  EXPECT_TRUE(has_warning(fr::load_scene(write("b.gltf", j)), "outside its buffer"));
+  j["bufferViews"][2]["buffer"] = 9;  // tinygltf itself checks the buffer index
+  EXPECT_THROW(fr::load_scene(write("c.gltf", j)), fovea::core::InputError);
+}
+
+TEST_F(Hostile, DeeplyNestedExtrasAreRefusedBeforeParsing) {
+  std::string text = make_gltf(kTwoTris, kTwoIdx).dump();
+  text.insert(1, "\"extras\":" + std::string(20000, '[') + std::string(20000, ']') + ",");
+  const std::string e = refusal(write("deep.gltf", text));
+  EXPECT_NE(e.find("deep.gltf: JSON nested deeper than"), std::string::npos) << e;
+}
+
+TEST_F(Hostile, NodeGraphWalkIsBoundedEvenWithoutTriangles) {
+  json j = make_gltf(kTwoTris, kTwoIdx);
+  json nodes = json::array();
+  for (int i = 0; i < 40; ++i) nodes.push_back({{"children", {i + 1, i + 1}}});
+  nodes.push_back(json::object());  // the leaf holds nothing: no triangle budget is reached
+  j["nodes"] = nodes;
+  const std::string e = refusal(write("dag.gltf", j));
+  EXPECT_NE(e.find("node instances"), std::string::npos) << e;
+}
+
+TEST_F(Hostile, OnlyUsedTexturesAreDecodedWithinABudget) {
+  json j = textured({{"uri", ppm_data_uri(32, 32)}});
+  fr::SceneLimits lim;
+  lim.max_texture_bytes = 32 * 32 * 4;
+  fr::Scene s = fr::load_scene(write("a.gltf", j), lim);
+  ASSERT_EQ(s.textures.size(), 1u);
+  EXPECT_EQ(s.textures[0].width, 32);
+  EXPECT_EQ(s.textures[0].rgba[0], 200);
+  // Ten more large images and textures nobody uses: not decoded, so within the budget.
+  for (int i = 0; i < 10; ++i) {
+    j["images"].push_back({{"uri", ppm_data_uri(256, 256)}});
+    j["textures"].push_back({{"source", i + 1}});
+  }
+  s = fr::load_scene(write("b.gltf", j), lim);
+  EXPECT_EQ(s.textures.size(), 11u);
+  EXPECT_EQ(s.textures[5].width, 1);
+  // Used, they exceed it: refused naming the file.
+  j["materials"].push_back({{"pbrMetallicRoughness", {{"baseColorTexture", {{"index", 3}}}}}});
+  const std::string e = refusal(write("c.gltf", j), lim);
+  EXPECT_NE(e.find("c.gltf: textures need more than"), std::string::npos) << e;
+}
+
+TEST_F(Hostile, ObjExponentOverflowIsRefusedNamingTheLine) {
+  for (const char* bad : {"1e99999999999", "-2.5E+0000000012345", "1e-2147483649"}) {
+    const std::string f = write("e.obj", std::string("v 0 0 0\nv 1 0 0\nv 0 ") + bad + " 0\nf 1 2 3\n");
+    const std::string e = refusal(f);
+    EXPECT_NE(e.find("e.obj:3: number with an exponent out of range"), std::string::npos) << bad << ": " << e;
+  }
+  // Ordinary exponents and names that merely contain an "e" load.
+  const std::string ok = write("ok.obj", std::string("o e1234567\nv 0 0 0\nv 1e0 0 0\nv 0 1.0e-000003 0\nv 0 100e-2 0\nf 1 2 4\n"));
+  EXPECT_EQ(fr::load_scene(ok).triangle_count(), 1u);
+}
+
+TEST_F(Hostile, EndlessOrHugeMaterialLibrariesAreBounded) {
+  const std::string tri = "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n";
+  // A device is not a material library: skipped with a warning, the geometry loads.
+  const fr::Scene s = fr::load_scene(write("dev.obj", "mtllib /dev/zero\n" + tri));
+  EXPECT_EQ(s.triangle_count(), 1u);
+  EXPECT_TRUE(has_warning(s, "material library \"/dev/zero\" missing"));
+  // A library beyond the byte budget: refused naming it.
+  write("big.mtl", "newmtl a\n" + std::string(3 << 20, '#'));
+  fr::SceneLimits lim;
+  lim.max_file_bytes = 1 << 20;
+  const std::string e = refusal(write("big.obj", "mtllib big.mtl\n" + tri), lim);
+  EXPECT_NE(e.find("big.obj: mtllib"), std::string::npos) << e;
+  EXPECT_NE(e.find("big.mtl: larger than"), std::string::npos) << e;
+  // Within the budget the library is used.
+  write("red.mtl", std::string("newmtl red\nKd 1 0 0\n"));
+  const fr::Scene r = fr::load_scene(write("red.obj", "mtllib red.mtl\nusemtl red\n" + tri));
+  EXPECT_EQ(r.materials.back().base_color.x, 1.0f);
+  EXPECT_EQ(r.materials.back().base_color.y, 0.0f);
+}
+
 // Every glTF and OBJ model of Debian's assimp-testmodels, including its deliberately
 // malformed ones (IndexOutOfRange, MissingBin, RecursiveNodes, BoxWithInfinites, ...).
 TEST(HostileCorpus, AssimpTestModelsLoadOrAreRefused) {

@@ -66,6 +66,11 @@ struct SceneLimits {
   std::size_t max_triangles = 4'000'000;
   double max_coordinate = 1e8;  // |x| beyond this (after transforms) drops the triangle
   int max_texture_size = 16384;
+  // Node instantiations while walking a glTF node graph: a DAG listing children twice
+  // doubles the walk per level, whether or not it reaches any triangles.
+  std::size_t max_node_instances = 1'000'000;
+  std::size_t max_texture_bytes = std::size_t(512) << 20;  // all decoded textures (RGBA8)
+  std::size_t max_file_bytes = std::size_t(1) << 30;       // a scene file plus the files it names
 };
 
 // Makes a scene safe: drops triangles with non-finite or out-of-range positions or zero
