@@ -15,6 +15,7 @@
 #include <nlohmann/json.hpp>
 
 #include "fovea/core/error.hpp"
+#include "fovea/core/input_limits.hpp"
 #include "fovea/core/image.hpp"
 #include "line_reader.hpp"
 #include "text.hpp"
@@ -227,20 +228,11 @@ class FoveaReader final : public ReaderBase {
  public:
   FoveaReader(const std::string& path, const SourceOptions& opt) : ReaderBase(path, opt, Format::Fovea) {
     const std::string side_path = path + ".json";
-    std::ifstream side(side_path, std::ios::binary);
-    if (side) {
+    if (std::filesystem::exists(side_path)) {
       // A sidecar holds a few fields: bound its size and nesting before parsing, so a hostile
       // file can neither exhaust memory nor the stack (parsing and dumping recurse per level).
-      constexpr std::size_t kMaxSidecar = 1 << 20;
-      constexpr int kMaxDepth = 64;
-      std::error_code ec;
-      const auto size = std::filesystem::file_size(side_path, ec);
-      if (ec || size > kMaxSidecar)
-        throw core::InputError(side_path + ": sidecar larger than 1 MiB (or unreadable); not a gaze sidecar");
-      std::string text(static_cast<std::size_t>(size), '\0');
-      side.read(text.data(), static_cast<std::streamsize>(text.size()));
-      if (detail::json_depth(text) > kMaxDepth)
-        throw core::InputError(side_path + ": sidecar JSON nested deeper than " + std::to_string(kMaxDepth) + " levels");
+      const std::string text = core::read_file_bounded(side_path, 1 << 20);
+      core::check_json_nesting(text, side_path, 64);
       try {
         meta_ = nlohmann::json::parse(text).dump();
       } catch (const nlohmann::json::exception& e) {

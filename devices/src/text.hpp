@@ -15,9 +15,6 @@ std::string_view trim(std::string_view s);
 enum class Num { Ok, Empty, Bad, NonFinite };
 Num parse_double(std::string_view s, double& v);
 Num parse_int64(std::string_view s, std::int64_t& v);
-// Deepest nesting of JSON arrays/objects in `text` (brackets inside strings ignored): checked
-// before a parser that recurses per level sees untrusted text.
-int json_depth(std::string_view text);
 
 // Drop reason for a failed parse ("empty_field", "bad_number", "non_finite").
 const char* num_reason(Num n);
