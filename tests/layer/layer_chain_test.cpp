@@ -107,6 +107,7 @@ XrResult XRAPI_CALL fake_gipa(XrInstance, const char* n, PFN_xrVoidFunction* fn)
   FAKE_PLAIN(xrAttachSessionActionSets)
   FAKE_PLAIN(xrSyncActions)
   FAKE_PLAIN(xrLocateSpace)
+  FAKE_PLAIN(xrPollEvent)
   *fn = nullptr;
   return XR_ERROR_FUNCTION_UNSUPPORTED;
 }
