@@ -19,6 +19,24 @@ struct Entry {
 const Entry kIntercepted[] = {FOVEA_LAYER_INTERCEPTED(FOVEA_LAYER_ENTRY)};
 #undef FOVEA_LAYER_ENTRY
 
+// Whether the end of the chain (the loader's terminator, then the runtime) offers an instance
+// extension. Asked there: a layer below need not answer a global command without an instance
+// (the core validation layer reports an internal error when asked).
+bool runtime_has_extension(PFN_xrGetInstanceProcAddr last_gipa, const char* name) {
+  PFN_xrEnumerateInstanceExtensionProperties enumerate = nullptr;
+  if (XR_FAILED(last_gipa(XR_NULL_HANDLE, "xrEnumerateInstanceExtensionProperties",
+                          reinterpret_cast<PFN_xrVoidFunction*>(&enumerate))) ||
+      !enumerate)
+    return false;
+  std::uint32_t n = 0;
+  if (XR_FAILED(enumerate(nullptr, 0, &n, nullptr))) return false;
+  std::vector<XrExtensionProperties> props(n, {XR_TYPE_EXTENSION_PROPERTIES});
+  if (XR_FAILED(enumerate(nullptr, n, &n, props.data()))) return false;
+  return std::any_of(props.begin(), props.begin() + n, [&](const XrExtensionProperties& p) {
+    return !std::strcmp(p.extensionName, name);
+  });
+}
+
 XrResult XRAPI_CALL get_instance_proc_addr(XrInstance instance, const char* name, PFN_xrVoidFunction* function) {
   if (!name || !function) return XR_ERROR_VALIDATION_FAILURE;
   if (!std::strcmp(name, "xrGetInstanceProcAddr")) {
@@ -26,14 +44,23 @@ XrResult XRAPI_CALL get_instance_proc_addr(XrInstance instance, const char* name
     return XR_SUCCESS;
   }
   PFN_xrGetInstanceProcAddr next = nullptr;
+  bool mask_hidden = false;
   {
     std::lock_guard lock(layer().mutex);
     auto it = layer().instances.find(instance);
-    if (it != layer().instances.end()) next = it->second.next.xrGetInstanceProcAddr;
+    if (it != layer().instances.end()) {
+      next = it->second.next.xrGetInstanceProcAddr;
+      mask_hidden = it->second.visibility_mask_hidden;
+    }
   }
   if (!next) {
     *function = nullptr;
     return XR_ERROR_HANDLE_INVALID;  // not an instance created through this layer
+  }
+  // What the application did not enable stays unsupported for it, as without the layer.
+  if (mask_hidden && !std::strcmp(name, "xrGetVisibilityMaskKHR")) {
+    *function = nullptr;
+    return XR_ERROR_FUNCTION_UNSUPPORTED;
   }
   // Resolve down the chain first: an intercepted command the runtime does not have stays
   // unsupported.
@@ -71,20 +98,25 @@ XrResult XRAPI_CALL create_api_layer_instance(const XrInstanceCreateInfo* info, 
   // With a scene configured, the layer's own eye-gaze input needs the extension enabled below.
   const std::string application(info->applicationInfo.applicationName,
                                 strnlen(info->applicationInfo.applicationName, XR_MAX_APPLICATION_NAME_SIZE));
-  bool want_gaze = false;
+  // With a scene configured, the runtime's hidden area lets the layer skip tracing it.
+  bool want_gaze = false, want_mask = false;
   try {
-    // Asked of the end of the chain (the loader's terminator, then the runtime): a layer below
-    // need not answer a global command without an instance (the core validation layer reports
-    // an internal error when asked).
-    const XrApiLayerNextInfo* last = next;
-    while (last->next) last = last->next;
-    want_gaze = !load_config(application).scene.empty() && runtime_has_eye_gaze(last->nextGetInstanceProcAddr);
+    if (!load_config(application).scene.empty()) {
+      const XrApiLayerNextInfo* last = next;
+      while (last->next) last = last->next;
+      want_gaze = runtime_has_extension(last->nextGetInstanceProcAddr, kEyeGazeExtension);
+      want_mask = runtime_has_extension(last->nextGetInstanceProcAddr, kVisibilityMaskExtension);
+    }
   } catch (const std::exception& e) {
     FOVEA_LAYER_WARN("layer configuration: %s", e.what());  // reported again when the session starts
   }
-  if (want_gaze && std::none_of(extensions.begin(), extensions.end(),
-                                [](const char* e) { return !std::strcmp(e, kEyeGazeExtension); }))
-    extensions.push_back(kEyeGazeExtension);
+  const auto enabled = [&](const char* name) {
+    return std::any_of(extensions.begin(), extensions.end(), [&](const char* e) { return !std::strcmp(e, name); });
+  };
+  if (want_gaze && !enabled(kEyeGazeExtension)) extensions.push_back(kEyeGazeExtension);
+  const bool app_mask = enabled(kVisibilityMaskExtension);
+  const bool mask_hidden = want_mask && !app_mask;
+  if (mask_hidden) extensions.push_back(kVisibilityMaskExtension);
   XrInstanceCreateInfo down = *info;
   down.enabledExtensionCount = uint32_t(extensions.size());
   down.enabledExtensionNames = extensions.data();
@@ -111,6 +143,15 @@ XrResult XRAPI_CALL create_api_layer_instance(const XrInstanceCreateInfo* info, 
     *instance = XR_NULL_HANDLE;
     return XR_ERROR_INITIALIZATION_FAILED;
   }
+  if ((want_mask || app_mask) &&
+      (XR_FAILED(next->nextGetInstanceProcAddr(*instance, "xrGetVisibilityMaskKHR",
+                                               reinterpret_cast<PFN_xrVoidFunction*>(&state.get_visibility_mask))) ||
+       !state.get_visibility_mask)) {
+    FOVEA_LAYER_WARN("%s enabled but xrGetVisibilityMaskKHR missing below: every view pixel is traced",
+                     kVisibilityMaskExtension);
+    state.get_visibility_mask = nullptr;
+  }
+  state.visibility_mask_hidden = mask_hidden;
   if (want_gaze) try {
       state.gaze = create_eye_gaze_actions(state.next, *instance);
     } catch (const std::exception& e) {

@@ -18,21 +18,6 @@ void check(XrResult r, const char* what) {
 
 }  // namespace
 
-bool runtime_has_eye_gaze(PFN_xrGetInstanceProcAddr next_gipa) {
-  PFN_xrEnumerateInstanceExtensionProperties enumerate = nullptr;
-  if (XR_FAILED(next_gipa(XR_NULL_HANDLE, "xrEnumerateInstanceExtensionProperties",
-                          reinterpret_cast<PFN_xrVoidFunction*>(&enumerate))) ||
-      !enumerate)
-    return false;
-  std::uint32_t n = 0;
-  if (XR_FAILED(enumerate(nullptr, 0, &n, nullptr))) return false;
-  std::vector<XrExtensionProperties> props(n, {XR_TYPE_EXTENSION_PROPERTIES});
-  if (XR_FAILED(enumerate(nullptr, n, &n, props.data()))) return false;
-  for (const auto& p : props)
-    if (!std::strcmp(p.extensionName, kEyeGazeExtension)) return true;
-  return false;
-}
-
 EyeGazeActions create_eye_gaze_actions(const Dispatch& next, XrInstance instance) {
   EyeGazeActions a;
   XrActionSetCreateInfo si{XR_TYPE_ACTION_SET_CREATE_INFO};

@@ -34,8 +34,6 @@ struct EyeGazeSession {
   bool attached() const { return gaze != XR_NULL_HANDLE; }
 };
 
-// Whether the runtime (below the layer) offers the extension; false when it cannot be asked.
-bool runtime_has_eye_gaze(PFN_xrGetInstanceProcAddr next_gipa);
 // Creates the action set and action and suggests the binding; throws std::runtime_error
 // after destroying whatever it had created.
 EyeGazeActions create_eye_gaze_actions(const Dispatch& next, XrInstance instance);

@@ -132,6 +132,8 @@ XrResult intercept::xrEndFrame(XrSession session, const XrFrameEndInfo* info) {
       in.app_views = replaceable_views(session, *p);
       break;
     }
+    in.get_visibility_mask = s.get_visibility_mask;
+    in.visibility_mask_generation = s.visibility_mask_generation;
     if (s.gaze.attached()) {
       in.gaze_from_action = true;
       in.action_gaze = locate_eye_gaze(*next_for_session(session), s.gaze, info->displayTime);

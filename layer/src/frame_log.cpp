@@ -39,7 +39,7 @@ void FrameLog::write(const FrameTimes& t) {
                "\"end_frame_ms\":%.3f,\"layers\":%u,\"projection_views\":%u,\"replaced\":%s,\"render_ms\":%.3f,"
                "\"trace_ms\":%.3f,\"reconstruct_ms\":%.3f,\"resolve_ms\":%.3f,\"transfer_ms\":%.3f,"
                "\"gaze_cpu_ms\":%.3f,\"grid_cpu_ms\":%.3f,\"submit_cpu_ms\":%.3f,\"readback_cpu_ms\":%.3f,"
-               "\"gaze_sample_ns\":%lld,\"gaze_receive_ns\":%lld,\"gaze_read_ns\":%lld}\n",
+               "\"gaze_sample_ns\":%lld,\"gaze_receive_ns\":%lld,\"gaze_read_ns\":%lld,\"samples_hidden\":%lld}\n",
                static_cast<long long>(t.frame), static_cast<long long>(t.display_time_ns),
                static_cast<long long>(t.wait_call_ns), static_cast<long long>(t.wait_return_ns),
                static_cast<long long>(t.begin_ns), static_cast<long long>(t.end_call_ns),
@@ -48,7 +48,7 @@ void FrameLog::write(const FrameTimes& t) {
                t.replaced ? "true" : "false", t.render.total, t.render.trace, t.render.reconstruct, t.render.resolve,
                t.render.transfer, t.render.gaze_cpu, t.render.grid_cpu, t.render.submit_cpu, t.render.readback_cpu,
                static_cast<long long>(t.render.gaze_sample_ns), static_cast<long long>(t.render.gaze_receive_ns),
-               static_cast<long long>(t.render.gaze_read_ns));
+               static_cast<long long>(t.render.gaze_read_ns), static_cast<long long>(t.render.samples_hidden));
   std::fflush(file_);
 }
 

@@ -12,12 +12,15 @@
 #include <cmath>
 #include <cstring>
 #include <stdexcept>
+#include <string>
+#include <vector>
 
 #include <glm/gtc/quaternion.hpp>
 
 #include "app_device.hpp"
 #include "composite.hpp"
 #include "fovea/core/display.hpp"
+#include "fovea/core/eye_optics.hpp"
 #include "fovea/core/stereo_views.hpp"
 #include "fovea/gpu/context.hpp"
 #include "fovea/pipeline/frame_pipeline.hpp"
@@ -45,6 +48,36 @@ core::Pose to_pose(const XrPosef& p) {
 
 void xr_check(XrResult r, const char* what) {
   if (XR_FAILED(r)) throw std::runtime_error(std::string(what) + " failed below the layer: XrResult " + std::to_string(int(r)));
+}
+
+// The runtime's hidden triangle mesh for stereo view `index` (XR_KHR_visibility_mask, two-call
+// idiom) rasterised into `view`, the submitted view's FOV and raster. Throws naming the call
+// or the mesh on failure.
+core::ViewMask fetch_visibility_mask(PFN_xrGetVisibilityMaskKHR get, XrSession session, std::uint32_t index,
+                                     const core::View& view) {
+  constexpr XrViewConfigurationType kStereo = XR_VIEW_CONFIGURATION_TYPE_PRIMARY_STEREO;
+  constexpr XrVisibilityMaskTypeKHR kHidden = XR_VISIBILITY_MASK_TYPE_HIDDEN_TRIANGLE_MESH_KHR;
+  // A mesh this large is not a hidden area (the project's runtime serves a few hundred vertices).
+  constexpr std::uint32_t kMaxCount = 1u << 20;
+  XrVisibilityMaskKHR m{XR_TYPE_VISIBILITY_MASK_KHR};
+  xr_check(get(session, kStereo, index, kHidden, &m), "xrGetVisibilityMaskKHR");
+  if (m.vertexCountOutput > kMaxCount || m.indexCountOutput > kMaxCount)
+    throw std::runtime_error("xrGetVisibilityMaskKHR: a mesh of " + std::to_string(m.vertexCountOutput) +
+                             " vertices and " + std::to_string(m.indexCountOutput) + " indices is beyond the layer's limit");
+  std::vector<XrVector2f> xr_vertices(m.vertexCountOutput);
+  std::vector<std::uint32_t> indices(m.indexCountOutput);
+  m.vertexCapacityInput = m.vertexCountOutput;
+  m.vertices = xr_vertices.data();
+  m.indexCapacityInput = m.indexCountOutput;
+  m.indices = indices.data();
+  xr_check(get(session, kStereo, index, kHidden, &m), "xrGetVisibilityMaskKHR");
+  xr_vertices.resize(m.vertexCountOutput);
+  indices.resize(m.indexCountOutput);
+  std::vector<glm::vec2> vertices;
+  vertices.reserve(xr_vertices.size());
+  for (const XrVector2f& v : xr_vertices) vertices.emplace_back(v.x, v.y);
+  const std::string what = "the runtime's hidden triangle mesh of view " + std::to_string(index);
+  return core::ViewMask::from_hidden_triangles(view, vertices, indices, what.c_str());
 }
 
 // The views the application submitted: FOV, raster from the imageRect, pose (its reference
@@ -95,6 +128,7 @@ class PathTraceRenderer final : public FrameRenderer {
     for (const AppView& v : in.app_views)
       if (v.rect.extent.width != r0.extent.width || v.rect.extent.height != r0.extent.height || v.format != format_)
         throw std::runtime_error("the application changed its projection views' size or format during the session");
+    update_visibility(in);
 
     const auto t_gaze = std::chrono::steady_clock::now();
     // Eye poses: the application's view poses (its reference space) placed at the scene's camera.
@@ -123,6 +157,8 @@ class PathTraceRenderer final : public FrameRenderer {
     times_.resolve = gt.resolve.gpu_ms;
     times_.grid_cpu = gt.grid.cpu_ms;
     times_.submit_cpu = gt.submit_cpu_ms;
+    // Counted from the grids (a read-back), so only while a mask is set.
+    if (mask_set_) times_.samples_hidden = pipeline_->hidden_cells(core::Eye::Left) + pipeline_->hidden_cells(core::Eye::Right);
 
     const auto t1 = std::chrono::steady_clock::now();
     std::vector<AppDevice::Read> reads;
@@ -229,6 +265,26 @@ class PathTraceRenderer final : public FrameRenderer {
     return app_.read_depth({*l.depth, *r.depth});
   }
 
+  // The runtime's hidden area for the submitted views: fetched at the first frame and after
+  // each change event. A failed fetch is reported and leaves the previous mask (none at
+  // first): culling saves work, the image is right without it.
+  void update_visibility(const FrameInput& in) {
+    if (!in.get_visibility_mask || mask_generation_ == in.visibility_mask_generation) return;
+    mask_generation_ = in.visibility_mask_generation;
+    for (int e = 0; e < 2; ++e) {
+      const core::Eye eye = core::Eye(e);
+      try {
+        const core::ViewMask mask = fetch_visibility_mask(in.get_visibility_mask, session_, std::uint32_t(e), views_in_[eye]);
+        pipeline_->set_visibility(eye, mask);
+        mask_set_ = true;
+        FOVEA_LAYER_INFO("visibility mask of the %s view: %.1f%% of its pixels hidden, not traced", core::eye_name(eye),
+                         100.0 * mask.hidden_fraction());
+      } catch (const std::exception& ex) {
+        FOVEA_LAYER_WARN("visibility mask of the %s view not used: %s", core::eye_name(eye), ex.what());
+      }
+    }
+  }
+
   // At the first stereo frame: the pipeline for the application's views, the layer's
   // swapchains in the application's format, the gaze source.
   void start(const FrameInput& in) {
@@ -286,6 +342,8 @@ class PathTraceRenderer final : public FrameRenderer {
   VkFormat format_ = VK_FORMAT_UNDEFINED;
   std::unique_ptr<LayerGaze> gaze_;
   bool gaze_from_action_ = false;
+  std::optional<std::uint64_t> mask_generation_;  // of the mask fetched last (none yet)
+  bool mask_set_ = false;                         // the pipeline culls with a runtime mask
   bool depth_noted_ = false;  // the depth decision was logged
   bool chain_noted_ = false;  // a view's next chain could not be kept whole (logged once)
   ChainCopies chains_;        // the views' next chains, this frame

@@ -65,6 +65,10 @@ struct FrameInput {
   // (FOVEA_GAZE) is used.
   bool gaze_from_action = false;
   ActionGaze action_gaze;
+  // The runtime's hidden area (XR_KHR_visibility_mask), when enabled below: fetched for the
+  // stereo views when the generation changes (first frame, each change event).
+  PFN_xrGetVisibilityMaskKHR get_visibility_mask = nullptr;
+  std::uint64_t visibility_mask_generation = 0;
 };
 
 // Where the layer's time went in the last render() (milliseconds).
@@ -80,6 +84,7 @@ struct RenderTimes {
   // The gaze sample the frame was foveated for (CLOCK_MONOTONIC ns; 0: none measured yet):
   // when it was measured, when the host received it, when the renderer read it.
   std::int64_t gaze_sample_ns = 0, gaze_receive_ns = 0, gaze_read_ns = 0;
+  std::int64_t samples_hidden = 0;  // grid cells under the runtime's hidden area, both eyes: not traced
 };
 
 class FrameRenderer {

@@ -30,6 +30,9 @@ constexpr const char* kLayerName = "XR_APILAYER_FOVEA_path_tracing";
 // present; rendering is switched on by the configuration (config.hpp). Never passed down.
 constexpr const char* kLayerExtension = "XR_FOVEA_path_tracing";
 constexpr std::uint32_t kLayerExtensionVersion = 1;
+// Enabled below the layer, when the runtime offers it and a scene is configured, for the
+// runtime's hidden area (the view pixels the layer does not trace).
+constexpr const char* kVisibilityMaskExtension = "XR_KHR_visibility_mask";
 
 // The next layer's (or the runtime's) commands the layer calls.
 #define FOVEA_LAYER_NEXT(X) \
@@ -56,7 +59,8 @@ constexpr std::uint32_t kLayerExtensionVersion = 1;
   X(xrCreateActionSpace)     \
   X(xrCreateReferenceSpace)  \
   X(xrLocateSpace)           \
-  X(xrDestroySpace)
+  X(xrDestroySpace)          \
+  X(xrPollEvent)
 
 struct Dispatch {
 #define FOVEA_LAYER_MEMBER(name) PFN_##name name = nullptr;
@@ -80,6 +84,10 @@ struct SessionState {
   FrameLog log;
   FrameTimes current;                     // the frame in flight
   EyeGazeSession gaze;                    // after an attach that included the layer's action set
+  // The runtime's xrGetVisibilityMaskKHR (null: not enabled below); the generation counts the
+  // XR_TYPE_EVENT_DATA_VISIBILITY_MASK_CHANGED_KHR events seen, so the renderer re-fetches.
+  PFN_xrGetVisibilityMaskKHR get_visibility_mask = nullptr;
+  std::uint64_t visibility_mask_generation = 0;
 };
 
 struct InstanceState {
@@ -87,6 +95,10 @@ struct InstanceState {
   bool extension_enabled = false;  // the application enabled kLayerExtension
   std::string application;         // XrApplicationInfo::applicationName (the config section)
   EyeGazeActions gaze;             // the layer's eye-gaze action (a scene configured, the runtime has it)
+  PFN_xrGetVisibilityMaskKHR get_visibility_mask = nullptr;  // the extension is enabled below
+  // The layer enabled kVisibilityMaskExtension for itself: the application must not see it
+  // (its command stays unsupported, its events are not delivered).
+  bool visibility_mask_hidden = false;
 };
 
 struct Layer {
@@ -123,7 +135,8 @@ namespace intercept {
   X(xrEndFrame)                    \
   X(xrSuggestInteractionProfileBindings) \
   X(xrAttachSessionActionSets)     \
-  X(xrSyncActions)
+  X(xrSyncActions)                 \
+  X(xrPollEvent)
 #define FOVEA_LAYER_DECLARE(name) std::remove_pointer_t<PFN_##name> name;
 FOVEA_LAYER_INTERCEPTED(FOVEA_LAYER_DECLARE)
 #undef FOVEA_LAYER_DECLARE

@@ -19,6 +19,7 @@ XrResult intercept::xrCreateSession(XrInstance instance, const XrSessionCreateIn
   PFN_xrCreateSession next = nullptr;
   const Dispatch* dispatch = nullptr;  // stable: instances live in a std::map until xrDestroyInstance
   std::string application;
+  PFN_xrGetVisibilityMaskKHR get_visibility_mask = nullptr;
   {
     std::lock_guard lock(layer().mutex);
     auto it = layer().instances.find(instance);
@@ -26,11 +27,13 @@ XrResult intercept::xrCreateSession(XrInstance instance, const XrSessionCreateIn
     next = it->second.next.xrCreateSession;
     dispatch = &it->second.next;
     application = it->second.application;
+    get_visibility_mask = it->second.get_visibility_mask;
   }
   const XrResult r = next(instance, info, session);
   if (XR_FAILED(r)) return r;
   SessionState st;
   st.instance = instance;
+  st.get_visibility_mask = get_visibility_mask;
   try {
     for (auto* p = static_cast<const XrBaseInStructure*>(info->next); p; p = p->next)
       if (p->type == XR_TYPE_GRAPHICS_BINDING_VULKAN_KHR) {
@@ -77,6 +80,33 @@ XrResult intercept::xrDestroySession(XrSession session) {
     l.sessions.erase(session);
   }
   return r;
+}
+
+// A visibility mask change makes the session's renderer fetch the mask again. When the layer
+// enabled the extension for itself the event is the layer's alone: it is consumed and the
+// next event, if any, is returned instead.
+XrResult intercept::xrPollEvent(XrInstance instance, XrEventDataBuffer* event) {
+  PFN_xrPollEvent next = nullptr;
+  bool hidden = false;
+  {
+    std::lock_guard lock(layer().mutex);
+    auto it = layer().instances.find(instance);
+    if (it == layer().instances.end()) return XR_ERROR_HANDLE_INVALID;
+    next = it->second.next.xrPollEvent;
+    hidden = it->second.visibility_mask_hidden;
+  }
+  for (;;) {
+    const XrResult r = next(instance, event);
+    if (r != XR_SUCCESS || event->type != XR_TYPE_EVENT_DATA_VISIBILITY_MASK_CHANGED_KHR) return r;
+    const XrSession session = reinterpret_cast<const XrEventDataVisibilityMaskChangedKHR*>(event)->session;
+    {
+      std::lock_guard lock(layer().mutex);
+      auto it = layer().sessions.find(session);
+      if (it != layer().sessions.end()) ++it->second.visibility_mask_generation;
+    }
+    if (!hidden) return r;
+    *event = {XR_TYPE_EVENT_DATA_BUFFER};  // the application's buffer, as the runtime expects it
+  }
 }
 
 }  // namespace fovea::layer

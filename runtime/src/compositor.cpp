@@ -7,6 +7,7 @@
 #include <stdexcept>
 
 #include "fovea/compositor/distortion.hpp"
+#include "fovea/core/clock.hpp"
 #include "fovea/core/error.hpp"
 #include "fovea/shaders/embedded.hpp"
 #include "log.hpp"
@@ -229,14 +230,24 @@ core::Image Compositor::read_back(const LayerView& v) {
   return img;
 }
 
-void Compositor::compose(std::int64_t index, const std::vector<ProjectionLayer>& layers) {
+ComposeTimes Compositor::compose(std::int64_t index, const std::vector<ProjectionLayer>& layers) {
+  ComposeTimes times;
+  core::TimeNs mark = core::now_ns();
+  // Adds the time since the previous mark to `ms`.
+  const auto lap = [&mark](double& ms) {
+    const core::TimeNs t = core::now_ns();
+    ms += core::ns_to_ms(t - mark);
+    mark = t;
+  };
   for (int e = 0; e < 2; ++e) {
     const core::Eye eye = e == 0 ? core::Eye::Left : core::Eye::Right;
     const core::View view = display_.view(eye);
     core::Image rendered(display_.width, display_.height, {0, 0, 0, 1});
     for (const ProjectionLayer& layer : layers) {
       const LayerView& lv = layer.views[size_t(e)];
+      lap(times.resample_ms);
       const core::Image src = read_back(lv);
+      lap(times.readback_ms);
       const bool copy = same_fov(lv.fov, display_.fov(eye)) && src.width == rendered.width && src.height == rendered.height;
       const core::View layer_view(lv.fov, src.width, src.height);
       for (int y = 0; y < rendered.height; ++y)
@@ -253,6 +264,7 @@ void Compositor::compose(std::int64_t index, const std::vector<ProjectionLayer>&
           dst = layer.alpha_blend ? glm::vec4(glm::vec3(c) * c.w + glm::vec3(dst) * (1 - c.w), 1) : glm::vec4(glm::vec3(c), 1);
         }
     }
+    lap(times.resample_ms);
     const core::HiddenAreaMask& hidden = *hidden_[size_t(e)];
     core::Image panel;
     if (lens_ == LensMode::Gpu) {
@@ -271,10 +283,13 @@ void Compositor::compose(std::int64_t index, const std::vector<ProjectionLayer>&
         if (!visible[i]) rendered.pixels[i] = {0, 0, 0, 1};
       panel = std::move(rendered);
     }
+    lap(times.lens_ms);
     char name[64];
     std::snprintf(name, sizeof name, "/panel_%06lld_%s.png", static_cast<long long>(index), core::eye_name(eye));
     core::write_png(out_dir_ + name, panel);
+    lap(times.write_ms);
   }
+  return times;
 }
 
 }  // namespace fovea::runtime

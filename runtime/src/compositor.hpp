@@ -35,6 +35,12 @@ struct LayerView {
   core::Fov fov;
 };
 
+// Host time of compose()'s stages over both eyes (ms, monotonic clock): swapchain read-back
+// (GPU copy and wait included), resampling into the rendered views, the lens, and PNG writing.
+struct ComposeTimes {
+  double readback_ms = 0, resample_ms = 0, lens_ms = 0, write_ms = 0;
+};
+
 struct ProjectionLayer {
   std::array<LayerView, 2> views;
   bool alpha_blend = false;  // XR_COMPOSITION_LAYER_BLEND_TEXTURE_SOURCE_ALPHA_BIT
@@ -55,7 +61,7 @@ class Compositor {
   // Composes and writes <out>/panel_<index>_{left,right}.png. The images must be in
   // COLOR_ATTACHMENT_OPTIMAL layout, owned by the session queue (as after release) and
   // sampleable (VK_IMAGE_USAGE_SAMPLED_BIT); they are left that way. Throws std::runtime_error on Vulkan or I/O failure.
-  void compose(std::int64_t index, const std::vector<ProjectionLayer>& layers);
+  ComposeTimes compose(std::int64_t index, const std::vector<ProjectionLayer>& layers);
 
   static bool readable_format(VkFormat f);
 

@@ -193,7 +193,10 @@ XrResult api::xrEndFrame(XrSession session, const XrFrameEndInfo* info) {
     FrameRecord r = s->current;
     r.end_call_ns = t_call;
     r.layers = info->layerCount;
+    const core::TimeNs t_gaze = core::now_ns();
+    r.cpu_validate_ms = core::ns_to_ms(t_gaze - t_call);
     const GazeSample g = s->instance->gaze->sample_at(r.predicted_display_ns, display_epoch(*s));
+    r.cpu_gaze_ms = core::ns_to_ms(core::now_ns() - t_gaze);
     r.gaze_sample_ns = g.sample_ns;
     r.gaze_receive_ns = g.receive_ns;
     r.gaze_read_ns = g.read_ns;
@@ -215,7 +218,11 @@ XrResult api::xrEndFrame(XrSession session, const XrFrameEndInfo* info) {
     if (s->compositor->wants(r.frame)) {
       const core::TimeNs t0 = core::now_ns();
       try {
-        s->compositor->compose(r.frame, projections);
+        const ComposeTimes t = s->compositor->compose(r.frame, projections);
+        r.cpu_readback_ms = t.readback_ms;
+        r.cpu_resample_ms = t.resample_ms;
+        r.cpu_lens_ms = t.lens_ms;
+        r.cpu_write_ms = t.write_ms;
         r.composited = true;
       } catch (const std::exception& e) {
         // Reported, and the application's frame still succeeds: it did nothing wrong.

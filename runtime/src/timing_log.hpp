@@ -25,6 +25,10 @@ struct FrameRecord {
   // measured, received by the host, and read for this frame (0: none measured yet).
   core::TimeNs gaze_sample_ns = 0, gaze_receive_ns = 0, gaze_read_ns = 0;
   bool gaze_valid = false;
+  // Host time of xrEndFrame's stages (ms, monotonic clock): layer validation, the gaze read,
+  // and the compositor's stages (0 on frames it does not produce).
+  double cpu_validate_ms = 0, cpu_gaze_ms = 0;
+  double cpu_readback_ms = 0, cpu_resample_ms = 0, cpu_lens_ms = 0, cpu_write_ms = 0;
 };
 
 class TimingLog {

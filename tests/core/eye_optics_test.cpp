@@ -6,6 +6,7 @@
 #include <gtest/gtest.h>
 
 #include "fovea/core/display.hpp"
+#include "fovea/core/error.hpp"
 #include "fovea/core/stereo_views.hpp"
 
 namespace core = fovea::core;
@@ -64,4 +65,43 @@ TEST(ViewMask, MatchesVisibilityAtPixelCentres) {
     for (int y = 0; y < m.height(); ++y)
       EXPECT_EQ(m.words()[std::size_t(y) * m.words_per_row() + m.words_per_row() - 1] >> (m.width() % 32), 0u);
   }
+}
+
+// A runtime's hidden triangle mesh, rasterised at view pixel centres: one counter-clockwise
+// triangle over the top-left corner and one clockwise over the bottom-right of a 90°×90°
+// view (tangents ±1) on an 8×4 raster, against the pattern worked out by hand from the
+// pixel centres' tangents (x: −1 + (i + 0.5)/4, y: 1 − (j + 0.5)/2).
+TEST(ViewMask, FromHiddenTriangles) {
+  const core::View view(core::Fov::from_degrees(-45, 45, 45, -45), 8, 4);
+  const std::vector<glm::vec2> vertices{{-1, 1}, {-1, 0}, {0, 1}, {1, -1}, {1, 0}, {0, -1}};
+  const std::vector<std::uint32_t> indices{0, 1, 2, 3, 4, 5};
+  const core::ViewMask m = core::ViewMask::from_hidden_triangles(view, vertices, indices, "test mesh");
+  const char* expected[4] = {"###.....", "#.......", ".......#", ".....###"};
+  ASSERT_EQ(m.width(), 8);
+  ASSERT_EQ(m.height(), 4);
+  for (int y = 0; y < 4; ++y)
+    for (int x = 0; x < 8; ++x) EXPECT_EQ(m.hidden(x, y), expected[y][x] == '#') << x << "," << y;
+  EXPECT_DOUBLE_EQ(m.hidden_fraction(), 8.0 / 32.0);
+  // An empty mesh hides nothing; a broken one is refused with its name.
+  EXPECT_EQ(core::ViewMask::from_hidden_triangles(view, vertices, {}, "empty").hidden_fraction(), 0.0);
+  const std::vector<std::uint32_t> beyond{0, 1, 6};
+  EXPECT_THROW(core::ViewMask::from_hidden_triangles(view, vertices, beyond, "beyond"), core::InputError);
+  const std::vector<std::uint32_t> partial{0, 1};
+  EXPECT_THROW(core::ViewMask::from_hidden_triangles(view, vertices, partial, "partial"), core::InputError);
+}
+
+// The hidden triangle mesh the runtime serves (visibility_mesh of the lens's hidden area)
+// rasterises back to the lens's own view mask, up to the polygon's edge pixels.
+TEST(ViewMask, HiddenMeshRoundTrip) {
+  const core::EyeOptics optics(core::load_display("tiny"), core::Eye::Left);
+  const core::ViewMask direct = optics.view_mask();
+  const core::VisibilityMesh mesh = core::visibility_mesh(optics.hidden(), core::VisibilityMeshType::HiddenTriangles);
+  const core::ViewMask from_mesh =
+      core::ViewMask::from_hidden_triangles(optics.view(), mesh.vertices, mesh.indices, "tiny mesh");
+  long differ = 0;
+  for (int y = 0; y < direct.height(); ++y)
+    for (int x = 0; x < direct.width(); ++x) differ += direct.hidden(x, y) != from_mesh.hidden(x, y);
+  ASSERT_GT(direct.hidden_fraction(), 0.0);
+  EXPECT_NEAR(from_mesh.hidden_fraction(), direct.hidden_fraction(), 0.02);
+  EXPECT_LT(double(differ) / (direct.width() * direct.height()), 0.02);
 }

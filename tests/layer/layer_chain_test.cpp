@@ -34,6 +34,9 @@ struct Fake {
   std::map<std::string, int> fail_at;  // command -> the call (1-based) that fails
   std::uint64_t next_handle = 0x1000;
   bool eye_gaze = true;
+  bool visibility_mask = false;         // the fake offers XR_KHR_visibility_mask
+  std::vector<std::string> enabled;     // the extensions enabled on the call down
+  int mask_events = 0;                  // visibility-mask change events queued for xrPollEvent
 } g;
 
 // Records a call; true when it is the one to fail.
@@ -58,14 +61,30 @@ XrResult create(const char* name, std::uint64_t parent, H* out) {
 }
 
 XrResult XRAPI_CALL fake_enumerate_extensions(const char*, uint32_t capacity, uint32_t* count, XrExtensionProperties* p) {
-  *count = g.eye_gaze ? 1 : 0;
-  if (capacity && g.eye_gaze) std::strcpy(p[0].extensionName, "XR_EXT_eye_gaze_interaction");
+  std::vector<const char*> names;
+  if (g.eye_gaze) names.push_back("XR_EXT_eye_gaze_interaction");
+  if (g.visibility_mask) names.push_back("XR_KHR_visibility_mask");
+  *count = uint32_t(names.size());
+  if (capacity < names.size()) return capacity ? XR_ERROR_SIZE_INSUFFICIENT : XR_SUCCESS;
+  for (std::size_t i = 0; i < names.size(); ++i) std::strcpy(p[i].extensionName, names[i]);
+  return XR_SUCCESS;
+}
+
+// Delivers the queued visibility-mask change events, then none.
+XrResult XRAPI_CALL fake_poll_event(XrInstance instance, XrEventDataBuffer* event) {
+  record("xrPollEvent", id(instance));
+  if (g.mask_events == 0) return XR_EVENT_UNAVAILABLE;
+  --g.mask_events;
+  auto* e = reinterpret_cast<XrEventDataVisibilityMaskChangedKHR*>(event);
+  *e = {XR_TYPE_EVENT_DATA_VISIBILITY_MASK_CHANGED_KHR};
+  e->viewConfigurationType = XR_VIEW_CONFIGURATION_TYPE_PRIMARY_STEREO;
   return XR_SUCCESS;
 }
 
 XrResult XRAPI_CALL fake_gipa(XrInstance instance, const char* name, PFN_xrVoidFunction* fn);
 
-XrResult XRAPI_CALL fake_create_instance(const XrInstanceCreateInfo*, const XrApiLayerCreateInfo*, XrInstance* out) {
+XrResult XRAPI_CALL fake_create_instance(const XrInstanceCreateInfo* info, const XrApiLayerCreateInfo*, XrInstance* out) {
+  g.enabled.assign(info->enabledExtensionNames, info->enabledExtensionNames + info->enabledExtensionCount);
   return create("xrCreateInstance", 0, out);
 }
 
@@ -107,6 +126,8 @@ XrResult XRAPI_CALL fake_gipa(XrInstance, const char* n, PFN_xrVoidFunction* fn)
   FAKE_PLAIN(xrAttachSessionActionSets)
   FAKE_PLAIN(xrSyncActions)
   FAKE_PLAIN(xrLocateSpace)
+  FAKE(xrPollEvent, &fake_poll_event)
+  if (g.visibility_mask) FAKE_PLAIN(xrGetVisibilityMaskKHR)
   *fn = nullptr;
   return XR_ERROR_FUNCTION_UNSUPPORTED;
 }
@@ -130,7 +151,7 @@ struct LayerLib {
     if (lib) dlclose(lib);
   }
 
-  XrInstance create_instance() {
+  XrInstance create_instance(std::vector<const char*> extensions = {}) {
     XrApiLayerNextInfo next{XR_LOADER_INTERFACE_STRUCT_API_LAYER_NEXT_INFO, XR_API_LAYER_NEXT_INFO_STRUCT_VERSION,
                             sizeof(XrApiLayerNextInfo), {}, &fake_gipa, &fake_create_instance, nullptr};
     std::strcpy(next.layerName, kLayerName);
@@ -140,6 +161,8 @@ struct LayerLib {
     XrInstanceCreateInfo ci{XR_TYPE_INSTANCE_CREATE_INFO};
     std::strcpy(ci.applicationInfo.applicationName, "fovea_layer_chain_test");
     ci.applicationInfo.apiVersion = XR_MAKE_VERSION(1, 0, 0);
+    ci.enabledExtensionCount = uint32_t(extensions.size());
+    ci.enabledExtensionNames = extensions.data();
     XrInstance instance = XR_NULL_HANDLE;
     EXPECT_EQ(request.createApiLayerInstance(&ci, &layer_info, &instance), XR_SUCCESS);
     return instance;
@@ -244,6 +267,38 @@ TEST_F(LayerChain, PassThroughDestroyInstanceOnlyCallsDown) {
   g.calls.clear();
   ASSERT_EQ(layer_.get<PFN_xrDestroyInstance>(instance, "xrDestroyInstance")(instance), XR_SUCCESS);
   EXPECT_EQ(g.calls, std::vector<std::string>{"xrDestroyInstance " + std::to_string(id(instance))});
+}
+
+// With a scene the layer enables XR_KHR_visibility_mask below itself; the application, which
+// did not, neither gets its command nor its change events (consumed; the next poll's answer
+// is returned). Enabled by the application, both pass through.
+TEST_F(LayerChain, VisibilityMaskEnabledBelowStaysHidden) {
+  g.visibility_mask = true;
+  for (const bool app_enables : {false, true}) {
+    SCOPED_TRACE(app_enables ? "the application enables it" : "the layer alone enables it");
+    const XrInstance instance =
+        app_enables ? layer_.create_instance({"XR_KHR_visibility_mask"}) : layer_.create_instance();
+    ASSERT_NE(instance, XR_NULL_HANDLE);
+    EXPECT_EQ(std::count(g.enabled.begin(), g.enabled.end(), "XR_KHR_visibility_mask"), 1);
+    PFN_xrVoidFunction fn = nullptr;
+    EXPECT_EQ(layer_.request.getInstanceProcAddr(instance, "xrGetVisibilityMaskKHR", &fn),
+              app_enables ? XR_SUCCESS : XR_ERROR_FUNCTION_UNSUPPORTED);
+    EXPECT_EQ(fn != nullptr, app_enables);
+    g.mask_events = 2;
+    g.count["xrPollEvent"] = 0;
+    auto poll = layer_.get<PFN_xrPollEvent>(instance, "xrPollEvent");
+    XrEventDataBuffer event{XR_TYPE_EVENT_DATA_BUFFER};
+    if (app_enables) {
+      EXPECT_EQ(poll(instance, &event), XR_SUCCESS);
+      EXPECT_EQ(event.type, XR_TYPE_EVENT_DATA_VISIBILITY_MASK_CHANGED_KHR);
+      EXPECT_EQ(g.count["xrPollEvent"], 1);
+    } else {
+      EXPECT_EQ(poll(instance, &event), XR_EVENT_UNAVAILABLE);
+      EXPECT_EQ(event.type, XR_TYPE_EVENT_DATA_BUFFER);
+      EXPECT_EQ(g.count["xrPollEvent"], 3);  // both events consumed
+    }
+    ASSERT_EQ(layer_.get<PFN_xrDestroyInstance>(instance, "xrDestroyInstance")(instance), XR_SUCCESS);
+  }
 }
 
 }  // namespace

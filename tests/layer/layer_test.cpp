@@ -171,6 +171,28 @@ TEST_F(LayerApiTest, OwnExtensionIsStrippedBeforeTheRuntime) {
   ASSERT_EQ(frame(), XR_SUCCESS);
 }
 
+// With a scene the layer enables XR_KHR_visibility_mask below itself for culling, unseen by
+// the application: the command stays unsupported unless the application enables the
+// extension itself, in which case it reaches the runtime and answers.
+TEST_F(LayerApiTest, VisibilityMaskStaysTheApplicationsChoice) {
+  setenv("FOVEA_LAYER_SCENE", "cornell", 1);
+  PFN_xrVoidFunction f = nullptr;
+  create_instance({});
+  EXPECT_EQ(xrGetInstanceProcAddr(instance_, "xrGetVisibilityMaskKHR", &f), XR_ERROR_FUNCTION_UNSUPPORTED);
+  EXPECT_EQ(f, nullptr);
+  ASSERT_EQ(xrDestroyInstance(instance_), XR_SUCCESS);
+  instance_ = XR_NULL_HANDLE;
+
+  create_instance({"XR_KHR_visibility_mask"});
+  ASSERT_EQ(xrGetInstanceProcAddr(instance_, "xrGetVisibilityMaskKHR", &f), XR_SUCCESS);
+  ASSERT_NE(f, nullptr);
+  create_session();
+  XrVisibilityMaskKHR m{XR_TYPE_VISIBILITY_MASK_KHR};
+  EXPECT_EQ(reinterpret_cast<PFN_xrGetVisibilityMaskKHR>(f)(session_, XR_VIEW_CONFIGURATION_TYPE_PRIMARY_STEREO, 0,
+                                                            XR_VISIBILITY_MASK_TYPE_HIDDEN_TRIANGLE_MESH_KHR, &m),
+            XR_SUCCESS);
+}
+
 // Error codes come from the runtime unchanged through the layer's intercepts.
 TEST_F(LayerApiTest, ErrorsPassThrough) {
   create_instance();

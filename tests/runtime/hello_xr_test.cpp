@@ -81,6 +81,11 @@ ProcessResult run_and_check(const std::string& graphics, std::map<std::string, s
     EXPECT_EQ(f["gaze_receive_ns"].get<std::int64_t>(), gaze_t);
     EXPECT_GT(f["gaze_read_ns"].get<std::int64_t>(), 0);
     EXPECT_EQ(f["composited"].get<bool>(), i % kPngEvery == 0);
+    // Host time per stage: read-back happened exactly on the composited frames with layers.
+    const auto& cpu = f["cpu_ms"];
+    const bool read = f["composited"].get<bool>() && f["layers"].get<int>() > 0;
+    EXPECT_EQ(cpu["readback"].get<double>() > 0, read) << f.dump();
+    EXPECT_GE(cpu["gaze"].get<double>(), 0);
   }
   // hello_xr renders from its second frame on (the first one is not yet visible).
   EXPECT_EQ(frames[0]["layers"].get<int>(), 0);

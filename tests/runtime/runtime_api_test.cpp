@@ -971,6 +971,46 @@ XrTime mono_now() {
   return XrTime(ts.tv_sec) * 1'000'000'000 + ts.tv_nsec;
 }
 
+// The timing log carries the host time of xrEndFrame's stages under "cpu_ms": on a frame
+// whose panels are produced, the lens and PNG writing took time, nothing was read back
+// without layers, and the stages fit in the compositor's total.
+TEST_F(XrTest, TimingLogCpuStages) {
+  TempDir dir("cpu_ms");
+  setenv("FOVEA_RUNTIME_OUT", dir.path().c_str(), 1);
+  setenv("FOVEA_RUNTIME_PNG_EVERY", "1", 1);
+  create_instance();
+  run_to_focused();
+  ASSERT_EQ(frame(), XR_SUCCESS);
+  unsetenv("FOVEA_RUNTIME_PNG_EVERY");
+  unsetenv("FOVEA_RUNTIME_OUT");
+  std::ifstream in(dir.path() + "/timing.jsonl");
+  int composited = 0;
+  for (std::string line; std::getline(in, line);) {
+    const auto cpu = line.find("\"cpu_ms\":{");
+    ASSERT_NE(cpu, std::string::npos) << line;
+    const auto field = [&](const char* name, std::size_t from) {
+      const auto at = line.find(std::string("\"") + name + "\":", from);
+      EXPECT_NE(at, std::string::npos) << name << " in " << line;
+      return at == std::string::npos ? -1.0 : std::stod(line.substr(at + std::strlen(name) + 3));
+    };
+    double sum = 0;
+    for (const char* stage : {"validate", "gaze", "readback", "resample", "lens", "write"}) {
+      const double ms = field(stage, cpu);
+      EXPECT_GE(ms, 0.0) << stage;
+      if (std::string(stage) != "validate" && std::string(stage) != "gaze") sum += ms;
+    }
+    if (line.find("\"composited\":true") == std::string::npos) continue;
+    ++composited;
+    if (field("layers", 0) == 0) {
+      EXPECT_EQ(field("readback", cpu), 0.0) << line;
+    }
+    EXPECT_GT(field("lens", cpu), 0.0) << line;
+    EXPECT_GT(field("write", cpu), 0.0) << line;
+    EXPECT_LE(sum, field("compositor_ms", 0) + 0.01) << line;  // %.3f rounding of five numbers
+  }
+  EXPECT_GE(composited, 1);
+}
+
 // A missing FOVEA_RUNTIME_OUT directory is created (with its parents): the first frame
 // succeeds and the timing log and runtime log are written. A path that cannot be a
 // directory fails instance creation with the variable named, not a frame.

@@ -25,6 +25,13 @@ class ViewMask {
  public:
   ViewMask() = default;
   explicit ViewMask(const HiddenAreaMask& hidden);
+  // A runtime's XR_KHR_visibility_mask hidden triangle mesh (vertices in the view's tangent
+  // plane z = −1, x right, y up; a triangle list) rasterised into `view`'s raster: a pixel is
+  // hidden when its centre lies in (or on the edge of) a triangle of either winding.
+  // Throws InputError naming `what` for an index out of range, an index count that is not a
+  // multiple of three, or a non-finite vertex.
+  static ViewMask from_hidden_triangles(const View& view, std::span<const glm::vec2> vertices,
+                                        std::span<const std::uint32_t> indices, const char* what);
 
   int width() const { return width_; }
   int height() const { return height_; }
@@ -37,6 +44,7 @@ class ViewMask {
   double hidden_fraction() const { return hidden_fraction_; }
 
  private:
+  ViewMask(int width, int height);
   int width_ = 0, height_ = 0, words_per_row_ = 0;
   std::vector<std::uint32_t> bits_;
   double hidden_fraction_ = 0;
