@@ -184,6 +184,7 @@ const Dispatch* next_for_session(XrSession session) {
 
 XrResult intercept::xrDestroyInstance(XrInstance instance) {
   PFN_xrDestroyInstance next = nullptr;
+  std::vector<std::shared_ptr<FrameRenderer>> renderers;
   {
     // What the layer created on the instance's handles goes first, while they are alive: the
     // sessions' renderers (swapchains, frees on the application's device), eye-gaze spaces
@@ -193,10 +194,11 @@ XrResult intercept::xrDestroyInstance(XrInstance instance) {
     if (it == layer().instances.end()) return XR_ERROR_HANDLE_INVALID;
     const Dispatch& d = it->second.next;
     for (auto& [handle, session] : layer().sessions)
-      if (session.instance == instance) release_session(session, d);
+      if (session.instance == instance) renderers.push_back(release_session(session, d));
     destroy_eye_gaze_actions(d, it->second.gaze);
     next = d.xrDestroyInstance;
   }
+  renderers.clear();  // joins the render threads, destroys their swapchains while the instance lives
   const XrResult r = next(instance);
   if (XR_SUCCEEDED(r)) {
     std::lock_guard lock(layer().mutex);

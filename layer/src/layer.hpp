@@ -21,6 +21,7 @@
 
 #include "eye_gaze.hpp"
 #include "frame_log.hpp"
+#include "frame_queue.hpp"
 #include "frame_renderer.hpp"
 
 namespace fovea::layer {
@@ -76,13 +77,22 @@ struct SwapchainState {
   std::int64_t last_released = -1;
 };
 
+// A session's frame loop records, under the session's own lock (held only for bookkeeping,
+// never across a render or a call down the chain).
+struct SessionFrames {
+  std::mutex mutex;
+  FrameQueue queue;
+  FrameLog log;
+};
+
+// Fields are read and written under Layer::mutex, held briefly; the renderer and the frame
+// records are shared so that the calls using them run outside it.
 struct SessionState {
   XrInstance instance = XR_NULL_HANDLE;
   bool disabled = false;  // an internal failure: pass everything through from then on
   VulkanBinding vulkan;
-  std::unique_ptr<FrameRenderer> renderer;  // null: pass-through, measure only
-  FrameLog log;
-  FrameTimes current;                     // the frame in flight
+  std::shared_ptr<FrameRenderer> renderer;  // null: pass-through, measure only
+  std::shared_ptr<SessionFrames> frames = std::make_shared<SessionFrames>();
   EyeGazeSession gaze;                    // after an attach that included the layer's action set
   // The runtime's xrGetVisibilityMaskKHR (null: not enabled below); the generation counts the
   // XR_TYPE_EVENT_DATA_VISIBILITY_MASK_CHANGED_KHR events seen, so the renderer re-fetches.
@@ -115,10 +125,12 @@ Layer& layer();
 // application's mistake) the most recent instance's, so the runtime reports the error.
 const Dispatch* next_for_session(XrSession session);
 
-// Destroys what the layer created on a session's handles (the renderer's swapchains and its
-// frees on the application's device, the eye-gaze spaces); called before the session, or
-// its instance, is destroyed below the layer. The session passes through from then on.
-void release_session(SessionState& s, const Dispatch& next);
+// Destroys what the layer created on a session's handles (the eye-gaze spaces) and returns
+// its renderer, for the caller to release outside Layer::mutex (that joins the render thread
+// and destroys the renderer's swapchains and its objects on the application's device) before
+// the session, or its instance, is destroyed below the layer. The session passes through
+// from then on.
+[[nodiscard]] std::shared_ptr<FrameRenderer> release_session(SessionState& s, const Dispatch& next);
 
 // Intercepted commands (hidden; reached through the layer's xrGetInstanceProcAddr).
 namespace intercept {

@@ -181,6 +181,27 @@ TEST(LayerComposite, ResamplesByDirection) {
   EXPECT_EQ(out.at(0, 0)[3], 0);
 }
 
+// Rotational reprojection of a path-traced frame to newer view poses: the head turned 10
+// degrees left since the frame was traced, so what lay straight ahead now lies 10 degrees to
+// the right (tangent projection: x = (tan 10 + tan 40) / (2 tan 40) * 80 = 48.4).
+TEST(LayerComposite, ReprojectsByRotation) {
+  const core::Fov wide = core::Fov::from_degrees(-40, 40, 40, -40);
+  Pixels8 traced = filled(80, 80, {10, 10, 10, 255});
+  std::copy_n(std::array<std::uint8_t, 4>{250, 0, 0, 255}.data(), 4, traced.at(40, 40));
+  const glm::dquat now = glm::angleAxis(glm::radians(10.0), glm::dvec3(0, 1, 0));
+  const glm::dquat then(1, 0, 0, 0);
+  const Pixels8 out = resample(traced, core::View(wide, 80, 80), core::View(wide, 80, 80), glm::conjugate(then) * now);
+  int found_x = -1, found_y = -1;
+  for (int y = 0; y < 80; ++y)
+    for (int x = 0; x < 80; ++x)
+      if (out.at(x, y)[0] == 250) found_x = x, found_y = y;
+  EXPECT_EQ(found_x, 48);
+  EXPECT_EQ(found_y, 40);
+  // The left border now looks where the frame was not traced.
+  EXPECT_EQ(out.at(0, 40)[3], 0);
+  EXPECT_EQ(out.at(79, 40)[3], 255);
+}
+
 // A raw HID capture configured as the layer's gaze is a recording: at display times on the
 // host clock the fovea follows it from the first frame on (it used to be taken for a live
 // device and froze on its last sample).
