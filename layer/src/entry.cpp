@@ -113,7 +113,8 @@ XrResult XRAPI_CALL create_api_layer_instance(const XrInstanceCreateInfo* info, 
   const auto enabled = [&](const char* name) {
     return std::any_of(extensions.begin(), extensions.end(), [&](const char* e) { return !std::strcmp(e, name); });
   };
-  if (want_gaze && !enabled(kEyeGazeExtension)) extensions.push_back(kEyeGazeExtension);
+  const bool gaze_hidden = want_gaze && !enabled(kEyeGazeExtension);
+  if (gaze_hidden) extensions.push_back(kEyeGazeExtension);
   const bool app_mask = enabled(kVisibilityMaskExtension);
   const bool mask_hidden = want_mask && !app_mask;
   if (mask_hidden) extensions.push_back(kVisibilityMaskExtension);
@@ -152,8 +153,17 @@ XrResult XRAPI_CALL create_api_layer_instance(const XrInstanceCreateInfo* info, 
     state.get_visibility_mask = nullptr;
   }
   state.visibility_mask_hidden = mask_hidden;
+  state.gaze_hidden = gaze_hidden;
   if (want_gaze) try {
       state.gaze = create_eye_gaze_actions(state.next, *instance);
+      // OpenXR 1.0's top-level user paths, and the eye tracker's when the application enabled it.
+      std::vector<const char*> users = {"/user/hand/left", "/user/hand/right", "/user/head", "/user/gamepad",
+                                        "/user/treadmill"};
+      if (!gaze_hidden) users.push_back(kEyeGazeUser);
+      for (const char* u : users) {
+        XrPath p = XR_NULL_PATH;
+        if (XR_SUCCEEDED(state.next.xrStringToPath(*instance, u, &p))) state.app_user_paths.push_back(p);
+      }
     } catch (const std::exception& e) {
       FOVEA_LAYER_WARN("eye-gaze action unavailable, gaze from FOVEA_GAZE: %s", e.what());
     }

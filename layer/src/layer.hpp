@@ -61,7 +61,9 @@ constexpr const char* kVisibilityMaskExtension = "XR_KHR_visibility_mask";
   X(xrCreateReferenceSpace)  \
   X(xrLocateSpace)           \
   X(xrDestroySpace)          \
-  X(xrPollEvent)
+  X(xrPollEvent)             \
+  X(xrGetSystemProperties)   \
+  X(xrGetCurrentInteractionProfile)
 
 struct Dispatch {
 #define FOVEA_LAYER_MEMBER(name) PFN_##name name = nullptr;
@@ -94,6 +96,9 @@ struct SessionState {
   std::shared_ptr<FrameRenderer> renderer;  // null: pass-through, measure only
   std::shared_ptr<SessionFrames> frames = std::make_shared<SessionFrames>();
   EyeGazeSession gaze;                    // after an attach that included the layer's action set
+  // The interaction profiles the application has seen for InstanceState::app_user_paths (the
+  // layer's binding hidden); a profile-changed event that changes none of them is the layer's.
+  std::vector<XrPath> app_profiles;
   // The runtime's xrGetVisibilityMaskKHR (null: not enabled below); the generation counts the
   // XR_TYPE_EVENT_DATA_VISIBILITY_MASK_CHANGED_KHR events seen, so the renderer re-fetches.
   PFN_xrGetVisibilityMaskKHR get_visibility_mask = nullptr;
@@ -105,6 +110,13 @@ struct InstanceState {
   bool extension_enabled = false;  // the application enabled kLayerExtension
   std::string application;         // XrApplicationInfo::applicationName (the config section)
   EyeGazeActions gaze;             // the layer's eye-gaze action (a scene configured, the runtime has it)
+  // The layer enabled XR_EXT_eye_gaze_interaction for itself: for the application it stays
+  // not enabled (its profile, top-level path and properties unsupported or absent).
+  bool gaze_hidden = false;
+  // The application's own suggestion for the eye-gaze profile succeeded: its binding, not only
+  // the layer's, makes the profile current.
+  bool app_suggested_gaze = false;
+  std::vector<XrPath> app_user_paths;  // the top-level user paths the application can query
   PFN_xrGetVisibilityMaskKHR get_visibility_mask = nullptr;  // the extension is enabled below
   // The layer enabled kVisibilityMaskExtension for itself: the application must not see it
   // (its command stays unsupported, its events are not delivered).
@@ -132,6 +144,10 @@ const Dispatch* next_for_session(XrSession session);
 // from then on.
 [[nodiscard]] std::shared_ptr<FrameRenderer> release_session(SessionState& s, const Dispatch& next);
 
+// Whether an interaction-profile-changed event of `session` changed nothing the application
+// can see (the layer's eye-gaze binding caused it); updates what the application has seen.
+bool layer_caused_profile_change(XrSession session);
+
 // Intercepted commands (hidden; reached through the layer's xrGetInstanceProcAddr).
 namespace intercept {
 #define FOVEA_LAYER_INTERCEPTED(X) \
@@ -148,7 +164,9 @@ namespace intercept {
   X(xrSuggestInteractionProfileBindings) \
   X(xrAttachSessionActionSets)     \
   X(xrSyncActions)                 \
-  X(xrPollEvent)
+  X(xrPollEvent)                   \
+  X(xrGetSystemProperties)         \
+  X(xrGetCurrentInteractionProfile)
 #define FOVEA_LAYER_DECLARE(name) std::remove_pointer_t<PFN_##name> name;
 FOVEA_LAYER_INTERCEPTED(FOVEA_LAYER_DECLARE)
 #undef FOVEA_LAYER_DECLARE

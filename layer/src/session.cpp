@@ -86,7 +86,8 @@ XrResult intercept::xrDestroySession(XrSession session) {
 
 // A visibility mask change makes the session's renderer fetch the mask again. When the layer
 // enabled the extension for itself the event is the layer's alone: it is consumed and the
-// next event, if any, is returned instead.
+// next event, if any, is returned instead. So is an interaction-profile change that only the
+// layer's eye-gaze binding caused.
 XrResult intercept::xrPollEvent(XrInstance instance, XrEventDataBuffer* event) {
   PFN_xrPollEvent next = nullptr;
   bool hidden = false;
@@ -99,6 +100,11 @@ XrResult intercept::xrPollEvent(XrInstance instance, XrEventDataBuffer* event) {
   }
   for (;;) {
     const XrResult r = next(instance, event);
+    if (r == XR_SUCCESS && event->type == XR_TYPE_EVENT_DATA_INTERACTION_PROFILE_CHANGED &&
+        layer_caused_profile_change(reinterpret_cast<const XrEventDataInteractionProfileChanged*>(event)->session)) {
+      *event = {XR_TYPE_EVENT_DATA_BUFFER};
+      continue;
+    }
     if (r != XR_SUCCESS || event->type != XR_TYPE_EVENT_DATA_VISIBILITY_MASK_CHANGED_KHR) return r;
     const XrSession session = reinterpret_cast<const XrEventDataVisibilityMaskChangedKHR*>(event)->session;
     {

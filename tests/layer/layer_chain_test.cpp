@@ -126,6 +126,8 @@ XrResult XRAPI_CALL fake_gipa(XrInstance, const char* n, PFN_xrVoidFunction* fn)
   FAKE_PLAIN(xrAttachSessionActionSets)
   FAKE_PLAIN(xrSyncActions)
   FAKE_PLAIN(xrLocateSpace)
+  FAKE_PLAIN(xrGetSystemProperties)
+  FAKE_PLAIN(xrGetCurrentInteractionProfile)
   FAKE(xrPollEvent, &fake_poll_event)
   if (g.visibility_mask) FAKE_PLAIN(xrGetVisibilityMaskKHR)
   *fn = nullptr;
