@@ -8,8 +8,13 @@
 // a discrete GPU this costs two PCIe round trips of the eye rasters per frame.
 #include "frame_renderer.hpp"
 
+#include <sys/resource.h>
+#include <sys/syscall.h>
+#include <unistd.h>
+
 #include <algorithm>
 #include <array>
+#include <cerrno>
 #include <chrono>
 #include <condition_variable>
 #include <cstdlib>
@@ -241,6 +246,9 @@ class PathTracer {
 };
 
 // The angle (degrees) of a rotation.
+// The render thread's nice value (19 is the lowest priority).
+constexpr int kRenderNice = 10;
+
 double rotation_deg(const glm::dquat& q) {
   return glm::degrees(2.0 * std::acos(std::min(1.0, std::abs(q.w))));
 }
@@ -267,7 +275,6 @@ class PathTraceRenderer final : public FrameRenderer {
 
   const XrFrameEndInfo* end_frame(const FrameInput& in, Shown& shown) override {
     if (in.app_views.size() != 2) return nullptr;  // only stereo projection layers are replaced
-    const auto t0 = std::chrono::steady_clock::now();
     if (!thread_.joinable()) start(in);
     const XrRect2Di& r0 = in.app_views[0].rect;
     for (const AppView& v : in.app_views)
@@ -297,6 +304,7 @@ class PathTraceRenderer final : public FrameRenderer {
       frame = newest_;
     }
     if (!frame) return nullptr;  // nothing traced yet: the application's own frame
+    const auto t0 = std::chrono::steady_clock::now();
     const XrFrameEndInfo* out = compose(in, *frame, shown);
     shown.times.transfer = ms_since(t0);
     return out;
@@ -309,6 +317,12 @@ class PathTraceRenderer final : public FrameRenderer {
   };
 
   void run() {
+    // Below the application's threads: on a CPU device (lavapipe) the path tracer would
+    // otherwise take the cores the application's frame loop needs. Linux nice values are per
+    // thread and inherited by the threads this one creates (the render device's workers).
+    if (setpriority(PRIO_PROCESS, static_cast<id_t>(syscall(SYS_gettid)), kRenderNice) != 0)
+      FOVEA_LAYER_WARN("render thread: cannot lower its priority (%s); it competes with the application's threads",
+                       std::strerror(errno));
     std::unique_ptr<PathTracer> tracer;
     try {
       tracer = std::make_unique<PathTracer>(config_, scene_, views_in_, display_, format_, session_);

@@ -136,6 +136,9 @@ TEST(Layer, CoreValidationBelowLayerWithScene) {
   const ProcessResult r = hello_xr(out.path(), env);
   ASSERT_EQ(r.exit_code, 0) << r.output;
   EXPECT_EQ(r.output.find("INTERNAL VALIDATION LAYER ERROR"), std::string::npos) << r.output;
+  // The runtime's eye gaze is still used with a layer below.
+  const std::string log = read_text(out.path() + "/layer.log");
+  EXPECT_NE(log.find("merged into the application's action sets"), std::string::npos) << log;
   const std::string cv = read_text(out.path() + "/core_validation.txt");
   EXPECT_EQ(cv.find("VUID-"), std::string::npos) << cv;
 }
