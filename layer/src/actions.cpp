@@ -72,7 +72,8 @@ XrResult intercept::xrSuggestInteractionProfileBindings(XrInstance instance,
   if (XR_FAILED(r)) r = l.next->xrSuggestInteractionProfileBindings(instance, info);
   std::lock_guard lock(layer().mutex);
   auto it = layer().instances.find(instance);
-  if (it != layer().instances.end()) it->second.app_suggested_gaze = XR_SUCCEEDED(r);
+  // A refused suggestion leaves the earlier one in force.
+  if (it != layer().instances.end() && XR_SUCCEEDED(r)) it->second.app_suggested_gaze = true;
   return r;
 }
 
