@@ -77,6 +77,54 @@ XrResult intercept::xrSuggestInteractionProfileBindings(XrInstance instance,
   return r;
 }
 
+// The application's action sets are recorded with their instance, so xrCreateAction knows
+// which instance's view of eye gaze applies (an unknown set: the most recent instance's
+// table, for the runtime to report).
+XrInstance instance_of(XrActionSet set) {
+  std::lock_guard lock(layer().mutex);
+  const auto it = layer().action_sets.find(set);
+  return it != layer().action_sets.end() ? it->second : layer().last_instance;
+}
+
+XrResult intercept::xrCreateActionSet(XrInstance instance, const XrActionSetCreateInfo* info, XrActionSet* set) {
+  const Lookup l = for_instance(instance);
+  if (!l.next) return XR_ERROR_HANDLE_INVALID;
+  const XrResult r = l.next->xrCreateActionSet(instance, info, set);
+  if (XR_SUCCEEDED(r)) {
+    std::lock_guard lock(layer().mutex);
+    layer().action_sets[*set] = instance;
+  }
+  return r;
+}
+
+XrResult intercept::xrDestroyActionSet(XrActionSet set) {
+  const Lookup l = for_instance(instance_of(set));
+  if (!l.next) return XR_ERROR_HANDLE_INVALID;
+  const XrResult r = l.next->xrDestroyActionSet(set);
+  if (XR_SUCCEEDED(r)) {
+    std::lock_guard lock(layer().mutex);
+    layer().action_sets.erase(set);
+  }
+  return r;
+}
+
+// /user/eyes_ext is no top-level user path for an application without the extension: an
+// action the runtime created with it as a subaction path is destroyed again and the call
+// answers XR_ERROR_PATH_UNSUPPORTED (the runtime's earlier checks still answer first).
+XrResult intercept::xrCreateAction(XrActionSet set, const XrActionCreateInfo* info, XrAction* action) {
+  const Lookup l = for_instance(instance_of(set));
+  if (!l.next) return XR_ERROR_HANDLE_INVALID;
+  const XrResult r = l.next->xrCreateAction(set, info, action);
+  if (XR_FAILED(r) || !l.gaze_hidden || l.gaze.user == XR_NULL_PATH) return r;
+  for (uint32_t i = 0; i < info->countSubactionPaths; ++i)
+    if (info->subactionPaths[i] == l.gaze.user) {
+      l.next->xrDestroyAction(*action);
+      *action = XR_NULL_HANDLE;
+      return XR_ERROR_PATH_UNSUPPORTED;
+    }
+  return r;
+}
+
 XrResult intercept::xrAttachSessionActionSets(XrSession session, const XrSessionActionSetsAttachInfo* info) {
   const Lookup l = for_session(session);
   if (!l.next) return XR_ERROR_HANDLE_INVALID;

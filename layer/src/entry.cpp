@@ -222,6 +222,8 @@ XrResult intercept::xrDestroyInstance(XrInstance instance) {
         sc = sc->second.session == it->first ? l.swapchains.erase(sc) : std::next(sc);
       it = l.sessions.erase(it);
     }
+    for (auto as = l.action_sets.begin(); as != l.action_sets.end();)
+      as = as->second == instance ? l.action_sets.erase(as) : std::next(as);
     l.instances.erase(instance);
     if (l.last_instance == instance) l.last_instance = l.instances.empty() ? XR_NULL_HANDLE : l.instances.rbegin()->first;
   }

@@ -53,6 +53,7 @@ constexpr const char* kVisibilityMaskExtension = "XR_KHR_visibility_mask";
   X(xrCreateActionSet)       \
   X(xrDestroyActionSet)      \
   X(xrCreateAction)          \
+  X(xrDestroyAction)         \
   X(xrStringToPath)          \
   X(xrSuggestInteractionProfileBindings) \
   X(xrAttachSessionActionSets) \
@@ -128,6 +129,7 @@ struct Layer {
   std::map<XrInstance, InstanceState> instances;
   std::map<XrSession, SessionState> sessions;
   std::map<XrSwapchain, SwapchainState> swapchains;
+  std::map<XrActionSet, XrInstance> action_sets;  // the application's, for xrCreateAction's instance
   XrInstance last_instance = XR_NULL_HANDLE;  // dispatch for handles the layer does not know
 };
 
@@ -162,6 +164,9 @@ namespace intercept {
   X(xrBeginFrame)                  \
   X(xrEndFrame)                    \
   X(xrSuggestInteractionProfileBindings) \
+  X(xrCreateActionSet)             \
+  X(xrDestroyActionSet)            \
+  X(xrCreateAction)                \
   X(xrAttachSessionActionSets)     \
   X(xrSyncActions)                 \
   X(xrPollEvent)                   \

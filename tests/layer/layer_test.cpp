@@ -201,7 +201,7 @@ TEST_F(LayerApiTest, VisibilityMaskStaysTheApplicationsChoice) {
 // What an application observes of eye gaze and its actions (codes, properties, profiles, events).
 struct Observed {
   XrBool32 supports_eye_gaze = 2;  // neither XR_TRUE nor XR_FALSE: whether it was written
-  XrResult suggest_gaze = XR_SUCCESS, suggest_hand = XR_SUCCESS;
+  XrResult eyes_action = XR_SUCCESS, suggest_gaze = XR_SUCCESS, suggest_hand = XR_SUCCESS;
   XrResult attach_none = XR_SUCCESS, profile_before = XR_SUCCESS, attach = XR_SUCCESS;
   XrResult eyes = XR_SUCCESS, hand = XR_SUCCESS;
   std::vector<XrStructureType> events;
@@ -209,14 +209,14 @@ struct Observed {
 };
 
 bool operator==(const Observed& a, const Observed& b) {
-  return a.supports_eye_gaze == b.supports_eye_gaze && a.suggest_gaze == b.suggest_gaze &&
+  return a.supports_eye_gaze == b.supports_eye_gaze && a.eyes_action == b.eyes_action && a.suggest_gaze == b.suggest_gaze &&
          a.suggest_hand == b.suggest_hand && a.attach_none == b.attach_none && a.profile_before == b.profile_before &&
          a.attach == b.attach && a.eyes == b.eyes && a.hand == b.hand && a.events == b.events &&
          a.eyes_profile_name == b.eyes_profile_name && a.hand_profile_name == b.hand_profile_name;
 }
 
 std::ostream& operator<<(std::ostream& os, const Observed& o) {
-  os << "{supports " << o.supports_eye_gaze << ", suggest gaze " << o.suggest_gaze << " hand " << o.suggest_hand
+  os << "{supports " << o.supports_eye_gaze << ", action on /user/eyes_ext " << o.eyes_action << ", suggest gaze " << o.suggest_gaze << " hand " << o.suggest_hand
      << ", attach none " << o.attach_none << ", profile before attach " << o.profile_before << ", attach " << o.attach
      << ", eyes " << o.eyes << " '" << o.eyes_profile_name << "', hand " << o.hand << " '" << o.hand_profile_name
      << "', events";
@@ -251,6 +251,14 @@ Observed observe(XrInstance instance, const XrSession& session, bool suggest_gaz
   std::strcpy(ai.localizedActionName, "Aim");
   XrAction aim = XR_NULL_HANDLE;
   EXPECT_EQ(xrCreateAction(set, &ai, &aim), XR_SUCCESS);
+  XrActionCreateInfo eyes_ai = ai;
+  std::strcpy(eyes_ai.actionName, "look");
+  std::strcpy(eyes_ai.localizedActionName, "Look");
+  const XrPath eyes_path = path("/user/eyes_ext");
+  eyes_ai.countSubactionPaths = 1;
+  eyes_ai.subactionPaths = &eyes_path;
+  XrAction look = XR_NULL_HANDLE;
+  o.eyes_action = xrCreateAction(set, &eyes_ai, &look);
   const auto suggest = [&](const char* profile, const char* binding) {
     const XrActionSuggestedBinding b{aim, path(binding)};
     XrInteractionProfileSuggestedBinding sb{XR_TYPE_INTERACTION_PROFILE_SUGGESTED_BINDING};
@@ -323,6 +331,8 @@ TEST_F(LayerApiTest, EyeGazeStaysTheApplicationsChoice) {
     // Not vacuous: attaching no set is an error, and the eye tracker's profile is current
     // exactly when the application bound it.
     EXPECT_EQ(seen[0].attach_none, XR_ERROR_VALIDATION_FAILURE);
+    EXPECT_EQ(seen[0].eyes_action, c.enable ? XR_SUCCESS : XR_ERROR_PATH_UNSUPPORTED);
+    EXPECT_EQ(seen[0].supports_eye_gaze, c.enable ? XR_TRUE : XR_FALSE);
     EXPECT_EQ(seen[0].eyes_profile_name == "/interaction_profiles/ext/eye_gaze_interaction", c.enable && c.suggest);
   }
 }
