@@ -163,7 +163,12 @@ void AppDevice::submit(F&& record) {
   si.commandBufferCount = 1;
   si.pCommandBuffers = &cmd_;
   check(vkQueueSubmit_(queue_, 1, &si, fence_), "vkQueueSubmit");
-  check(vkWaitForFences_(device_, 1, &fence_, VK_TRUE, UINT64_MAX), "vkWaitForFences");
+  // Bounded: a lost or hung device fails the session (the layer then passes it through)
+  // instead of hanging the application's xrEndFrame.
+  constexpr std::uint64_t kTimeoutNs = 10'000'000'000;
+  const VkResult w = vkWaitForFences_(device_, 1, &fence_, VK_TRUE, kTimeoutNs);
+  if (w == VK_TIMEOUT) throw std::runtime_error("the layer's transfer did not finish on the application's device in 10 s");
+  check(w, "vkWaitForFences");
   check(vkResetFences_(device_, 1, &fence_), "vkResetFences");
 }
 

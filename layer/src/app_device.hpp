@@ -1,7 +1,8 @@
 #pragma once
 // Transfers between host memory and images on the application's VkDevice, on the
 // session's queue (the queue the runtime also uses; the layer submits only inside
-// xrEndFrame, before calling down). Each transfer is one submission and a fence wait.
+// xrEndFrame, before calling down). Each transfer is one submission and a bounded fence wait,
+// under no lock another application call needs.
 #include <cstdint>
 #include <vector>
 

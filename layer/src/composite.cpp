@@ -55,18 +55,23 @@ std::array<std::uint8_t, 3> border_colour(const Pixels8& img) {
   return {std::uint8_t(best->first), std::uint8_t(best->first >> 8), std::uint8_t(best->first >> 16)};
 }
 
-Pixels8 resample(const Pixels8& app, const core::View& app_view, const core::View& scene_view) {
+Pixels8 resample(const Pixels8& app, const core::View& app_view, const core::View& scene_view,
+                 const glm::dquat& scene_to_app) {
   const auto same = [](const core::Fov& a, const core::Fov& b) {
     return std::abs(a.angle_left - b.angle_left) < 1e-6 && std::abs(a.angle_right - b.angle_right) < 1e-6 &&
            std::abs(a.angle_up - b.angle_up) < 1e-6 && std::abs(a.angle_down - b.angle_down) < 1e-6;
   };
-  if (same(app_view.fov(), scene_view.fov()) && app.width == scene_view.width() && app.height == scene_view.height())
+  // Below a micro-radian (|w| within 1e-12 of 1) the rotation moves no pixel.
+  const bool rotated = std::abs(std::abs(scene_to_app.w) - 1.0) > 1e-12;
+  if (!rotated && same(app_view.fov(), scene_view.fov()) && app.width == scene_view.width() &&
+      app.height == scene_view.height())
     return app;
   Pixels8 out{scene_view.width(), scene_view.height(),
               std::vector<std::uint8_t>(std::size_t(scene_view.width()) * std::size_t(scene_view.height()) * 4, 0)};
   for (int y = 0; y < out.height; ++y)
     for (int x = 0; x < out.width; ++x) {
-      const auto px = app_view.dir_to_pixel(scene_view.pixel_to_dir({x + 0.5, y + 0.5}));
+      const glm::dvec3 d = scene_view.pixel_to_dir({x + 0.5, y + 0.5});
+      const auto px = app_view.dir_to_pixel(rotated ? scene_to_app * d : d);
       if (!px || px->x < 0 || px->y < 0 || px->x >= app.width || px->y >= app.height) continue;
       std::copy_n(app.at(int(px->x), int(px->y)), 4, out.at(x, y));
     }

@@ -7,6 +7,7 @@
 #include <optional>
 #include <vector>
 
+#include <glm/gtc/quaternion.hpp>
 #include <vulkan/vulkan.h>
 #include <openxr/openxr.h>
 
@@ -41,10 +42,13 @@ Pixels8 encode_scene(const core::Image& linear, PixelFormat fmt);
 // clear colour when it draws content away from the edges.
 std::array<std::uint8_t, 3> border_colour(const Pixels8& img);
 
-// The application's image `app` (seen through `app_view`) resampled (nearest, by direction)
-// into `scene_view`'s raster; identity when both views are the same. Pixels the application
-// did not cover get alpha 0.
-Pixels8 resample(const Pixels8& app, const core::View& app_view, const core::View& scene_view);
+// The image `app` (seen through `app_view`) resampled (nearest, by direction) into
+// `scene_view`'s raster; `scene_to_app` turns a direction of `scene_view` into one of
+// `app_view` (a rotational reprojection: conj(app orientation) * scene orientation, the
+// orientations in one space). Identity when both views and the rotation are. Pixels the
+// image did not cover get alpha 0.
+Pixels8 resample(const Pixels8& app, const core::View& app_view, const core::View& scene_view,
+                 const glm::dquat& scene_to_app = glm::dquat(1, 0, 0, 0));
 
 // How the application's projection layer blends over what lies below it, from its
 // XrCompositionLayerFlags (OpenXR 1.0 "Composition Layer Blending"): without

@@ -17,6 +17,12 @@ std::string env(const char* name) {
   return v ? v : "";
 }
 
+bool parse_render_mode(const std::string& v, const std::string& where) {
+  if (v == "async") return false;
+  if (v == "lockstep") return true;
+  throw core::InputError(where + ": \"" + v + "\" must be \"async\" or \"lockstep\"");
+}
+
 void apply_section(const nlohmann::json& s, const std::string& where, LayerConfig& c) {
   if (!s.is_object()) throw core::InputError(where + ": must be an object");
   for (const auto& [key, v] : s.items()) {
@@ -31,6 +37,8 @@ void apply_section(const nlohmann::json& s, const std::string& where, LayerConfi
       else if (m == "alpha") c.composite = Composite::Alpha;
       else if (m == "scene-only") c.composite = Composite::SceneOnly;
       else throw core::InputError(field + ": must be \"app-on-top\", \"alpha\" or \"scene-only\"");
+    } else if (key == "render") {
+      c.lockstep = parse_render_mode(v.is_string() ? v.get<std::string>() : v.dump(), field);
     } else if (key == "app_background") {
       if (v.is_string() && v.get<std::string>() == "auto") {
         c.app_background.reset();
@@ -50,7 +58,7 @@ void apply_section(const nlohmann::json& s, const std::string& where, LayerConfi
       }
       c.app_background = rgb;
     } else {
-      throw core::InputError(field + ": unknown key (scene, composite, app_background, gaze)");
+      throw core::InputError(field + ": unknown key (scene, composite, app_background, gaze, render)");
     }
   }
 }
@@ -103,6 +111,7 @@ LayerConfig load_config(const std::string& application) {
       c.origin = name;
     }
   if (!env("FOVEA_GAZE").empty()) c.gaze = env("FOVEA_GAZE");
+  if (!env("FOVEA_LAYER_RENDER").empty()) c.lockstep = parse_render_mode(env("FOVEA_LAYER_RENDER"), "FOVEA_LAYER_RENDER");
   return c;
 }
 

@@ -2,9 +2,10 @@
 // The layer's configuration for one application. Sources, later ones winning:
 //   $XDG_CONFIG_HOME/fovea/layer.json (else ~/.config/fovea/layer.json):
 //     {"default": {...}, "applications": {"<XrApplicationInfo::applicationName>": {...}}}
-//     with keys "scene", "composite", "app_background", "gaze" (an application's section
-//     over "default");
-//   env FOVEA_LAYER_SCENE, then FOVEA_SCENE (the scene); FOVEA_GAZE (the gaze source).
+//     with keys "scene", "composite", "app_background", "gaze", "render" (an application's
+//     section over "default");
+//   env FOVEA_LAYER_SCENE, then FOVEA_SCENE (the scene); FOVEA_GAZE (the gaze source);
+//   FOVEA_LAYER_RENDER (the render mode).
 #include <array>
 #include <optional>
 #include <string>
@@ -26,6 +27,10 @@ struct LayerConfig {
   std::optional<std::array<int, 3>> app_background;
   std::string gaze;  // devices::open_gaze_source URI; empty: none (fixed foveation, gaze_input.hpp)
   std::string origin;  // where the scene setting came from, for the log
+  // "render": "async" (false): xrEndFrame shows the newest frame the render thread finished;
+  // "lockstep" (true): it waits for the frame traced for its own views (deterministic output
+  // for captures and comparisons; the application runs at the path tracer's rate).
+  bool lockstep = false;
 };
 
 // Throws core::InputError naming the file and field for a malformed configuration file.

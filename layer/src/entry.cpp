@@ -113,7 +113,8 @@ XrResult XRAPI_CALL create_api_layer_instance(const XrInstanceCreateInfo* info, 
   const auto enabled = [&](const char* name) {
     return std::any_of(extensions.begin(), extensions.end(), [&](const char* e) { return !std::strcmp(e, name); });
   };
-  if (want_gaze && !enabled(kEyeGazeExtension)) extensions.push_back(kEyeGazeExtension);
+  const bool gaze_hidden = want_gaze && !enabled(kEyeGazeExtension);
+  if (gaze_hidden) extensions.push_back(kEyeGazeExtension);
   const bool app_mask = enabled(kVisibilityMaskExtension);
   const bool mask_hidden = want_mask && !app_mask;
   if (mask_hidden) extensions.push_back(kVisibilityMaskExtension);
@@ -152,8 +153,17 @@ XrResult XRAPI_CALL create_api_layer_instance(const XrInstanceCreateInfo* info, 
     state.get_visibility_mask = nullptr;
   }
   state.visibility_mask_hidden = mask_hidden;
+  state.gaze_hidden = gaze_hidden;
   if (want_gaze) try {
       state.gaze = create_eye_gaze_actions(state.next, *instance);
+      // OpenXR 1.0's top-level user paths, and the eye tracker's when the application enabled it.
+      std::vector<const char*> users = {"/user/hand/left", "/user/hand/right", "/user/head", "/user/gamepad",
+                                        "/user/treadmill"};
+      if (!gaze_hidden) users.push_back(kEyeGazeUser);
+      for (const char* u : users) {
+        XrPath p = XR_NULL_PATH;
+        if (XR_SUCCEEDED(state.next.xrStringToPath(*instance, u, &p))) state.app_user_paths.push_back(p);
+      }
     } catch (const std::exception& e) {
       FOVEA_LAYER_WARN("eye-gaze action unavailable, gaze from FOVEA_GAZE: %s", e.what());
     }
@@ -184,6 +194,7 @@ const Dispatch* next_for_session(XrSession session) {
 
 XrResult intercept::xrDestroyInstance(XrInstance instance) {
   PFN_xrDestroyInstance next = nullptr;
+  std::vector<std::shared_ptr<FrameRenderer>> renderers;
   {
     // What the layer created on the instance's handles goes first, while they are alive: the
     // sessions' renderers (swapchains, frees on the application's device), eye-gaze spaces
@@ -193,10 +204,11 @@ XrResult intercept::xrDestroyInstance(XrInstance instance) {
     if (it == layer().instances.end()) return XR_ERROR_HANDLE_INVALID;
     const Dispatch& d = it->second.next;
     for (auto& [handle, session] : layer().sessions)
-      if (session.instance == instance) release_session(session, d);
+      if (session.instance == instance) renderers.push_back(release_session(session, d));
     destroy_eye_gaze_actions(d, it->second.gaze);
     next = d.xrDestroyInstance;
   }
+  renderers.clear();  // joins the render threads, destroys their swapchains while the instance lives
   const XrResult r = next(instance);
   if (XR_SUCCEEDED(r)) {
     std::lock_guard lock(layer().mutex);
@@ -210,6 +222,8 @@ XrResult intercept::xrDestroyInstance(XrInstance instance) {
         sc = sc->second.session == it->first ? l.swapchains.erase(sc) : std::next(sc);
       it = l.sessions.erase(it);
     }
+    for (auto as = l.action_sets.begin(); as != l.action_sets.end();)
+      as = as->second == instance ? l.action_sets.erase(as) : std::next(as);
     l.instances.erase(instance);
     if (l.last_instance == instance) l.last_instance = l.instances.empty() ? XR_NULL_HANDLE : l.instances.rbegin()->first;
   }

@@ -39,6 +39,7 @@ EyeGazeActions create_eye_gaze_actions(const Dispatch& next, XrInstance instance
   check(next.xrCreateAction(a.set, &ai, &a.pose), "xrCreateAction");
   check(next.xrStringToPath(instance, kEyeGazeProfile, &a.profile), "xrStringToPath");
   check(next.xrStringToPath(instance, kEyeGazePath, &a.binding), "xrStringToPath");
+  check(next.xrStringToPath(instance, kEyeGazeUser, &a.user), "xrStringToPath");
   const XrActionSuggestedBinding b{a.pose, a.binding};
   XrInteractionProfileSuggestedBinding sb{XR_TYPE_INTERACTION_PROFILE_SUGGESTED_BINDING};
   sb.interactionProfile = a.profile;

@@ -4,6 +4,9 @@
 // to /user/eyes_ext/input/gaze_ext/pose, merged into the application's
 // xrSuggestInteractionProfileBindings (for the eye-gaze profile), xrAttachSessionActionSets
 // and xrSyncActions. The gaze is located in VIEW space at each frame's display time.
+// The application does not see it (actions.cpp): an extension it did not enable stays
+// unsupported for it, and what the layer's binding changes (the eye-gaze profile becoming
+// current, its change event) is answered and filtered as without the layer.
 
 #define XR_USE_GRAPHICS_API_VULKAN
 #include <vulkan/vulkan.h>
@@ -18,13 +21,14 @@ struct Dispatch;
 constexpr const char* kEyeGazeExtension = "XR_EXT_eye_gaze_interaction";
 constexpr const char* kEyeGazeProfile = "/interaction_profiles/ext/eye_gaze_interaction";
 constexpr const char* kEyeGazePath = "/user/eyes_ext/input/gaze_ext/pose";
+constexpr const char* kEyeGazeUser = "/user/eyes_ext";
 
 // Per instance: created after xrCreateInstance when the extension was enabled below.
 struct EyeGazeActions {
   XrActionSet set = XR_NULL_HANDLE;
   XrAction pose = XR_NULL_HANDLE;
   XrPath profile = XR_NULL_PATH, binding = XR_NULL_PATH;
-  bool suggested = false;  // the application's own suggestion for the profile included ours
+  XrPath user = XR_NULL_PATH;  // /user/eyes_ext
   bool valid() const { return pose != XR_NULL_HANDLE; }
 };
 

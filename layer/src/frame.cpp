@@ -1,5 +1,10 @@
-// Frame intercepts: xrWaitFrame/xrBeginFrame/xrEndFrame are timed. Without a renderer the
-// application's frame goes down unchanged; with one, its layers replace the application's (frame_renderer.hpp).
+// Frame intercepts: xrWaitFrame/xrBeginFrame/xrEndFrame are timed, each frame's record kept in
+// the session's frames-in-flight queue by predicted display time (frame_queue.hpp). Without a
+// renderer the application's frame goes down unchanged; with one, the newest path-traced
+// frame replaces its projection layer (frame_renderer.hpp). No lock is held across a call
+// down the chain or a composition.
+#include <memory>
+#include <optional>
 #include <stdexcept>
 #include <vector>
 
@@ -9,25 +14,44 @@
 namespace fovea::layer {
 namespace {
 
-// Runs layer bookkeeping for a session; an exception disables the layer for the session.
-template <class F>
-void bookkeeping(XrSession session, F&& f) {
+// What an intercepted frame call needs of its session, copied under Layer::mutex so that the
+// call itself runs without it.
+struct SessionRefs {
+  const Dispatch* next = nullptr;
+  std::shared_ptr<SessionFrames> frames;     // null: a session the layer does not track
+  std::shared_ptr<FrameRenderer> renderer;   // null: pass-through or disabled
+  EyeGazeSession gaze;
+  PFN_xrGetVisibilityMaskKHR get_visibility_mask = nullptr;
+  std::uint64_t visibility_mask_generation = 0;
+};
+
+SessionRefs refs(XrSession session) {
   std::lock_guard lock(layer().mutex);
+  SessionRefs r;
+  r.next = next_for_session(session);
   auto it = layer().sessions.find(session);
-  if (it == layer().sessions.end() || it->second.disabled) return;
-  try {
-    f(it->second);
-  } catch (const std::exception& e) {
-    FOVEA_LAYER_ERROR("internal failure, the layer passes this session through from now on: %s", e.what());
-    it->second.renderer.reset();
-    it->second.disabled = true;
-  }
+  if (it == layer().sessions.end() || it->second.disabled) return r;
+  const SessionState& s = it->second;
+  r.frames = s.frames;
+  r.renderer = s.renderer;
+  r.gaze = s.gaze;
+  r.get_visibility_mask = s.get_visibility_mask;
+  r.visibility_mask_generation = s.visibility_mask_generation;
+  return r;
 }
 
-// The views of an application's stereo projection layer, if the layer can replace it: each
-// is a projection view on a swapchain of this session with a released image, its rect inside
-// the image and its array layer present. Otherwise nothing: the application's frame goes down
-// unchanged and the runtime reports the application's error, while the layer stays enabled.
+// An internal failure: the session passes through from now on. Its renderer is released by
+// the last reference (the caller's, after its call down).
+void disable(XrSession session, const std::exception& e) {
+  FOVEA_LAYER_ERROR("internal failure, the layer passes this session through from now on: %s", e.what());
+  std::shared_ptr<FrameRenderer> renderer;
+  std::lock_guard lock(layer().mutex);
+  auto it = layer().sessions.find(session);
+  if (it == layer().sessions.end()) return;
+  it->second.disabled = true;
+  renderer = std::move(it->second.renderer);
+}
+
 // A released image of a swapchain of `session` whose rect and array layer lie inside it.
 const SwapchainState* usable_sub_image(XrSession session, const XrSwapchainSubImage& sub) {
   const auto sc = layer().swapchains.find(sub.swapchain);
@@ -78,86 +102,97 @@ std::vector<AppView> replaceable_views(XrSession session, const XrCompositionLay
   return views;
 }
 
-template <class PFN>
-PFN next_fn(XrSession session, PFN Dispatch::*member) {
-  std::lock_guard lock(layer().mutex);
-  const Dispatch* d = next_for_session(session);
-  return d ? d->*member : nullptr;
-}
-
 }  // namespace
 
 XrResult intercept::xrWaitFrame(XrSession session, const XrFrameWaitInfo* info, XrFrameState* state) {
-  const auto next = next_fn(session, &Dispatch::xrWaitFrame);
-  if (!next) return XR_ERROR_HANDLE_INVALID;
+  const SessionRefs s = refs(session);
+  if (!s.next) return XR_ERROR_HANDLE_INVALID;
   const std::int64_t t0 = now_ns();
-  const XrResult r = next(session, info, state);
+  const XrResult r = s.next->xrWaitFrame(session, info, state);
   const std::int64_t t1 = now_ns();
-  if (XR_SUCCEEDED(r))
-    bookkeeping(session, [&](SessionState& s) {
-      s.current.wait_call_ns = t0;
-      s.current.wait_return_ns = t1;
-      s.current.display_time_ns = state->predictedDisplayTime;
-    });
+  if (XR_SUCCEEDED(r) && s.frames) {
+    std::lock_guard lock(s.frames->mutex);
+    s.frames->queue.waited(state->predictedDisplayTime, t0, t1);
+  }
   return r;
 }
 
 XrResult intercept::xrBeginFrame(XrSession session, const XrFrameBeginInfo* info) {
-  const auto next = next_fn(session, &Dispatch::xrBeginFrame);
-  if (!next) return XR_ERROR_HANDLE_INVALID;
-  const XrResult r = next(session, info);
-  if (XR_SUCCEEDED(r)) bookkeeping(session, [&](SessionState& s) { s.current.begin_ns = now_ns(); });
+  const SessionRefs s = refs(session);
+  if (!s.next) return XR_ERROR_HANDLE_INVALID;
+  const XrResult r = s.next->xrBeginFrame(session, info);
+  if (XR_SUCCEEDED(r) && s.frames) {
+    std::lock_guard lock(s.frames->mutex);
+    s.frames->queue.begun(now_ns());
+  }
   return r;
 }
 
 XrResult intercept::xrEndFrame(XrSession session, const XrFrameEndInfo* info) {
-  const auto next = next_fn(session, &Dispatch::xrEndFrame);
-  if (!next) return XR_ERROR_HANDLE_INVALID;
-  const XrFrameEndInfo* submit = info;
+  const SessionRefs s = refs(session);
+  if (!s.next) return XR_ERROR_HANDLE_INVALID;
   const std::int64_t t_call = now_ns();
-  bookkeeping(session, [&](SessionState& s) {
-    if (!s.renderer || !info) return;
+  // The frame this call ends (its record leaves the queue): a frame begun before, with a valid
+  // end info, is one the runtime may accept and the only kind rendered.
+  std::optional<FrameTimes> record;
+  if (s.frames && info && info->type == XR_TYPE_FRAME_END_INFO) {
+    std::lock_guard lock(s.frames->mutex);
+    record = s.frames->queue.end(info->displayTime);
+  }
+  const XrFrameEndInfo* submit = info;
+  Shown shown;
+  if (s.renderer && record && info->displayTime > 0) {
     FrameInput in;
-    in.frame = s.current.frame;
     in.display_time = info->displayTime;
     in.app_frame = info;
-    // Only a frame the runtime may accept is rendered: begun, with a valid end info.
-    if (info->type != XR_TYPE_FRAME_END_INFO || info->displayTime <= 0 || s.current.begin_ns == 0) return;
-    // The first stereo projection layer is the one replaced.
-    for (uint32_t i = 0; info->layers && i < info->layerCount; ++i) {
-      if (!info->layers[i] || info->layers[i]->type != XR_TYPE_COMPOSITION_LAYER_PROJECTION) continue;
-      const auto* p = reinterpret_cast<const XrCompositionLayerProjection*>(info->layers[i]);
-      if (p->viewCount != 2 || !p->views) continue;
-      in.projection_layer = i;
-      in.app_views = replaceable_views(session, *p);
-      break;
+    {
+      // The first stereo projection layer is the one replaced.
+      std::lock_guard lock(layer().mutex);
+      for (uint32_t i = 0; info->layers && i < info->layerCount; ++i) {
+        if (!info->layers[i] || info->layers[i]->type != XR_TYPE_COMPOSITION_LAYER_PROJECTION) continue;
+        const auto* p = reinterpret_cast<const XrCompositionLayerProjection*>(info->layers[i]);
+        if (p->viewCount != 2 || !p->views) continue;
+        in.projection_layer = i;
+        in.app_views = replaceable_views(session, *p);
+        break;
+      }
     }
     in.get_visibility_mask = s.get_visibility_mask;
     in.visibility_mask_generation = s.visibility_mask_generation;
     if (s.gaze.attached()) {
       in.gaze_from_action = true;
-      in.action_gaze = locate_eye_gaze(*next_for_session(session), s.gaze, info->displayTime);
+      in.action_gaze = locate_eye_gaze(*s.next, s.gaze, info->displayTime);
     }
-    if (const XrFrameEndInfo* replaced = s.renderer->render(in)) submit = replaced;
-    s.current.render = s.renderer->times();
-  });
-  const XrResult r = next(session, submit);
+    try {
+      if (const XrFrameEndInfo* replaced = s.renderer->end_frame(in, shown)) submit = replaced;
+    } catch (const std::exception& e) {
+      disable(session, e);
+      submit = info;
+      shown = Shown{};
+    }
+  }
+  const XrResult r = s.next->xrEndFrame(session, submit);
   const std::int64_t t_return = now_ns();
-  bookkeeping(session, [&](SessionState& s) {
-    FrameTimes& t = s.current;
+  if (record) {
+    FrameTimes& t = *record;
     t.end_call_ns = t_call;
     t.end_return_ns = t_return;
-    t.layers = info ? info->layerCount : 0;
+    t.layers = info->layerCount;
     t.projection_views = 0;
-    for (uint32_t i = 0; info && info->layers && i < info->layerCount; ++i)
+    for (uint32_t i = 0; info->layers && i < info->layerCount; ++i)
       if (info->layers[i] && info->layers[i]->type == XR_TYPE_COMPOSITION_LAYER_PROJECTION)
         t.projection_views += reinterpret_cast<const XrCompositionLayerProjection*>(info->layers[i])->viewCount;
     t.replaced = submit != info;
-    s.log.write(t);
-    const std::int64_t frame = t.frame;
-    t = FrameTimes{};
-    t.frame = frame + 1;
-  });
+    if (t.replaced) {
+      t.traced_frame = shown.frame;
+      t.traced_for_ns = shown.traced_for_ns;
+      t.traced_done_ns = shown.done_ns;
+      t.reprojected_deg = shown.reprojected_deg;
+      t.render = shown.times;
+    }
+    std::lock_guard lock(s.frames->mutex);
+    s.frames->log.write(t);
+  }
   return r;
 }
 

@@ -3,6 +3,7 @@
 #include <time.h>
 
 #include <cerrno>
+#include <cmath>
 #include <cstring>
 
 #include "log.hpp"
@@ -39,7 +40,9 @@ void FrameLog::write(const FrameTimes& t) {
                "\"end_frame_ms\":%.3f,\"layers\":%u,\"projection_views\":%u,\"replaced\":%s,\"render_ms\":%.3f,"
                "\"trace_ms\":%.3f,\"reconstruct_ms\":%.3f,\"resolve_ms\":%.3f,\"transfer_ms\":%.3f,"
                "\"gaze_cpu_ms\":%.3f,\"grid_cpu_ms\":%.3f,\"submit_cpu_ms\":%.3f,\"readback_cpu_ms\":%.3f,"
-               "\"gaze_sample_ns\":%lld,\"gaze_receive_ns\":%lld,\"gaze_read_ns\":%lld,\"samples_hidden\":%lld}\n",
+               "\"gaze_sample_ns\":%lld,\"gaze_receive_ns\":%lld,\"gaze_read_ns\":%lld,\"samples_hidden\":%lld,"
+               "\"traced_frame\":%lld,\"traced_for_ns\":%lld,\"traced_done_ns\":%lld,\"traced_age_ns\":%lld,"
+               "\"reprojected_deg\":%.4f}\n",
                static_cast<long long>(t.frame), static_cast<long long>(t.display_time_ns),
                static_cast<long long>(t.wait_call_ns), static_cast<long long>(t.wait_return_ns),
                static_cast<long long>(t.begin_ns), static_cast<long long>(t.end_call_ns),
@@ -48,7 +51,11 @@ void FrameLog::write(const FrameTimes& t) {
                t.replaced ? "true" : "false", t.render.total, t.render.trace, t.render.reconstruct, t.render.resolve,
                t.render.transfer, t.render.gaze_cpu, t.render.grid_cpu, t.render.submit_cpu, t.render.readback_cpu,
                static_cast<long long>(t.render.gaze_sample_ns), static_cast<long long>(t.render.gaze_receive_ns),
-               static_cast<long long>(t.render.gaze_read_ns), static_cast<long long>(t.render.samples_hidden));
+               static_cast<long long>(t.render.gaze_read_ns), static_cast<long long>(t.render.samples_hidden),
+               static_cast<long long>(t.traced_frame), static_cast<long long>(t.traced_for_ns),
+               static_cast<long long>(t.traced_done_ns),
+               static_cast<long long>(t.traced_frame >= 0 ? t.display_time_ns - t.traced_for_ns : 0),
+               std::isfinite(t.reprojected_deg) ? t.reprojected_deg : 0.0);
   std::fflush(file_);
 }
 

@@ -19,7 +19,13 @@ struct FrameTimes {
   std::int64_t end_call_ns = 0, end_return_ns = 0;  // around the call down the chain
   std::uint32_t layers = 0, projection_views = 0;
   bool replaced = false;  // a frame renderer replaced the application's layers
-  RenderTimes render;     // the frame renderer's split (zero without one)
+  // The path-traced frame shown (-1: none finished yet, or no renderer): its number, the
+  // display time it was traced for (its age is display_time_ns - traced_for_ns), when it
+  // finished, and the head rotation reprojected since (degrees, the larger of the two eyes).
+  std::int64_t traced_frame = -1;
+  std::int64_t traced_for_ns = 0, traced_done_ns = 0;
+  double reprojected_deg = 0;
+  RenderTimes render;     // the frame renderer's split of the traced frame (zero without one)
 };
 
 class FrameLog {

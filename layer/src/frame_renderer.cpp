@@ -1,14 +1,25 @@
-// The layer's path-tracing renderer. Fovea's pipeline runs on its own compute context
-// (gpu::Context creates its own VkInstance/VkDevice and cannot wrap the application's), so
-// each frame moves through host memory: the pipeline's linear images are read back, the
-// application's projection views are read back from its device, both are composited on the
-// host in the application's 8-bit encoding and uploaded into the layer's swapchains on the
-// application's device. On lavapipe both devices are host memory anyway; on a discrete GPU
-// this costs two PCIe round trips of the eye rasters per frame.
+// The layer's path-tracing renderer. Fovea's pipeline runs on its own thread and its own
+// compute context (gpu::Context creates its own VkInstance/VkDevice and queue, so the render
+// thread never touches the application's queue), and publishes each finished frame read back
+// and encoded in the application's format. xrEndFrame takes the newest finished frame,
+// reprojects it by rotation to the submitted view orientations, reads the application's
+// projection views back from its device, composites on the host and uploads into the layer's
+// swapchains on the application's device. On lavapipe both devices are host memory anyway; on
+// a discrete GPU this costs two PCIe round trips of the eye rasters per frame.
 #include "frame_renderer.hpp"
 
+#include <sys/resource.h>
+#include <sys/syscall.h>
+#include <unistd.h>
+
+#include <algorithm>
 #include <array>
+#include <cerrno>
 #include <chrono>
+#include <condition_variable>
+#include <cstdlib>
+#include <mutex>
+#include <thread>
 #include <cmath>
 #include <cstring>
 #include <stdexcept>
@@ -96,40 +107,65 @@ core::StereoViews submitted_views(const std::vector<AppView>& v) {
 // resample moves 4-byte texels by direction, so each float travels as its bytes (pixels the
 // application did not cover read 0, where the colour's alpha 0 already keeps the scene).
 std::vector<float> resample_depth(const std::vector<float>& depth, const core::View& app_view,
-                                  const core::View& scene_view) {
+                                  const core::View& scene_view, const glm::dquat& scene_to_app = glm::dquat(1, 0, 0, 0)) {
   Pixels8 packed{app_view.width(), app_view.height(), std::vector<std::uint8_t>(depth.size() * 4)};
   std::memcpy(packed.data.data(), depth.data(), packed.data.size());
-  const Pixels8 moved = resample(packed, app_view, scene_view);
+  const Pixels8 moved = resample(packed, app_view, scene_view, scene_to_app);
   std::vector<float> out(moved.data.size() / 4);
   std::memcpy(out.data(), moved.data.data(), moved.data.size());
   return out;
 }
 
-class PathTraceRenderer final : public FrameRenderer {
+// What the application thread hands the render thread: the newest submitted views and gaze.
+struct TraceRequest {
+  std::int64_t id = 0;
+  XrTime display_time = 0;
+  std::array<XrPosef, 2> poses{};
+  bool gaze_from_action = false;
+  ActionGaze action_gaze;
+  PFN_xrGetVisibilityMaskKHR get_visibility_mask = nullptr;
+  std::uint64_t visibility_mask_generation = 0;
+};
+
+// A finished path-traced frame, encoded in the application's swapchain format.
+struct TracedFrame {
+  std::int64_t id = 0;
+  XrTime traced_for = 0;
+  std::int64_t done_ns = 0;
+  std::array<glm::dquat, 2> orientation{};  // the views' orientations it was traced for (the application's space)
+  std::array<Pixels8, 2> colour;
+  std::array<std::vector<float>, 2> depth;  // view distances (FramePipeline::depth); empty in scene-only mode
+  RenderTimes times;
+};
+
+std::int64_t monotonic_ns() {
+  return std::chrono::duration_cast<std::chrono::nanoseconds>(std::chrono::steady_clock::now().time_since_epoch()).count();
+}
+
+// The render thread's side: Fovea's pipeline on its own gpu::Context (its own VkDevice and
+// queue), created on the render thread so that the application's first frames do not wait
+// for the scene upload and shader setup either.
+class PathTracer {
  public:
-  PathTraceRenderer(const LayerConfig& config, const VulkanBinding& vk, const Dispatch& next, XrSession session)
-      : config_(config), next_(next), session_(session), scene_(renderer::load_scene(config.scene)), app_(vk) {
-    for (const auto& w : scene_.warnings) FOVEA_LAYER_WARN("scene %s: %s", config.scene.c_str(), w.c_str());
+  PathTracer(const LayerConfig& config, const renderer::Scene& scene, const core::StereoViews& views,
+             const core::DisplayPreset& display, VkFormat format, XrSession session)
+      : config_(config), scene_(scene), views_(views), format_(format), session_(session),
+        gaze_(std::make_unique<LayerGaze>(config.gaze, display)), ctx_(std::make_unique<gpu::Context>()),
+        gpu_scene_(std::make_unique<renderer::GpuScene>(*ctx_, scene_)) {
+    reconstruct::ReconSettings settings;
+    settings.share = reconstruct::StereoShare::Gather;
+    pipeline_ = std::make_unique<pipeline::FramePipeline>(*ctx_, *gpu_scene_, views_, core::DistributionParams{}, settings);
+    FOVEA_LAYER_INFO("rendering scene \"%s\" (from %s) at %dx%d per eye on %s, composite %s, gaze %s, render %s",
+                     config_.scene.c_str(), config_.origin.c_str(), display.width, display.height,
+                     ctx_->info().name.c_str(), composite_name(config_.composite), gaze_->describe().c_str(),
+                     config_.lockstep ? "lockstep" : "async");
   }
 
-  ~PathTraceRenderer() override {
-    for (Eye& e : eyes_)
-      if (e.swapchain != XR_NULL_HANDLE) next_.xrDestroySwapchain(e.swapchain);
-  }
-
-  const RenderTimes& times() const override { return times_; }
-
-  const XrFrameEndInfo* render(const FrameInput& in) override {
-    times_ = RenderTimes{};
-    if (in.app_views.size() != 2) return nullptr;  // only stereo projection layers are replaced
+  std::shared_ptr<const TracedFrame> trace(const TraceRequest& in) {
+    auto f = std::make_shared<TracedFrame>();
+    RenderTimes& times = f->times;
     const auto t0 = std::chrono::steady_clock::now();
-    if (!pipeline_) start(in);
-    const XrRect2Di& r0 = in.app_views[0].rect;
-    for (const AppView& v : in.app_views)
-      if (v.rect.extent.width != r0.extent.width || v.rect.extent.height != r0.extent.height || v.format != format_)
-        throw std::runtime_error("the application changed its projection views' size or format during the session");
     update_visibility(in);
-
     const auto t_gaze = std::chrono::steady_clock::now();
     // Eye poses: the application's view poses (its reference space) placed at the scene's camera.
     std::array<core::Pose, 2> poses;
@@ -140,27 +176,188 @@ class PathTraceRenderer final : public FrameRenderer {
       gaze_from_action_ = in.gaze_from_action;
     }
     if (fg.has_sample) {
-      times_.gaze_sample_ns = fg.sample_ns;
-      times_.gaze_receive_ns = fg.receive_ns;
+      times.gaze_sample_ns = fg.sample_ns;
+      times.gaze_receive_ns = fg.receive_ns;
     }
-    times_.gaze_read_ns = fg.read_ns;
+    times.gaze_read_ns = fg.read_ns;
     for (int e = 0; e < 2; ++e) {
-      const core::Pose p = to_pose(in.app_views[std::size_t(e)].pose);
-      poses[std::size_t(e)].orientation = scene_.camera.orientation * p.orientation;
-      poses[std::size_t(e)].position = scene_.camera.position + scene_.camera.orientation * p.position;
-      gaze[std::size_t(e)] = fg.eye(core::Eye(e)).dir;
+      const auto ei = std::size_t(e);
+      const core::Pose p = to_pose(in.poses[ei]);
+      f->orientation[ei] = p.orientation;
+      poses[ei].orientation = scene_.camera.orientation * p.orientation;
+      poses[ei].position = scene_.camera.position + scene_.camera.orientation * p.position;
+      gaze[ei] = fg.eye(core::Eye(e)).dir;
     }
-    times_.gaze_cpu = ms_since(t_gaze);
-    const pipeline::FrameTimes gt = pipeline_->render(poses, gaze, std::uint32_t(in.frame));
-    times_.trace = gt.grid.gpu_ms + gt.trace.gpu_ms;
-    times_.reconstruct = gt.reconstruct.gpu_ms;
-    times_.resolve = gt.resolve.gpu_ms;
-    times_.grid_cpu = gt.grid.cpu_ms;
-    times_.submit_cpu = gt.submit_cpu_ms;
+    times.gaze_cpu = ms_since(t_gaze);
+    const pipeline::FrameTimes gt = pipeline_->render(poses, gaze, std::uint32_t(in.id));
+    times.trace = gt.grid.gpu_ms + gt.trace.gpu_ms;
+    times.reconstruct = gt.reconstruct.gpu_ms;
+    times.resolve = gt.resolve.gpu_ms;
+    times.grid_cpu = gt.grid.cpu_ms;
+    times.submit_cpu = gt.submit_cpu_ms;
     // Counted from the grids (a read-back), so only while a mask is set.
-    if (mask_set_) times_.samples_hidden = pipeline_->hidden_cells(core::Eye::Left) + pipeline_->hidden_cells(core::Eye::Right);
+    if (mask_set_) times.samples_hidden = pipeline_->hidden_cells(core::Eye::Left) + pipeline_->hidden_cells(core::Eye::Right);
+    const auto r0 = std::chrono::steady_clock::now();
+    for (int e = 0; e < 2; ++e) {
+      f->colour[std::size_t(e)] = encode_scene(pipeline_->image(core::Eye(e)), pixel_format(format_));
+      if (config_.composite != Composite::SceneOnly) f->depth[std::size_t(e)] = pipeline_->depth(core::Eye(e));
+    }
+    times.readback_cpu = ms_since(r0);
+    times.total = ms_since(t0);
+    f->id = in.id;
+    f->traced_for = in.display_time;
+    f->done_ns = monotonic_ns();
+    return f;
+  }
 
-    const auto t1 = std::chrono::steady_clock::now();
+ private:
+  // The runtime's hidden area for the submitted views: fetched at the first frame and after
+  // each change event. A failed fetch is reported and leaves the previous mask (none at
+  // first): culling saves work, the image is right without it.
+  void update_visibility(const TraceRequest& in) {
+    if (!in.get_visibility_mask || mask_generation_ == in.visibility_mask_generation) return;
+    mask_generation_ = in.visibility_mask_generation;
+    for (int e = 0; e < 2; ++e) {
+      const core::Eye eye = core::Eye(e);
+      try {
+        const core::ViewMask mask = fetch_visibility_mask(in.get_visibility_mask, session_, std::uint32_t(e), views_[eye]);
+        pipeline_->set_visibility(eye, mask);
+        mask_set_ = true;
+        FOVEA_LAYER_INFO("visibility mask of the %s view: %.1f%% of its pixels hidden, not traced", core::eye_name(eye),
+                         100.0 * mask.hidden_fraction());
+      } catch (const std::exception& ex) {
+        FOVEA_LAYER_WARN("visibility mask of the %s view not used: %s", core::eye_name(eye), ex.what());
+      }
+    }
+  }
+
+  const LayerConfig& config_;
+  const renderer::Scene& scene_;
+  const core::StereoViews views_;
+  const VkFormat format_;
+  const XrSession session_;
+  std::unique_ptr<LayerGaze> gaze_;
+  bool gaze_from_action_ = false;
+  std::optional<std::uint64_t> mask_generation_;  // of the mask fetched last (none yet)
+  bool mask_set_ = false;                         // the pipeline culls with a runtime mask
+  std::unique_ptr<gpu::Context> ctx_;
+  std::unique_ptr<renderer::GpuScene> gpu_scene_;
+  std::unique_ptr<pipeline::FramePipeline> pipeline_;
+};
+
+// The angle (degrees) of a rotation.
+// The render thread's nice value (19 is the lowest priority).
+constexpr int kRenderNice = 10;
+
+double rotation_deg(const glm::dquat& q) {
+  return glm::degrees(2.0 * std::acos(std::min(1.0, std::abs(q.w))));
+}
+
+class PathTraceRenderer final : public FrameRenderer {
+ public:
+  PathTraceRenderer(const LayerConfig& config, const VulkanBinding& vk, const Dispatch& next, XrSession session)
+      : config_(config), next_(next), session_(session), scene_(renderer::load_scene(config.scene)), app_(vk) {
+    for (const auto& w : scene_.warnings) FOVEA_LAYER_WARN("scene %s: %s", config.scene.c_str(), w.c_str());
+    // Tests slow the render thread down to show that the application never waits for it.
+    if (const char* d = std::getenv("FOVEA_LAYER_TEST_RENDER_DELAY_MS")) test_delay_ = std::chrono::milliseconds(std::atoll(d));
+  }
+
+  ~PathTraceRenderer() override {
+    {
+      std::lock_guard lock(mutex_);
+      stop_ = true;
+    }
+    wake_.notify_all();
+    if (thread_.joinable()) thread_.join();
+    for (Eye& e : eyes_)
+      if (e.swapchain != XR_NULL_HANDLE) next_.xrDestroySwapchain(e.swapchain);
+  }
+
+  const XrFrameEndInfo* end_frame(const FrameInput& in, Shown& shown) override {
+    if (in.app_views.size() != 2) return nullptr;  // only stereo projection layers are replaced
+    if (!thread_.joinable()) start(in);
+    const XrRect2Di& r0 = in.app_views[0].rect;
+    for (const AppView& v : in.app_views)
+      if (v.rect.extent.width != r0.extent.width || v.rect.extent.height != r0.extent.height || v.format != format_)
+        throw std::runtime_error("the application changed its projection views' size or format during the session");
+
+    TraceRequest req;
+    req.display_time = in.display_time;
+    for (std::size_t e = 0; e < 2; ++e) req.poses[e] = in.app_views[e].pose;
+    req.gaze_from_action = in.gaze_from_action;
+    req.action_gaze = in.action_gaze;
+    req.get_visibility_mask = in.get_visibility_mask;
+    req.visibility_mask_generation = in.visibility_mask_generation;
+    std::shared_ptr<const TracedFrame> frame;
+    {
+      std::unique_lock lock(mutex_);
+      if (!error_.empty()) throw std::runtime_error("the render thread failed: " + error_);
+      req.id = next_request_++;
+      pending_ = req;  // replaces a request the thread has not picked up: only the newest views count
+      wake_.notify_all();
+      if (config_.lockstep) {
+        constexpr auto kLimit = std::chrono::minutes(10);
+        if (!done_.wait_for(lock, kLimit, [&] { return !error_.empty() || (newest_ && newest_->id >= req.id); }))
+          throw std::runtime_error("lockstep rendering: the render thread did not finish a frame in 10 minutes");
+        if (!error_.empty()) throw std::runtime_error("the render thread failed: " + error_);
+      }
+      frame = newest_;
+    }
+    if (!frame) return nullptr;  // nothing traced yet: the application's own frame
+    const auto t0 = std::chrono::steady_clock::now();
+    const XrFrameEndInfo* out = compose(in, *frame, shown);
+    shown.times.transfer = ms_since(t0);
+    return out;
+  }
+
+ private:
+  struct Eye {
+    XrSwapchain swapchain = XR_NULL_HANDLE;
+    std::vector<VkImage> images;
+  };
+
+  void run() {
+    // Below the application's threads: on a CPU device (lavapipe) the path tracer would
+    // otherwise take the cores the application's frame loop needs. Linux nice values are per
+    // thread and inherited by the threads this one creates (the render device's workers).
+    if (setpriority(PRIO_PROCESS, static_cast<id_t>(syscall(SYS_gettid)), kRenderNice) != 0)
+      FOVEA_LAYER_WARN("render thread: cannot lower its priority (%s); it competes with the application's threads",
+                       std::strerror(errno));
+    std::unique_ptr<PathTracer> tracer;
+    try {
+      tracer = std::make_unique<PathTracer>(config_, scene_, views_in_, display_, format_, session_);
+      for (;;) {
+        TraceRequest req;
+        {
+          std::unique_lock lock(mutex_);
+          wake_.wait(lock, [&] { return stop_ || pending_.has_value(); });
+          if (stop_) return;
+          if (test_delay_.count() > 0 && wake_.wait_for(lock, test_delay_, [&] { return stop_; })) return;
+          req = *pending_;  // the newest, also when it arrived during the delay
+          pending_.reset();
+        }
+        std::shared_ptr<const TracedFrame> f = tracer->trace(req);
+        {
+          std::lock_guard lock(mutex_);
+          newest_ = std::move(f);
+        }
+        done_.notify_all();
+      }
+    } catch (const std::exception& e) {
+      std::lock_guard lock(mutex_);
+      error_ = e.what();
+    }
+    done_.notify_all();
+  }
+
+  // The traced frame reprojected (rotation only) from the orientations it was traced for to
+  // the submitted ones, the application's pixels composited over it, written into the
+  // layer's swapchains; the application's frame with its projection layer replaced.
+  const XrFrameEndInfo* compose(const FrameInput& in, const TracedFrame& f, Shown& shown) {
+    shown.frame = f.id;
+    shown.traced_for_ns = f.traced_for;
+    shown.done_ns = f.done_ns;
+    shown.times = f.times;
     std::vector<AppDevice::Read> reads;
     for (const AppView& v : in.app_views) reads.push_back({v.image, v.array_index, v.rect});
     const std::vector<Pixels8> app = config_.composite == Composite::SceneOnly ? std::vector<Pixels8>{} : app_.read(reads);
@@ -169,17 +366,19 @@ class PathTraceRenderer final : public FrameRenderer {
     std::vector<VkImage> targets;
     for (int e = 0; e < 2; ++e) {
       const auto ei = std::size_t(e);
-      const auto r0 = std::chrono::steady_clock::now();
-      const core::Image rendered = pipeline_->image(core::Eye(e));
-      times_.readback_cpu += ms_since(r0);
-      out[ei] = encode_scene(rendered, pixel_format(format_));
+      const core::View& traced_view = views_in_[core::Eye(e)];
+      const core::View out_view(to_fov(in.app_views[ei].fov), traced_view.width(), traced_view.height());
+      const glm::dquat to_traced = glm::conjugate(f.orientation[ei]) * to_pose(in.app_views[ei].pose).orientation;
+      shown.reprojected_deg = std::max(shown.reprojected_deg, rotation_deg(to_traced));
+      out[ei] = resample(f.colour[ei], traced_view, out_view, to_traced);
+      // Where the traced frame does not reach (the head turned past its border): opaque black.
+      for (std::size_t i = 3; i < out[ei].data.size(); i += 4) out[ei].data[i] = 255;
       if (!app.empty()) {
         const core::View app_view(to_fov(in.app_views[ei].fov), app[ei].width, app[ei].height);
-        const core::View& scene_view = views_in_[core::Eye(e)];
-        const Pixels8 a = resample(app[ei], app_view, scene_view);
-        if (!app_depth.empty()) {
-          composite_depth(out[ei], pipeline_->depth(core::Eye(e)), a,
-                          resample_depth(app_depth[ei], app_view, scene_view), in.app_views[ei].depth->range);
+        const Pixels8 a = resample(app[ei], app_view, out_view);
+        if (!app_depth.empty() && !f.depth[ei].empty()) {
+          composite_depth(out[ei], resample_depth(f.depth[ei], traced_view, out_view, to_traced), a,
+                          resample_depth(app_depth[ei], app_view, out_view), in.app_views[ei].depth->range);
         } else {
           const auto bg = config_.app_background
                               ? std::array<std::uint8_t, 3>{std::uint8_t((*config_.app_background)[0]),
@@ -201,7 +400,6 @@ class PathTraceRenderer final : public FrameRenderer {
     }
     app_.write(targets, {&out[0], &out[1]});
     for (Eye& eye : eyes_) xr_check(next_.xrReleaseSwapchainImage(eye.swapchain, nullptr), "xrReleaseSwapchainImage");
-    times_.transfer = ms_since(t1);
 
     // The application's frame with its stereo projection layer replaced by the layer's.
     const auto* app_proj = reinterpret_cast<const XrCompositionLayerProjection*>(in.app_frame->layers[in.projection_layer]);
@@ -228,15 +426,8 @@ class PathTraceRenderer final : public FrameRenderer {
     layers_[in.projection_layer] = reinterpret_cast<const XrCompositionLayerBaseHeader*>(&projection_);
     frame_ = *in.app_frame;
     frame_.layers = layers_.data();
-    times_.total = ms_since(t0);
     return &frame_;
   }
-
- private:
-  struct Eye {
-    XrSwapchain swapchain = XR_NULL_HANDLE;
-    std::vector<VkImage> images;
-  };
 
   // The application's window depths of both views, when it chained depth to both and the layer
   // can use it (a format it decodes, the colour rect's size); else nothing and the configured
@@ -265,28 +456,8 @@ class PathTraceRenderer final : public FrameRenderer {
     return app_.read_depth({*l.depth, *r.depth});
   }
 
-  // The runtime's hidden area for the submitted views: fetched at the first frame and after
-  // each change event. A failed fetch is reported and leaves the previous mask (none at
-  // first): culling saves work, the image is right without it.
-  void update_visibility(const FrameInput& in) {
-    if (!in.get_visibility_mask || mask_generation_ == in.visibility_mask_generation) return;
-    mask_generation_ = in.visibility_mask_generation;
-    for (int e = 0; e < 2; ++e) {
-      const core::Eye eye = core::Eye(e);
-      try {
-        const core::ViewMask mask = fetch_visibility_mask(in.get_visibility_mask, session_, std::uint32_t(e), views_in_[eye]);
-        pipeline_->set_visibility(eye, mask);
-        mask_set_ = true;
-        FOVEA_LAYER_INFO("visibility mask of the %s view: %.1f%% of its pixels hidden, not traced", core::eye_name(eye),
-                         100.0 * mask.hidden_fraction());
-      } catch (const std::exception& ex) {
-        FOVEA_LAYER_WARN("visibility mask of the %s view not used: %s", core::eye_name(eye), ex.what());
-      }
-    }
-  }
-
-  // At the first stereo frame: the pipeline for the application's views, the layer's
-  // swapchains in the application's format, the gaze source.
+  // At the first stereo frame: the layer's swapchains in the application's format for its
+  // views, then the render thread.
   void start(const FrameInput& in) {
     const AppView& v0 = in.app_views[0];
     format_ = v0.format;
@@ -301,7 +472,6 @@ class PathTraceRenderer final : public FrameRenderer {
     display_.fov_left = views_in_[core::Eye::Left].fov();
     display_.fov_right = views_in_[core::Eye::Right].fov();
     display_.ipd_m = views_in_.ipd_m;
-    gaze_ = std::make_unique<LayerGaze>(config_.gaze, display_);
 
     for (Eye& e : eyes_) {
       XrSwapchainCreateInfo ci{XR_TYPE_SWAPCHAIN_CREATE_INFO};
@@ -320,38 +490,36 @@ class PathTraceRenderer final : public FrameRenderer {
                "xrEnumerateSwapchainImages");
       for (const auto& i : imgs) e.images.push_back(i.image);
     }
-
-    ctx_ = std::make_unique<gpu::Context>();
-    gpu_scene_ = std::make_unique<renderer::GpuScene>(*ctx_, scene_);
-    reconstruct::ReconSettings settings;
-    settings.share = reconstruct::StereoShare::Gather;
-    pipeline_ = std::make_unique<pipeline::FramePipeline>(*ctx_, *gpu_scene_, views_in_, core::DistributionParams{},
-                                                          settings);
-    FOVEA_LAYER_INFO("rendering scene \"%s\" (from %s) at %dx%d per eye on %s, composite %s, gaze %s",
-                     config_.scene.c_str(), config_.origin.c_str(), display_.width, display_.height,
-                     ctx_->info().name.c_str(), composite_name(config_.composite), gaze_->describe().c_str());
+    thread_ = std::thread([this] { run(); });
   }
 
+  // Set at construction or in start() before the render thread exists; read-only after.
   LayerConfig config_;
   const Dispatch& next_;
   XrSession session_;
   renderer::Scene scene_;
-  AppDevice app_;
-  core::StereoViews views_in_;  // the submitted views: FOV, raster (imageRect), pose, IPD
+  core::StereoViews views_in_;  // the traced views: FOV, raster (the first frame's imageRect), pose, IPD
   core::DisplayPreset display_;
   VkFormat format_ = VK_FORMAT_UNDEFINED;
-  std::unique_ptr<LayerGaze> gaze_;
-  bool gaze_from_action_ = false;
-  std::optional<std::uint64_t> mask_generation_;  // of the mask fetched last (none yet)
-  bool mask_set_ = false;                         // the pipeline culls with a runtime mask
+  std::chrono::milliseconds test_delay_{0};
+
+  // The mailbox between the application's xrEndFrame and the render thread; held only to
+  // hand a request or a finished frame over, never across a render or a call down the chain.
+  std::mutex mutex_;
+  std::condition_variable wake_, done_;
+  std::optional<TraceRequest> pending_;
+  std::shared_ptr<const TracedFrame> newest_;
+  std::string error_;  // the render thread's failure (it has stopped)
+  bool stop_ = false;
+  std::int64_t next_request_ = 0;
+  std::thread thread_;
+
+  // xrEndFrame's composition (the application's thread).
+  AppDevice app_;
   bool depth_noted_ = false;  // the depth decision was logged
   bool chain_noted_ = false;  // a view's next chain could not be kept whole (logged once)
   ChainCopies chains_;        // the views' next chains, this frame
-  std::unique_ptr<gpu::Context> ctx_;
-  std::unique_ptr<renderer::GpuScene> gpu_scene_;
-  std::unique_ptr<pipeline::FramePipeline> pipeline_;
   std::array<Eye, 2> eyes_;
-  RenderTimes times_;
   XrCompositionLayerProjection projection_{XR_TYPE_COMPOSITION_LAYER_PROJECTION};
   std::array<XrCompositionLayerProjectionView, 2> views_{};
   std::vector<const XrCompositionLayerBaseHeader*> layers_;

@@ -56,7 +56,6 @@ struct AppView {
 };
 
 struct FrameInput {
-  std::int64_t frame = 0;
   XrTime display_time = 0;
   std::vector<AppView> app_views;  // the first stereo projection layer's views
   std::uint32_t projection_layer = 0;  // its index in app_frame->layers
@@ -73,11 +72,11 @@ struct FrameInput {
 
 // Where the layer's time went in the last render() (milliseconds).
 struct RenderTimes {
-  double total = 0;        // wall time of render()
+  double total = 0;        // wall time of the render on the render thread (trace, read-back, encoding)
   double trace = 0;        // GPU: grid generation + path tracing, both eyes
   double reconstruct = 0;  // GPU: accumulation, stereo sharing, BMFR, TAA
   double resolve = 0;      // GPU: resolve to the display, blur
-  double transfer = 0;     // read-back of the app's images, compositing, upload
+  double transfer = 0;     // in xrEndFrame: read-back of the app's images, reprojection, compositing, upload
   // CPU (monotonic clock): the gaze sample, the grids' per-frame build, recording and
   // submission until the GPU finished, read-back of the rendered images.
   double gaze_cpu = 0, grid_cpu = 0, submit_cpu = 0, readback_cpu = 0;
@@ -87,14 +86,27 @@ struct RenderTimes {
   std::int64_t samples_hidden = 0;  // grid cells under the runtime's hidden area, both eyes: not traced
 };
 
+// The path-traced frame an xrEndFrame showed.
+struct Shown {
+  std::int64_t frame = -1;          // its number (-1: none)
+  std::int64_t traced_for_ns = 0;   // the display time of the views it was traced for
+  std::int64_t done_ns = 0;         // when it finished (CLOCK_MONOTONIC)
+  double reprojected_deg = 0;       // head rotation since, the larger of the two eyes
+  RenderTimes times;                // its render's split; `transfer` is this xrEndFrame's composition
+};
+
+// Renders on its own thread: end_frame() hands the submitted views and gaze over and shows
+// the newest frame the thread finished; it never waits for a render (unless configured
+// "render": "lockstep", for deterministic captures).
 class FrameRenderer {
  public:
-  virtual ~FrameRenderer() = default;
-  // Renders the frame; returns the layers to submit instead of the application's (they must
-  // stay valid until the next call), or nullptr to submit the application's frame unchanged.
-  // Throws on failure; the layer then disables itself for the session.
-  virtual const XrFrameEndInfo* render(const FrameInput& in) = 0;
-  virtual const RenderTimes& times() const = 0;
+  virtual ~FrameRenderer() = default;  // stops the render thread after its current frame
+  // Returns the layers to submit instead of the application's (valid until the next call):
+  // the newest finished path-traced frame, reprojected to the submitted view poses and
+  // composited with the application's pixels; nullptr to submit the application's frame
+  // unchanged (not a stereo projection, nothing finished yet). Throws on failure, also the
+  // render thread's; the layer then disables itself for the session.
+  virtual const XrFrameEndInfo* end_frame(const FrameInput& in, Shown& shown) = 0;
 };
 
 // Null when no scene is configured; throws when one is configured but cannot be loaded or

@@ -21,6 +21,7 @@
 
 #include "eye_gaze.hpp"
 #include "frame_log.hpp"
+#include "frame_queue.hpp"
 #include "frame_renderer.hpp"
 
 namespace fovea::layer {
@@ -52,6 +53,7 @@ constexpr const char* kVisibilityMaskExtension = "XR_KHR_visibility_mask";
   X(xrCreateActionSet)       \
   X(xrDestroyActionSet)      \
   X(xrCreateAction)          \
+  X(xrDestroyAction)         \
   X(xrStringToPath)          \
   X(xrSuggestInteractionProfileBindings) \
   X(xrAttachSessionActionSets) \
@@ -60,7 +62,9 @@ constexpr const char* kVisibilityMaskExtension = "XR_KHR_visibility_mask";
   X(xrCreateReferenceSpace)  \
   X(xrLocateSpace)           \
   X(xrDestroySpace)          \
-  X(xrPollEvent)
+  X(xrPollEvent)             \
+  X(xrGetSystemProperties)   \
+  X(xrGetCurrentInteractionProfile)
 
 struct Dispatch {
 #define FOVEA_LAYER_MEMBER(name) PFN_##name name = nullptr;
@@ -76,14 +80,26 @@ struct SwapchainState {
   std::int64_t last_released = -1;
 };
 
+// A session's frame loop records, under the session's own lock (held only for bookkeeping,
+// never across a render or a call down the chain).
+struct SessionFrames {
+  std::mutex mutex;
+  FrameQueue queue;
+  FrameLog log;
+};
+
+// Fields are read and written under Layer::mutex, held briefly; the renderer and the frame
+// records are shared so that the calls using them run outside it.
 struct SessionState {
   XrInstance instance = XR_NULL_HANDLE;
   bool disabled = false;  // an internal failure: pass everything through from then on
   VulkanBinding vulkan;
-  std::unique_ptr<FrameRenderer> renderer;  // null: pass-through, measure only
-  FrameLog log;
-  FrameTimes current;                     // the frame in flight
+  std::shared_ptr<FrameRenderer> renderer;  // null: pass-through, measure only
+  std::shared_ptr<SessionFrames> frames = std::make_shared<SessionFrames>();
   EyeGazeSession gaze;                    // after an attach that included the layer's action set
+  // The interaction profiles the application has seen for InstanceState::app_user_paths (the
+  // layer's binding hidden); a profile-changed event that changes none of them is the layer's.
+  std::vector<XrPath> app_profiles;
   // The runtime's xrGetVisibilityMaskKHR (null: not enabled below); the generation counts the
   // XR_TYPE_EVENT_DATA_VISIBILITY_MASK_CHANGED_KHR events seen, so the renderer re-fetches.
   PFN_xrGetVisibilityMaskKHR get_visibility_mask = nullptr;
@@ -95,6 +111,13 @@ struct InstanceState {
   bool extension_enabled = false;  // the application enabled kLayerExtension
   std::string application;         // XrApplicationInfo::applicationName (the config section)
   EyeGazeActions gaze;             // the layer's eye-gaze action (a scene configured, the runtime has it)
+  // The layer enabled XR_EXT_eye_gaze_interaction for itself: for the application it stays
+  // not enabled (its profile, top-level path and properties unsupported or absent).
+  bool gaze_hidden = false;
+  // The application's own suggestion for the eye-gaze profile succeeded: its binding, not only
+  // the layer's, makes the profile current.
+  bool app_suggested_gaze = false;
+  std::vector<XrPath> app_user_paths;  // the top-level user paths the application can query
   PFN_xrGetVisibilityMaskKHR get_visibility_mask = nullptr;  // the extension is enabled below
   // The layer enabled kVisibilityMaskExtension for itself: the application must not see it
   // (its command stays unsupported, its events are not delivered).
@@ -106,6 +129,7 @@ struct Layer {
   std::map<XrInstance, InstanceState> instances;
   std::map<XrSession, SessionState> sessions;
   std::map<XrSwapchain, SwapchainState> swapchains;
+  std::map<XrActionSet, XrInstance> action_sets;  // the application's, for xrCreateAction's instance
   XrInstance last_instance = XR_NULL_HANDLE;  // dispatch for handles the layer does not know
 };
 
@@ -115,10 +139,16 @@ Layer& layer();
 // application's mistake) the most recent instance's, so the runtime reports the error.
 const Dispatch* next_for_session(XrSession session);
 
-// Destroys what the layer created on a session's handles (the renderer's swapchains and its
-// frees on the application's device, the eye-gaze spaces); called before the session, or
-// its instance, is destroyed below the layer. The session passes through from then on.
-void release_session(SessionState& s, const Dispatch& next);
+// Destroys what the layer created on a session's handles (the eye-gaze spaces) and returns
+// its renderer, for the caller to release outside Layer::mutex (that joins the render thread
+// and destroys the renderer's swapchains and its objects on the application's device) before
+// the session, or its instance, is destroyed below the layer. The session passes through
+// from then on.
+[[nodiscard]] std::shared_ptr<FrameRenderer> release_session(SessionState& s, const Dispatch& next);
+
+// Whether an interaction-profile-changed event of `session` changed nothing the application
+// can see (the layer's eye-gaze binding caused it); updates what the application has seen.
+bool layer_caused_profile_change(XrSession session);
 
 // Intercepted commands (hidden; reached through the layer's xrGetInstanceProcAddr).
 namespace intercept {
@@ -134,9 +164,14 @@ namespace intercept {
   X(xrBeginFrame)                  \
   X(xrEndFrame)                    \
   X(xrSuggestInteractionProfileBindings) \
+  X(xrCreateActionSet)             \
+  X(xrDestroyActionSet)            \
+  X(xrCreateAction)                \
   X(xrAttachSessionActionSets)     \
   X(xrSyncActions)                 \
-  X(xrPollEvent)
+  X(xrPollEvent)                   \
+  X(xrGetSystemProperties)         \
+  X(xrGetCurrentInteractionProfile)
 #define FOVEA_LAYER_DECLARE(name) std::remove_pointer_t<PFN_##name> name;
 FOVEA_LAYER_INTERCEPTED(FOVEA_LAYER_DECLARE)
 #undef FOVEA_LAYER_DECLARE

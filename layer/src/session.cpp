@@ -40,7 +40,7 @@ XrResult intercept::xrCreateSession(XrInstance instance, const XrSessionCreateIn
         const auto* b = reinterpret_cast<const XrGraphicsBindingVulkanKHR*>(p);
         st.vulkan = {b->instance, b->physicalDevice, b->device, b->queueFamilyIndex, b->queueIndex};
       }
-    st.log.open(env("FOVEA_LAYER_OUT"));
+    st.frames->log.open(env("FOVEA_LAYER_OUT"));
     st.renderer = make_frame_renderer(load_config(application), st.vulkan, *dispatch, *session);
     FOVEA_LAYER_INFO("session: Vulkan device %s (queue family %u index %u); %s", st.vulkan.valid() ? "captured" : "absent",
                      st.vulkan.queue_family, st.vulkan.queue_index,
@@ -55,22 +55,24 @@ XrResult intercept::xrCreateSession(XrInstance instance, const XrSessionCreateIn
   return r;
 }
 
-void release_session(SessionState& s, const Dispatch& next) {
-  s.renderer.reset();
+std::shared_ptr<FrameRenderer> release_session(SessionState& s, const Dispatch& next) {
   destroy_eye_gaze_session(next, s.gaze);
   s.disabled = true;
+  return std::move(s.renderer);
 }
 
 XrResult intercept::xrDestroySession(XrSession session) {
   PFN_xrDestroySession next = nullptr;
+  std::shared_ptr<FrameRenderer> renderer;
   {
     std::lock_guard lock(layer().mutex);
     const Dispatch* d = next_for_session(session);
     if (!d) return XR_ERROR_HANDLE_INVALID;
     next = d->xrDestroySession;
     auto it = layer().sessions.find(session);
-    if (it != layer().sessions.end()) release_session(it->second, *d);
+    if (it != layer().sessions.end()) renderer = release_session(it->second, *d);
   }
+  renderer.reset();  // joins the render thread; the swapchains go while the session lives
   const XrResult r = next(session);
   if (XR_SUCCEEDED(r)) {
     std::lock_guard lock(layer().mutex);
@@ -84,7 +86,8 @@ XrResult intercept::xrDestroySession(XrSession session) {
 
 // A visibility mask change makes the session's renderer fetch the mask again. When the layer
 // enabled the extension for itself the event is the layer's alone: it is consumed and the
-// next event, if any, is returned instead.
+// next event, if any, is returned instead. So is an interaction-profile change that only the
+// layer's eye-gaze binding caused.
 XrResult intercept::xrPollEvent(XrInstance instance, XrEventDataBuffer* event) {
   PFN_xrPollEvent next = nullptr;
   bool hidden = false;
@@ -97,6 +100,11 @@ XrResult intercept::xrPollEvent(XrInstance instance, XrEventDataBuffer* event) {
   }
   for (;;) {
     const XrResult r = next(instance, event);
+    if (r == XR_SUCCESS && event->type == XR_TYPE_EVENT_DATA_INTERACTION_PROFILE_CHANGED &&
+        layer_caused_profile_change(reinterpret_cast<const XrEventDataInteractionProfileChanged*>(event)->session)) {
+      *event = {XR_TYPE_EVENT_DATA_BUFFER};
+      continue;
+    }
     if (r != XR_SUCCESS || event->type != XR_TYPE_EVENT_DATA_VISIBILITY_MASK_CHANGED_KHR) return r;
     const XrSession session = reinterpret_cast<const XrEventDataVisibilityMaskChangedKHR*>(event)->session;
     {

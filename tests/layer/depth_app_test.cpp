@@ -38,7 +38,7 @@ constexpr int kFrames = 3;
 constexpr const char* kVariables[] = {"XR_API_LAYER_PATH", "XR_ENABLE_API_LAYERS", "FOVEA_LAYER_OUT",
                                       "FOVEA_LAYER_LOG_FILE", "FOVEA_SCENE", "FOVEA_LAYER_SCENE",
                                       "XDG_CONFIG_HOME", "FOVEA_RUNTIME_OUT", "FOVEA_RUNTIME_PNG_EVERY",
-                                      "FOVEA_RUNTIME_LENS", "FOVEA_TEST_RECORD"};
+                                      "FOVEA_RUNTIME_LENS", "FOVEA_TEST_RECORD", "FOVEA_LAYER_RENDER"};
 
 // Occurrences of `what` in `text`.
 int count(const std::string& text, const std::string& what) {
@@ -67,6 +67,8 @@ class DepthApp : public XrTest, public ::testing::WithParamInterface<DepthVarian
     setenv("FOVEA_LAYER_OUT", out_->path().c_str(), 1);
     setenv("FOVEA_LAYER_LOG_FILE", log_path().c_str(), 1);
     setenv("FOVEA_SCENE", "cornell", 1);
+    // Each frame shows the path-traced frame of its own views: the composite is checked per frame.
+    setenv("FOVEA_LAYER_RENDER", "lockstep", 1);
     unsetenv("FOVEA_LAYER_SCENE");
   }
 

@@ -54,6 +54,8 @@ ProcessResult run(const std::string& out, const std::string& display, const std:
     env["XR_ENABLE_API_LAYERS"] = "XR_APILAYER_FOVEA_path_tracing";
     env["FOVEA_LAYER_OUT"] = out;
     env["FOVEA_LAYER_LOG_FILE"] = out + "/layer.log";
+    // Each frame shows the path-traced frame of its own views (deterministic panels to compare).
+    env["FOVEA_LAYER_RENDER"] = "lockstep";
   }
   return run_process({FOVEA_HELLO_XR, "-g", "Vulkan2"}, env, 120);
 }

@@ -3,6 +3,8 @@
 #include <cstring>
 #include <filesystem>
 #include <fstream>
+#include <functional>
+#include <ostream>
 
 #include <gtest/gtest.h>
 #include <nlohmann/json.hpp>
@@ -134,6 +136,9 @@ TEST(Layer, CoreValidationBelowLayerWithScene) {
   const ProcessResult r = hello_xr(out.path(), env);
   ASSERT_EQ(r.exit_code, 0) << r.output;
   EXPECT_EQ(r.output.find("INTERNAL VALIDATION LAYER ERROR"), std::string::npos) << r.output;
+  // The runtime's eye gaze is still used with a layer below.
+  const std::string log = read_text(out.path() + "/layer.log");
+  EXPECT_NE(log.find("merged into the application's action sets"), std::string::npos) << log;
   const std::string cv = read_text(out.path() + "/core_validation.txt");
   EXPECT_EQ(cv.find("VUID-"), std::string::npos) << cv;
 }
@@ -191,6 +196,145 @@ TEST_F(LayerApiTest, VisibilityMaskStaysTheApplicationsChoice) {
   EXPECT_EQ(reinterpret_cast<PFN_xrGetVisibilityMaskKHR>(f)(session_, XR_VIEW_CONFIGURATION_TYPE_PRIMARY_STEREO, 0,
                                                             XR_VISIBILITY_MASK_TYPE_HIDDEN_TRIANGLE_MESH_KHR, &m),
             XR_SUCCESS);
+}
+
+// What an application observes of eye gaze and its actions (codes, properties, profiles, events).
+struct Observed {
+  XrBool32 supports_eye_gaze = 2;  // neither XR_TRUE nor XR_FALSE: whether it was written
+  XrResult eyes_action = XR_SUCCESS, suggest_gaze = XR_SUCCESS, suggest_hand = XR_SUCCESS;
+  XrResult attach_none = XR_SUCCESS, profile_before = XR_SUCCESS, attach = XR_SUCCESS;
+  XrResult eyes = XR_SUCCESS, hand = XR_SUCCESS;
+  std::vector<XrStructureType> events;
+  std::string eyes_profile_name, hand_profile_name;  // paths differ between instances: compared as strings
+};
+
+bool operator==(const Observed& a, const Observed& b) {
+  return a.supports_eye_gaze == b.supports_eye_gaze && a.eyes_action == b.eyes_action && a.suggest_gaze == b.suggest_gaze &&
+         a.suggest_hand == b.suggest_hand && a.attach_none == b.attach_none && a.profile_before == b.profile_before &&
+         a.attach == b.attach && a.eyes == b.eyes && a.hand == b.hand && a.events == b.events &&
+         a.eyes_profile_name == b.eyes_profile_name && a.hand_profile_name == b.hand_profile_name;
+}
+
+std::ostream& operator<<(std::ostream& os, const Observed& o) {
+  os << "{supports " << o.supports_eye_gaze << ", action on /user/eyes_ext " << o.eyes_action << ", suggest gaze " << o.suggest_gaze << " hand " << o.suggest_hand
+     << ", attach none " << o.attach_none << ", profile before attach " << o.profile_before << ", attach " << o.attach
+     << ", eyes " << o.eyes << " '" << o.eyes_profile_name << "', hand " << o.hand << " '" << o.hand_profile_name
+     << "', events";
+  for (XrStructureType t : o.events) os << " " << int(t);
+  return os << "}";
+}
+
+// The application's eye-gaze and action calls through whatever layers are enabled: a pose
+// action suggested for the eye-gaze profile (when `suggest_gaze`) and the simple controller,
+// attach with no set, then with its set, the profiles and the events that follow.
+Observed observe(XrInstance instance, const XrSession& session, bool suggest_gaze,
+                 const std::function<void()>& create_session, const std::function<XrPath(const char*)>& path) {
+  Observed o;
+  XrSystemEyeGazeInteractionPropertiesEXT gp{XR_TYPE_SYSTEM_EYE_GAZE_INTERACTION_PROPERTIES_EXT};
+  gp.supportsEyeGazeInteraction = 2;
+  XrSystemProperties sp{XR_TYPE_SYSTEM_PROPERTIES, &gp};
+  XrSystemGetInfo gi{XR_TYPE_SYSTEM_GET_INFO};
+  gi.formFactor = XR_FORM_FACTOR_HEAD_MOUNTED_DISPLAY;
+  XrSystemId system = XR_NULL_SYSTEM_ID;
+  EXPECT_EQ(xrGetSystem(instance, &gi, &system), XR_SUCCESS);
+  EXPECT_EQ(xrGetSystemProperties(instance, system, &sp), XR_SUCCESS);
+  o.supports_eye_gaze = gp.supportsEyeGazeInteraction;
+
+  XrActionSetCreateInfo si{XR_TYPE_ACTION_SET_CREATE_INFO};
+  std::strcpy(si.actionSetName, "app");
+  std::strcpy(si.localizedActionSetName, "App");
+  XrActionSet set = XR_NULL_HANDLE;
+  EXPECT_EQ(xrCreateActionSet(instance, &si, &set), XR_SUCCESS);
+  XrActionCreateInfo ai{XR_TYPE_ACTION_CREATE_INFO};
+  ai.actionType = XR_ACTION_TYPE_POSE_INPUT;
+  std::strcpy(ai.actionName, "aim");
+  std::strcpy(ai.localizedActionName, "Aim");
+  XrAction aim = XR_NULL_HANDLE;
+  EXPECT_EQ(xrCreateAction(set, &ai, &aim), XR_SUCCESS);
+  XrActionCreateInfo eyes_ai = ai;
+  std::strcpy(eyes_ai.actionName, "look");
+  std::strcpy(eyes_ai.localizedActionName, "Look");
+  const XrPath eyes_path = path("/user/eyes_ext");
+  eyes_ai.countSubactionPaths = 1;
+  eyes_ai.subactionPaths = &eyes_path;
+  XrAction look = XR_NULL_HANDLE;
+  o.eyes_action = xrCreateAction(set, &eyes_ai, &look);
+  const auto suggest = [&](const char* profile, const char* binding) {
+    const XrActionSuggestedBinding b{aim, path(binding)};
+    XrInteractionProfileSuggestedBinding sb{XR_TYPE_INTERACTION_PROFILE_SUGGESTED_BINDING};
+    sb.interactionProfile = path(profile);
+    sb.countSuggestedBindings = 1;
+    sb.suggestedBindings = &b;
+    return xrSuggestInteractionProfileBindings(instance, &sb);
+  };
+  if (suggest_gaze)
+    o.suggest_gaze = suggest("/interaction_profiles/ext/eye_gaze_interaction", "/user/eyes_ext/input/gaze_ext/pose");
+  o.suggest_hand = suggest("/interaction_profiles/khr/simple_controller", "/user/hand/left/input/aim/pose");
+  create_session();
+  XrSessionActionSetsAttachInfo none{XR_TYPE_SESSION_ACTION_SETS_ATTACH_INFO};
+  o.attach_none = xrAttachSessionActionSets(session, &none);
+  XrInteractionProfileState ps{XR_TYPE_INTERACTION_PROFILE_STATE};
+  o.profile_before = xrGetCurrentInteractionProfile(session, path("/user/eyes_ext"), &ps);
+  XrSessionActionSetsAttachInfo attach{XR_TYPE_SESSION_ACTION_SETS_ATTACH_INFO};
+  attach.countActionSets = 1;
+  attach.actionSets = &set;
+  o.attach = xrAttachSessionActionSets(session, &attach);
+  const auto name = [&](XrPath p) {
+    if (p == XR_NULL_PATH) return std::string("null");
+    char buf[XR_MAX_PATH_LENGTH];
+    uint32_t n = 0;
+    return xrPathToString(instance, p, sizeof buf, &n, buf) == XR_SUCCESS ? std::string(buf) : std::string("?");
+  };
+  ps = {XR_TYPE_INTERACTION_PROFILE_STATE};
+  o.eyes = xrGetCurrentInteractionProfile(session, path("/user/eyes_ext"), &ps);
+  o.eyes_profile_name = o.eyes == XR_SUCCESS ? name(ps.interactionProfile) : "";
+  ps = {XR_TYPE_INTERACTION_PROFILE_STATE};
+  o.hand = xrGetCurrentInteractionProfile(session, path("/user/hand/left"), &ps);
+  o.hand_profile_name = o.hand == XR_SUCCESS ? name(ps.interactionProfile) : "";
+  for (;;) {
+    XrEventDataBuffer e{XR_TYPE_EVENT_DATA_BUFFER};
+    if (xrPollEvent(instance, &e) != XR_SUCCESS) break;
+    o.events.push_back(e.type);
+  }
+  return o;
+}
+
+// With a scene the layer reads the eye tracker through the runtime's eye-gaze action, enabling
+// XR_EXT_eye_gaze_interaction below itself: the application sees exactly what it sees without
+// the layer, whether it enabled the extension or not, suggested eye-gaze bindings or not.
+TEST_F(LayerApiTest, EyeGazeStaysTheApplicationsChoice) {
+  setenv("FOVEA_LAYER_SCENE", "cornell", 1);
+  struct Case {
+    bool enable, suggest;
+  };
+  for (const Case c : {Case{false, true}, Case{true, false}, Case{true, true}}) {
+    SCOPED_TRACE(std::string("extension ") + (c.enable ? "enabled" : "not enabled") + ", eye-gaze bindings " +
+                 (c.suggest ? "suggested" : "not suggested"));
+    Observed seen[2];
+    for (int layered = 1; layered >= 0; --layered) {
+      if (!layered) unsetenv("XR_ENABLE_API_LAYERS");
+      std::vector<const char*> ext;
+      if (c.enable) ext.push_back("XR_EXT_eye_gaze_interaction");
+      ASSERT_NO_FATAL_FAILURE(create_instance(ext));
+      seen[layered] = observe(instance_, session_, c.suggest, [&] { create_session(); },
+                              [&](const char* s) { return path(s); });
+      XrTest::TearDown();
+      instance_ = XR_NULL_HANDLE;
+      session_ = XR_NULL_HANDLE;
+      vk_instance_ = VK_NULL_HANDLE;
+      vk_physical_ = VK_NULL_HANDLE;
+      vk_device_ = VK_NULL_HANDLE;
+      messenger_ = VK_NULL_HANDLE;
+      setenv("XR_ENABLE_API_LAYERS", kLayer, 1);
+    }
+    EXPECT_EQ(seen[1], seen[0]) << "through the layer: " << seen[1] << "\nwithout it: " << seen[0];
+    // Not vacuous: attaching no set is an error, and the eye tracker's profile is current
+    // exactly when the application bound it.
+    EXPECT_EQ(seen[0].attach_none, XR_ERROR_VALIDATION_FAILURE);
+    EXPECT_EQ(seen[0].eyes_action, c.enable ? XR_SUCCESS : XR_ERROR_PATH_UNSUPPORTED);
+    EXPECT_EQ(seen[0].supports_eye_gaze, c.enable ? XR_TRUE : XR_FALSE);
+    EXPECT_EQ(seen[0].eyes_profile_name == "/interaction_profiles/ext/eye_gaze_interaction", c.enable && c.suggest);
+  }
 }
 
 // Error codes come from the runtime unchanged through the layer's intercepts.

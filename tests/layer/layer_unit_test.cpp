@@ -12,6 +12,7 @@
 #include "fovea/core/error.hpp"
 #include "fovea/core/clock.hpp"
 #include "fovea/devices/hid_stream.hpp"
+#include "frame_queue.hpp"
 #include "gaze_input.hpp"
 #include "next_chain.hpp"
 
@@ -179,6 +180,76 @@ TEST(LayerComposite, ResamplesByDirection) {
   // The wide view seen from the narrow one: its border is not covered.
   const Pixels8 out = resample(app, core::View(narrow, 40, 40), core::View(wide, 40, 40));
   EXPECT_EQ(out.at(0, 0)[3], 0);
+}
+
+// Rotational reprojection of a path-traced frame to newer view poses: the head turned 10
+// degrees left since the frame was traced, so what lay straight ahead now lies 10 degrees to
+// the right (tangent projection: x = (tan 10 + tan 40) / (2 tan 40) * 80 = 48.4).
+TEST(LayerComposite, ReprojectsByRotation) {
+  const core::Fov wide = core::Fov::from_degrees(-40, 40, 40, -40);
+  Pixels8 traced = filled(80, 80, {10, 10, 10, 255});
+  std::copy_n(std::array<std::uint8_t, 4>{250, 0, 0, 255}.data(), 4, traced.at(40, 40));
+  const glm::dquat now = glm::angleAxis(glm::radians(10.0), glm::dvec3(0, 1, 0));
+  const glm::dquat then(1, 0, 0, 0);
+  const Pixels8 out = resample(traced, core::View(wide, 80, 80), core::View(wide, 80, 80), glm::conjugate(then) * now);
+  int found_x = -1, found_y = -1;
+  for (int y = 0; y < 80; ++y)
+    for (int x = 0; x < 80; ++x)
+      if (out.at(x, y)[0] == 250) found_x = x, found_y = y;
+  EXPECT_EQ(found_x, 48);
+  EXPECT_EQ(found_y, 40);
+  // The left border now looks where the frame was not traced.
+  EXPECT_EQ(out.at(0, 40)[3], 0);
+  EXPECT_EQ(out.at(79, 40)[3], 255);
+}
+
+// A pipelined application: frame N+1 is waited before frame N ends. Each end gets its own
+// frame's record (by predicted display time), a frame begun again is discarded, an end
+// without a begin has no record.
+TEST(LayerFrameQueue, PipelinedFramesKeepTheirOwnRecords) {
+  FrameQueue q;
+  EXPECT_FALSE(q.end(100).has_value());  // nothing begun
+  q.waited(100, 1, 2);
+  q.begun(3);
+  q.waited(200, 4, 5);  // the next frame waited before the first ends
+  const auto first = q.end(100);
+  ASSERT_TRUE(first.has_value());
+  EXPECT_EQ(first->frame, 0);
+  EXPECT_EQ(first->wait_call_ns, 1);
+  EXPECT_EQ(first->begin_ns, 3);
+  q.begun(6);
+  q.waited(300, 7, 8);
+  // An end naming no waited time ends the oldest begun frame.
+  const auto second = q.end(12345);
+  ASSERT_TRUE(second.has_value());
+  EXPECT_EQ(second->frame, 1);
+  EXPECT_EQ(second->display_time_ns, 200);
+  EXPECT_EQ(second->begin_ns, 6);
+  // Frame 2 begun, then frame 3 begun without ending 2: ending 3 drops 2.
+  q.begun(9);
+  q.waited(400, 10, 11);
+  q.begun(12);
+  const auto fourth = q.end(400);
+  ASSERT_TRUE(fourth.has_value());
+  EXPECT_EQ(fourth->frame, 3);
+  EXPECT_EQ(q.in_flight(), 0u);
+  // An application that waits without ever ending keeps a bounded queue.
+  for (int i = 0; i < 100; ++i) q.waited(1000 + i, 0, 0);
+  EXPECT_EQ(q.in_flight(), FrameQueue::kMaxInFlight);
+}
+
+TEST(LayerConfig, RenderMode) {
+  EXPECT_FALSE(parse_config(R"({"default": {"scene": "cornell"}})", "cfg.json", "App").lockstep);
+  EXPECT_TRUE(parse_config(R"({"default": {"render": "lockstep"}})", "cfg.json", "App").lockstep);
+  EXPECT_FALSE(parse_config(R"({"default": {"render": "lockstep"}, "applications": {"App": {"render": "async"}}})",
+                            "cfg.json", "App")
+                   .lockstep);
+  try {
+    parse_config(R"({"default": {"render": "sync"}})", "cfg.json", "App");
+    FAIL() << "accepted";
+  } catch (const core::InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("cfg.json: default.render"), std::string::npos) << e.what();
+  }
 }
 
 // A raw HID capture configured as the layer's gaze is a recording: at display times on the

@@ -1,0 +1,221 @@
+// The layer's asynchronous path tracing, in-process on the Fovea runtime: an application that
+// pipelines its frames on two threads (xrWaitFrame on one, xrBeginFrame/xrEndFrame on the
+// other) through the layer with the Cornell box, the render thread slowed down by the test
+// hook FOVEA_LAYER_TEST_RENDER_DELAY_MS. Structural, not timed: the application's frames
+// keep ending while one path-traced frame is in the works, each displayed frame's record
+// names the traced frame it showed, and the session tears down while the thread is busy.
+#include <atomic>
+#include <condition_variable>
+#include <cstdlib>
+#include <deque>
+#include <fstream>
+#include <mutex>
+#include <set>
+#include <thread>
+
+#include <gtest/gtest.h>
+#include <nlohmann/json.hpp>
+
+#include "xr_fixture.hpp"
+#include "xr_process.hpp"
+
+namespace fovea::test {
+namespace {
+
+constexpr const char* kVariables[] = {"XR_API_LAYER_PATH", "XR_ENABLE_API_LAYERS", "FOVEA_LAYER_OUT",
+                                      "FOVEA_LAYER_LOG_FILE", "FOVEA_SCENE", "FOVEA_LAYER_SCENE",
+                                      "XDG_CONFIG_HOME", "FOVEA_LAYER_RENDER", "FOVEA_LAYER_TEST_RENDER_DELAY_MS"};
+
+std::vector<nlohmann::json> records(const std::string& file) {
+  std::vector<nlohmann::json> out;
+  std::ifstream in(file);
+  for (std::string line; std::getline(in, line);)
+    if (!line.empty()) out.push_back(nlohmann::json::parse(line));
+  return out;
+}
+
+class AsyncLayer : public XrTest {
+ protected:
+  void SetUp() override {
+    XrTest::SetUp();  // the tiny display
+    out_ = std::make_unique<TempDir>("async-layer");
+    setenv("XDG_CONFIG_HOME", (out_->path() + "/no-config").c_str(), 1);
+    setenv("XR_API_LAYER_PATH", FOVEA_LAYER_EXPLICIT_DIR, 1);
+    setenv("XR_ENABLE_API_LAYERS", "XR_APILAYER_FOVEA_path_tracing", 1);
+    setenv("FOVEA_LAYER_OUT", out_->path().c_str(), 1);
+    setenv("FOVEA_LAYER_LOG_FILE", (out_->path() + "/layer.log").c_str(), 1);
+    setenv("FOVEA_SCENE", "cornell", 1);
+    unsetenv("FOVEA_LAYER_SCENE");
+    unsetenv("FOVEA_LAYER_RENDER");  // the default: asynchronous
+    // Far slower than a frame interval: the application must not notice.
+    setenv("FOVEA_LAYER_TEST_RENDER_DELAY_MS", "700", 1);
+  }
+  void TearDown() override {
+    for (XrSwapchain sc : eye_)
+      if (sc) xrDestroySwapchain(sc);
+    XrTest::TearDown();
+    for (const char* k : kVariables) unsetenv(k);
+  }
+  std::string timing() const { return out_->path() + "/layer_timing.jsonl"; }
+
+  void cycle(XrSwapchain sc) {
+    uint32_t index = 0;
+    ASSERT_EQ(xrAcquireSwapchainImage(sc, nullptr, &index), XR_SUCCESS);
+    XrSwapchainImageWaitInfo wi{XR_TYPE_SWAPCHAIN_IMAGE_WAIT_INFO};
+    wi.timeout = XR_INFINITE_DURATION;
+    ASSERT_EQ(xrWaitSwapchainImage(sc, &wi), XR_SUCCESS);
+    ASSERT_EQ(xrReleaseSwapchainImage(sc, nullptr), XR_SUCCESS);
+  }
+
+  std::unique_ptr<TempDir> out_;
+  XrSwapchain eye_[2] = {XR_NULL_HANDLE, XR_NULL_HANDLE};
+};
+
+TEST_F(AsyncLayer, PipelinedFramesOnTwoThreadsNeverWaitForTheRenderThread) {
+  ASSERT_NO_FATAL_FAILURE(create_instance());
+  ASSERT_NO_FATAL_FAILURE(run_to_focused());
+  const XrSpace local = reference_space(XR_REFERENCE_SPACE_TYPE_LOCAL);
+  XrViewConfigurationView vcv[2] = {{XR_TYPE_VIEW_CONFIGURATION_VIEW}, {XR_TYPE_VIEW_CONFIGURATION_VIEW}};
+  uint32_t n = 0;
+  ASSERT_EQ(xrEnumerateViewConfigurationViews(instance_, system_, XR_VIEW_CONFIGURATION_TYPE_PRIMARY_STEREO, 2, &n, vcv),
+            XR_SUCCESS);
+  const auto w = int32_t(vcv[0].recommendedImageRectWidth), h = int32_t(vcv[0].recommendedImageRectHeight);
+  for (XrSwapchain& sc : eye_) sc = color_swapchain(uint32_t(w), uint32_t(h));
+
+  // Until the records show three distinct traced frames (the first is the renderer's set-up):
+  // the waiter runs one frame ahead of the submitting thread.
+  constexpr int kMaxFrames = 20000;  // a hang guard only: far more than three renders take
+  std::mutex m;
+  std::condition_variable cv;
+  std::deque<XrTime> ready;
+  bool stop = false, waiter_done = false;  // under m
+  std::atomic<int> failures{0};
+  std::thread waiter([&] {
+    for (int i = 0; i < kMaxFrames; ++i) {
+      {
+        std::unique_lock lock(m);
+        cv.wait(lock, [&] { return ready.size() < 2 || stop; });
+        if (stop) break;
+      }
+      XrFrameState fs{XR_TYPE_FRAME_STATE};
+      if (xrWaitFrame(session_, nullptr, &fs) != XR_SUCCESS) ++failures;
+      std::lock_guard lock(m);
+      ready.push_back(fs.predictedDisplayTime);
+      cv.notify_all();
+    }
+    std::lock_guard lock(m);
+    waiter_done = true;
+    cv.notify_all();
+  });
+  // The next waited frame; 0 once the waiter has stopped and every waited frame was taken.
+  const auto next_waited = [&] {
+    std::unique_lock lock(m);
+    cv.wait(lock, [&] { return !ready.empty() || waiter_done; });
+    if (ready.empty()) return XrTime(0);
+    const XrTime t = ready.front();
+    ready.pop_front();
+    cv.notify_all();
+    return t;
+  };
+  const auto submit = [&](XrTime t) {
+    if (xrBeginFrame(session_, nullptr) != XR_SUCCESS) ++failures;
+    XrViewLocateInfo li{XR_TYPE_VIEW_LOCATE_INFO};
+    li.viewConfigurationType = XR_VIEW_CONFIGURATION_TYPE_PRIMARY_STEREO;
+    li.displayTime = t;
+    li.space = local;
+    XrViewState vs{XR_TYPE_VIEW_STATE};
+    XrView located[2] = {{XR_TYPE_VIEW}, {XR_TYPE_VIEW}};
+    ASSERT_EQ(xrLocateViews(session_, &li, &vs, 2, &n, located), XR_SUCCESS);
+    XrCompositionLayerProjectionView views[2];
+    for (int e = 0; e < 2; ++e) {
+      ASSERT_NO_FATAL_FAILURE(cycle(eye_[e]));
+      views[e] = {XR_TYPE_COMPOSITION_LAYER_PROJECTION_VIEW};
+      views[e].pose = located[e].pose;
+      views[e].fov = located[e].fov;
+      views[e].subImage = {eye_[e], {{0, 0}, {w, h}}, 0};
+    }
+    XrCompositionLayerProjection proj{XR_TYPE_COMPOSITION_LAYER_PROJECTION};
+    proj.space = local;
+    proj.viewCount = 2;
+    proj.views = views;
+    const XrCompositionLayerBaseHeader* layers[] = {reinterpret_cast<const XrCompositionLayerBaseHeader*>(&proj)};
+    XrFrameEndInfo ei{XR_TYPE_FRAME_END_INFO};
+    ei.displayTime = t;
+    ei.environmentBlendMode = XR_ENVIRONMENT_BLEND_MODE_OPAQUE;
+    ei.layerCount = 1;
+    ei.layers = layers;
+    if (xrEndFrame(session_, &ei) != XR_SUCCESS) ++failures;
+  };
+  int ended = 0;
+  std::set<std::int64_t> traced;
+  while (ended < kMaxFrames) {
+    const XrTime t = next_waited();
+    if (t == 0) break;
+    ASSERT_NO_FATAL_FAILURE(submit(t));
+    ++ended;
+    if (ended % 8 == 0) {
+      traced.clear();
+      for (const auto& r : records(timing()))
+        if (r["traced_frame"].get<std::int64_t>() >= 0) traced.insert(r["traced_frame"].get<std::int64_t>());
+      if (traced.size() >= 3) break;
+    }
+  }
+  {
+    std::lock_guard lock(m);
+    stop = true;
+  }
+  cv.notify_all();
+  // The waiter may be inside xrWaitFrame until the frame it waits behind begins: the frames it
+  // got are still submitted.
+  for (XrTime t = next_waited(); t != 0; t = next_waited()) {
+    ASSERT_NO_FATAL_FAILURE(submit(t));
+    ++ended;
+  }
+  waiter.join();
+  EXPECT_EQ(failures, 0);
+  ASSERT_GE(traced.size(), 3u) << "the render thread finished fewer than three frames in " << ended << " frames";
+
+  const auto recs = records(timing());
+  ASSERT_GE(recs.size(), std::size_t(ended - 1));
+  // Every application frame was ended and logged, far more of them than frames traced: while
+  // the render thread sleeps 700 ms per frame, xrEndFrame returns with the newest finished one.
+  EXPECT_GT(recs.size(), 4 * traced.size()) << recs.size() << " frames, " << traced.size() << " traced";
+  std::int64_t last_traced = -1, last_display = 0;
+  int replaced = 0;
+  for (const auto& r : recs) {
+    const std::int64_t tf = r["traced_frame"].get<std::int64_t>();
+    const std::int64_t display = r["display_time_ns"].get<std::int64_t>();
+    EXPECT_GT(display, last_display) << r.dump();  // the queue matched each end to its own wait
+    last_display = display;
+    EXPECT_EQ(r["replaced"].get<bool>(), tf >= 0) << r.dump();
+    if (tf < 0) {
+      EXPECT_EQ(last_traced, -1) << "a frame after the first traced one was not replaced: " << r.dump();
+      continue;
+    }
+    ++replaced;
+    // The newest finished frame: never an older one than the previous frame showed.
+    EXPECT_GE(tf, last_traced) << r.dump();
+    last_traced = tf;
+    // Traced for views submitted earlier (or these): its age is never negative, its gaze sample named.
+    EXPECT_LE(r["traced_for_ns"].get<std::int64_t>(), display) << r.dump();
+    EXPECT_GE(r["traced_age_ns"].get<std::int64_t>(), 0) << r.dump();
+    EXPECT_GT(r["traced_done_ns"].get<std::int64_t>(), 0) << r.dump();
+    EXPECT_GT(r["gaze_read_ns"].get<std::int64_t>(), 0) << r.dump();
+    EXPECT_GT(r["render_ms"].get<double>(), 0) << r.dump();
+  }
+  EXPECT_GT(replaced, 0);
+  const std::string log = read_text(out_->path() + "/layer.log");
+  EXPECT_NE(log.find("render async"), std::string::npos) << log;
+  EXPECT_EQ(log.find("internal failure"), std::string::npos) << log;
+
+  // Teardown while the render thread is inside a render's delay: it is woken and joined.
+  for (XrSwapchain& sc : eye_) {
+    EXPECT_EQ(xrDestroySwapchain(sc), XR_SUCCESS);
+    sc = XR_NULL_HANDLE;
+  }
+  EXPECT_EQ(xrDestroySession(session_), XR_SUCCESS);
+  session_ = XR_NULL_HANDLE;
+}
+
+}  // namespace
+}  // namespace fovea::test
