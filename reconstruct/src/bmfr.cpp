@@ -88,7 +88,7 @@ Bmfr::Bmfr(gpu::Context& ctx, std::span<const EyeGrid> eyes, const Accumulation&
     e.grid = {eyes[i].padded_columns, eyes[i].padded_rows};
     e.fitted = storage(ctx, VkDeviceSize(eyes[i].cells) * 16, "recon.fitted");
     for (int p = 0; p < 2; ++p)
-      e.set[p] = fit_.bind(acc.position(int(i), p), acc.normal(int(i), p), gather.z(int(i)), e.fitted);
+      e.set[p] = fit_.bind(acc.position(int(i), p), acc.normal(int(i), p), gather.shared(int(i)), e.fitted);
   }
 }
 

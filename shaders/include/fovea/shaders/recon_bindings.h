@@ -56,7 +56,8 @@
 #define RECON_POST_ACC_DIRECT 4
 #define RECON_POST_PREV 5
 #define RECON_POST_OUT 6
-#define RECON_POST_COUNT 7
+#define RECON_POST_PREV_ACC_DIRECT 7
+#define RECON_POST_COUNT 8
 
 // recon_taa.comp
 #define RECON_TAA_POS 2
