@@ -64,9 +64,13 @@ struct ShareBindings {
 
 struct BmfrBindings {
   FOVEA_BINDING_COUNT(RECON_BMFR_COUNT)
-  Buf pos, nrm, z, fitted;
+  Buf pos, nrm, z, fitted, columns;
   Slots slots() const {
-    return {{{RECON_BMFR_POS, pos}, {RECON_BMFR_NRM, nrm}, {RECON_BMFR_Z, z}, {RECON_BMFR_FITTED, fitted}}};
+    return {{{RECON_BMFR_POS, pos},
+             {RECON_BMFR_NRM, nrm},
+             {RECON_BMFR_Z, z},
+             {RECON_BMFR_FITTED, fitted},
+             {RECON_BMFR_COLUMNS, columns}}};
   }
 };
 

@@ -46,7 +46,8 @@
 #define RECON_BMFR_NRM 1
 #define RECON_BMFR_Z 2
 #define RECON_BMFR_FITTED 3
-#define RECON_BMFR_COUNT 4
+#define RECON_BMFR_COLUMNS 4
+#define RECON_BMFR_COUNT 5
 
 // recon_post.comp (BMFR Phase III)
 #define RECON_POST_POS 0
