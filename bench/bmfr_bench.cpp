@@ -71,12 +71,13 @@ void fit(benchmark::State& state) {
     return fg::Buffer(ctx, {.size = bytes, .usage = fg::BufferUsage::Storage, .memory = fg::Memory::DeviceLocal,
                             .name = name});
   };
-  fg::Buffer p = make("bench.vpos"), n = make("bench.vnrm"), z = make("bench.z"), out = make("bench.fitted");
+  fg::Buffer p = make("bench.vpos"), n = make("bench.vnrm"), z = make("bench.z"), out = make("bench.fitted"),
+             columns = make("bench.columns");  // unread: a raster grid does not wrap
   p.upload(in.pos);
   n.upload(in.nrm);
   z.upload(in.z);
   const fc::BmfrFit bmfr(ctx, options);
-  const fg::DescriptorSet set = bmfr.bind(p, n, z, out);
+  const fg::DescriptorSet set = bmfr.bind(p, n, z, out, columns);
   std::uint32_t frame = 0;
   auto run = [&] {
     ctx.submit_and_wait([&](VkCommandBuffer cmd) {

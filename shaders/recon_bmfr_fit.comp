@@ -28,6 +28,7 @@ layout(std430, binding = RECON_BMFR_POS) readonly buffer Pos { vec4 vpos[]; };
 layout(std430, binding = RECON_BMFR_NRM) readonly buffer Nrm { vec4 vnrm[]; };
 layout(std430, binding = RECON_BMFR_Z) readonly buffer Z { vec4 z[]; };
 layout(std430, binding = RECON_BMFR_FITTED) writeonly buffer Fitted { vec4 fitted[]; };
+layout(std430, binding = RECON_BMFR_COLUMNS) readonly buffer Columns { GridColumn columns[]; };
 
 layout(push_constant) uniform Push { ReconBmfrPush pc; };
 
@@ -112,10 +113,17 @@ void householder_column(const uint k) {
   }
 }
 
+// The grid cell of one of the block's rows. On polar grids φ is cyclic: the displaced block
+// rows v ∈ [−offset_y, padded_rows − offset_y) of column x take its rows modulo their count
+// R (v < R − offset_y), so no block boundary stays at φ = 0; v beyond covers the clipped
+// rows [R, padded_rows) once, so every cell still belongs to exactly one block.
 ivec2 cell_of(uint row) {
   uint block = gl_WorkGroupID.x;
-  ivec2 origin = ivec2(int(block % pc.blocks_x) * 32 - pc.offset_x, int(block / pc.blocks_x) * 32 - pc.offset_y);
-  return origin + ivec2(int(row & 31u), int(row >> 5));
+  int x = int(block % pc.blocks_x) * 32 - pc.offset_x + int(row & 31u);
+  int v = int(block / pc.blocks_x) * 32 - pc.offset_y + int(row >> 5);
+  if (pc.columns == 0u) return ivec2(x, v);
+  int rows = x >= 0 && x < int(pc.columns) ? int(columns[x].rows) : 0;
+  return ivec2(x, v < rows - pc.offset_y ? (v % rows + rows) % rows : v + pc.offset_y);
 }
 
 bool inside(ivec2 c) { return c.x >= 0 && c.y >= 0 && c.x < int(pc.padded_columns) && c.y < int(pc.padded_rows); }

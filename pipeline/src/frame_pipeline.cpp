@@ -82,6 +82,7 @@ FramePipeline::FramePipeline(gpu::Context& ctx, const renderer::GpuScene& scene,
     e->mapping = std::make_unique<reconstruct::GridMapping>(ctx, *e->dist, o ? o->dist.get() : nullptr);
     const renderer::TraceOutputs& t = e->trace;
     grids.push_back({.cells = e->cells,
+                     .columns = std::uint32_t(e->dist->columns()),
                      .padded_columns = std::uint32_t(e->dist->padded_columns()),
                      .padded_rows = std::uint32_t(e->dist->padded_rows()),
                      .polar = e->dist->gpu_params().family != shaders::kFamilyCartesian,

@@ -1,6 +1,7 @@
 // BMFR Phase II (shaders/recon_bmfr_fit.comp): the fit on its own (BmfrFit) and as a stage.
 #include "fovea/reconstruct/bmfr.hpp"
 
+#include <algorithm>
 #include <string>
 
 #include "bindings.hpp"
@@ -9,6 +10,7 @@
 #include "fovea/gpu/barriers.hpp"
 #include "fovea/gpu/context.hpp"
 #include "fovea/reconstruct/stages.hpp"
+#include "fovea/shaders/grid_params.h"
 #include "fovea/shaders/recon_grid.h"
 
 namespace fovea::reconstruct {
@@ -33,35 +35,48 @@ BmfrFit::BmfrFit(gpu::Context& ctx, const BmfrOptions& options)
            gpu::SpecConstant::boolean(1, options.precision == BmfrPrecision::Fp16)})) {}
 
 gpu::DescriptorSet BmfrFit::bind(const gpu::Buffer& vpos, const gpu::Buffer& vnrm, const gpu::Buffer& z,
-                                 const gpu::Buffer& fitted) const {
-  return make_set(*ctx_, pipeline_, BmfrBindings{&vpos, &vnrm, &z, &fitted});
+                                 const gpu::Buffer& fitted, const gpu::Buffer& columns) const {
+  return make_set(*ctx_, pipeline_, BmfrBindings{&vpos, &vnrm, &z, &fitted, &columns});
 }
 
 void BmfrFit::record(VkCommandBuffer cmd, const gpu::DescriptorSet& set, BmfrGrid g, std::uint32_t frame,
                      glm::ivec2 offset, float noise) const {
-  // One block of margin in each direction so a displaced block grid still covers the grid.
-  const std::uint32_t bx = g.padded_columns / 32 + 1, by = g.padded_rows / 32 + 1;
+  // One block of margin in each direction so a displaced block grid still covers the grid;
+  // none in φ when the rows wrap (the displaced blocks cycle through each column's rows).
+  const std::uint32_t bx = g.padded_columns / 32 + 1, by = g.padded_rows / 32 + (g.columns ? 0 : 1);
   pipeline_.run(cmd, {&set},
-                shaders::ReconBmfrPush{g.padded_columns, g.padded_rows, bx, frame, offset.x, offset.y, noise, 0},
+                shaders::ReconBmfrPush{g.padded_columns, g.padded_rows, bx, frame, offset.x, offset.y, noise, g.columns},
                 bx * by * workgroup_);
 }
 
 std::vector<glm::vec4> BmfrFit::fit(BmfrGrid g, const std::vector<glm::vec4>& vpos, const std::vector<glm::vec4>& vnrm,
                                     const std::vector<glm::vec4>& z, std::uint32_t frame, glm::ivec2 offset,
-                                    float noise) const {
+                                    float noise, const std::vector<std::uint32_t>& rows) const {
   const std::size_t cells = std::size_t(g.padded_columns) * g.padded_rows;
   if (g.padded_columns % 32 || g.padded_rows % 32 || cells == 0 || vpos.size() != cells || vnrm.size() != cells ||
       z.size() != cells)
     throw core::InputError("bmfr: inputs must cover a grid of whole 32x32 blocks");
+  if (rows.size() != g.columns || g.columns > g.padded_columns)
+    throw core::InputError("bmfr: need one row count per column of a polar grid (" + std::to_string(g.columns) +
+                           "), got " + std::to_string(rows.size()));
+  std::vector<shaders::GridColumn> table(std::max<std::size_t>(rows.size(), 1));
+  for (std::size_t c = 0; c < rows.size(); ++c) {
+    if (rows[c] > g.padded_rows)
+      throw core::InputError("bmfr: column " + std::to_string(c) + " has more rows than the grid");
+    table[c].rows = rows[c];
+  }
   auto make = [&](const char* name) {
     return gpu::Buffer(*ctx_, {.size = cells * 16, .usage = gpu::BufferUsage::Storage,
                                .memory = gpu::Memory::HostVisible, .name = name});
   };
   gpu::Buffer bp = make("bmfr.vpos"), bn = make("bmfr.vnrm"), bz = make("bmfr.z"), out = make("bmfr.fitted");
+  gpu::Buffer bt(*ctx_, {.size = table.size() * sizeof(shaders::GridColumn), .usage = gpu::BufferUsage::Storage,
+                         .memory = gpu::Memory::HostVisible, .name = "bmfr.columns"});
   bp.upload(vpos);
   bn.upload(vnrm);
   bz.upload(z);
-  const gpu::DescriptorSet set = bind(bp, bn, bz, out);
+  bt.upload(table);
+  const gpu::DescriptorSet set = bind(bp, bn, bz, out, bt);
   ctx_->submit_and_wait([&](VkCommandBuffer cmd) { record(cmd, set, g, frame, offset, noise); });
   return out.download<glm::vec4>();
 }
@@ -85,10 +100,11 @@ Bmfr::Bmfr(gpu::Context& ctx, std::span<const EyeGrid> eyes, const Accumulation&
     : fit_(ctx, {.precision = precision}), eyes_(eyes.size()) {
   for (std::size_t i = 0; i < eyes.size(); ++i) {
     Eye& e = eyes_[i];
-    e.grid = {eyes[i].padded_columns, eyes[i].padded_rows};
+    e.grid = {eyes[i].padded_columns, eyes[i].padded_rows, eyes[i].polar ? eyes[i].columns : 0};
     e.fitted = storage(ctx, VkDeviceSize(eyes[i].cells) * 16, "recon.fitted");
     for (int p = 0; p < 2; ++p)
-      e.set[p] = fit_.bind(acc.position(int(i), p), acc.normal(int(i), p), gather.z(int(i)), e.fitted);
+      e.set[p] = fit_.bind(acc.position(int(i), p), acc.normal(int(i), p), gather.shared(int(i)), e.fitted,
+                           *eyes[i].tables);
   }
 }
 

@@ -2,7 +2,8 @@
 // BMFR Phase II on the GPU (shaders/recon_bmfr_fit.comp): per 32×32 block of a padded grid,
 // the regression of the demodulated input z on the features [1, n, w, w²] and the weighted
 // sum. Inputs per cell (vec4): vpos (world position, .w material; < 0 = no surface),
-// vnrm (normal), z (rgb); output: fitted (rgb, .w = 1).
+// vnrm (normal), z (rgb); output: fitted (rgb, .w = 1). On polar grids the blocks wrap in φ:
+// rows are read modulo each column's row count (the grid's column table).
 #include <cstdint>
 #include <vector>
 
@@ -17,6 +18,9 @@ namespace fovea::reconstruct {
 
 struct BmfrGrid {
   std::uint32_t padded_columns = 0, padded_rows = 0;  // multiples of 32
+  // Polar grids: the logical columns, whose rows (shaders::GridColumn::rows of the bound
+  // column table) are cyclic in φ; 0: a raster, no wrap.
+  std::uint32_t columns = 0;
 };
 
 // Storage of the block's regression matrix [T + N | z] during the QR: fp32, or fp16 (the
@@ -34,15 +38,17 @@ struct BmfrOptions {
 class BmfrFit {
  public:
   explicit BmfrFit(gpu::Context& ctx, const BmfrOptions& options = {});
+  // `columns`: the grid's column table (shaders::GridColumn, this frame's first).
   gpu::DescriptorSet bind(const gpu::Buffer& vpos, const gpu::Buffer& vnrm, const gpu::Buffer& z,
-                          const gpu::Buffer& fitted) const;
+                          const gpu::Buffer& fitted, const gpu::Buffer& columns) const;
   // Records the fit; `offset` is the block-grid displacement in [0, 32)².
   void record(VkCommandBuffer cmd, const gpu::DescriptorSet& set, BmfrGrid grid, std::uint32_t frame,
               glm::ivec2 offset, float noise) const;
-  // Upload, fit, download in one submission (tests, tools).
+  // Upload, fit, download in one submission (tests, tools). `rows`: rows per column of a
+  // polar grid (grid.columns entries) or empty for a raster.
   std::vector<glm::vec4> fit(BmfrGrid grid, const std::vector<glm::vec4>& vpos, const std::vector<glm::vec4>& vnrm,
                              const std::vector<glm::vec4>& z, std::uint32_t frame = 0, glm::ivec2 offset = {0, 0},
-                             float noise = 0.01f) const;
+                             float noise = 0.01f, const std::vector<std::uint32_t>& rows = {}) const;
 
  private:
   gpu::Context* ctx_;

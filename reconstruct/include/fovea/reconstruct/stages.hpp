@@ -22,7 +22,7 @@ namespace fovea::reconstruct {
 
 // One eye's padded grid and the buffers every stage reads for it.
 struct EyeGrid {
-  std::uint32_t cells = 0, padded_columns = 0, padded_rows = 0;
+  std::uint32_t cells = 0, columns = 0, padded_columns = 0, padded_rows = 0;
   bool polar = true;                   // φ-only mip chain (polar grids) or one level
   std::uint32_t width = 0, height = 0;  // the display raster the grid resolves to
   const gpu::Buffer* maps = nullptr;    // GridMapping::maps(), tables()

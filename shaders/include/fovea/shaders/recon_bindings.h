@@ -46,7 +46,8 @@
 #define RECON_BMFR_NRM 1
 #define RECON_BMFR_Z 2
 #define RECON_BMFR_FITTED 3
-#define RECON_BMFR_COUNT 4
+#define RECON_BMFR_COLUMNS 4
+#define RECON_BMFR_COUNT 5
 
 // recon_post.comp (BMFR Phase III)
 #define RECON_POST_POS 0
@@ -56,7 +57,8 @@
 #define RECON_POST_ACC_DIRECT 4
 #define RECON_POST_PREV 5
 #define RECON_POST_OUT 6
-#define RECON_POST_COUNT 7
+#define RECON_POST_PREV_ACC_DIRECT 7
+#define RECON_POST_COUNT 8
 
 // recon_taa.comp
 #define RECON_TAA_POS 2

@@ -54,7 +54,8 @@ struct ReconSharePush {
 struct ReconBmfrPush {
   FOVEA_UINT padded_columns, padded_rows, blocks_x, frame;
   FOVEA_INT offset_x, offset_y;  // this frame's block-grid displacement (cells, in [0, 32))
-  float noise, pad;              // stochastic regularisation ε
+  float noise;                   // stochastic regularisation ε
+  FOVEA_UINT columns;            // > 0: polar grid, blocks wrap in φ over the rows of columns[0, columns)
 };
 
 struct ReconPostPush {
