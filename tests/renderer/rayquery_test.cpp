@@ -16,6 +16,7 @@
 #include <glm/mat3x3.hpp>
 
 #include "fovea/core/error.hpp"
+#include "fovea/gpu/accel.hpp"
 #include "fovea/renderer/procedural.hpp"
 #include "fovea/renderer/raycaster.hpp"
 #include "fovea/renderer/scene_io.hpp"
@@ -148,6 +149,18 @@ TEST_F(RayQuery, ConvergedMeansMatchTheComputeTraversal) {
   }
 }
 
+TEST_F(RayQuery, AccelerationStructureInputIsChecked) {
+  const std::vector<float> one = {0, 0, 0, 1, 0, 0, 0, 1, 0};
+  const fovea::gpu::TriangleAccel accel(ctx(), one);
+  EXPECT_GT(accel.bytes(), 0u);
+  EXPECT_THROW(fovea::gpu::TriangleAccel(ctx(), std::vector<float>(one.begin(), one.end() - 1)), fc::InputError);
+  EXPECT_THROW(fovea::gpu::TriangleAccel(ctx(), std::vector<float>{}), fc::InputError);
+  // An acceleration structure only goes where the layout declares one.
+  const fovea::gpu::DescriptorSetLayout layout(ctx(), {fovea::gpu::Binding::StorageBuffer});
+  fovea::gpu::DescriptorSet set(ctx(), layout);
+  EXPECT_THROW(set.bind(0, accel), fc::InputError);
+}
+
 // A device without ray queries, simulated by leaving them off: auto falls back to the
 // compute traversal, which renders; rayquery is refused with the reason.
 TEST(RayQueryFallback, AutoUsesTheComputeTraversalAndRayQueryIsRefused) {
@@ -163,6 +176,7 @@ TEST(RayQueryFallback, AutoUsesTheComputeTraversalAndRayQueryIsRefused) {
   const fc::View view = scene_view(s, 8);
   const auto t = fovea::test::trace_grid(ctx, g, fr::cartesian_grid(view), view, fc::Eye::Left, {});
   EXPECT_GT(fovea::test::mean_rgb(t.radiance).x, 0.0);
+  EXPECT_THROW(fovea::gpu::TriangleAccel(ctx, std::vector<float>(9, 0.0f)), fc::InputError);
   try {
     const fr::GpuScene refused(ctx, s, {}, fr::Tracing::RayQuery);
     ADD_FAILURE() << "rayquery accepted on a context without ray queries";
