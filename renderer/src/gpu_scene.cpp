@@ -8,6 +8,7 @@
 #include "fovea/core/error.hpp"
 #include "fovea/gpu/accel.hpp"
 #include "ggx_albedo.hpp"
+#include "tracer_pipeline.hpp"
 
 namespace fovea::renderer {
 

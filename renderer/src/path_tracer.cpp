@@ -8,6 +8,7 @@
 
 #include "fovea/core/error.hpp"
 #include "fovea/gpu/barriers.hpp"
+#include "tracer_pipeline.hpp"
 
 namespace fovea::renderer {
 

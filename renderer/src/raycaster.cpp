@@ -4,6 +4,7 @@
 
 #include "fovea/gpu/barriers.hpp"
 #include "fovea/gpu/timer.hpp"
+#include "tracer_pipeline.hpp"
 
 namespace fovea::renderer {
 

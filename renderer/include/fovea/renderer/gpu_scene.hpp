@@ -10,7 +10,6 @@
 #include "fovea/gpu/buffer.hpp"
 #include "fovea/gpu/context.hpp"
 #include "fovea/gpu/descriptors.hpp"
-#include "fovea/gpu/pipeline.hpp"
 #include "fovea/renderer/bvh.hpp"
 #include "fovea/renderer/scene.hpp"
 
@@ -67,10 +66,5 @@ class GpuScene {
   gpu::DescriptorSetLayout accel_layout_;
   gpu::DescriptorSet accel_set_;
 };
-
-// The description of a tracer pipeline for `scene`: `shader` (e.g. "pt_trace") or its
-// ray-query variant, set 0 as given, set 1 the acceleration structure when ray querying.
-gpu::ComputePipelineDesc tracer_pipeline(const GpuScene& scene, const char* shader, std::vector<gpu::Binding> set0,
-                                         std::uint32_t push_constant_bytes);
 
 }  // namespace fovea::renderer
