@@ -1,7 +1,9 @@
 // Ray-tracing throughput per scene on the current Vulkan device: primary rays (closest
 // hit through the BVH, Mrays/s) and full paths of the BMFR/P5 configuration (primary,
 // NEE, one bounce, NEE: Msamples/s). With Embree 3 installed, the same primary rays are
-// traced by Embree on the CPU (all hardware threads) and the ratio is printed.
+// traced by Embree on the CPU (all hardware threads) and the ratio is printed. Both with
+// the compute BVH traversal and, where the device offers them, with ray queries
+// (RayQuery*; --trace rayquery).
 //   fovea_bench_raytrace [--benchmark_filter=...]   env FOVEA_BENCH_DISPLAY (default small)
 #include <benchmark/benchmark.h>
 
@@ -69,9 +71,11 @@ std::map<std::string, double>& results() {  // "<kind>/<scene>" -> rays or sampl
   return r;
 }
 
-void BM_PrimaryRays(benchmark::State& state, const char* scene) {
+const char* result_key(fr::Tracing t) { return t == fr::Tracing::RayQuery ? "rayquery/" : "gpu/"; }
+
+void BM_PrimaryRays(benchmark::State& state, const char* scene, fr::Tracing tracing) {
   const Fixture& f = fixture(scene);
-  fr::GpuScene g(context(), f.scene);
+  fr::GpuScene g(context(), f.scene, {}, tracing);
   fr::Raycaster rc(context(), g);
   rc.set_rays(f.rays);
   rc.trace(fr::RayQuery::Closest);  // warm-up (pipeline compilation)
@@ -87,12 +91,12 @@ void BM_PrimaryRays(benchmark::State& state, const char* scene) {
   }
   state.counters["Mrays/s"] = rays / secs * 1e-6;
   state.counters["triangles"] = double(g.stats().triangles);
-  results()["gpu/" + std::string(scene)] = rays / secs;
+  results()[result_key(tracing) + std::string(scene)] = rays / secs;
 }
 
-void BM_Paths(benchmark::State& state, const char* scene) {
+void BM_Paths(benchmark::State& state, const char* scene, fr::Tracing tracing) {
   const Fixture& f = fixture(scene);
-  fr::GpuScene g(context(), f.scene);
+  fr::GpuScene g(context(), f.scene, {}, tracing);
   const auto grid = fr::cartesian_grid(f.view);
   fovea::gpu::Buffer gb(context(), {grid.size() * sizeof(fovea::shaders::GridSample), fovea::gpu::BufferUsage::Storage,
                                     fovea::gpu::Memory::DeviceLocal, "bench.grid"});
@@ -178,9 +182,23 @@ void BM_EmbreePrimaryRays(benchmark::State& state, const char* scene) {
 }  // namespace
 
 int main(int argc, char** argv) {
+  const bool ray_query = context().features().ray_query;
   for (const char* s : kScenes) {
-    benchmark::RegisterBenchmark((std::string("PrimaryRays/") + s).c_str(), BM_PrimaryRays, s)->UseManualTime()->MinTime(1.0);
-    benchmark::RegisterBenchmark((std::string("Paths/") + s).c_str(), BM_Paths, s)->UseManualTime()->MinTime(1.0);
+    benchmark::RegisterBenchmark((std::string("PrimaryRays/") + s).c_str(), BM_PrimaryRays, s, fr::Tracing::Compute)
+        ->UseManualTime()
+        ->MinTime(1.0);
+    benchmark::RegisterBenchmark((std::string("Paths/") + s).c_str(), BM_Paths, s, fr::Tracing::Compute)
+        ->UseManualTime()
+        ->MinTime(1.0);
+    if (ray_query) {
+      benchmark::RegisterBenchmark((std::string("RayQueryPrimaryRays/") + s).c_str(), BM_PrimaryRays, s,
+                                   fr::Tracing::RayQuery)
+          ->UseManualTime()
+          ->MinTime(1.0);
+      benchmark::RegisterBenchmark((std::string("RayQueryPaths/") + s).c_str(), BM_Paths, s, fr::Tracing::RayQuery)
+          ->UseManualTime()
+          ->MinTime(1.0);
+    }
 #ifdef FOVEA_HAVE_EMBREE
     benchmark::RegisterBenchmark((std::string("EmbreePrimaryRays/") + s).c_str(), BM_EmbreePrimaryRays, s)
         ->UseManualTime()
@@ -192,11 +210,13 @@ int main(int argc, char** argv) {
   std::printf("device: %s (%s)\n", context().info().name.c_str(), context().info().driver.c_str());
   benchmark::RunSpecifiedBenchmarks();
   benchmark::Shutdown();
-  for (const char* s : kScenes) {
-    const auto g = results().find(std::string("gpu/") + s), e = results().find(std::string("embree/") + s);
-    if (g != results().end() && e != results().end())
-      std::printf("%-18s primary rays: %s %.2f Mrays/s, Embree %.2f Mrays/s, Embree/GPU = %.1fx\n", s,
-                  context().info().name.c_str(), g->second * 1e-6, e->second * 1e-6, e->second / g->second);
-  }
+  for (const char* s : kScenes)
+    for (const fr::Tracing t : {fr::Tracing::Compute, fr::Tracing::RayQuery}) {
+      const auto g = results().find(result_key(t) + std::string(s)), e = results().find(std::string("embree/") + s);
+      if (g != results().end() && e != results().end())
+        std::printf("%-18s primary rays (%s): %s %.2f Mrays/s, Embree %.2f Mrays/s, Embree/GPU = %.1fx\n", s,
+                    fr::tracing_name(t), context().info().name.c_str(), g->second * 1e-6, e->second * 1e-6,
+                    e->second / g->second);
+    }
   return 0;
 }

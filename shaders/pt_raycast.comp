@@ -13,6 +13,7 @@ layout(std430, set = 0, binding = 3) writeonly buffer Hits { PtHitRecord hits[];
 layout(push_constant) uniform Params { PtRaycastParams pc; };
 
 #include "fovea/shaders/pt_traverse.h"
+#include "fovea/shaders/pt_rayquery.h"
 
 void main() {
   const uint i = gl_GlobalInvocationID.x;
@@ -22,7 +23,7 @@ void main() {
   const bool any_hit = pc.mode == kPtRaycastAny || pc.mode == kPtRaycastBruteAny;
   PtHit h;
   bool found;
-  if (pc.mode == kPtRaycastClosest || pc.mode == kPtRaycastAny) found = pt_traverse(org, dir, ray.tmin, ray.tmax, any_hit, h);
+  if (pc.mode == kPtRaycastClosest || pc.mode == kPtRaycastAny) found = pt_trace_ray(org, dir, ray.tmin, ray.tmax, any_hit, h);
   else found = pt_brute_force(org, dir, ray.tmin, ray.tmax, any_hit, h);
   PtHitRecord rec;
   rec.t = found ? h.t : ray.tmax;

@@ -29,6 +29,7 @@ layout(push_constant) uniform Params { PtFrameParams pc; };
 
 #include "fovea/shaders/pt_sampling.h"
 #include "fovea/shaders/pt_traverse.h"
+#include "fovea/shaders/pt_rayquery.h"
 
 const float kPtMaxValue = 1e30;  // clamp so sums of finite samples stay finite
 
@@ -140,7 +141,7 @@ vec3 sample_light(Surface s, PtBsdf b, vec3 wo, bool mis, inout PtRng rng) {
   if (pt_max3(f) <= 0.0) return vec3(0.0);
   const vec3 org = offset_origin(s, wi);
   PtHit sh;
-  if (pt_traverse(org, wi, 0.0, distance(q, org) * (1.0 - 1e-4), true, sh)) return vec3(0.0);
+  if (pt_trace_ray(org, wi, 0.0, distance(q, org) * (1.0 - 1e-4), true, sh)) return vec3(0.0);
   const float light_pdf = l.pmf / l.area * d2 / cos_l;  // area -> solid angle
   const float w = mis ? pt_power_heuristic(light_pdf, bsdf_pdf) : 1.0;
   return f * vec3(lm.emit_r, lm.emit_g, lm.emit_b) * (w / light_pdf);
@@ -168,7 +169,7 @@ Sample trace_path(vec3 org, vec3 dir, vec3 forward, inout PtRng rng) {
   const vec3 env = vec3(pc.env_r, pc.env_g, pc.env_b);
   const uint max_bounces = min(pc.max_bounces, kPtHardMaxBounces);
   PtHit h;
-  if (!pt_traverse(org, dir, 0.0, kPtInf, false, h)) {
+  if (!pt_trace_ray(org, dir, 0.0, kPtInf, false, h)) {
     r.direct = env;
     return r;
   }
@@ -230,7 +231,7 @@ Sample trace_path(vec3 org, vec3 dir, vec3 forward, inout PtRng rng) {
     org = offset_origin(s, wi);
     dir = wi;
     wo = -wi;
-    if (!pt_traverse(org, dir, 0.0, kPtInf, false, h)) {
+    if (!pt_trace_ray(org, dir, 0.0, kPtInf, false, h)) {
       // The environment is not light-sampled, so BSDF sampling carries its full weight.
       const vec3 c = finite_or_zero(beta * env);
       if (k == 0u) r.direct += c;

@@ -41,6 +41,9 @@ Buffer::Buffer(Context& ctx, const BufferDesc& desc) : ctx_(&ctx), size_(desc.si
   VkMemoryAllocateInfo ai{VK_STRUCTURE_TYPE_MEMORY_ALLOCATE_INFO};
   ai.allocationSize = req.size;
   ai.memoryTypeIndex = type;
+  VkMemoryAllocateFlagsInfo flags{VK_STRUCTURE_TYPE_MEMORY_ALLOCATE_FLAGS_INFO};
+  flags.flags = VK_MEMORY_ALLOCATE_DEVICE_ADDRESS_BIT;
+  if ((ci.usage & VK_BUFFER_USAGE_SHADER_DEVICE_ADDRESS_BIT) != 0) ai.pNext = &flags;
   VkDeviceMemory memory = VK_NULL_HANDLE;
   check(vkAllocateMemory(dev, &ai, nullptr, &memory), "vkAllocateMemory");
   memory_ = {dev, memory};
@@ -69,6 +72,12 @@ Buffer& Buffer::operator=(Buffer&& o) noexcept {
     mapped_ = std::exchange(o.mapped_, nullptr);
   }
   return *this;
+}
+
+VkDeviceAddress Buffer::device_address() const {
+  VkBufferDeviceAddressInfo info{VK_STRUCTURE_TYPE_BUFFER_DEVICE_ADDRESS_INFO};
+  info.buffer = buffer_.get();
+  return vkGetBufferDeviceAddress(ctx_->device(), &info);
 }
 
 void Buffer::upload_bytes(std::span<const std::byte> data, VkDeviceSize offset) {

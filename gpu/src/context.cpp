@@ -77,7 +77,7 @@ Context::Context(const ContextOptions& options) {
   try {
     create_instance(validation);
     pick_device(override);
-    create_device();
+    create_device(options.ray_query);
   } catch (...) {
     release();  // the destructor does not run for a constructor that throws
     throw;
@@ -194,7 +194,7 @@ void Context::pick_device(const std::string& override) {
   physical_device_ = devices[choose_device(candidates, override)];
 }
 
-void Context::create_device() {
+void Context::create_device(bool ray_query) {
   // Queue: the first compute family that has timestamps, else the first compute family.
   std::uint32_t nq = 0;
   vkGetPhysicalDeviceQueueFamilyProperties(physical_device_, &nq, nullptr);
@@ -249,7 +249,6 @@ void Context::create_device() {
   enabled.features.shaderStorageImageWriteWithoutFormat = features_.storage_image_write_without_format =
       supported.features.shaderStorageImageWriteWithoutFormat;
 
-  // Portability implementations (MoltenVK) require their subset extension to be enabled.
   std::uint32_t ne = 0;
   check(vkEnumerateDeviceExtensionProperties(physical_device_, nullptr, &ne, nullptr),
         "vkEnumerateDeviceExtensionProperties");
@@ -257,7 +256,36 @@ void Context::create_device() {
   check(vkEnumerateDeviceExtensionProperties(physical_device_, nullptr, &ne, exts.data()),
         "vkEnumerateDeviceExtensionProperties");
   std::vector<const char*> device_exts;
+  // Portability implementations (MoltenVK) require their subset extension to be enabled.
   if (has_extension(exts, "VK_KHR_portability_subset")) device_exts.push_back("VK_KHR_portability_subset");
+
+  // Ray queries: all three extensions and both features, or none (Vulkan 1.2 devices
+  // without them keep the compute BVH traversal).
+  VkPhysicalDeviceAccelerationStructureFeaturesKHR e_as{VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_ACCELERATION_STRUCTURE_FEATURES_KHR};
+  VkPhysicalDeviceRayQueryFeaturesKHR e_rq{VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_RAY_QUERY_FEATURES_KHR, &e_as};
+  if (ray_query && has_extension(exts, VK_KHR_ACCELERATION_STRUCTURE_EXTENSION_NAME) &&
+      has_extension(exts, VK_KHR_RAY_QUERY_EXTENSION_NAME) &&
+      has_extension(exts, VK_KHR_DEFERRED_HOST_OPERATIONS_EXTENSION_NAME) && s12.bufferDeviceAddress) {
+    VkPhysicalDeviceAccelerationStructureFeaturesKHR s_as{VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_ACCELERATION_STRUCTURE_FEATURES_KHR};
+    VkPhysicalDeviceRayQueryFeaturesKHR s_rq{VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_RAY_QUERY_FEATURES_KHR, &s_as};
+    VkPhysicalDeviceFeatures2 f2{VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_FEATURES_2, &s_rq};
+    vkGetPhysicalDeviceFeatures2(physical_device_, &f2);
+    if (s_as.accelerationStructure && s_rq.rayQuery) {
+      VkPhysicalDeviceAccelerationStructurePropertiesKHR as_props{
+          VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_ACCELERATION_STRUCTURE_PROPERTIES_KHR};
+      VkPhysicalDeviceProperties2 p2{VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_PROPERTIES_2, &as_props};
+      vkGetPhysicalDeviceProperties2(physical_device_, &p2);
+      features_.ray_query = true;
+      features_.as_scratch_alignment = as_props.minAccelerationStructureScratchOffsetAlignment;
+      e_as.accelerationStructure = VK_TRUE;
+      e_rq.rayQuery = VK_TRUE;
+      e12.bufferDeviceAddress = VK_TRUE;
+      e12.pNext = &e_rq;
+      for (const char* e : {VK_KHR_ACCELERATION_STRUCTURE_EXTENSION_NAME, VK_KHR_RAY_QUERY_EXTENSION_NAME,
+                            VK_KHR_DEFERRED_HOST_OPERATIONS_EXTENSION_NAME})
+        device_exts.push_back(e);
+    }
+  }
 
   const float priority = 1.0f;
   VkDeviceQueueCreateInfo qci{VK_STRUCTURE_TYPE_DEVICE_QUEUE_CREATE_INFO};

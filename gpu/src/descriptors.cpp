@@ -4,6 +4,7 @@
 #include <string>
 
 #include "fovea/core/error.hpp"
+#include "fovea/gpu/accel.hpp"
 #include "fovea/gpu/buffer.hpp"
 #include "fovea/gpu/context.hpp"
 #include "fovea/gpu/error.hpp"
@@ -18,6 +19,7 @@ VkDescriptorType vk_type(Binding b) {
     case Binding::UniformBuffer: return VK_DESCRIPTOR_TYPE_UNIFORM_BUFFER;
     case Binding::StorageImage: return VK_DESCRIPTOR_TYPE_STORAGE_IMAGE;
     case Binding::SampledImage: return VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER;
+    case Binding::AccelerationStructure: return VK_DESCRIPTOR_TYPE_ACCELERATION_STRUCTURE_KHR;
   }
   return VK_DESCRIPTOR_TYPE_MAX_ENUM;
 }
@@ -30,6 +32,7 @@ const char* binding_name(Binding b) {
     case Binding::UniformBuffer: return "uniform buffer";
     case Binding::StorageImage: return "storage image";
     case Binding::SampledImage: return "sampled image";
+    case Binding::AccelerationStructure: return "acceleration structure";
   }
   return "?";
 }
@@ -117,9 +120,19 @@ DescriptorSet& DescriptorSet::bind(std::uint32_t binding, const Image2D& image, 
   return *this;
 }
 
+DescriptorSet& DescriptorSet::bind(std::uint32_t binding, const TriangleAccel& accel) {
+  expect(binding, Binding::AccelerationStructure);
+  const VkAccelerationStructureKHR top = accel.top();
+  VkWriteDescriptorSetAccelerationStructureKHR info{VK_STRUCTURE_TYPE_WRITE_DESCRIPTOR_SET_ACCELERATION_STRUCTURE_KHR};
+  info.accelerationStructureCount = 1;
+  info.pAccelerationStructures = &top;
+  write(binding, nullptr, nullptr, &info);
+  return *this;
+}
+
 void DescriptorSet::write(std::uint32_t binding, const VkDescriptorBufferInfo* buffer,
-                          const VkDescriptorImageInfo* image) {
-  VkWriteDescriptorSet w{VK_STRUCTURE_TYPE_WRITE_DESCRIPTOR_SET};
+                          const VkDescriptorImageInfo* image, const void* next) {
+  VkWriteDescriptorSet w{VK_STRUCTURE_TYPE_WRITE_DESCRIPTOR_SET, next};
   w.dstSet = set_;
   w.dstBinding = binding;
   w.descriptorCount = 1;

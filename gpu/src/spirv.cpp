@@ -20,6 +20,7 @@ constexpr std::uint32_t kModeLocalSize = 17, kModeLocalSizeId = 38;
 constexpr std::uint32_t kDecorationSpecId = 1, kDecorationBuiltIn = 11, kBuiltInWorkgroupSize = 25;
 constexpr std::uint32_t kOpTypeImage = 25, kOpTypeSampledImage = 27, kOpTypeArray = 28, kOpTypeRuntimeArray = 29,
                         kOpTypePointer = 32, kOpVariable = 59;
+constexpr std::uint32_t kOpTypeAccelerationStructureKHR = 5341;
 constexpr std::uint32_t kDecorationBufferBlock = 3, kDecorationBinding = 33, kDecorationDescriptorSet = 34;
 constexpr std::uint32_t kStorageUniformConstant = 0, kStorageUniform = 2, kStorageStorageBuffer = 12;
 
@@ -90,6 +91,7 @@ std::vector<DeclaredBinding> descriptor_bindings(std::span<const std::uint32_t> 
   std::unordered_map<std::uint32_t, std::uint32_t> element;             // array type id -> element type
   std::unordered_map<std::uint32_t, std::uint32_t> image_sampled;       // image type id -> Sampled operand
   std::unordered_map<std::uint32_t, bool> sampled_image;                // OpTypeSampledImage ids
+  std::unordered_map<std::uint32_t, bool> accel;                        // OpTypeAccelerationStructureKHR ids
   std::vector<std::pair<std::uint32_t, std::uint32_t>> variables;       // (id, pointer type)
   for_each_instruction(words, [&](std::uint32_t op, std::span<const std::uint32_t> w) {
     const std::size_t count = w.size();
@@ -105,6 +107,8 @@ std::vector<DeclaredBinding> descriptor_bindings(std::span<const std::uint32_t> 
       image_sampled[w[1]] = w[7];
     } else if (op == kOpTypeSampledImage && count >= 3) {
       sampled_image[w[1]] = true;
+    } else if (op == kOpTypeAccelerationStructureKHR && count >= 2) {
+      accel[w[1]] = true;
     } else if (op == kOpVariable && count >= 4) {
       variables.emplace_back(w[2], w[1]);
     }
@@ -128,6 +132,8 @@ std::vector<DeclaredBinding> descriptor_bindings(std::span<const std::uint32_t> 
       d.type = Binding::UniformBuffer;
     } else if (storage == kStorageUniformConstant && sampled_image.count(t)) {
       d.type = Binding::SampledImage;
+    } else if (storage == kStorageUniformConstant && accel.count(t)) {
+      d.type = Binding::AccelerationStructure;
     } else if (storage == kStorageUniformConstant && image_sampled.count(t) && image_sampled[t] == 2) {
       d.type = Binding::StorageImage;
     } else {

@@ -5,7 +5,10 @@
 
 #include <glm/geometric.hpp>
 
+#include "fovea/core/error.hpp"
+#include "fovea/gpu/accel.hpp"
 #include "ggx_albedo.hpp"
+#include "tracer_pipeline.hpp"
 
 namespace fovea::renderer {
 
@@ -20,8 +23,38 @@ gpu::Buffer upload(gpu::Context& ctx, const std::vector<T>& data, const char* na
 
 }  // namespace
 
-GpuScene::GpuScene(gpu::Context& ctx, const Scene& s, const BvhOptions& bvh_options) {
+Tracing parse_tracing(std::string_view s, std::string_view what) {
+  for (Tracing t : {Tracing::Auto, Tracing::RayQuery, Tracing::Compute})
+    if (s == tracing_name(t)) return t;
+  throw core::InputError(std::string(what) + ": expected auto, rayquery or compute, got \"" + std::string(s) + "\"");
+}
+
+const char* tracing_name(Tracing t) {
+  switch (t) {
+    case Tracing::Auto: return "auto";
+    case Tracing::RayQuery: return "rayquery";
+    case Tracing::Compute: return "compute";
+  }
+  return "?";
+}
+
+gpu::ComputePipelineDesc tracer_pipeline(const GpuScene& scene, const char* shader, std::vector<gpu::Binding> set0,
+                                         std::uint32_t push_constant_bytes) {
+  const bool rq = scene.tracing() == Tracing::RayQuery;
+  gpu::ComputePipelineDesc d{std::string(shader) + (rq ? ".rayquery.comp.spv" : ".comp.spv"), {std::move(set0)},
+                             push_constant_bytes, {}};
+  if (rq) d.sets.push_back({gpu::Binding::AccelerationStructure});
+  return d;
+}
+
+GpuScene::~GpuScene() = default;
+
+GpuScene::GpuScene(gpu::Context& ctx, const Scene& s, const BvhOptions& bvh_options, Tracing tracing) {
   using namespace shaders;
+  if (tracing == Tracing::RayQuery && !ctx.features().ray_query)
+    throw core::InputError("--trace rayquery: the Vulkan device '" + ctx.info().name + "' (" + ctx.info().driver +
+                           ") does not offer ray queries (VK_KHR_acceleration_structure + VK_KHR_ray_query); "
+                           "use --trace compute or auto");
   const auto t0 = std::chrono::steady_clock::now();
   const Bvh bvh = build_bvh(s.positions, bvh_options);
   stats_.build_ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
@@ -93,6 +126,22 @@ GpuScene::GpuScene(gpu::Context& ctx, const Scene& s, const BvhOptions& bvh_opti
   stats_.nodes = std::uint32_t(bvh.nodes.size());
   stats_.bvh_depth = bvh.depth;
   stats_.bvh_sah_cost = bvh.sah_cost;
+
+  if (tracing != Tracing::Compute && ctx.features().ray_query) {
+    // The triangles in BVH order, so a ray query's primitive index addresses tris[] as
+    // the compute traversal's hits do.
+    std::vector<float> vertices;
+    vertices.reserve(9 * n);
+    for (const PtTriangle& t : tris)
+      vertices.insert(vertices.end(), {t.v0_x, t.v0_y, t.v0_z, t.v1_x, t.v1_y, t.v1_z, t.v2_x, t.v2_y, t.v2_z});
+    const auto t1 = std::chrono::steady_clock::now();
+    accel_ = std::make_unique<gpu::TriangleAccel>(ctx, vertices);
+    stats_.accel_build_ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t1).count();
+    stats_.accel_bytes = accel_->bytes();
+    accel_layout_ = gpu::DescriptorSetLayout(ctx, {gpu::Binding::AccelerationStructure});
+    accel_set_ = gpu::DescriptorSet(ctx, accel_layout_);
+    accel_set_.bind(0, *accel_);
+  }
 }
 
 }  // namespace fovea::renderer

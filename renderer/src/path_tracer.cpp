@@ -8,6 +8,7 @@
 
 #include "fovea/core/error.hpp"
 #include "fovea/gpu/barriers.hpp"
+#include "tracer_pipeline.hpp"
 
 namespace fovea::renderer {
 
@@ -19,9 +20,8 @@ constexpr int kBindings = 8 + kOutputs + 1;  // scene, grid, outputs, GGX albedo
 PathTracer::PathTracer(gpu::Context& ctx, const GpuScene& scene)
     : ctx_(ctx),
       scene_(scene),
-      pipeline_(ctx, {"pt_trace.comp.spv",
-                      {std::vector<gpu::Binding>(kBindings, gpu::Binding::StorageBuffer)},
-                      sizeof(shaders::PtFrameParams)}) {}
+      pipeline_(ctx, tracer_pipeline(scene, "pt_trace", std::vector<gpu::Binding>(kBindings, gpu::Binding::StorageBuffer),
+                                     sizeof(shaders::PtFrameParams))) {}
 
 TraceOutputs PathTracer::bind(const gpu::Buffer& grid, std::uint32_t cells) const {
   if (cells == 0) throw core::InputError("path tracer: empty sample grid");
@@ -76,7 +76,8 @@ void PathTracer::record(VkCommandBuffer cmd, TraceOutputs& out, const core::View
     p.sample_offset = first;
     p.accumulated_samples = std::uint32_t(std::min<std::uint64_t>(done, 0xFFFFFFFFu));
     p.flags = (c.jitter ? shaders::kPtJitter : 0u) | (done > 0 ? shaders::kPtAccumulate : 0u);
-    pipeline_.run(cmd, {&out.set_}, p, out.cells_);
+    if (scene_.tracing() == Tracing::RayQuery) pipeline_.run(cmd, {&out.set_, &scene_.ray_query_set()}, p, out.cells_);
+    else pipeline_.run(cmd, {&out.set_}, p, out.cells_);
     done += p.spp;
   }
 }

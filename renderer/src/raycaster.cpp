@@ -4,16 +4,15 @@
 
 #include "fovea/gpu/barriers.hpp"
 #include "fovea/gpu/timer.hpp"
+#include "tracer_pipeline.hpp"
 
 namespace fovea::renderer {
 
 Raycaster::Raycaster(gpu::Context& ctx, const GpuScene& scene)
     : ctx_(ctx),
       scene_(scene),
-      pipeline_(ctx, {"pt_raycast.comp.spv",
-                      {{gpu::Binding::StorageBuffer, gpu::Binding::StorageBuffer, gpu::Binding::StorageBuffer,
-                        gpu::Binding::StorageBuffer}},
-                      sizeof(shaders::PtRaycastParams)}) {}
+      pipeline_(ctx, tracer_pipeline(scene, "pt_raycast", std::vector<gpu::Binding>(4, gpu::Binding::StorageBuffer),
+                                     sizeof(shaders::PtRaycastParams))) {}
 
 void Raycaster::set_rays(std::span<const shaders::PtRay> rays) {
   if (rays.empty()) throw std::invalid_argument("Raycaster::set_rays: no rays");
@@ -34,7 +33,8 @@ std::vector<shaders::PtHitRecord> Raycaster::trace(RayQuery query, int repeat) {
     const shaders::PtRaycastParams p{count_, static_cast<std::uint32_t>(query), 0, 0};
     for (int r = 0; r < repeat; ++r) {
       if (r) gpu::barrier(cmd, gpu::access::compute_write, gpu::access::compute_write);
-      pipeline_.run(cmd, {&set_}, p, count_);
+      if (scene_.tracing() == Tracing::RayQuery) pipeline_.run(cmd, {&set_, &scene_.ray_query_set()}, p, count_);
+      else pipeline_.run(cmd, {&set_}, p, count_);
     }
     timer.stage(cmd, "raycast");
   });

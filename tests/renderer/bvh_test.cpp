@@ -121,7 +121,7 @@ class BvhGpu : public fovea::test::GpuTest {
     s.materials.push_back({});
     for (std::size_t t = 0; t < p.size() / 3; ++t) s.add_triangle(p[3 * t], p[3 * t + 1], p[3 * t + 2], 0);
     fr::sanitize(s, "test");
-    fr::GpuScene g(ctx(), s);
+    fr::GpuScene g(ctx(), s, {}, fr::Tracing::Compute);  // the compute BVH under test
     fr::Raycaster rc(ctx(), g);
     rc.set_rays(rays);
     const auto bvh = rc.trace(fr::RayQuery::Closest), brute = rc.trace(fr::RayQuery::BruteClosest);
@@ -204,7 +204,7 @@ TEST_F(BvhGpu, ClosedMeshIsWatertight) {
       rays.push_back(ray(c, s.positions[3 * t + k] - c));
       rays.push_back(ray(c, 0.5f * (s.positions[3 * t + k] + s.positions[3 * t + (k + 1) % 3]) - c));
     }
-  fr::GpuScene g(ctx(), s);
+  fr::GpuScene g(ctx(), s, {}, fr::Tracing::Compute);
   fr::Raycaster rc(ctx(), g);
   rc.set_rays(rays);
   const auto hits = rc.trace(fr::RayQuery::Closest);

@@ -28,6 +28,9 @@ and prints JSON: {"spp": N, "mean_rgb": [r, g, b], "rel_error": x, "seconds": t}
 
   --scene S             cornell | furnace | glossy-spheres | stereo-occluders | default,
                         or a .gltf/.glb/.obj file [default]
+  --trace auto|rayquery|compute
+                        ray queries through the device's acceleration structure, or the
+                        compute BVH traversal; auto: ray queries when the device has them [auto]
   --display NAME|FILE   display preset (fove0, vive, modern, small, tiny) or JSON [small]
   --eye left|right      which eye; it sits ipd/2 beside the scene's camera [left]
   --spp N               samples per pixel to stop at [256]
@@ -58,7 +61,7 @@ int run(std::vector<std::string> argv) {
       std::cout << kHelp;
       return 0;
     }
-  const Args args(argv, {"scene", "display", "eye", "spp", "until-rel-error", "batch", "bounces", "rr-start", "out"},
+  const Args args(argv, {"scene", "display", "eye", "spp", "until-rel-error", "batch", "bounces", "rr-start", "out", "trace"},
                   {"quiet"});
   const auto out = args.opt("out");
   if (!out) throw core::InputError("--out F.exr|F.png is required (see --help)");
@@ -80,13 +83,14 @@ int run(std::vector<std::string> argv) {
 
   const core::DisplayPreset display = core::load_display(args.str("display", "small"));
   const core::Eye eye = core::parse_eye(args.str("eye", "left"));
+  const renderer::Tracing tracing = renderer::parse_tracing(args.str("trace", "auto"));
   const renderer::Scene scene = renderer::load_scene(args.str("scene", "default"));
   for (const auto& w : scene.warnings) std::cerr << "warning: " << w << "\n";
 
   const core::View view = core::stereo_views(display, scene.camera)[eye];
 
   gpu::Context ctx;
-  renderer::GpuScene gs(ctx, scene);
+  renderer::GpuScene gs(ctx, scene, {}, tracing);
   renderer::ReferenceOptions o;
   o.path.spp = std::uint32_t(batch);
   o.path.max_bounces = int(bounces);

@@ -48,7 +48,7 @@ the peripheral blur. Writes to --out:
                 compare two runs with `fovea replay-diff A B`
   frame_times.jsonl  per frame: GPU and CPU ms per stage, the host time the gaze was read
   report.json   {"frames", "samples_traced_per_eye", "samples_hidden": {"left", "right"},
-                 "device": {name, driver},
+                 "device": {name, driver}, "trace": "rayquery" or "compute",
                  "gpu_ms": {grid, trace, reconstruct, resolve, total, bmfr_fit},
                  "cpu_ms": {gaze, grid, trace, reconstruct, resolve, submit, readback, total}
                  (medians per frame), "summary": {"left": {...}, "right": {...}}}
@@ -60,6 +60,9 @@ temporal_error (always). With no options: a short demo on the shipped scene and 
 
   --scene S             cornell | furnace | glossy-spheres | stereo-occluders | default,
                         or a .gltf/.glb/.obj file [default]
+  --trace auto|rayquery|compute
+                        ray queries through the device's acceleration structure, or the
+                        compute BVH traversal; auto: ray queries when the device has them [auto]
   --display NAME|FILE   display preset (fove0, vive, modern, small, tiny) or JSON [small]
   --gaze URI            recording, or synthetic:<seed>[?...] (docs/gaze.md)
                         [the shipped recording data/gaze/default.csv]
@@ -139,7 +142,7 @@ int run(std::vector<std::string> argv) {
     }
   const Args args(argv,
                   {"scene", "display", "gaze", "frames", "distribution", "budget", "denoiser", "bmfr-precision", "stereo-share",
-                   "reference", "png-every", "out", "screen"},
+                   "reference", "png-every", "out", "screen", "trace"},
                   {"no-blur", "no-cull", "no-marker", "quiet"});
   const long frames = args.integer("frames", 24);
   if (frames < 1 || frames > 100000) throw core::InputError("--frames must be in 1..100000");
@@ -177,12 +180,13 @@ int run(std::vector<std::string> argv) {
   devices::FoveationGaze gaze_source(gaze_uri, so);
   for (const auto& n : devices::recording_notes(gaze_uri, so)) std::cerr << "warning: " << n << "\n";
 
+  const renderer::Tracing tracing = renderer::parse_tracing(args.str("trace", "auto"));
   const renderer::Scene scene = renderer::load_scene(args.str("scene", "default"));
   for (const auto& w : scene.warnings) std::cerr << "warning: " << w << "\n";
   fs::create_directories(out_dir);
 
   gpu::Context ctx;
-  renderer::GpuScene gpu_scene(ctx, scene);
+  renderer::GpuScene gpu_scene(ctx, scene, {}, tracing);
   // A static head at the scene's camera.
   const core::StereoViews views = core::stereo_views(display, scene.camera);
   const std::array<core::Pose, 2> poses = views.poses();
@@ -275,6 +279,7 @@ int run(std::vector<std::string> argv) {
   for (const auto& [name, v] : cpu_ms) j["cpu_ms"][name] = median(v);
   // Which Vulkan driver produced the timings (lavapipe 22.3 and 25 differ ~2x).
   j["device"] = {{"name", ctx.info().name}, {"driver", ctx.info().driver}};
+  j["trace"] = renderer::tracing_name(gpu_scene.tracing());
   // Effective indirect-diffuse samples per cell after sharing vs the eye's own.
   double own = 0, shared = 0;
   for (int e = 0; e < 2; ++e) {

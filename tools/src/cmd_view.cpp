@@ -42,6 +42,9 @@ of view directions (lines every 5 degrees), a picture of the optics.
   --display NAME|FILE   display preset (fove0, vive, modern, small, tiny) or JSON file [small]
   --scene S             cornell | furnace | glossy-spheres | stereo-occluders | default, or a
                         .gltf/.glb/.obj file: path trace it (otherwise the direction grid)
+  --trace auto|rayquery|compute
+                        ray queries through the device's acceleration structure, or the
+                        compute BVH traversal; auto: ray queries when the device has them [auto]
   --gaze G              mouse: the cursor over a panel is the gaze (looked at through that
                         eye's lens; kept when the cursor leaves the panels);
                         X,Y: fixed gaze in normalised view coordinates;
@@ -117,7 +120,7 @@ int run(std::vector<std::string> argv) {
       return 0;
     }
   const Args args(argv,
-                  {"display", "scene", "gaze", "gaze-dir", "budget", "optics", "window", "frames", "screenshot",
+                  {"display", "scene", "trace", "gaze", "gaze-dir", "budget", "optics", "window", "frames", "screenshot",
                    "panels"},
                   {});
   const core::DisplayPreset d = core::load_display(args.str("display", "small"));
@@ -146,6 +149,7 @@ int run(std::vector<std::string> argv) {
 
   // Inputs are checked (the scene loaded) before the window opens, the window before the
   // GPU work: without an X display there is no point building the renderer.
+  const renderer::Tracing tracing = renderer::parse_tracing(args.str("trace", "auto"));
   std::optional<renderer::Scene> scene;
   if (auto name = args.opt("scene")) {
     scene = renderer::load_scene(*name);
@@ -166,7 +170,7 @@ int run(std::vector<std::string> argv) {
   std::optional<SceneRenderer> sr;
   if (scene) {
     sr.emplace();
-    sr->gpu_scene = std::make_unique<renderer::GpuScene>(ctx, *scene);
+    sr->gpu_scene = std::make_unique<renderer::GpuScene>(ctx, *scene, renderer::BvhOptions{}, tracing);
     const core::StereoViews views = core::stereo_views(d, scene->camera);
     sr->poses = views.poses();
     sr->pipeline = std::make_unique<pipeline::FramePipeline>(ctx, *sr->gpu_scene, views, dp, reconstruct::ReconSettings{});

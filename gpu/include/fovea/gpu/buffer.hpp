@@ -22,6 +22,11 @@ enum class BufferUsage : std::uint32_t {
   Uniform = VK_BUFFER_USAGE_UNIFORM_BUFFER_BIT,
   TransferSrc = VK_BUFFER_USAGE_TRANSFER_SRC_BIT,
   TransferDst = VK_BUFFER_USAGE_TRANSFER_DST_BIT,
+  // Ray queries (EnabledFeatures::ray_query): addressable memory, acceleration-structure
+  // storage and build inputs.
+  DeviceAddress = VK_BUFFER_USAGE_SHADER_DEVICE_ADDRESS_BIT,
+  AccelerationStructure = VK_BUFFER_USAGE_ACCELERATION_STRUCTURE_STORAGE_BIT_KHR,
+  BuildInput = VK_BUFFER_USAGE_ACCELERATION_STRUCTURE_BUILD_INPUT_READ_ONLY_BIT_KHR,
 };
 constexpr BufferUsage operator|(BufferUsage a, BufferUsage b) {
   return static_cast<BufferUsage>(static_cast<std::uint32_t>(a) | static_cast<std::uint32_t>(b));
@@ -50,6 +55,8 @@ class Buffer {
 
   VkBuffer handle() const { return buffer_.get(); }
   VkDeviceSize size() const { return size_; }
+  // For buffers created with BufferUsage::DeviceAddress.
+  VkDeviceAddress device_address() const;
   bool host_visible() const { return mapped_ != nullptr; }
   // The mapped bytes of a HostVisible buffer (empty for DeviceLocal). The GPU must be
   // done with them (submit_and_wait returned) before the host reads.

@@ -29,6 +29,9 @@ struct ContextOptions {
   std::optional<bool> validation;
   // Unset: read env FOVEA_VK_DEVICE. Empty: automatic choice.
   std::optional<std::string> device;
+  // Ray queries (VK_KHR_acceleration_structure + VK_KHR_ray_query) are enabled when the
+  // device offers them; false leaves them off, as on a device without them.
+  bool ray_query = true;
 };
 
 // Counters of validation messages, shared so they can be read after the context
@@ -79,6 +82,10 @@ struct EnabledFeatures {
   bool storage_image_read_without_format = false;
   bool storage_image_write_without_format = false;
   bool timeline_semaphore = false;
+  // VK_KHR_acceleration_structure + VK_KHR_ray_query + VK_KHR_deferred_host_operations with
+  // bufferDeviceAddress: compute shaders may trace rays through acceleration structures.
+  bool ray_query = false;
+  std::uint32_t as_scratch_alignment = 0;  // minAccelerationStructureScratchOffsetAlignment
 };
 
 class Context {
@@ -119,7 +126,7 @@ class Context {
  private:
   void create_instance(bool validation);
   void pick_device(const std::string& override);
-  void create_device();
+  void create_device(bool ray_query);
   void release();
 
   std::shared_ptr<ValidationCounters> counters_ = std::make_shared<ValidationCounters>();

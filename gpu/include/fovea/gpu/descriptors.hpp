@@ -14,12 +14,14 @@ class Context;
 class Buffer;
 class Image2D;
 class Sampler;
+class TriangleAccel;
 
 enum class Binding {
   StorageBuffer,  // buffer { ... }
   UniformBuffer,  // uniform { ... }
   StorageImage,   // image2D / uimage2D with a format qualifier
   SampledImage,   // sampler2D (combined image sampler)
+  AccelerationStructure,  // accelerationStructureEXT (the top level of a TriangleAccel)
 };
 const char* binding_name(Binding b);  // "storage buffer", ... for messages
 
@@ -59,10 +61,12 @@ class DescriptorSet {
   // binding of the layout exactly once with a buffer.
   DescriptorSet& bind_all(std::span<const BufferSlot> slots);
   DescriptorSet& bind(std::uint32_t binding, const Image2D& image, const Sampler& sampler);
+  DescriptorSet& bind(std::uint32_t binding, const TriangleAccel& accel);
 
  private:
   void expect(std::uint32_t binding, Binding type) const;
-  void write(std::uint32_t binding, const VkDescriptorBufferInfo* buffer, const VkDescriptorImageInfo* image);
+  void write(std::uint32_t binding, const VkDescriptorBufferInfo* buffer, const VkDescriptorImageInfo* image,
+             const void* next = nullptr);
 
   std::vector<Binding> bindings_;
   DeviceHandle<VkDescriptorPool, vkDestroyDescriptorPool> pool_;

@@ -1,27 +1,46 @@
 #pragma once
 // A scene on the GPU: BVH nodes, triangles in BVH order, shading attributes, materials,
 // the emissive-triangle table for next-event estimation, the textures and the GGX albedo
-// table of the layered BSDF, uploaded once.
+// table of the layered BSDF, uploaded once; on devices with ray queries also the
+// acceleration structure over the same triangles.
 #include <cstdint>
+#include <memory>
+#include <string_view>
 
 #include "fovea/gpu/buffer.hpp"
 #include "fovea/gpu/context.hpp"
+#include "fovea/gpu/descriptors.hpp"
 #include "fovea/renderer/bvh.hpp"
 #include "fovea/renderer/scene.hpp"
 
+namespace fovea::gpu {
+class TriangleAccel;
+}
+
 namespace fovea::renderer {
+
+// How the tracers find hits: Auto = ray queries (VK_KHR_ray_query through an acceleration
+// structure) when the device offers them, else the compute BVH traversal (pt_traverse.h).
+enum class Tracing { Auto, RayQuery, Compute };
+// "auto", "rayquery", "compute"; anything else: core::InputError naming `what`.
+Tracing parse_tracing(std::string_view s, std::string_view what = "--trace");
+const char* tracing_name(Tracing t);
 
 struct GpuSceneStats {
   std::uint32_t triangles = 0, nodes = 0, lights = 0, textures = 0;
   int bvh_depth = 0;
   double bvh_sah_cost = 0;
   double build_ms = 0;  // CPU BVH build
+  double accel_build_ms = 0;       // acceleration-structure build (ray queries), wall clock
+  std::uint64_t accel_bytes = 0;   // its storage, both levels
 };
 
 class GpuScene {
  public:
-  // `scene` must be sanitised (every loader does that).
-  GpuScene(gpu::Context& ctx, const Scene& scene, const BvhOptions& bvh = {});
+  // `scene` must be sanitised (every loader does that). Tracing::RayQuery on a device
+  // without ray queries throws core::InputError.
+  GpuScene(gpu::Context& ctx, const Scene& scene, const BvhOptions& bvh = {}, Tracing tracing = Tracing::Auto);
+  ~GpuScene();
 
   const gpu::Buffer& nodes() const { return nodes_; }
   const gpu::Buffer& triangles() const { return triangles_; }
@@ -34,11 +53,18 @@ class GpuScene {
   std::uint32_t light_count() const { return stats_.lights; }     // real emissive triangles
   glm::vec3 environment() const { return environment_; }
   const GpuSceneStats& stats() const { return stats_; }
+  // Resolved: RayQuery or Compute. With RayQuery the tracers use the *.rayquery.comp.spv
+  // shaders and bind ray_query_set() as set 1.
+  Tracing tracing() const { return accel_ ? Tracing::RayQuery : Tracing::Compute; }
+  const gpu::DescriptorSet& ray_query_set() const { return accel_set_; }
 
  private:
   gpu::Buffer nodes_, triangles_, shading_, materials_, lights_, texture_table_, texels_, ggx_albedo_;
   glm::vec3 environment_{0};
   GpuSceneStats stats_;
+  std::unique_ptr<gpu::TriangleAccel> accel_;  // null: compute traversal
+  gpu::DescriptorSetLayout accel_layout_;
+  gpu::DescriptorSet accel_set_;
 };
 
 }  // namespace fovea::renderer

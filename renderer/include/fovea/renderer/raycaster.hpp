@@ -1,6 +1,7 @@
 #pragma once
 // Batches of rays against a GpuScene (pt_raycast.comp): closest-hit or any-hit, through
-// the BVH or by brute force. For BVH tests and the ray-throughput benchmark.
+// the scene's tracing (ray queries or the compute BVH, GpuScene::tracing()) or by brute
+// force. For BVH tests and the ray-throughput benchmark.
 #include <span>
 #include <vector>
 
