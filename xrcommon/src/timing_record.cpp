@@ -6,6 +6,7 @@
 #include <nlohmann/json.hpp>
 
 #include "fovea/core/error.hpp"
+#include "fovea/core/view.hpp"
 
 namespace fovea::xrcommon {
 
@@ -34,9 +35,7 @@ const char* time_base_name(TimeBase b) { return b == TimeBase::Monotonic ? "mono
 
 std::optional<double> TimingRecord::foveal_error_deg() const {
   if (!fovea_dir || !true_gaze_dir) return std::nullopt;
-  const glm::dvec3 a = glm::normalize(*fovea_dir), b = glm::normalize(*true_gaze_dir);
-  // atan2 of |a×b| and a·b: accurate at small angles, where acos of a dot product is not.
-  const double deg = glm::degrees(std::atan2(glm::length(glm::cross(a, b)), glm::dot(a, b)));
+  const double deg = core::angle_deg(*fovea_dir, *true_gaze_dir);
   return std::isfinite(deg) ? std::optional<double>(deg) : std::nullopt;
 }
 
