@@ -29,18 +29,10 @@ void FrameLog::write(const FrameTimes& t) {
   xrcommon::TimingRecord r;
   r.source = "layer";
   r.frame = t.frame;
-  // 0: no tracker sample measured yet (or no renderer).
-  const auto known = [](std::int64_t v) { return v ? std::optional<std::int64_t>(v) : std::nullopt; };
-  r.gaze_valid = rt.gaze_sample_ns != 0;
-  r.gaze_sample_ns = known(rt.gaze_sample_ns);
-  r.gaze_receive_ns = known(rt.gaze_receive_ns);
-  r.gaze_read_ns = known(rt.gaze_read_ns);
+  r.gaze_valid = rt.gaze_sample_ns != 0;  // 0: no tracker sample measured yet (or no renderer)
+  r.set_gaze_times(rt.gaze_sample_ns, rt.gaze_receive_ns, rt.gaze_read_ns);
   r.predicted_display_ns = t.display_time_ns;
-  r.wait_call_ns = t.wait_call_ns;
-  r.wait_return_ns = t.wait_return_ns;
-  r.begin_ns = t.begin_ns;
-  r.end_call_ns = t.end_call_ns;
-  r.end_return_ns = t.end_return_ns;
+  r.set_frame_calls(t.wait_call_ns, t.wait_return_ns, t.begin_ns, t.end_call_ns, t.end_return_ns);
   r.cpu_ms = {{"app", double(t.end_call_ns - t.begin_ns) * 1e-6},
               {"end_frame", double(t.end_return_ns - t.end_call_ns) * 1e-6},
               {"gaze", rt.gaze_cpu},

@@ -22,17 +22,9 @@ void TimingLog::write(const FrameRecord& r) {
   t.source = "runtime";
   t.frame = r.frame;
   t.gaze_valid = r.gaze_valid;
-  // 0: no tracker sample measured yet. The runtime's sources carry no separate device clock.
-  const auto known = [](core::TimeNs v) { return v ? std::optional<core::TimeNs>(v) : std::nullopt; };
-  t.gaze_sample_ns = known(r.gaze_sample_ns);
-  t.gaze_receive_ns = known(r.gaze_receive_ns);
-  t.gaze_read_ns = known(r.gaze_read_ns);
+  t.set_gaze_times(r.gaze_sample_ns, r.gaze_receive_ns, r.gaze_read_ns);  // the runtime's sources carry no device clock
   t.predicted_display_ns = r.predicted_display_ns;
-  t.wait_call_ns = r.wait_call_ns;
-  t.wait_return_ns = r.wait_return_ns;
-  t.begin_ns = r.begin_ns;
-  t.end_call_ns = r.end_call_ns;
-  t.end_return_ns = r.end_return_ns;
+  t.set_frame_calls(r.wait_call_ns, r.wait_return_ns, r.begin_ns, r.end_call_ns, r.end_return_ns);
   t.submit_ns = r.end_call_ns;  // the panel images after it are the simulator's, not the frame's
   t.vsync_ns = r.displayed_ns;
   t.missed_vsyncs = r.missed_vsyncs;

@@ -27,6 +27,24 @@ json stages(const std::vector<std::pair<std::string, double>>& v) {
   return j;
 }
 
+// The optional times, in the order they are written.
+using TimeField = std::optional<core::TimeNs> TimingRecord::*;
+constexpr std::pair<const char*, TimeField> kTimes[] = {
+    {"gaze_sample_ns", &TimingRecord::gaze_sample_ns},
+    {"gaze_device_ns", &TimingRecord::gaze_device_ns},
+    {"gaze_receive_ns", &TimingRecord::gaze_receive_ns},
+    {"gaze_read_ns", &TimingRecord::gaze_read_ns},
+    {"head_pose_ns", &TimingRecord::head_pose_ns},
+    {"predicted_display_ns", &TimingRecord::predicted_display_ns},
+    {"wait_call_ns", &TimingRecord::wait_call_ns},
+    {"wait_return_ns", &TimingRecord::wait_return_ns},
+    {"begin_ns", &TimingRecord::begin_ns},
+    {"end_call_ns", &TimingRecord::end_call_ns},
+    {"end_return_ns", &TimingRecord::end_return_ns},
+    {"submit_ns", &TimingRecord::submit_ns},
+    {"vsync_ns", &TimingRecord::vsync_ns},
+};
+
 json photons(const PhotonTimes& p) { return {{"start", p.start}, {"mid", p.mid}, {"end", p.end}}; }
 
 }  // namespace
@@ -39,6 +57,22 @@ std::optional<double> TimingRecord::foveal_error_deg() const {
   return std::isfinite(deg) ? std::optional<double>(deg) : std::nullopt;
 }
 
+void TimingRecord::set_gaze_times(core::TimeNs sample, core::TimeNs receive, core::TimeNs read) {
+  const auto known = [](core::TimeNs v) { return v ? std::optional<core::TimeNs>(v) : std::nullopt; };
+  gaze_sample_ns = known(sample);
+  gaze_receive_ns = known(receive);
+  gaze_read_ns = known(read);
+}
+
+void TimingRecord::set_frame_calls(core::TimeNs wait_call, core::TimeNs wait_return, core::TimeNs begin,
+                                   core::TimeNs end_call, core::TimeNs end_return) {
+  wait_call_ns = wait_call;
+  wait_return_ns = wait_return;
+  begin_ns = begin;
+  end_call_ns = end_call;
+  end_return_ns = end_return;
+}
+
 std::string to_json_line(const TimingRecord& r) {
   json j;
   j["schema"] = kSchema;
@@ -47,19 +81,7 @@ std::string to_json_line(const TimingRecord& r) {
   j["clock"] = time_base_name(r.clock);
   j["frame"] = r.frame;
   j["gaze_valid"] = r.gaze_valid;
-  j["gaze_sample_ns"] = time_or_null(r.gaze_sample_ns);
-  j["gaze_device_ns"] = time_or_null(r.gaze_device_ns);
-  j["gaze_receive_ns"] = time_or_null(r.gaze_receive_ns);
-  j["gaze_read_ns"] = time_or_null(r.gaze_read_ns);
-  j["head_pose_ns"] = time_or_null(r.head_pose_ns);
-  j["predicted_display_ns"] = time_or_null(r.predicted_display_ns);
-  j["wait_call_ns"] = time_or_null(r.wait_call_ns);
-  j["wait_return_ns"] = time_or_null(r.wait_return_ns);
-  j["begin_ns"] = time_or_null(r.begin_ns);
-  j["end_call_ns"] = time_or_null(r.end_call_ns);
-  j["end_return_ns"] = time_or_null(r.end_return_ns);
-  j["submit_ns"] = time_or_null(r.submit_ns);
-  j["vsync_ns"] = time_or_null(r.vsync_ns);
+  for (const auto& [key, field] : kTimes) j[key] = time_or_null(r.*field);
   j["missed_vsyncs"] = r.missed_vsyncs;
   j["photon_ns"] = r.photon_ns ? json{{"left", photons((*r.photon_ns)[0])}, {"right", photons((*r.photon_ns)[1])}}
                                : json(nullptr);
@@ -101,22 +123,8 @@ TimingRecord parse_timing_record(std::string_view line, const std::string& where
     r.clock = clock == "monotonic" ? TimeBase::Monotonic : TimeBase::Virtual;
     r.frame = j.at("frame").get<std::int64_t>();
     r.gaze_valid = j.value("gaze_valid", false);
-    const auto time = [&](const char* key, std::optional<core::TimeNs>& out) {
-      if (j.contains(key) && !j[key].is_null()) out = j[key].get<core::TimeNs>();
-    };
-    time("gaze_sample_ns", r.gaze_sample_ns);
-    time("gaze_device_ns", r.gaze_device_ns);
-    time("gaze_receive_ns", r.gaze_receive_ns);
-    time("gaze_read_ns", r.gaze_read_ns);
-    time("head_pose_ns", r.head_pose_ns);
-    time("predicted_display_ns", r.predicted_display_ns);
-    time("wait_call_ns", r.wait_call_ns);
-    time("wait_return_ns", r.wait_return_ns);
-    time("begin_ns", r.begin_ns);
-    time("end_call_ns", r.end_call_ns);
-    time("end_return_ns", r.end_return_ns);
-    time("submit_ns", r.submit_ns);
-    time("vsync_ns", r.vsync_ns);
+    for (const auto& [key, field] : kTimes)
+      if (j.contains(key) && !j[key].is_null()) r.*field = j[key].get<core::TimeNs>();
     r.missed_vsyncs = j.value("missed_vsyncs", std::int64_t(0));
     if (j.contains("photon_ns") && !j["photon_ns"].is_null()) {
       std::array<PhotonTimes, 2> p;

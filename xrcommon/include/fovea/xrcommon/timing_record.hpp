@@ -52,6 +52,10 @@ struct TimingRecord {
   std::vector<std::pair<std::string, std::variant<std::int64_t, double, bool>>> extra;
 
   std::optional<double> foveal_error_deg() const;
+  // The gaze sample's host times where 0 means "none measured" (the OpenXR paths' convention).
+  void set_gaze_times(core::TimeNs sample, core::TimeNs receive, core::TimeNs read);
+  void set_frame_calls(core::TimeNs wait_call, core::TimeNs wait_return, core::TimeNs begin, core::TimeNs end_call,
+                       core::TimeNs end_return);
 };
 
 const char* time_base_name(TimeBase b);  // "monotonic" | "virtual"
