@@ -107,10 +107,7 @@ Simulation simulate(devices::TrackerModel& tracker, const Scenario& sc, const Re
     r.gaze_read_ns = wake;
     r.head_pose_ns = wake;  // the application locates its views when it wakes
     r.predicted_display_ns = slot.display_ns;
-    r.wait_call_ns = now;
-    r.wait_return_ns = wake;
-    r.begin_ns = wake;
-    r.end_call_ns = submit;
+    r.set_frame_calls(now, wake, wake, submit, submit);  // the modelled calls return at once
     r.submit_ns = submit;
     r.vsync_ns = shown.vsync_ns;
     r.missed_vsyncs = slot.missed + shown.missed;
