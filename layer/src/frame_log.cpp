@@ -2,9 +2,7 @@
 
 #include <time.h>
 
-#include <cerrno>
 #include <cmath>
-#include <cstring>
 
 #include "log.hpp"
 
@@ -16,47 +14,43 @@ std::int64_t now_ns() {
   return std::int64_t(ts.tv_sec) * 1'000'000'000 + ts.tv_nsec;
 }
 
-FrameLog::~FrameLog() {
-  if (file_) std::fclose(file_);
-}
-
 void FrameLog::open(const std::string& dir) {
-  if (file_) std::fclose(file_);
-  file_ = nullptr;
+  writer_ = xrcommon::TimingWriter();
   if (dir.empty()) return;
-  const std::string path = dir + "/layer_timing.jsonl";
-  file_ = std::fopen(path.c_str(), "w");
-  // Reported, not fatal: the session works, its frames are just not logged.
-  if (!file_)
-    FOVEA_LAYER_WARN("cannot write the timing log \"%s\" (FOVEA_LAYER_OUT): %s; frames are not logged", path.c_str(),
-                     std::strerror(errno));
+  try {
+    writer_.open(dir + "/layer_timing.jsonl");
+  } catch (const std::exception& e) {
+    // Reported, not fatal: the session works, its frames are just not logged.
+    FOVEA_LAYER_WARN("%s (FOVEA_LAYER_OUT); frames are not logged", e.what());
+  }
 }
 
 void FrameLog::write(const FrameTimes& t) {
-  if (!file_) return;
-  std::fprintf(file_,
-               "{\"frame\":%lld,\"display_time_ns\":%lld,\"wait_call_ns\":%lld,\"wait_return_ns\":%lld,"
-               "\"begin_ns\":%lld,\"end_call_ns\":%lld,\"end_return_ns\":%lld,\"app_cpu_ms\":%.3f,"
-               "\"end_frame_ms\":%.3f,\"layers\":%u,\"projection_views\":%u,\"replaced\":%s,\"render_ms\":%.3f,"
-               "\"trace_ms\":%.3f,\"reconstruct_ms\":%.3f,\"resolve_ms\":%.3f,\"transfer_ms\":%.3f,"
-               "\"gaze_cpu_ms\":%.3f,\"grid_cpu_ms\":%.3f,\"submit_cpu_ms\":%.3f,\"readback_cpu_ms\":%.3f,"
-               "\"gaze_sample_ns\":%lld,\"gaze_receive_ns\":%lld,\"gaze_read_ns\":%lld,\"samples_hidden\":%lld,"
-               "\"traced_frame\":%lld,\"traced_for_ns\":%lld,\"traced_done_ns\":%lld,\"traced_age_ns\":%lld,"
-               "\"reprojected_deg\":%.4f}\n",
-               static_cast<long long>(t.frame), static_cast<long long>(t.display_time_ns),
-               static_cast<long long>(t.wait_call_ns), static_cast<long long>(t.wait_return_ns),
-               static_cast<long long>(t.begin_ns), static_cast<long long>(t.end_call_ns),
-               static_cast<long long>(t.end_return_ns), double(t.end_call_ns - t.begin_ns) * 1e-6,
-               double(t.end_return_ns - t.end_call_ns) * 1e-6, t.layers, t.projection_views,
-               t.replaced ? "true" : "false", t.render.total, t.render.trace, t.render.reconstruct, t.render.resolve,
-               t.render.transfer, t.render.gaze_cpu, t.render.grid_cpu, t.render.submit_cpu, t.render.readback_cpu,
-               static_cast<long long>(t.render.gaze_sample_ns), static_cast<long long>(t.render.gaze_receive_ns),
-               static_cast<long long>(t.render.gaze_read_ns), static_cast<long long>(t.render.samples_hidden),
-               static_cast<long long>(t.traced_frame), static_cast<long long>(t.traced_for_ns),
-               static_cast<long long>(t.traced_done_ns),
-               static_cast<long long>(t.traced_frame >= 0 ? t.display_time_ns - t.traced_for_ns : 0),
-               std::isfinite(t.reprojected_deg) ? t.reprojected_deg : 0.0);
-  std::fflush(file_);
+  if (!writer_.is_open()) return;
+  const RenderTimes& rt = t.render;
+  xrcommon::TimingRecord r;
+  r.source = "layer";
+  r.frame = t.frame;
+  r.gaze_valid = rt.gaze_sample_ns != 0;  // 0: no tracker sample measured yet (or no renderer)
+  r.set_gaze_times(rt.gaze_sample_ns, rt.gaze_receive_ns, rt.gaze_read_ns);
+  r.predicted_display_ns = t.display_time_ns;
+  r.set_frame_calls(t.wait_call_ns, t.wait_return_ns, t.begin_ns, t.end_call_ns, t.end_return_ns);
+  r.cpu_ms = {{"app", double(t.end_call_ns - t.begin_ns) * 1e-6},
+              {"end_frame", double(t.end_return_ns - t.end_call_ns) * 1e-6},
+              {"gaze", rt.gaze_cpu},
+              {"grid", rt.grid_cpu},
+              {"submit", rt.submit_cpu},
+              {"readback", rt.readback_cpu}};
+  r.gpu_ms = {{"trace", rt.trace}, {"reconstruct", rt.reconstruct}, {"resolve", rt.resolve}};
+  r.extra = {{"layers", std::int64_t(t.layers)},     {"projection_views", std::int64_t(t.projection_views)},
+             {"replaced", t.replaced},                {"render_ms", rt.total},
+             {"transfer_ms", rt.transfer},            {"samples_hidden", rt.samples_hidden},
+             // Which path-traced frame this displayed frame shows (asynchronous rendering).
+             {"traced_frame", t.traced_frame},        {"traced_for_ns", t.traced_for_ns},
+             {"traced_done_ns", t.traced_done_ns},
+             {"traced_age_ns", t.traced_frame >= 0 ? t.display_time_ns - t.traced_for_ns : std::int64_t(0)},
+             {"reprojected_deg", std::isfinite(t.reprojected_deg) ? t.reprojected_deg : 0.0}};
+  if (!writer_.write(r)) FOVEA_LAYER_WARN("%s", writer_.error().c_str());
 }
 
 }  // namespace fovea::layer

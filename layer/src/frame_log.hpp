@@ -1,10 +1,11 @@
 #pragma once
-// The layer's per-frame timing log (pass-through measurement): one JSON object per line in
-// <FOVEA_LAYER_OUT>/layer_timing.jsonl. Times are int64 ns of CLOCK_MONOTONIC.
+// The layer's per-frame timing log (pass-through measurement): one timing record
+// (fovea/xrcommon/timing_record.hpp) per line in <FOVEA_LAYER_OUT>/layer_timing.jsonl.
+// Times are int64 ns of CLOCK_MONOTONIC.
 #include <cstdint>
-#include <cstdio>
 #include <string>
 
+#include "fovea/xrcommon/timing_writer.hpp"
 #include "frame_renderer.hpp"
 
 namespace fovea::layer {
@@ -30,24 +31,11 @@ struct FrameTimes {
 
 class FrameLog {
  public:
-  FrameLog() = default;
-  ~FrameLog();
-  FrameLog(const FrameLog&) = delete;
-  FrameLog& operator=(const FrameLog&) = delete;
-  FrameLog(FrameLog&& o) noexcept : file_(o.file_) { o.file_ = nullptr; }
-  FrameLog& operator=(FrameLog&& o) noexcept {
-    if (this != &o) {
-      if (file_) std::fclose(file_);
-      file_ = o.file_;
-      o.file_ = nullptr;
-    }
-    return *this;
-  }
   void open(const std::string& dir);  // empty: no log
   void write(const FrameTimes& t);
 
  private:
-  std::FILE* file_ = nullptr;
+  xrcommon::TimingWriter writer_;
 };
 
 }  // namespace fovea::layer

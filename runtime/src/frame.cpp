@@ -215,6 +215,9 @@ XrResult api::xrEndFrame(XrSession session, const XrFrameEndInfo* info) {
     // Submitted at the call: the panel images below are the simulator's output, not part of
     // the application's frame, so their cost does not delay the display of this frame.
     r.displayed_ns = s->clock.displayed(r.predicted_display_ns, t_call);
+    r.missed_vsyncs += (r.displayed_ns - r.predicted_display_ns) / s->clock.period();
+    for (core::Eye e : {core::Eye::Left, core::Eye::Right})
+      r.photon[std::size_t(e)] = s->clock.model().photons(r.displayed_ns, e);
     if (s->compositor->wants(r.frame)) {
       const core::TimeNs t0 = core::now_ns();
       try {

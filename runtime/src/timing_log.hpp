@@ -1,11 +1,12 @@
 #pragma once
-// Per-frame timing log: one JSON object per line in <out>/timing.jsonl. All times are int64
-// ns of CLOCK_MONOTONIC (the XrTime base).
+// Per-frame timing log: <out>/timing.jsonl, one timing record (fovea/xrcommon/timing_record.hpp)
+// per line. All times are int64 ns of CLOCK_MONOTONIC (the XrTime base).
+#include <array>
 #include <cstdint>
-#include <cstdio>
 #include <string>
 
 #include "fovea/core/clock.hpp"
+#include "fovea/xrcommon/timing_writer.hpp"
 
 namespace fovea::runtime {
 
@@ -14,10 +15,11 @@ struct FrameRecord {
   core::TimeNs predicted_display_ns = 0;
   core::TimeNs wait_call_ns = 0, wait_return_ns = 0;  // xrWaitFrame entry and return
   core::TimeNs late_ns = 0;                            // wait return past the frame's wake time
-  std::int64_t missed_vsyncs = 0;                      // vsyncs skipped because xrWaitFrame came late
+  std::int64_t missed_vsyncs = 0;  // vsyncs skipped: xrWaitFrame came late, or the frame missed its vsync
   core::TimeNs begin_ns = 0;                           // xrBeginFrame
   core::TimeNs end_call_ns = 0, end_return_ns = 0;     // xrEndFrame entry and return
   core::TimeNs displayed_ns = 0;  // the vsync that shows the frame (>= submission + compositor budget)
+  std::array<xrcommon::PhotonTimes, 2> photon{};  // light from the panel (display model), left and right
   double compositor_ms = 0;                            // read-back, resampling, mask, PNG
   bool composited = false;                             // panel images produced for this frame
   std::uint32_t layers = 0;
@@ -33,18 +35,13 @@ struct FrameRecord {
 
 class TimingLog {
  public:
-  TimingLog() = default;
-  ~TimingLog();
-  TimingLog(const TimingLog&) = delete;
-  TimingLog& operator=(const TimingLog&) = delete;
   // Starts <dir>/timing.jsonl (truncating); an empty dir disables the log. A file that
   // cannot be opened or written is reported (error log naming it), never silently dropped.
   void open(const std::string& dir);
   void write(const FrameRecord& r);
 
  private:
-  std::FILE* file_ = nullptr;
-  std::string path_;
+  xrcommon::TimingWriter writer_;
 };
 
 }  // namespace fovea::runtime

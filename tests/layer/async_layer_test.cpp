@@ -184,7 +184,7 @@ TEST_F(AsyncLayer, PipelinedFramesOnTwoThreadsNeverWaitForTheRenderThread) {
   int replaced = 0;
   for (const auto& r : recs) {
     const std::int64_t tf = r["traced_frame"].get<std::int64_t>();
-    const std::int64_t display = r["display_time_ns"].get<std::int64_t>();
+    const std::int64_t display = r["predicted_display_ns"].get<std::int64_t>();
     EXPECT_GT(display, last_display) << r.dump();  // the queue matched each end to its own wait
     last_display = display;
     EXPECT_EQ(r["replaced"].get<bool>(), tf >= 0) << r.dump();

@@ -43,8 +43,9 @@ TEST(ReplayDiffCli, TwoRunsAgreeAndChangesAreFound) {
   EXPECT_EQ(slurp(a + "/frames.jsonl"), slurp(b + "/frames.jsonl"));
   const auto times = nlohmann::json::parse(slurp(a + "/frame_times.jsonl").substr(0, slurp(a + "/frame_times.jsonl").find('\n')));
   EXPECT_EQ(times["frame"], 0);
-  EXPECT_TRUE(times.contains("gpu_trace"));
-  EXPECT_TRUE(times.contains("cpu_grid"));
+  EXPECT_EQ(times["schema"], "fovea-timing");
+  EXPECT_TRUE(times["gpu_ms"].contains("trace"));
+  EXPECT_TRUE(times["cpu_ms"].contains("grid"));
 
   const auto same = run_fovea("replay-diff --json " + a + " " + b);
   ASSERT_EQ(same.status, 0) << same.out << same.err;

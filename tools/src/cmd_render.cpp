@@ -46,7 +46,8 @@ the peripheral blur. Writes to --out:
   frames.jsonl  per frame: the gaze sample used (its times, flags), the gaze each eye used,
                 eye poses, grid size — deterministic: identical runs write identical bytes;
                 compare two runs with `fovea replay-diff A B`
-  frame_times.jsonl  per frame: GPU and CPU ms per stage, the host time the gaze was read
+  frame_times.jsonl  per frame a timing record (docs/openxr.md): the gaze sample's times, GPU
+                and CPU ms per stage
   report.json   {"frames", "samples_traced_per_eye", "samples_hidden": {"left", "right"},
                  "device": {name, driver}, "trace": "rayquery" or "compute",
                  "gpu_ms": {grid, trace, reconstruct, resolve, total, bmfr_fit},
@@ -225,10 +226,10 @@ int run(std::vector<std::string> argv) {
     cpu_ms["readback"].push_back(core::ns_to_ms(core::now_ns() - t0));
     cpu_ms["total"].push_back(cpu_ms["gaze"].back() + t.cpu_ms() + cpu_ms["readback"].back());
     const auto& dist = pipeline.distribution(core::Eye::Left);
-    std::vector<std::pair<std::string, double>> timings;
-    for (const auto& [name, v] : gpu_ms) timings.emplace_back("gpu_" + name, v.back());
-    for (const auto& [name, v] : cpu_ms) timings.emplace_back("cpu_" + name, v.back());
-    frame_log.add({f, t_ns, g, gaze, poses, dist.columns(), dist.rows(), std::move(timings)});
+    FrameRecord rec{f, t_ns, g, gaze, poses, dist.columns(), dist.rows(), {}, {}, gaze_source.live()};
+    for (const auto& [name, v] : gpu_ms) rec.gpu_ms.emplace_back(name, v.back());
+    for (const auto& [name, v] : cpu_ms) rec.cpu_ms.emplace_back(name, v.back());
+    frame_log.add(rec);
     std::array<core::Image, 2> ldr;
     for (int e = 0; e < 2; ++e) {
       if (f > 0) te_sum[e] += core::temporal_error(previous[e], last[e]);

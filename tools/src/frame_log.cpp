@@ -1,6 +1,7 @@
 #include "frame_log.hpp"
 
 #include <cmath>
+#include <stdexcept>
 
 #include <nlohmann/json.hpp>
 
@@ -21,6 +22,10 @@ nlohmann::json eye(const devices::FoveaEye& g) {
           {"tracked", g.tracked()}};
 }
 }  // namespace
+
+FrameLog::FrameLog(std::string frames_path, const std::string& times_path) : path_(std::move(frames_path)) {
+  times_.open(times_path, xrcommon::TimingWriter::Mode::Atomic);
+}
 
 void FrameLog::add(const FrameRecord& r) {
   const devices::FoveaGaze& g = r.gaze;
@@ -45,14 +50,29 @@ void FrameLog::add(const FrameRecord& r) {
   j["eye_poses"] = poses;
   j["grid"] = {r.grid_columns, r.grid_rows};
   text_ += j.dump() + "\n";
-  nlohmann::json t = {{"frame", r.frame}, {"gaze_read_ns", g.read_ns}};
-  for (const auto& [k, v] : r.timings_ms) t[k] = std::isfinite(v) ? v : 0.0;
-  times_ += t.dump() + "\n";
+  // The timing record: on the frame timeline (the gaze read at the frame's time t_ns), or
+  // the host clock for a live source.
+  xrcommon::TimingRecord t;
+  t.source = "render";
+  t.clock = r.live ? xrcommon::TimeBase::Monotonic : xrcommon::TimeBase::Virtual;
+  t.frame = r.frame;
+  t.gaze_valid = g.combined.tracked();
+  if (g.has_sample) {
+    t.gaze_sample_ns = g.sample_ns;
+    t.gaze_device_ns = g.device_ns;
+    t.gaze_receive_ns = g.receive_ns;
+  }
+  t.gaze_read_ns = r.live ? g.read_ns : r.t_ns;
+  t.predicted_display_ns = r.t_ns;
+  t.cpu_ms = r.cpu_ms;
+  t.gpu_ms = r.gpu_ms;
+  t.fovea_dir = g.combined.dir;
+  if (!times_.write(t)) throw std::runtime_error(times_.error());
 }
 
-void FrameLog::finish() const {
+void FrameLog::finish() {
   core::write_file_atomic(path_, text_);
-  core::write_file_atomic(times_path_, times_);
+  times_.close();
 }
 
 }  // namespace fovea::tools

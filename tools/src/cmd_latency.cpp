@@ -1,0 +1,359 @@
+// fovea latency: the latency harness. A true eye behind a modelled eye tracker, the real
+// foveated pipeline, and the display model, in virtual time; or the timing records of an
+// OpenXR session. Reports latency distributions and the foveal error they cause.
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <iostream>
+#include <sstream>
+
+#include <nlohmann/json.hpp>
+
+#include "command.hpp"
+#include "fovea/core/display.hpp"
+#include "fovea/core/duration.hpp"
+#include "fovea/core/error.hpp"
+#include "fovea/core/eye_optics.hpp"
+#include "fovea/core/image.hpp"
+#include "fovea/core/metrics.hpp"
+#include "fovea/core/stereo_views.hpp"
+#include "fovea/gpu/context.hpp"
+#include "fovea/pipeline/frame_pipeline.hpp"
+#include "fovea/renderer/reference.hpp"
+#include "fovea/renderer/scene_io.hpp"
+#include "fovea/xrcommon/timing_writer.hpp"
+#include "latency/analysis.hpp"
+
+namespace fovea::tools {
+namespace {
+
+namespace fs = std::filesystem;
+
+constexpr const char* kDefaultGaze = "synthetic:1?task=search&rate=1000&noise=0&dropouts=0";
+
+constexpr const char* kHelp = R"(usage: fovea latency [options]
+       fovea latency --records FILE.jsonl [--out DIR]
+
+Measures latency the way it reaches the eye, in virtual time (reproducible): a true eye
+(synthetic saccades or a recording) behind a modelled eye tracker; an application paced by
+the display model that reads the tracker when xrWaitFrame returns, renders with the real
+foveated pipeline on the Vulkan device and submits; the display model shows each frame at
+the first vsync it makes (later frames are counted as missed, the previous frame stays) and
+lights each eye and panel region. Per frame a timing record (docs/openxr.md), with the true
+gaze at photon time; per vsync the foveal error (true gaze to the fovea on the panel).
+Then the same scenario with injected latency (extra tracker delay) against foveal error
+and fovea quality. With --records: the same analysis of an OpenXR session's timing records
+(the runtime's timing.jsonl, the layer's layer_timing.jsonl, a render's frame_times.jsonl).
+
+Prints the summary JSON on stdout; writes into --out:
+  records.jsonl        the simulation's timing records (virtual clock, from 0)
+  summary.json         the summary
+  latency.png          CDFs of tracker delay, gaze-to-photon, motion-to-photon
+  stages.png           CDFs of each stage's CPU and GPU time
+  foveal_error.png     foveal error at photon time over time, saccade onsets marked
+  sweep_error.png      injected latency vs foveal error (median, p95)
+  sweep_quality.png    injected latency vs tone-mapped PSNR in the fovea (--quality-frames > 0)
+
+  --scene S             cornell | furnace | glossy-spheres | stereo-occluders | default,
+                        or a .gltf/.glb/.obj file [default]
+  --display NAME|FILE   display preset or JSON: raster, FOV, refresh [small]
+  --gaze SRC            the true eye: recording or synthetic:<seed>[?...] (docs/gaze.md)
+                        [synthetic:1?task=search&rate=1000&noise=0&dropouts=0]
+  --tracker PRESET      eye-tracker model preset: fove0 | ideal [fove0]
+  --tracker-delay T     delay from measurement to delivery [preset's]
+  --jitter T            extra delivery delay, uniform in [0, T] [preset's]
+  --rate HZ             tracker sample rate [preset's]
+  --predict MODE        gaze compensation: none [none]
+  --seconds S           scenario length [2]
+  --render-time T       fixed render cost per frame instead of the measured CPU time
+                        (reproducible runs); the pipeline still renders every frame
+  --scan-out M          global | rolling [global]
+  --persistence T       how long a row stays lit [0]
+  --inject-latency LIST injected latencies for the sweep, e.g. 0,25ms,50,100 ("none": no
+                        sweep) [0,25,50,75,100]
+  --quality-frames N    frames rendered per sweep point for fovea quality, around the first
+                        saccade of at least 5 deg (0: no quality) [8]
+  --reference-spp N     samples per pixel of the quality reference [64]
+  --records FILE        analyse timing records instead of simulating
+  --out DIR             output directory [out/latency]
+  --quiet               no progress on stderr
+  --help                this text
+Times take a unit, ms or us (also ns, s); a bare number is milliseconds.
+
+Exit status: 0 on success, 2 on invalid arguments or input files, 1 on other errors.
+)";
+
+std::vector<core::TimeNs> parse_latency_list(const std::string& s) {
+  std::vector<core::TimeNs> out;
+  if (s == "none") return out;
+  std::stringstream in(s);
+  for (std::string item; std::getline(in, item, ',');) {
+    const core::TimeNs t = core::parse_duration_ns(item, "--inject-latency");
+    if (t > core::ms_to_ns(1000)) throw core::InputError("--inject-latency: " + item + " is over 1 s");
+    out.push_back(t);
+  }
+  if (out.empty()) throw core::InputError("--inject-latency: empty list (\"none\" for no sweep)");
+  return out;
+}
+
+std::vector<xrcommon::TimingRecord> read_records(const std::string& path) {
+  std::ifstream in(path);
+  if (!in) throw core::InputError(path + ": cannot open");
+  std::vector<xrcommon::TimingRecord> out;
+  std::string line;
+  for (long n = 1; std::getline(in, line); ++n)
+    if (line.find_first_not_of(" \t\r") != std::string::npos)
+      out.push_back(xrcommon::parse_timing_record(line, path + ":" + std::to_string(n)));
+  if (out.empty()) throw core::InputError(path + ": no timing records");
+  return out;
+}
+
+void finish(const fs::path& out, nlohmann::json summary, const std::vector<std::string>& plots) {
+  summary["plots"] = plots;
+  core::write_file_atomic((out / "summary.json").string(), summary.dump(2) + "\n");
+  std::cout << summary.dump(2) << "\n";
+}
+
+int run_records(const Args& args, const fs::path& out) {
+  const std::string path = *args.opt("records");
+  const std::vector<xrcommon::TimingRecord> records = read_records(path);
+  nlohmann::json j = latency::summarize(records, nullptr);
+  j["mode"] = "records";
+  j["records"] = path;
+  j["source"] = records.front().source;
+  j["clock"] = xrcommon::time_base_name(records.front().clock);
+  finish(out, j, latency::write_plots(out.string(), records, nullptr, "records: " + fs::path(path).filename().string()));
+  return 0;
+}
+
+// Fovea quality of frames rendered for `sim`'s gaze: tone-mapped PSNR and LDR-FLIP within
+// 2.5° of the true gaze at photon time, against the converged reference (left eye).
+struct Quality {
+  double psnr = 0, flip = 0;
+  int frames = 0;
+};
+Quality fovea_quality(pipeline::FramePipeline& pipe, const std::array<core::Pose, 2>& poses,
+                      const latency::Simulation& sim, std::size_t first, std::size_t count, std::size_t warm,
+                      const core::Image& reference) {
+  Quality q;
+  pipe.reset();
+  const core::View view = pipe.view(core::Eye::Left);
+  for (std::size_t f = first; f < std::min(first + count, sim.frames.size()); ++f) {
+    pipe.render(poses, sim.frames[f].fovea, std::uint32_t(f));
+    const auto& truth = sim.frames[f].truth[0];
+    if (f < first + warm || !truth) continue;
+    const std::vector<float> ecc = core::eccentricity_map(view, *truth);
+    std::vector<float> w(ecc.size());
+    for (std::size_t i = 0; i < ecc.size(); ++i) w[i] = ecc[i] <= 2.5f ? 1.0f : 0.0f;
+    const double ppd = std::sqrt(view.pixels_per_deg2(*truth));
+    const core::Scores s = core::pool(core::error_maps(pipe.image(core::Eye::Left), reference, ppd), w);
+    if (s.weight <= 0) continue;  // the true gaze is off the view
+    q.psnr += s.psnr;
+    q.flip += s.ldr_flip;
+    ++q.frames;
+  }
+  if (q.frames) q.psnr /= q.frames, q.flip /= q.frames;
+  return q;
+}
+
+// The first frame of the quality window: a few frames before the first saccade of at least
+// 5° (where latency shows), after the pipeline's warm-up.
+std::size_t quality_window(const latency::Simulation& sim, std::size_t warm) {
+  for (const latency::Saccade& s : sim.saccades) {
+    if (s.amplitude_deg < 5) continue;
+    for (std::size_t f = 0; f < sim.records.size(); ++f)
+      if ((*sim.records[f].photon_ns)[0].mid >= s.onset_ns) return f > warm + 2 ? f - warm - 2 : 0;
+  }
+  return 0;
+}
+
+int run(std::vector<std::string> argv) {
+  for (const auto& a : argv)
+    if (a == "--help" || a == "-h") {
+      std::cout << kHelp;
+      return 0;
+    }
+  const std::vector<std::string> sim_options{"scene", "display", "gaze", "tracker", "tracker-delay", "jitter", "rate",
+                                             "predict", "seconds", "render-time", "scan-out", "persistence",
+                                             "inject-latency", "quality-frames", "reference-spp"};
+  std::vector<std::string> valued = sim_options;
+  valued.insert(valued.end(), {"records", "out"});
+  const Args args(argv, valued, {"quiet"});
+  const fs::path out(args.str("out", "out/latency"));
+  if (args.has("records")) {
+    for (const auto& o : sim_options)
+      if (args.has(o)) throw core::InputError("--" + o + " configures a simulation; --records analyses a file");
+    fs::create_directories(out);
+    return run_records(args, out);
+  }
+
+  const core::DisplayPreset display = core::load_display(args.str("display", "small"));
+  const double seconds = args.num("seconds", 2);
+  if (!(seconds > 0 && seconds <= 600)) throw core::InputError("--seconds must be in (0, 600]");
+  const std::string predict = args.str("predict", "none");
+  if (predict != "none") throw core::InputError("--predict \"" + predict + "\": expected none");
+  latency::TrackerChoice tracker;
+  tracker.preset = args.str("tracker", "fove0");
+  if (auto t = args.opt("tracker-delay")) tracker.delay_ns = core::parse_duration_ns(*t, "--tracker-delay");
+  if (auto t = args.opt("jitter")) tracker.jitter_ns = core::parse_duration_ns(*t, "--jitter");
+  if (args.has("rate")) tracker.rate_hz = args.num("rate", 0);
+  std::optional<core::TimeNs> fixed_cost;
+  if (auto t = args.opt("render-time")) fixed_cost = core::parse_duration_ns(*t, "--render-time");
+  latency::Scenario sc;
+  sc.display.refresh_hz = display.refresh_hz;
+  sc.display.scan_out = xrcommon::parse_scan_out(args.str("scan-out", "global"));
+  if (auto t = args.opt("persistence")) sc.display.persistence_ns = core::parse_duration_ns(*t, "--persistence");
+  sc.display.validate();
+  sc.duration_ns = core::TimeNs(std::llround(seconds * 1e9));
+  const std::vector<core::TimeNs> injected = parse_latency_list(args.str("inject-latency", "0,25,50,75,100"));
+  const long quality_frames = args.integer("quality-frames", 8);
+  if (quality_frames < 0 || quality_frames > 1000) throw core::InputError("--quality-frames must be in 0..1000");
+  const long ref_spp = args.integer("reference-spp", 64);
+  if (ref_spp < 1 || ref_spp > 65536) throw core::InputError("--reference-spp must be in 1..65536");
+  const std::string gaze_uri = args.str("gaze", kDefaultGaze);
+  devices::SourceOptions so;
+  so.display = display;
+  so.horizon_ns = 0;  // --predict none: the newest delivered sample as it is
+  std::unique_ptr<devices::TrackerModel> model = latency::open_tracker(gaze_uri, tracker, so);
+  const bool quiet = args.has("quiet");
+
+  const renderer::Scene scene = renderer::load_scene(args.str("scene", "default"));
+  for (const auto& w : scene.warnings) std::cerr << "warning: " << w << "\n";
+  fs::create_directories(out);
+  gpu::Context ctx;
+  renderer::GpuScene gpu_scene(ctx, scene);
+  const core::StereoViews views = core::stereo_views(display, scene.camera);
+  const std::array<core::Pose, 2> poses = views.poses();  // a static head at the scene's camera
+  pipeline::FramePipeline pipe(ctx, gpu_scene, views, core::DistributionParams{}, reconstruct::ReconSettings{});
+  for (core::Eye e : {core::Eye::Left, core::Eye::Right}) pipe.set_visibility(e, core::EyeOptics(display, e).view_mask());
+
+  // The main run: every frame rendered; its cost is the measured CPU time of the frame (the
+  // submission waits for the GPU, so the GPU's work is inside it) or the fixed one.
+  std::vector<core::TimeNs> measured;  // the cost each frame was given
+  std::vector<double> pipeline_ms;     // what each frame took here
+  const latency::RenderFn render = [&](std::int64_t f, const std::array<glm::dvec3, 2>& gaze) {
+    const pipeline::FrameTimes t = pipe.render(poses, gaze, std::uint32_t(f));
+    latency::FrameWork w;
+    w.cost_ns = fixed_cost ? *fixed_cost : core::ms_to_ns(t.cpu_ms());
+    measured.push_back(w.cost_ns);
+    pipeline_ms.push_back(t.cpu_ms());
+    for (const auto& [name, st] : {std::pair{"grid", t.grid}, {"trace", t.trace}, {"reconstruct", t.reconstruct},
+                                   {"resolve", t.resolve}}) {
+      w.cpu_ms.emplace_back(name, st.cpu_ms);
+      w.gpu_ms.emplace_back(name, st.gpu_ms);
+    }
+    w.cpu_ms.emplace_back("submit", t.submit_cpu_ms);
+    w.cpu_ms.emplace_back("total", t.cpu_ms());
+    if (!quiet) std::fprintf(stderr, "\rframe %lld", static_cast<long long>(f + 1));
+    return w;
+  };
+  const latency::Simulation sim = latency::simulate(*model, sc, render);
+  if (!quiet) std::fprintf(stderr, "\n");
+  xrcommon::TimingWriter writer;
+  writer.open((out / "records.jsonl").string(), xrcommon::TimingWriter::Mode::Atomic);
+  for (const auto& r : sim.records)
+    if (!writer.write(r)) throw std::runtime_error(writer.error());
+  writer.close();
+
+  std::vector<double> cost_ms;
+  for (core::TimeNs c : measured) cost_ms.push_back(core::ns_to_ms(c));
+  const latency::Distribution cost = latency::distribution(cost_ms);
+  const latency::Distribution took = latency::distribution(pipeline_ms);
+  const std::string cost_text = fixed_cost ? "fixed --render-time " + std::to_string(core::ns_to_ms(*fixed_cost)) + " ms"
+                                           : "measured CPU time per frame (GPU wait included)";
+  nlohmann::json j = latency::summarize(sim.records, &sim);
+  j["mode"] = "simulation";
+  j["clock"] = "virtual";
+  j["render_cost"] = {{"source", fixed_cost ? "fixed" : "measured"},
+                      {"ms", latency::to_json(cost)},
+                      {"measured_ms", latency::to_json(took)},
+                      {"note", cost_text}};
+  const devices::TrackerParams& tp = model->params();
+  j["config"] = {{"scene", args.str("scene", "default")},
+                 {"display", display.name},
+                 {"refresh_hz", display.refresh_hz},
+                 {"scan_out", xrcommon::scan_out_name(sc.display.scan_out)},
+                 {"persistence_ms", core::ns_to_ms(sc.display.persistence_ns)},
+                 {"compositor_budget_ms", core::ns_to_ms(xrcommon::DisplayModel(sc.display).compositor_budget())},
+                 {"gaze", gaze_uri},
+                 {"tracker", {{"preset", tp.name}, {"rate_hz", tp.rate_hz}, {"delay_ms", core::ns_to_ms(tp.delay_ns)},
+                              {"jitter_ms", core::ns_to_ms(tp.jitter_ns)}, {"noise_deg", tp.noise_deg},
+                              {"dropout", tp.dropout}}},
+                 {"predict", predict},
+                 {"seconds", seconds},
+                 {"device", {{"name", ctx.info().name}, {"driver", ctx.info().driver}}}};
+  char notebuf[256];
+  std::snprintf(notebuf, sizeof notebuf, "%s %.0f Hz, tracker %s %.0f Hz delay %.1f ms jitter %.1f ms, render %s",
+                display.name.c_str(), display.refresh_hz, tp.name.c_str(), tp.rate_hz, core::ns_to_ms(tp.delay_ns),
+                core::ns_to_ms(tp.jitter_ns), fixed_cost ? "fixed" : "measured");
+  std::vector<std::string> plots = latency::write_plots(out.string(), sim.records, &sim, notebuf);
+
+  if (!injected.empty()) {
+    // The sweep replays the main run's costs frame by frame, so every point has the same
+    // frames at the same times and differs only by the tracker's delivery.
+    const latency::RenderFn replay = [&](std::int64_t f, const std::array<glm::dvec3, 2>&) {
+      latency::FrameWork w;
+      w.cost_ns = measured.empty() ? 0 : measured[std::min<std::size_t>(std::size_t(f), measured.size() - 1)];
+      return w;
+    };
+    std::optional<core::Image> reference;
+    const std::size_t warm = 3;
+    const std::size_t first = quality_window(sim, warm);
+    if (quality_frames > 0) {
+      renderer::ReferenceOptions o;
+      o.path.spp = std::uint32_t(std::min<long>(ref_spp, 16));
+      o.max_spp = std::uint32_t(ref_spp);
+      if (!quiet) std::fprintf(stderr, "reference, %ld spp...\n", ref_spp);
+      reference = renderer::render_reference(ctx, gpu_scene, pipe.view(core::Eye::Left), core::Eye::Left, o).image;
+    }
+    std::vector<latency::SweepPoint> points;
+    nlohmann::json sweep = nlohmann::json::array();
+    for (core::TimeNs inj : injected) {
+      latency::TrackerChoice c = tracker;
+      c.inject_ns = inj;
+      std::unique_ptr<devices::TrackerModel> m = latency::open_tracker(gaze_uri, c, so);
+      const latency::Simulation s = latency::simulate(*m, sc, replay);
+      latency::SweepPoint p;
+      p.inject_ms = core::ns_to_ms(inj);
+      p.error = latency::error_summary([&] {
+        std::vector<double> e;
+        for (const auto& v : s.shown)
+          if (v.error_deg) e.push_back(*v.error_deg);
+        return e;
+      }());
+      p.gaze_to_photon_median_ms = latency::distribution(latency::latencies(s.records).gaze_to_photon_ms).median;
+      const std::vector<double> rec = latency::recovery_ms(s);
+      p.recovery_median_ms = latency::distribution(rec).median;
+      p.recovered = rec.size();
+      nlohmann::json pj = {{"inject_ms", p.inject_ms},
+                           {"gaze_to_photon_median_ms", p.gaze_to_photon_median_ms},
+                           {"foveal_error_deg", p.error},
+                           {"recovery_ms_median", p.recovery_median_ms},
+                           {"saccades_recovered", p.recovered}};
+      if (reference) {
+        if (!quiet) std::fprintf(stderr, "quality at +%.0f ms...\n", p.inject_ms);
+        const Quality q = fovea_quality(pipe, poses, s, first, std::size_t(quality_frames) + warm, warm, *reference);
+        if (q.frames) {
+          p.fovea_psnr_db = q.psnr;
+          p.fovea_flip = q.flip;
+          pj["fovea_quality"] = {{"psnr_db", q.psnr}, {"ldr_flip", q.flip}, {"frames", q.frames}, {"first_frame", first + warm}};
+        }
+      }
+      points.push_back(p);
+      sweep.push_back(pj);
+    }
+    j["sweep"] = sweep;
+    for (const auto& f : latency::write_sweep_plots(out.string(), points, notebuf)) plots.push_back(f);
+  }
+  finish(out, j, plots);
+  return 0;
+}
+
+}  // namespace
+
+FOVEA_COMMAND(latency_command, "latency", "latency harness: tracker + pipeline + display model, gaze-to-photon, foveal error",
+              run);
+
+}  // namespace fovea::tools

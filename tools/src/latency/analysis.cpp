@@ -1,0 +1,226 @@
+#include "latency/analysis.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <filesystem>
+#include <map>
+
+#include "fovea/core/image.hpp"
+#include "sweep/plot.hpp"
+
+namespace fovea::latency {
+
+namespace {
+
+double percentile(const std::vector<double>& sorted, double p) {
+  const auto rank = static_cast<std::size_t>(std::ceil(p * double(sorted.size())));
+  return sorted[std::clamp<std::size_t>(rank, 1, sorted.size()) - 1];
+}
+
+std::string fmt(double v, int decimals = 1) {
+  char b[32];
+  std::snprintf(b, sizeof b, "%.*f", std::abs(v) >= 100 ? 0 : decimals, v);
+  return b;
+}
+
+// The empirical CDF of v as a step line.
+sweep::Series cdf(const std::string& name, std::vector<double> v, std::size_t colour) {
+  std::sort(v.begin(), v.end());
+  const Distribution d = distribution(v);
+  sweep::Series s;
+  s.label = name + ": med " + fmt(d.median) + " p95 " + fmt(d.p95) + " p99 " + fmt(d.p99) + " max " + fmt(d.max);
+  s.color = sweep::palette(colour);
+  s.line = true;
+  s.markers = false;
+  for (std::size_t i = 0; i < v.size(); ++i) {
+    s.points.push_back({v[i], double(i) / double(v.size())});
+    s.points.push_back({v[i], double(i + 1) / double(v.size())});
+  }
+  return s;
+}
+
+std::vector<double> shown_errors(const Simulation& sim) {
+  std::vector<double> v;
+  for (const Shown& s : sim.shown)
+    if (s.error_deg) v.push_back(*s.error_deg);
+  return v;
+}
+
+void save(const std::string& dir, const std::string& name, const sweep::Chart& c, std::vector<std::string>& written) {
+  // Wide: the legend carries each distribution's median, p95, p99 and max.
+  core::write_png((std::filesystem::path(dir) / name).string(), sweep::draw_chart(c, 1600, 700));
+  written.push_back(name);
+}
+
+}  // namespace
+
+Distribution distribution(std::vector<double> v) {
+  v.erase(std::remove_if(v.begin(), v.end(), [](double x) { return !std::isfinite(x); }), v.end());
+  Distribution d;
+  d.n = v.size();
+  if (v.empty()) return d;
+  std::sort(v.begin(), v.end());
+  d.median = percentile(v, 0.5);
+  d.p95 = percentile(v, 0.95);
+  d.p99 = percentile(v, 0.99);
+  d.max = v.back();
+  return d;
+}
+
+nlohmann::json to_json(const Distribution& d) {
+  return {{"n", d.n}, {"median", d.median}, {"p95", d.p95}, {"p99", d.p99}, {"max", d.max}};
+}
+
+Latencies latencies(const std::vector<xrcommon::TimingRecord>& records) {
+  Latencies l;
+  for (const auto& r : records) {
+    std::optional<core::TimeNs> photon = r.vsync_ns;
+    if (r.photon_ns) photon = (*r.photon_ns)[0].mid;
+    if (r.gaze_sample_ns && r.gaze_receive_ns)
+      l.tracker_delay_ms.push_back(core::ns_to_ms(*r.gaze_receive_ns - *r.gaze_sample_ns));
+    if (r.gaze_sample_ns && photon) l.gaze_to_photon_ms.push_back(core::ns_to_ms(*photon - *r.gaze_sample_ns));
+    if (r.head_pose_ns && photon) l.motion_to_photon_ms.push_back(core::ns_to_ms(*photon - *r.head_pose_ns));
+  }
+  return l;
+}
+
+nlohmann::json error_summary(const std::vector<double>& error_deg) {
+  nlohmann::json j = to_json(distribution(error_deg));
+  for (double th : {1.0, 2.0, 5.0}) {
+    const auto above = std::count_if(error_deg.begin(), error_deg.end(), [&](double e) { return e > th; });
+    j["above_" + fmt(th, 0) + "deg"] = error_deg.empty() ? 0.0 : double(above) / double(error_deg.size());
+  }
+  return j;
+}
+
+nlohmann::json summarize(const std::vector<xrcommon::TimingRecord>& records, const Simulation* sim) {
+  nlohmann::json j;
+  j["frames"] = records.size();
+  std::int64_t missed = 0, missed_frames = 0;
+  for (const auto& r : records) {
+    missed += r.missed_vsyncs;
+    missed_frames += r.missed_vsyncs > 0;
+  }
+  j["missed_vsyncs"] = missed;
+  j["frames_missing_a_vsync"] = missed_frames;
+  const Latencies l = latencies(records);
+  j["tracker_delay_ms"] = to_json(distribution(l.tracker_delay_ms));
+  j["gaze_to_photon_ms"] = to_json(distribution(l.gaze_to_photon_ms));
+  j["motion_to_photon_ms"] = to_json(distribution(l.motion_to_photon_ms));
+  std::map<std::string, std::vector<double>> cpu, gpu;
+  for (const auto& r : records) {
+    for (const auto& [k, v] : r.cpu_ms) cpu[k].push_back(v);
+    for (const auto& [k, v] : r.gpu_ms) gpu[k].push_back(v);
+  }
+  for (const auto& [k, v] : cpu) j["stages"]["cpu_ms"][k] = to_json(distribution(v));
+  for (const auto& [k, v] : gpu) j["stages"]["gpu_ms"][k] = to_json(distribution(v));
+  if (sim) {
+    // What the eye saw: every vsync, repeated frames included.
+    std::size_t repeats = 0;
+    for (std::size_t i = 1; i < sim->shown.size(); ++i) repeats += sim->shown[i].frame == sim->shown[i - 1].frame;
+    j["panel"] = {{"vsyncs", sim->shown.size()}, {"repeated_vsyncs", repeats}};
+    j["foveal_error_deg"] = error_summary(shown_errors(*sim));
+    j["foveal_error_deg"]["over"] = "vsyncs";
+    std::size_t big = 0;
+    for (const Saccade& s : sim->saccades) big += s.amplitude_deg >= 2.0;
+    j["saccades"] = {{"detected", sim->saccades.size()}, {"at_least_2deg", big}};
+    j["recovery_ms"] = to_json(distribution(recovery_ms(*sim)));
+  } else {
+    std::vector<double> e;
+    for (const auto& r : records)
+      if (auto d = r.foveal_error_deg()) e.push_back(*d);
+    if (!e.empty()) {
+      j["foveal_error_deg"] = error_summary(e);
+      j["foveal_error_deg"]["over"] = "frames";
+    }
+  }
+  return j;
+}
+
+std::vector<std::string> write_plots(const std::string& dir, const std::vector<xrcommon::TimingRecord>& records,
+                                     const Simulation* sim, const std::string& note) {
+  std::vector<std::string> written;
+  const Latencies l = latencies(records);
+  sweep::Chart c;
+  c.title = "Latency distributions (CDF)";
+  c.note = note;
+  c.x_label = "latency (ms)";
+  c.y_label = "fraction of frames";
+  std::size_t colour = 0;
+  for (auto [name, v] : {std::pair{"tracker delay", &l.tracker_delay_ms}, {"gaze-to-photon", &l.gaze_to_photon_ms},
+                         {"motion-to-photon", &l.motion_to_photon_ms}})
+    if (!v->empty()) c.series.push_back(cdf(name, *v, colour++));
+  if (!c.series.empty()) save(dir, "latency.png", c, written);
+
+  std::map<std::string, std::vector<double>> stages;
+  for (const auto& r : records) {
+    for (const auto& [k, v] : r.cpu_ms) stages["CPU " + k].push_back(v);
+    for (const auto& [k, v] : r.gpu_ms) stages["GPU " + k].push_back(v);
+  }
+  sweep::Chart st;
+  st.title = "Per-stage time (CDF)";
+  st.note = note;
+  st.x_label = "time per frame (ms)";
+  st.y_label = "fraction of frames";
+  colour = 0;
+  for (const auto& [k, v] : stages) st.series.push_back(cdf(k, v, colour++));
+  if (!st.series.empty()) save(dir, "stages.png", st, written);
+
+  if (sim && !sim->shown.empty()) {
+    sweep::Chart e;
+    e.title = "Foveal error at photon time";
+    e.note = note;
+    e.x_label = "time (s)";
+    e.y_label = "angle true gaze to fovea (deg)";
+    sweep::Series err{"foveal error (panel, every vsync)", sweep::palette(0), {}, true, false, {}};
+    double top = 5;
+    for (const Shown& s : sim->shown)
+      if (s.error_deg) {
+        err.points.push_back({double(s.photon_ns) * 1e-9, *s.error_deg});
+        top = std::max(top, *s.error_deg);
+      }
+    e.series.push_back(err);
+    sweep::Series onsets{"saccade onset (I-VT on the true eye)", sweep::palette(3), {}, true, false, {}};
+    for (const Saccade& s : sim->saccades) {
+      const double t = double(s.onset_ns) * 1e-9;
+      onsets.points.insert(onsets.points.end(), {{t, 0}, {t, top}, {t, 0}});
+    }
+    if (!onsets.points.empty()) e.series.push_back(onsets);
+    const double t0 = double(sim->shown.front().photon_ns) * 1e-9, t1 = double(sim->shown.back().photon_ns) * 1e-9;
+    e.series.push_back({"2 deg (recovered below)", sweep::palette(2), {{t0, 2.0}, {t1, 2.0}}, true, false, {}});
+    save(dir, "foveal_error.png", e, written);
+  }
+  return written;
+}
+
+std::vector<std::string> write_sweep_plots(const std::string& dir, const std::vector<SweepPoint>& points,
+                                           const std::string& note) {
+  std::vector<std::string> written;
+  sweep::Chart c;
+  c.title = "Injected latency vs foveal error";
+  c.note = note;
+  c.x_label = "injected latency (ms)";
+  c.y_label = "foveal error at photon time (deg)";
+  sweep::Series med{"median", sweep::palette(0), {}, true, true, {}}, p95{"p95", sweep::palette(1), {}, true, true, {}};
+  for (const SweepPoint& p : points) {
+    med.points.push_back({p.inject_ms, p.error.value("median", 0.0)});
+    p95.points.push_back({p.inject_ms, p.error.value("p95", 0.0)});
+  }
+  c.series = {med, p95};
+  save(dir, "sweep_error.png", c, written);
+  sweep::Chart q;
+  q.title = "Injected latency vs fovea quality";
+  q.note = note;
+  q.x_label = "injected latency (ms)";
+  q.y_label = "fovea PSNR, tone-mapped (dB)";
+  sweep::Series ps{"fovea PSNR (2.5 deg around the true gaze)", sweep::palette(0), {}, true, true, {}};
+  for (const SweepPoint& p : points)
+    if (p.fovea_psnr_db) ps.points.push_back({p.inject_ms, *p.fovea_psnr_db});
+  if (!ps.points.empty()) {
+    q.series = {ps};
+    save(dir, "sweep_quality.png", q, written);
+  }
+  return written;
+}
+
+}  // namespace fovea::latency
