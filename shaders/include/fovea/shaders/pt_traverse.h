@@ -22,6 +22,10 @@ struct PtHit {
   vec2 bary;  // weights of vertices 1 and 2
 };
 
+// v[k] by selects: lavapipe lowers a vector indexed by a per-invocation value to memory
+// traffic (docs/reconstruction.md), which made this test ~20× slower than its arithmetic.
+float pt_axis(vec3 v, int k) { return k == 0 ? v.x : (k == 1 ? v.y : v.z); }
+
 PtRayPre pt_prepare(vec3 org, vec3 dir, float tmin) {
   PtRayPre r;
   r.org = org;
@@ -30,12 +34,13 @@ PtRayPre pt_prepare(vec3 org, vec3 dir, float tmin) {
   r.kz = a.x > a.y ? (a.x > a.z ? 0 : 2) : (a.y > a.z ? 1 : 2);
   r.kx = (r.kz + 1) % 3;
   r.ky = (r.kx + 1) % 3;
-  if (dir[r.kz] < 0.0) {  // keep the winding, so the sign of U, V, W stays meaningful
+  const float dz = pt_axis(dir, r.kz);
+  if (dz < 0.0) {  // keep the winding, so the sign of U, V, W stays meaningful
     const int k = r.kx;
     r.kx = r.ky;
     r.ky = k;
   }
-  r.shear = vec3(dir[r.kx] / dir[r.kz], dir[r.ky] / dir[r.kz], 1.0 / dir[r.kz]);
+  r.shear = vec3(pt_axis(dir, r.kx) / dz, pt_axis(dir, r.ky) / dz, 1.0 / dz);
   for (int i = 0; i < 3; ++i) r.inv[i] = 1.0 / (a[i] > 1e-20 ? dir[i] : (dir[i] < 0.0 ? -1e-20 : 1e-20));
   return r;
 }
@@ -46,14 +51,15 @@ bool pt_hit_triangle(PtRayPre r, uint i, float tmax, inout PtHit hit) {
   const vec3 A = vec3(tri.v0_x, tri.v0_y, tri.v0_z) - r.org;
   const vec3 B = vec3(tri.v1_x, tri.v1_y, tri.v1_z) - r.org;
   const vec3 C = vec3(tri.v2_x, tri.v2_y, tri.v2_z) - r.org;
-  const float Ax = A[r.kx] - r.shear.x * A[r.kz], Ay = A[r.ky] - r.shear.y * A[r.kz];
-  const float Bx = B[r.kx] - r.shear.x * B[r.kz], By = B[r.ky] - r.shear.y * B[r.kz];
-  const float Cx = C[r.kx] - r.shear.x * C[r.kz], Cy = C[r.ky] - r.shear.y * C[r.kz];
+  const float Az = pt_axis(A, r.kz), Bz = pt_axis(B, r.kz), Cz = pt_axis(C, r.kz);
+  const float Ax = pt_axis(A, r.kx) - r.shear.x * Az, Ay = pt_axis(A, r.ky) - r.shear.y * Az;
+  const float Bx = pt_axis(B, r.kx) - r.shear.x * Bz, By = pt_axis(B, r.ky) - r.shear.y * Bz;
+  const float Cx = pt_axis(C, r.kx) - r.shear.x * Cz, Cy = pt_axis(C, r.ky) - r.shear.y * Cz;
   const float U = Cx * By - Cy * Bx, V = Ax * Cy - Ay * Cx, W = Bx * Ay - By * Ax;
   if ((U < 0.0 || V < 0.0 || W < 0.0) && (U > 0.0 || V > 0.0 || W > 0.0)) return false;
   const float det = U + V + W;
   if (det == 0.0) return false;
-  const float T = U * (r.shear.z * A[r.kz]) + V * (r.shear.z * B[r.kz]) + W * (r.shear.z * C[r.kz]);
+  const float T = U * (r.shear.z * Az) + V * (r.shear.z * Bz) + W * (r.shear.z * Cz);
   const float sd = det < 0.0 ? -1.0 : 1.0;
   if (T * sd <= r.tmin * det * sd || T * sd >= tmax * det * sd) return false;
   const float rcp = 1.0 / det;
