@@ -63,6 +63,12 @@ GpuScene::GpuScene(gpu::Context& ctx, const Scene& s, const BvhOptions& bvh_opti
                   uv[0].x, uv[0].y, uv[1].x, uv[1].y, uv[2].x, uv[2].y, 0.0f};
   }
 
+  features_ = {false, false, false};
+  for (const Material& m : s.materials) {
+    features_.textures |= m.base_color_texture >= 0;
+    features_.glossy |= m.specular != 0.0f || m.metallic != 0.0f;
+    features_.emitters |= m.emission != glm::vec3(0.0f);
+  }
   std::vector<PtMaterial> mats;
   for (const Material& m : s.materials)
     mats.push_back({m.base_color.x, m.base_color.y, m.base_color.z, m.base_color_texture, m.emission.x, m.emission.y,

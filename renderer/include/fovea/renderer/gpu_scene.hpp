@@ -18,6 +18,18 @@ struct GpuSceneStats {
   double build_ms = 0;  // CPU BVH build
 };
 
+// Shading features a scene uses; the path tracer compiles a variant without the others.
+struct SceneFeatures {
+  bool textures = true;  // a material has a base-colour texture
+  bool glossy = true;    // a material has a specular lobe (F0 > 0: specular or metallic > 0)
+  bool emitters = true;  // a material emits (emission, next-event estimation)
+  bool operator==(const SceneFeatures&) const = default;
+  // Everything `other` uses is on here.
+  bool covers(const SceneFeatures& other) const {
+    return (textures || !other.textures) && (glossy || !other.glossy) && (emitters || !other.emitters);
+  }
+};
+
 class GpuScene {
  public:
   // `scene` must be sanitised (every loader does that).
@@ -34,11 +46,13 @@ class GpuScene {
   std::uint32_t light_count() const { return stats_.lights; }     // real emissive triangles
   glm::vec3 environment() const { return environment_; }
   const GpuSceneStats& stats() const { return stats_; }
+  const SceneFeatures& features() const { return features_; }
 
  private:
   gpu::Buffer nodes_, triangles_, shading_, materials_, lights_, texture_table_, texels_, ggx_albedo_;
   glm::vec3 environment_{0};
   GpuSceneStats stats_;
+  SceneFeatures features_;
 };
 
 }  // namespace fovea::renderer
