@@ -13,7 +13,8 @@ Raycaster::Raycaster(gpu::Context& ctx, const GpuScene& scene)
       pipeline_(ctx, {"pt_raycast.comp.spv",
                       {{gpu::Binding::StorageBuffer, gpu::Binding::StorageBuffer, gpu::Binding::StorageBuffer,
                         gpu::Binding::StorageBuffer}},
-                      sizeof(shaders::PtRaycastParams)}) {}
+                      sizeof(shaders::PtRaycastParams),
+                      {gpu::SpecConstant::u32(shaders::kPtSpecBvhStack, scene.bvh_stack())}}) {}
 
 void Raycaster::set_rays(std::span<const shaders::PtRay> rays) {
   if (rays.empty()) throw std::invalid_argument("Raycaster::set_rays: no rays");

@@ -47,6 +47,9 @@ class GpuScene {
   glm::vec3 environment() const { return environment_; }
   const GpuSceneStats& stats() const { return stats_; }
   const SceneFeatures& features() const { return features_; }
+  // Traversal stack entries this tree needs (specialization constant kPtSpecBvhStack):
+  // at most 3 deferred children per 4-wide level (pt_traverse.h).
+  std::uint32_t bvh_stack() const { return 3u * std::uint32_t(stats_.bvh_depth > 0 ? stats_.bvh_depth : 1); }
 
  private:
   gpu::Buffer nodes_, triangles_, shading_, materials_, lights_, texture_table_, texels_, ggx_albedo_;

@@ -4,6 +4,8 @@
 #define FOVEA_SHADERS_PT_TRAVERSE_H
 
 
+layout(constant_id = kPtSpecBvhStack) const uint kPtStackSize = kPtBvhStackSize;
+
 const float kPtInf = 1e30;
 // Ize 2013, "Robust BVH ray traversal": scaling the far slab distance by 1 + 2γ(3)
 // keeps rounding in the box test from culling hits.
@@ -106,7 +108,7 @@ bool pt_traverse(vec3 org, vec3 dir, float tmin, float tmax, bool any_hit, out P
   hit.tri = kPtNoHit;
   hit.bary = vec2(0.0);
   const PtRayPre r = pt_prepare(org, dir, tmin);
-  uvec2 stack[kPtBvhStackSize];  // (node, floatBitsToUint(entry distance))
+  uvec2 stack[kPtStackSize];  // (node, floatBitsToUint(entry distance))
   uint sp = 0u;
   uint n = 0u;
   while (true) {
