@@ -1,12 +1,14 @@
 // Ray-tracing throughput per scene on the current Vulkan device: primary rays (closest
 // hit through the BVH, Mrays/s) and full paths of the BMFR/P5 configuration (primary,
-// NEE, one bounce, NEE: Msamples/s). With Embree 3 installed, the same primary rays are
+// NEE, one bounce, NEE: Msamples/s, and the trace stage's GPU ms with the scene's shader
+// variant and with the full shader). With Embree 3 installed, the same primary rays are
 // traced by Embree on the CPU (all hardware threads) and the ratio is printed. Both with
 // the compute BVH traversal and, where the device offers them, with ray queries
 // (RayQuery*; --trace rayquery).
 //   fovea_bench_raytrace [--benchmark_filter=...]   env FOVEA_BENCH_DISPLAY (default small)
 #include <benchmark/benchmark.h>
 
+#include <algorithm>
 #include <chrono>
 #include <cstdio>
 #include <cstdlib>
@@ -21,6 +23,7 @@
 
 #include "fovea/core/display.hpp"
 #include "fovea/gpu/context.hpp"
+#include "fovea/gpu/timer.hpp"
 #include "fovea/renderer/path_tracer.hpp"
 #include "fovea/renderer/raycaster.hpp"
 #include "fovea/renderer/scene_io.hpp"
@@ -94,19 +97,28 @@ void BM_PrimaryRays(benchmark::State& state, const char* scene, fr::Tracing trac
   results()[result_key(tracing) + std::string(scene)] = rays / secs;
 }
 
-void BM_Paths(benchmark::State& state, const char* scene, fr::Tracing tracing) {
+// full: the shader with every scene feature compiled in, else the scene's variant.
+void BM_Paths(benchmark::State& state, const char* scene, fr::Tracing tracing, bool full) {
   const Fixture& f = fixture(scene);
   fr::GpuScene g(context(), f.scene, {}, tracing);
   const auto grid = fr::cartesian_grid(f.view);
   fovea::gpu::Buffer gb(context(), {grid.size() * sizeof(fovea::shaders::GridSample), fovea::gpu::BufferUsage::Storage,
                                     fovea::gpu::Memory::DeviceLocal, "bench.grid"});
   gb.upload(grid);
-  fr::PathTracer pt(context(), g);
+  const fr::PathTracer pt = full ? fr::PathTracer(context(), g, fr::SceneFeatures{}) : fr::PathTracer(context(), g);
   fr::TraceOutputs out = pt.bind(gb, std::uint32_t(grid.size()));
+  fovea::gpu::GpuTimer timer(context(), 2);
   std::uint32_t frame = 0;
-  auto run = [&] { context().submit_and_wait([&](VkCommandBuffer cmd) { pt.record(cmd, out, f.view, fc::Eye::Left, frame++, {}); }); };
+  auto run = [&] {
+    context().submit_and_wait([&](VkCommandBuffer cmd) {
+      timer.begin(cmd);
+      pt.record(cmd, out, f.view, fc::Eye::Left, frame++, {});
+      timer.stage(cmd, "trace");
+    });
+  };
   run();
   double samples = 0, secs = 0;
+  std::vector<double> gpu_ms;
   for (auto _ : state) {
     const auto t0 = std::chrono::steady_clock::now();
     run();
@@ -114,9 +126,16 @@ void BM_Paths(benchmark::State& state, const char* scene, fr::Tracing tracing) {
     state.SetIterationTime(s);
     samples += double(grid.size());
     secs += s;
+    if (const auto t = timer.read(); t && !t->empty()) gpu_ms.push_back(double(t->back().duration_ns()) * 1e-6);
   }
   state.counters["Msamples/s"] = samples / secs * 1e-6;
   state.counters["ms/frame"] = secs / double(state.iterations()) * 1e3;
+  if (!gpu_ms.empty()) {
+    std::nth_element(gpu_ms.begin(), gpu_ms.begin() + gpu_ms.size() / 2, gpu_ms.end());
+    const double median = gpu_ms[gpu_ms.size() / 2];
+    state.counters["trace_gpu_ms"] = median;
+    if (tracing == fr::Tracing::Compute) results()[(full ? "full/" : "variant/") + std::string(scene)] = median;
+  }
 }
 
 #ifdef FOVEA_HAVE_EMBREE
@@ -187,7 +206,11 @@ int main(int argc, char** argv) {
     benchmark::RegisterBenchmark((std::string("PrimaryRays/") + s).c_str(), BM_PrimaryRays, s, fr::Tracing::Compute)
         ->UseManualTime()
         ->MinTime(1.0);
-    benchmark::RegisterBenchmark((std::string("Paths/") + s).c_str(), BM_Paths, s, fr::Tracing::Compute)
+    benchmark::RegisterBenchmark((std::string("Paths/") + s).c_str(), BM_Paths, s, fr::Tracing::Compute, false)
+        ->UseManualTime()
+        ->MinTime(1.0);
+    benchmark::RegisterBenchmark((std::string("PathsFullShader/") + s).c_str(), BM_Paths, s, fr::Tracing::Compute,
+                                 true)
         ->UseManualTime()
         ->MinTime(1.0);
     if (ray_query) {
@@ -195,7 +218,8 @@ int main(int argc, char** argv) {
                                    fr::Tracing::RayQuery)
           ->UseManualTime()
           ->MinTime(1.0);
-      benchmark::RegisterBenchmark((std::string("RayQueryPaths/") + s).c_str(), BM_Paths, s, fr::Tracing::RayQuery)
+      benchmark::RegisterBenchmark((std::string("RayQueryPaths/") + s).c_str(), BM_Paths, s, fr::Tracing::RayQuery,
+                                   false)
           ->UseManualTime()
           ->MinTime(1.0);
     }
@@ -210,7 +234,7 @@ int main(int argc, char** argv) {
   std::printf("device: %s (%s)\n", context().info().name.c_str(), context().info().driver.c_str());
   benchmark::RunSpecifiedBenchmarks();
   benchmark::Shutdown();
-  for (const char* s : kScenes)
+  for (const char* s : kScenes) {
     for (const fr::Tracing t : {fr::Tracing::Compute, fr::Tracing::RayQuery}) {
       const auto g = results().find(result_key(t) + std::string(s)), e = results().find(std::string("embree/") + s);
       if (g != results().end() && e != results().end())
@@ -218,5 +242,10 @@ int main(int argc, char** argv) {
                     fr::tracing_name(t), context().info().name.c_str(), g->second * 1e-6, e->second * 1e-6,
                     e->second / g->second);
     }
+    const auto v = results().find(std::string("variant/") + s), f = results().find(std::string("full/") + s);
+    if (v != results().end() && f != results().end())
+      std::printf("%-18s paths: trace stage %.1f ms with the scene's shader variant, %.1f ms with the full shader (%.2fx)\n",
+                  s, v->second, f->second, f->second / v->second);
+  }
   return 0;
 }

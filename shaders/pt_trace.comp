@@ -26,6 +26,11 @@ layout(std430, set = 0, binding = 12) buffer OutPosMat { vec4 out_position_mater
 layout(std430, set = 0, binding = 13) buffer OutRadiance { vec4 out_radiance[]; };
 layout(std430, set = 0, binding = 14) readonly buffer GgxAlbedo { vec4 ggx_albedo[]; };  // read by pt_sampling.h
 layout(push_constant) uniform Params { PtFrameParams pc; };
+// What the scene uses (PathTracer sets them from GpuScene::features()); false removes the
+// code: base-colour textures, GGX lobes (all F0 = 0), emission and next-event estimation.
+layout(constant_id = kPtSpecTextures) const bool kTextures = true;
+layout(constant_id = kPtSpecGlossy) const bool kGlossy = true;
+layout(constant_id = kPtSpecEmitters) const bool kEmitters = true;
 
 #include "fovea/shaders/pt_sampling.h"
 #include "fovea/shaders/pt_traverse.h"
@@ -85,7 +90,7 @@ Surface surface(PtHit h, vec3 org, vec3 dir) {
   const PtMaterial m = materials[t.material];
   s.lit = s.front || m.double_sided != 0u;
   s.base = s.lit ? vec3(m.base_r, m.base_g, m.base_b) : vec3(0.0);
-  if (m.texture >= 0 && s.lit) {
+  if (kTextures && m.texture >= 0 && s.lit) {
     const vec2 uv = w0 * vec2(sh.uv0_x, sh.uv0_y) + h.bary.x * vec2(sh.uv1_x, sh.uv1_y) + h.bary.y * vec2(sh.uv2_x, sh.uv2_y);
     s.base *= sample_texture(m.texture, uv);
   }
@@ -98,7 +103,7 @@ PtBsdf bsdf_of(Surface s) {
   const PtMaterial m = materials[s.material];
   PtBsdf b;
   b.diffuse = s.base * (1.0 - m.metallic);
-  b.f0 = s.lit ? mix(vec3(m.specular), s.base, m.metallic) : vec3(0.0);
+  b.f0 = kGlossy && s.lit ? mix(vec3(m.specular), s.base, m.metallic) : vec3(0.0);
   b.alpha = max(m.roughness * m.roughness, 4e-4);
   return b;
 }
@@ -113,7 +118,7 @@ vec3 offset_origin(Surface s, vec3 towards) {
 // Returns f·cos·Le·w / pdf; `mis` weighs against BSDF sampling (false at the last vertex).
 vec3 sample_light(Surface s, PtBsdf b, vec3 wo, bool mis, inout PtRng rng) {
   const float ul = pt_rand(rng), u1 = pt_rand(rng), u2 = pt_rand(rng);
-  if (pc.light_count == 0u) return vec3(0.0);
+  if (!kEmitters || pc.light_count == 0u) return vec3(0.0);  // after the draws: same random stream
   uint lo = 0u, hi = pc.light_count - 1u;
   while (lo < hi) {  // first light whose CDF exceeds ul
     const uint mid = (lo + hi) / 2u;
@@ -187,7 +192,7 @@ Sample trace_path(vec3 org, vec3 dir, vec3 forward, inout PtRng rng) {
       r.material = float(s.material);
     }
     // Emission found by BSDF sampling, MIS-weighted against NEE from the previous vertex.
-    if (pt_max3(s.emission) > 0.0) {
+    if (kEmitters && pt_max3(s.emission) > 0.0) {
       vec3 c;
       if (k == 0u) {
         c = s.emission;

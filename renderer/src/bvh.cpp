@@ -14,6 +14,8 @@ namespace fovea::renderer {
 
 namespace {
 
+constexpr int kSahDepth = 60;
+
 struct Aabb {
   glm::vec3 lo{std::numeric_limits<float>::max()};
   glm::vec3 hi{-std::numeric_limits<float>::max()};
@@ -56,10 +58,13 @@ class Builder {
     const std::uint32_t n = end - begin;
     node->begin = begin;
     node->count = n;
-    // The traversal stack holds one entry per level; a forced leaf keeps the tree shallow.
-    if (n == 1 || depth + 1 >= int(shaders::kPtBvhMaxDepth)) return node;
+    // The traversal stack grows with the depth: past kSahDepth, leaves are accepted up to
+    // the size a node can encode and larger ones halved (median split below).
+    const bool deep = depth + 1 >= kSahDepth;
+    if (n == 1 || (deep && n <= shaders::kPtBvhMaxLeaf)) return node;
+    if (depth + 1 >= int(shaders::kPtBvhMaxDepth)) throw std::logic_error("build_bvh: depth bound exceeded");
 
-    const Split s = best_split(begin, end, node->box, cbox);
+    const Split s = deep ? Split{} : best_split(begin, end, node->box, cbox);
     std::uint32_t mid = begin;
     if (s.axis >= 0) {
       if (s.cost >= float(n) && n <= std::uint32_t(o_.max_leaf)) return node;
@@ -150,39 +155,91 @@ class Builder {
   int parallel_depth_ = 0;
 };
 
-// Boxes grow by a relative margin so that rounding in the slab test can never cull a
-// triangle the watertight triangle test would hit.
-shaders::PtBvhNode make_node(const Aabb& b) {
-  shaders::PtBvhNode n{};
-  float lo[3], hi[3];
-  for (int i = 0; i < 3; ++i) {
-    const float pad = std::max(std::max(std::abs(b.lo[i]), std::abs(b.hi[i])) * 1e-6f, 1e-12f);
-    lo[i] = b.lo[i] - pad;
-    hi[i] = b.hi[i] + pad;
+// Quantises the slot boxes to the node's grid, rounding outwards and checking the planes
+// as the shader decodes them (origin + q·2^e, exact product, one rounding). Boxes first
+// grow by a relative margin so that rounding in the slab test can never cull a triangle
+// the watertight triangle test would hit.
+void encode_boxes(shaders::PtBvhNode& n, const std::vector<Aabb>& slots) {
+  Aabb all;
+  std::vector<Aabb> padded(slots.size());
+  for (std::size_t k = 0; k < slots.size(); ++k) {
+    for (int i = 0; i < 3; ++i) {
+      const float pad = std::max(std::max(std::abs(slots[k].lo[i]), std::abs(slots[k].hi[i])) * 1e-6f, 1e-12f);
+      padded[k].lo[i] = slots[k].lo[i] - pad;
+      padded[k].hi[i] = slots[k].hi[i] + pad;
+    }
+    all.grow(padded[k]);
   }
-  n.lo_x = lo[0]; n.lo_y = lo[1]; n.lo_z = lo[2];
-  n.hi_x = hi[0]; n.hi_y = hi[1]; n.hi_z = hi[2];
-  return n;
+  float* origin[3] = {&n.origin_x, &n.origin_y, &n.origin_z};
+  std::uint32_t* lo[3] = {&n.lo_x, &n.lo_y, &n.lo_z};
+  std::uint32_t* hi[3] = {&n.hi_x, &n.hi_y, &n.hi_z};
+  for (int i = 0; i < 3; ++i) {
+    const float o = all.lo[i];
+    // Grid step 2^e: 253 steps span the union (2 spare for rounding), and a step is at
+    // least 2 ulps of the coordinates so that the grid planes are distinct floats.
+    int e = 0;
+    std::frexp(std::max((all.hi[i] - o) / 253.0f, 2.0f * std::max(std::abs(o), std::abs(all.hi[i])) *
+                                                        std::numeric_limits<float>::epsilon()), &e);
+    e = std::clamp(e, -126, 127);
+    const float step = std::ldexp(1.0f, e);
+    *origin[i] = o;
+    n.exponents |= std::uint32_t(std::uint8_t(std::int8_t(e))) << (8 * i);
+    const auto plane = [&](int q) { return o + float(q) * step; };
+    for (std::size_t k = 0; k < slots.size(); ++k) {
+      int ql = std::clamp(int(std::floor((padded[k].lo[i] - o) / step)), 0, 255);
+      int qh = std::clamp(int(std::ceil((padded[k].hi[i] - o) / step)), 0, 255);
+      while (ql > 0 && plane(ql) > padded[k].lo[i]) --ql;
+      while (qh < 255 && plane(qh) < padded[k].hi[i]) ++qh;
+      if (plane(ql) > padded[k].lo[i] || plane(qh) < padded[k].hi[i])
+        throw std::logic_error("build_bvh: box quantisation failed");
+      *lo[i] |= std::uint32_t(ql) << (8 * k);
+      *hi[i] |= std::uint32_t(qh) << (8 * k);
+    }
+  }
 }
 
-void flatten(const Node& t, std::size_t index, int depth, float root_inv_area, Bvh& out) {
+double sah_cost(const Node& t, float root_inv_area) {
+  if (!t.left) return double(t.count) * t.box.area() * root_inv_area;
+  return double(t.box.area()) * root_inv_area + sah_cost(*t.left, root_inv_area) + sah_cost(*t.right, root_inv_area);
+}
+
+// Collapses the binary subtree under `t` into the 4-wide node `index` (children of the
+// largest inner slot are pulled up until four slots are filled) and recurses.
+void flatten(const Node& t, std::size_t index, int depth, Bvh& out) {
   out.depth = std::max(out.depth, depth);
-  shaders::PtBvhNode n = make_node(t.box);
-  if (!t.left) {
-    n.first = t.begin;
-    n.count = t.count;
-    out.nodes[index] = n;
-    out.sah_cost += double(t.count) * t.box.area() * root_inv_area;
-    return;
+  std::vector<const Node*> slots;
+  if (t.left) slots = {t.left.get(), t.right.get()};
+  else slots = {&t};  // a single-leaf tree
+  while (slots.size() < 4) {
+    int widest = -1;
+    for (int k = 0; k < int(slots.size()); ++k)
+      if (slots[k]->left && (widest < 0 || slots[k]->box.area() > slots[widest]->box.area())) widest = k;
+    if (widest < 0) break;
+    const Node* w = slots[widest];
+    slots[widest] = w->left.get();
+    slots.push_back(w->right.get());
   }
-  const std::size_t child = out.nodes.size();
-  out.nodes.resize(child + 2);
-  n.first = std::uint32_t(child);
-  n.count = 0;
+  shaders::PtBvhNode n{};
+  std::vector<std::pair<const Node*, std::size_t>> inner;
+  std::vector<Aabb> boxes;
+  for (int k = 0; k < 4; ++k) {
+    if (k >= int(slots.size())) {
+      n.child[k] = shaders::kPtNoHit;
+      continue;
+    }
+    boxes.push_back(slots[k]->box);
+    if (slots[k]->left) {
+      n.child[k] = std::uint32_t(out.nodes.size() + inner.size());
+      inner.emplace_back(slots[k], n.child[k]);
+    } else {
+      n.child[k] = slots[k]->begin;
+      n.counts |= slots[k]->count << (8 * k);
+    }
+  }
+  encode_boxes(n, boxes);
   out.nodes[index] = n;
-  out.sah_cost += double(t.box.area()) * root_inv_area;
-  flatten(*t.left, child, depth + 1, root_inv_area, out);
-  flatten(*t.right, child + 1, depth + 1, root_inv_area, out);
+  out.nodes.resize(out.nodes.size() + inner.size());
+  for (const auto& [child, at] : inner) flatten(*child, at, depth + 1, out);
 }
 
 }  // namespace
@@ -206,10 +263,11 @@ Bvh build_bvh(std::span<const glm::vec3> positions, const BvhOptions& options) {
   const int threads = options.threads > 0 ? options.threads : int(std::max(1u, std::thread::hardware_concurrency()));
   Builder b(prims, out.order, options, threads);
   const auto root = b.build(0, std::uint32_t(n), 0);
-  out.nodes.reserve(2 * n);
+  out.nodes.reserve(n / 2 + 1);
   out.nodes.resize(1);
+  flatten(*root, 0, 1, out);
   const float ra = root->box.area();
-  flatten(*root, 0, 1, ra > 0 ? 1.0f / ra : 0.0f, out);
+  out.sah_cost = sah_cost(*root, ra > 0 ? 1.0f / ra : 0.0f);
   return out;
 }
 

@@ -39,10 +39,11 @@ const char* tracing_name(Tracing t) {
 }
 
 gpu::ComputePipelineDesc tracer_pipeline(const GpuScene& scene, const char* shader, std::vector<gpu::Binding> set0,
-                                         std::uint32_t push_constant_bytes) {
+                                         std::uint32_t push_constant_bytes,
+                                         std::vector<gpu::SpecConstant> specialization) {
   const bool rq = scene.tracing() == Tracing::RayQuery;
   gpu::ComputePipelineDesc d{std::string(shader) + (rq ? ".rayquery.comp.spv" : ".comp.spv"), {std::move(set0)},
-                             push_constant_bytes, {}};
+                             push_constant_bytes, std::move(specialization)};
   if (rq) d.sets.push_back({gpu::Binding::AccelerationStructure});
   return d;
 }
@@ -96,6 +97,12 @@ GpuScene::GpuScene(gpu::Context& ctx, const Scene& s, const BvhOptions& bvh_opti
                   uv[0].x, uv[0].y, uv[1].x, uv[1].y, uv[2].x, uv[2].y, 0.0f};
   }
 
+  features_ = {false, false, false};
+  for (const Material& m : s.materials) {
+    features_.textures |= m.base_color_texture >= 0;
+    features_.glossy |= m.specular != 0.0f || m.metallic != 0.0f;
+    features_.emitters |= m.emission != glm::vec3(0.0f);
+  }
   std::vector<PtMaterial> mats;
   for (const Material& m : s.materials)
     mats.push_back({m.base_color.x, m.base_color.y, m.base_color.z, m.base_color_texture, m.emission.x, m.emission.y,

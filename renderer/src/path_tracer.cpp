@@ -17,11 +17,20 @@ constexpr int kOutputs = 6;
 constexpr int kBindings = 8 + kOutputs + 1;  // scene, grid, outputs, GGX albedo table
 }  // namespace
 
-PathTracer::PathTracer(gpu::Context& ctx, const GpuScene& scene)
-    : ctx_(ctx),
-      scene_(scene),
-      pipeline_(ctx, tracer_pipeline(scene, "pt_trace", std::vector<gpu::Binding>(kBindings, gpu::Binding::StorageBuffer),
-                                     sizeof(shaders::PtFrameParams))) {}
+PathTracer::PathTracer(gpu::Context& ctx, const GpuScene& scene) : PathTracer(ctx, scene, scene.features()) {}
+
+PathTracer::PathTracer(gpu::Context& ctx, const GpuScene& scene, const SceneFeatures& f) : ctx_(ctx), scene_(scene) {
+  if (!f.covers(scene.features()))
+    throw core::InputError("path tracer: the requested shader features lack some the scene uses");
+  using gpu::SpecConstant;
+  pipeline_ = gpu::ComputePipeline(
+      ctx, tracer_pipeline(scene, "pt_trace", std::vector<gpu::Binding>(kBindings, gpu::Binding::StorageBuffer),
+                           sizeof(shaders::PtFrameParams),
+                           {SpecConstant::boolean(shaders::kPtSpecTextures, f.textures),
+                            SpecConstant::boolean(shaders::kPtSpecGlossy, f.glossy),
+                            SpecConstant::boolean(shaders::kPtSpecEmitters, f.emitters),
+                            SpecConstant::u32(shaders::kPtSpecBvhStack, scene.bvh_stack())}));
+}
 
 TraceOutputs PathTracer::bind(const gpu::Buffer& grid, std::uint32_t cells) const {
   if (cells == 0) throw core::InputError("path tracer: empty sample grid");

@@ -12,7 +12,8 @@ Raycaster::Raycaster(gpu::Context& ctx, const GpuScene& scene)
     : ctx_(ctx),
       scene_(scene),
       pipeline_(ctx, tracer_pipeline(scene, "pt_raycast", std::vector<gpu::Binding>(4, gpu::Binding::StorageBuffer),
-                                     sizeof(shaders::PtRaycastParams))) {}
+                                     sizeof(shaders::PtRaycastParams),
+                                     {gpu::SpecConstant::u32(shaders::kPtSpecBvhStack, scene.bvh_stack())})) {}
 
 void Raycaster::set_rays(std::span<const shaders::PtRay> rays) {
   if (rays.empty()) throw std::invalid_argument("Raycaster::set_rays: no rays");

@@ -10,8 +10,9 @@ namespace fovea::renderer {
 
 // `shader` (e.g. "pt_trace") as <shader>.comp.spv, or <shader>.rayquery.comp.spv with set 1
 // = the acceleration structure (GpuScene::ray_query_set()) when the scene ray queries; set 0
-// as given.
+// as given; `specialization` for both variants.
 gpu::ComputePipelineDesc tracer_pipeline(const GpuScene& scene, const char* shader, std::vector<gpu::Binding> set0,
-                                         std::uint32_t push_constant_bytes);
+                                         std::uint32_t push_constant_bytes,
+                                         std::vector<gpu::SpecConstant> specialization = {});
 
 }  // namespace fovea::renderer

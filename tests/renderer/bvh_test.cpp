@@ -3,10 +3,13 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <limits>
 #include <random>
 #include <set>
 
+#include <glm/common.hpp>
 #include <glm/geometric.hpp>
+#include <glm/vector_relational.hpp>
 
 #include "fovea/renderer/bvh.hpp"
 #include "fovea/renderer/procedural.hpp"
@@ -41,6 +44,23 @@ std::vector<glm::vec3> coplanar_grid(int n, float cell) {
   return p;
 }
 
+// The box of slot k of a node as the shader decodes it (origin + q·2^e per plane).
+struct Box {
+  glm::vec3 lo, hi;
+};
+Box slot_box(const fovea::shaders::PtBvhNode& n, int k) {
+  const float origin[3] = {n.origin_x, n.origin_y, n.origin_z};
+  const std::uint32_t lo[3] = {n.lo_x, n.lo_y, n.lo_z}, hi[3] = {n.hi_x, n.hi_y, n.hi_z};
+  Box b;
+  for (int i = 0; i < 3; ++i) {
+    const float step = std::ldexp(1.0f, int(std::int8_t(std::uint8_t(n.exponents >> (8 * i)))));
+    b.lo[i] = origin[i] + float((lo[i] >> (8 * k)) & 0xFF) * step;
+    b.hi[i] = origin[i] + float((hi[i] >> (8 * k)) & 0xFF) * step;
+  }
+  return b;
+}
+bool inside(const Box& b, glm::vec3 q) { return glm::all(glm::greaterThanEqual(q, b.lo)) && glm::all(glm::lessThanEqual(q, b.hi)); }
+
 // sah_gain: the geometry is spread out, so the tree must beat a flat list clearly.
 void check_structure(const std::vector<glm::vec3>& p, bool sah_gain = true) {
   const fr::Bvh b = fr::build_bvh(p);
@@ -48,33 +68,38 @@ void check_structure(const std::vector<glm::vec3>& p, bool sah_gain = true) {
   ASSERT_EQ(b.order.size(), n);
   std::vector<int> seen(n, 0);
   EXPECT_LE(b.depth, int(fovea::shaders::kPtBvhMaxDepth));
-  // Walk the tree: children inside parents, leaves contain their triangles.
-  std::vector<std::size_t> stack{0};
-  std::size_t visited = 0;
-  auto inside = [](const fovea::shaders::PtBvhNode& outer, glm::vec3 q) {
-    return q.x >= outer.lo_x && q.y >= outer.lo_y && q.z >= outer.lo_z && q.x <= outer.hi_x && q.y <= outer.hi_y &&
-           q.z <= outer.hi_z;
+  // Walk the tree: every node reached once, every triangle inside the (decoded) boxes of
+  // all slots on its path, as traversal needs.
+  struct Item {
+    std::size_t node;
+    Box box;
   };
+  const float big = std::numeric_limits<float>::max();
+  std::vector<Item> stack{{0, {glm::vec3(-big), glm::vec3(big)}}};
+  std::vector<int> reached(b.nodes.size(), 0);
   while (!stack.empty()) {
-    const auto& node = b.nodes[stack.back()];
+    const Item it = stack.back();
     stack.pop_back();
-    ++visited;
-    if (node.count > 0) {
-      EXPECT_LE(node.first + node.count, n);
-      for (std::uint32_t i = node.first; i < node.first + node.count; ++i) {
-        ++seen[b.order[i]];
-        for (int k = 0; k < 3; ++k) EXPECT_TRUE(inside(node, p[3 * b.order[i] + k]));
-      }
-    } else {
-      ASSERT_LT(node.first + 1, b.nodes.size());
-      for (std::uint32_t c = node.first; c <= node.first + 1; ++c) {
-        const auto& ch = b.nodes[c];
-        EXPECT_TRUE(inside(node, {ch.lo_x, ch.lo_y, ch.lo_z}) || ch.count > 0);
-        stack.push_back(c);
+    ASSERT_LT(it.node, b.nodes.size());
+    ++reached[it.node];
+    const auto& node = b.nodes[it.node];
+    for (int k = 0; k < 4; ++k) {
+      if (node.child[k] == fovea::shaders::kPtNoHit) continue;
+      const Box own = slot_box(node, k);
+      const Box box{glm::max(own.lo, it.box.lo), glm::min(own.hi, it.box.hi)};
+      const std::uint32_t count = (node.counts >> (8 * k)) & 0xFF;
+      if (count > 0) {
+        EXPECT_LE(node.child[k] + count, n);
+        for (std::uint32_t i = node.child[k]; i < node.child[k] + count; ++i) {
+          ++seen[b.order[i]];
+          for (int v = 0; v < 3; ++v) EXPECT_TRUE(inside(box, p[3 * b.order[i] + v]));
+        }
+      } else {
+        stack.push_back({node.child[k], box});
       }
     }
   }
-  EXPECT_EQ(visited, b.nodes.size());
+  for (std::size_t i = 0; i < b.nodes.size(); ++i) ASSERT_EQ(reached[i], 1) << "node " << i;
   for (std::size_t t = 0; t < n; ++t) ASSERT_EQ(seen[t], 1) << "triangle " << t;
   if (sah_gain) {
     EXPECT_LT(b.sah_cost, 0.5 * double(n)) << "SAH cost no better than a flat list";
@@ -111,32 +136,40 @@ TEST(Bvh, CoplanarHugeAndTinyGeometry) {
     chain.insert(chain.end(), {{s, 0, 0}, {s, s * 0.5f, 0}, {s, 0, s * 0.5f}});
   }
   check_structure(chain, false);
+  // Slowly shrinking scales keep SAH splitting past its depth limit with many triangles
+  // left: leaves beyond what a node can count are halved.
+  std::vector<glm::vec3> slow;
+  for (int i = 0; i < 3000; ++i) {
+    const float s = std::pow(1.01f, -float(i));
+    slow.insert(slow.end(), {{s, 0, 0}, {s, s * 0.5f, 0}, {s, 0, s * 0.5f}});
+  }
+  check_structure(slow, false);
 }
 
 class BvhGpu : public fovea::test::GpuTest {
  protected:
   // Closest and any hit through the BVH equal brute force for every ray.
-  void expect_equal_to_brute_force(const std::vector<glm::vec3>& p, const std::vector<PtRay>& rays) {
+  // sanitize = false keeps zero-area triangles (the loaders drop them, the BVH must not care).
+  void expect_equal_to_brute_force(const std::vector<glm::vec3>& p, const std::vector<PtRay>& rays, bool sanitize = true) {
     fr::Scene s;
     s.materials.push_back({});
     for (std::size_t t = 0; t < p.size() / 3; ++t) s.add_triangle(p[3 * t], p[3 * t + 1], p[3 * t + 2], 0);
-    fr::sanitize(s, "test");
+    if (sanitize) fr::sanitize(s, "test");
     fr::GpuScene g(ctx(), s, {}, fr::Tracing::Compute);  // the compute BVH under test
     fr::Raycaster rc(ctx(), g);
     rc.set_rays(rays);
     const auto bvh = rc.trace(fr::RayQuery::Closest), brute = rc.trace(fr::RayQuery::BruteClosest);
     const auto any = rc.trace(fr::RayQuery::Any), brute_any = rc.trace(fr::RayQuery::BruteAny);
-    int hits = 0, ties = 0;
+    int hits = 0;
     for (std::size_t i = 0; i < rays.size(); ++i) {
       ASSERT_EQ(bvh[i].triangle == fovea::shaders::kPtNoHit, brute[i].triangle == fovea::shaders::kPtNoHit) << "ray " << i;
       ASSERT_EQ(bvh[i].t, brute[i].t) << "ray " << i;
-      ties += bvh[i].triangle != brute[i].triangle;  // equal distance, e.g. on a shared edge
+      ASSERT_EQ(bvh[i].triangle, brute[i].triangle) << "ray " << i;  // equal distances: the lower index
       hits += bvh[i].triangle != fovea::shaders::kPtNoHit;
       ASSERT_EQ(any[i].triangle, brute_any[i].triangle) << "ray " << i;
       ASSERT_EQ(any[i].triangle == 0, bvh[i].triangle != fovea::shaders::kPtNoHit) << "ray " << i;
     }
     EXPECT_GT(hits, int(rays.size() / 20)) << "too few hits to test anything";
-    EXPECT_LT(ties, int(rays.size() / 20));
   }
 };
 
@@ -188,6 +221,72 @@ TEST_F(BvhGpu, HugeAndTinyCoordinatesEqualBruteForce) {
   expect_equal_to_brute_force(big, adversarial_rays(big, 1e7f, 9));
   auto tiny = random_soup(1500, 1e-3f, 1e-4f, 10);
   expect_equal_to_brute_force(tiny, adversarial_rays(tiny, 1e-3f, 11));
+}
+
+TEST_F(BvhGpu, RaysFromFarAwayEqualBruteForce) {
+  // Origins 10⁴–10⁶ units from a scene of extent 10, aimed at vertices, edge midpoints and
+  // random points of its bounds: box and triangle tests at large t.
+  const auto p = random_soup(3000, 10, 1.0f, 12);
+  std::mt19937 rng(13);
+  std::uniform_real_distribution<float> u(-1, 1);
+  std::vector<PtRay> rays;
+  for (int i = 0; i < 6000; ++i) {
+    const glm::vec3 away = glm::normalize(glm::vec3(u(rng), u(rng), u(rng))) * std::pow(10.0f, 4.0f + 2.0f * (0.5f + 0.5f * u(rng)));
+    const std::size_t t = 3 * (rng() % (p.size() / 3));
+    const glm::vec3 target = i % 3 == 0 ? p[t] : i % 3 == 1 ? 0.5f * (p[t] + p[t + 1]) : 10.0f * glm::vec3(u(rng), u(rng), u(rng));
+    rays.push_back(ray(away, target - away));
+  }
+  expect_equal_to_brute_force(p, rays);
+  // The same scene moved 10⁶ units from the world origin, rays from near it.
+  std::vector<glm::vec3> moved = p;
+  for (auto& v : moved) v += glm::vec3(1e6f, -2e6f, 5e5f);
+  auto near = adversarial_rays(moved, 10, 14);
+  for (auto& r : near) {
+    r.org_x += 1e6f;
+    r.org_y -= 2e6f;
+    r.org_z += 5e5f;
+  }
+  expect_equal_to_brute_force(moved, near);
+}
+
+TEST_F(BvhGpu, DegenerateAndSliverTrianglesEqualBruteForce) {
+  // Zero-area triangles (repeated vertices, collinear vertices), needles and slivers with
+  // edges 10⁻⁶ of the others, mixed with ordinary ones.
+  std::mt19937 rng(15);
+  std::uniform_real_distribution<float> u(-1, 1);
+  std::vector<glm::vec3> p = random_soup(1000, 10, 1.0f, 16);
+  for (int i = 0; i < 2000; ++i) {
+    const glm::vec3 a(10 * u(rng), 10 * u(rng), 10 * u(rng)), d = glm::vec3(u(rng), u(rng), u(rng));
+    const glm::vec3 e = glm::vec3(u(rng), u(rng), u(rng));
+    switch (i % 4) {
+      case 0: p.insert(p.end(), {a, a, a + d}); break;                    // repeated vertex
+      case 1: p.insert(p.end(), {a, a + d, a + 2.0f * d}); break;         // collinear
+      case 2: p.insert(p.end(), {a, a + d, a + d + 1e-6f * e}); break;    // needle
+      default: p.insert(p.end(), {a, a + d, a + 0.5f * d + 1e-6f * e});   // sliver
+    }
+  }
+  auto rays = adversarial_rays(p, 10, 17);
+  expect_equal_to_brute_force(p, rays, false);
+}
+
+TEST_F(BvhGpu, DeepTreeEqualsBruteForce) {
+  // Nested triangles at slowly shrinking scales make a deep tree (12 4-wide levels, over
+  // twice the shipped scenes'), and the traversal stack is sized from the depth. The smallest
+  // are 2.5·10⁻³ across: much smaller ones, seen from unit distance, fall below float
+  // resolution and the triangle test (no double-precision fallback) reports false hits by
+  // rounding, which brute force returns and the BVH's box test rightly culls.
+  std::vector<glm::vec3> p;
+  for (int i = 0; i < 3000; ++i) {
+    const float s = std::pow(1.002f, -float(i));
+    p.insert(p.end(), {{s, 0, 0}, {s, s * 0.5f, 0}, {s, 0, s * 0.5f}});
+  }
+  EXPECT_GE(fr::build_bvh(p).depth, 10);
+  auto rays = adversarial_rays(p, 1.0f, 18);
+  for (int i = 0; i < 2000; ++i) {  // along −x through the nested triangles
+    const float y = 0.25f * std::pow(1.002f, -float(i)), z = 0.5f * y;
+    rays.push_back(ray({2.0f, y, z}, {-1, 0, 0}));
+  }
+  expect_equal_to_brute_force(p, rays, false);
 }
 
 TEST_F(BvhGpu, ClosedMeshIsWatertight) {

@@ -1,7 +1,7 @@
 #pragma once
 // Bounding volume hierarchy over a triangle soup: binned surface-area-heuristic build on
-// the CPU (subtrees built in parallel), flattened to the compact 32-byte node layout the
-// GPU traverses (shaders/include/fovea/shaders/pt_scene.h).
+// the CPU (subtrees built in parallel), collapsed to the 4-wide 128-byte nodes the GPU
+// traverses (shaders/include/fovea/shaders/pt_scene.h).
 #include <cstdint>
 #include <span>
 #include <vector>
@@ -22,8 +22,8 @@ struct BvhOptions {
 struct Bvh {
   std::vector<shaders::PtBvhNode> nodes;  // nodes[0] is the root
   std::vector<std::uint32_t> order;       // order[i]: input triangle stored at slot i
-  int depth = 0;                          // levels, root = 1
-  double sah_cost = 0;                    // SAH cost of the tree (for tests and reports)
+  int depth = 0;                          // 4-wide levels, root = 1
+  double sah_cost = 0;                    // SAH cost of the binary tree (for tests and reports)
 };
 
 // `positions`: three vertices per triangle, all finite (scenes are sanitised first).

@@ -35,6 +35,18 @@ struct GpuSceneStats {
   std::uint64_t accel_bytes = 0;   // its storage, both levels
 };
 
+// Shading features a scene uses; the path tracer compiles a variant without the others.
+struct SceneFeatures {
+  bool textures = true;  // a material has a base-colour texture
+  bool glossy = true;    // a material has a specular lobe (F0 > 0: specular or metallic > 0)
+  bool emitters = true;  // a material emits (emission, next-event estimation)
+  bool operator==(const SceneFeatures&) const = default;
+  // Everything `other` uses is on here.
+  bool covers(const SceneFeatures& other) const {
+    return (textures || !other.textures) && (glossy || !other.glossy) && (emitters || !other.emitters);
+  }
+};
+
 class GpuScene {
  public:
   // `scene` must be sanitised (every loader does that). Tracing::RayQuery on a device
@@ -57,6 +69,10 @@ class GpuScene {
   // shaders and bind ray_query_set() as set 1.
   Tracing tracing() const { return accel_ ? Tracing::RayQuery : Tracing::Compute; }
   const gpu::DescriptorSet& ray_query_set() const { return accel_set_; }
+  const SceneFeatures& features() const { return features_; }
+  // Traversal stack entries this tree needs (specialization constant kPtSpecBvhStack):
+  // at most 3 deferred children per 4-wide level (pt_traverse.h).
+  std::uint32_t bvh_stack() const { return 3u * std::uint32_t(stats_.bvh_depth > 0 ? stats_.bvh_depth : 1); }
 
  private:
   gpu::Buffer nodes_, triangles_, shading_, materials_, lights_, texture_table_, texels_, ggx_albedo_;
@@ -65,6 +81,7 @@ class GpuScene {
   std::unique_ptr<gpu::TriangleAccel> accel_;  // null: compute traversal
   gpu::DescriptorSetLayout accel_layout_;
   gpu::DescriptorSet accel_set_;
+  SceneFeatures features_;
 };
 
 }  // namespace fovea::renderer

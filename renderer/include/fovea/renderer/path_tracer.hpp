@@ -50,7 +50,10 @@ class TraceOutputs {
 
 class PathTracer {
  public:
+  // The shader variant of the scene's features (GpuScene::features()), or of `features`,
+  // which must cover them (core::InputError otherwise; all on is the full shader).
   PathTracer(gpu::Context& ctx, const GpuScene& scene);
+  PathTracer(gpu::Context& ctx, const GpuScene& scene, const SceneFeatures& features);
 
   // Output buffers for a grid of `cells` GridSample entries held in `grid`.
   TraceOutputs bind(const gpu::Buffer& grid, std::uint32_t cells) const;

@@ -7,17 +7,33 @@
 namespace fovea::shaders {
 #endif
 
-// Traversal stack size; the builder keeps the tree shallower than this.
-FOVEA_CONST FOVEA_UINT kPtBvhMaxDepth = 60;
+// Depth bound of the binary tree the builder makes before collapsing it to 4-wide nodes:
+// SAH splits stop at depth 60, and larger leaves are then halved until they fit
+// kPtBvhMaxLeaf (at most 20 more levels for the 4·10⁶-triangle scene limit).
+FOVEA_CONST FOVEA_UINT kPtBvhMaxDepth = 80;
+FOVEA_CONST FOVEA_UINT kPtBvhMaxLeaf = 255;
+// Traversal stack: at most 3 deferred children per 4-wide level, and a 4-wide tree is
+// never deeper than the binary one.
+FOVEA_CONST FOVEA_UINT kPtBvhStackSize = 3 * kPtBvhMaxDepth;
+// Specialization constant (constant_id) of the shaders that traverse: the stack entries a
+// scene needs, 3 × its 4-wide depth (a smaller private array is cheaper on lavapipe).
+FOVEA_CONST FOVEA_UINT kPtSpecBvhStack = 16;
 FOVEA_CONST FOVEA_UINT kPtNoHit = 0xFFFFFFFF;
 
-// BVH node, 32 bytes. Interior nodes (count == 0) have their children at `first` and
-// `first + 1`; leaves hold triangles [first, first + count) of the reordered triangles.
+// Compressed 4-wide BVH node, 64 bytes (Ylitie, Karras, Laine 2017, "Efficient incoherent
+// ray traversal on GPUs through compressed wide BVHs", §3.1): the four child boxes are
+// quantised to 8 bits per plane on a grid of origin + 2^e·q per axis, rounded outwards,
+// so one small fetch serves four box tests. Byte k of lo_*, hi_*, counts is slot k.
+// counts byte k > 0: slot k is a leaf of triangles [child[k], child[k] + count) of the
+// reordered triangles; 0: an inner node at index child[k]; child[k] == kPtNoHit: empty.
 struct PtBvhNode {
-  float lo_x, lo_y, lo_z;
-  FOVEA_UINT first;
-  float hi_x, hi_y, hi_z;
-  FOVEA_UINT count;
+  float origin_x, origin_y, origin_z;
+  FOVEA_UINT exponents;  // e per axis, signed bytes 0..2
+  FOVEA_UINT lo_x, lo_y, lo_z;
+  FOVEA_UINT hi_x, hi_y, hi_z;
+  FOVEA_UINT child[4];
+  FOVEA_UINT counts;
+  FOVEA_UINT pad;
 };
 
 // Triangle vertices in BVH order, what traversal reads (48 bytes).
@@ -70,7 +86,7 @@ struct PtLight {
 FOVEA_CONST FOVEA_UINT kPtGgxTableSize = 32;
 
 #ifdef __cplusplus
-static_assert(sizeof(PtBvhNode) == 32 && sizeof(PtTriangle) == 48 && sizeof(PtShading) == 64);
+static_assert(sizeof(PtBvhNode) == 64 && sizeof(PtTriangle) == 48 && sizeof(PtShading) == 64);
 static_assert(sizeof(PtMaterial) == 48 && sizeof(PtTextureInfo) == 16 && sizeof(PtLight) == 16);
 }  // namespace fovea::shaders
 #endif

@@ -28,6 +28,12 @@ FOVEA_CONST FOVEA_UINT kPtHardMaxBounces = 256;
 FOVEA_CONST FOVEA_UINT kPtJitter = 1;      // jitter directions over the cell's footprint
 FOVEA_CONST FOVEA_UINT kPtAccumulate = 2;  // running mean with `accumulated_samples` earlier samples
 
+// Scene features, specialization constants of pt_trace.comp (constant_id): a variant
+// without texture fetches, GGX lobes or light sampling for scenes that do not need them.
+FOVEA_CONST FOVEA_UINT kPtSpecTextures = 0;
+FOVEA_CONST FOVEA_UINT kPtSpecGlossy = 1;
+FOVEA_CONST FOVEA_UINT kPtSpecEmitters = 2;
+
 // Samples per dispatch. lavapipe (gallivm) caps the iterations of all loops nested in one
 // outermost loop at 65535 per invocation and silently breaks out beyond, so long
 // sample loops are split into several dispatches.

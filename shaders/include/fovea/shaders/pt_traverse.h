@@ -3,6 +3,9 @@
 #ifndef FOVEA_SHADERS_PT_TRAVERSE_H
 #define FOVEA_SHADERS_PT_TRAVERSE_H
 
+
+layout(constant_id = kPtSpecBvhStack) const uint kPtStackSize = kPtBvhStackSize;
+
 const float kPtInf = 1e30;
 // Ize 2013, "Robust BVH ray traversal": scaling the far slab distance by 1 + 2γ(3)
 // keeps rounding in the box test from culling hits.
@@ -22,6 +25,10 @@ struct PtHit {
   vec2 bary;  // weights of vertices 1 and 2
 };
 
+// v[k] by selects: lavapipe lowers a vector indexed by a per-invocation value to memory
+// traffic (docs/reconstruction.md), which made this test ~20× slower than its arithmetic.
+float pt_axis(vec3 v, int k) { return k == 0 ? v.x : (k == 1 ? v.y : v.z); }
+
 PtRayPre pt_prepare(vec3 org, vec3 dir, float tmin) {
   PtRayPre r;
   r.org = org;
@@ -30,12 +37,13 @@ PtRayPre pt_prepare(vec3 org, vec3 dir, float tmin) {
   r.kz = a.x > a.y ? (a.x > a.z ? 0 : 2) : (a.y > a.z ? 1 : 2);
   r.kx = (r.kz + 1) % 3;
   r.ky = (r.kx + 1) % 3;
-  if (dir[r.kz] < 0.0) {  // keep the winding, so the sign of U, V, W stays meaningful
+  const float dz = pt_axis(dir, r.kz);
+  if (dz < 0.0) {  // keep the winding, so the sign of U, V, W stays meaningful
     const int k = r.kx;
     r.kx = r.ky;
     r.ky = k;
   }
-  r.shear = vec3(dir[r.kx] / dir[r.kz], dir[r.ky] / dir[r.kz], 1.0 / dir[r.kz]);
+  r.shear = vec3(pt_axis(dir, r.kx) / dz, pt_axis(dir, r.ky) / dz, 1.0 / dz);
   for (int i = 0; i < 3; ++i) r.inv[i] = 1.0 / (a[i] > 1e-20 ? dir[i] : (dir[i] < 0.0 ? -1e-20 : 1e-20));
   return r;
 }
@@ -46,66 +54,104 @@ bool pt_hit_triangle(PtRayPre r, uint i, float tmax, inout PtHit hit) {
   const vec3 A = vec3(tri.v0_x, tri.v0_y, tri.v0_z) - r.org;
   const vec3 B = vec3(tri.v1_x, tri.v1_y, tri.v1_z) - r.org;
   const vec3 C = vec3(tri.v2_x, tri.v2_y, tri.v2_z) - r.org;
-  const float Ax = A[r.kx] - r.shear.x * A[r.kz], Ay = A[r.ky] - r.shear.y * A[r.kz];
-  const float Bx = B[r.kx] - r.shear.x * B[r.kz], By = B[r.ky] - r.shear.y * B[r.kz];
-  const float Cx = C[r.kx] - r.shear.x * C[r.kz], Cy = C[r.ky] - r.shear.y * C[r.kz];
+  const float Az = pt_axis(A, r.kz), Bz = pt_axis(B, r.kz), Cz = pt_axis(C, r.kz);
+  const float Ax = pt_axis(A, r.kx) - r.shear.x * Az, Ay = pt_axis(A, r.ky) - r.shear.y * Az;
+  const float Bx = pt_axis(B, r.kx) - r.shear.x * Bz, By = pt_axis(B, r.ky) - r.shear.y * Bz;
+  const float Cx = pt_axis(C, r.kx) - r.shear.x * Cz, Cy = pt_axis(C, r.ky) - r.shear.y * Cz;
   const float U = Cx * By - Cy * Bx, V = Ax * Cy - Ay * Cx, W = Bx * Ay - By * Ax;
   if ((U < 0.0 || V < 0.0 || W < 0.0) && (U > 0.0 || V > 0.0 || W > 0.0)) return false;
   const float det = U + V + W;
   if (det == 0.0) return false;
-  const float T = U * (r.shear.z * A[r.kz]) + V * (r.shear.z * B[r.kz]) + W * (r.shear.z * C[r.kz]);
+  const float T = U * (r.shear.z * Az) + V * (r.shear.z * Bz) + W * (r.shear.z * Cz);
   const float sd = det < 0.0 ? -1.0 : 1.0;
-  if (T * sd <= r.tmin * det * sd || T * sd >= tmax * det * sd) return false;
+  if (T * sd <= r.tmin * det * sd) return false;
+  // Compared as the distance it reports, and equal distances resolved to the lower index,
+  // so the closest hit does not depend on the order in which triangles are tested
+  // (T < tmax·det rounds differently from triangle to triangle).
   const float rcp = 1.0 / det;
-  hit.t = T * rcp;
+  const float t = T * rcp;
+  if (!(t < tmax || (t == tmax && i < hit.tri && hit.tri != kPtNoHit))) return false;
+  hit.t = t;
   hit.tri = i;
   hit.bary = vec2(V, W) * rcp;
   return true;
 }
 
-// Entry distance of the ray into node n's box, or kPtInf when it misses [tmin, tmax].
-float pt_box_entry(PtRayPre r, uint n, float tmax) {
-  const PtBvhNode b = nodes[n];
-  const vec3 t0 = (vec3(b.lo_x, b.lo_y, b.lo_z) - r.org) * r.inv;
-  const vec3 t1 = (vec3(b.hi_x, b.hi_y, b.hi_z) - r.org) * r.inv;
-  const vec3 tn = min(t0, t1), tf = max(t0, t1);
-  const float enter = max(max(tn.x, tn.y), max(tn.z, r.tmin));
-  const float leave = min(min(tf.x, tf.y), min(tf.z, tmax)) * kPtBoxFarScale;
-  return enter <= leave ? enter : kPtInf;
+// The four slots' planes origin + q·2^e of one axis (bytes of `q`); the product is exact,
+// so these are the floats the builder checked against the boxes.
+vec4 pt_planes(float origin, float step, uint q) {
+  return origin + vec4((uvec4(q) >> uvec4(0u, 8u, 16u, 24u)) & 0xFFu) * step;
 }
 
-// Stack-based traversal, nearer child first. any_hit: stop at the first hit (shadow rays).
+// Tests the triangles [first, first + count) (a leaf); true on a hit when any_hit.
+bool pt_hit_leaf(PtRayPre r, uint first, uint count, bool any_hit, inout PtHit hit) {
+  for (uint i = first; i < first + count; ++i)
+    if (pt_hit_triangle(r, i, hit.t, hit) && any_hit) return true;
+  return false;
+}
+
+// Compare-exchange of two (entry distance, node) pairs, nearer first.
+void pt_order(inout float ta, inout uint na, inout float tb, inout uint nb) {
+  if (tb < ta) {
+    const float t = ta; ta = tb; tb = t;
+    const uint n = na; na = nb; nb = n;
+  }
+}
+
+// Stack-based traversal of the 4-wide tree. Each step fetches one node and tests its four
+// boxes at once; leaf children are intersected right away (their hits shorten the ray
+// before the inner children are culled), inner children are visited nearest first and the
+// others deferred with their entry distance, so a pop needs no refetch to be culled.
+// any_hit: stop at the first hit (shadow rays).
 bool pt_traverse(vec3 org, vec3 dir, float tmin, float tmax, bool any_hit, out PtHit hit) {
   hit.t = tmax;
   hit.tri = kPtNoHit;
   hit.bary = vec2(0.0);
   const PtRayPre r = pt_prepare(org, dir, tmin);
-  if (pt_box_entry(r, 0u, tmax) >= kPtInf) return false;
-  uint stack[kPtBvhMaxDepth];
+  uvec2 stack[kPtStackSize];  // (node, floatBitsToUint(entry distance))
   uint sp = 0u;
   uint n = 0u;
   while (true) {
-    const PtBvhNode node = nodes[n];
-    if (node.count > 0u) {
-      for (uint i = node.first; i < node.first + node.count; ++i)
-        if (pt_hit_triangle(r, i, hit.t, hit) && any_hit) return true;
-    } else {
-      const float tl = pt_box_entry(r, node.first, hit.t), tr = pt_box_entry(r, node.first + 1u, hit.t);
-      if (tl < kPtInf && tr < kPtInf) {
-        n = tl <= tr ? node.first : node.first + 1u;
-        stack[sp++] = tl <= tr ? node.first + 1u : node.first;
-        continue;
-      }
-      if (tl < kPtInf || tr < kPtInf) {
-        n = tl < kPtInf ? node.first : node.first + 1u;
-        continue;
-      }
+    const PtBvhNode b = nodes[n];
+    const int e = int(b.exponents);
+    const vec3 step = ldexp(vec3(1.0), ivec3(bitfieldExtract(e, 0, 8), bitfieldExtract(e, 8, 8), bitfieldExtract(e, 16, 8)));
+    const vec4 t0x = (pt_planes(b.origin_x, step.x, b.lo_x) - r.org.x) * r.inv.x;
+    const vec4 t1x = (pt_planes(b.origin_x, step.x, b.hi_x) - r.org.x) * r.inv.x;
+    const vec4 t0y = (pt_planes(b.origin_y, step.y, b.lo_y) - r.org.y) * r.inv.y;
+    const vec4 t1y = (pt_planes(b.origin_y, step.y, b.hi_y) - r.org.y) * r.inv.y;
+    const vec4 t0z = (pt_planes(b.origin_z, step.z, b.lo_z) - r.org.z) * r.inv.z;
+    const vec4 t1z = (pt_planes(b.origin_z, step.z, b.hi_z) - r.org.z) * r.inv.z;
+    const vec4 enter = max(max(min(t0x, t1x), min(t0y, t1y)), max(min(t0z, t1z), vec4(r.tmin)));
+    const vec4 leave = min(min(max(t0x, t1x), max(t0y, t1y)), min(max(t0z, t1z), vec4(hit.t))) * kPtBoxFarScale;
+    const uvec4 child = uvec4(b.child[0], b.child[1], b.child[2], b.child[3]);
+    const uvec4 count = (uvec4(b.counts) >> uvec4(0u, 8u, 16u, 24u)) & 0xFFu;
+    const bvec4 overlap = bvec4(uvec4(lessThanEqual(enter, leave)) * uvec4(notEqual(child, uvec4(kPtNoHit))));
+    for (int k = 0; k < 4; ++k)
+      if (overlap[k] && count[k] > 0u && pt_hit_leaf(r, child[k], count[k], any_hit, hit)) return true;
+    // Inner children still in front of the closest hit, sorted (5-comparator network).
+    const bvec4 inner = bvec4(uvec4(overlap) * uvec4(equal(count, uvec4(0u))) *
+                              uvec4(lessThanEqual(enter, vec4(hit.t * kPtBoxFarScale))));
+    float ta = inner.x ? enter.x : kPtInf, tb = inner.y ? enter.y : kPtInf;
+    float tc = inner.z ? enter.z : kPtInf, td = inner.w ? enter.w : kPtInf;
+    uint na = child.x, nb = child.y, nc = child.z, nd = child.w;
+    pt_order(ta, na, tb, nb);
+    pt_order(tc, nc, td, nd);
+    pt_order(ta, na, tc, nc);
+    pt_order(tb, nb, td, nd);
+    pt_order(tb, nb, tc, nc);
+    if (td < kPtInf) stack[sp++] = uvec2(nd, floatBitsToUint(td));
+    if (tc < kPtInf) stack[sp++] = uvec2(nc, floatBitsToUint(tc));
+    if (tb < kPtInf) stack[sp++] = uvec2(nb, floatBitsToUint(tb));
+    if (ta < kPtInf) {
+      n = na;
+      continue;
     }
     // Pop the next subtree that still starts before the closest hit found so far.
     bool next = false;
     while (sp > 0u && !next) {
-      n = stack[--sp];
-      next = pt_box_entry(r, n, hit.t) < kPtInf;
+      const uvec2 e = stack[--sp];
+      n = e.x;
+      next = uintBitsToFloat(e.y) <= hit.t * kPtBoxFarScale;
     }
     if (!next) break;
   }
