@@ -70,6 +70,12 @@ void Resolve::record_depth(VkCommandBuffer cmd, int parity) const {
 }
 
 void Resolve::record_resolve(VkCommandBuffer cmd, bool blur, const ReconSettings& s) const {
+  record_mips(cmd);
+  record_resample(cmd);
+  if (blur) record_blur(cmd, s);
+}
+
+void Resolve::record_mips(VkCommandBuffer cmd) const {
   for (std::uint32_t l = 0; l + 1 < max_levels(); ++l) {
     for (const Eye& e : eyes_) {
       if (l + 1 >= e.levels) continue;
@@ -79,14 +85,19 @@ void Resolve::record_resolve(VkCommandBuffer cmd, bool blur, const ReconSettings
     }
     gpu::compute_to_compute(cmd);
   }
+}
+
+void Resolve::record_resample(VkCommandBuffer cmd) const {
   for (const Eye& e : eyes_)
     resolve_.run(cmd, {&e.resolve_set}, shaders::ReconResolvePush{e.width, e.height, e.levels, 0}, e.width, e.height);
   gpu::compute_to_compute(cmd);
-  if (!blur) return;
+}
+
+void Resolve::record_blur(VkCommandBuffer cmd, const ReconSettings& s) const {
   for (int pass = 0; pass < 2; ++pass) {
     for (const Eye& e : eyes_) {
-      const shaders::ReconBlurPush push{e.width, e.height, std::uint32_t(pass), 0, float(s.blur_fovea_deg),
-                                        float(s.blur_sigma_deg_at_30 / (30.0 - s.blur_fovea_deg)),
+      const shaders::ReconBlurPush push{e.width, e.height, std::uint32_t(pass), 0,
+                                        float(blur_sigma_deg(0.0, s.blur_mar_fovea_deg)), float(s.blur_min_sigma_px),
                                         float(s.blur_max_sigma_px), 0};
       blur_.run(cmd, {pass == 0 ? &e.blur_h : &e.blur_v}, push, e.width, e.height);
     }

@@ -123,12 +123,17 @@ class Resolve {
   void record_copy(VkCommandBuffer cmd, std::span<const gpu::Buffer* const> grid_images) const;
   // Depth of the nearest sample per display pixel from the positions of `parity`.
   void record_depth(VkCommandBuffer cmd, int parity) const;
-  // Mips from level 0, resolve, optional blur: into the screen buffers.
+  // Mips from level 0, resolve, optional blur: into the screen buffers. The three kernels
+  // are also recorded one by one (per-kernel timestamps between them).
   void record_resolve(VkCommandBuffer cmd, bool blur, const ReconSettings& settings) const;
+  void record_mips(VkCommandBuffer cmd) const;
+  void record_resample(VkCommandBuffer cmd) const;
+  void record_blur(VkCommandBuffer cmd, const ReconSettings& settings) const;
   void fill(VkCommandBuffer cmd, std::uint32_t word) const;
 
   gpu::Buffer& level0(int eye) { return eyes_[eye].mips; }  // for a given grid image
   const gpu::Buffer& screen(int eye) const { return eyes_[eye].screen_a; }
+  gpu::Buffer& screen(int eye) { return eyes_[eye].screen_a; }  // for a given display image
   const gpu::Buffer& depth(int eye) const { return eyes_[eye].depth; }
 
  private:
