@@ -28,6 +28,11 @@ void main() {
   vec2 px = vec2(p) + 0.5;
   vec3 d = rg_pixel_to_dir(m, px);
   vec3 g = rg_gaze(m);
+  uint i = p.y * pc.width + p.x;
+  if (dot(d, g) > pc.cos_skip) {  // near the gaze: σ < min_sigma_px on any pixel of this raster
+    dst[i] = src[i];
+    return;
+  }
   float e = atan(length(cross(d, g)), dot(d, g)) * (180.0 / kRgPi);
   // Local pixels per degree along the pass direction: finite difference of the angle.
   vec2 step_px = pc.vertical != 0u ? vec2(0.0, 1.0) : vec2(1.0, 0.0);
@@ -35,7 +40,6 @@ void main() {
   float deg_per_px = atan(length(cross(d, d1)), dot(d, d1)) * (180.0 / kRgPi);
   float acuity = e <= 5.79 ? 1.0 : 7.49 / ((0.3 * e + 1.0) * (0.3 * e + 1.0));
   float sigma = min(pc.sigma_fovea_deg / acuity / max(deg_per_px, 1e-6), pc.max_sigma_px);
-  uint i = p.y * pc.width + p.x;
   if (sigma < pc.min_sigma_px) {
     dst[i] = src[i];
     return;

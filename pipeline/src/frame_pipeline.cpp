@@ -24,6 +24,18 @@ double lap_ms(core::TimeNs& t0) {
   return ms;
 }
 
+// The raster's largest pixels per degree (a rectilinear raster's pixels subtend the least
+// at its corners; the centre is checked too), along x and y.
+double max_pixels_per_deg(const core::View& v) {
+  double best = 0;
+  const double w = v.width(), h = v.height();
+  for (const glm::dvec2 c : {glm::dvec2(0.5, 0.5), glm::dvec2(w - 1.5, 0.5), glm::dvec2(0.5, h - 1.5),
+                             glm::dvec2(w - 1.5, h - 1.5), glm::dvec2(0.5 * w, 0.5 * h)})
+    for (const glm::dvec2 step : {glm::dvec2(1, 0), glm::dvec2(0, 1)})
+      best = std::max(best, 1.0 / std::max(core::angle_deg(v.pixel_to_dir(c), v.pixel_to_dir(c + step)), 1e-9));
+  return best;
+}
+
 std::unique_ptr<EyeState> make_eye(gpu::Context& ctx, renderer::PathTracer& tracer, core::Eye eye,
                                    const core::View& view, const core::DistributionParams& dp) {
   auto e = std::make_unique<EyeState>();
@@ -87,6 +99,7 @@ FramePipeline::FramePipeline(gpu::Context& ctx, const renderer::GpuScene& scene,
                      .polar = e->dist->gpu_params().family != shaders::kFamilyCartesian,
                      .width = std::uint32_t(e->base_view.width()),
                      .height = std::uint32_t(e->base_view.height()),
+                     .max_pixels_per_deg = max_pixels_per_deg(e->base_view),
                      .maps = &e->mapping->maps(),
                      .tables = &e->mapping->tables(),
                      .samples = &e->grid,

@@ -64,7 +64,7 @@ TEST_F(GpuTest, BlurWidthFollowsTheAcuityModelAcrossEccentricities) {
 }
 
 TEST_F(GpuTest, BlurLeavesTheFoveaAndNearPeripheryUntouchedAtTheModelsScale) {
-  // With MAR₀ = 1′ σ stays below 0.3 px out to ~30° on this raster: those pixels pass unchanged.
+  // With MAR₀ = 1′ σ stays below 0.5 px out to ~30° on this raster: those pixels pass unchanged.
   const renderer::Scene scene = renderer::load_scene("cornell");
   renderer::GpuScene gs(ctx(), scene);
   const core::DisplayPreset display = fovea::test::display_of_size(320, 360);

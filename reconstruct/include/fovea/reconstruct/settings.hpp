@@ -36,7 +36,7 @@ struct ReconSettings {
   bool block_offsets = true;     // 16 static block-grid displacements
   bool blur = true;              // peripheral blur
   double blur_mar_fovea_deg = kMarFoveaDeg;  // MAR₀ of blur_sigma_deg
-  double blur_min_sigma_px = 0.3;            // narrower kernels leave the pixel as it is (weights ≤ 0.4% at ±1 px)
+  double blur_min_sigma_px = 0.5;            // narrower kernels leave the pixel as it is (sub-pixel: ±1 px weighs ≤ 11%)
   double blur_max_sigma_px = 16;
 };
 

@@ -25,6 +25,7 @@ struct EyeGrid {
   std::uint32_t cells = 0, padded_columns = 0, padded_rows = 0;
   bool polar = true;                   // φ-only mip chain (polar grids) or one level
   std::uint32_t width = 0, height = 0;  // the display raster the grid resolves to
+  double max_pixels_per_deg = 0;        // the raster's densest pixels (bounds the blur's reach)
   const gpu::Buffer* maps = nullptr;    // GridMapping::maps(), tables()
   const gpu::Buffer* tables = nullptr;
   // The path tracer's per-cell outputs (renderer::TraceOutputs) and the grid itself.
@@ -139,6 +140,7 @@ class Resolve {
  private:
   struct Eye {
     std::uint32_t cells = 0, width = 0, height = 0, padded_columns = 0, levels = 1;
+    double max_pixels_per_deg = 0;
     std::vector<std::uint32_t> level_rows, level_offset;
     gpu::Buffer mips, offsets, screen_a, screen_b, depth;
     gpu::DescriptorSet mip_set, resolve_set, blur_h, blur_v, depth_set[2];

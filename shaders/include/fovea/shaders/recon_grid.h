@@ -78,7 +78,7 @@ struct ReconResolvePush {
 
 struct ReconBlurPush {
   FOVEA_UINT width, height, vertical, pad0;
-  float sigma_fovea_deg, min_sigma_px, max_sigma_px, pad1;  // σ(e) = σ_fovea / m(e) degrees
+  float sigma_fovea_deg, min_sigma_px, max_sigma_px, cos_skip;  // σ(e) = σ_fovea / m(e) degrees; cos e > cos_skip: σ < min
 };
 
 #ifdef __cplusplus
