@@ -3,6 +3,8 @@
 // sample's world position is reprojected into the previous frame's view and grid mapping
 // (the gaze moved), the history is fetched bilinearly with a validity test per tap,
 // renormalised over the accepted taps, and blended with α = max(1/n, α_min) (CMA, then EMA).
+// Taps are read at the cell centre (the frame's sub-cell jitter taken off), and taps from
+// cells coarser than the sample's own are down-weighted or rejected (rg_coarse_weight).
 // Direct+specular and indirect diffuse are accumulated separately (the indirect one is
 // shared between the eyes later); each carries its own 8-bit sample count in .w.
 #extension GL_GOOGLE_include_directive : require
@@ -69,17 +71,23 @@ void main() {
   vec4 hd = vec4(0.0), hi = vec4(0.0);
   uvec4 idx = uvec4(0u);
   vec4 w = vec4(0.0);
-  float wsum = 0.0;
+  float confidence = 0.0;  // the history's share: valid taps, less for coarser cells
   if (pc.has_history != 0u && maps[kReconPrevious].valid != 0u) {
+    ReconGrid prev = maps[kReconPrevious];
     vec2 uv;
-    if (rg_world_to_grid(maps[kReconPrevious], p, sky, uv)) {
-      rg_taps(maps[kReconPrevious], uv, idx, w);
+    if (rg_world_to_grid(prev, p, sky, uv)) {
+      uint col = i % cur.g.padded_columns;
+      rg_taps(prev, rg_unjitter(cur, col, prev, uv), idx, w);
+      float own = rg_cell_size(cur, col), valid = 0.0, kept = 0.0;
       for (int k = 0; k < 4; ++k) {
         if (w[k] <= 0.0 || !rg_tap_valid(here, n, depth, prev_pos[idx[k]], prev_nrm[idx[k]].xyz)) w[k] = 0.0;
-        wsum += w[k];
+        valid += w[k];
+        w[k] *= rg_coarse_weight(prev, idx[k], own);
+        kept += w[k];
       }
-      if (wsum > 1e-4) {
-        w /= wsum;
+      if (kept > 1e-4) {
+        confidence = kept / valid;
+        w /= kept;
         for (int k = 0; k < 4; ++k) {
           hd += w[k] * prev_direct[idx[k]];
           hi += w[k] * prev_indirect[idx[k]];
@@ -91,7 +99,10 @@ void main() {
   }
   tap_idx[i] = idx;
   tap_w[i] = w;
-  // Counts are fetched with the same weights and rounded (BMFR §3.2).
+  // Counts are fetched with the same weights and rounded (BMFR §3.2); a partly coarse
+  // history counts for its share only, which raises α.
+  hd.w *= confidence;
+  hi.w *= confidence;
   float nd = min(round(hd.w) + 1.0, 255.0);
   float ad = max(1.0 / nd, pc.alpha_min);
   acc_direct[i] = vec4(mix(hd.rgb, direct[i].rgb, ad), nd);

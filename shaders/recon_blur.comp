@@ -1,8 +1,9 @@
 #version 460
-// Peripheral blur (P5 §3.5): one pass of a separable Gaussian on the display whose σ is zero
-// in the fovea and rises linearly with eccentricity, specified in degrees (σ_deg = slope ·
-// max(e − e_fovea, 0)) and converted to pixels with the local pixel density, so one setting
-// carries across displays. Weights renormalise at the raster's border.
+// Peripheral blur (P5 §3.5): one pass of a separable Gaussian on the display whose σ follows
+// the acuity model: σ(e) = σ_fovea / m(e) degrees (reconstruct::blur_sigma_deg; m of P4
+// Eq. 1 as core::acuity::m), converted to pixels with the local pixel density along the pass
+// direction, so it carries across displays. Pixels whose σ is below min_sigma_px are copied.
+// Weights renormalise at the raster's border.
 #extension GL_GOOGLE_include_directive : require
 
 layout(local_size_x = 8, local_size_y = 8) in;
@@ -27,14 +28,19 @@ void main() {
   vec2 px = vec2(p) + 0.5;
   vec3 d = rg_pixel_to_dir(m, px);
   vec3 g = rg_gaze(m);
+  uint i = p.y * pc.width + p.x;
+  if (dot(d, g) > pc.cos_skip) {  // near the gaze: σ < min_sigma_px on any pixel of this raster
+    dst[i] = src[i];
+    return;
+  }
   float e = atan(length(cross(d, g)), dot(d, g)) * (180.0 / kRgPi);
   // Local pixels per degree along the pass direction: finite difference of the angle.
   vec2 step_px = pc.vertical != 0u ? vec2(0.0, 1.0) : vec2(1.0, 0.0);
   vec3 d1 = rg_pixel_to_dir(m, px + step_px);
   float deg_per_px = atan(length(cross(d, d1)), dot(d, d1)) * (180.0 / kRgPi);
-  float sigma = min(pc.sigma_deg_per_deg * max(e - pc.fovea_deg, 0.0) / max(deg_per_px, 1e-6), pc.max_sigma_px);
-  uint i = p.y * pc.width + p.x;
-  if (sigma < 0.05) {
+  float acuity = e <= 5.79 ? 1.0 : 7.49 / ((0.3 * e + 1.0) * (0.3 * e + 1.0));
+  float sigma = min(pc.sigma_fovea_deg / acuity / max(deg_per_px, 1e-6), pc.max_sigma_px);
+  if (sigma < pc.min_sigma_px) {
     dst[i] = src[i];
     return;
   }

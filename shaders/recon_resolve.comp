@@ -2,7 +2,8 @@
 // Resolve to the display (P5 §3.4): every display pixel computes its grid coordinate through
 // the current mapping and samples the grid — trilinear over the φ-only mip chain (bilinear
 // in ρ between the two columns, each with its own row count; φ wraps, ρ clamps). The level
-// comes from the pixel's footprint along φ measured in rows of its column.
+// comes from the pixel's footprint along φ measured in rows of its column (analytic: one grid
+// coordinate per pixel instead of three finite-difference ones).
 #extension GL_GOOGLE_include_directive : require
 
 layout(local_size_x = 8, local_size_y = 8) in;
@@ -53,6 +54,22 @@ vec4 fetch_level(ReconGrid m, vec2 uv, uint level) {
   return acc;
 }
 
+// Footprint of the pixel along φ in rows of column c (the LOD's argument), analytically:
+// a pixel of angular size δ at eccentricity r spans δ / (360° sin r) of the circle (angular
+// polar), one pixel at radius r spans 1 / (2π r) (screen polar).
+float phi_footprint(ReconGrid m, vec2 px, vec2 uv) {
+  uint c = uint(clamp(int(uv.x), 0, int(m.g.columns) - 1));
+  float rows = float(rg_rows(m, c));
+  if (m.g.family == kFamilyAngularPolar) {
+    vec3 d = rg_pixel_to_dir(m, px), g = rg_gaze(m);
+    vec3 dx = rg_pixel_to_dir(m, px + vec2(1.0, 0.0)), dy = rg_pixel_to_dir(m, px + vec2(0.0, 1.0));
+    float delta = max(atan(length(cross(d, dx)), dot(d, dx)), atan(length(cross(d, dy)), dot(d, dy)));
+    return delta * rows / (2.0 * kRgPi * max(length(cross(d, g)), 1e-6));
+  }
+  float r = length(px - vec2(m.g.gaze_px_x, m.g.gaze_px_y));
+  return rows / (2.0 * kRgPi * max(r, 1e-6));
+}
+
 void main() {
   uvec2 p = gl_GlobalInvocationID.xy;
   if (p.x >= pc.width || p.y >= pc.height) return;
@@ -60,13 +77,8 @@ void main() {
   vec2 px = vec2(p) + 0.5;
   vec2 uv = coord(m, px);
   float lod = 0.0;
-  if (pc.levels > 1u && m.g.family != kFamilyCartesian) {
-    vec2 ux = coord(m, px + vec2(1.0, 0.0)), uy = coord(m, px + vec2(0.0, 1.0));
-    float dtx = fract(ux.y - uv.y + 0.5) - 0.5, dty = fract(uy.y - uv.y + 0.5) - 0.5;
-    uint c = uint(clamp(int(uv.x), 0, int(m.g.columns) - 1));
-    float footprint = max(abs(dtx), abs(dty)) * float(rg_rows(m, c));
-    lod = clamp(log2(max(footprint, 1.0)), 0.0, float(pc.levels - 1u));
-  }
+  if (pc.levels > 1u && m.g.family != kFamilyCartesian)
+    lod = clamp(log2(max(phi_footprint(m, px, uv), 1.0)), 0.0, float(pc.levels - 1u));
   uint l0 = uint(floor(lod));
   float f = lod - float(l0);
   vec4 v = fetch_level(m, uv, l0);

@@ -2,9 +2,9 @@
 // Stereo sharing of indirect diffuse (Gersthofer 2020 §3.4.2): each sample gathers the other
 // eye's accumulated indirect diffuse through its world position -> the other eye's view ->
 // the other eye's grid, bilinear over the taps that pass the same validity test as the
-// temporal reprojection, and combines it with its own, weighted by sample counts. Direct and
-// specular light are view dependent and never shared. Also writes z = direct + indirect,
-// the demodulated input of the regression.
+// temporal reprojection (jitter taken off, coarser cells down-weighted), and combines it with
+// its own, weighted by sample counts. Direct and specular light are view dependent and never
+// shared. Also writes z = direct + indirect, the demodulated input of the regression.
 #extension GL_GOOGLE_include_directive : require
 
 layout(local_size_x = 64) in;
@@ -47,12 +47,15 @@ void main() {
     if (rg_world_to_grid(other, here.xyz, sky, uv)) {
       uvec4 idx;
       vec4 w;
-      rg_taps(other, uv, idx, w);
+      ReconGrid cur = maps[kReconCurrent];
+      uint col = i % cur.g.padded_columns;
+      rg_taps(other, rg_unjitter(cur, col, other, uv), idx, w);
       vec4 n = vnrm[i];
-      float wsum = 0.0;
+      float wsum = 0.0, own_size = rg_cell_size(cur, col);
       vec4 acc = vec4(0.0);
       for (int k = 0; k < 4; ++k) {
         if (w[k] <= 0.0 || !rg_tap_valid(here, n.xyz, n.w, other_pos[idx[k]], other_nrm[idx[k]].xyz)) continue;
+        w[k] *= rg_coarse_weight(other, idx[k], own_size);
         acc += w[k] * other_indirect[idx[k]];
         wsum += w[k];
       }

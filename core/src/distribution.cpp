@@ -36,6 +36,12 @@ DistributionKind parse_distribution(std::string_view s) {
   throw InputError("distribution: unknown \"" + std::string(s) + "\" (expected " + all + ")");
 }
 
+bool parse_jitter(std::string_view s) {
+  if (s == "on") return true;
+  if (s == "off") return false;
+  throw InputError("--jitter: unknown \"" + std::string(s) + "\" (expected on|off)");
+}
+
 const char* distribution_name(DistributionKind k) {
   for (const auto& n : kNames)
     if (n.kind == k) return n.name;

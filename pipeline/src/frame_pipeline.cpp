@@ -24,6 +24,18 @@ double lap_ms(core::TimeNs& t0) {
   return ms;
 }
 
+// The raster's largest pixels per degree (a rectilinear raster's pixels subtend the least
+// at its corners; the centre is checked too), along x and y.
+double max_pixels_per_deg(const core::View& v) {
+  double best = 0;
+  const double w = v.width(), h = v.height();
+  for (const glm::dvec2 c : {glm::dvec2(0.5, 0.5), glm::dvec2(w - 1.5, 0.5), glm::dvec2(0.5, h - 1.5),
+                             glm::dvec2(w - 1.5, h - 1.5), glm::dvec2(0.5 * w, 0.5 * h)})
+    for (const glm::dvec2 step : {glm::dvec2(1, 0), glm::dvec2(0, 1)})
+      best = std::max(best, 1.0 / std::max(core::angle_deg(v.pixel_to_dir(c), v.pixel_to_dir(c + step)), 1e-9));
+  return best;
+}
+
 std::unique_ptr<EyeState> make_eye(gpu::Context& ctx, renderer::PathTracer& tracer, core::Eye eye,
                                    const core::View& view, const core::DistributionParams& dp) {
   auto e = std::make_unique<EyeState>();
@@ -88,6 +100,7 @@ FramePipeline::FramePipeline(gpu::Context& ctx, const renderer::GpuScene& scene,
                      .polar = e->dist->gpu_params().family != shaders::kFamilyCartesian,
                      .width = std::uint32_t(e->base_view.width()),
                      .height = std::uint32_t(e->base_view.height()),
+                     .max_pixels_per_deg = max_pixels_per_deg(e->base_view),
                      .maps = &e->mapping->maps(),
                      .tables = &e->mapping->tables(),
                      .samples = &e->grid,
@@ -174,8 +187,13 @@ FrameTimes FramePipeline::render(const std::array<core::Pose, 2>& eye_pose, cons
     for (std::size_t i = 0; i < m.eyes.size(); ++i) finals.push_back(&m.post->final_color(int(i), p));
     m.resolve->record_copy(cmd, finals);
     m.resolve->record_depth(cmd, p);
-    m.resolve->record_resolve(cmd, m.settings.blur, m.settings);
     m.timer.stage(cmd, "resolve");
+    m.resolve->record_mips(cmd);
+    m.timer.stage(cmd, "mip");
+    m.resolve->record_resample(cmd);
+    m.timer.stage(cmd, "resample");
+    if (m.settings.blur) m.resolve->record_blur(cmd, m.settings);
+    m.timer.stage(cmd, "blur");
     t.resolve.cpu_ms = lap_ms(r0);
     recording_ms = core::ns_to_ms(r0 - start);
   });
@@ -190,9 +208,12 @@ FrameTimes FramePipeline::render(const std::array<core::Pose, 2>& eye_pose, cons
       const double ms = double(s.duration_ns()) * 1e-6;
       if (s.name == "grid") t.grid.gpu_ms += ms;
       else if (s.name == "trace") t.trace.gpu_ms += ms;
-      else if (s.name == "resolve") t.resolve.gpu_ms += ms;
+      else if (s.name == "resolve" || s.name == "mip" || s.name == "resample" || s.name == "blur") t.resolve.gpu_ms += ms;
       else t.reconstruct.gpu_ms += ms;
       if (s.name == "bmfr_fit") t.bmfr_fit_gpu_ms = ms;
+      if (s.name == "mip") t.mip_gpu_ms = ms;
+      if (s.name == "resample") t.resample_gpu_ms = ms;
+      if (s.name == "blur") t.blur_gpu_ms = ms;
     }
   }
   return t;

@@ -46,4 +46,16 @@ core::Image resolve_grid(FramePipeline& pipeline, core::Eye eye, const std::vect
   return pipeline.image(eye);
 }
 
+core::Image blur_image(FramePipeline& pipeline, core::Eye eye, const core::Image& image) {
+  auto& m = Access::impl(pipeline);
+  const int i = m.index(eye, "blur_image");
+  const core::View& v = m.eyes[std::size_t(i)]->base_view;
+  if (image.width != v.width() || image.height != v.height())
+    throw core::InputError("blur_image: the image's size differs from the eye's raster");
+  m.write_mappings();
+  m.resolve->screen(i).upload(image.pixels);
+  m.ctx.submit_and_wait([&](VkCommandBuffer cmd) { m.resolve->record_blur(cmd, m.settings); });
+  return pipeline.image(eye);
+}
+
 }  // namespace fovea::pipeline::testing

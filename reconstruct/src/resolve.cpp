@@ -1,6 +1,8 @@
 // Resolve to the display (shaders/recon_mip.comp, recon_resolve.comp, recon_blur.comp) and
 // the display-space depth (recon_depth.comp).
 #include <algorithm>
+#include <cmath>
+#include <numbers>
 
 #include "bindings.hpp"
 #include "buffers.hpp"
@@ -12,7 +14,20 @@ namespace fovea::reconstruct {
 
 namespace {
 constexpr std::uint32_t kMaxMipLevels = 12;
+
+// cos of the eccentricity within which no pixel of a raster of at most `ppd` pixels/degree
+// gets a kernel of min_sigma_px or more (σ grows with e): the blur copies those pixels
+// after one dot product.
+float blur_skip_cos(const ReconSettings& s, double ppd) {
+  double lo = 0, hi = 180;
+  if (blur_sigma_deg(0, s.blur_mar_fovea_deg) * ppd >= s.blur_min_sigma_px) return 2.0f;  // nothing skipped
+  for (int i = 0; i < 40; ++i) {
+    const double mid = 0.5 * (lo + hi);
+    (blur_sigma_deg(mid, s.blur_mar_fovea_deg) * ppd < s.blur_min_sigma_px ? lo : hi) = mid;
+  }
+  return float(std::cos(lo * std::numbers::pi / 180));
 }
+}  // namespace
 
 Resolve::Resolve(gpu::Context& ctx, std::span<const EyeGrid> eyes, const Accumulation& acc)
     : mip_(kernel<MipBindings, shaders::ReconMipPush>(ctx, "recon_mip.comp.spv")),
@@ -27,6 +42,7 @@ Resolve::Resolve(gpu::Context& ctx, std::span<const EyeGrid> eyes, const Accumul
     e.width = g.width;
     e.height = g.height;
     e.padded_columns = g.padded_columns;
+    e.max_pixels_per_deg = g.max_pixels_per_deg;
     // φ-only mip chain (polar grids): level l has ceil(rows / 2^l) rows.
     std::uint32_t rows = g.padded_rows, offset = 0;
     do {
@@ -70,6 +86,12 @@ void Resolve::record_depth(VkCommandBuffer cmd, int parity) const {
 }
 
 void Resolve::record_resolve(VkCommandBuffer cmd, bool blur, const ReconSettings& s) const {
+  record_mips(cmd);
+  record_resample(cmd);
+  if (blur) record_blur(cmd, s);
+}
+
+void Resolve::record_mips(VkCommandBuffer cmd) const {
   for (std::uint32_t l = 0; l + 1 < max_levels(); ++l) {
     for (const Eye& e : eyes_) {
       if (l + 1 >= e.levels) continue;
@@ -79,15 +101,20 @@ void Resolve::record_resolve(VkCommandBuffer cmd, bool blur, const ReconSettings
     }
     gpu::compute_to_compute(cmd);
   }
+}
+
+void Resolve::record_resample(VkCommandBuffer cmd) const {
   for (const Eye& e : eyes_)
     resolve_.run(cmd, {&e.resolve_set}, shaders::ReconResolvePush{e.width, e.height, e.levels, 0}, e.width, e.height);
   gpu::compute_to_compute(cmd);
-  if (!blur) return;
+}
+
+void Resolve::record_blur(VkCommandBuffer cmd, const ReconSettings& s) const {
   for (int pass = 0; pass < 2; ++pass) {
     for (const Eye& e : eyes_) {
-      const shaders::ReconBlurPush push{e.width, e.height, std::uint32_t(pass), 0, float(s.blur_fovea_deg),
-                                        float(s.blur_sigma_deg_at_30 / (30.0 - s.blur_fovea_deg)),
-                                        float(s.blur_max_sigma_px), 0};
+      const shaders::ReconBlurPush push{e.width, e.height, std::uint32_t(pass), 0,
+                                        float(blur_sigma_deg(0.0, s.blur_mar_fovea_deg)), float(s.blur_min_sigma_px),
+                                        float(s.blur_max_sigma_px), blur_skip_cos(s, e.max_pixels_per_deg)};
       blur_.run(cmd, {pass == 0 ? &e.blur_h : &e.blur_v}, push, e.width, e.height);
     }
     gpu::compute_to_compute(cmd);

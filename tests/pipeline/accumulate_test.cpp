@@ -22,8 +22,13 @@ TEST_F(GpuTest, AccumulationKeepsAStaticSceneStableWhileTheGazeSweeps) {
   reconstruct::ReconSettings s;
   s.denoiser = reconstruct::Denoiser::None;
   s.blur = false;
-  pipeline::FramePipeline with(ctx(), gs, core::stereo_views(display), {}, s, {}, true);
-  pipeline::FramePipeline without(ctx(), gs, core::stereo_views(display), {}, s, {}, true);
+  // Jitter off: this measures the moving grid's resampling alone. With the default jitter the
+  // frames also differ at edges by the sub-cell offsets (no TAA with denoiser none), with and
+  // without history alike: the ratio below was 0.67 then.
+  core::DistributionParams dp;
+  dp.jitter = false;
+  pipeline::FramePipeline with(ctx(), gs, core::stereo_views(display), dp, s, {}, true);
+  pipeline::FramePipeline without(ctx(), gs, core::stereo_views(display), dp, s, {}, true);
   const auto poses = core::eye_poses(scene.camera, display.ipd_m);
   const int frames = 12;
   double te_with = 0, te_without = 0;
@@ -47,6 +52,7 @@ TEST_F(GpuTest, AccumulationKeepsAStaticSceneStableWhileTheGazeSweeps) {
     if (samples[i].flags == 0) count += acc[i].w, ++n;
   std::printf("temporal error %.5f with history, %.5f without; mean count %.2f\n", te_with / (frames - 1),
               te_without / (frames - 1), count / double(n));
-  EXPECT_GT(count / double(n), 0.6 * frames);
+  // Smooth pursuit (2.7°/frame) keeps its history through the cell-size test (measured 12.00).
+  EXPECT_GT(count / double(n), 0.9 * frames);
   EXPECT_LT(te_with, 0.65 * te_without);  // measured 0.54: EMA noise floor plus resampling of the moving grid
 }

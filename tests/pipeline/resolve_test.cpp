@@ -88,12 +88,3 @@ TEST_F(Resolve, RoundTripWithinHalfDecibelOfTheBudgetLimitedIdeal) {
   std::printf("round trip %.2f dB, ideal %.2f dB\n", got, best);
   EXPECT_GE(got, best - 0.5);
 }
-
-TEST_F(Resolve, BlurDefaultMatchesP5OnTheFove0Panel) {
-  // 0.544° at 30° is 6.8 px where the FOVE 0 panel has 12.5 px/° horizontally.
-  const core::View v = core::load_display("fove0").view(core::Eye::Left);
-  const glm::dvec3 d30 = glm::normalize(glm::dvec3(std::tan(30 * M_PI / 180), 0, -1));
-  const glm::dvec2 px = *v.dir_to_pixel(d30);
-  const double deg_per_px = core::angle_deg(v.pixel_to_dir(px), v.pixel_to_dir(px + glm::dvec2(1, 0)));
-  EXPECT_NEAR(reconstruct::kBlurSigmaDegAt30 / deg_per_px, 6.8, 0.1);
-}

@@ -50,7 +50,7 @@ the peripheral blur. Writes to --out:
                 and CPU ms per stage
   report.json   {"frames", "samples_traced_per_eye", "samples_hidden": {"left", "right"},
                  "device": {name, driver}, "trace": "rayquery" or "compute",
-                 "gpu_ms": {grid, trace, reconstruct, resolve, total, bmfr_fit},
+                 "gpu_ms": {grid, trace, reconstruct, resolve, total, bmfr_fit, mip, resample, blur},
                  "cpu_ms": {gaze, grid, trace, reconstruct, resolve, submit, readback, total}
                  (medians per frame), "summary": {"left": {...}, "right": {...}}}
 Cells that the preset's lens hides (its hidden area, seen from the view) are neither traced
@@ -73,6 +73,7 @@ temporal_error (always). With no options: a short demo on the shipped scene and 
   --distribution D      visual-polar | paper-visual-polar | cartesian | cartesian-uniform |
                         log-polar [visual-polar]
   --budget B            grid samples as a fraction of display pixels [0.39]
+  --jitter on|off       per-frame sub-cell jitter (Halton 2, 3) of every grid [on]
   --denoiser D          bmfr | none (accumulation only) [bmfr]
   --bmfr-precision P    fp32 | fp16: storage of BMFR's regression matrix [fp32]
   --stereo-share M      off | gather | alternate [off]
@@ -142,8 +143,8 @@ int run(std::vector<std::string> argv) {
       return 0;
     }
   const Args args(argv,
-                  {"scene", "display", "gaze", "frames", "distribution", "budget", "denoiser", "bmfr-precision", "stereo-share",
-                   "reference", "png-every", "out", "screen", "trace"},
+                  {"scene", "display", "gaze", "frames", "distribution", "budget", "jitter", "denoiser", "bmfr-precision",
+                   "stereo-share", "reference", "png-every", "out", "screen", "trace"},
                   {"no-blur", "no-cull", "no-marker", "quiet"});
   const long frames = args.integer("frames", 24);
   if (frames < 1 || frames > 100000) throw core::InputError("--frames must be in 1..100000");
@@ -155,6 +156,7 @@ int run(std::vector<std::string> argv) {
   core::DistributionParams dp;
   dp.kind = core::parse_distribution(args.str("distribution", "visual-polar"));
   dp.budget = args.num("budget", dp.budget);
+  dp.jitter = core::parse_jitter(args.str("jitter", "on"));
   dp.validate();
   reconstruct::ReconSettings settings;
   settings.denoiser = reconstruct::parse_denoiser(args.str("denoiser", "bmfr"));
@@ -220,6 +222,9 @@ int run(std::vector<std::string> argv) {
     }
     gpu_ms["total"].push_back(t.gpu_ms());
     gpu_ms["bmfr_fit"].push_back(t.bmfr_fit_gpu_ms);
+    gpu_ms["mip"].push_back(t.mip_gpu_ms);
+    gpu_ms["resample"].push_back(t.resample_gpu_ms);
+    gpu_ms["blur"].push_back(t.blur_gpu_ms);
     cpu_ms["submit"].push_back(t.submit_cpu_ms);
     t0 = core::now_ns();
     for (int e = 0; e < 2; ++e) last[e] = pipeline.image(core::Eye(e));

@@ -32,6 +32,7 @@ namespace fovea::core {
 enum class DistributionKind { VisualPolar, PaperVisualPolar, Cartesian, CartesianUniform, LinearFalloff, LogPolar };
 
 DistributionKind parse_distribution(std::string_view name);  // InputError on unknown names
+bool parse_jitter(std::string_view s);                       // --jitter: "on" | "off", else InputError
 const char* distribution_name(DistributionKind k);
 
 struct DistributionParams {
@@ -45,6 +46,7 @@ struct DistributionParams {
   double falloff_fovea_deg = 10, falloff_periphery_deg = 20, falloff_min_p = 0.2;  // Weier 2016
   double logpolar_sigma = 1.8, logpolar_alpha = 4.0;                              // Meng 2018
   std::uint32_t seed = 0;    // random killing (linear fall-off)
+  bool jitter = true;        // per-frame Halton (2, 3) sub-cell offset (anti-aliasing over frames)
 
   void validate() const;     // InputError naming the parameter
 };
@@ -99,7 +101,7 @@ class SampleDistribution {
   const std::vector<shaders::GridColumn>& column_table() const { return table_; }
 
  protected:
-  SampleDistribution(const View& view, const DistributionParams& p) : view_(view), params_(p) {}
+  SampleDistribution(const View& view, const DistributionParams& p) : view_(view), params_(p), jitter_(p.jitter) {}
   // Continuous grid position (cell centre + jitter) -> unit direction and display position.
   virtual void map(glm::dvec2 grid, int column, glm::dvec3& dir, glm::dvec2& px) const = 0;
   virtual void on_frame() = 0;                    // rebuild per-frame state after the gaze moved
@@ -115,7 +117,7 @@ class SampleDistribution {
   glm::dvec3 last_valid_gaze_{0, 0, -1};
   bool has_valid_gaze_ = false;
   std::uint32_t frame_ = 0;
-  bool jitter_ = false;
+  bool jitter_ = true;
   std::function<bool(glm::dvec2)> visible_;
   std::vector<shaders::GridColumn> table_;  // polar kinds: per column radius range and rows
 };

@@ -34,6 +34,7 @@ struct FrameTimes {
   StageTime reconstruct;  // CPU: grid mappings and recording; GPU: accumulation, sharing, BMFR, post, TAA
   StageTime resolve;      // CPU: recording; GPU: mips, resolve, depth, blur
   double bmfr_fit_gpu_ms = 0;  // part of reconstruct: the regression alone
+  double mip_gpu_ms = 0, resample_gpu_ms = 0, blur_gpu_ms = 0;  // parts of resolve: its three kernels
   double submit_cpu_ms = 0;    // the submission until the GPU finished
   double gpu_ms() const { return grid.gpu_ms + trace.gpu_ms + reconstruct.gpu_ms + resolve.gpu_ms; }
   double cpu_ms() const { return grid.cpu_ms + trace.cpu_ms + reconstruct.cpu_ms + resolve.cpu_ms + submit_cpu_ms; }

@@ -34,4 +34,8 @@ void fill_buffers(FramePipeline& p, std::uint32_t word);
 // with eye `e`'s current mapping, optionally blurred; for round-trip tests.
 core::Image resolve_grid(FramePipeline& p, core::Eye e, const std::vector<glm::vec4>& grid, bool blur);
 
+// Runs only the peripheral blur on a display image (the eye's raster) with eye `e`'s current
+// mapping; for measuring the kernel.
+core::Image blur_image(FramePipeline& p, core::Eye e, const core::Image& image);
+
 }  // namespace fovea::pipeline::testing

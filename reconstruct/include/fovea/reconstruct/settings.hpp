@@ -17,9 +17,13 @@ StereoShare parse_stereo_share(std::string_view s);  // "off" | "gather" | "alte
 const char* denoiser_name(Denoiser d);
 const char* stereo_share_name(StereoShare s);
 
-// P5 §3.5: σ = 6.8 px at 30° on the FOVE 0 panel (1280×1440, 100° wide), whose horizontal
-// density at 30° is 12.5 px/° (f·sec²30° with f = 640 / tan 50° px): 6.8 / 12.5 = 0.544°.
-constexpr double kBlurSigmaDegAt30 = 0.544;
+// Peripheral blur from the acuity model (docs/reconstruction.md): the minimum angle of
+// resolution MAR(e) = MAR₀ / m(e) (core::acuity::m, P4 Eq. 1; MAR₀ = 1 arcmin, 20/20 vision)
+// and a Gaussian whose MTF exp(−2π²σ²f²) is 1/2 at f = 1/MAR(e) cycles per degree:
+// σ(e) = √(ln 2 / 2) / π · MAR(e) ≈ 0.187 MAR(e), 0.042° at 30°. Gratings the eye resolves
+// (f ≤ 1/(2 MAR)) keep at least 84% of their contrast.
+constexpr double kMarFoveaDeg = 1.0 / 60.0;
+double blur_sigma_deg(double e_deg, double mar_fovea_deg = kMarFoveaDeg);
 
 struct ReconSettings {
   Denoiser denoiser = Denoiser::Bmfr;
@@ -31,8 +35,8 @@ struct ReconSettings {
   float noise = 0.01f;           // stochastic regularisation ε (BMFR Eq. 7)
   bool block_offsets = true;     // 16 static block-grid displacements
   bool blur = true;              // peripheral blur
-  double blur_fovea_deg = 5.79;  // blur starts at the acuity plateau's edge
-  double blur_sigma_deg_at_30 = kBlurSigmaDegAt30;
+  double blur_mar_fovea_deg = kMarFoveaDeg;  // MAR₀ of blur_sigma_deg
+  double blur_min_sigma_px = 0.5;            // narrower kernels leave the pixel as it is (sub-pixel: ±1 px weighs ≤ 11%)
   double blur_max_sigma_px = 16;
 };
 

@@ -25,6 +25,7 @@ struct EyeGrid {
   std::uint32_t cells = 0, columns = 0, padded_columns = 0, padded_rows = 0;
   bool polar = true;                   // φ-only mip chain (polar grids) or one level
   std::uint32_t width = 0, height = 0;  // the display raster the grid resolves to
+  double max_pixels_per_deg = 0;        // the raster's densest pixels (bounds the blur's reach)
   const gpu::Buffer* maps = nullptr;    // GridMapping::maps(), tables()
   const gpu::Buffer* tables = nullptr;
   // The path tracer's per-cell outputs (renderer::TraceOutputs) and the grid itself.
@@ -123,17 +124,23 @@ class Resolve {
   void record_copy(VkCommandBuffer cmd, std::span<const gpu::Buffer* const> grid_images) const;
   // Depth of the nearest sample per display pixel from the positions of `parity`.
   void record_depth(VkCommandBuffer cmd, int parity) const;
-  // Mips from level 0, resolve, optional blur: into the screen buffers.
+  // Mips from level 0, resolve, optional blur: into the screen buffers. The three kernels
+  // are also recorded one by one (per-kernel timestamps between them).
   void record_resolve(VkCommandBuffer cmd, bool blur, const ReconSettings& settings) const;
+  void record_mips(VkCommandBuffer cmd) const;
+  void record_resample(VkCommandBuffer cmd) const;
+  void record_blur(VkCommandBuffer cmd, const ReconSettings& settings) const;
   void fill(VkCommandBuffer cmd, std::uint32_t word) const;
 
   gpu::Buffer& level0(int eye) { return eyes_[eye].mips; }  // for a given grid image
   const gpu::Buffer& screen(int eye) const { return eyes_[eye].screen_a; }
+  gpu::Buffer& screen(int eye) { return eyes_[eye].screen_a; }  // for a given display image
   const gpu::Buffer& depth(int eye) const { return eyes_[eye].depth; }
 
  private:
   struct Eye {
     std::uint32_t cells = 0, width = 0, height = 0, padded_columns = 0, levels = 1;
+    double max_pixels_per_deg = 0;
     std::vector<std::uint32_t> level_rows, level_offset;
     gpu::Buffer mips, offsets, screen_a, screen_b, depth;
     gpu::DescriptorSet mip_set, resolve_set, blur_h, blur_v, depth_set[2];

@@ -34,6 +34,11 @@ FOVEA_CONST FOVEA_UINT kReconOther = 2u;
 FOVEA_CONST float kReconNormalLimit2 = 0.25f;
 FOVEA_CONST float kReconPlaneTol = 0.03f;
 FOVEA_CONST float kReconDistTol = 0.25f;  // and |Δp| < this·depth (other surfaces far along the plane)
+// Cell-size awareness: a tap from a cell up to kReconCoarseKeep times the sample's cell size
+// (linear) counts fully, beyond that less, and not at all from kReconCoarseReject on. Smooth
+// pursuit changes sizes by < 1.25 per frame at 2.5°/frame; a saccade by far more.
+FOVEA_CONST float kReconCoarseKeep = 1.25f;
+FOVEA_CONST float kReconCoarseReject = 2.0f;
 
 // Material codes in the validation data (.w of the position): >= 0 a surface, -1 the sky
 // (position = direction), -2 no sample, <= -3 an emitter (−3 − material): emission is not
@@ -74,7 +79,7 @@ struct ReconResolvePush {
 
 struct ReconBlurPush {
   FOVEA_UINT width, height, vertical, pad0;
-  float fovea_deg, sigma_deg_per_deg, max_sigma_px, pad1;  // σ(e) = slope·max(e − fovea, 0) degrees
+  float sigma_fovea_deg, min_sigma_px, max_sigma_px, cos_skip;  // σ(e) = σ_fovea / m(e) degrees; cos e > cos_skip: σ < min
 };
 
 #ifdef __cplusplus

@@ -110,6 +110,36 @@ void rg_taps(ReconGrid m, vec2 uv, out uvec4 idx, out vec4 w) {
   }
 }
 
+// Where the centre of the current frame's cell `col` lies in mapping m, given the grid
+// coordinate uv in m of the cell's (jittered) sample: the current jitter (cells of `cur`) is
+// taken off, so taps read cells whose accumulated content stands for their centres (TAA's
+// unjittered reprojection). Exact when m shares cur's gaze (a still gaze, the other eye);
+// under gaze motion the offset (≤ half a cell) is applied in m's cells.
+vec2 rg_unjitter(ReconGrid cur, uint col, ReconGrid m, vec2 uv) {
+  float t = uv.y - cur.g.jitter_v / float(max(rg_rows(cur, col), 1u));
+  return vec2(uv.x - cur.g.jitter_u, m.g.family != kFamilyCartesian ? fract(t) : t);
+}
+
+// Linear size of a cell of column c: the square root of its area in the family's radius
+// units (degrees of visual angle for angular polar, pixels for screen polar); 1 for the
+// Cartesian raster, whose cells never change size.
+float rg_cell_size(ReconGrid m, uint c) {
+  if (m.g.family == kFamilyCartesian) return 1.0;
+  GridColumn col = tables[m.table_offset + min(c, m.g.columns - 1u)];
+  float rm = 0.5 * (col.r0 + col.r1);
+  float circumference = m.g.family == kFamilyAngularPolar ? 360.0 * sin(rm * (kRgPi / 180.0)) : 2.0 * kRgPi * rm;
+  return sqrt(max((col.r1 - col.r0) * circumference / float(max(col.rows, 1u)), 0.0));
+}
+
+// Weight of a tap whose cell (index `tap` of mapping m) is `ratio` = its size / the sample's
+// own cell size: 1 up to kReconCoarseKeep, falling linearly to 0 at kReconCoarseReject. A
+// coarser cell holds a blurred estimate (after a saccade the new fovea lands on old
+// periphery); reusing it would keep the fovea blurred for many frames.
+float rg_coarse_weight(ReconGrid m, uint tap, float own_size) {
+  float ratio = rg_cell_size(m, tap % m.g.padded_columns) / max(own_size, 1e-12);
+  return clamp((kReconCoarseReject - ratio) / (kReconCoarseReject - kReconCoarseKeep), 0.0, 1.0);
+}
+
 // Tap validity (see kRecon* above). vpos: xyz world position (sky: world direction),
 // w material (-1 sky, kReconNoSample none); n: unit normal; depth: the sample's distance.
 bool rg_tap_valid(vec4 vpos, vec3 n, float depth, vec4 tap_pos, vec3 tap_n) {
