@@ -78,6 +78,10 @@ TEST(SweepPlan, ReferencesAreSharedPerSceneAndDisplay) {
     ASSERT_NE(s, nullptr);
     EXPECT_EQ(s->settings["scene"], j.settings["scene"]);
     EXPECT_EQ(s->settings["spp"], 16);
+    // The job loads the shared reference instead of rendering one.
+    const auto ref = std::find(j.argv.begin(), j.argv.end(), "--reference");
+    ASSERT_NE(ref, j.argv.end());
+    EXPECT_EQ(*(ref + 1), s->out);
     ++users[s->id];
   }
   for (const auto& s : p.shared) {
