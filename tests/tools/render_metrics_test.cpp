@@ -180,4 +180,23 @@ TEST(SweepSharedReference, TwoJobsOnOneSceneRenderTheReferenceOnce) {
   fs::remove_all(dir);
 }
 
+// Budgets the distribution cannot meet exit 2 naming what it reaches; linear fall-off renders
+// and traces its budget.
+TEST(RenderBudget, RefusedBudgetsExitTwoAndLinearFalloffRenders) {
+  const std::string dir = fovea::test::temp_dir("budget");
+  for (const auto& [args, says] : {std::pair{"--distribution visual-polar --budget 0.9", "reaches at most"},
+                                   std::pair{"--distribution linear-falloff --budget 0.05", "reaches no less than"},
+                                   std::pair{"--distribution cartesian --budget 0.5", "cartesian-uniform"}}) {
+    const auto r = run_fovea(std::string("render --display tiny --frames 1 --quiet ") + args + " --out " + dir + "/x");
+    EXPECT_EQ(r.status, 2) << args;
+    EXPECT_NE(r.err.find(says), std::string::npos) << args << ": " << r.err;
+  }
+  const json j = render("--frames 1 --gaze synthetic:3 --distribution linear-falloff --budget 0.5", dir + "/lf");
+  EXPECT_EQ(j["config"]["distribution"], "linear-falloff");
+  // Traced: the kept cells minus the lens' hidden ones, so at most the budget (+5%).
+  EXPECT_LT(j["samples_traced_per_eye"].get<double>(), 1.05 * 0.5 * 64 * 72);
+  EXPECT_GT(j["samples_traced_per_eye"].get<double>(), 0.3 * 64 * 72);
+  fs::remove_all(dir);
+}
+
 }  // namespace

@@ -75,8 +75,10 @@ With no options: a short demo on the shipped scene and gaze.
                         WxH@SWxSHmm@Dmm (as the URI key screen=; docs/gaze.md)
   --frames N            frames to render [24]
   --distribution D      visual-polar | paper-visual-polar | cartesian | cartesian-uniform |
-                        log-polar [visual-polar]
-  --budget B            grid samples as a fraction of display pixels [0.39]
+                        linear-falloff | log-polar [visual-polar]
+  --budget B            grid samples as a fraction of display pixels, met within 5% or
+                        refused with exit 2 naming what the distribution reaches
+                        (cartesian: 1 only) [0.39]
   --denoiser D          bmfr | none (accumulation only) [bmfr]
   --bmfr-precision P    fp32 | fp16: storage of BMFR's regression matrix [fp32]
   --stereo-share M      off | gather | alternate [gather]
@@ -233,6 +235,13 @@ int run(std::vector<std::string> argv) {
   core::DistributionParams dp;
   dp.kind = core::parse_distribution(args.str("distribution", "visual-polar"));
   dp.budget = args.num("budget", dp.budget);
+  // Cartesian traces every pixel: a smaller budget is cartesian-uniform's job.
+  if (dp.kind == core::DistributionKind::Cartesian) {
+    if (args.has("budget") && dp.budget != 1.0)
+      throw core::InputError("--budget: cartesian traces every pixel (budget 1); use cartesian-uniform for " +
+                             args.str("budget", "") + " of the pixels");
+    dp.budget = 1.0;
+  }
   dp.validate();
   reconstruct::ReconSettings settings;
   settings.denoiser = reconstruct::parse_denoiser(args.str("denoiser", "bmfr"));
