@@ -143,7 +143,28 @@ std::string settings_id(const json& settings) {
 }
 
 Plan expand_sweep(const json& sweep, const std::string& source, const std::vector<RenderOption>& options) {
-  if (!sweep.is_object()) throw InputError(source + ": a sweep file is a JSON object");
+  // A list of sweeps is their union (settings that only make sense together, e.g. budgets
+  // for the foveated distributions and none for cartesian): jobs in list order, a job two
+  // parts share once, the first part's report settings.
+  if (sweep.is_array()) {
+    if (sweep.empty()) throw InputError(source + ": an empty list of sweeps");
+    Plan all;
+    json report;
+    std::set<std::string> ids;
+    for (std::size_t i = 0; i < sweep.size(); ++i) {
+      Plan part = expand_sweep(sweep[i], source + "[" + std::to_string(i) + "]", options);
+      if (report.is_null() && !part.header["report"].empty()) report = part.header["report"];
+      for (auto& s : part.shared)
+        if (!all.find_shared(s.id)) all.shared.push_back(std::move(s));
+      for (auto& j : part.jobs)
+        if (ids.insert(j.id).second) all.jobs.push_back(std::move(j));
+      if (all.jobs.size() > kMaxJobs) throw InputError(source + ": more than 100000 jobs");
+    }
+    all.header = {{"type", "sweep"}, {"version", 1}, {"source", source}, {"report", report.is_null() ? json::object() : report},
+                  {"jobs", all.jobs.size()}, {"shared", all.shared.size()}};
+    return all;
+  }
+  if (!sweep.is_object()) throw InputError(source + ": a sweep file is a JSON object or a list of them");
   std::map<std::string, bool> known;  // option -> valued
   for (const auto& o : options) known[o.name] = o.valued;
   Plan plan;
