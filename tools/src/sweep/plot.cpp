@@ -99,8 +99,12 @@ core::Image draw_chart(const Chart& chart, int W, int H) {
   auto px = [&](double v) { return x0 + (x1 - x0) * (v - rx.lo) / (rx.hi - rx.lo); };
   auto py = [&](double v) { return y1 - (y1 - y0) * (v - ry.lo) / (ry.hi - ry.lo); };
 
-  draw_text(c, chart.title, (W - text_width(chart.title, 3)) / 2.0, 14, 3, kInk);
-  if (!chart.note.empty()) draw_text(c, chart.note, (W - text_width(chart.note, 2)) / 2.0, 48, 2, {0.3f, 0.3f, 0.3f, 1});
+  // Title and note shrink to the width when they would not fit.
+  const int title_scale = text_width(chart.title, 3) <= W - 20 ? 3 : 2;
+  const int note_scale = text_width(chart.note, 2) <= W - 20 ? 2 : 1;
+  draw_text(c, chart.title, (W - text_width(chart.title, title_scale)) / 2.0, 14, title_scale, kInk);
+  if (!chart.note.empty())
+    draw_text(c, chart.note, (W - text_width(chart.note, note_scale)) / 2.0, 48, note_scale, {0.3f, 0.3f, 0.3f, 1});
   const auto xt = nice_ticks(rx.lo, rx.hi, 8), yt = nice_ticks(ry.lo, ry.hi, 7);
   for (double t : xt) {
     c.line(px(t), y0, px(t), y1, {0, 0, 0, 0.08f});
