@@ -4,7 +4,10 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <numbers>
+#include <string>
+#include <vector>
 
 #include <glm/geometric.hpp>
 
@@ -61,7 +64,6 @@ void DistributionParams::validate() const {
            falloff_periphery_deg > falloff_fovea_deg,
        "linear fall-off: need 0 <= fl < pl");
   need(std::isfinite(falloff_min_p) && falloff_min_p > 0 && falloff_min_p <= 1, "linear fall-off: Pp must be in (0, 1]");
-  need(std::isfinite(logpolar_sigma) && logpolar_sigma >= 1 && logpolar_sigma <= 8, "log-polar: sigma must be in [1, 8]");
   need(std::isfinite(logpolar_alpha) && logpolar_alpha >= 1 && logpolar_alpha <= 8, "log-polar: alpha must be in [1, 8]");
 }
 
@@ -149,6 +151,13 @@ double SampleDistribution::samples_per_pixel(glm::dvec2 px) const {
   return ppc > 0 && std::isfinite(ppc) ? 1.0 / ppc : 0;
 }
 
+double SampleDistribution::grid_samples() const {
+  if (table_.empty()) return double(columns_) * rows_;
+  double n = 0;
+  for (const auto& c : table_) n += c.rows;
+  return n;
+}
+
 shaders::GridParams SampleDistribution::gpu_params() const {
   shaders::GridParams g{};
   g.columns = std::uint32_t(columns_);
@@ -198,19 +207,25 @@ class RasterDistribution final : public SampleDistribution {
     set_frame(v.centre_dir());
   }
 
-  bool invertible() const override { return params_.kind != DistributionKind::LinearFalloff; }
-
+  // Linear fall-off keeps the raster: killed cells are holes the reconstruction fills.
   std::optional<glm::dvec2> screen_to_grid(glm::dvec2 px) const override {
-    if (!invertible() || !std::isfinite(px.x) || !std::isfinite(px.y)) return std::nullopt;
+    if (!std::isfinite(px.x) || !std::isfinite(px.y)) return std::nullopt;
     return glm::dvec2(px.x * columns_ / view_.width(), px.y * rows_ / view_.height());
   }
 
-  double keep_probability(double e) const {
-    // Dissertation Eq. 4.1: 1 inside fl, linear to Pp at pl, Pp beyond.
+  // Dissertation Eq. 4.1: 1 inside fl, linear to Pp at pl, Pp beyond; fl and pl are the
+  // parameters' scaled by this frame's budget factor.
+  double keep_probability(double e, double scale) const {
     const auto& p = params_;
-    if (e <= p.falloff_fovea_deg) return 1.0;
-    if (e >= p.falloff_periphery_deg) return p.falloff_min_p;
-    return 1.0 + (e - p.falloff_fovea_deg) * (p.falloff_min_p - 1.0) / (p.falloff_periphery_deg - p.falloff_fovea_deg);
+    const double fl = scale * p.falloff_fovea_deg, pl = scale * p.falloff_periphery_deg;
+    if (e <= fl) return 1.0;
+    if (e >= pl) return p.falloff_min_p;
+    return 1.0 + (e - fl) * (p.falloff_min_p - 1.0) / (pl - fl);
+  }
+  double keep_probability(double e) const { return keep_probability(e, scale_); }
+
+  double grid_samples() const override {
+    return params_.kind == DistributionKind::LinearFalloff ? expected_kept_ : SampleDistribution::grid_samples();
   }
 
   double target_density(glm::dvec3 dir) const override {
@@ -234,7 +249,30 @@ class RasterDistribution final : public SampleDistribution {
     px = {grid.x * view_.width() / columns_, grid.y * view_.height() / rows_};
     dir = view_.pixel_to_dir(px);
   }
-  void on_frame() override {}
+  // Linear fall-off: the factor on (fl, pl) whose expected kept pixels are the budget, by
+  // bisection over the eccentricities of a subsampled raster (the mean keep probability
+  // grows with the factor, from Pp at 0 to 1 once fl passes the farthest pixel).
+  void on_frame() override {
+    if (params_.kind != DistributionKind::LinearFalloff) return;
+    const int step = std::max(1, int(std::sqrt(double(view_.width()) * view_.height() / 40000.0)));
+    std::vector<double> ecc;
+    for (int y = step / 2; y < view_.height(); y += step)
+      for (int x = step / 2; x < view_.width(); x += step)
+        ecc.push_back(angle_deg(view_.pixel_to_dir({x + 0.5, y + 0.5}), gaze_));
+    const auto mean_keep = [&](double scale) {
+      double sum = 0;
+      for (double e : ecc) sum += keep_probability(e, scale);
+      return sum / double(ecc.size());
+    };
+    const double e_max = *std::max_element(ecc.begin(), ecc.end());
+    double lo = 0, hi = std::max(1.0, e_max / std::max(params_.falloff_fovea_deg, 1e-3) + 1);
+    for (int i = 0; i < 60; ++i) {
+      const double mid = 0.5 * (lo + hi);
+      (mean_keep(mid) < params_.budget ? lo : hi) = mid;
+    }
+    scale_ = 0.5 * (lo + hi);
+    expected_kept_ = mean_keep(scale_) * view_.width() * view_.height();
+  }
   std::uint32_t cell_flags(int column, int row, glm::dvec3 dir) const override {
     if (params_.kind != DistributionKind::LinearFalloff) return 0;
     const double u = shaders::hash_to_unit(shaders::hash3(std::uint32_t(column), std::uint32_t(row),
@@ -244,22 +282,54 @@ class RasterDistribution final : public SampleDistribution {
   void fill_gpu(shaders::GridParams& g) const override {
     g.family = shaders::kFamilyCartesian;
     g.kill = params_.kind == DistributionKind::LinearFalloff ? 1u : 0u;
-    g.fl_deg = float(params_.falloff_fovea_deg);
-    g.pl_deg = float(params_.falloff_periphery_deg);
+    g.fl_deg = float(scale_ * params_.falloff_fovea_deg);
+    g.pl_deg = float(scale_ * params_.falloff_periphery_deg);
     g.pp = float(params_.falloff_min_p);
   }
+
+ private:
+  double scale_ = 1, expected_kept_ = 0;
 };
 
-}  // namespace
-
-std::unique_ptr<SampleDistribution> make_distribution(const View& view, const DistributionParams& p) {
-  p.validate();
+std::unique_ptr<SampleDistribution> make_unchecked(const View& view, const DistributionParams& p) {
   switch (p.kind) {
     case DistributionKind::VisualPolar: return make_visual_polar(view, p);
     case DistributionKind::PaperVisualPolar:
     case DistributionKind::LogPolar: return make_screen_polar(view, p);
     default: return std::make_unique<RasterDistribution>(view, p);
   }
+}
+
+std::string fraction(double f) {
+  char buf[32];
+  std::snprintf(buf, sizeof buf, "%.3g", f);
+  return buf;
+}
+
+}  // namespace
+
+std::unique_ptr<SampleDistribution> make_distribution(const View& view, const DistributionParams& p) {
+  p.validate();
+  auto d = make_unchecked(view, p);
+  // Cartesian: every pixel, whatever the budget. P5's staircase rounds rows up per 32
+  // columns on top of the budgeted grid (+12% on `small`): an option of the layout study.
+  if (p.kind == DistributionKind::Cartesian || p.staircase) return d;
+  // The budget is met at the centred gaze the distribution starts with, or refused; two
+  // samples of slack let displays of a few pixels keep their minimal grids.
+  const double pixels = double(view.width()) * view.height();
+  const double got = d->grid_samples() / pixels;
+  if (std::abs(got - p.budget) * pixels <= std::max(0.05 * p.budget * pixels, 2.0)) return d;
+  const std::string name = distribution_name(p.kind);
+  const std::string where = " on this " + std::to_string(view.width()) + "x" + std::to_string(view.height()) + " display";
+  if (got < p.budget) {
+    DistributionParams full = p;
+    full.budget = 1.0;
+    const double most = make_unchecked(view, full)->grid_samples() / pixels;
+    throw InputError("budget: " + name + " reaches at most " + fraction(std::max(most, got)) + " of the display's pixels" +
+                     where + " (requested " + fraction(p.budget) + ")");
+  }
+  throw InputError("budget: " + name + " reaches no less than " + fraction(got) + " of the display's pixels" + where +
+                   " (requested " + fraction(p.budget) + ")");
 }
 
 }  // namespace fovea::core

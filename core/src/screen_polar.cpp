@@ -3,8 +3,9 @@
 //    display corner is 80° of the acuity CDF ("dynamic rescaling"); a linear fovea with a
 //    triangular clip of the φ axis removing 12% of the grid; the periphery through the P4
 //    Eq. 7 inverse-CDF polynomial; grid 853×960 for 1280×1440 at the paper's 39% budget.
-//  - log-polar (Meng et al. 2018, "Kernel foveated rendering"): buffer (W/σ)×(H/σ),
-//    r(u) = exp(L·(u/w)^α) with L = ln(farthest corner distance), φ uniform.
+//  - log-polar (Meng et al. 2018, "Kernel foveated rendering"): buffer (W/σ)×(H/σ) with
+//    σ = 1/√budget (Meng's σ = 1.8 is budget 0.31), r(u) = exp(L·(u/w)^α) with
+//    L = ln(farthest corner distance), φ uniform.
 #include <algorithm>
 #include <cmath>
 #include <numbers>
@@ -30,8 +31,9 @@ class ScreenPolar final : public PolarDistribution {
       columns_ = std::max(2, int(std::lround(v.width() * k)));
       rows_ = std::max(1, int(std::lround(v.height() * k)));
     } else {
-      columns_ = std::max(1, int(std::lround(v.width() / p.logpolar_sigma)));
-      rows_ = std::max(1, int(std::lround(v.height() / p.logpolar_sigma)));
+      const double k = std::sqrt(p.budget);
+      columns_ = std::max(1, int(std::lround(v.width() * k)));
+      rows_ = std::max(1, int(std::lround(v.height() * k)));
     }
     set_frame(view_.centre_dir());
   }

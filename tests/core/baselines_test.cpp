@@ -64,7 +64,7 @@ TEST(LinearFalloff, KeepProbabilityPerBandWithinThreeSigma) {
   // several frames (the random killing changes per frame), per 2° band against the mean p.
   auto d = make(DistributionKind::LinearFalloff, "fove0");
   const View& v = d->view();
-  EXPECT_FALSE(d->invertible());
+  EXPECT_TRUE(d->invertible());  // the raster; killed cells are holes
   struct Acc {
     double kept = 0, n = 0, p_sum = 0, var_sum = 0;
   };
@@ -153,8 +153,9 @@ TEST(PaperVisualPolar, ReproducesThePaperGrid) {
 
 TEST(LogPolar, KernelParametersAndCentreSpike) {
   auto d = make(DistributionKind::LogPolar, "fove0");
-  EXPECT_EQ(d->columns(), int(std::lround(1280 / 1.8)));
-  EXPECT_EQ(d->rows(), int(std::lround(1440 / 1.8)));
+  // Meng's buffer (W/σ)×(H/σ) with σ = 1/√budget: the budget's fraction of the pixels.
+  EXPECT_EQ(d->columns(), int(std::lround(1280 * std::sqrt(0.39))));
+  EXPECT_EQ(d->rows(), int(std::lround(1440 * std::sqrt(0.39))));
   const View& v = d->view();
   const glm::dvec2 c{v.width() / 2.0, v.height() / 2.0};
   // Log-polar puts orders of magnitude more samples at the gaze than in the periphery (P5 Fig. 8).

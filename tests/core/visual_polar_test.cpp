@@ -278,7 +278,11 @@ TEST(VisualPolarExtremes, DisplaysFrom1x1To8k) {
 #endif
   for (int size : sizes) {
     const View v(Fov::from_degrees(-50, 50, 50, -50), size, size);
-    for (double budget : {0.01, 0.39, 1.0}) {
+    // Above ~0.55 κ caps σ everywhere: refused (Budget.* checks the message).
+    if (size > 2) {
+      EXPECT_THROW(make_distribution(v, DistributionParams{.budget = 1.0}), InputError);
+    }
+    for (double budget : {0.01, 0.39, 0.5}) {
       DistributionParams p;
       p.budget = budget;
       auto d = make_distribution(v, p);
@@ -302,7 +306,12 @@ TEST(VisualPolarExtremes, DisplaysFrom1x1To8k) {
 
 TEST(VisualPolarExtremes, WideFieldOfView170) {
   const View v(Fov::from_degrees(-85, 85, 85, -85), 512, 512);
-  auto d = make_distribution(v, DistributionParams{});
+  // The tangent raster is sparsest in angle at the centre: κ caps the grid at ~1% of the
+  // pixels, so the default budget is refused and 1% is met.
+  EXPECT_THROW(make_distribution(v, DistributionParams{}), InputError);
+  DistributionParams p;
+  p.budget = 0.01;
+  auto d = make_distribution(v, p);
   double widest = 0;
   for (glm::dvec3 g : {v.centre_dir(), v.pixel_to_dir({0, 0}), v.pixel_to_dir({512, 256})}) {
     d->set_frame(g);

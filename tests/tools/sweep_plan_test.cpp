@@ -78,6 +78,10 @@ TEST(SweepPlan, ReferencesAreSharedPerSceneAndDisplay) {
     ASSERT_NE(s, nullptr);
     EXPECT_EQ(s->settings["scene"], j.settings["scene"]);
     EXPECT_EQ(s->settings["spp"], 16);
+    // The job loads the shared reference instead of rendering one.
+    const auto ref = std::find(j.argv.begin(), j.argv.end(), "--reference");
+    ASSERT_NE(ref, j.argv.end());
+    EXPECT_EQ(*(ref + 1), s->out);
     ++users[s->id];
   }
   for (const auto& s : p.shared) {
@@ -91,6 +95,28 @@ TEST(SweepPlan, ReferencesAreSharedPerSceneAndDisplay) {
   json f = sweep_file();
   f.erase("reference");
   EXPECT_TRUE(expand_sweep(f, "s.json", options()).shared.empty());
+}
+
+// A list of sweeps is their union: cartesian without budgets next to budgeted distributions.
+TEST(SweepPlan, AListOfSweepsIsTheirUnion) {
+  const json list = json::parse(R"([
+    {"scenes": "cornell", "distribution": ["visual-polar", "log-polar"], "budget": [0.2, 0.3], "reference": 8,
+     "report": {"group": "distribution"}},
+    {"scenes": "cornell", "distribution": "cartesian", "reference": 8},
+    {"scenes": "cornell", "distribution": "log-polar", "budget": 0.3, "reference": 8}])");
+  const Plan p = expand_sweep(list, "list.json", options());
+  ASSERT_EQ(p.jobs.size(), 5u);  // 4 + 1, the third part's job is already planned
+  EXPECT_EQ(p.jobs[4].settings, json({{"distribution", "cartesian"}, {"reference", 8}, {"scene", "cornell"}}));
+  EXPECT_EQ(p.shared.size(), 1u);  // one reference for all of them
+  EXPECT_EQ(p.header["report"]["group"], "distribution");
+  EXPECT_EQ(p.header["jobs"], 5);
+  try {
+    expand_sweep(json::parse(R"([{"scenes": "cornell"}, {"budgett": 1}])"), "list.json", options());
+    ADD_FAILURE() << "unknown key accepted";
+  } catch (const core::InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("list.json[1]"), std::string::npos) << e.what();
+  }
+  EXPECT_THROW(expand_sweep(json::array(), "list.json", options()), core::InputError);
 }
 
 TEST(SweepPlan, RejectsBadSweepFilesNamingKeyAndFile) {

@@ -14,6 +14,7 @@
 #include "fovea/gpu/context.hpp"
 #include "fovea/renderer/reference.hpp"
 #include "fovea/renderer/scene_io.hpp"
+#include "reference_cache.hpp"
 
 namespace fovea::tools {
 namespace {
@@ -21,10 +22,13 @@ namespace {
 constexpr const char* kHelp = R"(usage: fovea reference --scene S --out F.exr|F.png [options]
 
 Renders one eye's view of a scene progressively on a Cartesian grid (one jittered
-sample per pixel and pass) until --spp samples per pixel, or earlier once the relative
-standard error of the image mean falls to --until-rel-error. Writes the linear image as
-OpenEXR (32-bit float) and a tone-mapped PNG next to it (same name, other extension),
-and prints JSON: {"spp": N, "mean_rgb": [r, g, b], "rel_error": x, "seconds": t}.
+sample per pixel and pass) until --spp samples per pixel, or earlier once a relative
+standard error falls to its target. Writes the linear image as OpenEXR (32-bit float),
+its description F.json (key, settings, statistics; what `fovea render --reference DIR`
+checks) and a tone-mapped PNG (same name, other extension), and prints JSON:
+{"spp", "mean_rgb", "rel_error", "pixel_rel_error", "seconds", "key", "cached"}.
+The result is kept in a cache keyed by the scene's bytes, the view, these settings and the
+renderer; the same request again reads it instead of rendering.
 
   --scene S             cornell | furnace | glossy-spheres | stereo-occluders | default,
                         or a .gltf/.glb/.obj file [default]
@@ -34,12 +38,15 @@ and prints JSON: {"spp": N, "mean_rgb": [r, g, b], "rel_error": x, "seconds": t}
   --display NAME|FILE   display preset (fove0, vive, modern, small, tiny) or JSON [small]
   --eye left|right      which eye; it sits ipd/2 beside the scene's camera [left]
   --spp N               samples per pixel to stop at [256]
-  --until-rel-error X   stop as soon as the relative standard error is <= X (> 0)
+  --until-rel-error X   stop once the image mean's relative standard error is <= X (> 0)
+  --until-pixel-rel-error X  stop once the RMS of the per-pixel standard errors over the
+                        mean luminance is <= X (> 0)
   --batch N             samples per pixel per progressive pass [16]
   --bounces N           BSDF-sampled bounces after the primary hit; -1 = unlimited
-                        (with Russian roulette) [1, the BMFR/P5 configuration]
+                        (with Russian roulette) [-1: full global illumination]
   --rr-start N          bounce from which Russian roulette applies [3]
-  --out F               output path ending in .exr or .png (both are written)
+  --reference-cache DIR|off  the cache [$XDG_CACHE_HOME/fovea/references]
+  --out F               output path ending in .exr or .png (all three are written)
   --quiet               no progress bar
   --help                this text
 
@@ -49,9 +56,10 @@ Exit status: 0 on success, 2 on invalid arguments or scene files, 1 on other err
 void progress_bar(const renderer::ReferenceProgress& p, std::uint32_t total) {
   const int width = 30;
   const int fill = int(double(width) * p.spp / std::max<std::uint32_t>(total, 1));
-  std::fprintf(stderr, "\r[%s%s] %u/%u spp  rel. error %s  %.1f s", std::string(std::size_t(fill), '#').c_str(),
+  std::fprintf(stderr, "\r[%s%s] %u/%u spp  pixel rel. error %s  %.1f s", std::string(std::size_t(fill), '#').c_str(),
                std::string(std::size_t(width - fill), ' ').c_str(), p.spp, total,
-               std::isnan(p.rel_error) ? "  -   " : (std::to_string(p.rel_error).substr(0, 8)).c_str(), p.seconds);
+               std::isnan(p.pixel_rel_error) ? "  -   " : (std::to_string(p.pixel_rel_error).substr(0, 8)).c_str(),
+               p.seconds);
   std::fflush(stderr);
 }
 
@@ -61,7 +69,8 @@ int run(std::vector<std::string> argv) {
       std::cout << kHelp;
       return 0;
     }
-  const Args args(argv, {"scene", "display", "eye", "spp", "until-rel-error", "batch", "bounces", "rr-start", "out", "trace"},
+  const Args args(argv, {"scene", "display", "eye", "spp", "until-rel-error", "until-pixel-rel-error", "batch", "bounces", "rr-start",
+                         "reference-cache", "out", "trace"},
                   {"quiet"});
   const auto out = args.opt("out");
   if (!out) throw core::InputError("--out F.exr|F.png is required (see --help)");
@@ -72,14 +81,17 @@ int run(std::vector<std::string> argv) {
   exr.replace_extension(".exr");
   png.replace_extension(".png");
 
-  const long spp = args.integer("spp", 256), batch = args.integer("batch", 16), bounces = args.integer("bounces", 1),
+  const long spp = args.integer("spp", 256), batch = args.integer("batch", 16), bounces = args.integer("bounces", -1),
              rr = args.integer("rr-start", 3);
   if (spp < 1 || spp > (1L << 24)) throw core::InputError("--spp must be in 1..16777216");
   if (batch < 1 || batch > 4096) throw core::InputError("--batch must be in 1..4096");
   if (bounces < -1 || bounces > 256) throw core::InputError("--bounces must be -1 (unlimited) or 0..256");
   if (rr < 0 || rr > 1000) throw core::InputError("--rr-start must be in 0..1000");
-  const double until = args.num("until-rel-error", 0);
-  if (until < 0) throw core::InputError("--until-rel-error must be > 0");
+  const double until = args.num("until-rel-error", 0), until_pixel = args.num("until-pixel-rel-error", 0);
+  if (!(until >= 0)) throw core::InputError("--until-rel-error must be > 0");
+  if (!(until_pixel >= 0)) throw core::InputError("--until-pixel-rel-error must be > 0");
+  const auto cache_opt = args.opt("reference-cache");
+  const std::string cache = reference_cache_arg(cache_opt ? &*cache_opt : nullptr);
 
   const core::DisplayPreset display = core::load_display(args.str("display", "small"));
   const core::Eye eye = core::parse_eye(args.str("eye", "left"));
@@ -91,25 +103,32 @@ int run(std::vector<std::string> argv) {
 
   gpu::Context ctx;
   renderer::GpuScene gs(ctx, scene, {}, tracing);
-  renderer::ReferenceOptions o;
-  o.path.spp = std::uint32_t(batch);
-  o.path.max_bounces = int(bounces);
-  o.path.rr_start = std::uint32_t(rr);
-  o.max_spp = std::uint32_t(spp);
-  o.until_rel_error = until;
+  ReferenceRequest req;
+  req.scene = args.str("scene", "default");
+  req.settings.max_spp = std::uint32_t(spp);
+  req.settings.batch = std::uint32_t(batch);
+  req.settings.bounces = int(bounces);
+  req.settings.rr_start = std::uint32_t(rr);
+  req.settings.until_rel_error = until;
+  req.settings.until_pixel_rel_error = until_pixel;
+  req.cache_dir = cache;
   const bool bar = !args.has("quiet") && stderr_is_tty();
-  const auto r = renderer::render_reference(ctx, gs, view, eye, o, [&](const renderer::ReferenceProgress& p) {
-    if (bar) progress_bar(p, o.max_spp);
+  const CachedReference c = cached_reference(ctx, gs, view, eye, req, [&](const renderer::ReferenceProgress& p) {
+    if (bar) progress_bar(p, req.settings.max_spp);
   });
   if (bar) std::fprintf(stderr, "\n");
+  const renderer::ReferenceResult& r = c.result;
 
-  renderer::write_exr(exr.string(), r.image);
+  write_reference(exr.string(), c);
   core::write_png(png.string(), renderer::tone_map(r.image));
   nlohmann::json j;
   j["spp"] = r.spp;
   j["mean_rgb"] = {r.mean_rgb.x, r.mean_rgb.y, r.mean_rgb.z};
   j["rel_error"] = r.rel_error;
+  j["pixel_rel_error"] = r.pixel_rel_error;
   j["seconds"] = r.seconds;
+  j["key"] = c.key;
+  j["cached"] = c.from_cache;
   std::cout << j.dump() << "\n";
   return 0;
 }

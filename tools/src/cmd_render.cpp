@@ -6,6 +6,7 @@
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
+#include <deque>
 #include <filesystem>
 #include <iostream>
 #include <map>
@@ -14,17 +15,20 @@
 #include <nlohmann/json.hpp>
 
 #include "command.hpp"
+#include "fovea/core/acuity.hpp"
 #include "fovea/core/clock.hpp"
 #include "fovea/core/display.hpp"
 #include "fovea/core/eye_optics.hpp"
 #include "fovea/core/stereo_views.hpp"
 #include "fovea/core/error.hpp"
 #include "fovea/core/image.hpp"
+#include "fovea/core/flip.hpp"
 #include "fovea/core/metrics.hpp"
 #include "fovea/devices/foveation_gaze.hpp"
 #include "fovea/devices/readers.hpp"
 #include "fovea/devices/screen.hpp"
 #include "frame_log.hpp"
+#include "reference_cache.hpp"
 #include "fovea/gpu/context.hpp"
 #include "fovea/pipeline/frame_pipeline.hpp"
 #include "fovea/renderer/reference.hpp"
@@ -52,12 +56,16 @@ the peripheral blur. Writes to --out:
                  "device": {name, driver}, "trace": "rayquery" or "compute",
                  "gpu_ms": {grid, trace, reconstruct, resolve, total, bmfr_fit, mip, resample, blur},
                  "cpu_ms": {gaze, grid, trace, reconstruct, resolve, submit, readback, total}
-                 (medians per frame), "summary": {"left": {...}, "right": {...}}}
+                 (medians per frame), "metrics": {tone mapper, exposure, ppd, reference},
+                 "summary": {"left": {...}, "right": {...}}}
 Cells that the preset's lens hides (its hidden area, seen from the view) are neither traced
 nor reconstructed; samples_hidden counts them in the last frame.
-With --reference SPP each eye's summary compares the last frame with a converged
-Cartesian reference: psnr, fovea_psnr, foveated_psnr, ssim, band_psnr (2° bands), next to
-temporal_error (always). With no options: a short demo on the shipped scene and gaze.
+With --reference each eye's summary compares the last frame with a converged Cartesian
+reference (docs/metrics.md): tone-mapped PSNR and SSIM (ACES fit + sRGB), relMSE (linear),
+LDR- and HDR-FLIP, each over the whole image, the fovea (fovea_*, e <= 5.79 deg),
+acuity-weighted (foveated_*) and per 2 deg band ("bands"). Always: temporal_error and, over
+the trailing frames whose gaze did not move (up to 8), the flicker of the still image.
+With no options: a short demo on the shipped scene and gaze.
 
   --scene S             cornell | furnace | glossy-spheres | stereo-occluders | default,
                         or a .gltf/.glb/.obj file [default]
@@ -71,15 +79,24 @@ temporal_error (always). With no options: a short demo on the shipped scene and 
                         WxH@SWxSHmm@Dmm (as the URI key screen=; docs/gaze.md)
   --frames N            frames to render [24]
   --distribution D      visual-polar | paper-visual-polar | cartesian | cartesian-uniform |
-                        log-polar [visual-polar]
-  --budget B            grid samples as a fraction of display pixels [0.39]
+                        linear-falloff | log-polar [visual-polar]
+  --budget B            grid samples as a fraction of display pixels, met within 5% or
+                        refused with exit 2 naming what the distribution reaches
+                        (cartesian: 1 only) [0.39]
   --jitter on|off       per-frame sub-cell jitter (Halton 2, 3) of every grid [on]
   --denoiser D          bmfr | none (accumulation only) [bmfr]
   --bmfr-precision P    fp32 | fp16: storage of BMFR's regression matrix [fp32]
-  --stereo-share M      off | gather | alternate [off]
+  --stereo-share M      off | gather | alternate [gather]
   --no-blur             skip the peripheral blur
   --no-cull             trace the lens' hidden area too
-  --reference SPP       converged reference of the last frame with SPP samples per pixel
+  --reference SPP|DIR   SPP: converged reference of the last frame (full global illumination,
+                        at most SPP samples per pixel, see --reference-error), from the
+                        cache or rendered into it; DIR: load reference_left.exr and
+                        reference_right.exr written by `fovea reference` (checked to show
+                        this scene and view)
+  --reference-error X   stop the reference once its per-pixel relative standard error
+                        (RMS over the pixels, over the mean luminance) is <= X [0.02]
+  --reference-cache DIR|off  where references are cached [$XDG_CACHE_HOME/fovea/references]
   --png-every N         write PNGs of every N-th frame (0: last frame only) [1]
   --no-marker           do not mark the gaze in the PNGs
   --out DIR             output directory [out/render]
@@ -136,6 +153,63 @@ void progress(int done, int total, double seconds) {
   std::fflush(stderr);
 }
 
+constexpr double kExposure = 0.0;  // of the display transform every metric uses
+constexpr double kBandDeg = 2.0;
+constexpr std::size_t kFlickerFrames = 8;
+
+nlohmann::json scores_json(const core::Scores& sc, const std::string& prefix) {
+  return {{prefix + "psnr", sc.psnr},
+          {prefix + "ssim", sc.ssim},
+          {prefix + "rel_mse", sc.rel_mse},
+          {prefix + "ldr_flip", sc.ldr_flip},
+          {prefix + "hdr_flip", sc.hdr_flip}};
+}
+
+std::vector<float> fovea_weights(const std::vector<float>& ecc) {
+  std::vector<float> w(ecc.size());
+  for (std::size_t i = 0; i < ecc.size(); ++i) w[i] = ecc[i] <= core::acuity::kFoveaDeg ? 1.0f : 0.0f;
+  return w;
+}
+
+// Quality of `img` against `ref`: whole image, fovea, acuity-weighted and per band.
+void add_quality(nlohmann::json& s, const core::Image& img, const core::Image& ref, const std::vector<float>& ecc,
+                 double ppd) {
+  const core::ErrorMaps maps = core::error_maps(img, ref, ppd, kExposure);
+  s.update(scores_json(core::pool(maps), ""));
+  s.update(scores_json(core::pool(maps, fovea_weights(ecc)), "fovea_"));
+  s.update(scores_json(core::pool(maps, core::foveation_weights(ecc)), "foveated_"));
+  s["linear_psnr"] = core::psnr(img, ref);  // linear HDR, peak 1: dominated by emitters
+  nlohmann::json bands = nlohmann::json::array();
+  for (const core::BandScores& b : core::band_scores(maps, ecc, kBandDeg)) {
+    nlohmann::json o = {{"e_min", b.e_min}, {"e_max", b.e_max}, {"pixels", b.pixels}};
+    o.update(scores_json(b.scores, ""));
+    bands.push_back(o);
+  }
+  s["bands"] = bands;
+}
+
+// Flicker of the still frames: whole image, fovea, acuity-weighted and per band.
+void add_flicker(nlohmann::json& s, const std::deque<core::Image>& frames, const std::vector<float>& ecc) {
+  const std::vector<float> map = core::flicker_map({frames.begin(), frames.end()}, kExposure);
+  s["flicker_frames"] = frames.size();
+  s["flicker"] = core::weighted_mean(map);
+  s["fovea_flicker"] = core::weighted_mean(map, fovea_weights(ecc));
+  s["foveated_flicker"] = core::weighted_mean(map, core::foveation_weights(ecc));
+  float e_max = 0;
+  for (float e : ecc) e_max = std::max(e_max, e);
+  nlohmann::json bands = nlohmann::json::array();
+  for (int k = 0; k * kBandDeg <= e_max; ++k) {
+    std::vector<float> w(ecc.size());
+    long pixels = 0;
+    for (std::size_t i = 0; i < ecc.size(); ++i)
+      if (ecc[i] >= k * kBandDeg && ecc[i] < (k + 1) * kBandDeg) w[i] = 1.0f, ++pixels;
+    if (pixels > 0)
+      bands.push_back({{"e_min", k * kBandDeg}, {"e_max", (k + 1) * kBandDeg}, {"pixels", pixels},
+                       {"flicker", core::weighted_mean(map, w)}});
+  }
+  s["flicker_bands"] = bands;
+}
+
 int run(std::vector<std::string> argv) {
   for (const auto& a : argv)
     if (a == "--help" || a == "-h") {
@@ -144,12 +218,23 @@ int run(std::vector<std::string> argv) {
     }
   const Args args(argv,
                   {"scene", "display", "gaze", "frames", "distribution", "budget", "jitter", "denoiser", "bmfr-precision",
-                   "stereo-share", "reference", "png-every", "out", "screen", "trace"},
+                   "stereo-share", "reference", "reference-error", "reference-cache", "png-every", "out", "screen",
+                   "trace"},
                   {"no-blur", "no-cull", "no-marker", "quiet"});
   const long frames = args.integer("frames", 24);
   if (frames < 1 || frames > 100000) throw core::InputError("--frames must be in 1..100000");
-  const long ref_spp = args.integer("reference", 0);
+  // --reference: a sample count renders (or finds in the cache), anything else is a directory.
+  const std::string ref_arg = args.str("reference", "0");
+  const bool ref_is_spp = !ref_arg.empty() && ref_arg.find_first_not_of("0123456789") == std::string::npos;
+  const long ref_spp = ref_is_spp ? args.integer("reference", 0) : 0;
   if (ref_spp < 0 || ref_spp > (1L << 20)) throw core::InputError("--reference must be in 1..1048576 samples per pixel");
+  const std::string ref_dir = ref_is_spp ? "" : ref_arg;
+  if (!ref_dir.empty() && !fs::is_directory(ref_dir))
+    throw core::InputError("--reference: \"" + ref_dir + "\" is neither a sample count nor a directory");
+  const double ref_error = args.num("reference-error", 0.02);
+  if (!(ref_error >= 0) || !std::isfinite(ref_error)) throw core::InputError("--reference-error must be >= 0");
+  const auto cache_opt = args.opt("reference-cache");
+  const std::string ref_cache = reference_cache_arg(cache_opt ? &*cache_opt : nullptr);
   const long png_every = args.integer("png-every", 1);
   if (png_every < 0) throw core::InputError("--png-every must be >= 0");
   const core::DisplayPreset display = core::load_display(args.str("display", "small"));
@@ -157,10 +242,17 @@ int run(std::vector<std::string> argv) {
   dp.kind = core::parse_distribution(args.str("distribution", "visual-polar"));
   dp.budget = args.num("budget", dp.budget);
   dp.jitter = core::parse_jitter(args.str("jitter", "on"));
+  // Cartesian traces every pixel: a smaller budget is cartesian-uniform's job.
+  if (dp.kind == core::DistributionKind::Cartesian) {
+    if (args.has("budget") && dp.budget != 1.0)
+      throw core::InputError("--budget: cartesian traces every pixel (budget 1); use cartesian-uniform for " +
+                             args.str("budget", "") + " of the pixels");
+    dp.budget = 1.0;
+  }
   dp.validate();
   reconstruct::ReconSettings settings;
   settings.denoiser = reconstruct::parse_denoiser(args.str("denoiser", "bmfr"));
-  settings.share = reconstruct::parse_stereo_share(args.str("stereo-share", "off"));
+  settings.share = reconstruct::parse_stereo_share(args.str("stereo-share", "gather"));
   const std::string precision = args.str("bmfr-precision", "fp32");
   if (precision != "fp32" && precision != "fp16")
     throw core::InputError("--bmfr-precision: expected fp32 or fp16, got \"" + precision + "\"");
@@ -184,7 +276,8 @@ int run(std::vector<std::string> argv) {
   for (const auto& n : devices::recording_notes(gaze_uri, so)) std::cerr << "warning: " << n << "\n";
 
   const renderer::Tracing tracing = renderer::parse_tracing(args.str("trace", "auto"));
-  const renderer::Scene scene = renderer::load_scene(args.str("scene", "default"));
+  const std::string scene_arg = args.str("scene", "default");
+  const renderer::Scene scene = renderer::load_scene(scene_arg);
   for (const auto& w : scene.warnings) std::cerr << "warning: " << w << "\n";
   fs::create_directories(out_dir);
 
@@ -199,12 +292,23 @@ int run(std::vector<std::string> argv) {
     for (core::Eye e : {core::Eye::Left, core::Eye::Right})
       pipeline.set_visibility(e, core::EyeOptics(display, e).view_mask());
 
+  // A loaded reference is checked before the frames are paid for.
+  std::array<std::optional<CachedReference>, 2> loaded;
+  if (!ref_dir.empty())
+    for (int e = 0; e < 2; ++e) {
+      const std::string file = (fs::path(ref_dir) / (std::string("reference_") + (e ? "right" : "left") + ".exr")).string();
+      loaded[e] = read_reference(file, scene_arg, pipeline.view(core::Eye(e)), core::Eye(e));
+    }
   const bool bar = !args.has("quiet") && stderr_is_tty();
   const bool marker = !args.has("no-marker");
   // Per-frame times, milliseconds: GPU and CPU per stage (medians reported).
   std::map<std::string, std::vector<double>> gpu_ms, cpu_ms;
   std::array<core::Image, 2> previous, last;
   std::array<double, 2> te_sum{0, 0};
+  // The trailing frames whose gaze equals the last one's: with the head and scene still,
+  // every change between them is an artefact (flicker).
+  std::array<std::deque<core::Image>, 2> still;
+  std::array<glm::dvec3, 2> still_gaze{};
   std::array<glm::dvec3, 2> gaze{glm::dvec3(0, 0, -1), glm::dvec3(0, 0, -1)};
   FrameLog frame_log((out_dir / "frames.jsonl").string(), (out_dir / "frame_times.jsonl").string());
   const auto start = std::chrono::steady_clock::now();
@@ -239,6 +343,10 @@ int run(std::vector<std::string> argv) {
     for (int e = 0; e < 2; ++e) {
       if (f > 0) te_sum[e] += core::temporal_error(previous[e], last[e]);
       previous[e] = last[e];
+      if (still[e].empty() || gaze[e] != still_gaze[e]) still[e].clear();
+      still_gaze[e] = gaze[e];
+      still[e].push_back(last[e]);
+      if (still[e].size() > kFlickerFrames) still[e].pop_front();
     }
     const bool write = png_every > 0 ? f % png_every == 0 || f == frames - 1 : f == frames - 1;
     if (write) {
@@ -296,34 +404,49 @@ int run(std::vector<std::string> argv) {
   j["stereo"] = {{"own_indirect_samples", own / 2}, {"effective_indirect_samples", shared / 2},
                  {"gain", own > 0 ? shared / own : 0.0}};
 
-  std::optional<renderer::ReferenceResult> refs[2];
+  const core::View left_view = pipeline.view(core::Eye::Left);
+  const double ppd = core::flip_ppd(left_view);
+  j["metrics"] = {{"tone_mapper", "ACES filmic, Narkowicz 2015 fit with HDR-FLIP's 0.6 input scale; sRGB OETF for "
+                                  "PSNR, SSIM and flicker; display-linear for LDR-FLIP"},
+                  {"exposure", kExposure},
+                  {"ppd", ppd},
+                  {"fovea_deg", core::acuity::kFoveaDeg},
+                  {"band_deg", kBandDeg},
+                  {"foveated_weights", "normalised acuity m(e), Koskela et al. 2018 P4 Eq. 1"}};
+  nlohmann::json ref_info;
   for (int e = 0; e < 2; ++e) {
     const core::Eye eye = core::Eye(e);
+    const char* name = e == 0 ? "left" : "right";
+    const core::View v = pipeline.view(eye);
+    const glm::dvec3 g = pipeline.distribution(eye).gaze();
+    const std::vector<float> ecc = core::eccentricity_map(v, g);
     nlohmann::json s;
     s["temporal_error"] = frames > 1 ? te_sum[e] / double(frames - 1) : 0.0;
-    if (ref_spp > 0) {
-      renderer::ReferenceOptions o;
-      o.path.spp = std::uint32_t(std::min<long>(ref_spp, 16));
-      o.max_spp = std::uint32_t(ref_spp);
-      const core::View v = pipeline.view(eye);
-      if (bar) std::fprintf(stderr, "reference %s eye, %ld spp...\n", eye == core::Eye::Left ? "left" : "right", ref_spp);
-      const renderer::ReferenceResult r = renderer::render_reference(ctx, gpu_scene, v, eye, o);
-      renderer::write_exr((out_dir / (std::string("reference_") + (e == 0 ? "left" : "right") + ".exr")).string(),
-                          r.image);
-      const glm::dvec3 g = pipeline.distribution(eye).gaze();
-      const std::vector<float> ecc = core::eccentricity_map(v, g);
-      s["psnr"] = core::psnr(last[e], r.image);
-      s["fovea_psnr"] = core::fovea_psnr(last[e], r.image, ecc);
-      s["foveated_psnr"] = core::foveated_psnr(last[e], r.image, v, g);
-      s["ssim"] = core::ssim(last[e], r.image);
-      nlohmann::json bands = nlohmann::json::array();
-      for (const core::BandPsnr& b : core::band_psnr(last[e], r.image, ecc, 2.0))
-        bands.push_back({{"e_min", b.e_min}, {"e_max", b.e_max}, {"pixels", b.pixels}, {"psnr", b.psnr}});
-      s["band_psnr"] = bands;
-      s["reference_spp"] = r.spp;
+    if (still[e].size() >= 2) add_flicker(s, still[e], ecc);
+    if (ref_spp > 0 || !ref_dir.empty()) {
+      CachedReference ref;
+      if (loaded[e]) {
+        ref = std::move(*loaded[e]);
+      } else {
+        ReferenceRequest req;
+        req.scene = scene_arg;
+        req.settings.max_spp = std::uint32_t(ref_spp);
+        req.settings.until_pixel_rel_error = ref_error;
+        req.cache_dir = ref_cache;
+        if (bar) std::fprintf(stderr, "reference %s eye, up to %ld spp...\n", name, ref_spp);
+        ref = cached_reference(ctx, gpu_scene, v, eye, req);
+        write_reference((out_dir / (std::string("reference_") + name + ".exr")).string(), ref);
+      }
+      ref_info[name] = {{"spp", ref.result.spp},
+                        {"pixel_rel_error", ref.result.pixel_rel_error},
+                        {"rel_error", ref.result.rel_error},
+                        {"key", ref.key},
+                        {"cached", ref.from_cache}};
+      add_quality(s, last[e], ref.result.image, ecc, ppd);
     }
-    j["summary"][e == 0 ? "left" : "right"] = s;
+    j["summary"][name] = s;
   }
+  if (!ref_info.is_null()) j["metrics"]["reference"] = ref_info;
   core::write_file_atomic((out_dir / "report.json").string(), j.dump(2) + "\n");
   std::cout << nlohmann::json{{"gpu_ms", j["gpu_ms"]}, {"cpu_ms", j["cpu_ms"]}}.dump() << "\n";
   return 0;

@@ -26,10 +26,11 @@ constexpr const char* kHelp = R"(usage: fovea sweep plan FILE --out PLAN
        fovea sweep run PLAN [--dir DIR] [--jobs N] [--shard I/N] [--quiet]
        fovea sweep slurm PLAN --shards N [--out DIR] [--dir DIR] [--partition P]
                          [--cpus-per-task C] [--mem M] [--time T] [--gpus G] [--submit]
-       fovea sweep report PLAN --out DIR [--dir DIR]
+       fovea sweep report PLAN --out DIR [--dir DIR] [--markdown PAGE [--command TEXT]]
 
 plan    expands a sweep file (JSON: "scenes", "displays", "gaze", "frames", any `fovea render`
-        option as a value, a list or {"from", "to", "step"}, and "report") into PLAN, one JSON
+        option as a value, a list or {"from", "to", "step"}, and "report"; or a list of
+        such objects, their union) into PLAN, one JSON
         line per job: id (FNV-1a 64 of its canonical settings), the `fovea render` argv, the
         shared inputs (references computed once per scene, display and spp).
 run     runs the plan's jobs with a pool of N processes [CPUs / LP_NUM_THREADS]; finished jobs
@@ -44,6 +45,10 @@ slurm   writes DIR/sweep-array.sbatch (one array task per shard), DIR/sweep-merg
 report  merges the results into DIR/results.csv and results.json and draws PNG plots:
         quality against time per frame with the Pareto front per distribution, quality
         against budget, per-band curves, latency against quality (when recorded).
+        --markdown PAGE also writes a Markdown page: every job at equal samples, the
+        best quality at equal time, per-band PSNR, the plots (linked relative to PAGE) and
+        the front's cost against the cartesian job for a 90 Hz frame; --command is the
+        regeneration command its header quotes.
 
 DIR (--dir) is the results directory [the plan's directory]. docs/sweep.md has the formats.
 Exit status: 0 on success, 2 on invalid arguments or input files, 1 on other errors.
@@ -152,11 +157,14 @@ int cmd_slurm(const std::vector<std::string>& argv) {
 }
 
 int cmd_report(const std::vector<std::string>& argv) {
-  const Args a(argv, {"out", "dir"}, {}, 1);
+  const Args a(argv, {"out", "dir", "markdown", "command"}, {}, 1);
   const std::string path = plan_arg(a, "report");
   if (!a.has("out")) throw core::InputError("sweep report needs --out DIR (see --help)");
   const sweep::Plan plan = sweep::read_plan(path);
-  const sweep::ReportSummary s = sweep::write_report(plan, {results_dir(a, path), a.str("out", "")});
+  std::string command = "fovea sweep report " + path + " --out " + a.str("out", "");
+  if (a.has("markdown")) command += " --markdown " + a.str("markdown", "");
+  const sweep::ReportSummary s = sweep::write_report(
+      plan, {results_dir(a, path), a.str("out", ""), a.str("markdown", ""), a.str("command", command)});
   std::cout << json{{"done", s.done}, {"failed", s.failed}, {"missing", s.missing}, {"files", s.files}}.dump() << "\n";
   return 0;
 }

@@ -81,10 +81,12 @@ std::vector<json> key_values(const json& v, const std::string& ctx, bool valued)
 
 std::string arg_text(const json& v) { return v.is_string() ? v.get<std::string>() : v.dump(); }
 
+// The settings a converged reference depends on: what `fovea render --reference SPP` would
+// render (its defaults when a setting is not swept).
 SharedInput reference_input(const json& settings) {
   SharedInput s;
   s.settings = {{"kind", "reference"}, {"spp", settings["reference"]}};
-  for (const char* k : {"scene", "display"})
+  for (const char* k : {"scene", "display", "reference-error"})
     if (settings.contains(k)) s.settings[k] = settings[k];
   s.id = settings_id(s.settings);
   s.out = "shared/" + s.id;
@@ -93,9 +95,13 @@ SharedInput reference_input(const json& settings) {
     std::vector<std::string> a = {"fovea", "reference"};
     for (const char* k : {"scene", "display"})
       if (settings.contains(k)) a.insert(a.end(), {std::string("--") + k, arg_text(settings[k])});
-    // The same batching as `fovea render --reference`, so the images are the ones it computes.
-    a.insert(a.end(), {"--eye", eye, "--spp", std::to_string(spp), "--batch", std::to_string(std::min(spp, 16L)), "--out",
-                       s.out + "/reference_" + eye + ".exr", "--quiet"});
+    // The same settings as `fovea render --reference SPP`, so the images are the ones it
+    // computes (and shares its cache entries).
+    const std::string error = settings.contains("reference-error") ? arg_text(settings["reference-error"]) : "0.02";
+    a.insert(a.end(), {"--eye", eye, "--spp", std::to_string(spp), "--until-pixel-rel-error", error});
+    // Where it is cached does not change the image: not part of the id.
+    if (settings.contains("reference-cache")) a.insert(a.end(), {"--reference-cache", arg_text(settings["reference-cache"])});
+    a.insert(a.end(), {"--out", s.out + "/reference_" + eye + ".exr", "--quiet"});
     s.commands.push_back(std::move(a));
   }
   return s;
@@ -137,7 +143,28 @@ std::string settings_id(const json& settings) {
 }
 
 Plan expand_sweep(const json& sweep, const std::string& source, const std::vector<RenderOption>& options) {
-  if (!sweep.is_object()) throw InputError(source + ": a sweep file is a JSON object");
+  // A list of sweeps is their union (settings that only make sense together, e.g. budgets
+  // for the foveated distributions and none for cartesian): jobs in list order, a job two
+  // parts share once, the first part's report settings.
+  if (sweep.is_array()) {
+    if (sweep.empty()) throw InputError(source + ": an empty list of sweeps");
+    Plan all;
+    json report;
+    std::set<std::string> ids;
+    for (std::size_t i = 0; i < sweep.size(); ++i) {
+      Plan part = expand_sweep(sweep[i], source + "[" + std::to_string(i) + "]", options);
+      if (report.is_null() && !part.header["report"].empty()) report = part.header["report"];
+      for (auto& s : part.shared)
+        if (!all.find_shared(s.id)) all.shared.push_back(std::move(s));
+      for (auto& j : part.jobs)
+        if (ids.insert(j.id).second) all.jobs.push_back(std::move(j));
+      if (all.jobs.size() > kMaxJobs) throw InputError(source + ": more than 100000 jobs");
+    }
+    all.header = {{"type", "sweep"}, {"version", 1}, {"source", source}, {"report", report.is_null() ? json::object() : report},
+                  {"jobs", all.jobs.size()}, {"shared", all.shared.size()}};
+    return all;
+  }
+  if (!sweep.is_object()) throw InputError(source + ": a sweep file is a JSON object or a list of them");
   std::map<std::string, bool> known;  // option -> valued
   for (const auto& o : options) known[o.name] = o.valued;
   Plan plan;
@@ -192,19 +219,22 @@ Plan expand_sweep(const json& sweep, const std::string& source, const std::vecto
     job.id = settings_id(job.settings);
     if (!ids.insert(job.id).second) throw InputError(source + ": two jobs with the same settings " + job.settings.dump());
     job.out = "jobs/" + job.id;
+    const bool shares_reference = job.settings.contains("reference") && job.settings["reference"].get<long>() > 0;
+    const SharedInput reference = shares_reference ? reference_input(job.settings) : SharedInput{};
     job.argv = {"fovea", "render"};
     for (auto it = job.settings.begin(); it != job.settings.end(); ++it) {
       job.argv.push_back("--" + it.key());
-      if (!it->is_boolean()) job.argv.push_back(arg_text(*it));
+      // The job loads the shared reference instead of rendering its own.
+      if (it.key() == "reference" && shares_reference) job.argv.push_back(reference.out);
+      else if (!it->is_boolean()) job.argv.push_back(arg_text(*it));
     }
     // PNGs of the last frame only (the sweep keeps numbers, not films), unless asked.
     if (known.count("png-every") && !job.settings.contains("png-every")) job.argv.insert(job.argv.end(), {"--png-every", "0"});
     if (known.count("quiet")) job.argv.push_back("--quiet");
     job.argv.insert(job.argv.end(), {"--out", job.out});
-    if (job.settings.contains("reference") && job.settings["reference"].get<long>() > 0) {
-      SharedInput s = reference_input(job.settings);
-      if (!plan.find_shared(s.id)) plan.shared.push_back(s);
-      job.shared.push_back(s.id);
+    if (shares_reference) {
+      if (!plan.find_shared(reference.id)) plan.shared.push_back(reference);
+      job.shared.push_back(reference.id);
     }
     plan.jobs.push_back(std::move(job));
     for (std::size_t a = axes.size(); a-- > 0;) {

@@ -7,46 +7,17 @@
 
 #include "plot_canvas.hpp"
 
-#if defined(__GNUC__)
-#pragma GCC diagnostic push
-#pragma GCC diagnostic ignored "-Wunused-function"
-#pragma GCC diagnostic ignored "-Wconversion"
-#pragma GCC diagnostic ignored "-Wsign-conversion"
-#pragma GCC diagnostic ignored "-Wold-style-cast"
-#pragma GCC diagnostic ignored "-Wuseless-cast"
-#pragma GCC diagnostic ignored "-Wdouble-promotion"
-#endif
-#include <stb/stb_easy_font.h>
-#if defined(__GNUC__)
-#pragma GCC diagnostic pop
-#endif
 
 namespace fovea::sweep {
 namespace {
 
 const glm::vec4 kInk{0.1f, 0.1f, 0.1f, 1};
 
-// stb_easy_font emits axis-aligned quads (4 vertices of x, y, z, rgba8) for 7-pixel-high
-// glyphs; each quad is filled as a rectangle `scale` times larger.
-int text_width(const std::string& s, int scale) {
-  return stb_easy_font_width(const_cast<char*>(s.c_str())) * scale;
-}
+// The canvas' 5x7 font, `scale` pixels per font pixel (lower case drawn as upper case).
+int text_width(const std::string& s, int scale) { return tools::Canvas::text_width(s, scale); }
 
-void draw_text(tools::Canvas& c, std::string s, double x, double y, int scale, glm::vec4 color) {
-  struct Vertex {
-    float x, y, z;
-    unsigned char rgba[4];
-  };
-  std::vector<Vertex> buf(s.size() * 64 + 64);
-  unsigned char col[4] = {0, 0, 0, 255};
-  const int quads = stb_easy_font_print(0, 0, s.data(), col, buf.data(), int(buf.size() * sizeof(Vertex)));
-  for (int q = 0; q < quads; ++q) {
-    const Vertex* v = &buf[std::size_t(q) * 4];
-    float x0 = v[0].x, x1 = v[0].x, y0 = v[0].y, y1 = v[0].y;
-    for (int k = 1; k < 4; ++k) x0 = std::min(x0, v[k].x), x1 = std::max(x1, v[k].x), y0 = std::min(y0, v[k].y), y1 = std::max(y1, v[k].y);
-    c.rect(int(std::lround(x + x0 * scale)), int(std::lround(y + y0 * scale)), int(std::lround(x + x1 * scale)),
-           int(std::lround(y + y1 * scale)), color);
-  }
+void draw_text(tools::Canvas& c, const std::string& s, double x, double y, int scale, glm::vec4 color) {
+  c.text(int(std::lround(x)), int(std::lround(y)), s, scale, color);
 }
 
 void disc(tools::Canvas& c, double cx, double cy, double r, glm::vec4 color) {
@@ -128,8 +99,12 @@ core::Image draw_chart(const Chart& chart, int W, int H) {
   auto px = [&](double v) { return x0 + (x1 - x0) * (v - rx.lo) / (rx.hi - rx.lo); };
   auto py = [&](double v) { return y1 - (y1 - y0) * (v - ry.lo) / (ry.hi - ry.lo); };
 
-  draw_text(c, chart.title, (W - text_width(chart.title, 3)) / 2.0, 14, 3, kInk);
-  if (!chart.note.empty()) draw_text(c, chart.note, (W - text_width(chart.note, 2)) / 2.0, 48, 2, {0.3f, 0.3f, 0.3f, 1});
+  // Title and note shrink to the width when they would not fit.
+  const int title_scale = text_width(chart.title, 3) <= W - 20 ? 3 : 2;
+  const int note_scale = text_width(chart.note, 2) <= W - 20 ? 2 : 1;
+  draw_text(c, chart.title, (W - text_width(chart.title, title_scale)) / 2.0, 14, title_scale, kInk);
+  if (!chart.note.empty())
+    draw_text(c, chart.note, (W - text_width(chart.note, note_scale)) / 2.0, 48, note_scale, {0.3f, 0.3f, 0.3f, 1});
   const auto xt = nice_ticks(rx.lo, rx.hi, 8), yt = nice_ticks(ry.lo, ry.hi, 7);
   for (double t : xt) {
     c.line(px(t), y0, px(t), y1, {0, 0, 0, 0.08f});

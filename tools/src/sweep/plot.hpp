@@ -1,6 +1,6 @@
 #pragma once
 // Line and scatter charts as PNG-ready images: axes with numbered ticks, axis labels,
-// title and legend. Text is stb_easy_font's vector font scaled up, so no font file is needed.
+// title and legend. Text is the plot canvas' built-in 5x7 font (plot_canvas.hpp), so no font file is needed.
 #include <string>
 #include <vector>
 

@@ -33,6 +33,9 @@ bool lower_is_better_by_name(const std::string& metric);
 struct ReportOptions {
   std::string dir;  // results directory
   std::string out;  // where results.csv, results.json and the PNGs go
+  // Non-empty: also a Markdown page there (tables and the PNGs, linked relative to it).
+  std::string markdown;
+  std::string command;  // how the page is regenerated, quoted in its header
 };
 
 struct ReportSummary {

@@ -191,17 +191,23 @@ class Pool {
     fs::remove_all(r.tmp);
     fs::create_directories(r.tmp);
     r.start = Clock::now();
-    r.pid = spawn(t.commands[0], t.out, r.tmp);
+    r.pid = spawn(t, 0, r.tmp);
     running_.push_back(r);
   }
 
   // argv[0] "fovea" is this program; arguments naming the task's output (out or out/...)
-  // are redirected into the temporary directory.
-  pid_t spawn(const std::vector<std::string>& argv, const std::string& out, const fs::path& tmp) {
-    std::vector<std::string> args = argv;
+  // are redirected into the temporary directory, those naming a shared input it needs
+  // (shared/<id> or below) into the results directory.
+  pid_t spawn(const Task& t, std::size_t command, const fs::path& tmp) {
+    std::vector<std::string> args = t.commands[command];
+    const std::string& out = t.out;
+    const auto under = [](const std::string& a, const std::string& dir) { return a == dir || a.rfind(dir + "/", 0) == 0; };
     if (!args.empty() && args[0] == "fovea") args[0] = o_.fovea_exe;
-    for (std::size_t k = 1; k < args.size(); ++k)
-      if (args[k] == out || args[k].rfind(out + "/", 0) == 0) args[k] = tmp.string() + args[k].substr(out.size());
+    for (std::size_t k = 1; k < args.size(); ++k) {
+      if (under(args[k], out)) args[k] = tmp.string() + args[k].substr(out.size());
+      for (const std::string& id : t.needs)
+        if (under(args[k], "shared/" + id)) args[k] = (dir_ / args[k]).string();
+    }
     std::vector<char*> cargv;
     for (auto& a : args) cargv.push_back(a.data());
     cargv.push_back(nullptr);
@@ -236,7 +242,7 @@ class Pool {
     const bool ok = WIFEXITED(status) && WEXITSTATUS(status) == 0;
     if (ok && r.command + 1 < t.commands.size()) {
       it->command = r.command + 1;
-      it->pid = spawn(t.commands[it->command], t.out, r.tmp);
+      it->pid = spawn(t, it->command, r.tmp);
       return;
     }
     running_.erase(it);

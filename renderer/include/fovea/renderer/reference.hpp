@@ -17,11 +17,13 @@ struct ReferenceOptions {
   PathConfig path;                  // path.spp = samples per batch; jitter is forced on
   std::uint32_t max_spp = 256;      // stop at this many samples per pixel
   double until_rel_error = 0;       // > 0: stop earlier once rel_error <= this (>= 4 batches)
+  double until_pixel_rel_error = 0; // > 0: stop earlier once pixel_rel_error <= this (>= 4 batches)
 };
 
 struct ReferenceProgress {
   std::uint32_t spp = 0;
-  double rel_error = 0;  // NaN until two batches exist
+  double rel_error = 0;        // NaN until two batches exist
+  double pixel_rel_error = 0;  // NaN until two batches exist
   double seconds = 0;
 };
 
@@ -32,6 +34,10 @@ struct ReferenceResult {
   // Relative standard error of the image-mean luminance, from the spread of the
   // per-batch image means (batch-means estimator).
   double rel_error = 0;
+  // √(mean over pixels of se² / (Y² + 0.01)), se the standard error of the pixel's
+  // luminance Y from its batch means: the reference's own expected relMSE (core/metrics'
+  // form), rooted — the noise left in the pixels, not only in the image mean.
+  double pixel_rel_error = 0;
   double seconds = 0;
 };
 
@@ -41,6 +47,9 @@ ReferenceResult render_reference(gpu::Context& ctx, const GpuScene& scene, const
 
 // OpenEXR, 32-bit float RGBA, written through a temporary file and renamed.
 void write_exr(const std::string& path, const core::Image& img);
+// Reads an RGBA OpenEXR file; InputError naming the file when it cannot be read or holds
+// non-finite values.
+core::Image read_exr(const std::string& path);
 // Tone map for display: core::tonemap_linear (exposure 0, the ACES fit the metrics use,
 // docs/metrics.md), alpha 1; write_png adds the sRGB OETF.
 core::Image tone_map(const core::Image& linear);

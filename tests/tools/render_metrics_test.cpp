@@ -1,0 +1,202 @@
+// `fovea render`'s quality metrics and references: the report's tone-mapped, FLIP, fovea,
+// foveated, per-band and flicker fields; more samples score better; a render compared with
+// itself scores FLIP 0; the reference cache (second run reads it, a changed scene byte
+// changes the key); a sweep renders a reference shared by its jobs once.
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <string>
+
+#include <gtest/gtest.h>
+#include <nlohmann/json.hpp>
+
+#include "cli.hpp"
+
+namespace {
+
+namespace fs = std::filesystem;
+using fovea::test::run_fovea;
+using nlohmann::json;
+
+json read_json(const std::string& path) {
+  std::ifstream in(path);
+  return json::parse(in);
+}
+
+// A gaze recording that never moves: the scene, head and gaze are still.
+std::string fixed_gaze(const std::string& dir) {
+  const std::string path = dir + "/fixed.csv";
+  std::ofstream(path) << "t_ns,eye,dir_x,dir_y,dir_z,confidence,flags\n"
+                         "0,combined,0.05,0.02,-1,1,1\n"
+                         "10000000000,combined,0.05,0.02,-1,1,1\n";
+  return path;
+}
+
+json render(const std::string& args, const std::string& out) {
+  const auto r = run_fovea("render --display tiny --scene cornell --quiet --png-every 0 " + args + " --out " + out);
+  EXPECT_EQ(r.status, 0) << args << "\n" << r.err;
+  return read_json(out + "/report.json");
+}
+
+const char* kScores[] = {"psnr", "ssim", "rel_mse", "ldr_flip", "hdr_flip"};
+
+TEST(RenderMetrics, ReportHasEveryScoreFiniteWithToneMapperAndFlicker) {
+  const std::string dir = fovea::test::temp_dir("metrics");
+  const json j = render("--frames 3 --gaze " + fixed_gaze(dir) + " --reference 8 --reference-cache " + dir + "/cache",
+                        dir + "/r");
+  EXPECT_NE(j["metrics"]["tone_mapper"].get<std::string>().find("ACES"), std::string::npos);
+  EXPECT_EQ(j["metrics"]["exposure"], 0.0);
+  EXPECT_GT(j["metrics"]["ppd"].get<double>(), 0.0);
+  EXPECT_EQ(j["config"]["stereo_share"], "gather");  // sharing is on by default
+  for (const char* eye : {"left", "right"}) {
+    const json& s = j["summary"][eye];
+    for (const char* prefix : {"", "fovea_", "foveated_"})
+      for (const char* k : kScores) {
+        const std::string name = std::string(prefix) + k;
+        ASSERT_TRUE(s.contains(name)) << eye << "." << name;
+        EXPECT_TRUE(std::isfinite(s[name].get<double>())) << eye << "." << name;
+      }
+    EXPECT_GE(s["hdr_flip"].get<double>(), 0.0);
+    EXPECT_LE(s["hdr_flip"].get<double>(), 1.0);
+    ASSERT_GT(s["bands"].size(), 3u);
+    for (const json& b : s["bands"]) {
+      EXPECT_EQ(b["e_max"].get<double>() - b["e_min"].get<double>(), 2.0);
+      for (const char* k : kScores) EXPECT_TRUE(std::isfinite(b[k].get<double>())) << k;
+    }
+    // Three frames with the gaze held: flicker over all three.
+    EXPECT_EQ(s["flicker_frames"], 3);
+    for (const char* k : {"flicker", "fovea_flicker", "foveated_flicker"}) {
+      EXPECT_TRUE(std::isfinite(s[k].get<double>())) << k;
+      EXPECT_GT(s[k].get<double>(), 0.0) << k;  // a 1-spp path tracer is never still
+    }
+    EXPECT_EQ(j["metrics"]["reference"][eye]["spp"].get<int>(), 8);
+  }
+  fs::remove_all(dir);
+}
+
+// Eight frames accumulate eight samples per cell at a still gaze; one frame has one.
+TEST(RenderMetrics, MoreSamplesScoreBetter) {
+  const std::string dir = fovea::test::temp_dir("metrics-spp");
+  const std::string common = "--denoiser none --distribution cartesian --gaze " + fixed_gaze(dir) +
+                             " --reference 64 --reference-cache " + dir + "/cache";
+  const json one = render("--frames 1 " + common, dir + "/one");
+  const json eight = render("--frames 8 " + common, dir + "/eight");
+  for (const char* eye : {"left", "right"}) {
+    const json &a = one["summary"][eye], &b = eight["summary"][eye];
+    EXPECT_GT(b["psnr"].get<double>(), a["psnr"].get<double>() + 1.0) << eye;
+    EXPECT_GT(b["fovea_psnr"].get<double>(), a["fovea_psnr"].get<double>()) << eye;
+    EXPECT_LT(b["hdr_flip"].get<double>(), a["hdr_flip"].get<double>()) << eye;
+    EXPECT_LT(b["foveated_ldr_flip"].get<double>(), a["foveated_ldr_flip"].get<double>()) << eye;
+    EXPECT_LT(b["rel_mse"].get<double>(), a["rel_mse"].get<double>()) << eye;
+  }
+  // The second render found both eyes' references in the cache.
+  EXPECT_FALSE(one["metrics"]["reference"]["left"]["cached"].get<bool>());
+  EXPECT_TRUE(eight["metrics"]["reference"]["left"]["cached"].get<bool>());
+  EXPECT_EQ(one["metrics"]["reference"]["left"]["key"], eight["metrics"]["reference"]["left"]["key"]);
+  fs::remove_all(dir);
+}
+
+// A render is deterministic: its own last frame, passed as the reference, scores identical.
+TEST(RenderMetrics, ARenderAgainstItselfScoresFlipZero) {
+  const std::string dir = fovea::test::temp_dir("metrics-self");
+  const std::string args = "--frames 2 --gaze synthetic:3 --reference 4 --reference-cache off";
+  render(args, dir + "/a");
+  for (const char* eye : {"left", "right"})
+    fs::copy_file(dir + "/a/last_" + eye + ".exr", dir + "/a/reference_" + eye + ".exr",
+                  fs::copy_options::overwrite_existing);
+  const json j = render("--frames 2 --gaze synthetic:3 --reference " + dir + "/a", dir + "/b");
+  for (const char* eye : {"left", "right"}) {
+    const json& s = j["summary"][eye];
+    for (const char* prefix : {"", "fovea_", "foveated_"}) {
+      EXPECT_EQ(s[std::string(prefix) + "hdr_flip"].get<double>(), 0.0) << eye << prefix;
+      EXPECT_EQ(s[std::string(prefix) + "ldr_flip"].get<double>(), 0.0) << eye << prefix;
+      EXPECT_EQ(s[std::string(prefix) + "psnr"].get<double>(), 100.0) << eye << prefix;
+    }
+  }
+  // A reference of another scene is refused before rendering, naming the file.
+  const auto r = run_fovea("render --display tiny --scene glossy-spheres --frames 1 --quiet --reference " + dir +
+                           "/a --out " + dir + "/c");
+  EXPECT_EQ(r.status, 2);
+  EXPECT_NE(r.err.find("reference_left.json"), std::string::npos) << r.err;
+  EXPECT_FALSE(fs::exists(dir + "/c/report.json"));
+  fs::remove_all(dir);
+}
+
+TEST(ReferenceCache, SecondRunReadsTheCacheAndASceneByteChangesTheKey) {
+  const std::string dir = fovea::test::temp_dir("refcache");
+  const std::string scene = dir + "/quad.obj";
+  std::ofstream(scene) << "v -1 -1 -3\nv 1 -1 -3\nv 1 1 -3\nv -1 1 -3\nf 1 2 3\nf 1 3 4\n";
+  auto reference = [&](const std::string& out) {
+    const auto r = run_fovea("reference --display tiny --scene " + scene + " --spp 4 --batch 2 --quiet --reference-cache " +
+                             dir + "/cache --out " + dir + "/" + out);
+    EXPECT_EQ(r.status, 0) << r.err;
+    return json::parse(r.out);
+  };
+  const json first = reference("a.exr"), second = reference("b.exr");
+  EXPECT_FALSE(first["cached"].get<bool>());
+  EXPECT_TRUE(second["cached"].get<bool>());
+  EXPECT_EQ(first["key"], second["key"]);
+  EXPECT_EQ(second["spp"], 4);
+  // The entry and the outputs record their key.
+  EXPECT_TRUE(fs::exists(dir + "/cache/" + first["key"].get<std::string>() + ".exr"));
+  EXPECT_EQ(read_json(dir + "/b.json")["key"], first["key"]);
+  std::ofstream(scene, std::ios::app) << "#\n";  // one more byte, same geometry
+  const json changed = reference("c.exr");
+  EXPECT_FALSE(changed["cached"].get<bool>());
+  EXPECT_NE(changed["key"], first["key"]);
+  // Other settings, other key.
+  const auto r = run_fovea("reference --display tiny --scene " + scene + " --spp 4 --batch 2 --bounces 1 --quiet " +
+                           "--reference-cache " + dir + "/cache --out " + dir + "/d.exr");
+  ASSERT_EQ(r.status, 0) << r.err;
+  EXPECT_NE(json::parse(r.out)["key"], changed["key"]);
+  fs::remove_all(dir);
+}
+
+TEST(SweepSharedReference, TwoJobsOnOneSceneRenderTheReferenceOnce) {
+  const std::string dir = fovea::test::temp_dir("sweep-ref");
+  std::ofstream(dir + "/sweep.json") << R"({"scenes": "cornell", "displays": "tiny", "frames": 1, "gaze": "synthetic:3",
+    "distribution": "visual-polar", "budget": [0.2, 0.3], "reference": 4, "reference-cache": "off"})";
+  ASSERT_EQ(run_fovea("sweep plan " + dir + "/sweep.json --out " + dir + "/plan.jsonl").status, 0);
+  const auto r = run_fovea("sweep run " + dir + "/plan.jsonl --jobs 1 --quiet");
+  ASSERT_EQ(r.status, 0) << r.err;
+  int shared = 0;
+  for (const auto& e : fs::directory_iterator(dir + "/shared")) {
+    ++shared;
+    EXPECT_TRUE(fs::exists(e.path() / "reference_left.json"));
+  }
+  EXPECT_EQ(shared, 1);
+  std::string key;
+  int jobs = 0;
+  for (const auto& e : fs::directory_iterator(dir + "/jobs")) {
+    const json j = read_json((e.path() / "report.json").string());
+    const json& ref = j["metrics"]["reference"]["left"];
+    EXPECT_TRUE(ref["cached"].get<bool>()) << "the job rendered its own reference";
+    if (key.empty()) key = ref["key"];
+    EXPECT_EQ(ref["key"], key);
+    EXPECT_FALSE(fs::exists(e.path() / "reference_left.exr"));
+    ++jobs;
+  }
+  EXPECT_EQ(jobs, 2);
+  fs::remove_all(dir);
+}
+
+// Budgets the distribution cannot meet exit 2 naming what it reaches; linear fall-off renders
+// and traces its budget.
+TEST(RenderBudget, RefusedBudgetsExitTwoAndLinearFalloffRenders) {
+  const std::string dir = fovea::test::temp_dir("budget");
+  for (const auto& [args, says] : {std::pair{"--distribution visual-polar --budget 0.9", "reaches at most"},
+                                   std::pair{"--distribution linear-falloff --budget 0.05", "reaches no less than"},
+                                   std::pair{"--distribution cartesian --budget 0.5", "cartesian-uniform"}}) {
+    const auto r = run_fovea(std::string("render --display tiny --frames 1 --quiet ") + args + " --out " + dir + "/x");
+    EXPECT_EQ(r.status, 2) << args;
+    EXPECT_NE(r.err.find(says), std::string::npos) << args << ": " << r.err;
+  }
+  const json j = render("--frames 1 --gaze synthetic:3 --distribution linear-falloff --budget 0.5", dir + "/lf");
+  EXPECT_EQ(j["config"]["distribution"], "linear-falloff");
+  // Traced: the kept cells minus the lens' hidden ones, so at most the budget (+5%).
+  EXPECT_LT(j["samples_traced_per_eye"].get<double>(), 1.05 * 0.5 * 64 * 72);
+  EXPECT_GT(j["samples_traced_per_eye"].get<double>(), 0.3 * 64 * 72);
+  fs::remove_all(dir);
+}
+
+}  // namespace

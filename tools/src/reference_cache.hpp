@@ -1,0 +1,54 @@
+#pragma once
+// Converged references of one eye, cached on disk so that runs and sweep jobs do not pay for
+// them again. An entry is <key>.exr (linear RGBA, float) with <key>.json beside it, which
+// records the key, everything the key hashes and the stop statistics; the JSON is written
+// last, so an entry without it is incomplete and ignored. docs/metrics.md, "Reference".
+#include <cstdint>
+#include <functional>
+#include <string>
+
+#include "fovea/core/view.hpp"
+#include "fovea/renderer/reference.hpp"
+
+namespace fovea::tools {
+
+struct ReferenceSettings {
+  std::uint32_t max_spp = 256;
+  std::uint32_t batch = 16;
+  int bounces = -1;             // unbounded, Russian roulette from rr_start
+  std::uint32_t rr_start = 3;
+  double until_rel_error = 0;        // image-mean luminance
+  double until_pixel_rel_error = 0;  // RMS of the per-pixel standard errors
+};
+
+// `dir` empty: no cache. `scene` is the --scene argument (a file's bytes are hashed).
+struct ReferenceRequest {
+  std::string scene;
+  ReferenceSettings settings;
+  std::string cache_dir;
+};
+
+struct CachedReference {
+  renderer::ReferenceResult result;
+  std::string key;         // 16 hex digits
+  std::string identity;    // the canonical JSON the key hashes
+  bool from_cache = false;
+};
+
+// $XDG_CACHE_HOME/fovea/references, else $HOME/.cache/fovea/references, else
+// out/reference-cache.
+std::string default_reference_cache();
+// "off" -> "", otherwise the directory itself; absent -> default_reference_cache().
+std::string reference_cache_arg(const std::string* value);
+
+CachedReference cached_reference(gpu::Context& ctx, const renderer::GpuScene& scene, const core::View& view,
+                                 core::Eye eye, const ReferenceRequest& request,
+                                 const std::function<void(const renderer::ReferenceProgress&)>& progress = {});
+
+// Writes `exr` and its description `<exr without extension>.json` (atomically, JSON last).
+void write_reference(const std::string& exr, const CachedReference& ref);
+// Reads a reference written by write_reference and checks that it shows `view` of `scene`
+// from `eye` (InputError naming the file otherwise).
+CachedReference read_reference(const std::string& exr, const std::string& scene, const core::View& view, core::Eye eye);
+
+}  // namespace fovea::tools
