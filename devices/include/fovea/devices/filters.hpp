@@ -14,6 +14,7 @@
 
 #include "fovea/devices/gaze.hpp"
 #include "fovea/devices/ivt.hpp"
+#include "fovea/devices/saccade_predict.hpp"
 
 namespace fovea::devices {
 
@@ -46,6 +47,8 @@ struct FilterParams {
 std::unique_ptr<SampleStream> apply_filters(std::unique_ptr<SampleStream> inner, std::string_view spec, const FilterParams& p);
 
 struct PredictParams {
+  PredictMode mode = PredictMode::Linear;         // None predicts nothing
+  LandingParams landing;                          // PredictMode::Landing
   double saccade_deg_s = 30;                      // above: a saccade, no extrapolation
   core::TimeNs velocity_window_ns = 30'000'000;   // velocity from the samples of the last 30 ms
 };
