@@ -215,6 +215,7 @@ XrResult api::xrEndFrame(XrSession session, const XrFrameEndInfo* info) {
     // Submitted at the call: the panel images below are the simulator's output, not part of
     // the application's frame, so their cost does not delay the display of this frame.
     r.displayed_ns = s->clock.displayed(r.predicted_display_ns, t_call);
+    s->compositor->observe_frame(r.frame, g, r.displayed_ns);
     if (s->compositor->wants(r.frame)) {
       const core::TimeNs t0 = core::now_ns();
       try {
