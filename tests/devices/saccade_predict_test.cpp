@@ -27,6 +27,17 @@ struct Recorded {
   std::vector<SynthEvent> saccades;  // SynthEvent::Saccade only
 };
 
+// The synthetic eye without dropouts (blinks stay).
+SynthParams eye(std::uint64_t seed, double seconds, double rate_hz, double noise_deg) {
+  SynthParams p;
+  p.seed = seed;
+  p.seconds = seconds;
+  p.rate_hz = rate_hz;
+  p.noise_deg = noise_deg;
+  p.dropout_per_s = 0;
+  return p;
+}
+
 Recorded record(SynthParams p) {
   SyntheticStream s(p);
   Recorded r;
@@ -57,13 +68,7 @@ bool finite(const glm::dvec3& d) { return std::isfinite(d.x) && std::isfinite(d.
 // predicted landing point is far closer to the true one than the saccade is long.
 TEST(SaccadeLanding, PredictsTheLandingPointFromTheEarlyProfile) {
   for (auto [rate, noise] : {std::pair{1000.0, 0.0}, std::pair{250.0, 0.0}, std::pair{120.0, 0.25}}) {
-    SynthParams p;
-    p.seed = 5;
-    p.seconds = 60;
-    p.rate_hz = rate;
-    p.noise_deg = noise;
-    p.dropout_per_s = 0;
-    const Recorded r = record(p);
+    const Recorded r = record(eye(5, 60, rate, noise));
     std::vector<double> rel30, rel50, rel30_held;
     int unsure = 0;
     for (const SynthEvent& e : r.saccades) {
@@ -116,13 +121,7 @@ struct Cut {
   double amplitude_deg;
 };
 Cut half_way_saccade(double min_amp) {
-  SynthParams p;
-  p.seed = 9;
-  p.seconds = 30;
-  p.rate_hz = 1000;
-  p.noise_deg = 0;
-  p.dropout_per_s = 0;
-  const Recorded r = record(p);
+  const Recorded r = record(eye(9, 30, 1000, 0));
   for (const SynthEvent& e : r.saccades) {
     const TimeNs cut = (e.start_ns + e.end_ns) / 2;
     Cut c{history_until(r.samples, cut), at_time(r.samples, e.end_ns).combined.dir, e.amplitude_deg};
@@ -185,7 +184,7 @@ TEST(SaccadeLanding, DropoutsMidSaccadeAreBridged) {
 // The marker's trigger: every saccade of the synthetic eye (120 Hz, its default 0.05° noise)
 // fires exactly once, inside the saccade; fixations (with microsaccades below 1°) never do.
 TEST(SaccadeOnset, FiresOncePerSaccade) {
-  SynthParams p;
+  SynthParams p;  // with its default noise and dropouts
   p.seed = 3;
   p.seconds = 60;
   const Recorded r = record(p);
@@ -221,13 +220,7 @@ TEST(SaccadeOnset, FiresOncePerSaccade) {
 TEST(SaccadeLanding, PredictionModeFromTheUri) {
   // An ideal 1 kHz tracker whose samples arrive 40 ms after they were measured.
   const std::string base = "synthetic:9?seconds=30&rate=1000&noise=0&dropouts=0&tracker=ideal&tracker_delay=40ms";
-  SynthParams p;
-  p.seed = 9;
-  p.seconds = 30;
-  p.rate_hz = 1000;
-  p.noise_deg = 0;
-  p.dropout_per_s = 0;
-  const Recorded r = record(p);
+  const Recorded r = record(eye(9, 30, 1000, 0));
   FoveationGaze none(base + "&predict=none", SourceOptions{}), landing(base + "&predict=landing", SourceOptions{});
   none.set_epoch(0);
   landing.set_epoch(0);
