@@ -164,8 +164,6 @@ LandingEstimate estimate_landing(const std::deque<GazeSample>& h, std::size_t co
   const auto amp_of_speed = [](double v) {
     return -main_sequence::kCDeg * std::log(1 - std::min(v, 0.99 * main_sequence::kVmaxDegS) / main_sequence::kVmaxDegS);
   };
-  // Least squares over the onset time (between the last fixation sample and the first one in
-  // flight) and the amplitude within those bounds: a grid, then golden section.
   // Noise can make intervals before the onset fast too: the saccade starts after the last
   // sample still within the fixation's noise (3σ), and, as that sample may already be
   // moving slowly, possibly somewhat before it.
@@ -178,6 +176,8 @@ LandingEstimate estimate_landing(const std::deque<GazeSample>& h, std::size_t co
   const double speed_noise = 2 * std::sqrt(2.0) * noise_deg / (static_cast<double>(p.speed_span_ns) * 1e-9);
   const double lo = std::clamp(std::max(e.progress_deg, amp_of_speed(0.8 * (peak - speed_noise))), 0.1, p.max_amplitude_deg);
   const double hi = std::clamp(amp_of_speed(now < 0.8 * peak ? 1.25 * peak : 1.5 * peak + speed_noise), lo, p.max_amplitude_deg);
+  // Least squares over the onset time (from somewhat before the last still sample to the
+  // first one in flight) and the amplitude within those bounds: a grid, then golden section.
   constexpr int kOnsets = 16, kAmps = 64;
   double best = INFINITY, best_amp = lo;
   core::TimeNs best_t0 = anchor.t;
