@@ -26,6 +26,15 @@ glm::dvec3 from_angles(glm::dvec2 a) {
   return glm::normalize(glm::dvec3(std::tan(a.x / kDeg), std::tan(a.y / kDeg), -1.0));
 }
 EyeGaze& slot(GazeSample& s, int i) { return i == 0 ? s.combined : i == 1 ? s.left : s.right; }
+// Moves every tracked eye by the same change of gaze angles (the eyes keep their vergence).
+GazeSample shifted(GazeSample s, glm::dvec2 delta) {
+  for (int k = 0; k < 3; ++k) {
+    EyeGaze& g = slot(s, k);
+    glm::dvec2 a;
+    if (g.tracked() && to_angles(g.dir, a)) g.dir = from_angles(a + delta);
+  }
+  return s;
+}
 
 // ---- ivt: gap fill + classification ---------------------------------------------------
 class IvtStream final : public SampleStream {
@@ -185,7 +194,15 @@ GazeSample GazePredictor::predict(const std::deque<GazeSample>& h, std::size_t c
   if (!last.tracked() || t <= last.t_ns) return out;
   const double ahead = static_cast<double>(std::min(t - last.t_ns, horizon)) * 1e-9;
   glm::dvec2 a_last;
-  if (!to_angles(last.combined.dir, a_last)) return out;
+  if (p_.mode == PredictMode::None || !to_angles(last.combined.dir, a_last)) return out;
+  if (p_.mode == PredictMode::Landing) {
+    // A fitted saccade in flight: its trajectory at t, i.e. its landing point once it is
+    // over. Not capped by the horizon: the fit bounds it (Arabadzhiyska et al. 2017 render
+    // for the landing point for the rest of the saccade).
+    const LandingEstimate e = estimate_landing(h, count, p_.landing);
+    glm::dvec2 a_pred;
+    if (e.confident && to_angles(e.at(t), a_pred)) return shifted(out, a_pred - a_last);
+  }
   // Sample-to-sample speeds backwards from the newest: the current motion and, in a
   // saccade, its onset and peak.
   std::size_t i = count - 1;
@@ -231,13 +248,7 @@ GazeSample GazePredictor::predict(const std::deque<GazeSample>& h, std::size_t c
     const glm::dvec2 v = (a_last - window_start) / (static_cast<double>(last.t_ns - window_t) * 1e-9);
     pred = a_last + v * ahead;  // constant velocity (fixation drift, pursuit)
   }
-  const glm::dvec2 delta = pred - a_last;
-  for (int k = 0; k < 3; ++k) {
-    EyeGaze& g = slot(out, k);
-    glm::dvec2 a;
-    if (g.tracked() && to_angles(g.dir, a)) g.dir = from_angles(a + delta);
-  }
-  return out;
+  return shifted(out, pred - a_last);
 }
 
 }  // namespace fovea::devices

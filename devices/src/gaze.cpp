@@ -21,6 +21,22 @@ namespace fovea::devices {
 
 void SampleStream::rewind() { throw std::logic_error(describe() + ": not rewindable"); }
 
+PredictMode parse_predict_mode(std::string_view s) {
+  if (s == "none") return PredictMode::None;
+  if (s == "linear") return PredictMode::Linear;
+  if (s == "landing") return PredictMode::Landing;
+  throw core::InputError("unknown prediction mode \"" + std::string(s) + "\" (none, linear, landing)");
+}
+
+const char* predict_mode_name(PredictMode m) {
+  switch (m) {
+    case PredictMode::None: return "none";
+    case PredictMode::Linear: return "linear";
+    case PredictMode::Landing: return "landing";
+  }
+  return "?";
+}
+
 EyeGaze combine_eyes(const EyeGaze& l, const EyeGaze& r) {
   EyeGaze c;
   if (l.tracked() && r.tracked()) {
@@ -140,6 +156,13 @@ void SourceUri::finish() const {
 
 void apply_common_options(SourceUri& u, SourceOptions& opt) {
   opt.horizon_ns = std::llround(u.take_number("horizon_ms", static_cast<double>(opt.horizon_ns) * 1e-6, 0, 1000) * 1e6);
+  if (auto m = u.take("predict"); !m.empty()) {
+    try {
+      opt.predict = parse_predict_mode(m);
+    } catch (const core::InputError& e) {
+      throw core::InputError("gaze source \"" + u.text + "\": " + e.what());
+    }
+  }
   opt.min_confidence = u.take_number("min_confidence", opt.min_confidence, 0, 1);
   if (auto f = u.take("filters"); !f.empty()) opt.filters = f;
   // The 2-D gaze geometry: the one place a URI sets it, so the layer's config and the

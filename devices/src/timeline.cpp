@@ -7,7 +7,7 @@
 namespace fovea::devices {
 
 TimelineSource::TimelineSource(std::unique_ptr<SampleStream> stream, const SourceOptions& opt)
-    : stream_(std::move(stream)), opt_(opt), opened_ns_(core::now_ns()) {}
+    : stream_(std::move(stream)), opt_(opt), opened_ns_(core::now_ns()), predictor_(PredictParams{.mode = opt.predict}) {}
 
 void TimelineSource::restart() {
   stream_->rewind();
@@ -69,7 +69,7 @@ GazeSample TimelineSource::at_recording_time(core::TimeNs tt) {
     s.combined.confidence = s.left.confidence = s.right.confidence = 0;
     return s;
   }
-  return opt_.horizon_ns > 0 ? predictor_.predict(win_, count, tt, opt_.horizon_ns) : s;
+  return opt_.predicts() ? predictor_.predict(win_, count, tt, opt_.horizon_ns) : s;
 }
 
 GazeSample TimelineSource::sample_at(core::TimeNs t) {

@@ -122,7 +122,11 @@ struct TrackerModel::Generator {
 };
 
 TrackerModel::TrackerModel(std::unique_ptr<GazeSource> truth, const TrackerParams& params, const SourceOptions& opt)
-    : truth_(std::move(truth)), params_(params), opt_(opt), opened_ns_(core::now_ns()) {
+    : truth_(std::move(truth)),
+      params_(params),
+      opt_(opt),
+      predictor_(PredictParams{.mode = opt.predict}),
+      opened_ns_(core::now_ns()) {
   params_.validate();
   if (!truth_) throw core::InputError("tracker model: no ground-truth gaze source");
   if (truth_->is_live())
@@ -216,7 +220,7 @@ GazeSample TrackerModel::sample_at(core::TimeNs t) {
     }
     return s;
   }
-  return opt_.horizon_ns > 0 && t > s.t_ns ? predictor_.predict(win_, count, t, opt_.horizon_ns) : s;
+  return opt_.predicts() && t > s.t_ns ? predictor_.predict(win_, count, t, opt_.horizon_ns) : s;
 }
 
 GazeSample TrackerModel::latest() { return sample_at(params_.host_clock ? core::now_ns() : core::now_ns() - opened_ns_); }

@@ -3,7 +3,9 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <cstdlib>
 #include <cstring>
+#include <fstream>
 #include <stdexcept>
 
 #include "fovea/compositor/distortion.hpp"
@@ -74,7 +76,9 @@ Compositor::Compositor(VkPhysicalDevice physical, VkDevice device, OneShotQueue&
       hidden_(hidden),
       lens_(lens),
       out_dir_(std::move(out_dir)),
-      png_every_(png_every) {
+      png_every_(png_every),
+      marker_config_(compositor::marker_config([](const char* name) -> const char* { return std::getenv(name); })),
+      marker_(marker_config_) {
   const char* mode = lens_ == LensMode::Gpu   ? "lens distortion + hidden area (GPU pass)"
                      : lens_ == LensMode::Cpu ? "lens distortion + hidden area (CPU reference)"
                                               : "undistorted view + hidden area";
@@ -230,6 +234,26 @@ core::Image Compositor::read_back(const LayerView& v) {
   return img;
 }
 
+void Compositor::observe_frame(std::int64_t index, const GazeSample& gaze, core::TimeNs displayed_ns) {
+  if (marker_config_.mode == compositor::MarkerMode::Off) return;
+  if (gaze.sample_ns != last_gaze_ns_) {  // each real sample once
+    last_gaze_ns_ = gaze.sample_ns;
+    devices::GazeSample s;
+    s.t_ns = gaze.sample_ns;
+    s.combined = {gaze.dir, gaze.valid ? 1.0 : 0.0, gaze.valid ? devices::kTracked : devices::kLost};
+    if (onsets_.add(s)) marker_.trigger(gaze.sample_ns);
+  }
+  const compositor::MarkerSchedule::Frame f = marker_.next_frame();
+  lit_frame_ = f.lit ? index : -1;
+  if (!f.first || out_dir_.empty()) return;
+  std::ofstream log(out_dir_ + "/marker.jsonl", std::ios::app);
+  log << "{\"frame\":" << index << ",\"event_sample_ns\":"
+      << (f.event_sample_ns ? std::to_string(*f.event_sample_ns) : std::string("null")) << ",\"displayed_ns\":" << displayed_ns
+      << ",\"mode\":\"" << (marker_config_.mode == compositor::MarkerMode::Saccade ? "saccade" : "periodic")
+      << "\",\"frames\":" << marker_config_.frames << ",\"size_px\":" << marker_config_.size_px << "}\n";
+  if (!log) FOVEA_LOG_ERROR("marker: cannot append to %s/marker.jsonl", out_dir_.c_str());
+}
+
 ComposeTimes Compositor::compose(std::int64_t index, const std::vector<ProjectionLayer>& layers) {
   ComposeTimes times;
   core::TimeNs mark = core::now_ns();
@@ -283,6 +307,8 @@ ComposeTimes Compositor::compose(std::int64_t index, const std::vector<Projectio
         if (!visible[i]) rendered.pixels[i] = {0, 0, 0, 1};
       panel = std::move(rendered);
     }
+    if (marker_config_.mode != compositor::MarkerMode::Off)
+      compositor::draw_marker(panel, marker_config_.corner, marker_config_.size_px, lit_frame_ == index);
     lap(times.lens_ms);
     char name[64];
     std::snprintf(name, sizeof name, "/panel_%06lld_%s.png", static_cast<long long>(index), core::eye_name(eye));

@@ -17,6 +17,9 @@
 #include "fovea/core/hidden_area.hpp"
 #include "fovea/core/image.hpp"
 #include "fovea/compositor/distortion.hpp"
+#include "fovea/compositor/marker.hpp"
+#include "fovea/devices/saccade_predict.hpp"
+#include "gaze.hpp"
 #include "fovea/gpu/context.hpp"
 #include "vk_util.hpp"
 #include "xr.hpp"
@@ -65,6 +68,12 @@ class Compositor {
 
   static bool readable_format(VkFormat f);
 
+  // Marker mode (FOVEA_MARKER…, docs/marker.md), called once per ended frame before
+  // compose(): feeds the frame's gaze to the saccade-onset detector and advances the marker;
+  // compose() then draws it. Each event is appended to <out>/marker.jsonl with the gaze
+  // sample time behind it and the frame's display time.
+  void observe_frame(std::int64_t index, const GazeSample& gaze, core::TimeNs displayed_ns);
+
  private:
   // The view's rect in linear RGBA, read by sampling the image (xr_readback.comp on the
   // application's device): swapchain images carry the sampled usage the runtime adds, not
@@ -86,6 +95,11 @@ class Compositor {
   std::array<std::vector<std::uint8_t>, 2> visible_;
   std::string out_dir_;
   std::int64_t png_every_;
+  compositor::MarkerConfig marker_config_;
+  compositor::MarkerSchedule marker_;
+  devices::SaccadeOnsetDetector onsets_;
+  core::TimeNs last_gaze_ns_ = 0;
+  std::int64_t lit_frame_ = -1;  // the frame index observe_frame() lit
   // The read-back pipeline (created at the first composed frame).
   VkSampler sampler_ = VK_NULL_HANDLE;
   VkDescriptorSetLayout set_layout_ = VK_NULL_HANDLE;

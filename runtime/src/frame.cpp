@@ -218,6 +218,7 @@ XrResult api::xrEndFrame(XrSession session, const XrFrameEndInfo* info) {
     r.missed_vsyncs += (r.displayed_ns - r.predicted_display_ns) / s->clock.period();
     for (core::Eye e : {core::Eye::Left, core::Eye::Right})
       r.photon[std::size_t(e)] = s->clock.model().photons(r.displayed_ns, e);
+    s->compositor->observe_frame(r.frame, g, r.displayed_ns);
     if (s->compositor->wants(r.frame)) {
       const core::TimeNs t0 = core::now_ns();
       try {

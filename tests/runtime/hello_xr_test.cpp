@@ -164,5 +164,50 @@ TEST(HelloXr, CoreValidationClean) {
   EXPECT_EQ(text.find("VALID_ERROR"), std::string::npos) << text;
 }
 
+// Marker mode through the runtime's display stage: FOVEA_MARKER=periodic lights frames 0–3
+// and 8–11 (4 on, 4 off); the composed panels (frames 0, 4, 8) show a white 24-pixel square
+// in the top-right corner when lit and a black one when not, and marker.jsonl logs each
+// event with the display time the timing log has for that frame.
+TEST(HelloXr, MarkerOnThePanels) {
+  TempDir dir("hello_xr_marker");
+  auto env = runtime_env(dir.path(), kFrames, kPngEvery);
+  env["FOVEA_MARKER"] = "periodic";
+  env["FOVEA_MARKER_CORNER"] = "tr";
+  env["FOVEA_MARKER_SIZE"] = "24";
+  env["FOVEA_MARKER_FRAMES"] = "4";
+  const ProcessResult r = run_process({FOVEA_HELLO_XR, "-g", "Vulkan2"}, env, 120);
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  expect_clean_output(r);
+  for (int f : {0, 4, 8}) {
+    const bool lit = f != 4;
+    char name[64];
+    std::snprintf(name, sizeof name, "/panel_%06d_right.png", f);
+    const core::Image img = core::read_png(dir.path() + name);
+    ASSERT_EQ(img.width, 320);
+    int inside = 0, white_outside = 0;
+    for (int y = 0; y < img.height; ++y)
+      for (int x = 0; x < img.width; ++x) {
+        const glm::vec4 c = img.at(x, y);
+        const bool white = c.x == 1 && c.y == 1 && c.z == 1;
+        if (x >= img.width - 24 && y < 24) inside += lit ? white : (c.x == 0 && c.y == 0 && c.z == 0);
+        else white_outside += white;
+      }
+    EXPECT_EQ(inside, 24 * 24) << name;
+    EXPECT_LT(white_outside, img.width * img.height / 2) << name;  // the scene is still there
+  }
+  const auto frames = timing(dir.path());
+  ASSERT_EQ(frames.size(), size_t(kFrames));
+  std::vector<nlohmann::json> events;
+  std::ifstream in(dir.path() + "/marker.jsonl");
+  for (std::string line; std::getline(in, line);) events.push_back(nlohmann::json::parse(line));
+  ASSERT_EQ(events.size(), 2u);
+  for (size_t i = 0; i < events.size(); ++i) {
+    const std::int64_t f = events[i]["frame"].get<std::int64_t>();
+    EXPECT_EQ(f, std::int64_t(8 * i));
+    EXPECT_EQ(events[i]["displayed_ns"].get<std::int64_t>(), frames[size_t(f)]["displayed_ns"].get<std::int64_t>());
+    EXPECT_TRUE(events[i]["event_sample_ns"].is_null());  // periodic: no gaze event behind it
+  }
+}
+
 }  // namespace
 }  // namespace fovea::test

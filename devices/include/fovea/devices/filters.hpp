@@ -6,7 +6,8 @@
 //               gaze angles, reset after dropouts.
 // Prediction (GazePredictor) extrapolates to the display time at constant velocity during
 // fixation and pursuit, and never across a saccade onset (hold, or the landing estimate
-// from the main sequence once the peak velocity has passed). What the fovea does while the
+// from the main sequence once the peak velocity has passed); PredictMode::Landing fits the
+// saccade in flight instead (saccade_predict.hpp). What the fovea does while the
 // eye is not tracked is the foveation gaze's policy (foveation_gaze.hpp), not a filter.
 #include <deque>
 #include <memory>
@@ -14,6 +15,7 @@
 
 #include "fovea/devices/gaze.hpp"
 #include "fovea/devices/ivt.hpp"
+#include "fovea/devices/saccade_predict.hpp"
 
 namespace fovea::devices {
 
@@ -46,6 +48,8 @@ struct FilterParams {
 std::unique_ptr<SampleStream> apply_filters(std::unique_ptr<SampleStream> inner, std::string_view spec, const FilterParams& p);
 
 struct PredictParams {
+  PredictMode mode = PredictMode::Linear;         // None predicts nothing
+  LandingParams landing;                          // PredictMode::Landing
   double saccade_deg_s = 30;                      // above: a saccade, no extrapolation
   core::TimeNs velocity_window_ns = 30'000'000;   // velocity from the samples of the last 30 ms
 };
@@ -53,7 +57,8 @@ struct PredictParams {
 class GazePredictor {
  public:
   explicit GazePredictor(const PredictParams& p = {}) : p_(p) {}
-  // The gaze at t ≥ newest sample time, at most `horizon_ns` ahead of it; `history` holds the
+  // The gaze at t ≥ newest sample time, at most `horizon_ns` ahead of it (Landing: a trusted
+  // fit of the saccade in flight gives its position at t, uncapped); `history` holds the
   // recent samples in time order, of which the first `count` are used (the newest last).
   // Only the directions move: the times stay those of the newest sample (it was measured
   // then; the prediction is not a measurement).

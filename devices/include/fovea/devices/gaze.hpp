@@ -64,6 +64,14 @@ class SampleStream {
   virtual std::string describe() const = 0;
 };
 
+// How a source predicts its newest sample to the time asked for (URI key predict=):
+// none; linear (GazePredictor: constant velocity, held across a saccade until its peak);
+// landing (as linear, but a saccade in flight goes to its fitted landing point,
+// saccade_predict.hpp).
+enum class PredictMode : std::uint8_t { None, Linear, Landing };
+PredictMode parse_predict_mode(std::string_view s);  // throws core::InputError
+const char* predict_mode_name(PredictMode m);
+
 // Geometry used to turn 2D gaze coordinates (display pixels, scene-camera pixels,
 // micrometres on a calibrated screen, normalised coordinates) into view directions:
 // a pinhole View (field of view + raster). Normalised inputs are scaled to the raster.
@@ -74,6 +82,7 @@ struct SourceOptions {
   std::string format;   // replay: force a format instead of auto-detection
   double speed = 1.0;   // replay: timeline speed factor
   bool loop = false;    // replay: wrap around at the end
+  PredictMode predict = PredictMode::Linear;
   core::TimeNs horizon_ns = 20'000'000;   // prediction never goes further past the newest sample (0: off)
   core::TimeNs max_gap_ns = 100'000'000;  // a newest sample older than this is stale (result: lost)
   core::TimeNs window_ns = 2'000'000'000; // history kept for sample_at()
@@ -82,6 +91,7 @@ struct SourceOptions {
   std::string filters;
   std::string raw_capture;  // HID sources: also write the raw device traffic here (docs/hid.md)
 
+  bool predicts() const { return predict != PredictMode::None && horizon_ns > 0; }
   core::View screen_view() const { return screen ? *screen : display.view(core::Eye::Left); }
 };
 
