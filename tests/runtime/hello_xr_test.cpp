@@ -204,7 +204,7 @@ TEST(HelloXr, MarkerOnThePanels) {
   for (size_t i = 0; i < events.size(); ++i) {
     const std::int64_t f = events[i]["frame"].get<std::int64_t>();
     EXPECT_EQ(f, std::int64_t(8 * i));
-    EXPECT_EQ(events[i]["displayed_ns"].get<std::int64_t>(), frames[size_t(f)]["displayed_ns"].get<std::int64_t>());
+    EXPECT_EQ(events[i]["displayed_ns"].get<std::int64_t>(), frames[size_t(f)]["vsync_ns"].get<std::int64_t>());
     EXPECT_TRUE(events[i]["event_sample_ns"].is_null());  // periodic: no gaze event behind it
   }
 }
