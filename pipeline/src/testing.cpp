@@ -1,9 +1,19 @@
 #include "fovea/pipeline/testing.hpp"
 
+#include <ctime>
+
 #include "fovea/core/error.hpp"
 #include "frame_pipeline_impl.hpp"
 
 namespace fovea::pipeline::testing {
+
+namespace {
+double process_cpu_ms() {
+  timespec ts{};
+  clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &ts);
+  return double(ts.tv_sec) * 1e3 + double(ts.tv_nsec) * 1e-6;
+}
+}  // namespace
 
 std::vector<glm::vec4> grid_buffer(const FramePipeline& pipeline, core::Eye eye, GridBuffer which) {
   auto& m = Access::impl(pipeline);
@@ -56,6 +66,33 @@ core::Image blur_image(FramePipeline& pipeline, core::Eye eye, const core::Image
   m.resolve->screen(i).upload(image.pixels);
   m.ctx.submit_and_wait([&](VkCommandBuffer cmd) { m.resolve->record_blur(cmd, m.settings); });
   return pipeline.image(eye);
+}
+
+ResolveKernelTimes time_resolve(FramePipeline& pipeline, bool blur) {
+  auto& m = Access::impl(pipeline);
+  const auto time = [&](auto&& record) {
+    KernelTime t;
+    const double cpu0 = process_cpu_ms();
+    m.ctx.submit_and_wait([&](VkCommandBuffer cmd) {
+      m.timer.begin(cmd);
+      record(cmd);
+      m.timer.stage(cmd, "kernel");
+    });
+    t.cpu_ms = process_cpu_ms() - cpu0;
+    if (const auto stages = m.timer.read()) t.gpu_ms = double(stages->front().duration_ns()) * 1e-6;
+    return t;
+  };
+  ResolveKernelTimes t;
+  t.copy_depth = time([&](VkCommandBuffer cmd) {
+    std::vector<const gpu::Buffer*> finals;
+    for (std::size_t i = 0; i < m.eyes.size(); ++i) finals.push_back(&m.post->final_color(int(i), m.parity));
+    m.resolve->record_copy(cmd, finals);
+    m.resolve->record_depth(cmd, m.parity);
+  });
+  t.mip = time([&](VkCommandBuffer cmd) { m.resolve->record_mips(cmd); });
+  t.resample = time([&](VkCommandBuffer cmd) { m.resolve->record_resample(cmd); });
+  if (blur) t.blur = time([&](VkCommandBuffer cmd) { m.resolve->record_blur(cmd, m.settings); });
+  return t;
 }
 
 }  // namespace fovea::pipeline::testing

@@ -18,10 +18,21 @@ vec3 rg_view_to_world_dir(ReconGrid m, vec3 d) {
          vec3(m.w2v2_x, m.w2v2_y, m.w2v2_z) * d.z;
 }
 
-vec3 rg_pixel_to_dir(ReconGrid m, vec2 px) {
-  float tx = m.g.tan_left + (px.x / m.g.width) * (m.g.tan_right - m.g.tan_left);
-  float ty = m.g.tan_up - (px.y / m.g.height) * (m.g.tan_up - m.g.tan_down);
-  return normalize(vec3(tx, ty, -1.0));
+// Tangent-space position (x right, y up) of display pixel position px.
+vec2 rg_pixel_tan(ReconGrid m, vec2 px) {
+  return vec2(m.g.tan_left + (px.x / m.g.width) * (m.g.tan_right - m.g.tan_left),
+              m.g.tan_up - (px.y / m.g.height) * (m.g.tan_up - m.g.tan_down));
+}
+
+vec3 rg_pixel_to_dir(ReconGrid m, vec2 px) { return normalize(vec3(rg_pixel_tan(m, px), -1.0)); }
+
+// Angle (radians) one pixel step spans at tangent position t, along x (vertical = false)
+// or y: |∂d/∂t_x| = √(1 + t_y²) / (1 + |t|²) for d = normalize(t, -1), times the step in
+// tangent units (the exact finite difference differs by O(step²)).
+float rg_pixel_angle(ReconGrid m, vec2 t, bool vertical) {
+  float step_t = vertical ? (m.g.tan_up - m.g.tan_down) / m.g.height : (m.g.tan_right - m.g.tan_left) / m.g.width;
+  float across = vertical ? t.x : t.y;
+  return step_t * sqrt(1.0 + across * across) / (1.0 + dot(t, t));
 }
 
 // View direction -> display pixel; false when not in front of the eye or off the raster.
