@@ -52,8 +52,19 @@ core::Image resolve_grid(FramePipeline& pipeline, core::Eye eye, const std::vect
     throw core::InputError("resolve_grid: grid size differs from the padded grid");
   m.write_mappings();
   m.resolve->level0(i).upload(grid);
-  m.ctx.submit_and_wait([&](VkCommandBuffer cmd) { m.resolve->record_resolve(cmd, blur, m.settings); });
+  m.ctx.submit_and_wait([&](VkCommandBuffer cmd) { m.resolve->record_resolve(cmd, m.parity, blur, m.settings); });
   return pipeline.image(eye);
+}
+
+std::vector<glm::vec4> resolve_grid_coords(FramePipeline& pipeline, core::Eye eye) {
+  auto& m = Access::impl(pipeline);
+  const int i = m.index(eye, "resolve_grid_coords");
+  m.write_mappings();
+  m.ctx.submit_and_wait([&](VkCommandBuffer cmd) { m.resolve->record_resample(cmd, m.parity, true); });
+  std::vector<glm::vec4> v = m.resolve->screen(i).download<glm::vec4>();
+  const core::View& view = m.eyes[std::size_t(i)]->base_view;
+  v.resize(std::size_t(view.width()) * view.height());
+  return v;
 }
 
 core::Image blur_image(FramePipeline& pipeline, core::Eye eye, const core::Image& image) {
@@ -83,14 +94,13 @@ ResolveKernelTimes time_resolve(FramePipeline& pipeline, bool blur) {
     return t;
   };
   ResolveKernelTimes t;
-  t.copy_depth = time([&](VkCommandBuffer cmd) {
+  t.copy = time([&](VkCommandBuffer cmd) {
     std::vector<const gpu::Buffer*> finals;
     for (std::size_t i = 0; i < m.eyes.size(); ++i) finals.push_back(&m.post->final_color(int(i), m.parity));
     m.resolve->record_copy(cmd, finals);
-    m.resolve->record_depth(cmd, m.parity);
   });
   t.mip = time([&](VkCommandBuffer cmd) { m.resolve->record_mips(cmd); });
-  t.resample = time([&](VkCommandBuffer cmd) { m.resolve->record_resample(cmd); });
+  t.resample = time([&](VkCommandBuffer cmd) { m.resolve->record_resample(cmd, m.parity); });
   if (blur) t.blur = time([&](VkCommandBuffer cmd) { m.resolve->record_blur(cmd, m.settings); });
   return t;
 }
