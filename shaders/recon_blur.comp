@@ -25,19 +25,17 @@ void main() {
   uvec2 p = gl_GlobalInvocationID.xy;
   if (p.x >= pc.width || p.y >= pc.height) return;
   ReconGrid m = maps[kReconCurrent];
-  vec2 px = vec2(p) + 0.5;
-  vec3 d = rg_pixel_to_dir(m, px);
+  vec2 t = rg_pixel_tan(m, vec2(p) + 0.5);
   vec3 g = rg_gaze(m);
+  float cos_e = dot(vec3(t, -1.0), g) * inversesqrt(1.0 + dot(t, t));
   uint i = p.y * pc.width + p.x;
-  if (dot(d, g) > pc.cos_skip) {  // near the gaze: σ < min_sigma_px on any pixel of this raster
+  if (cos_e > pc.cos_skip) {  // near the gaze: σ < min_sigma_px on any pixel of this raster
     dst[i] = src[i];
     return;
   }
-  float e = atan(length(cross(d, g)), dot(d, g)) * (180.0 / kRgPi);
-  // Local pixels per degree along the pass direction: finite difference of the angle.
-  vec2 step_px = pc.vertical != 0u ? vec2(0.0, 1.0) : vec2(1.0, 0.0);
-  vec3 d1 = rg_pixel_to_dir(m, px + step_px);
-  float deg_per_px = atan(length(cross(d, d1)), dot(d, d1)) * (180.0 / kRgPi);
+  float e = atan(sqrt(max(1.0 - cos_e * cos_e, 0.0)), cos_e) * (180.0 / kRgPi);
+  bool vertical = pc.vertical != 0u;
+  float deg_per_px = rg_pixel_angle(m, t, vertical) * (180.0 / kRgPi);
   float acuity = e <= 5.79 ? 1.0 : 7.49 / ((0.3 * e + 1.0) * (0.3 * e + 1.0));
   float sigma = min(pc.sigma_fovea_deg / acuity / max(deg_per_px, 1e-6), pc.max_sigma_px);
   if (sigma < pc.min_sigma_px) {
@@ -45,15 +43,26 @@ void main() {
     return;
   }
   int radius = int(ceil(3.0 * sigma));
-  int pos = int(pc.vertical != 0u ? p.y : p.x);
-  int n = int(pc.vertical != 0u ? pc.height : pc.width);
-  vec4 acc = vec4(0.0);
-  float wsum = 0.0;
-  for (int k = max(-radius, -pos); k <= min(radius, n - 1 - pos); ++k) {
-    float w = exp(-0.5 * float(k * k) / (sigma * sigma));
-    uint j = pc.vertical != 0u ? uint(pos + k) * pc.width + p.x : p.y * pc.width + uint(pos + k);
-    acc += w * src[j];
-    wsum += w;
+  int pos = int(vertical ? p.y : p.x);
+  int n = int(vertical ? pc.height : pc.width);
+  int stride = vertical ? int(pc.width) : 1;
+  // Taps ±k share the weight exp(a k²), a = -1/(2σ²), built by the recurrence
+  // w_k = w_{k-1}·q_{k-1}, q_k = q_{k-1}·exp(2a) (no exp per tap).
+  float a = -0.5 / (sigma * sigma);
+  float w = 1.0, q = exp(a), q2 = q * q;
+  vec4 acc = src[i];
+  float wsum = 1.0;
+  for (int k = 1; k <= radius; ++k) {
+    w *= q;
+    q *= q2;
+    if (pos - k >= 0) {
+      acc += w * src[int(i) - k * stride];
+      wsum += w;
+    }
+    if (pos + k < n) {
+      acc += w * src[int(i) + k * stride];
+      wsum += w;
+    }
   }
   dst[i] = acc / wsum;
 }

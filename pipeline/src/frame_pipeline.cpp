@@ -186,11 +186,10 @@ FrameTimes FramePipeline::render(const std::array<core::Pose, 2>& eye_pose, cons
     std::vector<const gpu::Buffer*> finals;
     for (std::size_t i = 0; i < m.eyes.size(); ++i) finals.push_back(&m.post->final_color(int(i), p));
     m.resolve->record_copy(cmd, finals);
-    m.resolve->record_depth(cmd, p);
     m.timer.stage(cmd, "resolve");
     m.resolve->record_mips(cmd);
     m.timer.stage(cmd, "mip");
-    m.resolve->record_resample(cmd);
+    m.resolve->record_resample(cmd, p);
     m.timer.stage(cmd, "resample");
     if (m.settings.blur) m.resolve->record_blur(cmd, m.settings);
     m.timer.stage(cmd, "blur");

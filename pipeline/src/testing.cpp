@@ -1,9 +1,19 @@
 #include "fovea/pipeline/testing.hpp"
 
+#include <ctime>
+
 #include "fovea/core/error.hpp"
 #include "frame_pipeline_impl.hpp"
 
 namespace fovea::pipeline::testing {
+
+namespace {
+double process_cpu_ms() {
+  timespec ts{};
+  clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &ts);
+  return double(ts.tv_sec) * 1e3 + double(ts.tv_nsec) * 1e-6;
+}
+}  // namespace
 
 std::vector<glm::vec4> grid_buffer(const FramePipeline& pipeline, core::Eye eye, GridBuffer which) {
   auto& m = Access::impl(pipeline);
@@ -42,8 +52,19 @@ core::Image resolve_grid(FramePipeline& pipeline, core::Eye eye, const std::vect
     throw core::InputError("resolve_grid: grid size differs from the padded grid");
   m.write_mappings();
   m.resolve->level0(i).upload(grid);
-  m.ctx.submit_and_wait([&](VkCommandBuffer cmd) { m.resolve->record_resolve(cmd, blur, m.settings); });
+  m.ctx.submit_and_wait([&](VkCommandBuffer cmd) { m.resolve->record_resolve(cmd, m.parity, blur, m.settings); });
   return pipeline.image(eye);
+}
+
+std::vector<glm::vec4> resolve_grid_coords(FramePipeline& pipeline, core::Eye eye) {
+  auto& m = Access::impl(pipeline);
+  const int i = m.index(eye, "resolve_grid_coords");
+  m.write_mappings();
+  m.ctx.submit_and_wait([&](VkCommandBuffer cmd) { m.resolve->record_resample(cmd, m.parity, true); });
+  std::vector<glm::vec4> v = m.resolve->screen(i).download<glm::vec4>();
+  const core::View& view = m.eyes[std::size_t(i)]->base_view;
+  v.resize(std::size_t(view.width()) * view.height());
+  return v;
 }
 
 core::Image blur_image(FramePipeline& pipeline, core::Eye eye, const core::Image& image) {
@@ -56,6 +77,32 @@ core::Image blur_image(FramePipeline& pipeline, core::Eye eye, const core::Image
   m.resolve->screen(i).upload(image.pixels);
   m.ctx.submit_and_wait([&](VkCommandBuffer cmd) { m.resolve->record_blur(cmd, m.settings); });
   return pipeline.image(eye);
+}
+
+ResolveKernelTimes time_resolve(FramePipeline& pipeline, bool blur) {
+  auto& m = Access::impl(pipeline);
+  const auto time = [&](auto&& record) {
+    KernelTime t;
+    const double cpu0 = process_cpu_ms();
+    m.ctx.submit_and_wait([&](VkCommandBuffer cmd) {
+      m.timer.begin(cmd);
+      record(cmd);
+      m.timer.stage(cmd, "kernel");
+    });
+    t.cpu_ms = process_cpu_ms() - cpu0;
+    if (const auto stages = m.timer.read()) t.gpu_ms = double(stages->front().duration_ns()) * 1e-6;
+    return t;
+  };
+  ResolveKernelTimes t;
+  t.copy = time([&](VkCommandBuffer cmd) {
+    std::vector<const gpu::Buffer*> finals;
+    for (std::size_t i = 0; i < m.eyes.size(); ++i) finals.push_back(&m.post->final_color(int(i), m.parity));
+    m.resolve->record_copy(cmd, finals);
+  });
+  t.mip = time([&](VkCommandBuffer cmd) { m.resolve->record_mips(cmd); });
+  t.resample = time([&](VkCommandBuffer cmd) { m.resolve->record_resample(cmd, m.parity); });
+  if (blur) t.blur = time([&](VkCommandBuffer cmd) { m.resolve->record_blur(cmd, m.settings); });
+  return t;
 }
 
 }  // namespace fovea::pipeline::testing

@@ -113,14 +113,23 @@ struct MipBindings {
 
 struct ResolveBindings {
   FOVEA_BINDING_COUNT(RECON_RESOLVE_COUNT)
-  Buf maps, tables, mips, offsets, screen;
+  Buf maps, tables, mips, offsets, screen, pos, depth, lut;
   Slots slots() const {
     return {{{RECON_MAPS, maps},
              {RECON_TABLES, tables},
              {RECON_RESOLVE_MIPS, mips},
              {RECON_RESOLVE_OFFSETS, offsets},
-             {RECON_RESOLVE_SCREEN, screen}}};
+             {RECON_RESOLVE_SCREEN, screen},
+             {RECON_RESOLVE_POS, pos},
+             {RECON_RESOLVE_DEPTH, depth},
+             {RECON_RESOLVE_LUT, lut}}};
   }
+};
+
+struct RadiusLutBindings {
+  FOVEA_BINDING_COUNT(RECON_LUT_COUNT)
+  Buf maps, tables, lut;
+  Slots slots() const { return {{{RECON_MAPS, maps}, {RECON_TABLES, tables}, {RECON_LUT_OUT, lut}}}; }
 };
 
 struct BlurBindings {
@@ -128,14 +137,6 @@ struct BlurBindings {
   Buf maps, tables, src, dst;
   Slots slots() const {
     return {{{RECON_MAPS, maps}, {RECON_TABLES, tables}, {RECON_BLUR_SRC, src}, {RECON_BLUR_DST, dst}}};
-  }
-};
-
-struct DepthBindings {
-  FOVEA_BINDING_COUNT(RECON_DEPTH_COUNT)
-  Buf maps, tables, pos, depth;
-  Slots slots() const {
-    return {{{RECON_MAPS, maps}, {RECON_TABLES, tables}, {RECON_DEPTH_POS, pos}, {RECON_DEPTH_OUT, depth}}};
   }
 };
 
@@ -150,6 +151,6 @@ static_assert(sizeof(TaaBindings) == TaaBindings::kCount * sizeof(Buf));
 static_assert(sizeof(MipBindings) == MipBindings::kCount * sizeof(Buf));
 static_assert(sizeof(ResolveBindings) == ResolveBindings::kCount * sizeof(Buf));
 static_assert(sizeof(BlurBindings) == BlurBindings::kCount * sizeof(Buf));
-static_assert(sizeof(DepthBindings) == DepthBindings::kCount * sizeof(Buf));
+static_assert(sizeof(RadiusLutBindings) == RadiusLutBindings::kCount * sizeof(Buf));
 
 }  // namespace fovea::reconstruct

@@ -1,5 +1,5 @@
-// Resolve to the display (shaders/recon_mip.comp, recon_resolve.comp, recon_blur.comp) and
-// the display-space depth (recon_depth.comp).
+// Resolve to the display (shaders/recon_mip.comp, recon_radius_lut.comp, recon_resolve.comp
+// with the display-space depth, recon_blur.comp).
 #include <algorithm>
 #include <cmath>
 #include <numbers>
@@ -33,7 +33,7 @@ Resolve::Resolve(gpu::Context& ctx, std::span<const EyeGrid> eyes, const Accumul
     : mip_(kernel<MipBindings, shaders::ReconMipPush>(ctx, "recon_mip.comp.spv")),
       resolve_(kernel<ResolveBindings, shaders::ReconResolvePush>(ctx, "recon_resolve.comp.spv")),
       blur_(kernel<BlurBindings, shaders::ReconBlurPush>(ctx, "recon_blur.comp.spv")),
-      depth_(kernel<DepthBindings, shaders::ReconResolvePush>(ctx, "recon_depth.comp.spv")),
+      lut_(kernel<RadiusLutBindings, shaders::ReconResolvePush>(ctx, "recon_radius_lut.comp.spv")),
       eyes_(eyes.size()) {
   for (std::size_t i = 0; i < eyes.size(); ++i) {
     const EyeGrid& g = eyes[i];
@@ -42,6 +42,7 @@ Resolve::Resolve(gpu::Context& ctx, std::span<const EyeGrid> eyes, const Accumul
     e.width = g.width;
     e.height = g.height;
     e.padded_columns = g.padded_columns;
+    e.polar = g.polar;
     e.max_pixels_per_deg = g.max_pixels_per_deg;
     // φ-only mip chain (polar grids): level l has ceil(rows / 2^l) rows.
     std::uint32_t rows = g.padded_rows, offset = 0;
@@ -59,12 +60,14 @@ Resolve::Resolve(gpu::Context& ctx, std::span<const EyeGrid> eyes, const Accumul
     e.screen_a = storage(ctx, screen, "recon.screen");
     e.screen_b = storage(ctx, screen, "recon.screen_tmp");
     e.depth = storage(ctx, screen / 4, "recon.depth");
+    e.lut = storage(ctx, sizeof(shaders::ReconRadiusLutHeader) + (shaders::kReconRadiusLutSize + 2) * 4, "recon.radius_lut");
     e.mip_set = make_set(ctx, mip_, MipBindings{g.maps, g.tables, &e.mips});
-    e.resolve_set = make_set(ctx, resolve_, ResolveBindings{g.maps, g.tables, &e.mips, &e.offsets, &e.screen_a});
+    e.lut_set = make_set(ctx, lut_, RadiusLutBindings{g.maps, g.tables, &e.lut});
+    for (int p = 0; p < 2; ++p)
+      e.resolve_set[p] = make_set(ctx, resolve_, ResolveBindings{g.maps, g.tables, &e.mips, &e.offsets, &e.screen_a,
+                                                                 &acc.position(int(i), p), &e.depth, &e.lut});
     e.blur_h = make_set(ctx, blur_, BlurBindings{g.maps, g.tables, &e.screen_a, &e.screen_b});
     e.blur_v = make_set(ctx, blur_, BlurBindings{g.maps, g.tables, &e.screen_b, &e.screen_a});
-    for (int p = 0; p < 2; ++p)
-      e.depth_set[p] = make_set(ctx, depth_, DepthBindings{g.maps, g.tables, &acc.position(int(i), p), &e.depth});
   }
 }
 
@@ -80,14 +83,9 @@ void Resolve::record_copy(VkCommandBuffer cmd, std::span<const gpu::Buffer* cons
   gpu::transfer_to_compute(cmd);
 }
 
-void Resolve::record_depth(VkCommandBuffer cmd, int parity) const {
-  for (const Eye& e : eyes_)
-    depth_.run(cmd, {&e.depth_set[parity]}, shaders::ReconResolvePush{e.width, e.height, 0, 0}, e.width, e.height);
-}
-
-void Resolve::record_resolve(VkCommandBuffer cmd, bool blur, const ReconSettings& s) const {
+void Resolve::record_resolve(VkCommandBuffer cmd, int parity, bool blur, const ReconSettings& s) const {
   record_mips(cmd);
-  record_resample(cmd);
+  record_resample(cmd, parity);
   if (blur) record_blur(cmd, s);
 }
 
@@ -103,9 +101,13 @@ void Resolve::record_mips(VkCommandBuffer cmd) const {
   }
 }
 
-void Resolve::record_resample(VkCommandBuffer cmd) const {
+void Resolve::record_resample(VkCommandBuffer cmd, int parity, bool grid_coords) const {
   for (const Eye& e : eyes_)
-    resolve_.run(cmd, {&e.resolve_set}, shaders::ReconResolvePush{e.width, e.height, e.levels, 0}, e.width, e.height);
+    if (e.polar) lut_.run(cmd, {&e.lut_set}, shaders::ReconResolvePush{}, shaders::kReconRadiusLutSize + 2);
+  gpu::compute_to_compute(cmd);
+  for (const Eye& e : eyes_)
+    resolve_.run(cmd, {&e.resolve_set[parity]}, shaders::ReconResolvePush{e.width, e.height, e.levels, grid_coords ? 1u : 0u}, e.width,
+                 e.height);
   gpu::compute_to_compute(cmd);
 }
 
@@ -123,7 +125,7 @@ void Resolve::record_blur(VkCommandBuffer cmd, const ReconSettings& s) const {
 
 void Resolve::fill(VkCommandBuffer cmd, std::uint32_t word) const {
   for (const Eye& e : eyes_)
-    for (const gpu::Buffer* b : {&e.mips, &e.screen_a, &e.screen_b, &e.depth}) gpu::fill_buffer(cmd, *b, word);
+    for (const gpu::Buffer* b : {&e.mips, &e.screen_a, &e.screen_b, &e.depth, &e.lut}) gpu::fill_buffer(cmd, *b, word);
 }
 
 }  // namespace fovea::reconstruct

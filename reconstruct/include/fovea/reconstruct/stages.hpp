@@ -122,13 +122,13 @@ class Resolve {
   Resolve(gpu::Context& ctx, std::span<const EyeGrid> eyes, const Accumulation& acc);
   // Copies a grid image into level 0 (transfer; the caller orders its writes before).
   void record_copy(VkCommandBuffer cmd, std::span<const gpu::Buffer* const> grid_images) const;
-  // Depth of the nearest sample per display pixel from the positions of `parity`.
-  void record_depth(VkCommandBuffer cmd, int parity) const;
-  // Mips from level 0, resolve, optional blur: into the screen buffers. The three kernels
-  // are also recorded one by one (per-kernel timestamps between them).
-  void record_resolve(VkCommandBuffer cmd, bool blur, const ReconSettings& settings) const;
+  // Mips from level 0, resolve, optional blur: into the screen buffers; the resample also
+  // writes the depth of the nearest sample per display pixel from the positions of
+  // `parity`. The three kernels are also recorded one by one (per-kernel timestamps).
+  void record_resolve(VkCommandBuffer cmd, int parity, bool blur, const ReconSettings& settings) const;
   void record_mips(VkCommandBuffer cmd) const;
-  void record_resample(VkCommandBuffer cmd) const;
+  // grid_coords: each pixel's grid coordinate (u, t, LOD, 0) instead of its colour (tests).
+  void record_resample(VkCommandBuffer cmd, int parity, bool grid_coords = false) const;
   void record_blur(VkCommandBuffer cmd, const ReconSettings& settings) const;
   void fill(VkCommandBuffer cmd, std::uint32_t word) const;
 
@@ -140,13 +140,14 @@ class Resolve {
  private:
   struct Eye {
     std::uint32_t cells = 0, width = 0, height = 0, padded_columns = 0, levels = 1;
+    bool polar = true;
     double max_pixels_per_deg = 0;
     std::vector<std::uint32_t> level_rows, level_offset;
-    gpu::Buffer mips, offsets, screen_a, screen_b, depth;
-    gpu::DescriptorSet mip_set, resolve_set, blur_h, blur_v, depth_set[2];
+    gpu::Buffer mips, offsets, screen_a, screen_b, depth, lut;
+    gpu::DescriptorSet mip_set, lut_set, resolve_set[2], blur_h, blur_v;
   };
   std::uint32_t max_levels() const;
-  gpu::ComputePipeline mip_, resolve_, blur_, depth_;
+  gpu::ComputePipeline mip_, resolve_, blur_, lut_;
   std::vector<Eye> eyes_;
 };
 

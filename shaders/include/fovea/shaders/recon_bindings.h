@@ -74,20 +74,22 @@
 #define RECON_MIP_MIPS 2
 #define RECON_MIP_COUNT 3
 
-// recon_resolve.comp
+// recon_resolve.comp (the display image and the display-space depth)
 #define RECON_RESOLVE_MIPS 2
 #define RECON_RESOLVE_OFFSETS 3
 #define RECON_RESOLVE_SCREEN 4
-#define RECON_RESOLVE_COUNT 5
+#define RECON_RESOLVE_POS 5
+#define RECON_RESOLVE_DEPTH 6
+#define RECON_RESOLVE_LUT 7
+#define RECON_RESOLVE_COUNT 8
+
+// recon_radius_lut.comp (radius -> column lookup table of the current mapping)
+#define RECON_LUT_OUT 2
+#define RECON_LUT_COUNT 3
 
 // recon_blur.comp
 #define RECON_BLUR_SRC 2
 #define RECON_BLUR_DST 3
 #define RECON_BLUR_COUNT 4
-
-// recon_depth.comp
-#define RECON_DEPTH_POS 2
-#define RECON_DEPTH_OUT 3
-#define RECON_DEPTH_COUNT 4
 
 #endif

@@ -74,7 +74,18 @@ struct ReconMipPush {
 };
 
 struct ReconResolvePush {
-  FOVEA_UINT width, height, levels, pad0;
+  FOVEA_UINT width, height, levels, grid_coords;  // grid_coords = 1: write (u, t, LOD, 0) per pixel, for tests
+};
+
+// Radius -> column lookup table of the current mapping (recon_radius_lut.comp builds it per
+// frame, the resolve reads it): kReconRadiusLutSize uniform radius bins over the column
+// table's range, each holding the column search's lower bound; + 2 entries, see the shader.
+FOVEA_CONST FOVEA_UINT kReconRadiusLutSize = 4096u;
+struct ReconRadiusLutHeader {
+  float scale;                 // bins per radius unit
+  FOVEA_UINT size;             // bins
+  FOVEA_UINT table_offset;     // the mapping's column table it was built from
+  FOVEA_UINT pad;
 };
 
 struct ReconBlurPush {
@@ -89,6 +100,7 @@ static_assert(sizeof(ReconBmfrPush) == 32);
 static_assert(sizeof(ReconPostPush) == 32);
 static_assert(sizeof(ReconMipPush) == 32);
 static_assert(sizeof(ReconBlurPush) == 32);
+static_assert(sizeof(ReconRadiusLutHeader) == 16);
 }  // namespace fovea::shaders
 #else
 bool rg_no_sample(float code) { return abs(code - kReconNoSample) < 0.5; }

@@ -18,10 +18,21 @@ vec3 rg_view_to_world_dir(ReconGrid m, vec3 d) {
          vec3(m.w2v2_x, m.w2v2_y, m.w2v2_z) * d.z;
 }
 
-vec3 rg_pixel_to_dir(ReconGrid m, vec2 px) {
-  float tx = m.g.tan_left + (px.x / m.g.width) * (m.g.tan_right - m.g.tan_left);
-  float ty = m.g.tan_up - (px.y / m.g.height) * (m.g.tan_up - m.g.tan_down);
-  return normalize(vec3(tx, ty, -1.0));
+// Tangent-space position (x right, y up) of display pixel position px.
+vec2 rg_pixel_tan(ReconGrid m, vec2 px) {
+  return vec2(m.g.tan_left + (px.x / m.g.width) * (m.g.tan_right - m.g.tan_left),
+              m.g.tan_up - (px.y / m.g.height) * (m.g.tan_up - m.g.tan_down));
+}
+
+vec3 rg_pixel_to_dir(ReconGrid m, vec2 px) { return normalize(vec3(rg_pixel_tan(m, px), -1.0)); }
+
+// Angle (radians) one pixel step spans at tangent position t, along x (vertical = false)
+// or y: |∂d/∂t_x| = √(1 + t_y²) / (1 + |t|²) for d = normalize(t, -1), times the step in
+// tangent units (the exact finite difference differs by O(step²)).
+float rg_pixel_angle(ReconGrid m, vec2 t, bool vertical) {
+  float step_t = vertical ? (m.g.tan_up - m.g.tan_down) / m.g.height : (m.g.tan_right - m.g.tan_left) / m.g.width;
+  float across = vertical ? t.x : t.y;
+  return step_t * sqrt(1.0 + across * across) / (1.0 + dot(t, t));
 }
 
 // View direction -> display pixel; false when not in front of the eye or off the raster.
@@ -37,36 +48,61 @@ bool rg_dir_to_pixel(ReconGrid m, vec3 d, out vec2 px) {
 // Rows of column c (the raster's row count for the Cartesian family).
 uint rg_rows(ReconGrid m, uint c) { return m.g.family == kFamilyCartesian ? m.g.rows : tables[m.table_offset + c].rows; }
 
-// Continuous column coordinate of radius r (core PolarDistribution::screen_to_grid): the
-// last boundary <= r, linear inside the column, clamped to the table (ρ clamp).
-float rg_radius_to_u(ReconGrid m, float r) {
-  uint lo = 0u, hi = m.g.columns;  // find the last i with r0(i) <= r
+// Column search range [x, y) for radius r: the whole table, or — in kernels that define
+// RG_RADIUS_LUT and bind the current mapping's radius -> column lookup table
+// (recon_radius_lut.comp) as lut_header / lut[] — the few columns the radius's bin allows,
+// so the search below takes ~1 step instead of log2(columns).
+#ifdef RG_RADIUS_LUT
+uvec2 rg_column_range(ReconGrid m, float r) {
+  if (m.table_offset != lut_header.table_offset) return uvec2(0u, m.g.columns);  // another mapping's table
+  uint k = min(uint(max(r, 0.0) * lut_header.scale), lut_header.size - 1u);
+  return uvec2(lut[k], lut[k + 2u] + 1u);
+}
+#else
+uvec2 rg_column_range(ReconGrid m, float r) { return uvec2(0u, m.g.columns); }
+#endif
+
+// The last column i in [range.x, range.y) with r0(i) <= r (range.x when none; the columns'
+// r0 are increasing), by binary search.
+uint rg_column_of(ReconGrid m, float r, uvec2 range) {
+  uint lo = range.x, hi = range.y;
   while (hi - lo > 1u) {
     uint mid = (lo + hi) >> 1;
     if (tables[m.table_offset + mid].r0 <= r) lo = mid; else hi = mid;
   }
-  GridColumn c = tables[m.table_offset + lo];
+  return lo;
+}
+
+// Continuous column coordinate of radius r (core PolarDistribution::screen_to_grid): the
+// last boundary <= r, linear inside the column, clamped to the table (ρ clamp).
+float rg_radius_to_u(ReconGrid m, float r) {
+  uint i = rg_column_of(m, r, rg_column_range(m, r));
+  GridColumn c = tables[m.table_offset + i];
   float w = c.r1 - c.r0;
-  return float(lo) + (w > 0.0 ? clamp((r - c.r0) / w, 0.0, 1.0) : 0.5);
+  return float(i) + (w > 0.0 ? clamp((r - c.r0) / w, 0.0, 1.0) : 0.5);
+}
+
+// Polar coordinates around the gaze of view direction d at display pixel px: (radius, φ),
+// the radius in the family's units (eccentricity in degrees for angular polar, pixels for
+// screen polar), φ in [-π, π] from the basis b1 (angular) or the display's x axis (screen).
+vec2 rg_polar(ReconGrid m, vec3 d, vec2 px) {
+  if (m.g.family == kFamilyAngularPolar) {
+    vec3 g = rg_gaze(m);
+    return vec2(atan(length(cross(d, g)), dot(d, g)) * (180.0 / kRgPi),
+                atan(dot(d, vec3(m.g.b2_x, m.g.b2_y, m.g.b2_z)), dot(d, vec3(m.g.b1_x, m.g.b1_y, m.g.b1_z))));
+  }
+  vec2 q = px - vec2(m.g.gaze_px_x, m.g.gaze_px_y);
+  return vec2(length(q), atan(q.y, q.x));
 }
 
 // Grid coordinate (u = column coordinate, cell centres at +0.5; t = φ / 2π in [0, 1) for
 // polar grids, y / height for the Cartesian raster) of view direction d at display pixel px.
 vec2 rg_grid_coord(ReconGrid m, vec3 d, vec2 px) {
   if (m.g.family == kFamilyCartesian) return vec2(px.x * float(m.g.columns) / m.g.width, px.y / m.g.height);
-  float r, phi;
-  if (m.g.family == kFamilyAngularPolar) {
-    vec3 g = rg_gaze(m);
-    r = atan(length(cross(d, g)), dot(d, g)) * (180.0 / kRgPi);
-    phi = atan(dot(d, vec3(m.g.b2_x, m.g.b2_y, m.g.b2_z)), dot(d, vec3(m.g.b1_x, m.g.b1_y, m.g.b1_z)));
-  } else {
-    vec2 q = px - vec2(m.g.gaze_px_x, m.g.gaze_px_y);
-    r = length(q);
-    phi = atan(q.y, q.x);
-  }
-  float t = phi / (2.0 * kRgPi);
+  vec2 rp = rg_polar(m, d, px);
+  float t = rp.y / (2.0 * kRgPi);
   t -= floor(t);
-  return vec2(rg_radius_to_u(m, r), t);
+  return vec2(rg_radius_to_u(m, rp.x), t);
 }
 
 // World point (or, is_direction, world direction of a sky sample) -> grid coordinate of
