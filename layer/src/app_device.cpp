@@ -81,34 +81,18 @@ AppDevice::AppDevice(const VulkanBinding& vk) : device_(vk.device) {
   FOVEA_APP_VK(FOVEA_APP_VK_LOAD)
 #undef FOVEA_APP_VK_LOAD
   props(vk.physical_device, &memory_);
-  vkGetDeviceQueue_(device_, vk.queue_family, vk.queue_index, &queue_);
-  VkCommandPoolCreateInfo pi{VK_STRUCTURE_TYPE_COMMAND_POOL_CREATE_INFO};
-  pi.flags = VK_COMMAND_POOL_CREATE_RESET_COMMAND_BUFFER_BIT;
-  pi.queueFamilyIndex = vk.queue_family;
-  check(vkCreateCommandPool_(device_, &pi, nullptr, &pool_), "vkCreateCommandPool");
-  VkCommandBufferAllocateInfo ai{VK_STRUCTURE_TYPE_COMMAND_BUFFER_ALLOCATE_INFO};
-  ai.commandPool = pool_;
-  ai.level = VK_COMMAND_BUFFER_LEVEL_PRIMARY;
-  ai.commandBufferCount = 1;
-  VkFenceCreateInfo fi{VK_STRUCTURE_TYPE_FENCE_CREATE_INFO};
-  try {
-    check(vkAllocateCommandBuffers_(device_, &ai, &cmd_), "vkAllocateCommandBuffers");
-    check(vkCreateFence_(device_, &fi, nullptr, &fence_), "vkCreateFence");
-  } catch (...) {
-    destroy();
-    throw;
-  }
+  VkQueue queue = VK_NULL_HANDLE;
+  vkGetDeviceQueue_(device_, vk.queue_family, vk.queue_index, &queue);
+  // Bounded: a lost or hung device fails the session (the layer then passes it through)
+  // instead of hanging the application's xrEndFrame.
+  constexpr std::uint64_t kTimeoutNs = 10'000'000'000;
+  queue_ = std::make_unique<xrcommon::ForeignQueue>(device_, gdpa, vk.queue_family, queue, kTimeoutNs,
+                                                    "the application's device");
 }
 
-AppDevice::~AppDevice() { destroy(); }
-
-void AppDevice::destroy() {
+AppDevice::~AppDevice() {
   release(download_);
   release(upload_);
-  if (fence_) vkDestroyFence_(device_, fence_, nullptr);
-  if (pool_) vkDestroyCommandPool_(device_, pool_, nullptr);
-  fence_ = VK_NULL_HANDLE;
-  pool_ = VK_NULL_HANDLE;
 }
 
 void AppDevice::release(HostBuffer& b) {
@@ -151,27 +135,6 @@ void AppDevice::reserve(HostBuffer& b, VkDeviceSize size, VkBufferUsageFlags usa
   b.size = size;
 }
 
-template <class F>
-void AppDevice::submit(F&& record) {
-  check(vkResetCommandBuffer_(cmd_, 0), "vkResetCommandBuffer");
-  VkCommandBufferBeginInfo bi{VK_STRUCTURE_TYPE_COMMAND_BUFFER_BEGIN_INFO};
-  bi.flags = VK_COMMAND_BUFFER_USAGE_ONE_TIME_SUBMIT_BIT;
-  check(vkBeginCommandBuffer_(cmd_, &bi), "vkBeginCommandBuffer");
-  record(cmd_);
-  check(vkEndCommandBuffer_(cmd_), "vkEndCommandBuffer");
-  VkSubmitInfo si{VK_STRUCTURE_TYPE_SUBMIT_INFO};
-  si.commandBufferCount = 1;
-  si.pCommandBuffers = &cmd_;
-  check(vkQueueSubmit_(queue_, 1, &si, fence_), "vkQueueSubmit");
-  // Bounded: a lost or hung device fails the session (the layer then passes it through)
-  // instead of hanging the application's xrEndFrame.
-  constexpr std::uint64_t kTimeoutNs = 10'000'000'000;
-  const VkResult w = vkWaitForFences_(device_, 1, &fence_, VK_TRUE, kTimeoutNs);
-  if (w == VK_TIMEOUT) throw std::runtime_error("the layer's transfer did not finish on the application's device in 10 s");
-  check(w, "vkWaitForFences");
-  check(vkResetFences_(device_, 1, &fence_), "vkResetFences");
-}
-
 std::vector<Pixels8> AppDevice::read(const std::vector<Read>& reads) {
   VkDeviceSize total = 0;
   std::vector<VkDeviceSize> offsets;
@@ -182,7 +145,7 @@ std::vector<Pixels8> AppDevice::read(const std::vector<Read>& reads) {
     total += VkDeviceSize(r.rect.extent.width) * VkDeviceSize(r.rect.extent.height) * 4;
   }
   reserve(download_, total, VK_BUFFER_USAGE_TRANSFER_DST_BIT);
-  submit([&](VkCommandBuffer cb) {
+  queue_->run([&](VkCommandBuffer cb) {
     for (std::size_t i = 0; i < reads.size(); ++i) {
       const Read& r = reads[i];
       record_download(cb, {r.image, r.array_layer, VK_IMAGE_LAYOUT_COLOR_ATTACHMENT_OPTIMAL,
@@ -241,7 +204,7 @@ std::vector<std::vector<float>> AppDevice::read_depth(const std::vector<AppDepth
              ~VkDeviceSize(3);
   }
   reserve(download_, total, VK_BUFFER_USAGE_TRANSFER_DST_BIT);
-  submit([&](VkCommandBuffer cb) {
+  queue_->run([&](VkCommandBuffer cb) {
     for (std::size_t i = 0; i < reads.size(); ++i) {
       const AppDepth& r = reads[i];
       // Layout transitions cover every aspect of a combined depth/stencil image.
@@ -276,7 +239,7 @@ void AppDevice::write(const std::vector<VkImage>& images, const std::vector<cons
   reserve(upload_, total, VK_BUFFER_USAGE_TRANSFER_SRC_BIT);
   for (std::size_t i = 0; i < pixels.size(); ++i)
     std::memcpy(static_cast<std::uint8_t*>(upload_.mapped) + offsets[i], pixels[i]->data.data(), pixels[i]->data.size());
-  submit([&](VkCommandBuffer cb) {
+  queue_->run([&](VkCommandBuffer cb) {
     for (std::size_t i = 0; i < images.size(); ++i) {
       // The whole image is overwritten: its old contents are discarded (after the runtime's
       // earlier reads of it on this queue).

@@ -4,6 +4,7 @@
 // xrEndFrame, before calling down). Each transfer is one submission and a bounded fence wait,
 // under no lock another application call needs.
 #include <cstdint>
+#include <memory>
 #include <vector>
 
 #include <vulkan/vulkan.h>
@@ -12,6 +13,7 @@
 #include <openxr/openxr.h>
 
 #include "composite.hpp"
+#include "fovea/xrcommon/foreign_queue.hpp"
 #include "frame_renderer.hpp"
 
 namespace fovea::layer {
@@ -50,9 +52,6 @@ class AppDevice {
   };
   void reserve(HostBuffer& b, VkDeviceSize size, VkBufferUsageFlags usage);
   void release(HostBuffer& b);
-  void destroy();
-  template <class F>
-  void submit(F&& record);
   // One region of an attachment image copied into download_ at `offset`: transition to
   // TRANSFER_SRC after the application's writes, copy `copy_aspect`, transition back.
   struct Download {
@@ -69,19 +68,14 @@ class AppDevice {
   void record_host_read_barrier(VkCommandBuffer cb);
 
   VkDevice device_ = VK_NULL_HANDLE;
-  VkQueue queue_ = VK_NULL_HANDLE;
-  VkCommandPool pool_ = VK_NULL_HANDLE;
-  VkCommandBuffer cmd_ = VK_NULL_HANDLE;
-  VkFence fence_ = VK_NULL_HANDLE;
+  std::unique_ptr<xrcommon::ForeignQueue> queue_;  // the session queue, bounded waits
   HostBuffer download_, upload_;
   VkPhysicalDeviceMemoryProperties memory_{};
 
 #define FOVEA_APP_VK(X)                                                                                          \
-  X(vkGetDeviceQueue) X(vkCreateCommandPool) X(vkDestroyCommandPool) X(vkAllocateCommandBuffers)                \
-  X(vkResetCommandBuffer) X(vkBeginCommandBuffer) X(vkEndCommandBuffer) X(vkCmdPipelineBarrier)                 \
-  X(vkCmdCopyImageToBuffer) X(vkCmdCopyBufferToImage) X(vkQueueSubmit) X(vkCreateFence) X(vkDestroyFence)       \
-  X(vkWaitForFences) X(vkResetFences) X(vkCreateBuffer) X(vkDestroyBuffer) X(vkGetBufferMemoryRequirements)     \
-  X(vkAllocateMemory) X(vkFreeMemory) X(vkBindBufferMemory) X(vkMapMemory) X(vkUnmapMemory)
+  X(vkGetDeviceQueue) X(vkCmdPipelineBarrier) X(vkCmdCopyImageToBuffer) X(vkCmdCopyBufferToImage)             \
+  X(vkCreateBuffer) X(vkDestroyBuffer) X(vkGetBufferMemoryRequirements) X(vkAllocateMemory) X(vkFreeMemory)     \
+  X(vkBindBufferMemory) X(vkMapMemory) X(vkUnmapMemory)
 #define FOVEA_APP_VK_MEMBER(name) PFN_##name name##_ = nullptr;
   FOVEA_APP_VK(FOVEA_APP_VK_MEMBER)
 #undef FOVEA_APP_VK_MEMBER
