@@ -6,11 +6,11 @@
 #include <string>
 
 namespace fovea::layer {
-namespace {
-
-void check(VkResult r, const char* what) {
+void app_check(VkResult r, const char* what) {
   if (r != VK_SUCCESS) throw std::runtime_error(std::string(what) + " failed on the application's device: VkResult " + std::to_string(int(r)));
 }
+
+namespace {
 
 VkImageMemoryBarrier image_barrier(VkImage image, std::uint32_t layer, VkImageLayout from, VkImageLayout to,
                                    VkAccessFlags src, VkAccessFlags dst,
@@ -68,7 +68,7 @@ bool depth_format_supported(VkFormat f) { return depth_texel_bytes(f) != 0; }
 
 // The application's device functions come from the Vulkan loader the layer links (through
 // fovea_gpu), the same loader instance the application uses.
-AppDevice::AppDevice(const VulkanBinding& vk) : device_(vk.device) {
+AppDevice::AppDevice(const VulkanBinding& vk) : device_(vk.device), queue_family_(vk.queue_family) {
   if (!vk.valid() || !vk.instance || !vk.physical_device)
     throw std::runtime_error("the session has no Vulkan graphics binding the layer can use");
   const auto gdpa = reinterpret_cast<PFN_vkGetDeviceProcAddr>(vkGetInstanceProcAddr(vk.instance, "vkGetDeviceProcAddr"));
@@ -81,6 +81,14 @@ AppDevice::AppDevice(const VulkanBinding& vk) : device_(vk.device) {
   FOVEA_APP_VK(FOVEA_APP_VK_LOAD)
 #undef FOVEA_APP_VK_LOAD
   props(vk.physical_device, &memory_);
+  if (const auto families = reinterpret_cast<PFN_vkGetPhysicalDeviceQueueFamilyProperties>(
+          vkGetInstanceProcAddr(vk.instance, "vkGetPhysicalDeviceQueueFamilyProperties"))) {
+    std::uint32_t n = 0;
+    families(vk.physical_device, &n, nullptr);
+    std::vector<VkQueueFamilyProperties> f(n);
+    families(vk.physical_device, &n, f.data());
+    family_has_compute_ = vk.queue_family < n && (f[vk.queue_family].queueFlags & VK_QUEUE_COMPUTE_BIT);
+  }
   VkQueue queue = VK_NULL_HANDLE;
   vkGetDeviceQueue_(device_, vk.queue_family, vk.queue_index, &queue);
   // Bounded: a lost or hung device fails the session (the layer then passes it through)
@@ -91,43 +99,46 @@ AppDevice::AppDevice(const VulkanBinding& vk) : device_(vk.device) {
 }
 
 AppDevice::~AppDevice() {
+  destroy_gpu();
   release(download_);
   release(upload_);
 }
 
-void AppDevice::release(HostBuffer& b) {
+void AppDevice::release(Buffer& b) {
   if (b.mapped) vkUnmapMemory_(device_, b.memory);
   if (b.buffer) vkDestroyBuffer_(device_, b.buffer, nullptr);
   if (b.memory) vkFreeMemory_(device_, b.memory, nullptr);
-  b = HostBuffer{};
+  b = Buffer{};
 }
 
-void AppDevice::reserve(HostBuffer& b, VkDeviceSize size, VkBufferUsageFlags usage) {
+void AppDevice::reserve(Buffer& b, VkDeviceSize size, VkBufferUsageFlags usage, bool host) {
   if (b.size >= size) return;
   release(b);
   VkBufferCreateInfo bi{VK_STRUCTURE_TYPE_BUFFER_CREATE_INFO};
   bi.size = size;
   bi.usage = usage;
   bi.sharingMode = VK_SHARING_MODE_EXCLUSIVE;
-  check(vkCreateBuffer_(device_, &bi, nullptr, &b.buffer), "vkCreateBuffer");
+  app_check(vkCreateBuffer_(device_, &bi, nullptr, &b.buffer), "vkCreateBuffer");
   VkMemoryRequirements req;
   vkGetBufferMemoryRequirements_(device_, b.buffer, &req);
   // Host-coherent memory: no flush/invalidate around the copies.
-  const VkMemoryPropertyFlags want = VK_MEMORY_PROPERTY_HOST_VISIBLE_BIT | VK_MEMORY_PROPERTY_HOST_COHERENT_BIT;
+  const VkMemoryPropertyFlags want = host ? VK_MEMORY_PROPERTY_HOST_VISIBLE_BIT | VK_MEMORY_PROPERTY_HOST_COHERENT_BIT
+                                          : VK_MEMORY_PROPERTY_DEVICE_LOCAL_BIT;
   std::uint32_t type = ~0u;
   for (std::uint32_t i = 0; i < memory_.memoryTypeCount && type == ~0u; ++i)
     if ((req.memoryTypeBits & (1u << i)) && (memory_.memoryTypes[i].propertyFlags & want) == want) type = i;
   if (type == ~0u) {
     release(b);
-    throw std::runtime_error("the application's device has no host-visible coherent memory for the layer's transfers");
+    throw std::runtime_error(std::string("the application's device has no ") +
+                             (host ? "host-visible coherent" : "device-local") + " memory for the layer's buffers");
   }
   VkMemoryAllocateInfo mi{VK_STRUCTURE_TYPE_MEMORY_ALLOCATE_INFO};
   mi.allocationSize = req.size;
   mi.memoryTypeIndex = type;
   try {
-    check(vkAllocateMemory_(device_, &mi, nullptr, &b.memory), "vkAllocateMemory");
-    check(vkBindBufferMemory_(device_, b.buffer, b.memory, 0), "vkBindBufferMemory");
-    check(vkMapMemory_(device_, b.memory, 0, VK_WHOLE_SIZE, 0, &b.mapped), "vkMapMemory");
+    app_check(vkAllocateMemory_(device_, &mi, nullptr, &b.memory), "vkAllocateMemory");
+    app_check(vkBindBufferMemory_(device_, b.buffer, b.memory, 0), "vkBindBufferMemory");
+    if (host) app_check(vkMapMemory_(device_, b.memory, 0, VK_WHOLE_SIZE, 0, &b.mapped), "vkMapMemory");
   } catch (...) {
     release(b);
     throw;
@@ -145,12 +156,14 @@ std::vector<Pixels8> AppDevice::read(const std::vector<Read>& reads) {
     total += VkDeviceSize(r.rect.extent.width) * VkDeviceSize(r.rect.extent.height) * 4;
   }
   reserve(download_, total, VK_BUFFER_USAGE_TRANSFER_DST_BIT);
+  ++host_readbacks_;
   queue_->run([&](VkCommandBuffer cb) {
     for (std::size_t i = 0; i < reads.size(); ++i) {
       const Read& r = reads[i];
       record_download(cb, {r.image, r.array_layer, VK_IMAGE_LAYOUT_COLOR_ATTACHMENT_OPTIMAL,
                            VK_ACCESS_COLOR_ATTACHMENT_WRITE_BIT | VK_ACCESS_SHADER_WRITE_BIT | VK_ACCESS_TRANSFER_WRITE_BIT,
-                           VK_IMAGE_ASPECT_COLOR_BIT, VK_IMAGE_ASPECT_COLOR_BIT, r.rect, offsets[i]});
+                           VK_IMAGE_ASPECT_COLOR_BIT, VK_IMAGE_ASPECT_COLOR_BIT, r.rect, offsets[i]},
+                      download_.buffer);
     }
     record_host_read_barrier(cb);
   });
@@ -164,7 +177,7 @@ std::vector<Pixels8> AppDevice::read(const std::vector<Read>& reads) {
   return out;
 }
 
-void AppDevice::record_download(VkCommandBuffer cb, const Download& d) {
+void AppDevice::record_download(VkCommandBuffer cb, const Download& d, VkBuffer buffer) {
   // After the application's rendering (earlier submissions on this queue).
   auto to_src = image_barrier(d.image, d.array_layer, d.attachment_layout, VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL,
                               d.attachment_writes, VK_ACCESS_TRANSFER_READ_BIT, d.aspects);
@@ -175,7 +188,7 @@ void AppDevice::record_download(VkCommandBuffer cb, const Download& d) {
   c.imageSubresource = {d.copy_aspect, 0, d.array_layer, 1};
   c.imageOffset = {d.rect.offset.x, d.rect.offset.y, 0};
   c.imageExtent = {std::uint32_t(d.rect.extent.width), std::uint32_t(d.rect.extent.height), 1};
-  vkCmdCopyImageToBuffer_(cb, d.image, VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL, download_.buffer, 1, &c);
+  vkCmdCopyImageToBuffer_(cb, d.image, VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL, buffer, 1, &c);
   auto back = image_barrier(d.image, d.array_layer, VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL, d.attachment_layout, 0, 0,
                             d.aspects);
   vkCmdPipelineBarrier_(cb, VK_PIPELINE_STAGE_TRANSFER_BIT, VK_PIPELINE_STAGE_ALL_COMMANDS_BIT, 0, 0, nullptr, 0, nullptr,
@@ -204,6 +217,7 @@ std::vector<std::vector<float>> AppDevice::read_depth(const std::vector<AppDepth
              ~VkDeviceSize(3);
   }
   reserve(download_, total, VK_BUFFER_USAGE_TRANSFER_DST_BIT);
+  ++host_readbacks_;
   queue_->run([&](VkCommandBuffer cb) {
     for (std::size_t i = 0; i < reads.size(); ++i) {
       const AppDepth& r = reads[i];
@@ -212,7 +226,8 @@ std::vector<std::vector<float>> AppDevice::read_depth(const std::vector<AppDepth
           VK_IMAGE_ASPECT_DEPTH_BIT | (has_stencil(r.format) ? VK_IMAGE_ASPECT_STENCIL_BIT : 0);
       record_download(cb, {r.image, r.array_index, VK_IMAGE_LAYOUT_DEPTH_STENCIL_ATTACHMENT_OPTIMAL,
                            VK_ACCESS_DEPTH_STENCIL_ATTACHMENT_WRITE_BIT | VK_ACCESS_TRANSFER_WRITE_BIT, aspects,
-                           VK_IMAGE_ASPECT_DEPTH_BIT, r.rect, offsets[i]});
+                           VK_IMAGE_ASPECT_DEPTH_BIT, r.rect, offsets[i]},
+                      download_.buffer);
     }
     record_host_read_barrier(cb);
   });
@@ -240,26 +255,30 @@ void AppDevice::write(const std::vector<VkImage>& images, const std::vector<cons
   for (std::size_t i = 0; i < pixels.size(); ++i)
     std::memcpy(static_cast<std::uint8_t*>(upload_.mapped) + offsets[i], pixels[i]->data.data(), pixels[i]->data.size());
   queue_->run([&](VkCommandBuffer cb) {
-    for (std::size_t i = 0; i < images.size(); ++i) {
-      // The whole image is overwritten: its old contents are discarded (after the runtime's
-      // earlier reads of it on this queue).
-      auto to_dst = image_barrier(images[i], 0, VK_IMAGE_LAYOUT_UNDEFINED, VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL, 0,
-                                  VK_ACCESS_TRANSFER_WRITE_BIT);
-      vkCmdPipelineBarrier_(cb, VK_PIPELINE_STAGE_ALL_COMMANDS_BIT, VK_PIPELINE_STAGE_TRANSFER_BIT, 0, 0, nullptr, 0,
-                            nullptr, 1, &to_dst);
-      VkBufferImageCopy c{};
-      c.bufferOffset = offsets[i];
-      c.imageSubresource = {VK_IMAGE_ASPECT_COLOR_BIT, 0, 0, 1};
-      c.imageExtent = {std::uint32_t(pixels[i]->width), std::uint32_t(pixels[i]->height), 1};
-      vkCmdCopyBufferToImage_(cb, upload_.buffer, images[i], VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL, 1, &c);
-      auto done = image_barrier(images[i], 0, VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL,
-                                VK_IMAGE_LAYOUT_COLOR_ATTACHMENT_OPTIMAL, VK_ACCESS_TRANSFER_WRITE_BIT,
-                                VK_ACCESS_TRANSFER_READ_BIT | VK_ACCESS_COLOR_ATTACHMENT_READ_BIT |
-                                    VK_ACCESS_COLOR_ATTACHMENT_WRITE_BIT);
-      vkCmdPipelineBarrier_(cb, VK_PIPELINE_STAGE_TRANSFER_BIT, VK_PIPELINE_STAGE_ALL_COMMANDS_BIT, 0, 0, nullptr, 0,
-                            nullptr, 1, &done);
-    }
+    for (std::size_t i = 0; i < images.size(); ++i)
+      record_upload(cb, upload_.buffer, offsets[i], images[i], pixels[i]->width, pixels[i]->height);
   });
+}
+
+void AppDevice::record_upload(VkCommandBuffer cb, VkBuffer buffer, VkDeviceSize offset, VkImage image, int width,
+                              int height) {
+  // The whole image is overwritten: its old contents are discarded (after the runtime's
+  // earlier reads of it on this queue).
+  auto to_dst = image_barrier(image, 0, VK_IMAGE_LAYOUT_UNDEFINED, VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL, 0,
+                              VK_ACCESS_TRANSFER_WRITE_BIT);
+  vkCmdPipelineBarrier_(cb, VK_PIPELINE_STAGE_ALL_COMMANDS_BIT, VK_PIPELINE_STAGE_TRANSFER_BIT, 0, 0, nullptr, 0,
+                        nullptr, 1, &to_dst);
+  VkBufferImageCopy c{};
+  c.bufferOffset = offset;
+  c.imageSubresource = {VK_IMAGE_ASPECT_COLOR_BIT, 0, 0, 1};
+  c.imageExtent = {std::uint32_t(width), std::uint32_t(height), 1};
+  vkCmdCopyBufferToImage_(cb, buffer, image, VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL, 1, &c);
+  auto done = image_barrier(image, 0, VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL, VK_IMAGE_LAYOUT_COLOR_ATTACHMENT_OPTIMAL,
+                            VK_ACCESS_TRANSFER_WRITE_BIT,
+                            VK_ACCESS_TRANSFER_READ_BIT | VK_ACCESS_COLOR_ATTACHMENT_READ_BIT |
+                                VK_ACCESS_COLOR_ATTACHMENT_WRITE_BIT);
+  vkCmdPipelineBarrier_(cb, VK_PIPELINE_STAGE_TRANSFER_BIT, VK_PIPELINE_STAGE_ALL_COMMANDS_BIT, 0, 0, nullptr, 0,
+                        nullptr, 1, &done);
 }
 
 }  // namespace fovea::layer
