@@ -73,8 +73,13 @@ void border_pass(uint e) {
   uint my_count = 0u, my_key = 0xffffffffu;
   for (uint i = tid; i < n; i += kLayerBorderGroup) {
     uint key = border_key(i, w, h, base);
-    uint count = 0u;
-    for (uint j = 0u; j < n; ++j) count += border_key(j, w, h, base) == key ? 1u : 0u;
+    // Counted once, at the colour's first border pixel: a border mostly of the clear colour
+    // (the usual case) costs O(n), not O(n^2).
+    bool first = true;
+    for (uint j = 0u; j < i && first; ++j) first = border_key(j, w, h, base) != key;
+    if (!first) continue;
+    uint count = 1u;
+    for (uint j = i + 1u; j < n; ++j) count += border_key(j, w, h, base) == key ? 1u : 0u;
     if (count > my_count || (count == my_count && key < my_key)) {
       my_count = count;
       my_key = key;

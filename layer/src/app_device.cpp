@@ -89,12 +89,12 @@ AppDevice::AppDevice(const VulkanBinding& vk) : device_(vk.device), queue_family
     families(vk.physical_device, &n, f.data());
     family_has_compute_ = vk.queue_family < n && (f[vk.queue_family].queueFlags & VK_QUEUE_COMPUTE_BIT);
   }
-  VkQueue queue = VK_NULL_HANDLE;
-  vkGetDeviceQueue_(device_, vk.queue_family, vk.queue_index, &queue);
+  get_device_proc_ = gdpa;
+  vkGetDeviceQueue_(device_, vk.queue_family, vk.queue_index, &queue_handle_);
   // Bounded: a lost or hung device fails the session (the layer then passes it through)
   // instead of hanging the application's xrEndFrame.
   constexpr std::uint64_t kTimeoutNs = 10'000'000'000;
-  queue_ = std::make_unique<xrcommon::ForeignQueue>(device_, gdpa, vk.queue_family, queue, kTimeoutNs,
+  queue_ = std::make_unique<xrcommon::ForeignQueue>(device_, gdpa, vk.queue_family, queue_handle_, kTimeoutNs,
                                                     "the application's device");
 }
 

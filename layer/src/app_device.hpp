@@ -60,9 +60,14 @@ class AppDevice {
     Read app;                    // the application's projection view (unused in scene-only mode)
     VkImage target;              // written whole (out_view's raster), ends in COLOR_ATTACHMENT_OPTIMAL
   };
-  // One submission: the traced frame uploaded if new, the application's rects copied into a
-  // device buffer, the composition pass, the results copied into the targets; bounded wait.
+  // Two submissions on the session queue. The first (waited for, bounded) uploads the traced
+  // frame if new and copies the application's rects into a device buffer, so its images are
+  // free again on return; the second (not waited for: the runtime's later work on this queue
+  // comes after it) runs the composition pass and copies the results into the targets. The
+  // next call first waits for it.
   void composite_gpu(std::int64_t traced_id, const std::array<GpuEye, 2>& eyes, const CompositionRule& rule);
+  // Waits for a composition pass still running (before its targets are destroyed).
+  void finish();
 
  private:
   struct Buffer {
@@ -93,6 +98,8 @@ class AppDevice {
   void record_upload(VkCommandBuffer cb, VkBuffer buffer, VkDeviceSize offset, VkImage image, int width, int height);
 
   VkDevice device_ = VK_NULL_HANDLE;
+  PFN_vkGetDeviceProcAddr get_device_proc_ = nullptr;
+  VkQueue queue_handle_ = VK_NULL_HANDLE;
   std::uint32_t queue_family_ = 0;
   bool family_has_compute_ = false;
   std::unique_ptr<xrcommon::ForeignQueue> queue_;  // the session queue, bounded waits
@@ -112,6 +119,7 @@ class AppDevice {
     std::int64_t uploaded = -1;             // the traced frame in `traced`
   };
   std::unique_ptr<Gpu> gpu_;
+  std::unique_ptr<xrcommon::ForeignQueue> pass_;  // the composition pass's submissions
   void destroy_gpu();
 
 #define FOVEA_APP_VK(X)                                                                                          \

@@ -271,6 +271,11 @@ class PathTraceRenderer final : public FrameRenderer {
     }
     wake_.notify_all();
     if (thread_.joinable()) thread_.join();
+    try {
+      app_.finish();  // a composition pass may still write the swapchain images destroyed below
+    } catch (const std::exception& e) {
+      FOVEA_LAYER_ERROR("the last composition pass did not finish: %s", e.what());
+    }
     for (Eye& e : eyes_)
       if (e.swapchain != XR_NULL_HANDLE) next_.xrDestroySwapchain(e.swapchain);
   }

@@ -93,13 +93,21 @@ void AppDevice::enable_gpu_composition() {
     constexpr VkBufferUsageFlags storage = VK_BUFFER_USAGE_STORAGE_BUFFER_BIT;
     reserve(g.params, sizeof(shaders::LayerCompositeParams), storage);
     reserve(g.background, 2 * sizeof(std::uint32_t), storage, false);
+    constexpr std::uint64_t kTimeoutNs = 10'000'000'000;
+    pass_ = std::make_unique<xrcommon::ForeignQueue>(device_, get_device_proc_, queue_family_, queue_handle_, kTimeoutNs,
+                                                     "the application's device");
   } catch (...) {
     destroy_gpu();
     throw;
   }
 }
 
+void AppDevice::finish() {
+  if (pass_) pass_->wait();
+}
+
 void AppDevice::destroy_gpu() {
+  pass_.reset();  // waits for a pass still running: it uses the buffers below
   if (!gpu_) return;
   Gpu& g = *gpu_;
   for (Buffer* b : {&g.params, &g.staging, &g.traced, &g.app, &g.out, &g.background}) release(*b);
@@ -114,6 +122,7 @@ void AppDevice::destroy_gpu() {
 void AppDevice::composite_gpu(std::int64_t traced_id, const std::array<GpuEye, 2>& eyes, const CompositionRule& rule) {
   if (!gpu_) throw std::logic_error("composite_gpu: GPU composition was not enabled");
   Gpu& g = *gpu_;
+  pass_->wait();  // the previous frame's pass reads the buffers rewritten below
   const bool with_app = rule.mode != Composite::SceneOnly;
   auto& p = *static_cast<shaders::LayerCompositeParams*>(g.params.mapped);
   std::uint32_t traced_px = 0, app_px = 0, out_px = 0;
@@ -203,7 +212,11 @@ void AppDevice::composite_gpu(std::int64_t traced_id, const std::array<GpuEye, 2
                          VK_IMAGE_ASPECT_COLOR_BIT, VK_IMAGE_ASPECT_COLOR_BIT, eyes[e].app.rect,
                          VkDeviceSize(p.eye[e].app_offset) * 4},
                         g.app.buffer);
-    // The parameters' host writes are visible through the submission itself.
+  });
+  g.uploaded = traced_id;
+  pass_->submit([&](VkCommandBuffer cb) {
+    // After the copies of the earlier submission (a barrier's first scope spans earlier
+    // submissions on the queue); the parameters' host writes are visible through the submission.
     const VkMemoryBarrier to_compute = memory_barrier(VK_ACCESS_TRANSFER_WRITE_BIT, VK_ACCESS_SHADER_READ_BIT);
     vkCmdPipelineBarrier_(cb, VK_PIPELINE_STAGE_TRANSFER_BIT, VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT, 0, 1, &to_compute, 0,
                           nullptr, 0, nullptr);
@@ -231,7 +244,6 @@ void AppDevice::composite_gpu(std::int64_t traced_id, const std::array<GpuEye, 2
       record_upload(cb, g.out.buffer, VkDeviceSize(p.eye[e].out_offset) * 4, eyes[e].target, p.eye[e].out_w,
                     p.eye[e].out_h);
   });
-  g.uploaded = traced_id;
 }
 
 }  // namespace fovea::layer

@@ -163,6 +163,7 @@ TEST_F(GpuComposite, MatchesTheHostPathPixelByPixel) {
       }
       const std::int64_t readbacks = dev.host_readbacks();
       dev.composite_gpu(++traced_id, jobs, rule);
+      dev.finish();
       EXPECT_EQ(dev.host_readbacks(), readbacks) << "the GPU path copied application images to the host";
       const std::vector<Pixels8> gpu_out =
           dev.read({{target[0].get(), 0, {{0, 0}, {g.traced_w, g.traced_h}}},

@@ -31,7 +31,11 @@ ForeignQueue::ForeignQueue(VkDevice device, PFN_vkGetDeviceProcAddr get_device_p
   }
 }
 
-ForeignQueue::~ForeignQueue() { destroy(); }
+ForeignQueue::~ForeignQueue() {
+  // The command buffer must not be pending when its pool goes; a failed wait leaves nothing better to do.
+  if (pending_) vkWaitForFences_(device_, 1, &fence_, VK_TRUE, timeout_ns_);
+  destroy();
+}
 
 void ForeignQueue::destroy() {
   if (fence_) vkDestroyFence_(device_, fence_, nullptr);
@@ -46,6 +50,12 @@ void ForeignQueue::check(VkResult r, const char* what) const {
 }
 
 void ForeignQueue::run(const std::function<void(VkCommandBuffer)>& record) {
+  submit(record);
+  wait();
+}
+
+void ForeignQueue::submit(const std::function<void(VkCommandBuffer)>& record) {
+  wait();
   check(vkResetCommandBuffer_(cmd_, 0), "vkResetCommandBuffer");
   VkCommandBufferBeginInfo bi{VK_STRUCTURE_TYPE_COMMAND_BUFFER_BEGIN_INFO};
   bi.flags = VK_COMMAND_BUFFER_USAGE_ONE_TIME_SUBMIT_BIT;
@@ -57,11 +67,17 @@ void ForeignQueue::run(const std::function<void(VkCommandBuffer)>& record) {
   si.pCommandBuffers = &cmd_;
   check(vkResetFences_(device_, 1, &fence_), "vkResetFences");
   check(vkQueueSubmit_(queue_, 1, &si, fence_), "vkQueueSubmit");
+  pending_ = true;
+}
+
+void ForeignQueue::wait() {
+  if (!pending_) return;
   const VkResult w = vkWaitForFences_(device_, 1, &fence_, VK_TRUE, timeout_ns_);
   if (w == VK_TIMEOUT)
     throw std::runtime_error("a submission did not finish on " + device_name_ + " in " +
                              std::to_string(timeout_ns_ / 1'000'000) + " ms");
   check(w, "vkWaitForFences");
+  pending_ = false;
 }
 
 }  // namespace fovea::xrcommon

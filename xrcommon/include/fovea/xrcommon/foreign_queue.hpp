@@ -18,7 +18,7 @@ class ForeignQueue {
   // `timeout_ns` bounds each wait (kNoTimeout: unbounded). Throws std::runtime_error.
   ForeignQueue(VkDevice device, PFN_vkGetDeviceProcAddr get_device_proc, std::uint32_t family, VkQueue queue,
                std::uint64_t timeout_ns, std::string device_name);
-  ~ForeignQueue();
+  ~ForeignQueue();  // waits (bounded) for a submission still running
   ForeignQueue(const ForeignQueue&) = delete;
   ForeignQueue& operator=(const ForeignQueue&) = delete;
 
@@ -27,6 +27,11 @@ class ForeignQueue {
   // beyond the timeout (a hung device fails the caller instead of hanging it); an exception
   // from `record` propagates, and the next run() starts afresh either way.
   void run(const std::function<void(VkCommandBuffer)>& record);
+  // The same without the wait: returns once submitted. The next submit(), run() or wait()
+  // first waits for it (the one command buffer is reused).
+  void submit(const std::function<void(VkCommandBuffer)>& record);
+  // Waits for the last submission, if one is still pending; throws as run().
+  void wait();
 
  private:
   void check(VkResult r, const char* what) const;
@@ -39,6 +44,7 @@ class ForeignQueue {
   VkCommandPool pool_ = VK_NULL_HANDLE;
   VkCommandBuffer cmd_ = VK_NULL_HANDLE;
   VkFence fence_ = VK_NULL_HANDLE;
+  bool pending_ = false;  // submitted, not yet waited for
 
 #define FOVEA_FOREIGN_VK(X)                                                                                  \
   X(vkCreateCommandPool) X(vkDestroyCommandPool) X(vkAllocateCommandBuffers) X(vkResetCommandBuffer)         \
