@@ -153,25 +153,42 @@ XrResult intercept::xrAttachSessionActionSets(XrSession session, const XrSession
   return r;
 }
 
+// An application without the extension naming /user/eyes_ext as an active set's subaction
+// path gets the runtime's answer for a path that is no top-level user path: the layer passes
+// its own binding path (/user/eyes_ext/input/gaze_ext/pose, never a top-level user path)
+// in its place, so the runtime's own checks, in their order, give the code the application
+// would get without the layer.
 XrResult intercept::xrSyncActions(XrSession session, const XrActionsSyncInfo* info) {
+  const Lookup hidden = for_session(session, false);
+  if (!hidden.next) return XR_ERROR_HANDLE_INVALID;
   const Lookup l = for_session(session);
-  if (!l.next) return XR_ERROR_HANDLE_INVALID;
   bool attached = false;
   {
     std::lock_guard lock(layer().mutex);
     auto s = layer().sessions.find(session);
     attached = s != layer().sessions.end() && s->second.gaze.attached();
   }
-  if (!attached || !l.gaze.valid() || !info || info->type != XR_TYPE_ACTIONS_SYNC_INFO)
-    return l.next->xrSyncActions(session, info);
-  std::vector<XrActiveActionSet> sets(info->activeActionSets,
-                                      info->activeActionSets + (info->activeActionSets ? info->countActiveActionSets : 0));
-  sets.push_back({l.gaze.set, XR_NULL_PATH});
+  const bool well_formed = info && info->type == XR_TYPE_ACTIONS_SYNC_INFO &&
+                           (info->activeActionSets || info->countActiveActionSets == 0);
+  if (!well_formed) return l.next->xrSyncActions(session, info);
+  std::vector<XrActiveActionSet> sets(info->activeActionSets, info->activeActionSets + info->countActiveActionSets);
+  bool hides = false;
+  if (hidden.gaze_hidden && hidden.gaze.user != XR_NULL_PATH)
+    for (XrActiveActionSet& s : sets)
+      if (s.subactionPath == hidden.gaze.user) {
+        s.subactionPath = hidden.gaze.binding;
+        hides = true;
+      }
+  XrActionsSyncInfo own = *info;
+  own.activeActionSets = sets.data();
+  if (!attached || !l.gaze.valid()) return l.next->xrSyncActions(session, hides ? &own : info);
+  std::vector<XrActiveActionSet> merged = sets;
+  merged.push_back({l.gaze.set, XR_NULL_PATH});
   XrActionsSyncInfo down = *info;
-  down.countActiveActionSets = std::uint32_t(sets.size());
-  down.activeActionSets = sets.data();
+  down.countActiveActionSets = std::uint32_t(merged.size());
+  down.activeActionSets = merged.data();
   const XrResult r = l.next->xrSyncActions(session, &down);
-  return XR_FAILED(r) ? l.next->xrSyncActions(session, info) : r;
+  return XR_FAILED(r) ? l.next->xrSyncActions(session, hides ? &own : info) : r;
 }
 
 namespace {

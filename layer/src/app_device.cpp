@@ -6,11 +6,11 @@
 #include <string>
 
 namespace fovea::layer {
-namespace {
-
-void check(VkResult r, const char* what) {
+void app_check(VkResult r, const char* what) {
   if (r != VK_SUCCESS) throw std::runtime_error(std::string(what) + " failed on the application's device: VkResult " + std::to_string(int(r)));
 }
+
+namespace {
 
 VkImageMemoryBarrier image_barrier(VkImage image, std::uint32_t layer, VkImageLayout from, VkImageLayout to,
                                    VkAccessFlags src, VkAccessFlags dst,
@@ -68,7 +68,7 @@ bool depth_format_supported(VkFormat f) { return depth_texel_bytes(f) != 0; }
 
 // The application's device functions come from the Vulkan loader the layer links (through
 // fovea_gpu), the same loader instance the application uses.
-AppDevice::AppDevice(const VulkanBinding& vk) : device_(vk.device) {
+AppDevice::AppDevice(const VulkanBinding& vk) : device_(vk.device), queue_family_(vk.queue_family) {
   if (!vk.valid() || !vk.instance || !vk.physical_device)
     throw std::runtime_error("the session has no Vulkan graphics binding the layer can use");
   const auto gdpa = reinterpret_cast<PFN_vkGetDeviceProcAddr>(vkGetInstanceProcAddr(vk.instance, "vkGetDeviceProcAddr"));
@@ -81,95 +81,69 @@ AppDevice::AppDevice(const VulkanBinding& vk) : device_(vk.device) {
   FOVEA_APP_VK(FOVEA_APP_VK_LOAD)
 #undef FOVEA_APP_VK_LOAD
   props(vk.physical_device, &memory_);
-  vkGetDeviceQueue_(device_, vk.queue_family, vk.queue_index, &queue_);
-  VkCommandPoolCreateInfo pi{VK_STRUCTURE_TYPE_COMMAND_POOL_CREATE_INFO};
-  pi.flags = VK_COMMAND_POOL_CREATE_RESET_COMMAND_BUFFER_BIT;
-  pi.queueFamilyIndex = vk.queue_family;
-  check(vkCreateCommandPool_(device_, &pi, nullptr, &pool_), "vkCreateCommandPool");
-  VkCommandBufferAllocateInfo ai{VK_STRUCTURE_TYPE_COMMAND_BUFFER_ALLOCATE_INFO};
-  ai.commandPool = pool_;
-  ai.level = VK_COMMAND_BUFFER_LEVEL_PRIMARY;
-  ai.commandBufferCount = 1;
-  VkFenceCreateInfo fi{VK_STRUCTURE_TYPE_FENCE_CREATE_INFO};
-  try {
-    check(vkAllocateCommandBuffers_(device_, &ai, &cmd_), "vkAllocateCommandBuffers");
-    check(vkCreateFence_(device_, &fi, nullptr, &fence_), "vkCreateFence");
-  } catch (...) {
-    destroy();
-    throw;
+  if (const auto families = reinterpret_cast<PFN_vkGetPhysicalDeviceQueueFamilyProperties>(
+          vkGetInstanceProcAddr(vk.instance, "vkGetPhysicalDeviceQueueFamilyProperties"))) {
+    std::uint32_t n = 0;
+    families(vk.physical_device, &n, nullptr);
+    std::vector<VkQueueFamilyProperties> f(n);
+    families(vk.physical_device, &n, f.data());
+    family_has_compute_ = vk.queue_family < n && (f[vk.queue_family].queueFlags & VK_QUEUE_COMPUTE_BIT);
   }
+  get_device_proc_ = gdpa;
+  vkGetDeviceQueue_(device_, vk.queue_family, vk.queue_index, &queue_handle_);
+  // Bounded: a lost or hung device fails the session (the layer then passes it through)
+  // instead of hanging the application's xrEndFrame.
+  constexpr std::uint64_t kTimeoutNs = 10'000'000'000;
+  queue_ = std::make_unique<xrcommon::ForeignQueue>(device_, gdpa, vk.queue_family, queue_handle_, kTimeoutNs,
+                                                    "the application's device");
 }
 
-AppDevice::~AppDevice() { destroy(); }
-
-void AppDevice::destroy() {
+AppDevice::~AppDevice() {
+  destroy_gpu();
   release(download_);
   release(upload_);
-  if (fence_) vkDestroyFence_(device_, fence_, nullptr);
-  if (pool_) vkDestroyCommandPool_(device_, pool_, nullptr);
-  fence_ = VK_NULL_HANDLE;
-  pool_ = VK_NULL_HANDLE;
 }
 
-void AppDevice::release(HostBuffer& b) {
+void AppDevice::release(Buffer& b) {
   if (b.mapped) vkUnmapMemory_(device_, b.memory);
   if (b.buffer) vkDestroyBuffer_(device_, b.buffer, nullptr);
   if (b.memory) vkFreeMemory_(device_, b.memory, nullptr);
-  b = HostBuffer{};
+  b = Buffer{};
 }
 
-void AppDevice::reserve(HostBuffer& b, VkDeviceSize size, VkBufferUsageFlags usage) {
+void AppDevice::reserve(Buffer& b, VkDeviceSize size, VkBufferUsageFlags usage, bool host) {
   if (b.size >= size) return;
   release(b);
   VkBufferCreateInfo bi{VK_STRUCTURE_TYPE_BUFFER_CREATE_INFO};
   bi.size = size;
   bi.usage = usage;
   bi.sharingMode = VK_SHARING_MODE_EXCLUSIVE;
-  check(vkCreateBuffer_(device_, &bi, nullptr, &b.buffer), "vkCreateBuffer");
+  app_check(vkCreateBuffer_(device_, &bi, nullptr, &b.buffer), "vkCreateBuffer");
   VkMemoryRequirements req;
   vkGetBufferMemoryRequirements_(device_, b.buffer, &req);
   // Host-coherent memory: no flush/invalidate around the copies.
-  const VkMemoryPropertyFlags want = VK_MEMORY_PROPERTY_HOST_VISIBLE_BIT | VK_MEMORY_PROPERTY_HOST_COHERENT_BIT;
+  const VkMemoryPropertyFlags want = host ? VK_MEMORY_PROPERTY_HOST_VISIBLE_BIT | VK_MEMORY_PROPERTY_HOST_COHERENT_BIT
+                                          : VK_MEMORY_PROPERTY_DEVICE_LOCAL_BIT;
   std::uint32_t type = ~0u;
   for (std::uint32_t i = 0; i < memory_.memoryTypeCount && type == ~0u; ++i)
     if ((req.memoryTypeBits & (1u << i)) && (memory_.memoryTypes[i].propertyFlags & want) == want) type = i;
   if (type == ~0u) {
     release(b);
-    throw std::runtime_error("the application's device has no host-visible coherent memory for the layer's transfers");
+    throw std::runtime_error(std::string("the application's device has no ") +
+                             (host ? "host-visible coherent" : "device-local") + " memory for the layer's buffers");
   }
   VkMemoryAllocateInfo mi{VK_STRUCTURE_TYPE_MEMORY_ALLOCATE_INFO};
   mi.allocationSize = req.size;
   mi.memoryTypeIndex = type;
   try {
-    check(vkAllocateMemory_(device_, &mi, nullptr, &b.memory), "vkAllocateMemory");
-    check(vkBindBufferMemory_(device_, b.buffer, b.memory, 0), "vkBindBufferMemory");
-    check(vkMapMemory_(device_, b.memory, 0, VK_WHOLE_SIZE, 0, &b.mapped), "vkMapMemory");
+    app_check(vkAllocateMemory_(device_, &mi, nullptr, &b.memory), "vkAllocateMemory");
+    app_check(vkBindBufferMemory_(device_, b.buffer, b.memory, 0), "vkBindBufferMemory");
+    if (host) app_check(vkMapMemory_(device_, b.memory, 0, VK_WHOLE_SIZE, 0, &b.mapped), "vkMapMemory");
   } catch (...) {
     release(b);
     throw;
   }
   b.size = size;
-}
-
-template <class F>
-void AppDevice::submit(F&& record) {
-  check(vkResetCommandBuffer_(cmd_, 0), "vkResetCommandBuffer");
-  VkCommandBufferBeginInfo bi{VK_STRUCTURE_TYPE_COMMAND_BUFFER_BEGIN_INFO};
-  bi.flags = VK_COMMAND_BUFFER_USAGE_ONE_TIME_SUBMIT_BIT;
-  check(vkBeginCommandBuffer_(cmd_, &bi), "vkBeginCommandBuffer");
-  record(cmd_);
-  check(vkEndCommandBuffer_(cmd_), "vkEndCommandBuffer");
-  VkSubmitInfo si{VK_STRUCTURE_TYPE_SUBMIT_INFO};
-  si.commandBufferCount = 1;
-  si.pCommandBuffers = &cmd_;
-  check(vkQueueSubmit_(queue_, 1, &si, fence_), "vkQueueSubmit");
-  // Bounded: a lost or hung device fails the session (the layer then passes it through)
-  // instead of hanging the application's xrEndFrame.
-  constexpr std::uint64_t kTimeoutNs = 10'000'000'000;
-  const VkResult w = vkWaitForFences_(device_, 1, &fence_, VK_TRUE, kTimeoutNs);
-  if (w == VK_TIMEOUT) throw std::runtime_error("the layer's transfer did not finish on the application's device in 10 s");
-  check(w, "vkWaitForFences");
-  check(vkResetFences_(device_, 1, &fence_), "vkResetFences");
 }
 
 std::vector<Pixels8> AppDevice::read(const std::vector<Read>& reads) {
@@ -182,12 +156,14 @@ std::vector<Pixels8> AppDevice::read(const std::vector<Read>& reads) {
     total += VkDeviceSize(r.rect.extent.width) * VkDeviceSize(r.rect.extent.height) * 4;
   }
   reserve(download_, total, VK_BUFFER_USAGE_TRANSFER_DST_BIT);
-  submit([&](VkCommandBuffer cb) {
+  ++host_readbacks_;
+  queue_->run([&](VkCommandBuffer cb) {
     for (std::size_t i = 0; i < reads.size(); ++i) {
       const Read& r = reads[i];
       record_download(cb, {r.image, r.array_layer, VK_IMAGE_LAYOUT_COLOR_ATTACHMENT_OPTIMAL,
                            VK_ACCESS_COLOR_ATTACHMENT_WRITE_BIT | VK_ACCESS_SHADER_WRITE_BIT | VK_ACCESS_TRANSFER_WRITE_BIT,
-                           VK_IMAGE_ASPECT_COLOR_BIT, VK_IMAGE_ASPECT_COLOR_BIT, r.rect, offsets[i]});
+                           VK_IMAGE_ASPECT_COLOR_BIT, VK_IMAGE_ASPECT_COLOR_BIT, r.rect, offsets[i]},
+                      download_.buffer);
     }
     record_host_read_barrier(cb);
   });
@@ -201,7 +177,7 @@ std::vector<Pixels8> AppDevice::read(const std::vector<Read>& reads) {
   return out;
 }
 
-void AppDevice::record_download(VkCommandBuffer cb, const Download& d) {
+void AppDevice::record_download(VkCommandBuffer cb, const Download& d, VkBuffer buffer) {
   // After the application's rendering (earlier submissions on this queue).
   auto to_src = image_barrier(d.image, d.array_layer, d.attachment_layout, VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL,
                               d.attachment_writes, VK_ACCESS_TRANSFER_READ_BIT, d.aspects);
@@ -212,7 +188,7 @@ void AppDevice::record_download(VkCommandBuffer cb, const Download& d) {
   c.imageSubresource = {d.copy_aspect, 0, d.array_layer, 1};
   c.imageOffset = {d.rect.offset.x, d.rect.offset.y, 0};
   c.imageExtent = {std::uint32_t(d.rect.extent.width), std::uint32_t(d.rect.extent.height), 1};
-  vkCmdCopyImageToBuffer_(cb, d.image, VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL, download_.buffer, 1, &c);
+  vkCmdCopyImageToBuffer_(cb, d.image, VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL, buffer, 1, &c);
   auto back = image_barrier(d.image, d.array_layer, VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL, d.attachment_layout, 0, 0,
                             d.aspects);
   vkCmdPipelineBarrier_(cb, VK_PIPELINE_STAGE_TRANSFER_BIT, VK_PIPELINE_STAGE_ALL_COMMANDS_BIT, 0, 0, nullptr, 0, nullptr,
@@ -241,7 +217,8 @@ std::vector<std::vector<float>> AppDevice::read_depth(const std::vector<AppDepth
              ~VkDeviceSize(3);
   }
   reserve(download_, total, VK_BUFFER_USAGE_TRANSFER_DST_BIT);
-  submit([&](VkCommandBuffer cb) {
+  ++host_readbacks_;
+  queue_->run([&](VkCommandBuffer cb) {
     for (std::size_t i = 0; i < reads.size(); ++i) {
       const AppDepth& r = reads[i];
       // Layout transitions cover every aspect of a combined depth/stencil image.
@@ -249,7 +226,8 @@ std::vector<std::vector<float>> AppDevice::read_depth(const std::vector<AppDepth
           VK_IMAGE_ASPECT_DEPTH_BIT | (has_stencil(r.format) ? VK_IMAGE_ASPECT_STENCIL_BIT : 0);
       record_download(cb, {r.image, r.array_index, VK_IMAGE_LAYOUT_DEPTH_STENCIL_ATTACHMENT_OPTIMAL,
                            VK_ACCESS_DEPTH_STENCIL_ATTACHMENT_WRITE_BIT | VK_ACCESS_TRANSFER_WRITE_BIT, aspects,
-                           VK_IMAGE_ASPECT_DEPTH_BIT, r.rect, offsets[i]});
+                           VK_IMAGE_ASPECT_DEPTH_BIT, r.rect, offsets[i]},
+                      download_.buffer);
     }
     record_host_read_barrier(cb);
   });
@@ -276,27 +254,31 @@ void AppDevice::write(const std::vector<VkImage>& images, const std::vector<cons
   reserve(upload_, total, VK_BUFFER_USAGE_TRANSFER_SRC_BIT);
   for (std::size_t i = 0; i < pixels.size(); ++i)
     std::memcpy(static_cast<std::uint8_t*>(upload_.mapped) + offsets[i], pixels[i]->data.data(), pixels[i]->data.size());
-  submit([&](VkCommandBuffer cb) {
-    for (std::size_t i = 0; i < images.size(); ++i) {
-      // The whole image is overwritten: its old contents are discarded (after the runtime's
-      // earlier reads of it on this queue).
-      auto to_dst = image_barrier(images[i], 0, VK_IMAGE_LAYOUT_UNDEFINED, VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL, 0,
-                                  VK_ACCESS_TRANSFER_WRITE_BIT);
-      vkCmdPipelineBarrier_(cb, VK_PIPELINE_STAGE_ALL_COMMANDS_BIT, VK_PIPELINE_STAGE_TRANSFER_BIT, 0, 0, nullptr, 0,
-                            nullptr, 1, &to_dst);
-      VkBufferImageCopy c{};
-      c.bufferOffset = offsets[i];
-      c.imageSubresource = {VK_IMAGE_ASPECT_COLOR_BIT, 0, 0, 1};
-      c.imageExtent = {std::uint32_t(pixels[i]->width), std::uint32_t(pixels[i]->height), 1};
-      vkCmdCopyBufferToImage_(cb, upload_.buffer, images[i], VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL, 1, &c);
-      auto done = image_barrier(images[i], 0, VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL,
-                                VK_IMAGE_LAYOUT_COLOR_ATTACHMENT_OPTIMAL, VK_ACCESS_TRANSFER_WRITE_BIT,
-                                VK_ACCESS_TRANSFER_READ_BIT | VK_ACCESS_COLOR_ATTACHMENT_READ_BIT |
-                                    VK_ACCESS_COLOR_ATTACHMENT_WRITE_BIT);
-      vkCmdPipelineBarrier_(cb, VK_PIPELINE_STAGE_TRANSFER_BIT, VK_PIPELINE_STAGE_ALL_COMMANDS_BIT, 0, 0, nullptr, 0,
-                            nullptr, 1, &done);
-    }
+  queue_->run([&](VkCommandBuffer cb) {
+    for (std::size_t i = 0; i < images.size(); ++i)
+      record_upload(cb, upload_.buffer, offsets[i], images[i], pixels[i]->width, pixels[i]->height);
   });
+}
+
+void AppDevice::record_upload(VkCommandBuffer cb, VkBuffer buffer, VkDeviceSize offset, VkImage image, int width,
+                              int height) {
+  // The whole image is overwritten: its old contents are discarded (after the runtime's
+  // earlier reads of it on this queue).
+  auto to_dst = image_barrier(image, 0, VK_IMAGE_LAYOUT_UNDEFINED, VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL, 0,
+                              VK_ACCESS_TRANSFER_WRITE_BIT);
+  vkCmdPipelineBarrier_(cb, VK_PIPELINE_STAGE_ALL_COMMANDS_BIT, VK_PIPELINE_STAGE_TRANSFER_BIT, 0, 0, nullptr, 0,
+                        nullptr, 1, &to_dst);
+  VkBufferImageCopy c{};
+  c.bufferOffset = offset;
+  c.imageSubresource = {VK_IMAGE_ASPECT_COLOR_BIT, 0, 0, 1};
+  c.imageExtent = {std::uint32_t(width), std::uint32_t(height), 1};
+  vkCmdCopyBufferToImage_(cb, buffer, image, VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL, 1, &c);
+  auto done = image_barrier(image, 0, VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL, VK_IMAGE_LAYOUT_COLOR_ATTACHMENT_OPTIMAL,
+                            VK_ACCESS_TRANSFER_WRITE_BIT,
+                            VK_ACCESS_TRANSFER_READ_BIT | VK_ACCESS_COLOR_ATTACHMENT_READ_BIT |
+                                VK_ACCESS_COLOR_ATTACHMENT_WRITE_BIT);
+  vkCmdPipelineBarrier_(cb, VK_PIPELINE_STAGE_TRANSFER_BIT, VK_PIPELINE_STAGE_ALL_COMMANDS_BIT, 0, 0, nullptr, 0,
+                        nullptr, 1, &done);
 }
 
 }  // namespace fovea::layer

@@ -1,9 +1,12 @@
 #pragma once
-// Transfers between host memory and images on the application's VkDevice, on the
-// session's queue (the queue the runtime also uses; the layer submits only inside
-// xrEndFrame, before calling down). Each transfer is one submission and a bounded fence wait,
-// under no lock another application call needs.
+// The layer's work on the application's VkDevice, on the session's queue (the queue the
+// runtime also uses; the layer submits only inside xrEndFrame, before calling down):
+// transfers between host memory and its images (the host composition), or the composition
+// as a compute pass there (the GPU composition). Each is one submission and a bounded fence
+// wait, under no lock another application call needs.
+#include <array>
 #include <cstdint>
+#include <memory>
 #include <vector>
 
 #include <vulkan/vulkan.h>
@@ -12,9 +15,13 @@
 #include <openxr/openxr.h>
 
 #include "composite.hpp"
+#include "fovea/xrcommon/foreign_queue.hpp"
 #include "frame_renderer.hpp"
 
 namespace fovea::layer {
+
+// Throws std::runtime_error naming the call unless r is VK_SUCCESS.
+void app_check(VkResult r, const char* what);
 
 // D16_UNORM, X8_D24_UNORM_PACK32, D24_UNORM_S8_UINT, D32_SFLOAT, D32_SFLOAT_S8_UINT.
 bool depth_format_supported(VkFormat f);
@@ -40,20 +47,39 @@ class AppDevice {
   // Overwrites each whole image (array layer 0) with `pixels` (same size); the images end in
   // COLOR_ATTACHMENT_OPTIMAL.
   void write(const std::vector<VkImage>& images, const std::vector<const Pixels8*>& pixels);
+  // How many read() and read_depth() calls copied application images to the host.
+  std::int64_t host_readbacks() const { return host_readbacks_; }
+
+  // Composition on this device (gpu_composite.cpp), without the host round trip: prepares the
+  // compute pass on the session queue; throws std::runtime_error with the reason when the
+  // device cannot run it (the session queue's family has no compute, no memory type).
+  void enable_gpu_composition();
+  bool gpu_composition() const { return gpu_ != nullptr; }
+  struct GpuEye {
+    EyeComposition composition;  // `traced` is uploaded only when `traced_id` changed; `app` unused
+    Read app;                    // the application's projection view (unused in scene-only mode)
+    VkImage target;              // written whole (out_view's raster), ends in COLOR_ATTACHMENT_OPTIMAL
+  };
+  // Two submissions on the session queue. The first (waited for, bounded) uploads the traced
+  // frame if new and copies the application's rects into a device buffer, so its images are
+  // free again on return; the second (not waited for: the runtime's later work on this queue
+  // comes after it) runs the composition pass and copies the results into the targets. The
+  // next call first waits for it.
+  void composite_gpu(std::int64_t traced_id, const std::array<GpuEye, 2>& eyes, const CompositionRule& rule);
+  // Waits for a composition pass still running (before its targets are destroyed).
+  void finish();
 
  private:
-  struct HostBuffer {
+  struct Buffer {
     VkBuffer buffer = VK_NULL_HANDLE;
     VkDeviceMemory memory = VK_NULL_HANDLE;
-    void* mapped = nullptr;
+    void* mapped = nullptr;  // host-visible buffers only
     VkDeviceSize size = 0;
   };
-  void reserve(HostBuffer& b, VkDeviceSize size, VkBufferUsageFlags usage);
-  void release(HostBuffer& b);
-  void destroy();
-  template <class F>
-  void submit(F&& record);
-  // One region of an attachment image copied into download_ at `offset`: transition to
+  // At least `size` bytes: host-visible and coherent (mapped), or device-local when `host` is false.
+  void reserve(Buffer& b, VkDeviceSize size, VkBufferUsageFlags usage, bool host = true);
+  void release(Buffer& b);
+  // One region of an attachment image copied into `buffer` at `offset`: transition to
   // TRANSFER_SRC after the application's writes, copy `copy_aspect`, transition back.
   struct Download {
     VkImage image;
@@ -65,23 +91,45 @@ class AppDevice {
     XrRect2Di rect;
     VkDeviceSize offset;
   };
-  void record_download(VkCommandBuffer cb, const Download& d);
+  void record_download(VkCommandBuffer cb, const Download& d, VkBuffer buffer);
   void record_host_read_barrier(VkCommandBuffer cb);
+  // `buffer` at `offset` (width x height 4-byte texels) into the whole image, its old contents
+  // discarded; the image ends in COLOR_ATTACHMENT_OPTIMAL.
+  void record_upload(VkCommandBuffer cb, VkBuffer buffer, VkDeviceSize offset, VkImage image, int width, int height);
 
   VkDevice device_ = VK_NULL_HANDLE;
-  VkQueue queue_ = VK_NULL_HANDLE;
-  VkCommandPool pool_ = VK_NULL_HANDLE;
-  VkCommandBuffer cmd_ = VK_NULL_HANDLE;
-  VkFence fence_ = VK_NULL_HANDLE;
-  HostBuffer download_, upload_;
+  PFN_vkGetDeviceProcAddr get_device_proc_ = nullptr;
+  VkQueue queue_handle_ = VK_NULL_HANDLE;
+  std::uint32_t queue_family_ = 0;
+  bool family_has_compute_ = false;
+  std::unique_ptr<xrcommon::ForeignQueue> queue_;  // the session queue, bounded waits
+  Buffer download_, upload_;
   VkPhysicalDeviceMemoryProperties memory_{};
+  std::int64_t host_readbacks_ = 0;
+  // The composition pass's objects (gpu_composite.cpp).
+  struct Gpu {
+    VkShaderModule shader = VK_NULL_HANDLE;
+    VkDescriptorSetLayout set_layout = VK_NULL_HANDLE;
+    VkPipelineLayout layout = VK_NULL_HANDLE;
+    VkPipeline pipeline = VK_NULL_HANDLE;
+    VkDescriptorPool pool = VK_NULL_HANDLE;
+    VkDescriptorSet set = VK_NULL_HANDLE;
+    Buffer params, staging;                 // host-visible
+    Buffer traced, app, out, background;    // device-local
+    std::int64_t uploaded = -1;             // the traced frame in `traced`
+  };
+  std::unique_ptr<Gpu> gpu_;
+  std::unique_ptr<xrcommon::ForeignQueue> pass_;  // the composition pass's submissions
+  void destroy_gpu();
 
 #define FOVEA_APP_VK(X)                                                                                          \
-  X(vkGetDeviceQueue) X(vkCreateCommandPool) X(vkDestroyCommandPool) X(vkAllocateCommandBuffers)                \
-  X(vkResetCommandBuffer) X(vkBeginCommandBuffer) X(vkEndCommandBuffer) X(vkCmdPipelineBarrier)                 \
-  X(vkCmdCopyImageToBuffer) X(vkCmdCopyBufferToImage) X(vkQueueSubmit) X(vkCreateFence) X(vkDestroyFence)       \
-  X(vkWaitForFences) X(vkResetFences) X(vkCreateBuffer) X(vkDestroyBuffer) X(vkGetBufferMemoryRequirements)     \
-  X(vkAllocateMemory) X(vkFreeMemory) X(vkBindBufferMemory) X(vkMapMemory) X(vkUnmapMemory)
+  X(vkGetDeviceQueue) X(vkCmdPipelineBarrier) X(vkCmdCopyImageToBuffer) X(vkCmdCopyBufferToImage)             \
+  X(vkCreateBuffer) X(vkDestroyBuffer) X(vkGetBufferMemoryRequirements) X(vkAllocateMemory) X(vkFreeMemory)     \
+  X(vkBindBufferMemory) X(vkMapMemory) X(vkUnmapMemory) X(vkCmdCopyBuffer) X(vkCreateShaderModule)             \
+  X(vkDestroyShaderModule) X(vkCreateDescriptorSetLayout) X(vkDestroyDescriptorSetLayout)                       \
+  X(vkCreatePipelineLayout) X(vkDestroyPipelineLayout) X(vkCreateComputePipelines) X(vkDestroyPipeline)         \
+  X(vkCreateDescriptorPool) X(vkDestroyDescriptorPool) X(vkAllocateDescriptorSets) X(vkUpdateDescriptorSets)    \
+  X(vkCmdBindPipeline) X(vkCmdBindDescriptorSets) X(vkCmdPushConstants) X(vkCmdDispatch)
 #define FOVEA_APP_VK_MEMBER(name) PFN_##name name##_ = nullptr;
   FOVEA_APP_VK(FOVEA_APP_VK_MEMBER)
 #undef FOVEA_APP_VK_MEMBER

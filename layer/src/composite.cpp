@@ -55,17 +55,27 @@ std::array<std::uint8_t, 3> border_colour(const Pixels8& img) {
   return {std::uint8_t(best->first), std::uint8_t(best->first >> 8), std::uint8_t(best->first >> 16)};
 }
 
-Pixels8 resample(const Pixels8& app, const core::View& app_view, const core::View& scene_view,
-                 const glm::dquat& scene_to_app) {
+namespace {
+
+// Below a micro-radian (|w| within 1e-12 of 1) a rotation moves no pixel.
+bool rotates(const glm::dquat& q) { return std::abs(std::abs(q.w) - 1.0) > 1e-12; }
+
+}  // namespace
+
+bool resample_copies(const core::View& app_view, int width, int height, const core::View& scene_view,
+                     const glm::dquat& scene_to_app) {
   const auto same = [](const core::Fov& a, const core::Fov& b) {
     return std::abs(a.angle_left - b.angle_left) < 1e-6 && std::abs(a.angle_right - b.angle_right) < 1e-6 &&
            std::abs(a.angle_up - b.angle_up) < 1e-6 && std::abs(a.angle_down - b.angle_down) < 1e-6;
   };
-  // Below a micro-radian (|w| within 1e-12 of 1) the rotation moves no pixel.
-  const bool rotated = std::abs(std::abs(scene_to_app.w) - 1.0) > 1e-12;
-  if (!rotated && same(app_view.fov(), scene_view.fov()) && app.width == scene_view.width() &&
-      app.height == scene_view.height())
-    return app;
+  return !rotates(scene_to_app) && same(app_view.fov(), scene_view.fov()) && width == scene_view.width() &&
+         height == scene_view.height();
+}
+
+Pixels8 resample(const Pixels8& app, const core::View& app_view, const core::View& scene_view,
+                 const glm::dquat& scene_to_app) {
+  if (resample_copies(app_view, app.width, app.height, scene_view, scene_to_app)) return app;
+  const bool rotated = rotates(scene_to_app);
   Pixels8 out{scene_view.width(), scene_view.height(),
               std::vector<std::uint8_t>(std::size_t(scene_view.width()) * std::size_t(scene_view.height()) * 4, 0)};
   for (int y = 0; y < out.height; ++y)
@@ -141,6 +151,21 @@ std::int64_t composite(Pixels8& scene, const Pixels8& app, Composite mode, std::
       ++shown;
     }
   return shown;
+}
+
+Pixels8 reproject_traced(const EyeComposition& eye) {
+  Pixels8 out = resample(*eye.traced, eye.traced_view, eye.out_view, eye.to_traced);
+  // Where the traced frame does not reach (the head turned past its border): opaque black.
+  for (std::size_t i = 3; i < out.data.size(); i += 4) out.data[i] = 255;
+  return out;
+}
+
+Pixels8 compose_eye(const EyeComposition& eye, const CompositionRule& rule) {
+  Pixels8 out = reproject_traced(eye);
+  if (!eye.app) return out;
+  const Pixels8 a = resample(*eye.app, eye.app_view, eye.out_view);
+  composite(out, a, rule.mode, rule.background ? *rule.background : border_colour(*eye.app), rule.blend);
+  return out;
 }
 
 double view_distance(float d, const DepthRange& r) {

@@ -1,5 +1,6 @@
 #pragma once
-// Combining the path-traced scene with the application's own pixels, on the host. Pixels are
+// Combining the path-traced scene with the application's own pixels, on the host (the GPU
+// path, xr_layer_composite.comp, repeats these steps on the application's device). Pixels are
 // kept in the 8-bit encoding of the application's swapchain (so the application's pixels pass
 // through bit-exact wherever they are kept); blending decodes to linear and re-encodes.
 #include <array>
@@ -49,6 +50,10 @@ std::array<std::uint8_t, 3> border_colour(const Pixels8& img);
 // image did not cover get alpha 0.
 Pixels8 resample(const Pixels8& app, const core::View& app_view, const core::View& scene_view,
                  const glm::dquat& scene_to_app = glm::dquat(1, 0, 0, 0));
+// Whether resample() returns a `width` x `height` image unchanged (same FOV and raster, a
+// rotation that moves no pixel).
+bool resample_copies(const core::View& app_view, int width, int height, const core::View& scene_view,
+                     const glm::dquat& scene_to_app = glm::dquat(1, 0, 0, 0));
 
 // How the application's projection layer blends over what lies below it, from its
 // XrCompositionLayerFlags (OpenXR 1.0 "Composition Layer Blending"): without
@@ -67,6 +72,31 @@ LayerBlend layer_blend(XrCompositionLayerFlags flags, PixelFormat fmt);
 // linear colour. Returns how many pixels show the application.
 std::int64_t composite(Pixels8& scene, const Pixels8& app, Composite mode, std::array<std::uint8_t, 3> background,
                        const LayerBlend& blend, int tolerance = 2);
+
+// One eye of a frame's composition: the traced frame (in `traced_view`'s raster) reprojected
+// by rotation into `out_view` (the submitted FOV at the traced raster; `to_traced` =
+// conj(q_traced) * q_submitted), opaque black where it does not reach, then the application's
+// pixels (`app`, seen through `app_view`: the submitted FOV at its rect's size) composited over
+// it. The host path runs it on the CPU, the GPU path (gpu_composite.hpp) the same steps in a
+// compute pass on the application's device.
+struct EyeComposition {
+  const Pixels8* traced = nullptr;
+  core::View traced_view, out_view;
+  glm::dquat to_traced{1, 0, 0, 0};
+  const Pixels8* app = nullptr;  // null: the scene only
+  core::View app_view;
+};
+// How the application's pixels are combined: the configured mode, AppOnTop's background
+// (unset: border_colour() of the application's image), the layer flags' blending.
+struct CompositionRule {
+  Composite mode = Composite::AppOnTop;
+  std::optional<std::array<std::uint8_t, 3>> background;
+  LayerBlend blend;
+};
+// The traced frame reprojected into out_view, alpha 255 everywhere.
+Pixels8 reproject_traced(const EyeComposition& eye);
+// reproject_traced, then composite() by `rule` (the scene alone without `app`).
+Pixels8 compose_eye(const EyeComposition& eye, const CompositionRule& rule);
 
 // The mapping of the application's depth values (XrCompositionLayerDepthInfoKHR): window
 // depth min_depth lies at view distance near_z, max_depth at far_z. near_z > far_z is

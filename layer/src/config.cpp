@@ -23,6 +23,12 @@ bool parse_render_mode(const std::string& v, const std::string& where) {
   throw core::InputError(where + ": \"" + v + "\" must be \"async\" or \"lockstep\"");
 }
 
+bool parse_compositor(const std::string& v, const std::string& where) {
+  if (v == "gpu") return true;
+  if (v == "host") return false;
+  throw core::InputError(where + ": \"" + v + "\" must be \"gpu\" or \"host\"");
+}
+
 void apply_section(const nlohmann::json& s, const std::string& where, LayerConfig& c) {
   if (!s.is_object()) throw core::InputError(where + ": must be an object");
   for (const auto& [key, v] : s.items()) {
@@ -37,6 +43,8 @@ void apply_section(const nlohmann::json& s, const std::string& where, LayerConfi
       else if (m == "alpha") c.composite = Composite::Alpha;
       else if (m == "scene-only") c.composite = Composite::SceneOnly;
       else throw core::InputError(field + ": must be \"app-on-top\", \"alpha\" or \"scene-only\"");
+    } else if (key == "compositor") {
+      c.gpu_compositor = parse_compositor(v.is_string() ? v.get<std::string>() : v.dump(), field);
     } else if (key == "render") {
       c.lockstep = parse_render_mode(v.is_string() ? v.get<std::string>() : v.dump(), field);
     } else if (key == "app_background") {
@@ -58,7 +66,7 @@ void apply_section(const nlohmann::json& s, const std::string& where, LayerConfi
       }
       c.app_background = rgb;
     } else {
-      throw core::InputError(field + ": unknown key (scene, composite, app_background, gaze, render)");
+      throw core::InputError(field + ": unknown key (scene, composite, app_background, gaze, render, compositor)");
     }
   }
 }
@@ -112,6 +120,8 @@ LayerConfig load_config(const std::string& application) {
     }
   if (!env("FOVEA_GAZE").empty()) c.gaze = env("FOVEA_GAZE");
   if (!env("FOVEA_LAYER_RENDER").empty()) c.lockstep = parse_render_mode(env("FOVEA_LAYER_RENDER"), "FOVEA_LAYER_RENDER");
+  if (!env("FOVEA_LAYER_COMPOSITOR").empty())
+    c.gpu_compositor = parse_compositor(env("FOVEA_LAYER_COMPOSITOR"), "FOVEA_LAYER_COMPOSITOR");
   return c;
 }
 

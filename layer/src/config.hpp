@@ -2,10 +2,10 @@
 // The layer's configuration for one application. Sources, later ones winning:
 //   $XDG_CONFIG_HOME/fovea/layer.json (else ~/.config/fovea/layer.json):
 //     {"default": {...}, "applications": {"<XrApplicationInfo::applicationName>": {...}}}
-//     with keys "scene", "composite", "app_background", "gaze", "render" (an application's
-//     section over "default");
+//     with keys "scene", "composite", "app_background", "gaze", "render", "compositor" (an
+//     application's section over "default");
 //   env FOVEA_LAYER_SCENE, then FOVEA_SCENE (the scene); FOVEA_GAZE (the gaze source);
-//   FOVEA_LAYER_RENDER (the render mode).
+//   FOVEA_LAYER_RENDER (the render mode); FOVEA_LAYER_COMPOSITOR (where compositing runs).
 #include <array>
 #include <optional>
 #include <string>
@@ -31,6 +31,9 @@ struct LayerConfig {
   // "lockstep" (true): it waits for the frame traced for its own views (deterministic output
   // for captures and comparisons; the application runs at the path tracer's rate).
   bool lockstep = false;
+  // "compositor": "gpu" (true): a compute pass on the application's device, the host path
+  // when that device cannot run it; "host" (false): always the host round trip.
+  bool gpu_compositor = true;
 };
 
 // Throws core::InputError naming the file and field for a malformed configuration file.

@@ -188,6 +188,8 @@ XrResult intercept::xrEndFrame(XrSession session, const XrFrameEndInfo* info) {
       t.traced_for_ns = shown.traced_for_ns;
       t.traced_done_ns = shown.done_ns;
       t.reprojected_deg = shown.reprojected_deg;
+      t.composited_on_gpu = shown.composited_on_gpu;
+      t.host_readbacks = shown.host_readbacks;
       t.render = shown.times;
     }
     std::lock_guard lock(s.frames->mutex);

@@ -49,7 +49,8 @@ void FrameLog::write(const FrameTimes& t) {
              {"traced_frame", t.traced_frame},        {"traced_for_ns", t.traced_for_ns},
              {"traced_done_ns", t.traced_done_ns},
              {"traced_age_ns", t.traced_frame >= 0 ? t.display_time_ns - t.traced_for_ns : std::int64_t(0)},
-             {"reprojected_deg", std::isfinite(t.reprojected_deg) ? t.reprojected_deg : 0.0}};
+             {"reprojected_deg", std::isfinite(t.reprojected_deg) ? t.reprojected_deg : 0.0},
+             {"composited_on_gpu", t.composited_on_gpu}, {"host_readbacks", t.host_readbacks}};
   if (!writer_.write(r)) FOVEA_LAYER_WARN("%s", writer_.error().c_str());
 }
 

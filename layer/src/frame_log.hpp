@@ -26,6 +26,9 @@ struct FrameTimes {
   std::int64_t traced_frame = -1;
   std::int64_t traced_for_ns = 0, traced_done_ns = 0;
   double reprojected_deg = 0;
+  // Where the shown frame was composited, and how many application images went to the host.
+  bool composited_on_gpu = false;
+  std::int64_t host_readbacks = 0;
   RenderTimes render;     // the frame renderer's split of the traced frame (zero without one)
 };
 

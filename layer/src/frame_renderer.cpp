@@ -2,10 +2,11 @@
 // compute context (gpu::Context creates its own VkInstance/VkDevice and queue, so the render
 // thread never touches the application's queue), and publishes each finished frame read back
 // and encoded in the application's format. xrEndFrame takes the newest finished frame,
-// reprojects it by rotation to the submitted view orientations, reads the application's
-// projection views back from its device, composites on the host and uploads into the layer's
-// swapchains on the application's device. On lavapipe both devices are host memory anyway; on
-// a discrete GPU this costs two PCIe round trips of the eye rasters per frame.
+// reprojects it by rotation to the submitted view orientations and composites the
+// application's projection views over it into the layer's swapchains: by a compute pass on the
+// application's device (the traced frame uploaded once per traced frame, the application's
+// images never leave the device), or, where that device cannot or the configuration says so
+// (and for depth compositing), on the host after reading the application's images back.
 #include "frame_renderer.hpp"
 
 #include <sys/resource.h>
@@ -256,7 +257,8 @@ double rotation_deg(const glm::dquat& q) {
 class PathTraceRenderer final : public FrameRenderer {
  public:
   PathTraceRenderer(const LayerConfig& config, const VulkanBinding& vk, const Dispatch& next, XrSession session)
-      : config_(config), next_(next), session_(session), scene_(renderer::load_scene(config.scene)), app_(vk) {
+      : config_(config), next_(next), session_(session), scene_(renderer::load_scene(config.scene)),
+        vk_queue_family_(vk.queue_family), app_(vk) {
     for (const auto& w : scene_.warnings) FOVEA_LAYER_WARN("scene %s: %s", config.scene.c_str(), w.c_str());
     // Tests slow the render thread down to show that the application never waits for it.
     if (const char* d = std::getenv("FOVEA_LAYER_TEST_RENDER_DELAY_MS")) test_delay_ = std::chrono::milliseconds(std::atoll(d));
@@ -269,6 +271,11 @@ class PathTraceRenderer final : public FrameRenderer {
     }
     wake_.notify_all();
     if (thread_.joinable()) thread_.join();
+    try {
+      app_.finish();  // a composition pass may still write the swapchain images destroyed below
+    } catch (const std::exception& e) {
+      FOVEA_LAYER_ERROR("the last composition pass did not finish: %s", e.what());
+    }
     for (Eye& e : eyes_)
       if (e.swapchain != XR_NULL_HANDLE) next_.xrDestroySwapchain(e.swapchain);
   }
@@ -352,44 +359,39 @@ class PathTraceRenderer final : public FrameRenderer {
 
   // The traced frame reprojected (rotation only) from the orientations it was traced for to
   // the submitted ones, the application's pixels composited over it, written into the
-  // layer's swapchains; the application's frame with its projection layer replaced.
+  // layer's swapchains (on the application's device when it can, else on the host); the
+  // application's frame with its projection layer replaced.
   const XrFrameEndInfo* compose(const FrameInput& in, const TracedFrame& f, Shown& shown) {
     shown.frame = f.id;
     shown.traced_for_ns = f.traced_for;
     shown.done_ns = f.done_ns;
     shown.times = f.times;
-    std::vector<AppDevice::Read> reads;
-    for (const AppView& v : in.app_views) reads.push_back({v.image, v.array_index, v.rect});
-    const std::vector<Pixels8> app = config_.composite == Composite::SceneOnly ? std::vector<Pixels8>{} : app_.read(reads);
-    const std::vector<std::vector<float>> app_depth = app.empty() ? std::vector<std::vector<float>>{} : read_depth(in);
-    std::array<Pixels8, 2> out;
-    std::vector<VkImage> targets;
+    const bool scene_only = config_.composite == Composite::SceneOnly;
+    // Compositing by depth runs on the host.
+    const bool depth = !scene_only && (in.app_views[0].depth || in.app_views[1].depth);
+    const bool on_gpu = app_.gpu_composition() && !depth;
+    const std::int64_t readbacks = app_.host_readbacks();
+    std::array<EyeComposition, 2> eyes;
     for (int e = 0; e < 2; ++e) {
       const auto ei = std::size_t(e);
-      const core::View& traced_view = views_in_[core::Eye(e)];
-      const core::View out_view(to_fov(in.app_views[ei].fov), traced_view.width(), traced_view.height());
-      const glm::dquat to_traced = glm::conjugate(f.orientation[ei]) * to_pose(in.app_views[ei].pose).orientation;
-      shown.reprojected_deg = std::max(shown.reprojected_deg, rotation_deg(to_traced));
-      out[ei] = resample(f.colour[ei], traced_view, out_view, to_traced);
-      // Where the traced frame does not reach (the head turned past its border): opaque black.
-      for (std::size_t i = 3; i < out[ei].data.size(); i += 4) out[ei].data[i] = 255;
-      if (!app.empty()) {
-        const core::View app_view(to_fov(in.app_views[ei].fov), app[ei].width, app[ei].height);
-        const Pixels8 a = resample(app[ei], app_view, out_view);
-        if (!app_depth.empty() && !f.depth[ei].empty()) {
-          composite_depth(out[ei], resample_depth(f.depth[ei], traced_view, out_view, to_traced), a,
-                          resample_depth(app_depth[ei], app_view, out_view), in.app_views[ei].depth->range);
-        } else {
-          const auto bg = config_.app_background
-                              ? std::array<std::uint8_t, 3>{std::uint8_t((*config_.app_background)[0]),
-                                                            std::uint8_t((*config_.app_background)[1]),
-                                                            std::uint8_t((*config_.app_background)[2])}
-                              : border_colour(app[ei]);
-          composite(out[ei], a, config_.composite, bg,
-                    layer_blend(in.app_frame->layers[in.projection_layer]->layerFlags, pixel_format(format_)));
-        }
-      }
-      Eye& eye = eyes_[ei];
+      EyeComposition& c = eyes[ei];
+      c.traced = &f.colour[ei];
+      c.traced_view = views_in_[core::Eye(e)];
+      c.out_view = core::View(to_fov(in.app_views[ei].fov), c.traced_view.width(), c.traced_view.height());
+      c.to_traced = glm::conjugate(f.orientation[ei]) * to_pose(in.app_views[ei].pose).orientation;
+      c.app_view = core::View(to_fov(in.app_views[ei].fov), in.app_views[ei].rect.extent.width,
+                              in.app_views[ei].rect.extent.height);
+      shown.reprojected_deg = std::max(shown.reprojected_deg, rotation_deg(c.to_traced));
+    }
+    CompositionRule rule;
+    rule.mode = config_.composite;
+    if (config_.app_background)
+      rule.background = std::array<std::uint8_t, 3>{std::uint8_t((*config_.app_background)[0]),
+                                                    std::uint8_t((*config_.app_background)[1]),
+                                                    std::uint8_t((*config_.app_background)[2])};
+    rule.blend = layer_blend(in.app_frame->layers[in.projection_layer]->layerFlags, pixel_format(format_));
+    std::vector<VkImage> targets;
+    for (Eye& eye : eyes_) {
       std::uint32_t index = 0;
       xr_check(next_.xrAcquireSwapchainImage(eye.swapchain, nullptr, &index), "xrAcquireSwapchainImage");
       XrSwapchainImageWaitInfo wi{XR_TYPE_SWAPCHAIN_IMAGE_WAIT_INFO};
@@ -398,7 +400,16 @@ class PathTraceRenderer final : public FrameRenderer {
       if (index >= eye.images.size()) throw std::runtime_error("the runtime acquired an unknown swapchain image");
       targets.push_back(eye.images[index]);
     }
-    app_.write(targets, {&out[0], &out[1]});
+    if (on_gpu) {
+      std::array<AppDevice::GpuEye, 2> jobs;
+      for (std::size_t e = 0; e < 2; ++e)
+        jobs[e] = {eyes[e], {in.app_views[e].image, in.app_views[e].array_index, in.app_views[e].rect}, targets[e]};
+      app_.composite_gpu(f.id, jobs, rule);
+    } else {
+      compose_on_host(in, f, eyes, rule, targets);
+    }
+    shown.composited_on_gpu = on_gpu;
+    shown.host_readbacks = app_.host_readbacks() - readbacks;
     for (Eye& eye : eyes_) xr_check(next_.xrReleaseSwapchainImage(eye.swapchain, nullptr), "xrReleaseSwapchainImage");
 
     // The application's frame with its stereo projection layer replaced by the layer's.
@@ -427,6 +438,30 @@ class PathTraceRenderer final : public FrameRenderer {
     frame_ = *in.app_frame;
     frame_.layers = layers_.data();
     return &frame_;
+  }
+
+  // The host path: the application's images read back, composited on the CPU (by depth when
+  // it chained usable depth), uploaded into `targets`.
+  void compose_on_host(const FrameInput& in, const TracedFrame& f, std::array<EyeComposition, 2>& eyes,
+                       const CompositionRule& rule, const std::vector<VkImage>& targets) {
+    std::vector<AppDevice::Read> reads;
+    for (const AppView& v : in.app_views) reads.push_back({v.image, v.array_index, v.rect});
+    const std::vector<Pixels8> app = rule.mode == Composite::SceneOnly ? std::vector<Pixels8>{} : app_.read(reads);
+    const std::vector<std::vector<float>> app_depth = app.empty() ? std::vector<std::vector<float>>{} : read_depth(in);
+    std::array<Pixels8, 2> out;
+    for (std::size_t e = 0; e < 2; ++e) {
+      EyeComposition& c = eyes[e];
+      c.app = app.empty() ? nullptr : &app[e];
+      if (!app_depth.empty() && !f.depth[e].empty()) {
+        out[e] = reproject_traced(c);
+        composite_depth(out[e], resample_depth(f.depth[e], c.traced_view, c.out_view, c.to_traced),
+                        resample(app[e], c.app_view, c.out_view), resample_depth(app_depth[e], c.app_view, c.out_view),
+                        in.app_views[e].depth->range);
+      } else {
+        out[e] = compose_eye(c, rule);
+      }
+    }
+    app_.write(targets, {&out[0], &out[1]});
   }
 
   // The application's window depths of both views, when it chained depth to both and the layer
@@ -490,6 +525,17 @@ class PathTraceRenderer final : public FrameRenderer {
                "xrEnumerateSwapchainImages");
       for (const auto& i : imgs) e.images.push_back(i.image);
     }
+    if (!config_.gpu_compositor) {
+      FOVEA_LAYER_INFO("composition: on the host (configured)");
+    } else {
+      try {
+        app_.enable_gpu_composition();
+        FOVEA_LAYER_INFO("composition: on the GPU (a compute pass on the application's device, session queue family %u)",
+                         vk_queue_family_);
+      } catch (const std::exception& e) {
+        FOVEA_LAYER_WARN("composition: on the host, the application's device cannot composite: %s", e.what());
+      }
+    }
     thread_ = std::thread([this] { run(); });
   }
 
@@ -501,6 +547,7 @@ class PathTraceRenderer final : public FrameRenderer {
   core::StereoViews views_in_;  // the traced views: FOV, raster (the first frame's imageRect), pose, IPD
   core::DisplayPreset display_;
   VkFormat format_ = VK_FORMAT_UNDEFINED;
+  std::uint32_t vk_queue_family_ = 0;
   std::chrono::milliseconds test_delay_{0};
 
   // The mailbox between the application's xrEndFrame and the render thread; held only to

@@ -76,7 +76,7 @@ struct RenderTimes {
   double trace = 0;        // GPU: grid generation + path tracing, both eyes
   double reconstruct = 0;  // GPU: accumulation, stereo sharing, BMFR, TAA
   double resolve = 0;      // GPU: resolve to the display, blur
-  double transfer = 0;     // in xrEndFrame: read-back of the app's images, reprojection, compositing, upload
+  double transfer = 0;     // in xrEndFrame: the composition (GPU pass, or read-back, host compositing and upload)
   // CPU (monotonic clock): the gaze sample, the grids' per-frame build, recording and
   // submission until the GPU finished, read-back of the rendered images.
   double gaze_cpu = 0, grid_cpu = 0, submit_cpu = 0, readback_cpu = 0;
@@ -93,6 +93,8 @@ struct Shown {
   std::int64_t done_ns = 0;         // when it finished (CLOCK_MONOTONIC)
   double reprojected_deg = 0;       // head rotation since, the larger of the two eyes
   RenderTimes times;                // its render's split; `transfer` is this xrEndFrame's composition
+  bool composited_on_gpu = false;   // a compute pass on the application's device (else the host path)
+  std::int64_t host_readbacks = 0;  // application images this xrEndFrame copied to the host
 };
 
 // Renders on its own thread: end_frame() hands the submitted views and gaze over and shows

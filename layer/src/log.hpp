@@ -1,10 +1,12 @@
 #pragma once
-// Layer diagnostics: env FOVEA_LAYER_LOG_LEVEL (error|warn|info|debug, default info) selects
-// what is logged; messages go to the file env FOVEA_LAYER_LOG_FILE (if set) and, at warn or
-// above, to stderr.
+// Layer diagnostics (xrcommon's logger): env FOVEA_LAYER_LOG_LEVEL (error|warn|info|debug,
+// default info) selects what is logged; messages go to the file env FOVEA_LAYER_LOG_FILE (if
+// set, opened at the first message) and, at warn or above, to stderr.
+#include "fovea/xrcommon/log.hpp"
+
 namespace fovea::layer::log {
 
-enum class Level { Error = 0, Warn = 1, Info = 2, Debug = 3 };
+using Level = xrcommon::LogLevel;
 void write(Level level, const char* fmt, ...) __attribute__((format(printf, 2, 3)));
 
 }  // namespace fovea::layer::log

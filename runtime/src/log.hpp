@@ -1,13 +1,14 @@
 #pragma once
-// Runtime diagnostics: stderr at the level of env FOVEA_RUNTIME_LOG (error|warn|info|debug,
-// default warn) and, when env FOVEA_RUNTIME_OUT is set, every message at info level or above
-// in <out>/runtime.log (the tests read it).
-#include <cstdarg>
+// Runtime diagnostics (xrcommon's logger): stderr at the level of env FOVEA_RUNTIME_LOG
+// (error|warn|info|debug, default warn) and, when env FOVEA_RUNTIME_OUT is set, every message
+// at info level or above in <out>/runtime.log (the tests read it).
 #include <string>
+
+#include "fovea/xrcommon/log.hpp"
 
 namespace fovea::runtime::log {
 
-enum class Level { Error = 0, Warn = 1, Info = 2, Debug = 3 };
+using Level = xrcommon::LogLevel;
 
 // Opens <dir>/runtime.log (appending) for the process; empty dir closes it.
 void set_file_dir(const std::string& dir);

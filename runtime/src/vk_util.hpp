@@ -4,28 +4,19 @@
 // xrAcquireSwapchainImage, xrReleaseSwapchainImage, xrBeginFrame, xrEndFrame) and memory
 // type selection.
 #include <cstdint>
-#include <functional>
 
 #include <vulkan/vulkan.h>
 
+#include "fovea/xrcommon/foreign_queue.hpp"
+
 namespace fovea::runtime {
 
-class OneShotQueue {
+// The session queue's one-shot submit-and-wait (xrcommon's), waiting without a bound as the
+// application's own submissions would.
+class OneShotQueue : public xrcommon::ForeignQueue {
  public:
-  OneShotQueue(VkDevice device, std::uint32_t family, VkQueue queue);
-  ~OneShotQueue();
-  OneShotQueue(const OneShotQueue&) = delete;
-  OneShotQueue& operator=(const OneShotQueue&) = delete;
-  // Records with `record`, submits, waits for completion. Throws std::runtime_error on a
-  // Vulkan failure.
-  void run(const std::function<void(VkCommandBuffer)>& record);
-
- private:
-  VkDevice device_;
-  VkQueue queue_;
-  VkCommandPool pool_ = VK_NULL_HANDLE;
-  VkCommandBuffer cmd_ = VK_NULL_HANDLE;
-  VkFence fence_ = VK_NULL_HANDLE;
+  OneShotQueue(VkDevice device, std::uint32_t family, VkQueue queue)
+      : ForeignQueue(device, &vkGetDeviceProcAddr, family, queue, kNoTimeout, "the application's device") {}
 };
 
 // Index of a memory type allowed by `type_bits` with all of `flags`; throws if none.

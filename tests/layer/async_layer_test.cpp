@@ -4,6 +4,7 @@
 // hook FOVEA_LAYER_TEST_RENDER_DELAY_MS. Structural, not timed: the application's frames
 // keep ending while one path-traced frame is in the works, each displayed frame's record
 // names the traced frame it showed, and the session tears down while the thread is busy.
+// Run with either compositor: on the GPU no application image is ever copied to the host.
 #include <atomic>
 #include <condition_variable>
 #include <cstdlib>
@@ -11,6 +12,7 @@
 #include <fstream>
 #include <mutex>
 #include <set>
+#include <string>
 #include <thread>
 
 #include <gtest/gtest.h>
@@ -24,7 +26,8 @@ namespace {
 
 constexpr const char* kVariables[] = {"XR_API_LAYER_PATH", "XR_ENABLE_API_LAYERS", "FOVEA_LAYER_OUT",
                                       "FOVEA_LAYER_LOG_FILE", "FOVEA_SCENE", "FOVEA_LAYER_SCENE",
-                                      "XDG_CONFIG_HOME", "FOVEA_LAYER_RENDER", "FOVEA_LAYER_TEST_RENDER_DELAY_MS"};
+                                      "XDG_CONFIG_HOME", "FOVEA_LAYER_RENDER", "FOVEA_LAYER_TEST_RENDER_DELAY_MS",
+                                      "FOVEA_LAYER_COMPOSITOR"};
 
 std::vector<nlohmann::json> records(const std::string& file) {
   std::vector<nlohmann::json> out;
@@ -34,7 +37,8 @@ std::vector<nlohmann::json> records(const std::string& file) {
   return out;
 }
 
-class AsyncLayer : public XrTest {
+// The parameter: FOVEA_LAYER_COMPOSITOR.
+class AsyncLayer : public XrTest, public ::testing::WithParamInterface<const char*> {
  protected:
   void SetUp() override {
     XrTest::SetUp();  // the tiny display
@@ -47,6 +51,7 @@ class AsyncLayer : public XrTest {
     setenv("FOVEA_SCENE", "cornell", 1);
     unsetenv("FOVEA_LAYER_SCENE");
     unsetenv("FOVEA_LAYER_RENDER");  // the default: asynchronous
+    setenv("FOVEA_LAYER_COMPOSITOR", GetParam(), 1);
     // Far slower than a frame interval: the application must not notice.
     setenv("FOVEA_LAYER_TEST_RENDER_DELAY_MS", "700", 1);
   }
@@ -71,7 +76,8 @@ class AsyncLayer : public XrTest {
   XrSwapchain eye_[2] = {XR_NULL_HANDLE, XR_NULL_HANDLE};
 };
 
-TEST_F(AsyncLayer, PipelinedFramesOnTwoThreadsNeverWaitForTheRenderThread) {
+TEST_P(AsyncLayer, PipelinedFramesOnTwoThreadsNeverWaitForTheRenderThread) {
+  const bool gpu = std::string(GetParam()) == "gpu";
   ASSERT_NO_FATAL_FAILURE(create_instance());
   ASSERT_NO_FATAL_FAILURE(run_to_focused());
   const XrSpace local = reference_space(XR_REFERENCE_SPACE_TYPE_LOCAL);
@@ -202,10 +208,16 @@ TEST_F(AsyncLayer, PipelinedFramesOnTwoThreadsNeverWaitForTheRenderThread) {
     EXPECT_GT(r["traced_done_ns"].get<std::int64_t>(), 0) << r.dump();
     EXPECT_GT(r["gaze_read_ns"].get<std::int64_t>(), 0) << r.dump();
     EXPECT_GT(r["render_ms"].get<double>(), 0) << r.dump();
+    // Composited on the application's device without a host copy of its images, or on the
+    // host with one read-back (both views) per frame.
+    EXPECT_EQ(r["composited_on_gpu"].get<bool>(), gpu) << r.dump();
+    EXPECT_EQ(r["host_readbacks"].get<std::int64_t>(), gpu ? 0 : 1) << r.dump();
   }
   EXPECT_GT(replaced, 0);
   const std::string log = read_text(out_->path() + "/layer.log");
   EXPECT_NE(log.find("render async"), std::string::npos) << log;
+  EXPECT_NE(log.find(gpu ? "composition: on the GPU" : "composition: on the host (configured)"), std::string::npos)
+      << log;
   EXPECT_EQ(log.find("internal failure"), std::string::npos) << log;
 
   // Teardown while the render thread is inside a render's delay: it is woken and joined.
@@ -216,6 +228,9 @@ TEST_F(AsyncLayer, PipelinedFramesOnTwoThreadsNeverWaitForTheRenderThread) {
   EXPECT_EQ(xrDestroySession(session_), XR_SUCCESS);
   session_ = XR_NULL_HANDLE;
 }
+
+INSTANTIATE_TEST_SUITE_P(Compositor, AsyncLayer, ::testing::Values("gpu", "host"),
+                         [](const ::testing::TestParamInfo<const char*>& info) { return std::string(info.param); });
 
 }  // namespace
 }  // namespace fovea::test

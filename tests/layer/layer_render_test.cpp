@@ -86,6 +86,7 @@ TEST(LayerRender, HelloXrCubesCompositedOverThePathTracedScene) {
   const std::string log = read_text(both.path() + "/layer.log");
   EXPECT_NE(log.find("rendering scene \"cornell\""), std::string::npos) << log;
   EXPECT_NE(log.find("applications.HelloXR"), std::string::npos) << log;
+  EXPECT_NE(log.find("composition: on the GPU"), std::string::npos) << log;
   // The runtime offers XR_EXT_eye_gaze_interaction: the layer's action rides along hello_xr's.
   EXPECT_NE(log.find("gaze: the eye-gaze action"), std::string::npos) << log;
   EXPECT_NE(log.find("visibility mask of the left view"), std::string::npos) << log;
@@ -108,6 +109,9 @@ TEST(LayerRender, HelloXrCubesCompositedOverThePathTracedScene) {
       // The runtime's hidden area (XR_KHR_visibility_mask, which hello_xr does not enable) is
       // not traced: the tiny preset's lens hides the views' corners.
       EXPECT_GT(j["samples_hidden"].get<std::int64_t>(), 0) << line;
+      // Composited by a compute pass on hello_xr's device: none of its images went to the host.
+      EXPECT_TRUE(j["composited_on_gpu"].get<bool>()) << line;
+      EXPECT_EQ(j["host_readbacks"].get<std::int64_t>(), 0) << line;
       ++replaced;
     }
     EXPECT_EQ(n, kFrames);

@@ -204,6 +204,7 @@ struct Observed {
   XrResult eyes_action = XR_SUCCESS, suggest_gaze = XR_SUCCESS, suggest_hand = XR_SUCCESS;
   XrResult attach_none = XR_SUCCESS, profile_before = XR_SUCCESS, attach = XR_SUCCESS;
   XrResult eyes = XR_SUCCESS, hand = XR_SUCCESS;
+  XrResult sync_eyes = XR_SUCCESS, sync_hand = XR_SUCCESS;  // xrSyncActions with that subaction path
   std::vector<XrStructureType> events;
   std::string eyes_profile_name, hand_profile_name;  // paths differ between instances: compared as strings
 };
@@ -211,7 +212,8 @@ struct Observed {
 bool operator==(const Observed& a, const Observed& b) {
   return a.supports_eye_gaze == b.supports_eye_gaze && a.eyes_action == b.eyes_action && a.suggest_gaze == b.suggest_gaze &&
          a.suggest_hand == b.suggest_hand && a.attach_none == b.attach_none && a.profile_before == b.profile_before &&
-         a.attach == b.attach && a.eyes == b.eyes && a.hand == b.hand && a.events == b.events &&
+         a.attach == b.attach && a.eyes == b.eyes && a.hand == b.hand && a.sync_eyes == b.sync_eyes &&
+         a.sync_hand == b.sync_hand && a.events == b.events &&
          a.eyes_profile_name == b.eyes_profile_name && a.hand_profile_name == b.hand_profile_name;
 }
 
@@ -219,7 +221,7 @@ std::ostream& operator<<(std::ostream& os, const Observed& o) {
   os << "{supports " << o.supports_eye_gaze << ", action on /user/eyes_ext " << o.eyes_action << ", suggest gaze " << o.suggest_gaze << " hand " << o.suggest_hand
      << ", attach none " << o.attach_none << ", profile before attach " << o.profile_before << ", attach " << o.attach
      << ", eyes " << o.eyes << " '" << o.eyes_profile_name << "', hand " << o.hand << " '" << o.hand_profile_name
-     << "', events";
+     << "', sync /user/eyes_ext " << o.sync_eyes << " /user/hand/left " << o.sync_hand << ", events";
   for (XrStructureType t : o.events) os << " " << int(t);
   return os << "}";
 }
@@ -291,6 +293,15 @@ Observed observe(XrInstance instance, const XrSession& session, bool suggest_gaz
   ps = {XR_TYPE_INTERACTION_PROFILE_STATE};
   o.hand = xrGetCurrentInteractionProfile(session, path("/user/hand/left"), &ps);
   o.hand_profile_name = o.hand == XR_SUCCESS ? name(ps.interactionProfile) : "";
+  const auto sync = [&](const char* subaction) {
+    const XrActiveActionSet active{set, path(subaction)};
+    XrActionsSyncInfo sync_info{XR_TYPE_ACTIONS_SYNC_INFO};
+    sync_info.countActiveActionSets = 1;
+    sync_info.activeActionSets = &active;
+    return xrSyncActions(session, &sync_info);
+  };
+  o.sync_eyes = sync("/user/eyes_ext");
+  o.sync_hand = sync("/user/hand/left");
   for (;;) {
     XrEventDataBuffer e{XR_TYPE_EVENT_DATA_BUFFER};
     if (xrPollEvent(instance, &e) != XR_SUCCESS) break;
@@ -333,6 +344,9 @@ TEST_F(LayerApiTest, EyeGazeStaysTheApplicationsChoice) {
     EXPECT_EQ(seen[0].attach_none, XR_ERROR_VALIDATION_FAILURE);
     EXPECT_EQ(seen[0].eyes_action, c.enable ? XR_SUCCESS : XR_ERROR_PATH_UNSUPPORTED);
     EXPECT_EQ(seen[0].supports_eye_gaze, c.enable ? XR_TRUE : XR_FALSE);
+    // The session is not focused: a sync the runtime accepts answers XR_SESSION_NOT_FOCUSED.
+    EXPECT_EQ(seen[0].sync_eyes, c.enable ? XR_SESSION_NOT_FOCUSED : XR_ERROR_PATH_UNSUPPORTED);
+    EXPECT_EQ(seen[0].sync_hand, XR_SESSION_NOT_FOCUSED);
     EXPECT_EQ(seen[0].eyes_profile_name == "/interaction_profiles/ext/eye_gaze_interaction", c.enable && c.suggest);
   }
 }

@@ -252,6 +252,27 @@ TEST(LayerConfig, RenderMode) {
   }
 }
 
+TEST(LayerConfig, Compositor) {
+  EXPECT_TRUE(parse_config(R"({"default": {"scene": "cornell"}})", "cfg.json", "App").gpu_compositor);
+  EXPECT_FALSE(parse_config(R"({"default": {"compositor": "host"}})", "cfg.json", "App").gpu_compositor);
+  EXPECT_TRUE(parse_config(R"({"default": {"compositor": "host"}, "applications": {"App": {"compositor": "gpu"}}})",
+                           "cfg.json", "App")
+                  .gpu_compositor);
+  try {
+    parse_config(R"({"default": {"compositor": 1}})", "cfg.json", "App");
+    FAIL() << "accepted";
+  } catch (const core::InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("cfg.json: default.compositor"), std::string::npos) << e.what();
+    EXPECT_NE(std::string(e.what()).find("\"gpu\" or \"host\""), std::string::npos) << e.what();
+  }
+  setenv("XDG_CONFIG_HOME", "/nonexistent-fovea-config", 1);  // no configuration file
+  setenv("FOVEA_LAYER_COMPOSITOR", "host", 1);
+  EXPECT_FALSE(load_config("App").gpu_compositor);
+  setenv("FOVEA_LAYER_COMPOSITOR", "cpu", 1);
+  EXPECT_THROW(load_config("App"), core::InputError);
+  unsetenv("FOVEA_LAYER_COMPOSITOR");
+}
+
 // A raw HID capture configured as the layer's gaze is a recording: at display times on the
 // host clock the fovea follows it from the first frame on (it used to be taken for a live
 // device and froze on its last sample).

@@ -1,0 +1,51 @@
+// The API layer's composition on the application's device (xr_layer_composite.comp): per eye,
+// the path-traced frame reprojected by rotation into the submitted view and the application's
+// pixels composited over it, as the layer's host path does (layer/src/composite.cpp). Pixels
+// are 4 bytes packed in a uint, in the swapchain's channel order and encoding. Shared C++/GLSL.
+#ifndef FOVEA_SHADERS_LAYER_COMPOSITE_H
+#define FOVEA_SHADERS_LAYER_COMPOSITE_H
+#include "fovea/shaders/common.h"
+
+#ifdef __cplusplus
+namespace fovea::shaders {
+#endif
+
+// LayerCompositeParams.mode (layer::Composite)
+FOVEA_CONST FOVEA_UINT kLayerAppOnTop = 0u;
+FOVEA_CONST FOVEA_UINT kLayerAlpha = 1u;
+FOVEA_CONST FOVEA_UINT kLayerSceneOnly = 2u;
+// Push constant `pass`: the border pass finds AppOnTop's background (the most frequent colour
+// on the application image's border, one workgroup per eye), the composite pass writes out.
+FOVEA_CONST FOVEA_UINT kLayerPassBorder = 0u;
+FOVEA_CONST FOVEA_UINT kLayerPassComposite = 1u;
+FOVEA_CONST FOVEA_UINT kLayerBorderGroup = 64u;
+
+// One eye. A view is its tangent-plane extents at z = -1 (left, right, up, down) and raster;
+// a direction of the output view turns into the traced view's by `to_traced` (row-major 3x3,
+// conj(q_traced) * q_submitted). `*_identity`: the host path copies without resampling
+// (same FOV and raster, no rotation), so the shader does too.
+struct LayerCompositeEye {
+  float out_tan[4];
+  float traced_tan[4];
+  float to_traced[9];
+  FOVEA_INT out_w, out_h, traced_w, traced_h, app_w, app_h;
+  FOVEA_UINT traced_offset, app_offset, out_offset;  // in pixels, into the three buffers
+  FOVEA_UINT traced_identity, app_identity;
+};
+
+struct LayerCompositeParams {
+  LayerCompositeEye eye[2];
+  FOVEA_UINT mode;
+  FOVEA_UINT auto_background;  // AppOnTop: 1 = the border pass's colour, 0 = `background`
+  FOVEA_UINT background;       // packed bytes 0..2
+  FOVEA_INT tolerance;         // AppOnTop: a channel differing by more keeps the application's pixel
+  FOVEA_UINT source_alpha, premultiplied, srgb, pad;
+  float decode[256];  // 8-bit channel -> linear (the host's table, so both decode alike)
+};
+
+#ifdef __cplusplus
+static_assert(sizeof(LayerCompositeEye) == 112);
+static_assert(sizeof(LayerCompositeParams) == 2 * 112 + 32 + 256 * 4);
+}  // namespace fovea::shaders
+#endif
+#endif

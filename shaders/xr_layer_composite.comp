@@ -1,0 +1,162 @@
+#version 450
+// The API layer's composition on the application's device (fovea/shaders/layer_composite.h):
+// the same steps, in the same order, as the host path's resample() and composite() in
+// layer/src/composite.cpp, on packed 8-bit pixels, so kept pixels stay bit-exact; blends
+// decode with the host's table and encode with the sRGB formula (within one 8-bit step).
+#extension GL_GOOGLE_include_directive : require
+#include "fovea/shaders/layer_composite.h"
+
+layout(local_size_x = 8, local_size_y = 8) in;
+
+layout(push_constant) uniform Push {
+  uint eye;
+  uint pass;
+} pc;
+
+layout(std430, set = 0, binding = 0) readonly buffer Params { LayerCompositeParams p; };
+layout(std430, set = 0, binding = 1) readonly buffer Traced { uint traced[]; };
+layout(std430, set = 0, binding = 2) readonly buffer App { uint app[]; };
+layout(std430, set = 0, binding = 3) writeonly buffer Out { uint outp[]; };
+layout(std430, set = 0, binding = 4) buffer Background { uint background[2]; };
+
+shared uint best_count[kLayerBorderGroup];
+shared uint best_key[kLayerBorderGroup];
+
+// View::pixel_to_dir of pixel centre (x, y) (unnormalised: only ratios are used).
+vec3 pixel_dir(float tan[4], int w, int h, int x, int y) {
+  return vec3(tan[0] + ((float(x) + 0.5) / float(w)) * (tan[1] - tan[0]),
+              tan[2] - ((float(y) + 0.5) / float(h)) * (tan[2] - tan[3]), -1.0);
+}
+
+// View::dir_to_pixel followed by resample()'s bounds check: the texel index, -1 outside.
+int dir_texel(float tan[4], int w, int h, vec3 d) {
+  if (!(d.z < 0.0)) return -1;
+  float tx = d.x / -d.z, ty = d.y / -d.z;
+  float px = (tx - tan[0]) / (tan[1] - tan[0]) * float(w);
+  float py = (tan[2] - ty) / (tan[2] - tan[3]) * float(h);
+  if (!(px >= 0.0) || !(py >= 0.0) || px >= float(w) || py >= float(h)) return -1;
+  return int(py) * w + int(px);
+}
+
+// The i-th pixel border_colour() counts (rows 0 and h-1 whole, then the side columns
+// between them), as its key: the first three bytes.
+uint border_key(uint i, int w, int h, uint base) {
+  int x, y;
+  if (i < uint(w)) {
+    x = int(i);
+    y = 0;
+  } else if (i < uint(2 * w)) {
+    x = int(i) - w;
+    y = h - 1;
+  } else {
+    int k = int(i) - 2 * w;
+    x = (k & 1) == 0 ? 0 : w - 1;
+    y = 1 + k / 2;
+  }
+  return app[base + uint(y * w + x)] & 0xffffffu;
+}
+
+uint channel(uint v, int c) { return (v >> (8 * c)) & 255u; }
+
+uint encode(float v) {
+  v = clamp(v, 0.0, 1.0);
+  if (p.srgb != 0u) v = v <= 0.0031308 ? 12.92 * v : 1.055 * pow(v, 1.0 / 2.4) - 0.055;
+  return uint(floor(v * 255.0 + 0.5));
+}
+
+void border_pass(uint e) {
+  int w = p.eye[e].app_w, h = p.eye[e].app_h;
+  uint base = p.eye[e].app_offset;
+  // border_colour(): both rows whole, then the side columns between them.
+  uint n = uint(2 * w + 2 * max(h - 2, 0));
+  uint tid = gl_LocalInvocationIndex;
+  uint my_count = 0u, my_key = 0xffffffffu;
+  for (uint i = tid; i < n; i += kLayerBorderGroup) {
+    uint key = border_key(i, w, h, base);
+    // Counted once, at the colour's first border pixel: a border mostly of the clear colour
+    // (the usual case) costs O(n), not O(n^2).
+    bool first = true;
+    for (uint j = 0u; j < i && first; ++j) first = border_key(j, w, h, base) != key;
+    if (!first) continue;
+    uint count = 1u;
+    for (uint j = i + 1u; j < n; ++j) count += border_key(j, w, h, base) == key ? 1u : 0u;
+    if (count > my_count || (count == my_count && key < my_key)) {
+      my_count = count;
+      my_key = key;
+    }
+  }
+  best_count[tid] = my_count;
+  best_key[tid] = my_key;
+  barrier();
+  // Most frequent, ties to the smallest key (std::map order + max_element's first maximum).
+  for (uint s = kLayerBorderGroup / 2u; s > 0u; s >>= 1) {
+    if (tid < s) {
+      uint c = best_count[tid + s], k = best_key[tid + s];
+      if (c > best_count[tid] || (c == best_count[tid] && k < best_key[tid])) {
+        best_count[tid] = c;
+        best_key[tid] = k;
+      }
+    }
+    barrier();
+  }
+  if (tid == 0u) background[e] = n == 0u ? 0u : best_key[0];
+}
+
+void composite_pass(uint e) {
+  ivec2 g = ivec2(gl_GlobalInvocationID.xy);
+  int w = p.eye[e].out_w, h = p.eye[e].out_h;
+  if (g.x >= w || g.y >= h) return;
+  int o = g.y * w + g.x;
+  vec3 d = pixel_dir(p.eye[e].out_tan, w, h, g.x, g.y);
+  // resample(traced, traced_view, out_view, to_traced); uncovered: black.
+  uint s = 0u;
+  if (p.eye[e].traced_identity != 0u) {
+    s = traced[p.eye[e].traced_offset + uint(o)];
+  } else {
+    float r[9] = p.eye[e].to_traced;
+    vec3 rd = vec3(r[0] * d.x + r[1] * d.y + r[2] * d.z, r[3] * d.x + r[4] * d.y + r[5] * d.z,
+                   r[6] * d.x + r[7] * d.y + r[8] * d.z);
+    int t = dir_texel(p.eye[e].traced_tan, p.eye[e].traced_w, p.eye[e].traced_h, rd);
+    if (t >= 0) s = traced[p.eye[e].traced_offset + uint(t)];
+  }
+  s = (s & 0xffffffu) | 0xff000000u;
+  if (p.mode != kLayerSceneOnly) {
+    // resample(app, app_view, out_view): the application's FOV at its own raster.
+    uint a = 0u;
+    if (p.eye[e].app_identity != 0u) {
+      a = app[p.eye[e].app_offset + uint(o)];
+    } else {
+      int t = dir_texel(p.eye[e].out_tan, p.eye[e].app_w, p.eye[e].app_h, d);
+      if (t >= 0) a = app[p.eye[e].app_offset + uint(t)];
+    }
+    uint alpha = channel(a, 3);
+    if (p.mode == kLayerAppOnTop) {
+      uint bg = p.auto_background != 0u ? background[e] : p.background;
+      bool differs = false;
+      for (int c = 0; c < 3; ++c) differs = differs || abs(int(channel(a, c)) - int(channel(bg, c))) > p.tolerance;
+      if (alpha != 0u && differs) s = a;
+    } else {
+      if (p.source_alpha == 0u) alpha = 255u;
+      bool adds = (a & 0xffffffu) != 0u;
+      if (alpha == 255u) {
+        s = (a & 0xffffffu) | 0xff000000u;
+      } else if (alpha != 0u || (p.premultiplied != 0u && adds)) {
+        // Premultiplied: out = src + (1 - a) dst; straight: out = a src + (1 - a) dst.
+        float fa = float(alpha) / 255.0;
+        float src_weight = p.premultiplied != 0u ? 1.0 : fa;
+        uint blended = 0xff000000u;
+        for (int c = 0; c < 3; ++c)
+          blended |= encode(src_weight * p.decode[channel(a, c)] + (1.0 - fa) * p.decode[channel(s, c)]) << (8 * c);
+        s = blended;
+      }
+    }
+  }
+  outp[p.eye[e].out_offset + uint(o)] = s;
+}
+
+void main() {
+  if (pc.pass == kLayerPassBorder)
+    border_pass(pc.eye);
+  else
+    composite_pass(pc.eye);
+}
