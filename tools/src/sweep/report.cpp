@@ -333,7 +333,8 @@ std::string markdown_page(const MarkdownInput& in) {
   const bool sectioned = in.sections.size() > 1;
   if (sectioned) {
     md << "One section per " << cfg.section << ":";
-    for (const auto& s : in.sections) md << " [" << s << "](#" << cfg.section << "-" << s << ")" << (s == in.sections.back() ? "" : ",");
+    for (const auto& s : in.sections)
+      md << " [" << s << "](#" << cfg.section << "-" << s << ")" << (s == in.sections.back() ? "" : ",");
     md << (in.images.count(kLatencySection) ? "; then [latency against quality](#latency-against-quality)" : "") << ".\n\n";
   }
   for (const auto& section : in.sections) {
@@ -342,7 +343,8 @@ std::string markdown_page(const MarkdownInput& in) {
       if (job_command(r->settings) == "render" && section_of(*r, cfg) == section) rows.push_back(r);
     if (sectioned) md << "## " << cfg.section << " " << section << "\n\n";
     const auto images = in.images.find(section);
-    markdown_section(md, in, rows, sectioned ? "### " : "## ", images != in.images.end() ? images->second : std::vector<std::string>{});
+    markdown_section(md, in, rows, sectioned ? "### " : "## ",
+                     images != in.images.end() ? images->second : std::vector<std::string>{});
   }
   if (const auto l = in.images.find(kLatencySection); l != in.images.end()) markdown_latency(md, in, l->second);
   return md.str();
@@ -360,7 +362,7 @@ void markdown_section(std::ostringstream& md, const MarkdownInput& in, const std
   const std::string q0 = cfg.quality.empty() ? "" : cfg.quality[0];
   if (!done.empty())
     md << "Each job is the command below with its row's settings (`shared/<id>`: the shared reference, "
-          "`jobs/<id>`: its output, both in the results directory `out/sweeps/results`):\n\n    "
+          "`jobs/<id>`: its output, both in the sweep's results directory):\n\n    "
        << job_argv_text(in.plan, done.front()->id) << "\n\n";
 
   // Every job, grouped by budget (equal samples), Pareto membership of the first quality.
@@ -524,7 +526,10 @@ void markdown_latency(std::ostringstream& md, const MarkdownInput& in, const std
   for (const Row& r : rows) {
     md << "|";
     for (const auto& k : keys) md << " " << (r.settings.contains(k) ? setting_text(r.settings[k]) : "–") << " |";
-    for (const auto& m : metrics) md << " " << (r.metrics.count(m) ? fixed(r.metrics.at(m), m.find("psnr") != std::string::npos ? 2 : 4) : "–") << " |";
+    for (const auto& m : metrics) {
+      const int decimals = m.find("_ms") != std::string::npos ? 1 : m.find("psnr") != std::string::npos ? 2 : 4;
+      md << " " << (r.metrics.count(m) ? fixed(r.metrics.at(m), decimals) : "–") << " |";
+    }
     md << "\n";
   }
   md << "\n";
