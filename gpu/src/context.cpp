@@ -4,6 +4,7 @@
 #include <cstdlib>
 #include <cstring>
 
+#include "fovea/core/clock.hpp"
 #include "fovea/core/error.hpp"
 #include "fovea/gpu/barriers.hpp"
 #include "fovea/gpu/error.hpp"
@@ -306,7 +307,7 @@ void Context::create_device(bool ray_query) {
   check(vkCreateCommandPool(device_, &pci, nullptr, &command_pool_), "vkCreateCommandPool");
 }
 
-void Context::submit_and_wait(const std::function<void(VkCommandBuffer)>& record) {
+void Context::submit_and_wait(const std::function<void(VkCommandBuffer)>& record, double* wait_ms) {
   VkCommandBufferAllocateInfo ai{VK_STRUCTURE_TYPE_COMMAND_BUFFER_ALLOCATE_INFO};
   ai.commandPool = command_pool_;
   ai.level = VK_COMMAND_BUFFER_LEVEL_PRIMARY;
@@ -340,7 +341,9 @@ void Context::submit_and_wait(const std::function<void(VkCommandBuffer)>& record
   si.commandBufferCount = 1;
   si.pCommandBuffers = &cmd;
   check(vkQueueSubmit(queue_, 1, &si, fence), "vkQueueSubmit");
+  const core::TimeNs waiting = core::now_ns();
   check(vkWaitForFences(device_, 1, &fence, VK_TRUE, kFenceTimeoutNs), "vkWaitForFences");
+  if (wait_ms) *wait_ms = core::ns_to_ms(core::now_ns() - waiting);
 }
 
 std::uint32_t Context::memory_type(std::uint32_t type_bits, VkMemoryPropertyFlags required,

@@ -195,8 +195,8 @@ FrameTimes FramePipeline::render(const std::array<core::Pose, 2>& eye_pose, cons
     m.timer.stage(cmd, "blur");
     t.resolve.cpu_ms = lap_ms(r0);
     recording_ms = core::ns_to_ms(r0 - start);
-  });
-  t.submit_cpu_ms = std::max(0.0, lap_ms(t0) - recording_ms);
+  }, &t.wait_cpu_ms);
+  t.submit_cpu_ms = std::max(0.0, lap_ms(t0) - recording_ms - t.wait_cpu_ms);
   for (auto& e : m.eyes) e->mapping->advance(e->pose);
   m.parity = p;
   ++m.frames_done;

@@ -55,8 +55,9 @@ the peripheral blur. Writes to --out:
   report.json   {"frames", "samples_traced_per_eye", "samples_hidden": {"left", "right"},
                  "device": {name, driver}, "trace": "rayquery" or "compute",
                  "gpu_ms": {grid, trace, reconstruct, resolve, total, bmfr_fit, mip, resample, blur},
-                 "cpu_ms": {gaze, grid, trace, reconstruct, resolve, submit, readback, total}
-                 (medians per frame), "metrics": {tone mapper, exposure, ppd, reference},
+                 "cpu_ms": {gaze, grid, trace, reconstruct, resolve, submit, wait, readback,
+                 total} (medians per frame; submit: vkQueueSubmit, wait: the fence),
+                 "metrics": {tone mapper, exposure, ppd, reference},
                  "summary": {"left": {...}, "right": {...}}}
 Cells that the preset's lens hides (its hidden area, seen from the view) are neither traced
 nor reconstructed; samples_hidden counts them in the last frame.
@@ -330,6 +331,7 @@ int run(std::vector<std::string> argv) {
     gpu_ms["resample"].push_back(t.resample_gpu_ms);
     gpu_ms["blur"].push_back(t.blur_gpu_ms);
     cpu_ms["submit"].push_back(t.submit_cpu_ms);
+    cpu_ms["wait"].push_back(t.wait_cpu_ms);
     t0 = core::now_ns();
     for (int e = 0; e < 2; ++e) last[e] = pipeline.image(core::Eye(e));
     cpu_ms["readback"].push_back(core::ns_to_ms(core::now_ns() - t0));

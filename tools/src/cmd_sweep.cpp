@@ -29,9 +29,10 @@ constexpr const char* kHelp = R"(usage: fovea sweep plan FILE --out PLAN
        fovea sweep report PLAN --out DIR [--dir DIR] [--markdown PAGE [--command TEXT]]
 
 plan    expands a sweep file (JSON: "scenes", "displays", "gaze", "frames", any `fovea render`
-        option as a value, a list or {"from", "to", "step"}, and "report"; or a list of
+        option as a value, a list or {"from", "to", "step"}, and "report"; "command":
+        "latency" makes the jobs `fovea latency` runs, keys its options; or a list of
         such objects, their union) into PLAN, one JSON
-        line per job: id (FNV-1a 64 of its canonical settings), the `fovea render` argv, the
+        line per job: id (FNV-1a 64 of its canonical settings), the command's argv, the
         shared inputs (references computed once per scene, display and spp).
 run     runs the plan's jobs with a pool of N processes [CPUs / LP_NUM_THREADS]; finished jobs
         (DIR/jobs/<id>) are skipped, failed ones recorded in DIR/failed/<id>.json and retried
@@ -44,7 +45,8 @@ slurm   writes DIR/sweep-array.sbatch (one array task per shard), DIR/sweep-merg
         next to the plan]
 report  merges the results into DIR/results.csv and results.json and draws PNG plots:
         quality against time per frame with the Pareto front per distribution, quality
-        against budget, per-band curves, latency against quality (when recorded).
+        against budget, per-band curves (per scene when the scene varies), latency against
+        quality (latency jobs: gaze-to-photon against foveal error and fovea quality).
         --markdown PAGE also writes a Markdown page: every job at equal samples, the
         best quality at equal time, per-band PSNR, the plots (linked relative to PAGE) and
         the front's cost against the cartesian job for a 90 Hz frame; --command is the
@@ -61,10 +63,10 @@ std::string self_exe() {
   return p.string();
 }
 
-// The options `fovea render --help` lists: the keys a sweep file may vary.
-std::vector<sweep::RenderOption> render_options() {
-  const auto it = commands().find("render");
-  if (it == commands().end()) throw std::runtime_error("this fovea has no render command");
+// The options `fovea <name> --help` lists: the keys a sweep file may vary for its jobs.
+std::vector<sweep::RenderOption> help_options(const std::string& name) {
+  const auto it = commands().find(name);
+  if (it == commands().end()) throw std::runtime_error("this fovea has no " + name + " command");
   std::ostringstream help;
   std::streambuf* old = std::cout.rdbuf(help.rdbuf());
   try {
@@ -75,6 +77,13 @@ std::vector<sweep::RenderOption> render_options() {
   }
   std::cout.rdbuf(old);
   return sweep::parse_help_options(help.str());
+}
+
+// The commands a sweep file may run ("command" key) and their options.
+sweep::CommandOptions command_options() {
+  sweep::CommandOptions o;
+  for (const char* name : {"render", "latency"}) o[name] = help_options(name);
+  return o;
 }
 
 std::string plan_arg(const Args& a, const char* sub) {
@@ -89,7 +98,7 @@ std::string results_dir(const Args& a, const std::string& plan) {
 int cmd_plan(const std::vector<std::string>& argv) {
   const Args a(argv, {"out"}, {}, 1);
   if (a.positional().size() != 1 || !a.has("out")) throw core::InputError("sweep plan needs FILE and --out PLAN (see --help)");
-  const sweep::Plan plan = sweep::load_sweep_file(a.positional()[0], render_options());
+  const sweep::Plan plan = sweep::load_sweep_file(a.positional()[0], command_options());
   const std::string out = a.str("out", "");
   if (fs::path(out).has_parent_path()) fs::create_directories(fs::path(out).parent_path());
   core::write_file_atomic(out, sweep::plan_to_jsonl(plan));

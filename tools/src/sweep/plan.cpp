@@ -142,7 +142,17 @@ std::string settings_id(const json& settings) {
   return buf;
 }
 
-Plan expand_sweep(const json& sweep, const std::string& source, const std::vector<RenderOption>& options) {
+std::string job_command(const json& settings) {
+  return settings.is_object() && settings.contains("command") && settings["command"].is_string()
+             ? settings["command"].get<std::string>()
+             : std::string("render");
+}
+
+Plan expand_sweep(const json& sweep, const std::string& source, const std::vector<RenderOption>& render_options) {
+  return expand_sweep(sweep, source, CommandOptions{{"render", render_options}});
+}
+
+Plan expand_sweep(const json& sweep, const std::string& source, const CommandOptions& options) {
   // A list of sweeps is their union (settings that only make sense together, e.g. budgets
   // for the foveated distributions and none for cartesian): jobs in list order, a job two
   // parts share once, the first part's report settings.
@@ -165,22 +175,39 @@ Plan expand_sweep(const json& sweep, const std::string& source, const std::vecto
     return all;
   }
   if (!sweep.is_object()) throw InputError(source + ": a sweep file is a JSON object or a list of them");
+  // The command this part's jobs run: its options are the keys the part may set.
+  std::string command = "render";
+  if (sweep.contains("command")) {
+    const json& c = sweep["command"];
+    if (!c.is_string() || !options.count(c.get<std::string>())) {
+      std::string names;
+      for (const auto& [name, o] : options) names += (names.empty() ? "" : ", ") + name;
+      throw InputError(where(source, "command") + ": expected one command name (" + names + "), got " + c.dump());
+    }
+    command = c.get<std::string>();
+  }
+  const auto command_options = options.find(command);
+  if (command_options == options.end()) throw InputError(source + ": this program cannot plan `fovea " + command + "` jobs");
   std::map<std::string, bool> known;  // option -> valued
-  for (const auto& o : options) known[o.name] = o.valued;
+  for (const auto& o : command_options->second) known[o.name] = o.valued;
   Plan plan;
   json report = json::object();
   std::vector<std::pair<std::string, std::vector<json>>> axes;  // sorted by option name
   std::map<std::string, std::string> seen;                     // option -> the key that set it
   for (auto it = sweep.begin(); it != sweep.end(); ++it) {
     const std::string& key = it.key();
+    if (key == "command") continue;
     if (key == "report") {
       if (!it->is_object()) throw InputError(where(source, key) + ": expected an object");
-      static const std::set<std::string> fields = {"quality", "time",           "group",           "budget",
-                                                   "latency", "lower_is_better", "higher_is_better"};
+      static const std::set<std::string> fields = {"quality",         "time",    "group",           "budget",
+                                                   "section",         "bands",   "latency",         "latency_quality",
+                                                   "latency_group",   "lower_is_better", "higher_is_better"};
       for (auto f = it->begin(); f != it->end(); ++f)
-        if (!fields.count(f.key()))
-          throw InputError(where(source, "report." + f.key()) +
-                           ": unknown key (expected quality, time, group, budget, latency, lower_is_better, higher_is_better)");
+        if (!fields.count(f.key())) {
+          std::string names;
+          for (const auto& n : fields) names += (names.empty() ? "" : ", ") + n;
+          throw InputError(where(source, "report." + f.key()) + ": unknown key (expected " + names + ")");
+        }
       report = *it;
       continue;
     }
@@ -189,7 +216,8 @@ Plan expand_sweep(const json& sweep, const std::string& source, const std::vecto
     if (kReserved.count(option)) throw InputError(where(source, key) + ": set by the sweep itself, remove it");
     const auto k = known.find(option);
     if (k == known.end())
-      throw InputError(where(source, key) + ": unknown key (expected scenes, displays, report or a `fovea render` option)");
+      throw InputError(where(source, key) + ": unknown key (expected scenes, displays, command, report or a `fovea " +
+                       command + "` option)");
     if (!seen.emplace(option, key).second)
       throw InputError(where(source, key) + ": sets --" + option + " already set by \"" + seen[option] + "\"");
     axes.emplace_back(option, key_values(*it, where(source, key), k->second));
@@ -212,6 +240,8 @@ Plan expand_sweep(const json& sweep, const std::string& source, const std::vecto
   for (std::size_t n = 0; n < total; ++n) {
     Job job;
     job.settings = json::object();
+    // Render jobs carry no "command", so their ids are those of sweeps before other commands.
+    if (command != "render") job.settings["command"] = command;
     for (std::size_t a = 0; a < axes.size(); ++a) {
       const json& v = axes[a].second[digit[a]];
       if (!(v.is_boolean() && !v.get<bool>())) job.settings[axes[a].first] = v;  // absent flag == false
@@ -221,8 +251,9 @@ Plan expand_sweep(const json& sweep, const std::string& source, const std::vecto
     job.out = "jobs/" + job.id;
     const bool shares_reference = job.settings.contains("reference") && job.settings["reference"].get<long>() > 0;
     const SharedInput reference = shares_reference ? reference_input(job.settings) : SharedInput{};
-    job.argv = {"fovea", "render"};
+    job.argv = {"fovea", command};
     for (auto it = job.settings.begin(); it != job.settings.end(); ++it) {
+      if (it.key() == "command") continue;
       job.argv.push_back("--" + it.key());
       // The job loads the shared reference instead of rendering its own.
       if (it.key() == "reference" && shares_reference) job.argv.push_back(reference.out);
@@ -230,6 +261,10 @@ Plan expand_sweep(const json& sweep, const std::string& source, const std::vecto
     }
     // PNGs of the last frame only (the sweep keeps numbers, not films), unless asked.
     if (known.count("png-every") && !job.settings.contains("png-every")) job.argv.insert(job.argv.end(), {"--png-every", "0"});
+    // A latency job measures its quality at its own settings (no injected-latency sweep of
+    // its own, which would render the quality frames once per injected value), unless asked.
+    if (command == "latency" && known.count("inject-latency") && !job.settings.contains("inject-latency"))
+      job.argv.insert(job.argv.end(), {"--inject-latency", "0"});
     if (known.count("quiet")) job.argv.push_back("--quiet");
     job.argv.insert(job.argv.end(), {"--out", job.out});
     if (shares_reference) {
@@ -247,7 +282,7 @@ Plan expand_sweep(const json& sweep, const std::string& source, const std::vecto
   return plan;
 }
 
-Plan load_sweep_file(const std::string& path, const std::vector<RenderOption>& options) {
+Plan load_sweep_file(const std::string& path, const CommandOptions& options) {
   std::ifstream in(path);
   if (!in) throw InputError(path + ": cannot open the sweep file");
   json j;

@@ -3,6 +3,7 @@
 // each a `fovea render` command with a stable id, plus the shared inputs (converged
 // references) that several jobs use. Format and hash: docs/sweep.md.
 #include <cstdint>
+#include <map>
 #include <string>
 #include <string_view>
 #include <vector>
@@ -29,7 +30,7 @@ struct SharedInput {
 
 struct Job {
   std::string id;
-  nlohmann::json settings;        // render option -> value (canonical, sorted keys)
+  nlohmann::json settings;        // option -> value (canonical, sorted keys); "command" unless render
   std::vector<std::string> argv;  // the exact command; its --out value is out
   std::string out;                // jobs/<id>, relative to the results directory
   std::vector<std::string> shared;
@@ -47,10 +48,19 @@ std::uint64_t fnv1a64(std::string_view bytes);
 // 16 lowercase hex digits of fnv1a64 over the compact JSON dump of `settings` (keys sorted).
 std::string settings_id(const nlohmann::json& settings);
 
-// Expands a parsed sweep file. `source` names it in error messages; `options` are the render
-// options allowed as keys. Throws core::InputError naming the key and the source.
-Plan expand_sweep(const nlohmann::json& sweep, const std::string& source, const std::vector<RenderOption>& options);
-Plan load_sweep_file(const std::string& path, const std::vector<RenderOption>& options);
+// The commands a sweep runs ("render", "latency") and the options each allows as keys.
+using CommandOptions = std::map<std::string, std::vector<RenderOption>>;
+
+// Expands a parsed sweep file. `source` names it in error messages; `options` are the options
+// allowed as keys for each command (a part's "command" key picks one; "render" when absent).
+// Throws core::InputError naming the key and the source.
+Plan expand_sweep(const nlohmann::json& sweep, const std::string& source, const CommandOptions& options);
+// `render_options` only: a sweep of `fovea render` jobs.
+Plan expand_sweep(const nlohmann::json& sweep, const std::string& source, const std::vector<RenderOption>& render_options);
+Plan load_sweep_file(const std::string& path, const CommandOptions& options);
+
+// The command a job runs: its settings' "command" ("render" when absent).
+std::string job_command(const nlohmann::json& settings);
 
 std::string plan_to_jsonl(const Plan& plan);
 // Reads a plan written by plan_to_jsonl; errors name the file and line.

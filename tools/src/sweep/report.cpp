@@ -54,10 +54,17 @@ std::string file_stem(const std::string& metric) {
 // Axis label with the unit the metric's name implies.
 std::string axis_label(const std::string& m) {
   if (m.find("psnr") != std::string::npos) return m + " (dB)";
+  if (m.find(".above_") != std::string::npos) return m + " (fraction of vsyncs)";
+  if (m.find("_deg") != std::string::npos) return m + " (deg)";
   if (m.find("_ms") != std::string::npos || m.rfind("ms", m.size() - 2) == m.size() - 2) return m + " (ms)";
   if (m.find("seconds") != std::string::npos) return m + " (s)";
   return m;
 }
+
+// fovea latency's summary: the share of vsyncs whose foveal error exceeds 2°, and the
+// prefix of the fovea quality its sweep point at the job's own latency reports.
+constexpr const char* kFovealErrorShare = "foveal_error_deg.above_2deg";
+constexpr const char* kLatencyQuality = "fovea_quality.";
 
 struct Row {
   std::string id, status;
@@ -70,8 +77,9 @@ struct Row {
 std::string setting_text(const json& v) { return v.is_string() ? v.get<std::string>() : v.dump(); }
 
 struct Config {
-  std::vector<std::string> quality;
-  std::string time = "gpu_ms.total", group = "distribution", budget = "budget", latency;
+  std::vector<std::string> quality, bands, latency_quality;
+  std::string time = "gpu_ms.total", group = "distribution", budget = "budget", section = "scene", latency,
+              latency_group;
   std::set<std::string> lower, higher;
   bool lower_better(const std::string& m) const {
     if (lower.count(m)) return true;
@@ -79,6 +87,13 @@ struct Config {
     return lower_is_better_by_name(m);
   }
 };
+
+// The section a render job's tables and plots belong to: its value of the section setting.
+std::string section_of(const Row& r, const Config& c) {
+  return r.settings.contains(c.section) ? setting_text(r.settings[c.section]) : std::string();
+}
+// The plots of latency jobs: their own section of the page, after the render sections.
+const std::string kLatencySection = "\n latency";
 
 Config read_config(const json& r, const std::vector<Row>& rows) {
   Config c;
@@ -115,13 +130,35 @@ Config read_config(const json& r, const std::vector<Row>& rows) {
   if (auto t = strings("time"); !t.empty()) c.time = t[0];
   if (auto g = strings("group"); !g.empty()) c.group = g[0];
   if (auto b = strings("budget"); !b.empty()) c.budget = b[0];
+  if (auto s = strings("section"); !s.empty()) c.section = s[0];
+  c.bands = strings("bands");
   if (auto l = strings("latency"); !l.empty()) c.latency = l[0];
+  else if (present.count("gaze_to_photon_ms.median")) c.latency = "gaze_to_photon_ms.median";  // fovea latency's
   else
     for (const auto& m : present)
       if (m.find("photon") != std::string::npos || m.find("latency") != std::string::npos) {
         c.latency = m;
         break;
       }
+  // Latency plots: y metrics and legend, from the rows that carry the latency metric.
+  std::set<std::string> with_latency;
+  bool predict = false;
+  for (const auto& row : rows)
+    if (row.metrics.count(c.latency)) {
+      for (const auto& [k, v] : row.metrics) with_latency.insert(k);
+      predict = predict || row.settings.contains("predict");
+    }
+  c.latency_quality = strings("latency_quality");
+  if (c.latency_quality.empty()) {
+    if (with_latency.count(kFovealErrorShare)) c.latency_quality.push_back(kFovealErrorShare);
+    for (const auto& m : with_latency)
+      if (m.rfind(kLatencyQuality, 0) == 0 && (m.find("flip") != std::string::npos || m.find("psnr") != std::string::npos))
+        c.latency_quality.push_back(m);
+    for (const auto& q : c.quality)
+      if (with_latency.count(q)) c.latency_quality.push_back(q);
+  }
+  if (auto g = strings("latency_group"); !g.empty()) c.latency_group = g[0];
+  else c.latency_group = predict ? "predict" : c.group;
   for (const auto& m : strings("lower_is_better")) c.lower.insert(m);
   for (const auto& m : strings("higher_is_better")) c.higher.insert(m);
   return c;
@@ -152,6 +189,22 @@ std::map<std::string, double> flatten_metrics(const json& report) {
     flatten(j["summary"]["right"], "", r);
     for (const auto& [k, v] : l)
       if (r.count(k)) out[k] = 0.5 * (v + r[k]);
+  }
+  return out;
+}
+
+std::map<std::string, double> latency_metrics(const json& summary) {
+  std::map<std::string, double> out = flatten_metrics(summary);
+  // Read by key name only: the summary may gain keys; a missing one leaves its metric out.
+  if (!summary.is_object() || !summary.contains("sweep") || !summary["sweep"].is_array()) return out;
+  for (const json& point : summary["sweep"]) {
+    if (!point.is_object() || !point.contains("inject_ms") || !point["inject_ms"].is_number() ||
+        point["inject_ms"].get<double>() != 0 || !point.contains("fovea_quality") || !point["fovea_quality"].is_object())
+      continue;
+    std::map<std::string, double> q;
+    flatten(point["fovea_quality"], "", q);
+    for (const auto& [k, v] : q) out.emplace(kLatencyQuality + k, v);  // emplace: the summary's own wins
+    break;
   }
   return out;
 }
@@ -236,9 +289,25 @@ struct MarkdownInput {
   const std::vector<Row>& rows;
   const Config& cfg;
   const std::map<std::string, std::map<std::string, bool>>& on_front;
-  const std::vector<std::string>& images;  // relative to the page
+  const std::vector<std::string>& sections;                         // of the render jobs, in plan order
+  const std::map<std::string, std::vector<std::string>>& images;  // per section, relative to the page
   const std::string& command;
 };
+
+// The exact command of a job, as the plan holds it ("fovea" is the program that ran it).
+std::string job_argv_text(const Plan& plan, const std::string& id) {
+  for (const Job& j : plan.jobs)
+    if (j.id == id) {
+      std::string s;
+      for (const auto& a : j.argv) s += (s.empty() ? "" : " ") + a;
+      return s;
+    }
+  return "";
+}
+
+void markdown_section(std::ostringstream& md, const MarkdownInput& in, const std::vector<const Row*>& done,
+                      const std::string& h, const std::vector<std::string>& images);
+void markdown_latency(std::ostringstream& md, const MarkdownInput& in, const std::vector<std::string>& images);
 
 // The page: settings, every job, equal samples, equal time, per band, the plots, and what
 // the Pareto front means for a 90 Hz frame.
@@ -247,11 +316,6 @@ std::string markdown_page(const MarkdownInput& in) {
   std::vector<const Row*> done;
   for (const Row& r : in.rows)
     if (r.status == "done") done.push_back(&r);
-  auto setting = [](const Row& r, const std::string& k) {
-    return r.settings.contains(k) ? setting_text(r.settings[k]) : std::string("–");
-  };
-  auto lower = [&](const std::string& q) { return cfg.lower_better(q); };
-  const std::string q0 = cfg.quality.empty() ? "" : cfg.quality[0];
   std::ostringstream md;
   md << "# Results: the sweep `" << in.plan.header.value("source", "") << "`\n\n"
      << "<!-- Generated by `fovea sweep report --markdown`; edit the sweep file or the generator, not this page. -->\n\n"
@@ -266,6 +330,40 @@ std::string markdown_page(const MarkdownInput& in) {
      << "`), both eyes; quality is of the last frame against the shared converged reference (docs/metrics.md): "
         "FLIP is lower-is-better, PSNR (tone-mapped) higher-is-better; `fovea_*` over e ≤ 5.79°, `foveated_*` "
         "weighted by acuity. Means of both eyes.\n\n";
+  const bool sectioned = in.sections.size() > 1;
+  if (sectioned) {
+    md << "One section per " << cfg.section << ":";
+    for (const auto& s : in.sections)
+      md << " [" << s << "](#" << cfg.section << "-" << s << ")" << (s == in.sections.back() ? "" : ",");
+    md << (in.images.count(kLatencySection) ? "; then [latency against quality](#latency-against-quality)" : "") << ".\n\n";
+  }
+  for (const auto& section : in.sections) {
+    std::vector<const Row*> rows;
+    for (const Row* r : done)
+      if (job_command(r->settings) == "render" && section_of(*r, cfg) == section) rows.push_back(r);
+    if (sectioned) md << "## " << cfg.section << " " << section << "\n\n";
+    const auto images = in.images.find(section);
+    markdown_section(md, in, rows, sectioned ? "### " : "## ",
+                     images != in.images.end() ? images->second : std::vector<std::string>{});
+  }
+  if (const auto l = in.images.find(kLatencySection); l != in.images.end()) markdown_latency(md, in, l->second);
+  return md.str();
+}
+
+// One section's tables: every job at equal samples, equal time, per band, the plots, and
+// what the Pareto front means for a 90 Hz frame.
+void markdown_section(std::ostringstream& md, const MarkdownInput& in, const std::vector<const Row*>& done,
+                      const std::string& h, const std::vector<std::string>& images) {
+  const Config& cfg = in.cfg;
+  auto setting = [](const Row& r, const std::string& k) {
+    return r.settings.contains(k) ? setting_text(r.settings[k]) : std::string("–");
+  };
+  auto lower = [&](const std::string& q) { return cfg.lower_better(q); };
+  const std::string q0 = cfg.quality.empty() ? "" : cfg.quality[0];
+  if (!done.empty())
+    md << "Each job is the command below with its row's settings (`shared/<id>`: the shared reference, "
+          "`jobs/<id>`: its output, both in the sweep's results directory):\n\n    "
+       << job_argv_text(in.plan, done.front()->id) << "\n\n";
 
   // Every job, grouped by budget (equal samples), Pareto membership of the first quality.
   std::vector<const Row*> sorted = done;
@@ -274,7 +372,7 @@ std::string markdown_page(const MarkdownInput& in) {
     const double bb = b->settings.contains(cfg.budget) && b->settings[cfg.budget].is_number() ? b->settings[cfg.budget].get<double>() : 2;
     return ba != bb ? ba < bb : setting(*a, cfg.group) < setting(*b, cfg.group);
   });
-  md << "## Equal samples: every job by " << cfg.budget << "\n\n| " << cfg.group << " | " << cfg.budget
+  md << h << "Equal samples: every job by " << cfg.budget << "\n\n| " << cfg.group << " | " << cfg.budget
      << " | samples/eye | " << cfg.time;
   for (const auto& q : cfg.quality) md << " | " << q;
   md << " | on the " << q0 << " front |\n|---|---|---|---";
@@ -298,7 +396,7 @@ std::string markdown_page(const MarkdownInput& in) {
     for (const Row* r : done)
       if (setting(*r, cfg.group) == anchor && r->metrics.count(cfg.time)) limits.push_back(r->metrics.at(cfg.time));
     std::sort(limits.begin(), limits.end());
-    md << "\n## Equal time: best " << q0 << " within each " << anchor << " job's time\n\n"
+    md << "\n" << h << "Equal time: best " << q0 << " within each " << anchor << " job's time\n\n"
        << "Each cell: the best " << q0 << " of that " << cfg.group << "'s jobs whose " << cfg.time
        << " is at most the limit (– if none is that fast).\n\n| " << cfg.time << " ≤";
     for (const auto& g : groups) md << " | " << g;
@@ -330,7 +428,7 @@ std::string markdown_page(const MarkdownInput& in) {
     for (const Row* r : done)
       if (r->bands.count(band_series) && r->bands.at(band_series).size() > edges.size()) edges = r->bands.at(band_series);
     const std::size_t shown = std::min<std::size_t>(edges.size(), 10);
-    md << "\n## Per band: `" << band_series << "` (dB) per eccentricity band\n\n| " << cfg.group << " | " << cfg.budget;
+    md << "\n" << h << "Per band: `" << band_series << "` (dB) per eccentricity band\n\n| " << cfg.group << " | " << cfg.budget;
     for (std::size_t b = 0; b < shown; ++b) md << " | " << cell(edges[b].e_min) << "–" << cell(edges[b].e_max) << "°";
     md << " |\n|---|---";
     for (std::size_t b = 0; b < shown; ++b) md << "|---";
@@ -348,8 +446,8 @@ std::string markdown_page(const MarkdownInput& in) {
     }
   }
 
-  md << "\n## Plots\n\n";
-  for (const auto& f : in.images) md << "![" << f << "](" << f << ")\n\n";
+  md << "\n" << h << "Plots\n\n";
+  for (const auto& f : images) md << "![" << f << "](" << f << ")\n\n";
 
   // 90 Hz: the front of the first quality, each job's cost relative to the full raster and
   // the speed-up a device needs for 11.1 ms at a display with more pixels.
@@ -362,7 +460,7 @@ std::string markdown_page(const MarkdownInput& in) {
     for (const Row* r : done)
       if (f != in.on_front.end() && f->second.count(r->id) && f->second.at(r->id) && r->metrics.count(cfg.time)) front.push_back(r);
     std::sort(front.begin(), front.end(), [&](const Row* a, const Row* b) { return a->metrics.at(cfg.time) < b->metrics.at(cfg.time); });
-    md << "## Towards 90 Hz (11.1 ms per frame)\n\nThe " << q0 << " Pareto fronts (every " << cfg.group
+    md << h << "Towards 90 Hz (11.1 ms per frame)\n\nThe " << q0 << " Pareto fronts (every " << cfg.group
        << "), cheapest first. *Cost* is the job's " << cfg.time << " over the full-raster cartesian job's; "
        << "*speed-up for 11.1 ms* is how much faster than this machine a device must run it for a 90 Hz frame at this "
           "display, and ×16 that for `fove0` (1280×1440 per eye, 16× the pixels of `small`), assuming the cost "
@@ -399,7 +497,43 @@ std::string markdown_page(const MarkdownInput& in) {
       break;
     }
   }
-  return md.str();
+}
+
+// Latency jobs: their settings, gaze-to-photon, foveal error and fovea quality, the plots.
+void markdown_latency(std::ostringstream& md, const MarkdownInput& in, const std::vector<std::string>& images) {
+  const Config& cfg = in.cfg;
+  std::vector<Row> rows;
+  for (const Row& r : in.rows)
+    if (r.status == "done" && r.metrics.count(cfg.latency)) rows.push_back(r);
+  std::vector<std::string> keys = varied_keys(rows);
+  keys.erase(std::remove(keys.begin(), keys.end(), cfg.latency_group), keys.end());
+  keys.insert(keys.begin(), cfg.latency_group);
+  std::vector<std::string> metrics = {cfg.latency};
+  if (cfg.latency != "foveal_error_deg.median") metrics.push_back("foveal_error_deg.median");
+  for (const auto& q : cfg.latency_quality)
+    if (std::find(metrics.begin(), metrics.end(), q) == metrics.end()) metrics.push_back(q);
+  md << "\n## Latency against quality\n\n";
+  if (!rows.empty())
+    md << "Each job is the command below with its row's settings; quality is the fovea's at the job's own latency "
+          "(docs/latency.md):\n\n    "
+       << job_argv_text(in.plan, rows.front().id) << "\n\n";
+  md << "|";
+  for (const auto& k : keys) md << " " << k << " |";
+  for (const auto& m : metrics) md << " " << m << " |";
+  md << "\n|";
+  for (std::size_t i = 0; i < keys.size() + metrics.size(); ++i) md << "---|";
+  md << "\n";
+  for (const Row& r : rows) {
+    md << "|";
+    for (const auto& k : keys) md << " " << (r.settings.contains(k) ? setting_text(r.settings[k]) : "–") << " |";
+    for (const auto& m : metrics) {
+      const int decimals = m.find("_ms") != std::string::npos ? 1 : m.find("psnr") != std::string::npos ? 2 : 4;
+      md << " " << (r.metrics.count(m) ? fixed(r.metrics.at(m), decimals) : "–") << " |";
+    }
+    md << "\n";
+  }
+  md << "\n";
+  for (const auto& f : images) md << "![" << f << "](" << f << ")\n\n";
 }
 
 }  // namespace
@@ -411,19 +545,23 @@ ReportSummary write_report(const Plan& plan, const ReportOptions& o) {
   json failed = json::array(), missing = json::array();
   for (const Job& j : plan.jobs) {
     Row r{j.id, "missing", j.settings, {}, {}};
-    const fs::path rep = dir / j.out / "report.json";
+    // A render job's report.json; a latency job's summary.json.
+    const bool latency = job_command(j.settings) == "latency";
+    const fs::path rep = dir / j.out / (latency ? "summary.json" : "report.json");
     if (fs::exists(dir / j.out)) {
       std::ifstream in(rep);
-      if (!in) throw core::InputError(rep.string() + ": finished job without report.json");
+      if (!in) throw core::InputError(rep.string() + ": finished job without " + rep.filename().string());
       json rj;
       try {
         rj = json::parse(in);
       } catch (const json::parse_error& e) {
         throw core::InputError(rep.string() + ": not valid JSON (" + e.what() + ")");
       }
-      r.metrics = flatten_metrics(rj);
-      if (rj.contains("device") && rj["device"].is_object())
-        r.device = rj["device"].value("name", "") + ", " + rj["device"].value("driver", "");
+      r.metrics = latency ? latency_metrics(rj) : flatten_metrics(rj);
+      const json device = rj.contains("device")                             ? rj["device"]
+                          : rj.contains("config") && rj["config"].is_object() ? rj["config"].value("device", json())
+                                                                            : json();
+      if (device.is_object()) r.device = device.value("name", "") + ", " + device.value("driver", "");
       r.bands = band_metrics(rj);
       std::ifstream tin(dir / j.out / "task.json");
       if (tin) {
@@ -447,120 +585,151 @@ ReportSummary write_report(const Plan& plan, const ReportOptions& o) {
   const Config cfg = read_config(plan.header.value("report", json::object()), rows);
   const std::vector<std::string> varied = varied_keys(rows);
   auto group_of = [&](const Row& r) { return r.settings.contains(cfg.group) ? setting_text(r.settings[cfg.group]) : std::string("all"); };
-  std::vector<std::string> groups;
-  for (const auto& r : rows)
-    if (r.status == "done" && std::find(groups.begin(), groups.end(), group_of(r)) == groups.end()) groups.push_back(group_of(r));
   auto label_of = [&](const Row& r) {
     std::string s;
     for (const auto& k : varied)
-      if (k != cfg.group && r.settings.contains(k)) s += (s.empty() ? "" : " ") + k + "=" + setting_text(r.settings[k]);
+      if (k != cfg.group && k != cfg.section && r.settings.contains(k)) s += (s.empty() ? "" : " ") + k + "=" + setting_text(r.settings[k]);
     return s;
   };
+  // Render jobs are compared within a section (a scene): their own fronts, plots and tables.
+  std::vector<std::string> sections;
+  for (const auto& r : rows)
+    if (r.status == "done" && job_command(r.settings) == "render" &&
+        std::find(sections.begin(), sections.end(), section_of(r, cfg)) == sections.end())
+      sections.push_back(section_of(r, cfg));
+  const bool sectioned = sections.size() > 1;
   fs::create_directories(out);
-  auto save = [&](const core::Image& img, const std::string& name) {
+  std::map<std::string, std::vector<std::string>> section_files;  // section -> PNGs; latency plots under kLatencySection
+  auto save = [&](const core::Image& img, const std::string& name, const std::string& section) {
     core::write_png((out / name).string(), img);
     sum.files.push_back(name);
+    section_files[section].push_back(name);
   };
 
-  // Pareto fronts of quality against time, per group.
   std::map<std::string, std::map<std::string, bool>> on_front;  // quality -> id -> flag
   json fronts = json::object();
-  for (const auto& q : cfg.quality) {
-    Chart ch;
-    ch.title = q + " against time per frame";
-    ch.note = "ringed: Pareto front per " + cfg.group + " (" + (cfg.lower_better(q) ? "lower" : "higher") + " " + q +
-              " is better, less time is better)";
-    ch.x_label = axis_label(cfg.time) + " per stereo frame";
-    ch.y_label = axis_label(q);
-    for (std::size_t g = 0; g < groups.size(); ++g) {
-      std::vector<const Row*> members;
-      std::vector<glm::dvec2> pts;
-      for (const auto& r : rows)
-        if (r.status == "done" && group_of(r) == groups[g] && r.metrics.count(cfg.time) && r.metrics.count(q)) {
-          members.push_back(&r);
-          pts.push_back({r.metrics.at(cfg.time), r.metrics.at(q)});
-        }
-      if (pts.empty()) continue;
-      const std::vector<bool> f = pareto_front(pts, !cfg.lower_better(q));
-      Series s{groups[g], palette(g), pts, false, true, f};
-      Series line{"", palette(g), {}, true, false, {}};
-      json ids = json::array();
-      std::vector<std::pair<glm::dvec2, std::string>> fp;
-      for (std::size_t i = 0; i < pts.size(); ++i) {
-        on_front[q][members[i]->id] = f[i];
-        if (f[i]) fp.push_back({pts[i], members[i]->id});
-      }
-      std::sort(fp.begin(), fp.end(), [](const auto& a, const auto& b) { return a.first.x < b.first.x; });
-      for (const auto& [p, id] : fp) line.points.push_back(p), ids.push_back(id);
-      fronts[q][groups[g]] = ids;
-      ch.series.push_back(line);
-      ch.series.push_back(s);
-    }
-    if (!ch.series.empty()) save(draw_chart(ch), "quality_vs_time_" + file_stem(q) + ".png");
-
-    // Quality against budget: the best job at each budget, per group.
-    std::set<std::string> budgets;
+  for (const std::string& section : sections) {
+    std::vector<const Row*> members_of_section;
     for (const auto& r : rows)
-      if (r.settings.contains(cfg.budget)) budgets.insert(r.settings[cfg.budget].dump());
-    if (budgets.size() > 1) {
-      Chart cb;
-      cb.title = q + " against " + cfg.budget;
-      cb.note = "best job at each " + cfg.budget + " over the other settings, per " + cfg.group;
-      cb.x_label = cfg.budget == "budget" ? "budget (grid samples / display pixels)" : cfg.budget;
-      cb.y_label = axis_label(q);
+      if (r.status == "done" && job_command(r.settings) == "render" && section_of(r, cfg) == section) members_of_section.push_back(&r);
+    std::vector<std::string> groups;
+    for (const Row* r : members_of_section)
+      if (std::find(groups.begin(), groups.end(), group_of(*r)) == groups.end()) groups.push_back(group_of(*r));
+    const std::string suffix = sectioned ? "_" + file_stem(section) : "";
+    const std::string where = sectioned ? ", " + cfg.section + " " + section : "";
+    // Pareto fronts of quality against time, per group.
+    for (const auto& q : cfg.quality) {
+      Chart ch;
+      ch.title = q + " against time per frame" + where;
+      ch.note = "ringed: Pareto front per " + cfg.group + " (" + (cfg.lower_better(q) ? "lower" : "higher") + " " + q +
+                " is better, less time is better)";
+      ch.x_label = axis_label(cfg.time) + " per stereo frame";
+      ch.y_label = axis_label(q);
       for (std::size_t g = 0; g < groups.size(); ++g) {
-        std::map<double, double> best;
-        for (const auto& r : rows)
-          if (r.status == "done" && group_of(r) == groups[g] && r.metrics.count(q) && r.settings.contains(cfg.budget) &&
-              r.settings[cfg.budget].is_number()) {
-            const double b = r.settings[cfg.budget].get<double>(), v = r.metrics.at(q);
-            auto it = best.find(b);
-            if (it == best.end() || (cfg.lower_better(q) ? v < it->second : v > it->second)) best[b] = v;
+        std::vector<const Row*> members;
+        std::vector<glm::dvec2> pts;
+        for (const Row* r : members_of_section)
+          if (group_of(*r) == groups[g] && r->metrics.count(cfg.time) && r->metrics.count(q)) {
+            members.push_back(r);
+            pts.push_back({r->metrics.at(cfg.time), r->metrics.at(q)});
           }
-        Series s{groups[g], palette(g), {}, true, true, {}};
-        for (const auto& [b, v] : best) s.points.push_back({b, v});
-        if (!s.points.empty()) cb.series.push_back(s);
+        if (pts.empty()) continue;
+        const std::vector<bool> f = pareto_front(pts, !cfg.lower_better(q));
+        Series s{groups[g], palette(g), pts, false, true, f};
+        Series line{"", palette(g), {}, true, false, {}};
+        json ids = json::array();
+        std::vector<std::pair<glm::dvec2, std::string>> fp;
+        for (std::size_t i = 0; i < pts.size(); ++i) {
+          on_front[q][members[i]->id] = f[i];
+          if (f[i]) fp.push_back({pts[i], members[i]->id});
+        }
+        std::sort(fp.begin(), fp.end(), [](const auto& a, const auto& b) { return a.first.x < b.first.x; });
+        for (const auto& [p, id] : fp) line.points.push_back(p), ids.push_back(id);
+        fronts[q][sectioned ? section + "/" + groups[g] : groups[g]] = ids;
+        ch.series.push_back(line);
+        ch.series.push_back(s);
       }
-      if (!cb.series.empty()) save(draw_chart(cb), "quality_vs_budget_" + file_stem(q) + ".png");
+      if (!ch.series.empty()) save(draw_chart(ch), "quality_vs_time_" + file_stem(q) + suffix + ".png", section);
+
+      // Quality against budget: the best job at each budget, per group.
+      std::set<std::string> budgets;
+      for (const Row* r : members_of_section)
+        if (r->settings.contains(cfg.budget)) budgets.insert(r->settings[cfg.budget].dump());
+      if (budgets.size() > 1) {
+        Chart cb;
+        cb.title = q + " against " + cfg.budget + where;
+        cb.note = "best job at each " + cfg.budget + " over the other settings, per " + cfg.group;
+        cb.x_label = cfg.budget == "budget" ? "budget (grid samples / display pixels)" : cfg.budget;
+        cb.y_label = axis_label(q);
+        for (std::size_t g = 0; g < groups.size(); ++g) {
+          std::map<double, double> best;
+          for (const Row* r : members_of_section)
+            if (group_of(*r) == groups[g] && r->metrics.count(q) && r->settings.contains(cfg.budget) &&
+                r->settings[cfg.budget].is_number()) {
+              const double b = r->settings[cfg.budget].get<double>(), v = r->metrics.at(q);
+              auto it = best.find(b);
+              if (it == best.end() || (cfg.lower_better(q) ? v < it->second : v > it->second)) best[b] = v;
+            }
+          Series s{groups[g], palette(g), {}, true, true, {}};
+          for (const auto& [b, v] : best) s.points.push_back({b, v});
+          if (!s.points.empty()) cb.series.push_back(s);
+        }
+        if (!cb.series.empty()) save(draw_chart(cb), "quality_vs_budget_" + file_stem(q) + suffix + ".png", section);
+      }
     }
 
-    if (!cfg.latency.empty()) {
+    // Per-band curves of the jobs on the first quality metric's fronts (at most 8 lines).
+    std::set<std::string> band_names;
+    for (const Row* r : members_of_section)
+      for (const auto& [k, v] : r->bands)
+        if (cfg.bands.empty() || std::find(cfg.bands.begin(), cfg.bands.end(), k) != cfg.bands.end()) band_names.insert(k);
+    for (const auto& bname : band_names) {
+      Chart cb;
+      cb.title = bname + " per eccentricity band" + where;
+      cb.note = cfg.quality.empty() ? "" : "jobs on the " + cfg.quality[0] + " Pareto fronts";
+      cb.x_label = "eccentricity, band centre (deg)";
+      cb.y_label = axis_label(bname);
+      std::size_t n = 0;
+      for (const Row* r : members_of_section) {
+        if (!r->bands.count(bname) || n >= 8) continue;
+        if (!cfg.quality.empty() && !on_front[cfg.quality[0]][r->id]) continue;
+        Series s{group_of(*r) + " " + label_of(*r), palette(n++), {}, true, true, {}};
+        for (const BandValue& b : r->bands.at(bname)) s.points.push_back({0.5 * (b.e_min + b.e_max), b.value});
+        cb.series.push_back(s);
+      }
+      if (!cb.series.empty()) save(draw_chart(cb), "bands_" + file_stem(bname) + suffix + ".png", section);
+    }
+  }
+
+  // Latency against quality: every job that reports the latency metric, one series per
+  // value of the latency group (e.g. each predict mode), joined by increasing latency.
+  if (!cfg.latency.empty()) {
+    std::vector<std::string> lgroups;
+    auto lgroup_of = [&](const Row& r) {
+      return r.settings.contains(cfg.latency_group) ? setting_text(r.settings[cfg.latency_group]) : std::string("all");
+    };
+    for (const auto& r : rows)
+      if (r.status == "done" && r.metrics.count(cfg.latency) &&
+          std::find(lgroups.begin(), lgroups.end(), lgroup_of(r)) == lgroups.end())
+        lgroups.push_back(lgroup_of(r));
+    for (const auto& q : cfg.latency_quality) {
       Chart cl;
       cl.title = q + " against " + cfg.latency;
+      cl.note = "one point per job; legend: " + cfg.latency_group + " (" + (cfg.lower_better(q) ? "lower" : "higher") +
+                " is better)";
       cl.x_label = axis_label(cfg.latency);
       cl.y_label = axis_label(q);
-      for (std::size_t g = 0; g < groups.size(); ++g) {
-        Series s{groups[g], palette(g), {}, false, true, {}};
+      for (std::size_t g = 0; g < lgroups.size(); ++g) {
+        Series s{cfg.latency_group + " " + lgroups[g], palette(g), {}, true, true, {}};
         for (const auto& r : rows)
-          if (r.status == "done" && group_of(r) == groups[g] && r.metrics.count(q) && r.metrics.count(cfg.latency))
+          if (r.status == "done" && lgroup_of(r) == lgroups[g] && r.metrics.count(q) && r.metrics.count(cfg.latency))
             s.points.push_back({r.metrics.at(cfg.latency), r.metrics.at(q)});
+        std::sort(s.points.begin(), s.points.end(), [](const glm::dvec2& a, const glm::dvec2& b) { return a.x < b.x; });
         if (!s.points.empty()) cl.series.push_back(s);
       }
-      if (!cl.series.empty()) save(draw_chart(cl), "latency_vs_" + file_stem(q) + ".png");
+      if (!cl.series.empty()) save(draw_chart(cl), "latency_vs_" + file_stem(q) + ".png", kLatencySection);
     }
   }
-
-  // Per-band curves of the jobs on the first quality metric's fronts (at most 8 lines).
-  std::set<std::string> band_names;
-  for (const auto& r : rows)
-    for (const auto& [k, v] : r.bands) band_names.insert(k);
-  for (const auto& bname : band_names) {
-    Chart cb;
-    cb.title = bname + " per eccentricity band";
-    cb.note = cfg.quality.empty() ? "" : "jobs on the " + cfg.quality[0] + " Pareto fronts";
-    cb.x_label = "eccentricity, band centre (deg)";
-    cb.y_label = axis_label(bname);
-    std::size_t n = 0;
-    for (const auto& r : rows) {
-      if (r.status != "done" || !r.bands.count(bname) || n >= 8) continue;
-      if (!cfg.quality.empty() && !on_front[cfg.quality[0]][r.id]) continue;
-      Series s{group_of(r) + " " + label_of(r), palette(n++), {}, true, true, {}};
-      for (const BandValue& b : r.bands.at(bname)) s.points.push_back({0.5 * (b.e_min + b.e_max), b.value});
-      cb.series.push_back(s);
-    }
-    if (!cb.series.empty()) save(draw_chart(cb), "bands_" + file_stem(bname) + ".png");
-  }
-
   // results.csv: one row per job; settings, metrics and bands as columns.
   std::set<std::string> setting_cols, metric_cols, band_cols;
   for (const auto& r : rows) {
@@ -617,12 +786,13 @@ ReportSummary write_report(const Plan& plan, const ReportOptions& o) {
   core::write_file_atomic((out / "results.json").string(), j.dump(2) + "\n");
   if (!o.markdown.empty()) {
     const fs::path page(o.markdown);
-    std::vector<std::string> images;
-    for (const auto& f : sum.files)
-      if (f.size() > 4 && f.substr(f.size() - 4) == ".png")
-        images.push_back(fs::relative(out / f, page.parent_path().empty() ? fs::path(".") : page.parent_path()).string());
+    std::map<std::string, std::vector<std::string>> images;
+    for (const auto& [section, files] : section_files)
+      for (const auto& f : files)
+        images[section].push_back(
+            fs::relative(out / f, page.parent_path().empty() ? fs::path(".") : page.parent_path()).string());
     if (!page.parent_path().empty()) fs::create_directories(page.parent_path());
-    core::write_file_atomic(page.string(), markdown_page({plan, rows, cfg, on_front, images, o.command}));
+    core::write_file_atomic(page.string(), markdown_page({plan, rows, cfg, on_front, sections, images, o.command}));
   }
   return sum;
 }

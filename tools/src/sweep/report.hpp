@@ -21,6 +21,11 @@ struct BandValue {
 // "summary.left.psnr"), "config" excepted, plus the mean over both eyes of each per-eye
 // number under its name without "summary.<eye>." ("psnr").
 std::map<std::string, double> flatten_metrics(const nlohmann::json& report);
+// A `fovea latency` summary: every finite number by its dotted name like a render report
+// ("gaze_to_photon_ms.median", "foveal_error_deg.above_2deg"), plus the numbers of the
+// fovea_quality object of its injected-latency point at 0 ms, the job's own latency
+// ("fovea_quality.psnr_db", "fovea_quality.ldr_flip"), unless the summary has its own.
+std::map<std::string, double> latency_metrics(const nlohmann::json& summary);
 // Per-eye arrays of {e_min, e_max, <value>...}: "<array>.<value>" -> bands, averaged over eyes.
 std::map<std::string, std::vector<BandValue>> band_metrics(const nlohmann::json& report);
 

@@ -112,7 +112,8 @@ class Context {
 
   // Records `record` into a fresh primary command buffer, submits it and waits for it.
   // Calls may nest (an upload inside `record` completes before the outer submission).
-  void submit_and_wait(const std::function<void(VkCommandBuffer)>& record);
+  // `wait_ms`, when given, receives the time spent in the fence wait alone (monotonic clock).
+  void submit_and_wait(const std::function<void(VkCommandBuffer)>& record, double* wait_ms = nullptr);
 
   // Index of a memory type allowed by `type_bits` having all of `required`, preferring
   // one that also has `preferred`; throws VulkanError when there is none.

@@ -35,9 +35,12 @@ struct FrameTimes {
   StageTime resolve;      // CPU: recording; GPU: mips, resolve, depth, blur
   double bmfr_fit_gpu_ms = 0;  // part of reconstruct: the regression alone
   double mip_gpu_ms = 0, resample_gpu_ms = 0, blur_gpu_ms = 0;  // parts of resolve: its three kernels
-  double submit_cpu_ms = 0;    // the submission until the GPU finished
+  double submit_cpu_ms = 0;    // ending the command buffer and vkQueueSubmit (recording is in the stages)
+  double wait_cpu_ms = 0;      // the fence wait until the GPU finished (on a CPU device: its work)
   double gpu_ms() const { return grid.gpu_ms + trace.gpu_ms + reconstruct.gpu_ms + resolve.gpu_ms; }
-  double cpu_ms() const { return grid.cpu_ms + trace.cpu_ms + reconstruct.cpu_ms + resolve.cpu_ms + submit_cpu_ms; }
+  double cpu_ms() const {
+    return grid.cpu_ms + trace.cpu_ms + reconstruct.cpu_ms + resolve.cpu_ms + submit_cpu_ms + wait_cpu_ms;
+  }
 };
 
 // Mean indirect-diffuse samples per traced cell: the eye's own and after stereo sharing.
