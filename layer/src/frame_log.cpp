@@ -40,6 +40,7 @@ void FrameLog::write(const FrameTimes& t) {
               {"gaze", rt.gaze_cpu},
               {"grid", rt.grid_cpu},
               {"submit", rt.submit_cpu},
+              {"wait", rt.wait_cpu},
               {"readback", rt.readback_cpu}};
   r.gpu_ms = {{"trace", rt.trace}, {"reconstruct", rt.reconstruct}, {"resolve", rt.resolve}};
   r.extra = {{"layers", std::int64_t(t.layers)},     {"projection_views", std::int64_t(t.projection_views)},

@@ -77,9 +77,9 @@ struct RenderTimes {
   double reconstruct = 0;  // GPU: accumulation, stereo sharing, BMFR, TAA
   double resolve = 0;      // GPU: resolve to the display, blur
   double transfer = 0;     // in xrEndFrame: the composition (GPU pass, or read-back, host compositing and upload)
-  // CPU (monotonic clock): the gaze sample, the grids' per-frame build, recording and
-  // submission until the GPU finished, read-back of the rendered images.
-  double gaze_cpu = 0, grid_cpu = 0, submit_cpu = 0, readback_cpu = 0;
+  // CPU (monotonic clock): the gaze sample, the grids' per-frame build, the submission, the
+  // fence wait until the GPU finished, read-back of the rendered images.
+  double gaze_cpu = 0, grid_cpu = 0, submit_cpu = 0, wait_cpu = 0, readback_cpu = 0;
   // The gaze sample the frame was foveated for (CLOCK_MONOTONIC ns; 0: none measured yet):
   // when it was measured, when the host received it, when the renderer read it.
   std::int64_t gaze_sample_ns = 0, gaze_receive_ns = 0, gaze_read_ns = 0;
