@@ -86,12 +86,25 @@ FoveaGaze FoveationGaze::apply(core::TimeNs t, const GazeSample& s, core::TimeNs
   return g;
 }
 
-FoveaGaze FoveationGaze::at(core::TimeNs t) {
+FoveaGaze FoveationGaze::read(core::TimeNs read_ns, core::TimeNs target_ns) {
+  std::lock_guard lock(mutex_);
+  const bool is_live = live();
+  if (!is_live && !epoch_) epoch_ = std::min(read_ns, target_ns);
+  const core::TimeNs offset = is_live ? 0 : *epoch_;
+  return apply(target_ns, source_->read_at(read_ns - offset, target_ns - offset), offset);
+}
+
+GazeSample FoveationGaze::truth_at(core::TimeNs t) {
   std::lock_guard lock(mutex_);
   const bool is_live = live();
   if (!is_live && !epoch_) epoch_ = t;
   const core::TimeNs offset = is_live ? 0 : *epoch_;
-  return apply(t, source_->sample_at(t - offset), offset);
+  GazeSample s = source_->truth_at(t - offset);
+  if (s.t_ns != kNoSample) {
+    s.t_ns += offset;
+    s.host_time_ns += offset;
+  }
+  return s;
 }
 
 FoveaGaze FoveationGaze::use(core::TimeNs t, const GazeSample& s) {

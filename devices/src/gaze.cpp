@@ -21,6 +21,12 @@ namespace fovea::devices {
 
 void SampleStream::rewind() { throw std::logic_error(describe() + ": not rewindable"); }
 
+GazeSample GazeSource::truth_at(core::TimeNs) {
+  GazeSample s;
+  s.t_ns = kNoSample;
+  return s;
+}
+
 PredictMode parse_predict_mode(std::string_view s) {
   if (s == "none") return PredictMode::None;
   if (s == "linear") return PredictMode::Linear;

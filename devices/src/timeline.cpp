@@ -31,7 +31,7 @@ void TimelineSource::pull_until(core::TimeNs t) {
   }
 }
 
-GazeSample TimelineSource::at_recording_time(core::TimeNs tt) {
+GazeSample TimelineSource::at_recording_time(core::TimeNs tt, core::TimeNs ahead_ns, bool predict) {
   loop_base_ = 0;
   if (!stream_->live()) {
     if (!win_.empty() && tt < win_.front().t_ns && trimmed_) restart();
@@ -63,25 +63,38 @@ GazeSample TimelineSource::at_recording_time(core::TimeNs tt) {
   GazeSample s = win_[count - 1];
   // The end of a recording holds its last sample; elsewhere an old newest sample is stale.
   const bool recording_over = ended_ && count == win_.size();
-  if (recording_over || tt == s.t_ns) return s;
+  if (recording_over || (tt == s.t_ns && ahead_ns == 0)) return s;
   if (tt - s.t_ns > opt_.max_gap_ns) {
     s.combined.flags = s.left.flags = s.right.flags = kLost;
     s.combined.confidence = s.left.confidence = s.right.confidence = 0;
     return s;
   }
-  return opt_.predicts() ? predictor_.predict(win_, count, tt, opt_.horizon_ns) : s;
+  // From the samples measured by tt only: win_ may hold later ones (read ahead).
+  return predict && opt_.predicts() ? predictor_.predict(win_, count, tt + ahead_ns, opt_.horizon_ns) : s;
 }
 
-GazeSample TimelineSource::sample_at(core::TimeNs t) {
+GazeSample TimelineSource::on_caller_timeline(core::TimeNs t, core::TimeNs ahead_ns, bool predict) {
   std::lock_guard lock(mutex_);
   const bool live = stream_->live();
-  GazeSample s = at_recording_time(
-      live ? t : std::llround(std::clamp(static_cast<double>(t) * opt_.speed, -9.2e18, 9.2e18)));
+  const auto scaled = [&](core::TimeNs x) {
+    return live ? x : std::llround(std::clamp(static_cast<double>(x) * opt_.speed, -9.2e18, 9.2e18));
+  };
+  GazeSample s = at_recording_time(scaled(t), scaled(ahead_ns), predict);
   // Back from recording time to the caller's timeline: the sample's own time, not t.
   // A recording carries no receive delay (a captured host clock is not this timeline).
   if (!live && s.t_ns != kNoSample)
     s.t_ns = s.host_time_ns = std::min<core::TimeNs>(t, std::llround(static_cast<double>(s.t_ns + loop_base_) / opt_.speed));
   return s;
+}
+
+GazeSample TimelineSource::read_at(core::TimeNs read_ns, core::TimeNs target_ns) {
+  const core::TimeNs avail = std::min(read_ns, target_ns);
+  return on_caller_timeline(avail, target_ns - avail, true);
+}
+
+GazeSample TimelineSource::truth_at(core::TimeNs t) {
+  if (stream_->live()) return GazeSource::truth_at(t);
+  return on_caller_timeline(t, 0, false);
 }
 
 GazeSample TimelineSource::latest() {

@@ -195,7 +195,8 @@ void TrackerModel::deliver_loop() {
   }
 }
 
-GazeSample TrackerModel::sample_at(core::TimeNs t) {
+GazeSample TrackerModel::read_at(core::TimeNs read_ns, core::TimeNs target_ns) {
+  const core::TimeNs t = std::min(read_ns, target_ns);
   std::lock_guard lock(mutex_);
   if (!params_.host_clock) {
     if (trimmed_ && !win_.empty() && t < win_.front().host_time_ns) restart();
@@ -220,7 +221,7 @@ GazeSample TrackerModel::sample_at(core::TimeNs t) {
     }
     return s;
   }
-  return opt_.predicts() && t > s.t_ns ? predictor_.predict(win_, count, t, opt_.horizon_ns) : s;
+  return opt_.predicts() && target_ns > s.t_ns ? predictor_.predict(win_, count, target_ns, opt_.horizon_ns) : s;
 }
 
 GazeSample TrackerModel::latest() { return sample_at(params_.host_clock ? core::now_ns() : core::now_ns() - opened_ns_); }

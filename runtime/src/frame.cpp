@@ -125,6 +125,7 @@ XrResult api::xrWaitFrame(XrSession session, const XrFrameWaitInfo* info, XrFram
     r.late_ns = std::max<core::TimeNs>(0, r.wait_return_ns - slot.wake_ns);
     s->clock.reslot(slot, r.wait_return_ns);
     r.frame = slot.index;
+    r.wake_ns = slot.wake_ns;
     r.predicted_display_ns = slot.display_ns;
     r.missed_vsyncs = slot.missed;
     s->waited.push_back(r);
@@ -195,12 +196,17 @@ XrResult api::xrEndFrame(XrSession session, const XrFrameEndInfo* info) {
     r.layers = info->layerCount;
     const core::TimeNs t_gaze = core::now_ns();
     r.cpu_validate_ms = core::ns_to_ms(t_gaze - t_call);
-    const GazeSample g = s->instance->gaze->sample_at(r.predicted_display_ns, display_epoch(*s));
+    // The gaze a renderer has for this frame: what the tracker had delivered when it read
+    // (now; in lockstep the frame's wake time), for the predicted display time. Never a
+    // sample measured later than the read.
+    const core::TimeNs read = s->clock.pacing() == Pacing::Lockstep ? r.wake_ns : t_gaze;
+    const GazeSample g = s->instance->gaze->read(read, r.predicted_display_ns, display_epoch(*s));
     r.cpu_gaze_ms = core::ns_to_ms(core::now_ns() - t_gaze);
     r.gaze_sample_ns = g.sample_ns;
     r.gaze_receive_ns = g.receive_ns;
     r.gaze_read_ns = g.read_ns;
     r.gaze_valid = g.valid;
+    r.gaze_dir = g.dir;
     s->frame_open = false;
     ++s->frames_ended;
     if (s->queued_state == XR_SESSION_STATE_SYNCHRONIZED && !s->exit_requested) {
@@ -218,6 +224,7 @@ XrResult api::xrEndFrame(XrSession session, const XrFrameEndInfo* info) {
     r.missed_vsyncs += (r.displayed_ns - r.predicted_display_ns) / s->clock.period();
     for (core::Eye e : {core::Eye::Left, core::Eye::Right})
       r.photon[std::size_t(e)] = s->clock.model().photons(r.displayed_ns, e);
+    r.true_gaze_dir = s->instance->gaze->truth_at(r.photon[0].mid, display_epoch(*s));
     s->compositor->observe_frame(r.frame, g, r.displayed_ns);
     if (s->compositor->wants(r.frame)) {
       const core::TimeNs t0 = core::now_ns();

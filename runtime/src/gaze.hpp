@@ -6,6 +6,7 @@
 // every time; live ones run on the host monotonic clock (the source says which it is).
 // The application gets the tracker's own measurement: no hold, a blink or a loss is invalid.
 #include <memory>
+#include <optional>
 #include <string>
 
 #include <glm/vec3.hpp>
@@ -23,7 +24,8 @@ struct GazeSample {
   glm::dvec3 dir{0, 0, -1};    // combined gaze, unit, view space (-Z forward)
   bool valid = false;          // tracked (not a blink, dropout, stale or low confidence)
   // The newest real sample used (never the time asked for; 0 when none was measured yet),
-  // when the host received it and when the runtime read it (CLOCK_MONOTONIC).
+  // when the host received it, and the read time: the samples delivered by then were
+  // available (CLOCK_MONOTONIC; sample_ns <= receive_ns <= read_ns).
   core::TimeNs sample_ns = 0, receive_ns = 0, read_ns = 0;
 };
 
@@ -35,9 +37,15 @@ class GazeTracker {
   GazeTracker(const GazeTracker&) = delete;
   GazeTracker& operator=(const GazeTracker&) = delete;
 
-  // The gaze at time t_ns from the samples measured by then; `epoch_ns` is where recorded
-  // and synthetic sources start.
-  GazeSample sample_at(core::TimeNs t_ns, core::TimeNs epoch_ns);
+  // The gaze for target_ns (a display time, a located time) as read at read_ns: the newest
+  // sample delivered by min(read_ns, target_ns), never a later one (so sample_ns <= read_ns),
+  // predicted to target_ns from the delivered samples when the source predicts (URI key
+  // predict=). `epoch_ns` is where recorded and synthetic sources start.
+  GazeSample read(core::TimeNs read_ns, core::TimeNs target_ns, core::TimeNs epoch_ns);
+  // The true gaze (combined, view space) at t: a recording's or synthetic gaze's own sample,
+  // without the tracker model's delay and noise; none for a live source or an untracked
+  // true eye (a blink).
+  std::optional<glm::dvec3> truth_at(core::TimeNs t, core::TimeNs epoch_ns);
   std::string describe() const;
 
  private:

@@ -3,6 +3,7 @@
 // the head's position at the display epoch, the floor (STAGE origin) 1.6 m below it.
 #include <cmath>
 #include <optional>
+#include <vector>
 
 #include <glm/gtx/quaternion.hpp>
 
@@ -57,12 +58,23 @@ std::optional<core::Pose> world_pose(Session& s, const Space& sp, XrTime t, Gaze
     // Untracked unless focused: an unfocused session receives no input.
     if (!action || s.state != XR_SESSION_STATE_FOCUSED || !s.gaze_profile_active || !action->gaze_bound())
       return std::nullopt;
-    const GazeSample g = s.instance->gaze->sample_at(t, display_epoch(s));
+    // Honest: the samples delivered by the read time (never one measured after it),
+    // predicted to t when the source predicts.
+    const GazeSample g = s.instance->gaze->read(tracker_read_time(s), t, display_epoch(s));
     if (gaze) *gaze = g;
     if (!g.valid) return std::nullopt;
     base = compose(head_pose(s, t), core::Pose{glm::rotation(glm::dvec3(0, 0, -1), g.dir), {0, 0, 0}});
   }
   return compose(base, from_xr(sp.offset));
+}
+
+// The frames waited on or open whose predicted display time is t.
+std::vector<FrameRecord*> frames_for(Session& s, XrTime t) {
+  std::vector<FrameRecord*> out;
+  for (FrameRecord& f : s.waited)
+    if (f.predicted_display_ns == t) out.push_back(&f);
+  if (s.frame_open && s.current.predicted_display_ns == t) out.push_back(&s.current);
+  return out;
 }
 
 }  // namespace
@@ -79,6 +91,12 @@ bool valid_pose(const XrPosef& p) {
 core::Pose session_head_pose(const Session& s, XrTime t) { return head_pose(s, t); }
 
 core::TimeNs display_epoch(const Session& s) { return s.clock.started() ? s.clock.epoch() : s.created_ns; }
+
+core::TimeNs tracker_read_time(const Session& s) {
+  if (s.clock.pacing() != Pacing::Lockstep) return core::now_ns();
+  const FrameRecord* newest = !s.waited.empty() ? &s.waited.back() : &s.current;
+  return newest->wake_ns ? newest->wake_ns : core::now_ns();
+}
 
 XrResult api::xrEnumerateReferenceSpaces(XrSession session, uint32_t capacity, uint32_t* count,
                                          XrReferenceSpaceType* spaces) {
@@ -210,6 +228,13 @@ XrResult api::xrLocateViews(XrSession session, const XrViewLocateInfo* info, XrV
       if (views[i].type != XR_TYPE_VIEW) return XR_ERROR_VALIDATION_FAILURE;
     const auto b = world_pose(*s, *base, info->displayTime, nullptr);
     const core::Pose head = head_pose(*s, info->displayTime);
+    // The frame these views are for (same display time) records when its head pose was
+    // read and the time it was predicted for; the last locate before xrEndFrame wins.
+    const core::TimeNs read = tracker_read_time(*s);
+    for (FrameRecord* f : frames_for(*s, info->displayTime)) {
+      f->head_pose_ns = std::min<core::TimeNs>(read, info->displayTime);
+      f->head_pose_target_ns = info->displayTime;
+    }
     const core::DisplayPreset& d = s->instance->display;
     for (uint32_t i = 0; i < 2; ++i) {
       const core::Eye eye = i == 0 ? core::Eye::Left : core::Eye::Right;

@@ -226,6 +226,10 @@ core::Pose session_head_pose(const Session& s, XrTime t);
 // Origin of the scripted head and gaze models: the display clock's epoch (the session's
 // creation before the first frame).
 core::TimeNs display_epoch(const Session& s);
+// When the runtime reads its trackers for the application: now on the realtime clock; in
+// lockstep the wake time of the newest frame xrWaitFrame returned (reads are then a function
+// of the frame index), now before the first frame.
+core::TimeNs tracker_read_time(const Session& s);
 // Queues the state transitions that end a running session (down to STOPPING).
 void request_exit(Session& s);
 constexpr XrSystemId kSystemId = 1;

@@ -1,10 +1,15 @@
-// The runtime's device models: the display clock and the head motion (scripted and files).
+// The runtime's device models: the display clock, the head motion (scripted and files) and
+// the eye tracker's reads.
 #include <cmath>
 #include <fstream>
+#include <string>
+
+#include <glm/geometric.hpp>
 
 #include <gtest/gtest.h>
 
 #include "display_clock.hpp"
+#include "gaze.hpp"
 #include "fovea/core/error.hpp"
 #include "head_motion.hpp"
 #include "xr_process.hpp"
@@ -143,6 +148,83 @@ TEST(HeadMotion, BadFilesNameTheLine) {
   expect_error("# only a comment\n", "no head pose samples");
   EXPECT_THROW(HeadMotion::from_file(dir.path() + "/missing.txt"), core::InputError);
   EXPECT_THROW(HeadMotion::from_spec(dir.path() + "/missing.txt"), core::InputError);
+}
+
+// The tracker's k-th sample time at `rate` (the synthetic stream's and the tracker model's grid).
+core::TimeNs sample_time(std::int64_t k, double rate) { return std::llround(double(k) * 1e9 / rate); }
+
+// The runtime reads the gaze honestly: at a read time between samples it gets the newest
+// sample delivered by then — device time <= read time - tracker delay — never one measured
+// later, whatever later time (the display time) it reads for; received `delay` after it was
+// measured; with and without prediction, at 60, 120, 250 and 1000 Hz. (The runtime used to
+// read at the display time: a sample from the future.)
+TEST(GazeRead, NewestSampleDeliveredByTheReadTime) {
+  const core::DisplayPreset display = core::load_display("small");
+  const core::TimeNs epoch = 3'000'000'000;  // host time of the source's t = 0
+  for (const double rate : {60.0, 120.0, 250.0, 1000.0})
+    for (const core::TimeNs delay : {core::TimeNs(0), core::TimeNs(20'000'000)})
+      for (const std::string predict : {"none", "linear"}) {
+        const std::string r = std::to_string(int(rate));
+        // Without a tracker model the synthetic stream is the tracker; with one, the model
+        // samples the 1 kHz true eye at its own rate and delivers after its delay.
+        const std::string uri = delay == 0 ? "synthetic:3?noise=0&dropouts=0&predict=" + predict + "&rate=" + r
+                                           : "synthetic:3?noise=0&dropouts=0&rate=1000&predict=" + predict +
+                                                 "&tracker=ideal&tracker_jitter=0&tracker_delay=20ms&tracker_rate=" + r;
+        SCOPED_TRACE(uri);
+        GazeTracker tracker(uri, display);
+        for (int i = 0; i < 60; ++i) {
+          const core::TimeNs read = epoch + 100'000'000 + core::TimeNs(i) * 7'300'001;  // between samples
+          const core::TimeNs target = read + 30'000'000;  // e.g. the frame's display time
+          const GazeSample g = tracker.read(read, target, epoch);
+          std::int64_t k = 0;
+          while (sample_time(k + 1, rate) <= read - epoch - delay) ++k;
+          EXPECT_EQ(g.sample_ns, epoch + sample_time(k, rate)) << i;
+          EXPECT_LE(g.sample_ns, read - delay);
+          EXPECT_EQ(g.receive_ns, g.sample_ns + delay);
+          EXPECT_EQ(g.read_ns, read);
+        }
+        // A time before the read: the samples measured by that time.
+        const GazeSample past = tracker.read(epoch + 500'000'000, epoch + 200'000'000, epoch);
+        EXPECT_LE(past.sample_ns, epoch + 200'000'000 - delay);
+        EXPECT_EQ(past.read_ns, epoch + 200'000'000);
+      }
+}
+
+// Prediction extrapolates from the delivered samples only: two recordings equal up to the
+// read time and different after it give the same predicted gaze; the prediction moves the
+// direction (a 10 deg/s pursuit) ahead of the newest sample towards the target time.
+TEST(GazeRead, PredictionUsesDeliveredSamplesOnly) {
+  test::TempDir dir("gaze_read");
+  const auto write = [&](const std::string& name, bool jump) {
+    const std::string file = dir.path() + "/" + name;
+    std::ofstream out(file);
+    out << "t_ns,eye,dir_x,dir_y,dir_z,confidence,flags\n";
+    for (int i = 0; i <= 100; ++i) {  // 100 Hz
+      const double yaw_deg = i <= 50 || !jump ? 0.1 * i : 25.0;  // 10 deg/s, or a jump after 0.5 s
+      const double yaw = yaw_deg * M_PI / 180;
+      out << std::int64_t(i) * 10'000'000 << ",combined," << std::sin(yaw) << ",0," << -std::cos(yaw) << ",1,1\n";
+    }
+    return file;
+  };
+  const std::string smooth = write("smooth.csv", false), jump = write("jump.csv", true);
+  const core::DisplayPreset display = core::load_display("small");
+  const core::TimeNs epoch = 1'000'000'000, read = epoch + 503'000'000, target = read + 17'000'000;
+  const auto yaw_deg = [](const GazeSample& g) { return std::atan2(g.dir.x, -g.dir.z) * 180 / M_PI; };
+  GazeTracker a("replay:" + smooth + "?predict=linear", display), b("replay:" + jump + "?predict=linear", display);
+  const GazeSample ga = a.read(read, target, epoch), gb = b.read(read, target, epoch);
+  EXPECT_EQ(ga.sample_ns, epoch + 500'000'000);
+  EXPECT_EQ(gb.sample_ns, epoch + 500'000'000);
+  ASSERT_TRUE(ga.valid && gb.valid);
+  EXPECT_NEAR(yaw_deg(ga), yaw_deg(gb), 1e-6);
+  EXPECT_NEAR(yaw_deg(ga), 5.0 + 10.0 * 0.020, 0.02);  // the newest sample (5 deg) 20 ms ahead
+  GazeTracker held("replay:" + smooth + "?predict=none", display);
+  EXPECT_NEAR(yaw_deg(held.read(read, target, epoch)), 5.0, 1e-4);
+  // The ground truth is the recording at the time asked for, whatever was delivered.
+  const auto truth = b.truth_at(epoch + 700'000'000, epoch);
+  ASSERT_TRUE(truth);
+  EXPECT_NEAR(std::atan2(truth->x, -truth->z) * 180 / M_PI, 25.0, 1e-4);
+  GazeTracker live("hid-emulated:ms?seed=1&seconds=0.1", display);
+  EXPECT_FALSE(live.truth_at(epoch, epoch));  // a live tracker has no ground truth
 }
 
 }  // namespace

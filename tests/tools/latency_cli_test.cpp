@@ -29,6 +29,12 @@ TEST(LatencyCli, SimulationThenItsRecords) {
   EXPECT_GE(delay, 15.0);
   EXPECT_LE(delay, 17.0);
   EXPECT_GT(j["gaze_to_photon_ms"]["median"].get<double>(), delay + 8.0);
+  // The same frames with each compensation mode (--predict), the first without.
+  ASSERT_EQ(j["compensation"].size(), 3u);
+  EXPECT_EQ(j["compensation"][0]["predict"], "none");
+  EXPECT_EQ(j["compensation"][2]["predict"], "landing");
+  // The main run is the one without: the same panel errors.
+  EXPECT_EQ(j["compensation"][0]["foveal_error_deg"]["median"], j["foveal_error_deg"]["median"]);
   ASSERT_EQ(j["sweep"].size(), 2u);
   EXPECT_EQ(j["sweep"][1]["inject_ms"].get<double>(), 60.0);
   EXPECT_GT(j["sweep"][1]["gaze_to_photon_median_ms"].get<double>(),
@@ -65,7 +71,7 @@ TEST(LatencyCli, BadInputExitsTwoNamingIt) {
       {"latency --records " + bad + " --scene cornell", "--scene"},
       {"latency --tracker-delay 5parsecs", "--tracker-delay"},
       {"latency --inject-latency 0,2s", "--inject-latency"},
-      {"latency --predict landing", "--predict"},
+      {"latency --predict sideways", "--predict"},
       {"latency --scan-out diagonal", "diagonal"},
       {"latency --gaze 'synthetic:1?tracker=fove0'", "--tracker-delay"},
   };

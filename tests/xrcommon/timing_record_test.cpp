@@ -29,6 +29,7 @@ TimingRecord sample_record() {
   r.gaze_receive_ns = 20'000'100;
   r.gaze_read_ns = 21'000'000;
   r.head_pose_ns = 21'000'000;
+  r.head_pose_target_ns = 40'000'000;
   r.submit_ns = 30'000'000;
   r.vsync_ns = 40'000'000;
   r.missed_vsyncs = 1;
@@ -64,6 +65,11 @@ TEST(TimingRecord, JsonLineRoundTripsAndHasNoNonFiniteNumbers) {
   EXPECT_EQ(back.frame, 7);
   EXPECT_EQ(back.clock, TimeBase::Virtual);
   EXPECT_EQ(*back.gaze_receive_ns - *back.gaze_sample_ns, 20'000'000);
+  EXPECT_EQ(*back.head_pose_target_ns - *back.head_pose_ns, 19'000'000);
+  // A version-1 line from before head_pose_target_ns still reads (the field is optional).
+  auto old = nlohmann::json::parse(line);
+  old.erase("head_pose_target_ns");
+  EXPECT_FALSE(parse_timing_record(old.dump(), "old.jsonl:1").head_pose_target_ns.has_value());
   EXPECT_EQ((*back.photon_ns)[1].end, 46);
   EXPECT_EQ(back.missed_vsyncs, 1);
   ASSERT_EQ(back.gpu_ms.size(), 1u);

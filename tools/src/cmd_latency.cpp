@@ -15,16 +15,13 @@
 #include "fovea/core/display.hpp"
 #include "fovea/core/duration.hpp"
 #include "fovea/core/error.hpp"
-#include "fovea/core/eye_optics.hpp"
 #include "fovea/core/image.hpp"
 #include "fovea/core/metrics.hpp"
-#include "fovea/core/stereo_views.hpp"
-#include "fovea/gpu/context.hpp"
-#include "fovea/pipeline/frame_pipeline.hpp"
 #include "fovea/renderer/reference.hpp"
 #include "fovea/renderer/scene_io.hpp"
 #include "fovea/xrcommon/timing_writer.hpp"
 #include "latency/analysis.hpp"
+#include "render_setup.hpp"
 
 namespace fovea::tools {
 namespace {
@@ -43,8 +40,9 @@ foveated pipeline on the Vulkan device and submits; the display model shows each
 the first vsync it makes (later frames are counted as missed, the previous frame stays) and
 lights each eye and panel region. Per frame a timing record (docs/openxr.md), with the true
 gaze at photon time; per vsync the foveal error (true gaze to the fovea on the panel).
-Then the same scenario with injected latency (extra tracker delay) against foveal error
-and fovea quality. With --records: the same analysis of an OpenXR session's timing records
+Then the same frames with each gaze compensation mode (the foveal error after saccades
+with and without prediction), and with injected latency (extra tracker delay) against
+foveal error and fovea quality. With --records: the same analysis of an OpenXR session's timing records
 (the runtime's timing.jsonl, the layer's layer_timing.jsonl, a render's frame_times.jsonl).
 
 Prints the summary JSON on stdout; writes into --out:
@@ -54,7 +52,8 @@ Prints the summary JSON on stdout; writes into --out:
   stages.png           CDFs of each stage's CPU and GPU time
   foveal_error.png     foveal error at photon time over time, saccade onsets marked
   sweep_error.png      injected latency vs foveal error (median, p95)
-  sweep_quality.png    injected latency vs tone-mapped PSNR in the fovea (--quality-frames > 0)
+  sweep_quality.png    injected latency vs tone-mapped PSNR and LDR-FLIP in the fovea
+                       after saccades (--quality-frames > 0)
 
   --scene S             cornell | furnace | glossy-spheres | stereo-occluders | default,
                         or a .gltf/.glb/.obj file [default]
@@ -65,7 +64,9 @@ Prints the summary JSON on stdout; writes into --out:
   --tracker-delay T     delay from measurement to delivery [preset's]
   --jitter T            extra delivery delay, uniform in [0, T] [preset's]
   --rate HZ             tracker sample rate [preset's]
-  --predict MODE        gaze compensation: none [none]
+  --predict MODE        gaze compensation of the main run: none | linear | landing (the
+                        delivered samples predicted to each frame's display time; docs/gaze.md)
+                        [none]
   --seconds S           scenario length [2]
   --render-time T       fixed render cost per frame instead of the measured CPU time
                         (reproducible runs); the pipeline still renders every frame
@@ -73,8 +74,9 @@ Prints the summary JSON on stdout; writes into --out:
   --persistence T       how long a row stays lit [0]
   --inject-latency LIST injected latencies for the sweep, e.g. 0,25ms,50,100 ("none": no
                         sweep) [0,25,50,75,100]
-  --quality-frames N    frames rendered per sweep point for fovea quality, around the first
-                        saccade of at least 5 deg (0: no quality) [8]
+  --quality-frames N    fovea quality of each sweep point at the N frames shown after the
+                        end of every saccade of at least 5 deg, each rendered from 3 frames
+                        before its onset on (0: no quality) [8]
   --reference-spp N     samples per pixel of the quality reference [64]
   --records FILE        analyse timing records instead of simulating
   --out DIR             output directory [out/latency]
@@ -128,45 +130,56 @@ int run_records(const Args& args, const fs::path& out) {
   return 0;
 }
 
-// Fovea quality of frames rendered for `sim`'s gaze: tone-mapped PSNR and LDR-FLIP within
-// 2.5° of the true gaze at photon time, against the converged reference (left eye).
+// Fovea quality after saccades, of frames rendered for `sim`'s gaze: for every saccade of at
+// least 5 deg the pipeline renders from `warm` frames before its onset on (from a reset
+// history) and scores the `count` frames shown first after its end, where latency decides
+// whether the fovea is there yet: tone-mapped PSNR and LDR-FLIP within 2.5 deg of the true
+// gaze at photon time, against the converged reference (left eye). Frame f is always
+// rendered with seed f, so sweep points differ by their gaze only, not by their noise.
 struct Quality {
   double psnr = 0, flip = 0;
-  int frames = 0;
+  int frames = 0, saccades = 0;
 };
 Quality fovea_quality(pipeline::FramePipeline& pipe, const std::array<core::Pose, 2>& poses,
-                      const latency::Simulation& sim, std::size_t first, std::size_t count, std::size_t warm,
-                      const core::Image& reference) {
+                      const latency::Simulation& sim, std::size_t count, std::size_t warm, const core::Image& reference) {
   Quality q;
-  pipe.reset();
   const core::View view = pipe.view(core::Eye::Left);
-  for (std::size_t f = first; f < std::min(first + count, sim.frames.size()); ++f) {
-    pipe.render(poses, sim.frames[f].fovea, std::uint32_t(f));
-    const auto& truth = sim.frames[f].truth[0];
-    if (f < first + warm || !truth) continue;
-    const std::vector<float> ecc = core::eccentricity_map(view, *truth);
-    std::vector<float> w(ecc.size());
-    for (std::size_t i = 0; i < ecc.size(); ++i) w[i] = ecc[i] <= 2.5f ? 1.0f : 0.0f;
-    const double ppd = std::sqrt(view.pixels_per_deg2(*truth));
-    const core::Scores s = core::pool(core::error_maps(pipe.image(core::Eye::Left), reference, ppd), w);
-    if (s.weight <= 0) continue;  // the true gaze is off the view
-    q.psnr += s.psnr;
-    q.flip += s.ldr_flip;
-    ++q.frames;
+  const auto first_shown_from = [&](core::TimeNs t) {
+    std::size_t f = 0;
+    while (f < sim.records.size() && (*sim.records[f].photon_ns)[0].mid < t) ++f;
+    return f;
+  };
+  for (const latency::Saccade& s : sim.saccades) {
+    if (s.amplitude_deg < 5) continue;
+    const std::size_t onset = first_shown_from(s.onset_ns), landed = first_shown_from(s.offset_ns);
+    if (landed + count > sim.frames.size()) continue;  // its window runs past the end
+    ++q.saccades;
+    pipe.reset();
+    for (std::size_t f = onset > warm ? onset - warm : 0; f < landed + count; ++f) {
+      pipe.render(poses, sim.frames[f].fovea, std::uint32_t(f));
+      const auto& truth = sim.frames[f].truth[0];
+      if (f < landed || !truth) continue;
+      const std::vector<float> ecc = core::eccentricity_map(view, *truth);
+      std::vector<float> w(ecc.size());
+      for (std::size_t i = 0; i < ecc.size(); ++i) w[i] = ecc[i] <= 2.5f ? 1.0f : 0.0f;
+      const double ppd = std::sqrt(view.pixels_per_deg2(*truth));
+      const core::Scores sc = core::pool(core::error_maps(pipe.image(core::Eye::Left), reference, ppd), w);
+      if (sc.weight <= 0) continue;  // the true gaze is off the view
+      q.psnr += sc.psnr;
+      q.flip += sc.ldr_flip;
+      ++q.frames;
+    }
   }
   if (q.frames) q.psnr /= q.frames, q.flip /= q.frames;
   return q;
 }
 
-// The first frame of the quality window: a few frames before the first saccade of at least
-// 5° (where latency shows), after the pipeline's warm-up.
-std::size_t quality_window(const latency::Simulation& sim, std::size_t warm) {
-  for (const latency::Saccade& s : sim.saccades) {
-    if (s.amplitude_deg < 5) continue;
-    for (std::size_t f = 0; f < sim.records.size(); ++f)
-      if ((*sim.records[f].photon_ns)[0].mid >= s.onset_ns) return f > warm + 2 ? f - warm - 2 : 0;
-  }
-  return 0;
+// The gaze source options with a compensation mode: the delivered samples predicted to the
+// display time, at most the default horizon ahead (Landing: a trusted fit, uncapped).
+devices::SourceOptions predicting(devices::SourceOptions o, devices::PredictMode m) {
+  o.predict = m;
+  o.horizon_ns = m == devices::PredictMode::None ? 0 : devices::SourceOptions{}.horizon_ns;
+  return o;
 }
 
 int run(std::vector<std::string> argv) {
@@ -193,7 +206,12 @@ int run(std::vector<std::string> argv) {
   const double seconds = args.num("seconds", 2);
   if (!(seconds > 0 && seconds <= 600)) throw core::InputError("--seconds must be in (0, 600]");
   const std::string predict = args.str("predict", "none");
-  if (predict != "none") throw core::InputError("--predict \"" + predict + "\": expected none");
+  devices::PredictMode predict_mode;
+  try {
+    predict_mode = devices::parse_predict_mode(predict);
+  } catch (const core::InputError& e) {
+    throw core::InputError(std::string("--predict: ") + e.what());
+  }
   latency::TrackerChoice tracker;
   tracker.preset = args.str("tracker", "fove0");
   if (auto t = args.opt("tracker-delay")) tracker.delay_ns = core::parse_duration_ns(*t, "--tracker-delay");
@@ -215,19 +233,18 @@ int run(std::vector<std::string> argv) {
   const std::string gaze_uri = args.str("gaze", kDefaultGaze);
   devices::SourceOptions so;
   so.display = display;
-  so.horizon_ns = 0;  // --predict none: the newest delivered sample as it is
+  so = predicting(so, predict_mode);
   std::unique_ptr<devices::TrackerModel> model = latency::open_tracker(gaze_uri, tracker, so);
   const bool quiet = args.has("quiet");
 
   const renderer::Scene scene = renderer::load_scene(args.str("scene", "default"));
   for (const auto& w : scene.warnings) std::cerr << "warning: " << w << "\n";
   fs::create_directories(out);
-  gpu::Context ctx;
-  renderer::GpuScene gpu_scene(ctx, scene);
-  const core::StereoViews views = core::stereo_views(display, scene.camera);
-  const std::array<core::Pose, 2> poses = views.poses();  // a static head at the scene's camera
-  pipeline::FramePipeline pipe(ctx, gpu_scene, views, core::DistributionParams{}, reconstruct::ReconSettings{});
-  for (core::Eye e : {core::Eye::Left, core::Eye::Right}) pipe.set_visibility(e, core::EyeOptics(display, e).view_mask());
+  // The defaults of `fovea render`: distribution, reconstruction, tracing, the hidden area culled.
+  RenderSetup setup(scene, display, {});
+  gpu::Context& ctx = setup.ctx;
+  const std::array<core::Pose, 2>& poses = setup.poses;
+  pipeline::FramePipeline& pipe = setup.pipeline;
 
   // The main run: every frame rendered; its cost is the measured CPU time of the frame (the
   // submission waits for the GPU, so the GPU's work is inside it) or the fixed one.
@@ -290,23 +307,34 @@ int run(std::vector<std::string> argv) {
                 core::ns_to_ms(tp.jitter_ns), fixed_cost ? "fixed" : "measured");
   std::vector<std::string> plots = latency::write_plots(out.string(), sim.records, &sim, notebuf);
 
+  // The comparisons replay the main run's costs frame by frame, so every run has the same
+  // frames at the same times and differs only by the gaze the frames were foveated for.
+  const latency::RenderFn replay = [&](std::int64_t f, const std::array<glm::dvec3, 2>&) {
+    latency::FrameWork w;
+    w.cost_ns = measured.empty() ? 0 : measured[std::min<std::size_t>(std::size_t(f), measured.size() - 1)];
+    return w;
+  };
+  // Compensation, measured: the foveal error after saccades with and without prediction.
+  nlohmann::json compensation = nlohmann::json::array();
+  for (devices::PredictMode m : {devices::PredictMode::None, devices::PredictMode::Linear, devices::PredictMode::Landing}) {
+    std::unique_ptr<devices::TrackerModel> t = latency::open_tracker(gaze_uri, tracker, predicting(so, m));
+    const latency::Simulation s = latency::simulate(*t, sc, replay);
+    compensation.push_back({{"predict", devices::predict_mode_name(m)},
+                            {"post_saccade_error_deg", latency::error_summary(latency::post_saccade_errors(s))},
+                            {"foveal_error_deg", latency::error_summary(latency::shown_errors(s))},
+                            {"recovery_ms", latency::to_json(latency::distribution(latency::recovery_ms(s)))}});
+  }
+  j["compensation"] = compensation;
+
   if (!injected.empty()) {
-    // The sweep replays the main run's costs frame by frame, so every point has the same
-    // frames at the same times and differs only by the tracker's delivery.
-    const latency::RenderFn replay = [&](std::int64_t f, const std::array<glm::dvec3, 2>&) {
-      latency::FrameWork w;
-      w.cost_ns = measured.empty() ? 0 : measured[std::min<std::size_t>(std::size_t(f), measured.size() - 1)];
-      return w;
-    };
     std::optional<core::Image> reference;
     const std::size_t warm = 3;
-    const std::size_t first = quality_window(sim, warm);
     if (quality_frames > 0) {
       renderer::ReferenceOptions o;
       o.path.spp = std::uint32_t(std::min<long>(ref_spp, 16));
       o.max_spp = std::uint32_t(ref_spp);
       if (!quiet) std::fprintf(stderr, "reference, %ld spp...\n", ref_spp);
-      reference = renderer::render_reference(ctx, gpu_scene, pipe.view(core::Eye::Left), core::Eye::Left, o).image;
+      reference = renderer::render_reference(ctx, setup.gpu_scene, pipe.view(core::Eye::Left), core::Eye::Left, o).image;
     }
     std::vector<latency::SweepPoint> points;
     nlohmann::json sweep = nlohmann::json::array();
@@ -317,12 +345,7 @@ int run(std::vector<std::string> argv) {
       const latency::Simulation s = latency::simulate(*m, sc, replay);
       latency::SweepPoint p;
       p.inject_ms = core::ns_to_ms(inj);
-      p.error = latency::error_summary([&] {
-        std::vector<double> e;
-        for (const auto& v : s.shown)
-          if (v.error_deg) e.push_back(*v.error_deg);
-        return e;
-      }());
+      p.error = latency::error_summary(latency::shown_errors(s));
       p.gaze_to_photon_median_ms = latency::distribution(latency::latencies(s.records).gaze_to_photon_ms).median;
       const std::vector<double> rec = latency::recovery_ms(s);
       p.recovery_median_ms = latency::distribution(rec).median;
@@ -334,11 +357,11 @@ int run(std::vector<std::string> argv) {
                            {"saccades_recovered", p.recovered}};
       if (reference) {
         if (!quiet) std::fprintf(stderr, "quality at +%.0f ms...\n", p.inject_ms);
-        const Quality q = fovea_quality(pipe, poses, s, first, std::size_t(quality_frames) + warm, warm, *reference);
+        const Quality q = fovea_quality(pipe, poses, s, std::size_t(quality_frames), warm, *reference);
         if (q.frames) {
           p.fovea_psnr_db = q.psnr;
           p.fovea_flip = q.flip;
-          pj["fovea_quality"] = {{"psnr_db", q.psnr}, {"ldr_flip", q.flip}, {"frames", q.frames}, {"first_frame", first + warm}};
+          pj["fovea_quality"] = {{"psnr_db", q.psnr}, {"ldr_flip", q.flip}, {"frames", q.frames}, {"saccades", q.saccades}};
         }
       }
       points.push_back(p);

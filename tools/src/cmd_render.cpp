@@ -18,8 +18,6 @@
 #include "fovea/core/acuity.hpp"
 #include "fovea/core/clock.hpp"
 #include "fovea/core/display.hpp"
-#include "fovea/core/eye_optics.hpp"
-#include "fovea/core/stereo_views.hpp"
 #include "fovea/core/error.hpp"
 #include "fovea/core/image.hpp"
 #include "fovea/core/flip.hpp"
@@ -29,6 +27,7 @@
 #include "fovea/devices/screen.hpp"
 #include "frame_log.hpp"
 #include "reference_cache.hpp"
+#include "render_setup.hpp"
 #include "fovea/gpu/context.hpp"
 #include "fovea/pipeline/frame_pipeline.hpp"
 #include "fovea/renderer/reference.hpp"
@@ -282,16 +281,12 @@ int run(std::vector<std::string> argv) {
   for (const auto& w : scene.warnings) std::cerr << "warning: " << w << "\n";
   fs::create_directories(out_dir);
 
-  gpu::Context ctx;
-  renderer::GpuScene gpu_scene(ctx, scene, {}, tracing);
-  // A static head at the scene's camera.
-  const core::StereoViews views = core::stereo_views(display, scene.camera);
-  const std::array<core::Pose, 2> poses = views.poses();
-  pipeline::FramePipeline pipeline(ctx, gpu_scene, views, dp, settings);
   const bool cull = !args.has("no-cull");
-  if (cull)
-    for (core::Eye e : {core::Eye::Left, core::Eye::Right})
-      pipeline.set_visibility(e, core::EyeOptics(display, e).view_mask());
+  RenderSetup setup(scene, display, {dp, settings, tracing, cull});
+  gpu::Context& ctx = setup.ctx;
+  renderer::GpuScene& gpu_scene = setup.gpu_scene;
+  const std::array<core::Pose, 2>& poses = setup.poses;
+  pipeline::FramePipeline& pipeline = setup.pipeline;
 
   // A loaded reference is checked before the frames are paid for.
   std::array<std::optional<CachedReference>, 2> loaded;

@@ -35,6 +35,7 @@ constexpr std::pair<const char*, TimeField> kTimes[] = {
     {"gaze_receive_ns", &TimingRecord::gaze_receive_ns},
     {"gaze_read_ns", &TimingRecord::gaze_read_ns},
     {"head_pose_ns", &TimingRecord::head_pose_ns},
+    {"head_pose_target_ns", &TimingRecord::head_pose_target_ns},
     {"predicted_display_ns", &TimingRecord::predicted_display_ns},
     {"wait_call_ns", &TimingRecord::wait_call_ns},
     {"wait_return_ns", &TimingRecord::wait_return_ns},

@@ -39,13 +39,6 @@ sweep::Series cdf(const std::string& name, std::vector<double> v, std::size_t co
   return s;
 }
 
-std::vector<double> shown_errors(const Simulation& sim) {
-  std::vector<double> v;
-  for (const Shown& s : sim.shown)
-    if (s.error_deg) v.push_back(*s.error_deg);
-  return v;
-}
-
 void save(const std::string& dir, const std::string& name, const sweep::Chart& c, std::vector<std::string>& written) {
   // Wide: the legend carries each distribution's median, p95, p99 and max.
   core::write_png((std::filesystem::path(dir) / name).string(), sweep::draw_chart(c, 1600, 700));
@@ -53,6 +46,13 @@ void save(const std::string& dir, const std::string& name, const sweep::Chart& c
 }
 
 }  // namespace
+
+std::vector<double> shown_errors(const Simulation& sim) {
+  std::vector<double> v;
+  for (const Shown& s : sim.shown)
+    if (s.error_deg) v.push_back(*s.error_deg);
+  return v;
+}
 
 Distribution distribution(std::vector<double> v) {
   v.erase(std::remove_if(v.begin(), v.end(), [](double x) { return !std::isfinite(x); }), v.end());
@@ -86,6 +86,9 @@ Latencies latencies(const std::vector<xrcommon::TimingRecord>& records) {
 
 nlohmann::json error_summary(const std::vector<double>& error_deg) {
   nlohmann::json j = to_json(distribution(error_deg));
+  double sum = 0;
+  for (double e : error_deg) sum += e;
+  j["mean"] = error_deg.empty() ? 0.0 : sum / double(error_deg.size());
   for (double th : {1.0, 2.0, 5.0}) {
     const auto above = std::count_if(error_deg.begin(), error_deg.end(), [&](double e) { return e > th; });
     j["above_" + fmt(th, 0) + "deg"] = error_deg.empty() ? 0.0 : double(above) / double(error_deg.size());
@@ -125,6 +128,8 @@ nlohmann::json summarize(const std::vector<xrcommon::TimingRecord>& records, con
     for (const Saccade& s : sim->saccades) big += s.amplitude_deg >= 2.0;
     j["saccades"] = {{"detected", sim->saccades.size()}, {"at_least_2deg", big}};
     j["recovery_ms"] = to_json(distribution(recovery_ms(*sim)));
+    j["post_saccade_error_deg"] = error_summary(post_saccade_errors(*sim));
+    j["post_saccade_error_deg"]["over"] = "vsyncs within 150 ms after each saccade of at least 2 deg";
   } else {
     std::vector<double> e;
     for (const auto& r : records)

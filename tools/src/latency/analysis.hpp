@@ -28,7 +28,10 @@ struct Latencies {
 };
 Latencies latencies(const std::vector<xrcommon::TimingRecord>& records);
 
-// Foveal-error figures from errors in degrees: distribution, fraction above 1°, 2°, 5°.
+// The panel's foveal error at every vsync with a tracked true eye, degrees.
+std::vector<double> shown_errors(const Simulation& sim);
+
+// Foveal-error figures from errors in degrees: distribution, mean, fraction above 1°, 2°, 5°.
 nlohmann::json error_summary(const std::vector<double>& error_deg);
 
 // The summary of records; `sim` (optional) adds the per-vsync foveal error, saccades and

@@ -74,6 +74,8 @@ Simulation simulate(devices::TrackerModel& tracker, const Scenario& sc, const Re
     explicit Borrowed(devices::TrackerModel& m) : t(m) {}
     devices::GazeSample latest() override { return t.latest(); }
     devices::GazeSample sample_at(core::TimeNs when) override { return t.sample_at(when); }
+    devices::GazeSample read_at(core::TimeNs read, core::TimeNs target) override { return t.read_at(read, target); }
+    devices::GazeSample truth_at(core::TimeNs when) override { return t.truth_at(when); }
     bool is_live() const override { return false; }
     std::string describe() const override { return t.describe(); }
   };
@@ -86,8 +88,9 @@ Simulation simulate(devices::TrackerModel& tracker, const Scenario& sc, const Re
     const core::TimeNs wake = std::max(now, slot.wake_ns);  // xrWaitFrame returns
     if (wake >= sc.duration_ns) break;
     pacer.reslot(slot, wake);
-    devices::FoveaGaze g = gaze.at(wake);
-    if (sc.adjust) sc.adjust(g, slot.display_ns);
+    // What the tracker had delivered at the wake, predicted to the display time when the
+    // tracker's source predicts (--predict).
+    const devices::FoveaGaze g = gaze.read(wake, slot.display_ns);
     const std::array<glm::dvec3, 2> dirs{g.left.dir, g.right.dir};
     FrameWork work = render(f, dirs);
     const core::TimeNs submit = wake + work.cost_ns;
@@ -105,7 +108,8 @@ Simulation simulate(devices::TrackerModel& tracker, const Scenario& sc, const Re
       r.gaze_receive_ns = g.receive_ns;
     }
     r.gaze_read_ns = wake;
-    r.head_pose_ns = wake;  // the application locates its views when it wakes
+    r.head_pose_ns = wake;  // the application locates its views when it wakes,
+    r.head_pose_target_ns = slot.display_ns;  // for the predicted display time
     r.predicted_display_ns = slot.display_ns;
     r.set_frame_calls(now, wake, wake, submit, submit);  // the modelled calls return at once
     r.submit_ns = submit;
@@ -157,6 +161,18 @@ std::vector<double> recovery_ms(const Simulation& sim, double threshold_deg, dou
     });
     if (it == sim.shown.end()) continue;  // not recovered before the end
     out.push_back(core::ns_to_ms(it->photon_ns - s.offset_ns));
+  }
+  return out;
+}
+
+std::vector<double> post_saccade_errors(const Simulation& sim, core::TimeNs window_ns, double min_amplitude_deg) {
+  std::vector<double> out;
+  for (const Shown& v : sim.shown) {
+    if (!v.error_deg) continue;
+    const bool after = std::any_of(sim.saccades.begin(), sim.saccades.end(), [&](const Saccade& s) {
+      return s.amplitude_deg >= min_amplitude_deg && v.photon_ns >= s.offset_ns && v.photon_ns - s.offset_ns <= window_ns;
+    });
+    if (after) out.push_back(*v.error_deg);
   }
   return out;
 }

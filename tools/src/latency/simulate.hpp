@@ -43,14 +43,12 @@ struct FrameWork {
 };
 // Renders frame `index` foveated at each eye's `gaze` (view space; left, right).
 using RenderFn = std::function<FrameWork(std::int64_t index, const std::array<glm::dvec3, 2>& gaze)>;
-// Where gaze compensation plugs in: may move the fovea of a frame given its predicted
-// display time before it is rendered (none by default).
-using GazeAdjustFn = std::function<void(devices::FoveaGaze& gaze, core::TimeNs predicted_display_ns)>;
 
+// Gaze compensation is the tracker's: its source options' predict mode and horizon
+// (open_tracker) predict the delivered samples to each frame's display time.
 struct Scenario {
   xrcommon::DisplayParams display;
   core::TimeNs duration_ns = 2'000'000'000;  // frames are started until this time
-  GazeAdjustFn adjust;
 };
 
 struct FrameTruth {
@@ -85,5 +83,11 @@ Simulation simulate(devices::TrackerModel& tracker, const Scenario& s, const Ren
 // Post-saccade recovery, ms: for each saccade of at least `min_amplitude_deg`, from its end
 // to the first photon time at which the panel's foveal error is below `threshold_deg`.
 std::vector<double> recovery_ms(const Simulation& sim, double threshold_deg = 2.0, double min_amplitude_deg = 2.0);
+
+// The panel's foveal errors (degrees) at the vsyncs whose photon time lies within
+// `window_ns` after the end of a saccade of at least `min_amplitude_deg`: where the fovea
+// should already be on the new target, and what gaze compensation is for.
+std::vector<double> post_saccade_errors(const Simulation& sim, core::TimeNs window_ns = 150'000'000,
+                                        double min_amplitude_deg = 2.0);
 
 }  // namespace fovea::latency

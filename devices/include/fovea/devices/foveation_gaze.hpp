@@ -72,7 +72,13 @@ class FoveationGaze {
   void set_epoch(core::TimeNs epoch_ns);
 
   // The fovea at time t (caller's clock) from the samples measured by t.
-  FoveaGaze at(core::TimeNs t);
+  FoveaGaze at(core::TimeNs t) { return read(t, t); }
+  // The fovea for target_ns (e.g. a frame's display time) as read at read_ns: from the
+  // samples available by min(read_ns, target_ns) only, predicted to target_ns when the
+  // source predicts (GazeSource::read_at); query_ns is target_ns.
+  FoveaGaze read(core::TimeNs read_ns, core::TimeNs target_ns);
+  // The true eye at t (caller's clock; GazeSource::truth_at): t_ns kNoSample when unknown.
+  GazeSample truth_at(core::TimeNs t);
   // For programs whose frames carry a virtual time (frame index / refresh rate, from 0):
   // recordings play on it, live sources are read at the host clock now.
   FoveaGaze at_frame_time(core::TimeNs frame_ns) { return at(live() ? core::now_ns() : frame_ns); }

@@ -3,6 +3,7 @@
 // Directions are unit vectors in view space (OpenXR: -Z forward, +Y up, +X right).
 // Times are int64 nanoseconds. Sources are opened from URI-like strings, see
 // open_gaze_source() and docs/gaze.md.
+#include <algorithm>
 #include <cstdint>
 #include <memory>
 #include <optional>
@@ -106,6 +107,18 @@ class GazeSource {
   // on the same timeline, never t; before the first sample t_ns is kNoSample and the
   // result is lost. A newest sample older than max_gap_ns is stale: flagged lost.
   virtual GazeSample sample_at(core::TimeNs t) = 0;
+  // The gaze a renderer reading at `read_ns` has for `target_ns` (e.g. its frame's display
+  // time): the newest sample available by min(read_ns, target_ns) — measured by then, or for
+  // a modelled tracker delivered by then — never a later one, its direction predicted to
+  // target_ns from those samples only when prediction is on. sample_at(t) is read_at(t, t).
+  // Sources that do not predict hold the newest sample.
+  virtual GazeSample read_at(core::TimeNs read_ns, core::TimeNs target_ns) {
+    return sample_at(std::min(read_ns, target_ns));
+  }
+  // The true eye at t, for measuring what latency costs: a recording's or synthetic gaze's
+  // own sample at t (no prediction), a tracker model's ground truth (no delay, no noise).
+  // t_ns is kNoSample when the source knows no truth (live devices).
+  virtual GazeSample truth_at(core::TimeNs t);
   // Live sources stamp samples with the host monotonic clock; recorded and synthetic ones
   // count from their first sample. Set by the source kind, never guessed from its name.
   virtual bool is_live() const = 0;

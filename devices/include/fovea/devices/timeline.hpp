@@ -5,7 +5,8 @@
 // scaled by `speed`, optionally looped; seeking backwards before the window re-reads the
 // stream from its start; past the end of a recording its last sample stays. Between
 // samples the direction is predicted to the time asked for (GazePredictor, at most
-// horizon_ns; horizon_ns = 0 holds the newest sample).
+// horizon_ns; horizon_ns = 0 holds the newest sample); read_at() predicts to a later target
+// from the samples measured by the read time.
 #include <deque>
 #include <memory>
 #include <mutex>
@@ -19,7 +20,10 @@ class TimelineSource final : public GazeSource {
  public:
   TimelineSource(std::unique_ptr<SampleStream> stream, const SourceOptions& opt);
   GazeSample latest() override;
-  GazeSample sample_at(core::TimeNs t) override;
+  GazeSample sample_at(core::TimeNs t) override { return read_at(t, t); }
+  GazeSample read_at(core::TimeNs read_ns, core::TimeNs target_ns) override;
+  // Recorded and synthetic streams: the newest sample at t as it is (live ones: unknown).
+  GazeSample truth_at(core::TimeNs t) override;
   bool is_live() const override { return stream_->live(); }
   std::string describe() const override { return stream_->describe(); }
   // Samples currently held (bounded by window_ns); for tests of the memory bound.
@@ -28,7 +32,9 @@ class TimelineSource final : public GazeSource {
  private:
   void pull_until(core::TimeNs t);
   void restart();
-  GazeSample at_recording_time(core::TimeNs tt);
+  // The newest sample at recording time tt, predicted `ahead_ns` past tt when `predict`.
+  GazeSample at_recording_time(core::TimeNs tt, core::TimeNs ahead_ns, bool predict);
+  GazeSample on_caller_timeline(core::TimeNs t, core::TimeNs ahead_ns, bool predict);
 
   std::unique_ptr<SampleStream> stream_;
   SourceOptions opt_;

@@ -48,12 +48,15 @@ class TrackerModel final : public GazeSource {
   // From the samples delivered by t (never one delivered later): the newest; t_ns is its
   // measurement time, host_time_ns its delivery time, device_time_ns its measurement time on
   // the tracker's clock (from 0). Stale (lost) when nothing was delivered for max_gap_ns.
-  GazeSample sample_at(core::TimeNs t) override;
+  GazeSample sample_at(core::TimeNs t) override { return read_at(t, t); }
+  // As sample_at(min(read, target)), its direction predicted to target_ns from the samples
+  // delivered by then (never from one delivered later).
+  GazeSample read_at(core::TimeNs read_ns, core::TimeNs target_ns) override;
   bool is_live() const override { return params_.host_clock; }
   std::string describe() const override;
 
   // The true eye at time t on this source's timeline (host clock: from the model's start).
-  GazeSample truth_at(core::TimeNs t);
+  GazeSample truth_at(core::TimeNs t) override;
   const TrackerParams& params() const { return params_; }
   // Host clock: the host time of the tracker's t = 0 (0 in virtual time).
   core::TimeNs epoch_ns() const { return epoch_; }

@@ -35,6 +35,7 @@ struct TimingRecord {
   bool gaze_valid = false;
   std::optional<core::TimeNs> gaze_sample_ns, gaze_device_ns, gaze_receive_ns, gaze_read_ns;
   std::optional<core::TimeNs> head_pose_ns;          // when the head pose the frame was rendered for was sampled
+  std::optional<core::TimeNs> head_pose_target_ns;   // the time that pose was predicted for (its display time)
   std::optional<core::TimeNs> predicted_display_ns;  // the display time the frame was rendered for
   // The OpenXR frame loop's calls (absent outside one).
   std::optional<core::TimeNs> wait_call_ns, wait_return_ns, begin_ns, end_call_ns, end_return_ns;

@@ -1,0 +1,18 @@
+#include "render_setup.hpp"
+
+#include "fovea/core/eye_optics.hpp"
+
+namespace fovea::tools {
+
+RenderSetup::RenderSetup(const renderer::Scene& scene, const core::DisplayPreset& display,
+                         const RenderSetupOptions& options)
+    : gpu_scene(ctx, scene, {}, options.tracing),
+      views(core::stereo_views(display, scene.camera)),
+      poses(views.poses()),
+      pipeline(ctx, gpu_scene, views, options.distribution, options.settings) {
+  if (options.cull)
+    for (core::Eye e : {core::Eye::Left, core::Eye::Right})
+      pipeline.set_visibility(e, core::EyeOptics(display, e).view_mask());
+}
+
+}  // namespace fovea::tools

@@ -1,0 +1,36 @@
+#pragma once
+// The scene on the Vulkan device and the stereo foveated pipeline over it, as `fovea render`
+// and `fovea latency` set them up: a static head at the scene's camera, the display's views,
+// and (when culling) each eye's lens hidden area skipped.
+#include <array>
+
+#include "fovea/core/display.hpp"
+#include "fovea/core/stereo_views.hpp"
+#include "fovea/gpu/context.hpp"
+#include "fovea/pipeline/frame_pipeline.hpp"
+#include "fovea/renderer/gpu_scene.hpp"
+#include "fovea/renderer/scene.hpp"
+
+namespace fovea::tools {
+
+struct RenderSetupOptions {
+  core::DistributionParams distribution;
+  reconstruct::ReconSettings settings;
+  renderer::Tracing tracing = renderer::Tracing::Auto;
+  bool cull = true;  // skip the lens' hidden area
+};
+
+// Members in construction order; they refer to each other, so the setup stays in place.
+struct RenderSetup {
+  RenderSetup(const renderer::Scene& scene, const core::DisplayPreset& display, const RenderSetupOptions& options);
+  RenderSetup(const RenderSetup&) = delete;
+  RenderSetup& operator=(const RenderSetup&) = delete;
+
+  gpu::Context ctx;
+  renderer::GpuScene gpu_scene;
+  core::StereoViews views;
+  std::array<core::Pose, 2> poses;  // the static head's eyes
+  pipeline::FramePipeline pipeline;
+};
+
+}  // namespace fovea::tools
