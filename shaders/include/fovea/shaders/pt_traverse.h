@@ -17,6 +17,7 @@ uint pt_stat_nodes = 0u, pt_stat_tris = 0u;
 #else
 #define PT_STAT(counter)
 #endif
+
 // Ize 2013, "Robust BVH ray traversal": scaling the far slab distance by 1 + 2γ(3)
 // keeps rounding in the box test from culling hits.
 const float kPtBoxFarScale = 1.0 + 2.0 * (3.0 * 5.9604645e-8) / (1.0 - 3.0 * 5.9604645e-8);
@@ -206,7 +207,7 @@ bool pt_brute_force(vec3 org, vec3 dir, float tmin, float tmax, bool any_hit, ou
   hit.tri = kPtNoHit;
   hit.bary = vec2(0.0);
   const PtRayPre r = pt_prepare(org, dir, tmin);
-    const uint count = uint(tris.length()) / 3u;
+  const uint count = uint(tris.length()) / 3u;
   for (uint i = 0u; i < count; ++i)
     if (pt_hit_triangle(r, i, hit.t, hit) && any_hit) return true;
   return hit.tri != kPtNoHit;
