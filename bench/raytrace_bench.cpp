@@ -12,6 +12,7 @@
 #include <chrono>
 #include <cstdio>
 #include <cstdlib>
+#include <ctime>
 #include <map>
 #include <memory>
 #include <string>
@@ -74,6 +75,36 @@ std::map<std::string, double>& results() {  // "<kind>/<scene>" -> rays or sampl
   return r;
 }
 
+// CPU time of the whole process (every lavapipe and Embree thread), ns: on a machine that
+// other jobs share, rays per CPU-second compare the two tracers more stably than wall time.
+std::int64_t process_cpu_ns() {
+  timespec ts{};
+  clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &ts);
+  return std::int64_t(ts.tv_sec) * 1000000000 + ts.tv_nsec;
+}
+
+// Times `run` (which traces `rays` rays) once per benchmark iteration; records rays per
+// wall-clock second and per process CPU-second under `key` and "cpu:" + key.
+template <class Run>
+void time_rays(benchmark::State& state, double rays_per_run, const std::string& key, Run&& run) {
+  double rays = 0, secs = 0;
+  std::int64_t cpu_ns = 0;
+  for (auto _ : state) {
+    const std::int64_t c0 = process_cpu_ns();
+    const auto t0 = std::chrono::steady_clock::now();
+    run();
+    const double s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+    cpu_ns += process_cpu_ns() - c0;
+    state.SetIterationTime(s);
+    rays += rays_per_run;
+    secs += s;
+  }
+  state.counters["Mrays/s"] = rays / secs * 1e-6;
+  state.counters["Mrays/cpu_s"] = rays / (double(cpu_ns) * 1e-9) * 1e-6;
+  results()[key] = rays / secs;
+  results()["cpu:" + key] = rays / (double(cpu_ns) * 1e-9);
+}
+
 const char* result_key(fr::Tracing t) { return t == fr::Tracing::RayQuery ? "rayquery/" : "gpu/"; }
 
 void BM_PrimaryRays(benchmark::State& state, const char* scene, fr::Tracing tracing) {
@@ -83,18 +114,18 @@ void BM_PrimaryRays(benchmark::State& state, const char* scene, fr::Tracing trac
   rc.set_rays(f.rays);
   rc.trace(fr::RayQuery::Closest);  // warm-up (pipeline compilation)
   const int repeat = 4;
-  double rays = 0, secs = 0;
-  for (auto _ : state) {
-    const auto t0 = std::chrono::steady_clock::now();
-    rc.trace(fr::RayQuery::Closest, repeat);
-    const double s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-    state.SetIterationTime(s);
-    rays += double(f.rays.size()) * repeat;
-    secs += s;
-  }
-  state.counters["Mrays/s"] = rays / secs * 1e-6;
+  time_rays(state, double(f.rays.size()) * repeat, result_key(tracing) + std::string(scene),
+            [&] { rc.trace(fr::RayQuery::Closest, repeat); });
   state.counters["triangles"] = double(g.stats().triangles);
-  results()[result_key(tracing) + std::string(scene)] = rays / secs;
+  if (g.tracing() == fr::Tracing::Compute) {
+    fr::Raycaster counting(context(), g, true);
+    counting.set_rays(f.rays);
+    const fr::TraversalStats t = counting.traversal_stats();
+    state.counters["nodes/ray"] = t.nodes;
+    state.counters["tris/ray"] = t.triangles;
+    state.counters["nodes/subgroup"] = t.subgroup_nodes;  // the most any ray of its subgroup visited
+    state.counters["tris/subgroup"] = t.subgroup_triangles;
+  }
 }
 
 // full: the shader with every scene feature compiled in, else the scene's variant.
@@ -182,17 +213,9 @@ void BM_EmbreePrimaryRays(benchmark::State& state, const char* scene) {
     for (auto& th : pool) th.join();
   };
   trace_all();
-  double rays = 0, secs = 0;
-  for (auto _ : state) {
-    const auto t0 = std::chrono::steady_clock::now();
+  time_rays(state, 4.0 * double(f.rays.size()), "embree/" + std::string(scene), [&] {
     for (int k = 0; k < 4; ++k) trace_all();
-    const double s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-    state.SetIterationTime(s);
-    rays += 4.0 * double(f.rays.size());
-    secs += s;
-  }
-  state.counters["Mrays/s"] = rays / secs * 1e-6;
-  results()["embree/" + std::string(scene)] = rays / secs;
+  });
   rtcReleaseScene(sc);
   rtcReleaseDevice(dev);
 }
@@ -238,9 +261,10 @@ int main(int argc, char** argv) {
     for (const fr::Tracing t : {fr::Tracing::Compute, fr::Tracing::RayQuery}) {
       const auto g = results().find(result_key(t) + std::string(s)), e = results().find(std::string("embree/") + s);
       if (g != results().end() && e != results().end())
-        std::printf("%-18s primary rays (%s): %s %.2f Mrays/s, Embree %.2f Mrays/s, Embree/GPU = %.1fx\n", s,
-                    fr::tracing_name(t), context().info().name.c_str(), g->second * 1e-6, e->second * 1e-6,
-                    e->second / g->second);
+        std::printf("%-18s primary rays (%s): %s %.2f Mrays/s, Embree %.2f Mrays/s, Embree/GPU = %.2fx; "
+                    "per CPU-second %.2fx\n",
+                    s, fr::tracing_name(t), context().info().name.c_str(), g->second * 1e-6, e->second * 1e-6,
+                    e->second / g->second, results()["cpu:embree/" + std::string(s)] / results()["cpu:" + g->first]);
     }
     const auto v = results().find(std::string("variant/") + s), f = results().find(std::string("full/") + s);
     if (v != results().end() && f != results().end())

@@ -2,12 +2,15 @@
 // Traces a batch of rays against the scene BVH (or by brute force): BVH tests and the
 // ray-throughput benchmark.
 #extension GL_GOOGLE_include_directive : require
+#ifdef FOVEA_TRAVERSE_STATS
+#extension GL_KHR_shader_subgroup_arithmetic : require
+#endif
 #include "fovea/shaders/pt_scene.h"
 #include "fovea/shaders/pt_raycast.h"
 
 layout(local_size_x = 64) in;
-layout(std430, set = 0, binding = 0) readonly buffer Nodes { PtBvhNode nodes[]; };
-layout(std430, set = 0, binding = 1) readonly buffer Tris { PtTriangle tris[]; };
+layout(std430, set = 0, binding = 0) readonly buffer Nodes { uvec4 nodes[]; };  // PtBvhNode: pt_node()
+layout(std430, set = 0, binding = 1) readonly buffer Tris { uvec4 tris[]; };    // PtTriangle: pt_tri()
 layout(std430, set = 0, binding = 2) readonly buffer Rays { PtRay rays[]; };
 layout(std430, set = 0, binding = 3) writeonly buffer Hits { PtHitRecord hits[]; };
 layout(push_constant) uniform Params { PtRaycastParams pc; };
@@ -27,8 +30,13 @@ void main() {
   else found = pt_brute_force(org, dir, ray.tmin, ray.tmax, any_hit, h);
   PtHitRecord rec;
   rec.t = found ? h.t : ray.tmax;
-  rec.triangle = found ? (any_hit ? 0u : tris[h.tri].source) : kPtNoHit;
+  rec.triangle = found ? (any_hit ? 0u : pt_tri(h.tri).source) : kPtNoHit;
   rec.u = found && !any_hit ? h.bary.x : 0.0;
   rec.v = found && !any_hit ? h.bary.y : 0.0;
+#ifdef FOVEA_TRAVERSE_STATS
+  // This ray's node visits and triangle tests, and the most of any ray in its subgroup
+  // (what a SIMD device pays when the subgroup's rays run in lockstep).
+  rec = PtHitRecord(float(pt_stat_nodes), pt_stat_tris, float(subgroupMax(pt_stat_nodes)), float(subgroupMax(pt_stat_tris)));
+#endif
   hits[i] = rec;
 }

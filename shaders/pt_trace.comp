@@ -10,8 +10,8 @@
 #include "fovea/shaders/pt_trace.h"
 
 layout(local_size_x = 64) in;
-layout(std430, set = 0, binding = 0) readonly buffer Nodes { PtBvhNode nodes[]; };
-layout(std430, set = 0, binding = 1) readonly buffer Tris { PtTriangle tris[]; };
+layout(std430, set = 0, binding = 0) readonly buffer Nodes { uvec4 nodes[]; };  // PtBvhNode: pt_node()
+layout(std430, set = 0, binding = 1) readonly buffer Tris { uvec4 tris[]; };    // PtTriangle: pt_tri()
 layout(std430, set = 0, binding = 2) readonly buffer Shading { PtShading shading[]; };
 layout(std430, set = 0, binding = 3) readonly buffer Materials { PtMaterial materials[]; };
 layout(std430, set = 0, binding = 4) readonly buffer Lights { PtLight lights[]; };
@@ -70,7 +70,7 @@ struct Surface {
 
 Surface surface(PtHit h, vec3 org, vec3 dir) {
   Surface s;
-  const PtTriangle t = tris[h.tri];
+  const PtTriangle t = pt_tri(h.tri);
   const PtShading sh = shading[h.tri];
   const vec3 v0 = vec3(t.v0_x, t.v0_y, t.v0_z), v1 = vec3(t.v1_x, t.v1_y, t.v1_z), v2 = vec3(t.v2_x, t.v2_y, t.v2_z);
   const float w0 = 1.0 - h.bary.x - h.bary.y;
@@ -125,7 +125,7 @@ vec3 sample_light(Surface s, PtBsdf b, vec3 wo, bool mis, inout PtRng rng) {
     if (lights[mid].cdf > ul) hi = mid; else lo = mid + 1u;
   }
   const PtLight l = lights[lo];
-  const PtTriangle t = tris[l.triangle];
+  const PtTriangle t = pt_tri(l.triangle);
   const vec3 v0 = vec3(t.v0_x, t.v0_y, t.v0_z), v1 = vec3(t.v1_x, t.v1_y, t.v1_z), v2 = vec3(t.v2_x, t.v2_y, t.v2_z);
   const float su = sqrt(u1);
   const vec3 q = (1.0 - su) * v0 + su * (1.0 - u2) * v1 + su * u2 * v2;

@@ -91,6 +91,18 @@ void PathTracer::record(VkCommandBuffer cmd, TraceOutputs& out, const core::View
   }
 }
 
+PathConfig albedo_path_config(const AlbedoStats& a, PathConfig c) {
+  // Least n >= 1 with x^n <= limit, at most `cap` (also for x close to 1).
+  const auto least_power = [](double x, double limit, int cap) {
+    if (!(x > limit)) return 1;
+    if (x >= 0.999) return cap;
+    return std::clamp(int(std::ceil(std::log(limit) / std::log(x) - 1e-9)), 1, cap);
+  };
+  c.max_bounces = a.max >= 0.999f ? -1 : least_power(a.max, kAlbedoBounceCutoff, int(shaders::kPtHardMaxBounces));
+  c.rr_start = std::uint32_t(least_power(a.mean, kAlbedoRouletteStart, kAlbedoRouletteLatest));
+  return c;
+}
+
 std::vector<shaders::GridSample> cartesian_grid(const core::View& view) {
   std::vector<shaders::GridSample> g(std::size_t(view.width()) * view.height());
   for (int y = 0; y < view.height(); ++y)

@@ -8,12 +8,37 @@
 
 namespace fovea::renderer {
 
-Raycaster::Raycaster(gpu::Context& ctx, const GpuScene& scene)
+namespace {
+
+const GpuScene& checked(const GpuScene& scene, bool count_traversal) {
+  if (count_traversal && scene.tracing() != Tracing::Compute)
+    throw std::invalid_argument("Raycaster: traversal counters need the compute traversal, not ray queries");
+  return scene;
+}
+
+}  // namespace
+
+Raycaster::Raycaster(gpu::Context& ctx, const GpuScene& scene, bool count_traversal)
     : ctx_(ctx),
-      scene_(scene),
-      pipeline_(ctx, tracer_pipeline(scene, "pt_raycast", std::vector<gpu::Binding>(4, gpu::Binding::StorageBuffer),
+      scene_(checked(scene, count_traversal)),
+      count_traversal_(count_traversal),
+      pipeline_(ctx, tracer_pipeline(scene, count_traversal ? "pt_raycast.stats" : "pt_raycast",
+                                     std::vector<gpu::Binding>(4, gpu::Binding::StorageBuffer),
                                      sizeof(shaders::PtRaycastParams),
                                      {gpu::SpecConstant::u32(shaders::kPtSpecBvhStack, scene.bvh_stack())})) {}
+
+TraversalStats Raycaster::traversal_stats() {
+  if (!count_traversal_) throw std::logic_error("Raycaster::traversal_stats needs count_traversal");
+  TraversalStats s;
+  for (const shaders::PtHitRecord& h : trace(RayQuery::Closest)) {
+    s.nodes += h.t;
+    s.triangles += h.triangle;
+    s.subgroup_nodes += h.u;
+    s.subgroup_triangles += h.v;
+  }
+  const double n = double(count_);
+  return {s.nodes / n, s.triangles / n, s.subgroup_nodes / n, s.subgroup_triangles / n};
+}
 
 void Raycaster::set_rays(std::span<const shaders::PtRay> rays) {
   if (rays.empty()) throw std::invalid_argument("Raycaster::set_rays: no rays");

@@ -9,6 +9,7 @@
 #include <glm/geometric.hpp>
 
 #include "fovea/core/error.hpp"
+#include "fovea/core/image.hpp"
 
 namespace fovea::renderer {
 
@@ -167,6 +168,55 @@ float triangle_power(const Scene& s, std::size_t t) {
   if (!(lum > 0.0f)) return 0.0f;
   const glm::vec3* p = &s.positions[3 * t];
   return 0.5f * glm::length(glm::cross(p[1] - p[0], p[2] - p[0])) * lum;
+}
+
+namespace {
+
+// Mean and brightest texel of a texture, linear RGB (textures are sRGB-encoded RGBA8).
+std::pair<glm::vec3, glm::vec3> texture_mean_max(const Texture& t) {
+  float lut[256];
+  for (int i = 0; i < 256; ++i) lut[i] = core::srgb_decode(float(i) / 255.0f);
+  glm::dvec3 sum(0.0);
+  glm::vec3 brightest(0.0f);
+  const std::size_t n = t.rgba.size() / 4;
+  for (std::size_t i = 0; i < n; ++i) {
+    const glm::vec3 c(lut[t.rgba[4 * i]], lut[t.rgba[4 * i + 1]], lut[t.rgba[4 * i + 2]]);
+    sum += glm::dvec3(c);
+    brightest = glm::max(brightest, c);
+  }
+  return {n ? glm::vec3(sum / double(n)) : glm::vec3(1.0f), n ? brightest : glm::vec3(1.0f)};
+}
+
+float material_albedo(const Material& m, glm::vec3 texture) {
+  const glm::vec3 base = m.base_color * texture;
+  const glm::vec3 f0 = glm::mix(glm::vec3(m.specular), base, m.metallic);
+  const glm::vec3 r = f0 + (1.0f - f0) * base * (1.0f - m.metallic);
+  return std::clamp(std::max({r.x, r.y, r.z}), 0.0f, 1.0f);
+}
+
+}  // namespace
+
+AlbedoStats albedo_stats(const Scene& s) {
+  std::vector<std::pair<glm::vec3, glm::vec3>> tex;
+  for (const Texture& t : s.textures) tex.push_back(texture_mean_max(t));
+  std::vector<float> mean_of(s.materials.size()), max_of(s.materials.size());
+  for (std::size_t i = 0; i < s.materials.size(); ++i) {
+    const Material& m = s.materials[i];
+    const bool textured = m.base_color_texture >= 0 && std::size_t(m.base_color_texture) < tex.size();
+    mean_of[i] = material_albedo(m, textured ? tex[std::size_t(m.base_color_texture)].first : glm::vec3(1.0f));
+    max_of[i] = material_albedo(m, textured ? tex[std::size_t(m.base_color_texture)].second : glm::vec3(1.0f));
+  }
+  AlbedoStats a;
+  double weighted = 0, area = 0;
+  for (std::size_t t = 0; t < s.material.size(); ++t) {
+    const glm::vec3* p = &s.positions[3 * t];
+    const double ta = 0.5 * double(glm::length(glm::cross(p[1] - p[0], p[2] - p[0])));
+    weighted += ta * mean_of[s.material[t]];
+    area += ta;
+    a.max = std::max(a.max, max_of[s.material[t]]);
+  }
+  a.mean = area > 0 ? float(weighted / area) : 0.0f;
+  return a;
 }
 
 }  // namespace fovea::renderer

@@ -311,3 +311,30 @@ TEST_F(BvhGpu, ClosedMeshIsWatertight) {
   for (const auto& h : hits) misses += h.triangle == fovea::shaders::kPtNoHit;
   EXPECT_EQ(misses, 0) << "of " << hits.size();
 }
+
+// The work counters of the benchmark (Raycaster count_traversal): two far-apart triangles
+// make a root with two leaf slots, so a ray at one of them visits one node and tests one
+// triangle, a ray past both visits the root only; every ray of a subgroup reports the
+// most of its subgroup. Ray queries have no counters.
+TEST_F(BvhGpu, TraversalCountersCountNodesAndTriangles) {
+  fr::Scene s;
+  s.materials.push_back({});
+  s.add_triangle({-10, -1, -5}, {-8, -1, -5}, {-9, 1, -5}, 0);
+  s.add_triangle({8, -1, -5}, {10, -1, -5}, {9, 1, -5}, 0);
+  fr::GpuScene g(ctx(), s, {}, fr::Tracing::Compute);
+  ASSERT_EQ(g.stats().nodes, 1u);
+  fr::Raycaster rc(ctx(), g, true);
+  std::vector<PtRay> rays;
+  for (int i = 0; i < 64; ++i) rays.push_back(ray({i < 32 ? -9.0f : 0.0f, 0, 0}, {0, 0, -1}));
+  rc.set_rays(rays);
+  const fr::TraversalStats t = rc.traversal_stats();
+  EXPECT_DOUBLE_EQ(t.nodes, 1.0);
+  EXPECT_DOUBLE_EQ(t.triangles, 0.5);
+  EXPECT_DOUBLE_EQ(t.subgroup_nodes, 1.0);
+  EXPECT_GE(t.subgroup_triangles, t.triangles);
+  EXPECT_THROW(fr::Raycaster(ctx(), g).traversal_stats(), std::logic_error);
+  if (ctx().features().ray_query) {
+    fr::GpuScene q(ctx(), s, {}, fr::Tracing::RayQuery);
+    EXPECT_THROW(fr::Raycaster(ctx(), q, true), std::invalid_argument);
+  }
+}

@@ -11,6 +11,7 @@
 #include "fovea/core/stereo_views.hpp"
 #include "fovea/core/error.hpp"
 #include "fovea/core/image.hpp"
+#include "fovea/renderer/path_tracer.hpp"
 #include "fovea/gpu/context.hpp"
 #include "fovea/renderer/reference.hpp"
 #include "fovea/renderer/scene_io.hpp"
@@ -42,9 +43,11 @@ renderer; the same request again reads it instead of rendering.
   --until-pixel-rel-error X  stop once the RMS of the per-pixel standard errors over the
                         mean luminance is <= X (> 0)
   --batch N             samples per pixel per progressive pass [16]
-  --bounces N           BSDF-sampled bounces after the primary hit; -1 = unlimited
-                        (with Russian roulette) [-1: full global illumination]
-  --rr-start N          bounce from which Russian roulette applies [3]
+  --bounces N|auto      BSDF-sampled bounces after the primary hit; -1 = unlimited
+                        (with Russian roulette); auto: from the scene's albedo, until a
+                        path keeps at most 0.1% of its light [auto]
+  --rr-start N|auto     bounce from which Russian roulette applies; auto: once the mean
+                        throughput is halved, from the scene's mean albedo [auto]
   --reference-cache DIR|off  the cache [$XDG_CACHE_HOME/fovea/references]
   --out F               output path ending in .exr or .png (all three are written)
   --quiet               no progress bar
@@ -81,8 +84,13 @@ int run(std::vector<std::string> argv) {
   exr.replace_extension(".exr");
   png.replace_extension(".png");
 
-  const long spp = args.integer("spp", 256), batch = args.integer("batch", 16), bounces = args.integer("bounces", -1),
-             rr = args.integer("rr-start", 3);
+  const renderer::Scene scene = renderer::load_scene(args.str("scene", "default"));
+  const renderer::PathConfig from_albedo = renderer::albedo_path_config(renderer::albedo_stats(scene));
+  const auto int_or_auto = [&](const char* name, long automatic) {
+    return args.str(name, "auto") == "auto" ? automatic : args.integer(name, automatic);
+  };
+  const long spp = args.integer("spp", 256), batch = args.integer("batch", 16),
+             bounces = int_or_auto("bounces", from_albedo.max_bounces), rr = int_or_auto("rr-start", from_albedo.rr_start);
   if (spp < 1 || spp > (1L << 24)) throw core::InputError("--spp must be in 1..16777216");
   if (batch < 1 || batch > 4096) throw core::InputError("--batch must be in 1..4096");
   if (bounces < -1 || bounces > 256) throw core::InputError("--bounces must be -1 (unlimited) or 0..256");
@@ -96,7 +104,6 @@ int run(std::vector<std::string> argv) {
   const core::DisplayPreset display = core::load_display(args.str("display", "small"));
   const core::Eye eye = core::parse_eye(args.str("eye", "left"));
   const renderer::Tracing tracing = renderer::parse_tracing(args.str("trace", "auto"));
-  const renderer::Scene scene = renderer::load_scene(args.str("scene", "default"));
   for (const auto& w : scene.warnings) std::cerr << "warning: " << w << "\n";
 
   const core::View view = core::stereo_views(display, scene.camera)[eye];
@@ -123,6 +130,8 @@ int run(std::vector<std::string> argv) {
   core::write_png(png.string(), renderer::tone_map(r.image));
   nlohmann::json j;
   j["spp"] = r.spp;
+  j["bounces"] = bounces;
+  j["rr_start"] = rr;
   j["mean_rgb"] = {r.mean_rgb.x, r.mean_rgb.y, r.mean_rgb.z};
   j["rel_error"] = r.rel_error;
   j["pixel_rel_error"] = r.pixel_rel_error;

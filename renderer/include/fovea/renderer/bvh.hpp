@@ -1,6 +1,6 @@
 #pragma once
 // Bounding volume hierarchy over a triangle soup: binned surface-area-heuristic build on
-// the CPU (subtrees built in parallel), collapsed to the 4-wide 128-byte nodes the GPU
+// the CPU (subtrees built in parallel), collapsed to the compressed 4-wide 64-byte nodes the GPU
 // traverses (shaders/include/fovea/shaders/pt_scene.h).
 #include <cstdint>
 #include <span>

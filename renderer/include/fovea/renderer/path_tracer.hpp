@@ -15,6 +15,7 @@
 #include "fovea/gpu/descriptors.hpp"
 #include "fovea/gpu/pipeline.hpp"
 #include "fovea/renderer/gpu_scene.hpp"
+#include "fovea/renderer/scene.hpp"
 #include "fovea/shaders/grid.h"
 #include "fovea/shaders/pt_trace.h"
 
@@ -28,6 +29,19 @@ struct PathConfig {
   std::uint32_t rr_start = 1000;  // bounce from which Russian roulette applies (large: off)
   bool jitter = false;            // spread samples over the cell's footprint (anti-aliasing)
 };
+
+// Bounce limit and Russian roulette from the scene's albedo (docs/renderer.md), for
+// configurations that do not set them: after n bounces a path keeps at most max^n of its
+// light, so max_bounces is the least n ≥ 1 with max^n ≤ kAlbedoBounceCutoff (unlimited,
+// i.e. Russian roulette alone, when max ≥ 0.999); the expected throughput is mean^k, so
+// Russian roulette starts at the least k ≥ 1 with mean^k ≤ kAlbedoRouletteStart (at the
+// latest at kAlbedoRouletteLatest). The
+// survival probability is the path throughput (the product of the albedo-weighted BSDF
+// weights so far), at most 0.95. `base` supplies spp and jitter.
+inline constexpr double kAlbedoBounceCutoff = 1e-3;
+inline constexpr double kAlbedoRouletteStart = 0.5;
+inline constexpr int kAlbedoRouletteLatest = 8;
+PathConfig albedo_path_config(const AlbedoStats& albedo, PathConfig base = {});
 
 // The outputs of one grid, with the descriptor set binding them, the scene and the grid.
 // The grid buffer and the scene must outlive it.

@@ -86,4 +86,14 @@ std::pair<glm::vec3, glm::vec3> scene_bounds(const Scene& scene);
 // Emitted power proxy of a triangle: area × luminance(emission) (W up to a constant).
 float triangle_power(const Scene& scene, std::size_t tri);
 
+// How much of the light a path keeps per bounce in this scene. A material's albedo is the
+// largest channel of F0 + (1 − F0)·ρd, the normal-incidence reflectance of the layered BSDF
+// (ρd = base·(1 − metallic), F0 = mix(specular, base, metallic); textures multiply the base
+// with their mean colour for `mean` and their brightest texel for `max`). Emissive
+// surfaces count like the others. mean: weighted by triangle area; max: over the triangles.
+struct AlbedoStats {
+  float mean = 0.0f, max = 0.0f;
+};
+AlbedoStats albedo_stats(const Scene& scene);
+
 }  // namespace fovea::renderer

@@ -4,6 +4,7 @@
 #include "fovea/shaders/common.h"
 
 #ifdef __cplusplus
+#include <cstddef>
 namespace fovea::shaders {
 #endif
 
@@ -87,6 +88,9 @@ FOVEA_CONST FOVEA_UINT kPtGgxTableSize = 32;
 
 #ifdef __cplusplus
 static_assert(sizeof(PtBvhNode) == 64 && sizeof(PtTriangle) == 48 && sizeof(PtShading) == 64);
+// pt_node() and pt_tri() (pt_traverse.h) decode these words from uvec4 loads.
+static_assert(offsetof(PtBvhNode, lo_x) == 16 && offsetof(PtBvhNode, child) == 40 && offsetof(PtBvhNode, counts) == 56);
+static_assert(offsetof(PtTriangle, source) == 28 && offsetof(PtTriangle, light_pdf) == 44);
 static_assert(sizeof(PtMaterial) == 48 && sizeof(PtTextureInfo) == 16 && sizeof(PtLight) == 16);
 }  // namespace fovea::shaders
 #endif
