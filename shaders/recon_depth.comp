@@ -29,7 +29,7 @@ void main() {
   vec2 uv = rg_grid_coord(m, rg_pixel_to_dir(m, px), px);
   uint c = uint(clamp(int(floor(uv.x)), 0, int(m.g.columns) - 1));
   uint rows = max(rg_rows(m, c), 1u);
-  uint r = min(uint(max(floor(uv.y * float(rows)), 0.0)), rows - 1u);
+  uint r = min(uint(max(floor(rg_row_coord(m, c, uv.y)), 0.0)), rows - 1u);
   vec4 s = vpos[r * m.g.padded_columns + c];
   bool surface = s.w >= 0.0 || s.w <= kReconEmitterBase + 0.5;  // materials and emitters
   depth[p.y * pc.width + p.x] = surface ? max(-rg_world_to_view(m, s.xyz, false).z, 0.0) : 0.0;

@@ -25,7 +25,6 @@ layout(push_constant) uniform Push { ReconResolvePush pc; };
 vec2 coord(ReconGrid m, vec2 px) { return rg_grid_coord(m, rg_pixel_to_dir(m, px), px); }
 
 vec4 fetch_level(ReconGrid m, vec2 uv, uint level) {
-  bool polar = m.g.family != kFamilyCartesian;
   float uc = uv.x - 0.5;
   float c0f = floor(uc);
   float fx = uc - c0f;
@@ -35,11 +34,11 @@ vec4 fetch_level(ReconGrid m, vec2 uv, uint level) {
     uint c = uint(clamp(int(c0f) + i, 0, int(m.g.columns) - 1));
     uint full = max(rg_rows(m, c), 1u);
     int rows = int((full + (1u << level) - 1u) >> level);
-    float vr = uv.y * float(full) / scale - 0.5;
+    float vr = rg_row_coord(m, c, uv.y) / scale - 0.5;
     float r0f = floor(vr);
     float fy = vr - r0f;
     int r0 = int(r0f), r1 = r0 + 1;
-    if (polar) {
+    if (rg_wraps(m, c)) {
       r0 = (r0 % rows + rows) % rows;
       r1 = r1 % rows;
     } else {
@@ -59,7 +58,7 @@ vec4 fetch_level(ReconGrid m, vec2 uv, uint level) {
 // polar), one pixel at radius r spans 1 / (2π r) (screen polar).
 float phi_footprint(ReconGrid m, vec2 px, vec2 uv) {
   uint c = uint(clamp(int(uv.x), 0, int(m.g.columns) - 1));
-  float rows = float(rg_rows(m, c));
+  float rows = rg_turn_rows(m, c);
   if (m.g.family == kFamilyAngularPolar) {
     vec3 d = rg_pixel_to_dir(m, px), g = rg_gaze(m);
     vec3 dx = rg_pixel_to_dir(m, px + vec2(1.0, 0.0)), dy = rg_pixel_to_dir(m, px + vec2(0.0, 1.0));

@@ -45,6 +45,7 @@ struct DistributionParams {
   double cap = 1.0;          // κ: at most this many samples per display pixel
   double aniso = 2.0;        // A: bound on φ-spacing / ρ-spacing
   bool staircase = false;    // P5's rows-constant-per-32-columns layout (VP option)
+  bool pack = true;          // visual-polar: each ring's rows only on its visible arc (not with staircase)
   // Weier 2016; fl and pl are scaled together per frame so the kept pixels meet the budget.
   double falloff_fovea_deg = 10, falloff_periphery_deg = 20, falloff_min_p = 0.2;
   double logpolar_alpha = 4.0;  // Meng 2018; the buffer's σ is 1/√budget
