@@ -12,6 +12,7 @@
 // from the previous frame's root and slope; the 56-step bisection it replaced stays
 // selectable as the reference the tests and bench/grid_bench.cpp compare against.
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <numbers>
 #include <stdexcept>
@@ -113,20 +114,32 @@ double solve_increasing(G&& g, double x0, double& slope, double tol, double piec
 // cos(φ − α) < −t, t = cos e·(n·g) / (sin e·|(n·b1, n·b2)|), α = atan2(n·b2, n·b1): an arc
 // centred at α + π of half-width acos t. The frustum is convex and holds g, so what is
 // hidden at e stays hidden further out: the arc at a column's inner radius covers the column.
-std::pair<double, double> visible_arc(const View& v, glm::dvec3 g, glm::dvec3 b1, glm::dvec3 b2, double e_deg) {
-  const double se = std::sin(e_deg * kDeg), ce = std::cos(e_deg * kDeg), two_pi = 2 * kPi;
-  const glm::dvec3 sides[] = {
+// One frustum side seen from the gaze: n·g, |(n·b1, n·b2)| and α + π (per frame).
+struct FrustumSide {
+  double along, across, hidden_centre;
+};
+std::array<FrustumSide, 4> frustum_sides(const View& v, glm::dvec3 g, glm::dvec3 b1, glm::dvec3 b2) {
+  const glm::dvec3 normals[] = {
       {1, 0, v.tan_left()}, {-1, 0, -v.tan_right()}, {0, 1, v.tan_down()}, {0, -1, -v.tan_up()}};
+  std::array<FrustumSide, 4> sides;
+  for (int k = 0; k < 4; ++k) {
+    const double a = glm::dot(normals[k], b1), b = glm::dot(normals[k], b2);
+    sides[size_t(k)] = {glm::dot(normals[k], g), std::hypot(a, b), std::atan2(b, a) + kPi};
+  }
+  return sides;
+}
+
+std::pair<double, double> visible_arc(const std::array<FrustumSide, 4>& sides, double e_deg) {
+  const double se = std::sin(e_deg * kDeg), ce = std::cos(e_deg * kDeg), two_pi = 2 * kPi;
   std::pair<double, double> runs[8];  // hidden [start, end), start in [0, 2π); then shifted by 2π
   int n = 0;
-  for (const glm::dvec3& side : sides) {
-    const double a = glm::dot(side, b1), b = glm::dot(side, b2), c = ce * glm::dot(side, g);
-    const double across = se * std::hypot(a, b);
+  for (const FrustumSide& side : sides) {
+    const double c = ce * side.along, across = se * side.across;
     if (across <= c) continue;  // the whole ring is inside this side
     const double t = c / across;
     if (t <= -1) return {0.0, 0.0};  // the whole ring hidden (not a column of the view): keep it full
     const double half = std::acos(t);
-    double start = std::fmod(std::atan2(b, a) + kPi - half, two_pi);
+    double start = std::fmod(side.hidden_centre - half, two_pi);
     if (start < 0) start += two_pi;
     runs[n++] = {start, start + 2 * half};
   }
@@ -158,6 +171,7 @@ class VisualPolar final : public PolarDistribution {
       circ_[k] = circumference_deg(e);
     }
     setup_session();
+    session_ = {sigma0_, slope_, e_max_, r_};
     set_frame(view_.centre_dir());
   }
 
@@ -193,6 +207,15 @@ class VisualPolar final : public PolarDistribution {
   }
 
   void fill_gpu(shaders::GridParams& g) const override { g.family = shaders::kFamilyAngularPolar; }
+
+  // The per-frame solve starts from the previous frame's root; its several close roots
+  // (docs/visual-polar.md) make the grid depend on that history in the last bits.
+  void forget_frames() override {
+    sigma0_ = session_.sigma0;
+    slope_ = session_.slope;
+    e_max_ = session_.e_max;
+    r_ = session_.r;
+  }
 
   void on_frame() override {
     orthonormal_basis(gaze_, b1_, b2_);
@@ -405,11 +428,12 @@ class VisualPolar final : public PolarDistribution {
     if (!packing()) return;
     glm::dvec3 b1, b2;
     orthonormal_basis(g, b1, b2);
+    const auto sides = frustum_sides(view_, g, b1, b2);
     const int n = int(h_.size());
     phi0_.assign(size_t(n), 0.0);
     gap_.assign(size_t(n), 0.0);
     for (int i = 0; i < n; ++i) {
-      const auto [phi0, gap] = visible_arc(view_, g, b1, b2, r_[i]);
+      const auto [phi0, gap] = visible_arc(sides, r_[i]);
       const double visible = 2 * kPi - gap;
       const int rows = int(std::clamp(std::ceil(h_[i] * visible / (2 * kPi) - 1e-9), 1.0, double(h_[i])));
       if (rows == h_[i]) continue;  // a complete ring: stays full and wraps
@@ -440,9 +464,9 @@ class VisualPolar final : public PolarDistribution {
     if (packing()) {
       glm::dvec3 b1, b2;
       orthonormal_basis(centre, b1, b2);
+      const auto sides = frustum_sides(view_, centre, b1, b2);
       visible.resize(size_t(kNodes) + 1);
-      for (int k = 0; k <= kNodes; ++k)
-        visible[size_t(k)] = 1 - visible_arc(view_, centre, b1, b2, k * kStep).second / (2 * kPi);
+      for (int k = 0; k <= kNodes; ++k) visible[size_t(k)] = 1 - visible_arc(sides, k * kStep).second / (2 * kPi);
     }
     double dlog = 1;  // d log(samples) / d log σ0 at the budget's root
     auto solve_budget = [&](glm::dvec3 g, double& e_max) {
@@ -516,6 +540,10 @@ class VisualPolar final : public PolarDistribution {
   // capped), then the previous solve's first secant.
   double slope_ = 0.5;
   int evaluations_ = 0;       // column marches the last per-frame solve used
+  struct {
+    double sigma0, slope, e_max;
+    std::vector<double> r;
+  } session_;  // the warm-start state the session set-up leaves (forget_frames)
   bool reference_solve_ = false;
 };
 

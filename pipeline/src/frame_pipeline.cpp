@@ -121,7 +121,10 @@ FramePipeline::FramePipeline(gpu::Context& ctx, const renderer::GpuScene& scene,
 
 FramePipeline::~FramePipeline() = default;
 
-void FramePipeline::reset() { impl_->frames_done = 0; }
+void FramePipeline::reset() {
+  impl_->frames_done = 0;
+  for (auto& e : impl_->eyes) e->dist->restart();  // no σ0 warm start from the frames before
+}
 
 void FramePipeline::set_visibility(core::Eye eye, const core::ViewMask& mask) {
   EyeState& e = *impl_->eyes[std::size_t(impl_->index(eye, "set_visibility"))];
