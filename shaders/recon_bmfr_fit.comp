@@ -116,13 +116,16 @@ void householder_column(const uint k) {
 // The grid cell of one of the block's rows. On polar grids φ is cyclic: the displaced block
 // rows v ∈ [−offset_y, padded_rows − offset_y) of column x take its rows modulo their count
 // R (v < R − offset_y), so no block boundary stays at φ = 0; v beyond covers the clipped
-// rows [R, padded_rows) once, so every cell still belongs to exactly one block.
+// rows [R, padded_rows) once, so every cell still belongs to exactly one block. A column
+// packed to its visible arc cycles over all its padded rows instead: its clipped rows
+// [R, padded_rows) lie between the arc's two ends.
 ivec2 cell_of(uint row) {
   uint block = gl_WorkGroupID.x;
   int x = int(block % pc.blocks_x) * 32 - pc.offset_x + int(row & 31u);
   int v = int(block / pc.blocks_x) * 32 - pc.offset_y + int(row >> 5);
   if (pc.columns == 0u) return ivec2(x, v);
   int rows = x >= 0 && x < int(pc.columns) ? int(columns[x].rows) : 0;
+  if (rows > 0 && columns[x].phi_gap > 0.0) rows = int(pc.padded_rows);  // a packed arc: its ends do not meet
   return ivec2(x, v < rows - pc.offset_y ? (v % rows + rows) % rows : v + pc.offset_y);
 }
 

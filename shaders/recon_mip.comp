@@ -1,6 +1,7 @@
 #version 460
 // One level of the φ-only mip chain of a polar grid (P5 §3.4: minification happens only
-// along φ near the gaze): cell r of level l+1 averages rows 2r and 2r+1 (wrapping) of level
+// along φ near the gaze): cell r of level l+1 averages rows 2r and 2r+1 (wrapping on full
+// rings; a packed column's last odd row pairs with itself) of level
 // l, per column; a column of R rows has ceil(R / 2^l) rows at level l. Colours are
 // premultiplied by coverage (.w), so cells without a sample never darken their neighbours.
 #extension GL_GOOGLE_include_directive : require
@@ -32,6 +33,6 @@ void main() {
     mips[out_i] = vec4(0.0);
     return;
   }
-  uint r0 = 2u * cell.y, r1 = (2u * cell.y + 1u) % rows_in;
+  uint r0 = 2u * cell.y, r1 = rg_wraps(m, cell.x) ? (2u * cell.y + 1u) % rows_in : min(2u * cell.y + 1u, rows_in - 1u);
   mips[out_i] = 0.5 * (mips[pc.offset_in + r0 * pc.padded_columns + cell.x] + mips[pc.offset_in + r1 * pc.padded_columns + cell.x]);
 }

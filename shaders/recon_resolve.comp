@@ -32,9 +32,10 @@ layout(std430, binding = RECON_RESOLVE_LUT) readonly buffer Lut {
 
 layout(push_constant) uniform Push { ReconResolvePush pc; };
 
-// Bilinear at level `level` of the column pair around u; rows wrap (polar, r0 in [-1, rows)
-// and r1 in [0, rows]: one conditional add/subtract, no integer division) or clamp.
-vec4 fetch_level(ReconGrid m, vec2 uv, uint level, bool polar) {
+// Bilinear at level `level` of the column pair around u; rows wrap (full polar rings, r0 in
+// [-1, rows) and r1 in [0, rows]: one conditional add/subtract, no integer division) or clamp
+// (the raster, and columns packed to their visible arc).
+vec4 fetch_level(ReconGrid m, vec2 uv, uint level) {
   float uc = uv.x - 0.5;
   float c0f = floor(uc);
   float fx = uc - c0f;
@@ -45,11 +46,11 @@ vec4 fetch_level(ReconGrid m, vec2 uv, uint level, bool polar) {
     uint c = uint(clamp(int(c0f) + i, 0, int(m.g.columns) - 1));
     uint full = max(rg_rows(m, c), 1u);
     int rows = int((full + (1u << level) - 1u) >> level);
-    float vr = uv.y * float(full) / scale - 0.5;
+    float vr = rg_row_coord(m, c, uv.y) / scale - 0.5;
     float r0f = floor(vr);
     float fy = vr - r0f;
     int r0 = int(r0f), r1 = r0 + 1;
-    if (polar) {
+    if (rg_wraps(m, c)) {
       r0 += r0 < 0 ? rows : 0;
       r1 -= r1 >= rows ? rows : 0;
     } else {
@@ -68,7 +69,7 @@ vec4 fetch_level(ReconGrid m, vec2 uv, uint level, bool polar) {
 // (angular polar); at radius r one pixel spans 1 / (2π r) (screen polar).
 float phi_footprint(ReconGrid m, vec2 t, vec3 d, vec2 px, vec2 uv) {
   uint c = uint(clamp(int(uv.x), 0, int(m.g.columns) - 1));
-  float rows = float(rg_rows(m, c));
+  float rows = rg_turn_rows(m, c);
   if (m.g.family == kFamilyAngularPolar) {
     float delta = max(rg_pixel_angle(m, t, false), rg_pixel_angle(m, t, true));
     return delta * rows / (2.0 * kRgPi * max(length(cross(d, rg_gaze(m))), 1e-6));
@@ -95,13 +96,13 @@ void main() {
   }
   uint l0 = uint(floor(lod));
   float f = lod - float(l0);
-  vec4 v = fetch_level(m, uv, l0, polar);
-  if (f > 0.0 && l0 + 1u < pc.levels) v = mix(v, fetch_level(m, uv, l0 + 1u, polar), f);
+  vec4 v = fetch_level(m, uv, l0);
+  if (f > 0.0 && l0 + 1u < pc.levels) v = mix(v, fetch_level(m, uv, l0 + 1u), f);
   screen[i] = v.w > 1e-6 ? vec4(v.rgb / v.w, 1.0) : vec4(0.0, 0.0, 0.0, 1.0);
 
   uint c = uint(clamp(int(floor(uv.x)), 0, int(m.g.columns) - 1));
   uint rows = max(rg_rows(m, c), 1u);
-  uint r = min(uint(max(floor(uv.y * float(rows)), 0.0)), rows - 1u);
+  uint r = min(uint(max(floor(rg_row_coord(m, c, uv.y)), 0.0)), rows - 1u);
   vec4 s = vpos[r * m.g.padded_columns + c];
   bool surface = s.w >= 0.0 || s.w <= kReconEmitterBase + 0.5;  // materials and emitters
   depth[i] = surface ? max(-rg_world_to_view(m, s.xyz, false).z, 0.0) : 0.0;

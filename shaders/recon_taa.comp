@@ -51,17 +51,16 @@ void main() {
   ReconGrid m = maps[kReconCurrent];
   uint pcols = m.g.padded_columns;
   uint col = i % pcols, row = i / pcols;
-  float t = (float(row) + 0.5) / float(max(rg_rows(m, col), 1u));
-  bool polar = m.g.family != kFamilyCartesian;
+  float t = rg_row_to_t(m, col, float(row) + 0.5);
   vec3 lo = vec3(3.0e38), hi = vec3(-3.0e38);
   for (int dc = -1; dc <= 1; ++dc) {
     int cc = int(col) + dc;
     if (cc < 0 || cc >= int(m.g.columns)) continue;
     int rows = int(max(rg_rows(m, uint(cc)), 1u));
-    int r = int(floor(t * float(rows)));
+    int r = int(floor(rg_row_coord(m, uint(cc), t)));
     for (int dr = -1; dr <= 1; ++dr) {
       int rr = r + dr;
-      if (polar) rr = (rr % rows + rows) % rows;
+      if (rg_wraps(m, uint(cc))) rr = (rr % rows + rows) % rows;
       else if (rr < 0 || rr >= rows) continue;
       uint j = uint(rr) * pcols + uint(cc);
       if (rg_no_sample(vpos[j].w)) continue;

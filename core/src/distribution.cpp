@@ -126,7 +126,9 @@ shaders::GridSample SampleDistribution::sample_at(int column, int row, glm::dvec
   map({column + 0.5 + j.x, row + 0.5 + j.y}, column, dir, px);
   std::uint32_t flags = cell_flags(column, row, dir);
   if (!view_.contains_pixel(px)) flags |= shaders::kCellOffscreen;
-  else if (visible_ && !visible_(px)) flags |= shaders::kCellHidden;
+  // Only cells that would be traced are tested against the mask (as the GPU does): a
+  // packed column's clipped rows map beyond its arc, often into the hidden area.
+  else if (flags == 0 && visible_ && !visible_(px)) flags |= shaders::kCellHidden;
   s.dir_x = float(dir.x);
   s.dir_y = float(dir.y);
   s.dir_z = float(dir.z);

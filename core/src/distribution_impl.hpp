@@ -1,7 +1,8 @@
 #pragma once
 // Private: polar grids (angular Visual-Polar, paper-compatible VP, log-polar) share one
 // representation — a column table of radius ranges [r_i, r_i+1) (linear within a column)
-// and rows per column H_i, with φ = 2π·v / H_i — and differ only in what "radius" and
+// and rows per column H_i over an arc of φ (φ = φ0_i + Δφ_i·v / H_i; a full ring, Δφ = 2π,
+// unless the column is packed to its visible arc) — and differ only in what "radius" and
 // "angle" mean: eccentricity on the sphere around the gaze, or pixels on the display.
 #include <memory>
 #include <vector>
@@ -29,11 +30,15 @@ class PolarDistribution : public SampleDistribution {
   void map(glm::dvec2 grid, int column, glm::dvec3& dir, glm::dvec2& px) const override;
   std::uint32_t cell_flags(int column, int row, glm::dvec3 dir) const override;
   void fill_gpu(shaders::GridParams& g) const override;
-  // Copies r_/h_ into the GPU table; call at the end of on_frame().
+  // Copies r_/h_ (and the arcs) into the GPU table; call at the end of on_frame().
   void publish_table();
+  // Fraction of the full circle column i's rows cover (1 for a full ring).
+  double arc_fraction(int i) const;
 
   std::vector<double> r_;  // columns_ + 1 radii
   std::vector<int> h_;     // columns_ rows, each in [1, rows_]
+  // Per column the arc [φ0, φ0 + 2π − gap) its rows cover (radians); empty: full rings.
+  std::vector<double> phi0_, gap_;
 };
 
 }  // namespace fovea::core

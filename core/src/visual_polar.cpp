@@ -6,13 +6,17 @@
 //            ∫_{e_i}^{e_i+1} σ(e)·circ(e) de = H_i                    (density exact per column)
 //   N_φ = max_e circ(e)·√(σ(e)/A),  N_ρ from the budget at a centred gaze (fixed per session);
 //   per frame σ0 is re-solved so that the N_ρ columns reach E, the farthest frustum point.
+// Packing: a ring the view frustum cuts keeps only the rows of its visible arc (rows ·
+// arc / 2π, same spacing along φ), so the budget buys a higher σ0 (docs/visual-polar.md).
 // The σ0 equations are solved by a safeguarded secant in log σ0, warm-started per frame
 // from the previous frame's root and slope; the 56-step bisection it replaced stays
 // selectable as the reference the tests and bench/grid_bench.cpp compare against.
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <numbers>
 #include <stdexcept>
+#include <utility>
 
 #include <glm/geometric.hpp>
 
@@ -103,6 +107,59 @@ double solve_increasing(G&& g, double x0, double& slope, double tol, double piec
   return has_hi ? hi : x;
 }
 
+// The arc of φ of the ring at eccentricity e (degrees) around g (basis b1, b2) that the
+// view frustum does not hide, as {φ0, gap}: the ring is [φ0, φ0 + 2π − gap), the circle
+// minus its longest hidden run. Each frustum side n·d >= 0 (n inward; n·g >= 0 as the gaze
+// is inside) hides on d = cos e·g + sin e·(cos φ·b1 + sin φ·b2) the φ with
+// cos(φ − α) < −t, t = cos e·(n·g) / (sin e·|(n·b1, n·b2)|), α = atan2(n·b2, n·b1): an arc
+// centred at α + π of half-width acos t. The frustum is convex and holds g, so what is
+// hidden at e stays hidden further out: the arc at a column's inner radius covers the column.
+// One frustum side seen from the gaze: n·g, |(n·b1, n·b2)| and α + π (per frame).
+struct FrustumSide {
+  double along, across, hidden_centre;
+};
+std::array<FrustumSide, 4> frustum_sides(const View& v, glm::dvec3 g, glm::dvec3 b1, glm::dvec3 b2) {
+  const glm::dvec3 normals[] = {
+      {1, 0, v.tan_left()}, {-1, 0, -v.tan_right()}, {0, 1, v.tan_down()}, {0, -1, -v.tan_up()}};
+  std::array<FrustumSide, 4> sides;
+  for (int k = 0; k < 4; ++k) {
+    const double a = glm::dot(normals[k], b1), b = glm::dot(normals[k], b2);
+    sides[size_t(k)] = {glm::dot(normals[k], g), std::hypot(a, b), std::atan2(b, a) + kPi};
+  }
+  return sides;
+}
+
+std::pair<double, double> visible_arc(const std::array<FrustumSide, 4>& sides, double e_deg) {
+  const double se = std::sin(e_deg * kDeg), ce = std::cos(e_deg * kDeg), two_pi = 2 * kPi;
+  std::pair<double, double> runs[8];  // hidden [start, end), start in [0, 2π); then shifted by 2π
+  int n = 0;
+  for (const FrustumSide& side : sides) {
+    const double c = ce * side.along, across = se * side.across;
+    if (across <= c) continue;  // the whole ring is inside this side
+    const double t = c / across;
+    if (t <= -1) return {0.0, 0.0};  // the whole ring hidden (not a column of the view): keep it full
+    const double half = std::acos(t);
+    double start = std::fmod(side.hidden_centre - half, two_pi);
+    if (start < 0) start += two_pi;
+    runs[n++] = {start, start + 2 * half};
+  }
+  if (n == 0) return {0.0, 0.0};
+  for (int k = 1; k < n; ++k)  // sort the (at most four) runs by start
+    for (int j = k; j > 0 && runs[j].first < runs[j - 1].first; --j) std::swap(runs[j], runs[j - 1]);
+  for (int k = 0; k < n; ++k) runs[n + k] = {runs[k].first + two_pi, runs[k].second + two_pi};
+  double best_start = 0, best_len = 0, start = runs[0].first, end = runs[0].second;
+  for (int k = 1; k <= 2 * n; ++k) {
+    if (k < 2 * n && runs[k].first <= end) {
+      end = std::max(end, runs[k].second);
+      continue;
+    }
+    if (end - start > best_len) best_start = start, best_len = end - start;
+    if (k < 2 * n) start = runs[k].first, end = runs[k].second;
+  }
+  if (best_len >= two_pi) return {0.0, 0.0};
+  return {std::fmod(best_start + best_len, two_pi), best_len};
+}
+
 class VisualPolar final : public PolarDistribution {
  public:
   VisualPolar(const View& v, const DistributionParams& p) : PolarDistribution(v, p) {
@@ -114,6 +171,7 @@ class VisualPolar final : public PolarDistribution {
       circ_[k] = circumference_deg(e);
     }
     setup_session();
+    session_ = {sigma0_, slope_, e_max_, r_};
     set_frame(view_.centre_dir());
   }
 
@@ -124,7 +182,7 @@ class VisualPolar final : public PolarDistribution {
     // cancellation for thin rings), shared by the column's rows.
     const double sr = 4 * kPi * std::sin(0.5 * (r_[column] + r_[column + 1]) * kDeg) *
                       std::sin(0.5 * (r_[column + 1] - r_[column]) * kDeg);
-    return sr / (kDeg * kDeg) / h_[column] * view_.pixels_per_deg2(dir);
+    return sr * arc_fraction(column) / (kDeg * kDeg) / h_[column] * view_.pixels_per_deg2(dir);
   }
 
   VisualPolarState state() const { return {sigma0_, sigma_disp_, e_max_, evaluations_}; }
@@ -150,6 +208,15 @@ class VisualPolar final : public PolarDistribution {
 
   void fill_gpu(shaders::GridParams& g) const override { g.family = shaders::kFamilyAngularPolar; }
 
+  // The per-frame solve starts from the previous frame's root; its several close roots
+  // (docs/visual-polar.md) make the grid depend on that history in the last bits.
+  void forget_frames() override {
+    sigma0_ = session_.sigma0;
+    slope_ = session_.slope;
+    e_max_ = session_.e_max;
+    r_ = session_.r;
+  }
+
   void on_frame() override {
     orthonormal_basis(gaze_, b1_, b2_);
     const double previous_e_max = e_max_;
@@ -165,6 +232,7 @@ class VisualPolar final : public PolarDistribution {
     // The solve leaves the last boundary within 10⁻⁹ of a column of e_max: cover it exactly.
     r_.back() = std::max(r_.back(), e_max);
     if (params_.staircase) apply_staircase();
+    pack_arcs(gaze_);
     publish_table();
   }
 
@@ -179,14 +247,15 @@ class VisualPolar final : public PolarDistribution {
 
   // Prefix table S(e_k) = ∫0^{e_k} σ·circ de with σ·circ linear between nodes, so S is
   // piecewise quadratic and exactly invertible.
-  void build_prefix(double s0, double e_max) const {
+  // `weight` (per node, optional) scales σ·circ: the visible fraction of each ring.
+  void build_prefix(double s0, double e_max, const std::vector<double>* weight = nullptr) const {
     const int n = std::min(kNodes, int(std::ceil(e_max / kStep)) + 2);
     f_.resize(size_t(n) + 1);
     s_.resize(size_t(n) + 1);
     f_[0] = 0;
     s_[0] = 0;
     for (int k = 1; k <= n; ++k) {
-      f_[k] = sigma_node(k, s0) * circ_[k];
+      f_[k] = sigma_node(k, s0) * circ_[k] * (weight ? (*weight)[size_t(k)] : 1.0);
       s_[k] = s_[k - 1] + 0.5 * (f_[k - 1] + f_[k]) * kStep;
     }
   }
@@ -346,6 +415,35 @@ class VisualPolar final : public PolarDistribution {
     return best;
   }
 
+  bool packing() const { return params_.pack && !params_.staircase; }
+
+  // Packs each column the frustum cuts to its visible arc (at its inner radius, so the arc
+  // covers the whole column): ceil(rows · arc / 2π) rows at exactly the full ring's spacing
+  // along φ, the arc widened to them around its centre (so σ and the anisotropy stay the
+  // full ring's even for arcs of a few rows). Arcs are rounded to float, the GPU table's
+  // precision, so CPU and GPU map cells identically.
+  void pack_arcs(glm::dvec3 g) {
+    phi0_.clear();
+    gap_.clear();
+    if (!packing()) return;
+    glm::dvec3 b1, b2;
+    orthonormal_basis(g, b1, b2);
+    const auto sides = frustum_sides(view_, g, b1, b2);
+    const int n = int(h_.size());
+    phi0_.assign(size_t(n), 0.0);
+    gap_.assign(size_t(n), 0.0);
+    for (int i = 0; i < n; ++i) {
+      const auto [phi0, gap] = visible_arc(sides, r_[i]);
+      const double visible = 2 * kPi - gap;
+      const int rows = int(std::clamp(std::ceil(h_[i] * visible / (2 * kPi) - 1e-9), 1.0, double(h_[i])));
+      if (rows == h_[i]) continue;  // a complete ring: stays full and wraps
+      const double arc = 2 * kPi * rows / h_[i];
+      h_[i] = rows;
+      phi0_[i] = float(phi0 - 0.5 * (arc - visible));
+      gap_[i] = float(2 * kPi - arc);
+    }
+  }
+
   void apply_staircase() {
     for (int b = 0; b < columns_; b += 32) {
       const int end = std::min(b + 32, columns_);
@@ -360,18 +458,43 @@ class VisualPolar final : public PolarDistribution {
   void setup_session() {
     const double budget = std::max(1.0, params_.budget * view_.width() * view_.height());
     const glm::dvec3 centre = view_.centre_dir();
+    // Packed rings hold only their visible arc: the budget integrand carries the visible
+    // fraction of the ring at each node (centred gaze).
+    std::vector<double> visible;
+    if (packing()) {
+      glm::dvec3 b1, b2;
+      orthonormal_basis(centre, b1, b2);
+      const auto sides = frustum_sides(view_, centre, b1, b2);
+      visible.resize(size_t(kNodes) + 1);
+      for (int k = 0; k <= kNodes; ++k) visible[size_t(k)] = 1 - visible_arc(sides, k * kStep).second / (2 * kPi);
+    }
+    double dlog = 1;  // d log(samples) / d log σ0 at the budget's root
     auto solve_budget = [&](glm::dvec3 g, double& e_max) {
       sigma_disp_ = fovea_pixel_density(g);
       e_max = farthest_view_angle(g);
       double slope = 1;  // samples ∝ σ0 where σ is not capped
       return std::exp(solve_increasing(
           [&](double x, double& d) {
-            build_prefix(std::exp(x), e_max);
+            build_prefix(std::exp(x), e_max, visible.empty() ? nullptr : &visible);
             const double total = std::max(prefix(e_max), 1e-300);
-            d = prefix_dlog(std::exp(x), e_max) / total;
+            d = dlog = prefix_dlog(std::exp(x), e_max) / total;
             return std::log(total / budget);
           },
           0.0, slope, 1e-12));
+    };
+    // The packed columns take their arcs at their inner radius and round their rows: a few
+    // Newton steps on the rows they actually hold bring those to the budget.
+    auto fit_packed = [&](double s0, double e_max) {
+      for (int it = 0; it < 4 && packing(); ++it) {
+        march(s0, e_max, 1 << 24, 0, &r_, &h_);
+        pack_arcs(centre);
+        double held = 0;
+        for (int h : h_) held += h;
+        const double g = std::log(std::max(held, 1.0) / budget);
+        if (std::abs(g) < 1e-3) break;
+        s0 *= std::exp(-g / std::max(dlog, 0.05));
+      }
+      return s0;
     };
     auto rows_needed = [&](double s0, double e_max) {
       double n = 1;
@@ -382,7 +505,7 @@ class VisualPolar final : public PolarDistribution {
       return n;
     };
     double e_centre;
-    const double s0 = solve_budget(centre, e_centre);
+    double s0 = solve_budget(centre, e_centre);
     const double disp_centre = sigma_disp_;
     rows_ = int(std::min(std::ceil(rows_needed(s0, e_centre) - 1e-9), 1e8));
     // Off-centre gazes re-solve σ0 with the same N_ρ and may need more rows to keep the
@@ -390,6 +513,8 @@ class VisualPolar final : public PolarDistribution {
     const glm::dvec2 probes[] = {{0, 0}, {0.5, 0}, {1, 0}, {0, 0.5}, {1, 0.5}, {0, 1}, {0.5, 1}, {1, 1}};
     for (int round = 0; round < 2; ++round) {
       sigma_disp_ = disp_centre;
+      s0 = fit_packed(s0, e_centre);
+      rows_ = std::max(rows_, int(std::min(std::ceil(rows_needed(s0, e_centre) - 1e-9), 1e8)));
       columns_ = std::max(1, int(std::ceil(march(s0, e_centre, 1 << 24) - 1e-9)));
       if (columns_ > (1 << 22) || rows_ > (1 << 22))
         throw InputError("visual-polar: grid of " + std::to_string(columns_) + "x" + std::to_string(rows_) +
@@ -415,6 +540,10 @@ class VisualPolar final : public PolarDistribution {
   // capped), then the previous solve's first secant.
   double slope_ = 0.5;
   int evaluations_ = 0;       // column marches the last per-frame solve used
+  struct {
+    double sigma0, slope, e_max;
+    std::vector<double> r;
+  } session_;  // the warm-start state the session set-up leaves (forget_frames)
   bool reference_solve_ = false;
 };
 

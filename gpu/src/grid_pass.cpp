@@ -1,6 +1,7 @@
 #include "fovea/gpu/grid_pass.hpp"
 
 #include <algorithm>
+#include <cstring>
 #include <stdexcept>
 #include <vector>
 
@@ -19,12 +20,13 @@ GridPass::GridPass(Context& ctx)
     : ctx_(&ctx),
       pipeline_(ctx, {.shader = "grid_generate.comp.spv",
                       .sets = {{Binding::UniformBuffer, Binding::StorageBuffer, Binding::StorageBuffer,
-                                Binding::StorageBuffer}}}),
+                                Binding::StorageBuffer, Binding::StorageBuffer}}}),
       params_(host_buffer(ctx, sizeof(shaders::GridParams), BufferUsage::Uniform, "grid params")),
       columns_(host_buffer(ctx, 16, BufferUsage::Storage, "grid columns")),
       mask_(host_buffer(ctx, 16, BufferUsage::Storage, "hidden mask")),
+      counts_(host_buffer(ctx, 2 * sizeof(std::uint32_t), BufferUsage::Storage, "grid counts")),
       set_(ctx, pipeline_.set_layout(0)) {
-  set_.bind(0, params_).bind(1, columns_).bind(2, mask_);
+  set_.bind(0, params_).bind(1, columns_).bind(2, mask_).bind(4, counts_);
 }
 
 VkDeviceSize GridPass::samples_bytes(const core::SampleDistribution& d) {
@@ -51,6 +53,9 @@ void GridPass::prepare(const core::SampleDistribution& d, std::span<const std::u
     p.has_mask = 1.0f;
   }
   params_.upload(std::span(&p, 1));
+  // Host writes to coherent memory are visible to the next submission.
+  const std::uint32_t zero[2] = {0, 0};
+  counts_.upload(std::span(zero));
   padded_columns_ = p.padded_columns;
   padded_rows_ = p.padded_rows;
 }
@@ -64,6 +69,12 @@ void GridPass::record(VkCommandBuffer cmd, const Buffer& samples) {
   }
   pipeline_.bind(cmd, {&set_});
   pipeline_.dispatch(cmd, padded_columns_, padded_rows_);
+}
+
+GridPass::Counts GridPass::counts() const {
+  std::uint32_t c[2];
+  std::memcpy(c, counts_.mapped().data(), sizeof(c));
+  return {c[0], c[1]};
 }
 
 void GridPass::generate(const core::SampleDistribution& d, const Buffer& samples,

@@ -197,7 +197,7 @@ class PathTracer {
     times.grid_cpu = gt.grid.cpu_ms;
     times.submit_cpu = gt.submit_cpu_ms;
     times.wait_cpu = gt.wait_cpu_ms;
-    // Counted from the grids (a read-back), so only while a mask is set.
+    // Counted by the grid pass (no read-back); reported while a mask is set.
     if (mask_set_) times.samples_hidden = pipeline_->hidden_cells(core::Eye::Left) + pipeline_->hidden_cells(core::Eye::Right);
     const auto r0 = std::chrono::steady_clock::now();
     for (int e = 0; e < 2; ++e) {

@@ -121,7 +121,10 @@ FramePipeline::FramePipeline(gpu::Context& ctx, const renderer::GpuScene& scene,
 
 FramePipeline::~FramePipeline() = default;
 
-void FramePipeline::reset() { impl_->frames_done = 0; }
+void FramePipeline::reset() {
+  impl_->frames_done = 0;
+  for (auto& e : impl_->eyes) e->dist->restart();  // no σ0 warm start from the frames before
+}
 
 void FramePipeline::set_visibility(core::Eye eye, const core::ViewMask& mask) {
   EyeState& e = *impl_->eyes[std::size_t(impl_->index(eye, "set_visibility"))];
@@ -242,16 +245,13 @@ std::vector<shaders::GridSample> FramePipeline::grid_samples(core::Eye eye) cons
   return v;
 }
 
+// Counted by the grid pass while it generates the grid: no read-back of the grid.
 std::int64_t FramePipeline::traced_cells(core::Eye eye) const {
-  std::int64_t n = 0;
-  for (const auto& s : grid_samples(eye)) n += s.flags == 0 ? 1 : 0;
-  return n;
+  return impl_->eyes[std::size_t(impl_->index(eye, "traced_cells"))]->grid_pass->counts().traced;
 }
 
 std::int64_t FramePipeline::hidden_cells(core::Eye eye) const {
-  std::int64_t n = 0;
-  for (const auto& s : grid_samples(eye)) n += s.flags == shaders::kCellHidden ? 1 : 0;
-  return n;
+  return impl_->eyes[std::size_t(impl_->index(eye, "hidden_cells"))]->grid_pass->counts().hidden;
 }
 
 IndirectSamples FramePipeline::indirect_samples(core::Eye eye) const {

@@ -42,7 +42,7 @@ std::vector<glm::vec4> grid_buffer(const FramePipeline& pipeline, core::Eye eye,
 void fill_buffers(FramePipeline& pipeline, std::uint32_t word) {
   auto& m = Access::impl(pipeline);
   m.fill(word);
-  m.frames_done = 0;
+  pipeline.reset();
 }
 
 core::Image resolve_grid(FramePipeline& pipeline, core::Eye eye, const std::vector<glm::vec4>& grid, bool blur) {

@@ -1,5 +1,8 @@
 // Stereo sharing of indirect diffuse on the stereo-occluders scene: gathering the other
 // eye's samples raises indirect PSNR, and never pulls data across a disocclusion.
+#include <cmath>
+#include <numbers>
+
 #include <glm/gtc/quaternion.hpp>
 
 #include "fovea/core/metrics.hpp"
@@ -12,6 +15,18 @@ namespace reconstruct = fovea::reconstruct;
 namespace core = fovea::core;
 namespace renderer = fovea::renderer;
 using fovea::test::GpuTest;
+
+namespace {
+// Row coordinate in column c of the φ at row coordinate v of column c0: columns packed to
+// their visible arcs start and span differently (docs/visual-polar.md).
+double row_in_column(const std::vector<fovea::shaders::GridColumn>& t, int c0, double v, int c) {
+  const double turn = 2 * std::numbers::pi;
+  const auto arc = [&](int k) { return 1.0 - t[std::size_t(k)].phi_gap / turn; };
+  double x = t[std::size_t(c0)].phi0 / turn + v / t[std::size_t(c0)].rows * arc(c0) - t[std::size_t(c)].phi0 / turn;
+  x -= std::floor(x);
+  return x / arc(c) * t[std::size_t(c)].rows;
+}
+}  // namespace
 
 TEST_F(GpuTest, StereoGatherRaisesIndirectPsnrAndRespectsDisocclusions) {
   const renderer::Scene scene = renderer::load_scene("stereo-occluders");
@@ -58,12 +73,11 @@ TEST_F(GpuTest, StereoGatherRaisesIndirectPsnrAndRespectsDisocclusions) {
     bool all_other = true;
     for (int dc = -1; dc <= 1 && all_other; ++dc)
       for (int drow = -1; drow <= 1 && all_other; ++drow) {
-        // The same φ in the neighbouring column (rows differ per column; φ wraps).
+        // The same φ in the neighbouring column (rows and arcs differ per column; φ wraps).
         const int c0 = std::clamp(int(g->x), 0, dr.columns() - 1);
         const int c = std::clamp(c0 + dc, 0, dr.columns() - 1);
-        const double t = g->y / dr.column_table()[c0].rows;
         const int rows = int(dr.column_table()[c].rows);
-        const int r = ((int(std::floor(t * rows)) + drow) % rows + rows) % rows;
+        const int r = ((int(std::floor(row_in_column(dr.column_table(), c0, g->y, c))) + drow) % rows + rows) % rows;
         const glm::vec4 q = rpos[std::size_t(r) * dr.padded_columns() + c];
         all_other = q.w >= 0 && glm::length(glm::dvec3(q) - p) > 0.2 * glm::length(p - vr.pose().position);
       }
@@ -72,7 +86,9 @@ TEST_F(GpuTest, StereoGatherRaisesIndirectPsnrAndRespectsDisocclusions) {
     EXPECT_EQ(shared[i], own_b[i]) << "cell " << i;
   }
   std::printf("%d left-eye cells disoccluded in the right eye\n", occluded);
-  EXPECT_GT(occluded, 3);  // the pillars hide some of the wall from the right eye
+  // The pillars hide some of the wall from the right eye: 2 cells of the packed grid at this
+  // size (more than 3 with full rings), each checked above.
+  EXPECT_GE(occluded, 2);
 }
 
 TEST_F(GpuTest, StereoAlternateFillsTheUntracedEyeFromTheOther) {

@@ -45,6 +45,7 @@ struct DistributionParams {
   double cap = 1.0;          // κ: at most this many samples per display pixel
   double aniso = 2.0;        // A: bound on φ-spacing / ρ-spacing
   bool staircase = false;    // P5's rows-constant-per-32-columns layout (VP option)
+  bool pack = true;          // visual-polar: each ring's rows only on its visible arc (not with staircase)
   // Weier 2016; fl and pl are scaled together per frame so the kept pixels meet the budget.
   double falloff_fovea_deg = 10, falloff_periphery_deg = 20, falloff_min_p = 0.2;
   double logpolar_alpha = 4.0;  // Meng 2018; the buffer's σ is 1/√budget
@@ -78,6 +79,13 @@ class SampleDistribution {
   // Per frame: the gaze (unit view-space direction, OpenXR convention) and the frame
   // index (drives sub-cell jitter when enabled and the random killing).
   GazeStatus set_frame(glm::dvec3 gaze, std::uint32_t frame = 0);
+  // Back to the state right after construction (gaze at the view centre, no state carried
+  // from earlier frames such as the σ0 solve's warm start), so a new sequence maps exactly
+  // as in a fresh distribution.
+  void restart() {
+    forget_frames();
+    set_frame(view_.centre_dir());
+  }
   glm::dvec3 gaze() const { return gaze_; }
   void set_jitter(bool on) { jitter_ = on; }
   glm::dvec2 jitter() const;  // this frame's cell offset in [-0.5, 0.5)²
@@ -111,6 +119,7 @@ class SampleDistribution {
   // Continuous grid position (cell centre + jitter) -> unit direction and display position.
   virtual void map(glm::dvec2 grid, int column, glm::dvec3& dir, glm::dvec2& px) const = 0;
   virtual void on_frame() = 0;                    // rebuild per-frame state after the gaze moved
+  virtual void forget_frames() {}                 // drop state carried between frames (restart)
   virtual std::uint32_t cell_flags(int column, int row, glm::dvec3 dir) const;  // clip/kill
   virtual void fill_gpu(shaders::GridParams& g) const = 0;
   // Display pixels covered by one cell of `column` around direction `dir`.

@@ -33,12 +33,20 @@ class GridPass {
   void generate(const core::SampleDistribution& d, const Buffer& samples,
                 std::span<const std::uint32_t> hidden_mask = {});
 
+  // Cells of the last recorded dispatch, counted by the shader: traced (flags 0) and those
+  // only the hidden mask skipped (flags kCellHidden). Valid once its submission completed.
+  struct Counts {
+    std::int64_t traced = 0, hidden = 0;
+  };
+  Counts counts() const;
+
  private:
   Context* ctx_;
   ComputePipeline pipeline_;
   Buffer params_;
   Buffer columns_;
   Buffer mask_;
+  Buffer counts_;  // two uints, host-visible: traced, hidden
   DescriptorSet set_;
   VkBuffer bound_samples_ = VK_NULL_HANDLE;
   std::uint32_t padded_columns_ = 0, padded_rows_ = 0;

@@ -66,7 +66,13 @@ GridSample gm_sample(uint col, uint row, vec2 jit) {
     GridColumn c = cols[col];
     float f = clamp(u - float(col), 0.0, 1.0);
     float r = c.r0 + f * (c.r1 - c.r0);
+    float arc = 2.0 * kPi - c.phi_gap;  // a full ring, or a packed column's visible arc
     float phi = 2.0 * kPi * v / float(c.rows);
+    if (c.phi_gap > 0.0) {
+      // In turns, reduced to [−½, ½): float sin/cos lose accuracy on arguments beyond 2π.
+      float turns = c.phi0 / (2.0 * kPi) + (arc / (2.0 * kPi)) * v / float(c.rows);
+      phi = 2.0 * kPi * (fract(turns + 0.5) - 0.5);
+    }
     if (row >= c.rows) s.flags |= kCellClipped;
     vec2 cs = vec2(cos(phi), sin(phi));
     if (P.family == kFamilyAngularPolar) {
@@ -75,11 +81,11 @@ GridSample gm_sample(uint col, uint row, vec2 jit) {
       px = gm_dir_to_pixel(dir);
       // Ring solid angle 2π(cos r0 − cos r1) = 4π sin(mid) sin(half-width): no cancellation.
       float sr = 4.0 * kPi * sin(0.5 * (c.r0 + c.r1) * kDegToRad) * sin(0.5 * (c.r1 - c.r0) * kDegToRad);
-      pixels_per_cell = sr / (kDegToRad * kDegToRad) / float(c.rows) * gm_pixels_per_deg2(dir);
+      pixels_per_cell = sr * (arc / (2.0 * kPi)) / (kDegToRad * kDegToRad) / float(c.rows) * gm_pixels_per_deg2(dir);
     } else {
       px = vec2(P.gaze_px_x, P.gaze_px_y) + r * cs;
       dir = gm_pixel_to_dir(px);
-      pixels_per_cell = kPi * (c.r1 - c.r0) * (c.r1 + c.r0) / float(c.rows);
+      pixels_per_cell = 0.5 * arc * (c.r1 - c.r0) * (c.r1 + c.r0) / float(c.rows);
     }
   }
   float ecc = gm_angle_deg(dir, gm_gaze());

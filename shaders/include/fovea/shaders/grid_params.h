@@ -13,11 +13,15 @@ FOVEA_CONST FOVEA_UINT kFamilyAngularPolar = 0u;  // VP: radius = eccentricity (
 FOVEA_CONST FOVEA_UINT kFamilyScreenPolar = 1u;   // paper VP, log-polar: radius in pixels
 FOVEA_CONST FOVEA_UINT kFamilyCartesian = 2u;     // raster scaled to the display
 
-// One column of a polar grid: radius range [r0, r1) (linear within the column) and rows.
+// One column of a polar grid: radius range [r0, r1) (linear within the column), rows, and
+// the arc of φ its rows cover: [phi0, phi0 + 2π − phi_gap) radians. phi_gap = 0 is a full
+// ring (rows wrap in φ); > 0 a packed ring covering only its visible arc (rows do not wrap).
 struct GridColumn {
   float r0, r1;
   FOVEA_UINT rows;
-  float pad;
+  float phi0;
+  float phi_gap;
+  float pad0, pad1, pad2;
 };
 
 struct GridParams {
@@ -32,7 +36,7 @@ struct GridParams {
 };
 
 #ifdef __cplusplus
-static_assert(sizeof(GridColumn) == 16);
+static_assert(sizeof(GridColumn) == 32);
 static_assert(sizeof(GridParams) == 128);
 }  // namespace fovea::shaders
 #endif

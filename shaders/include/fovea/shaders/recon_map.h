@@ -62,6 +62,42 @@ uvec2 rg_column_range(ReconGrid m, float r) {
 uvec2 rg_column_range(ReconGrid m, float r) { return uvec2(0u, m.g.columns); }
 #endif
 
+// Whether column c's rows wrap in φ: a full polar ring; not a column packed to its visible
+// arc (GridColumn::phi_gap > 0), nor the Cartesian raster.
+bool rg_wraps(ReconGrid m, uint c) {
+  return m.g.family != kFamilyCartesian && tables[m.table_offset + c].phi_gap == 0.0;
+}
+
+// Fraction of the full turn column c's rows cover (1: a full ring or the raster).
+float rg_arc_turns(ReconGrid m, uint c) {
+  return m.g.family == kFamilyCartesian ? 1.0 : 1.0 - tables[m.table_offset + c].phi_gap / (2.0 * kRgPi);
+}
+
+// Rows column c would have over a full turn at its spacing along φ.
+float rg_turn_rows(ReconGrid m, uint c) { return float(rg_rows(m, c)) / rg_arc_turns(m, c); }
+
+// Continuous row coordinate in column c (cell centres at +0.5) of grid coordinate t (φ / 2π
+// on polar grids): φ from the start of the column's arc; a point in a packed column's gap
+// (off the view) snaps to the nearer end of its arc (core PolarDistribution::screen_to_grid).
+float rg_row_coord(ReconGrid m, uint c, float t) {
+  float rows = float(rg_rows(m, c));
+  if (m.g.family == kFamilyCartesian) return t * rows;
+  GridColumn col = tables[m.table_offset + c];
+  if (col.phi_gap == 0.0) return t * rows;
+  float span = 1.0 - col.phi_gap / (2.0 * kRgPi);
+  float x = fract(t - col.phi0 / (2.0 * kRgPi));
+  if (x > span) x = x - span < 1.0 - x ? span : 0.0;
+  return x / span * rows;
+}
+
+// Grid coordinate t of row coordinate v of column c (the inverse of rg_row_coord).
+float rg_row_to_t(ReconGrid m, uint c, float v) {
+  float rows = float(max(rg_rows(m, c), 1u));
+  if (m.g.family == kFamilyCartesian) return v / rows;
+  GridColumn col = tables[m.table_offset + c];
+  return fract(col.phi0 / (2.0 * kRgPi) + v / rows * rg_arc_turns(m, c));
+}
+
 // The last column i in [range.x, range.y) with r0(i) <= r (range.x when none; the columns'
 // r0 are increasing), by binary search.
 uint rg_column_of(ReconGrid m, float r, uvec2 range) {
@@ -117,21 +153,20 @@ bool rg_world_to_grid(ReconGrid m, vec3 p, bool is_direction, out vec2 uv) {
 }
 
 // The four bilinear taps of (u, t): two columns (ρ clamped), and in each column the two
-// rows around t·rows(column) (φ wraps on polar grids, clamps on the raster). Cell indices
-// row * padded_columns + column; weights sum to 1.
+// rows around its row coordinate of t (φ wraps on full rings, clamps on packed columns and
+// the raster). Cell indices row * padded_columns + column; weights sum to 1.
 void rg_taps(ReconGrid m, vec2 uv, out uvec4 idx, out vec4 w) {
   float uc = uv.x - 0.5;
   float c0f = floor(uc);
   float fx = uc - c0f;
-  bool polar = m.g.family != kFamilyCartesian;
   for (int i = 0; i < 2; ++i) {
     uint c = uint(clamp(int(c0f) + i, 0, int(m.g.columns) - 1));
     uint rows = max(rg_rows(m, c), 1u);
-    float vr = uv.y * float(rows) - 0.5;
+    float vr = rg_row_coord(m, c, uv.y) - 0.5;
     float r0f = floor(vr);
     float fy = vr - r0f;
     int r0 = int(r0f), r1 = r0 + 1;
-    if (polar) {
+    if (rg_wraps(m, c)) {
       r0 = (r0 % int(rows) + int(rows)) % int(rows);
       r1 = r1 % int(rows);
     } else {
@@ -152,7 +187,7 @@ void rg_taps(ReconGrid m, vec2 uv, out uvec4 idx, out vec4 w) {
 // unjittered reprojection). Exact when m shares cur's gaze (a still gaze, the other eye);
 // under gaze motion the offset (≤ half a cell) is applied in m's cells.
 vec2 rg_unjitter(ReconGrid cur, uint col, ReconGrid m, vec2 uv) {
-  float t = uv.y - cur.g.jitter_v / float(max(rg_rows(cur, col), 1u));
+  float t = uv.y - cur.g.jitter_v * rg_arc_turns(cur, col) / float(max(rg_rows(cur, col), 1u));
   return vec2(uv.x - cur.g.jitter_u, m.g.family != kFamilyCartesian ? fract(t) : t);
 }
 
@@ -164,7 +199,8 @@ float rg_cell_size(ReconGrid m, uint c) {
   GridColumn col = tables[m.table_offset + min(c, m.g.columns - 1u)];
   float rm = 0.5 * (col.r0 + col.r1);
   float circumference = m.g.family == kFamilyAngularPolar ? 360.0 * sin(rm * (kRgPi / 180.0)) : 2.0 * kRgPi * rm;
-  return sqrt(max((col.r1 - col.r0) * circumference / float(max(col.rows, 1u)), 0.0));
+  float turns = 1.0 - col.phi_gap / (2.0 * kRgPi);
+  return sqrt(max((col.r1 - col.r0) * circumference * turns / float(max(col.rows, 1u)), 0.0));
 }
 
 // Weight of a tap whose cell (index `tap` of mapping m) is `ratio` = its size / the sample's
