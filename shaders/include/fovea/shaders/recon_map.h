@@ -110,6 +110,22 @@ void rg_taps(ReconGrid m, vec2 uv, out uvec4 idx, out vec4 w) {
   }
 }
 
+// Cell k of mapping m next to cell j: dc columns over (false beyond the grid), then dr rows
+// from the row at j's φ in that column (φ wraps on polar grids, false beyond the raster).
+bool rg_neighbour(ReconGrid m, uint j, int dc, int dr, out uint k) {
+  k = j;
+  uint pcols = m.g.padded_columns, col = j % pcols;
+  int cc = int(col) + dc;
+  if (cc < 0 || cc >= int(m.g.columns)) return false;
+  float t = (float(j / pcols) + 0.5) / float(max(rg_rows(m, col), 1u));
+  int rows = int(max(rg_rows(m, uint(cc)), 1u));
+  int rr = int(floor(t * float(rows))) + dr;
+  if (m.g.family != kFamilyCartesian) rr = (rr % rows + rows) % rows;
+  else if (rr < 0 || rr >= rows) return false;
+  k = uint(rr) * pcols + uint(cc);
+  return true;
+}
+
 // Where the centre of the current frame's cell `col` lies in mapping m, given the grid
 // coordinate uv in m of the cell's (jittered) sample: the current jitter (cells of `cur`) is
 // taken off, so taps read cells whose accumulated content stands for their centres (TAA's
