@@ -97,7 +97,7 @@ void main() {
       for (int k = 0; k < 4; ++k) {
         if (w[k] <= 0.0 || !seen_near(prev, idx[k], here, n, depth)) w[k] = 0.0;
         valid += w[k];
-        w[k] *= rg_coarse_weight(prev, idx[k], own);
+        w[k] *= rg_coarse_weight(prev, idx[k], own, pc.coarse_keep, pc.coarse_reject);
         kept += w[k];
       }
       if (kept > 1e-4) {

@@ -148,12 +148,12 @@ float rg_cell_size(ReconGrid m, uint c) {
 }
 
 // Weight of a tap whose cell (index `tap` of mapping m) is `ratio` = its size / the sample's
-// own cell size: 1 up to kReconCoarseKeep, falling linearly to 0 at kReconCoarseReject. A
+// own cell size: 1 up to `keep`, falling linearly to 0 at `reject` (ReconSettings). A
 // coarser cell holds a blurred estimate (after a saccade the new fovea lands on old
 // periphery); reusing it would keep the fovea blurred for many frames.
-float rg_coarse_weight(ReconGrid m, uint tap, float own_size) {
+float rg_coarse_weight(ReconGrid m, uint tap, float own_size, float keep, float reject) {
   float ratio = rg_cell_size(m, tap % m.g.padded_columns) / max(own_size, 1e-12);
-  return clamp((kReconCoarseReject - ratio) / (kReconCoarseReject - kReconCoarseKeep), 0.0, 1.0);
+  return clamp((reject - ratio) / max(reject - keep, 1e-6), 0.0, 1.0);
 }
 
 // Tap validity (see kRecon* above). vpos: xyz world position (sky: world direction),
