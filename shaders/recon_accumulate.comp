@@ -3,7 +3,8 @@
 // sample's world position is reprojected into the previous frame's view and grid mapping
 // (the gaze moved), the history is fetched bilinearly with a validity test per tap,
 // renormalised over the accepted taps, and blended with α = max(1/n, α_min) (CMA, then EMA).
-// Taps are read at the cell centre (the frame's sub-cell jitter taken off), and taps from
+// Taps are read at the cell centre (the frame's sub-cell jitter taken off) and count as valid
+// when the sample's surface was seen in the tap's cell or next to it (seen_near); taps from
 // cells coarser than the sample's own are down-weighted or rejected (rg_coarse_weight).
 // Direct+specular and indirect diffuse are accumulated separately (the indirect one is
 // shared between the eyes later); each carries its own 8-bit sample count in .w.
@@ -38,6 +39,20 @@ layout(std430, binding = RECON_ACC_MATERIALS) readonly buffer Materials { PtMate
 #include "fovea/shaders/recon_map.h"
 
 layout(push_constant) uniform Push { ReconAccumulatePush pc; };
+
+// Whether the previous frame saw the sample's surface (rg_tap_valid) in cell j of mapping m
+// or next to it. With sub-cell jitter a cell on an edge sees one side or the other from
+// frame to frame; its history stands for the cell's whole area, so it stays valid as long
+// as the surface now hit was seen within a cell of it. A disocclusion has no such neighbour.
+bool seen_near(ReconGrid m, uint j, vec4 here, vec3 n, float depth) {
+  if (rg_no_sample(prev_pos[j].w)) return false;
+  for (int dc = -1; dc <= 1; ++dc)
+    for (int dr = -1; dr <= 1; ++dr) {
+      uint k;
+      if (rg_neighbour(m, j, dc, dr, k) && rg_tap_valid(here, n, depth, prev_pos[k], prev_nrm[k].xyz)) return true;
+    }
+  return false;
+}
 
 void main() {
   uint i = gl_GlobalInvocationID.x;
@@ -80,9 +95,9 @@ void main() {
       rg_taps(prev, rg_unjitter(cur, col, prev, uv), idx, w);
       float own = rg_cell_size(cur, col), valid = 0.0, kept = 0.0;
       for (int k = 0; k < 4; ++k) {
-        if (w[k] <= 0.0 || !rg_tap_valid(here, n, depth, prev_pos[idx[k]], prev_nrm[idx[k]].xyz)) w[k] = 0.0;
+        if (w[k] <= 0.0 || !seen_near(prev, idx[k], here, n, depth)) w[k] = 0.0;
         valid += w[k];
-        w[k] *= rg_coarse_weight(prev, idx[k], own);
+        w[k] *= rg_coarse_weight(prev, idx[k], own, pc.coarse_keep, pc.coarse_reject);
         kept += w[k];
       }
       if (kept > 1e-4) {

@@ -55,7 +55,7 @@ void main() {
       vec4 acc = vec4(0.0);
       for (int k = 0; k < 4; ++k) {
         if (w[k] <= 0.0 || !rg_tap_valid(here, n.xyz, n.w, other_pos[idx[k]], other_nrm[idx[k]].xyz)) continue;
-        w[k] *= rg_coarse_weight(other, idx[k], own_size);
+        w[k] *= rg_coarse_weight(other, idx[k], own_size, pc.coarse_keep, pc.coarse_reject);
         acc += w[k] * other_indirect[idx[k]];
         wsum += w[k];
       }

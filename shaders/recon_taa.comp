@@ -49,26 +49,15 @@ void main() {
     return;
   }
   ReconGrid m = maps[kReconCurrent];
-  uint pcols = m.g.padded_columns;
-  uint col = i % pcols, row = i / pcols;
-  float t = rg_row_to_t(m, col, float(row) + 0.5);
   vec3 lo = vec3(3.0e38), hi = vec3(-3.0e38);
-  for (int dc = -1; dc <= 1; ++dc) {
-    int cc = int(col) + dc;
-    if (cc < 0 || cc >= int(m.g.columns)) continue;
-    int rows = int(max(rg_rows(m, uint(cc)), 1u));
-    int r = int(floor(rg_row_coord(m, uint(cc), t)));
+  for (int dc = -1; dc <= 1; ++dc)
     for (int dr = -1; dr <= 1; ++dr) {
-      int rr = r + dr;
-      if (rg_wraps(m, uint(cc))) rr = (rr % rows + rows) % rows;
-      else if (rr < 0 || rr >= rows) continue;
-      uint j = uint(rr) * pcols + uint(cc);
-      if (rg_no_sample(vpos[j].w)) continue;
+      uint j;
+      if (!rg_neighbour(m, i, dc, dr, j) || rg_no_sample(vpos[j].w)) continue;
       vec3 y = to_ycocg(remodulated(j));
       lo = min(lo, y);
       hi = max(hi, y);
     }
-  }
   uvec4 idx = tap_idx[i];
   vec3 h = vec3(0.0);
   for (int k = 0; k < 4; ++k) h += w[k] * prev_final[idx[k]].rgb;

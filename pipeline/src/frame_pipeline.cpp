@@ -176,8 +176,8 @@ FrameTimes FramePipeline::render(const std::array<core::Pose, 2>& eye_pose, cons
     gpu::compute_to_compute(cmd);
     m.timer.stage(cmd, "trace");
     t.trace.cpu_ms = lap_ms(r0);
-    m.accumulation->record(cmd, p, history, std::span(fresh, m.eyes.size()), m.settings.alpha_min);
-    m.gather->record(cmd, p, stereo && m.settings.share != reconstruct::StereoShare::Off);
+    m.accumulation->record(cmd, p, history, std::span(fresh, m.eyes.size()), m.settings);
+    m.gather->record(cmd, p, stereo && m.settings.share != reconstruct::StereoShare::Off, m.settings);
     m.timer.stage(cmd, "accumulate");
     if (m.bmfr)
       m.bmfr->record(cmd, p, frame, m.settings.block_offsets ? reconstruct::bmfr_block_offset(frame) : glm::ivec2(0),

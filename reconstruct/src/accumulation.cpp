@@ -35,11 +35,12 @@ Accumulation::Accumulation(gpu::Context& ctx, std::span<const EyeGrid> eyes, con
 }
 
 void Accumulation::record(VkCommandBuffer cmd, int parity, bool history, std::span<const bool> fresh,
-                          float alpha_min) const {
+                          const ReconSettings& s) const {
   for (std::size_t i = 0; i < eyes_.size(); ++i) {
     const Eye& e = eyes_[i];
     kernel_.run(cmd, {&e.set[parity]},
-                shaders::ReconAccumulatePush{e.cells, history ? 1u : 0u, fresh[i] ? 1u : 0u, 0, alpha_min, 0, 0, 0},
+                shaders::ReconAccumulatePush{e.cells, history ? 1u : 0u, fresh[i] ? 1u : 0u, 0, s.alpha_min,
+                                             s.coarse_keep, s.coarse_reject, 0},
                 e.cells);
   }
   gpu::compute_to_compute(cmd);
@@ -71,9 +72,10 @@ StereoGather::StereoGather(gpu::Context& ctx, std::span<const EyeGrid> eyes, con
   }
 }
 
-void StereoGather::record(VkCommandBuffer cmd, int parity, bool share) const {
+void StereoGather::record(VkCommandBuffer cmd, int parity, bool share, const ReconSettings& s) const {
   for (const Eye& e : eyes_)
-    kernel_.run(cmd, {&e.set[parity]}, shaders::ReconSharePush{e.cells, share ? 1u : 0u, 0, 0}, e.cells);
+    kernel_.run(cmd, {&e.set[parity]},
+                shaders::ReconSharePush{e.cells, share ? 1u : 0u, s.coarse_keep, s.coarse_reject}, e.cells);
   gpu::compute_to_compute(cmd);
 }
 

@@ -83,7 +83,7 @@ With no options: a short demo on the shipped scene and gaze.
   --budget B            grid samples as a fraction of display pixels, met within 5% or
                         refused with exit 2 naming what the distribution reaches
                         (cartesian: 1 only) [0.39]
-  --jitter on|off       per-frame sub-cell jitter (Halton 2, 3) of every grid [off]
+  --jitter on|off       per-frame sub-cell jitter (Halton 2, 3) of every grid [on]
   --denoiser D          bmfr | none (accumulation only) [bmfr]
   --bmfr-precision P    fp32 | fp16: storage of BMFR's regression matrix [fp32]
   --stereo-share M      off | gather | alternate [gather]
@@ -241,7 +241,7 @@ int run(std::vector<std::string> argv) {
   core::DistributionParams dp;
   dp.kind = core::parse_distribution(args.str("distribution", "visual-polar"));
   dp.budget = args.num("budget", dp.budget);
-  dp.jitter = core::parse_jitter(args.str("jitter", "off"));
+  dp.jitter = core::parse_jitter(args.str("jitter", "on"));
   // Cartesian traces every pixel: a smaller budget is cartesian-uniform's job.
   if (dp.kind == core::DistributionKind::Cartesian) {
     if (args.has("budget") && dp.budget != 1.0)

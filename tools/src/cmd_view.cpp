@@ -52,7 +52,7 @@ of view directions (lines every 5 degrees), a picture of the optics.
                         (docs/gaze.md), sampled at frame / refresh rate [0.5,0.5]
   --gaze-dir x,y,z      fixed gaze as a view-space direction (OpenXR: -Z forward, +Y up)
   --budget B            grid samples as a fraction of display pixels [0.39]
-  --jitter on|off       per-frame sub-cell jitter (Halton 2, 3) of every grid [off]
+  --jitter on|off       per-frame sub-cell jitter (Halton 2, 3) of every grid [on]
   --optics direct|lut   distortion pass: evaluate the optics per pixel, or read them from
                         the 128x128 LUT cache [direct]
   --window WxH          window size [fits both panels in 1280x720]
@@ -130,7 +130,7 @@ int run(std::vector<std::string> argv) {
   const compositor::OpticsEval eval = parse_optics(args.str("optics", "direct"));
   core::DistributionParams dp;
   dp.budget = args.num("budget", dp.budget);
-  dp.jitter = core::parse_jitter(args.str("jitter", "off"));
+  dp.jitter = core::parse_jitter(args.str("jitter", "on"));
   dp.validate();
   const core::EyeOptics optics[2] = {core::EyeOptics(d, core::Eye::Left), core::EyeOptics(d, core::Eye::Right)};
 

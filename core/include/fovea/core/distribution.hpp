@@ -50,7 +50,7 @@ struct DistributionParams {
   double falloff_fovea_deg = 10, falloff_periphery_deg = 20, falloff_min_p = 0.2;
   double logpolar_alpha = 4.0;  // Meng 2018; the buffer's σ is 1/√budget
   std::uint32_t seed = 0;    // random killing (linear fall-off)
-  bool jitter = false;       // per-frame Halton (2, 3) sub-cell offset (anti-aliasing over frames)
+  bool jitter = true;        // per-frame Halton (2, 3) sub-cell offset (anti-aliasing over frames)
 
   void validate() const;     // InputError naming the parameter
 };

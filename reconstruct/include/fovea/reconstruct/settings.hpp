@@ -32,6 +32,11 @@ struct ReconSettings {
   float alpha_min = 0.2f;        // BMFR Phase I EMA floor
   float post_alpha_min = 0.1f;   // BMFR Phase III EMA floor
   float taa_alpha = 0.2f;        // TAA blend (Karis 2014 / BMFR reference)
+  // Cell-size awareness of history and other-eye taps: a tap from a cell up to coarse_keep
+  // times the sample's cell size (linear) counts fully, beyond that less, not at all from
+  // coarse_reject on. Smooth pursuit changes sizes by < 1.25 per frame at 2.5°/frame; a
+  // saccade by far more. Huge values switch the test off (for measuring what it does).
+  float coarse_keep = 1.25f, coarse_reject = 2.0f;
   float noise = 0.01f;           // stochastic regularisation ε (BMFR Eq. 7)
   bool block_offsets = true;     // 16 static block-grid displacements
   bool blur = true;              // peripheral blur

@@ -37,7 +37,8 @@ class Accumulation {
  public:
   Accumulation(gpu::Context& ctx, std::span<const EyeGrid> eyes, const gpu::Buffer& materials);
   // `fresh[e]`: eye e traced new indirect diffuse this frame.
-  void record(VkCommandBuffer cmd, int parity, bool history, std::span<const bool> fresh, float alpha_min) const;
+  void record(VkCommandBuffer cmd, int parity, bool history, std::span<const bool> fresh,
+              const ReconSettings& settings) const;
   void fill(VkCommandBuffer cmd, std::uint32_t word) const;
 
   const gpu::Buffer& direct(int eye, int parity) const { return eyes_[eye].direct[parity]; }
@@ -61,7 +62,7 @@ class StereoGather {
  public:
   StereoGather(gpu::Context& ctx, std::span<const EyeGrid> eyes, const Accumulation& acc);
   // `share`: gather the other eye's indirect diffuse (else z = own direct + indirect).
-  void record(VkCommandBuffer cmd, int parity, bool share) const;
+  void record(VkCommandBuffer cmd, int parity, bool share, const ReconSettings& settings) const;
   void fill(VkCommandBuffer cmd, std::uint32_t word) const;
 
   const gpu::Buffer& shared(int eye) const { return eyes_[eye].shared; }

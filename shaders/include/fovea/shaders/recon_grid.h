@@ -34,11 +34,6 @@ FOVEA_CONST FOVEA_UINT kReconOther = 2u;
 FOVEA_CONST float kReconNormalLimit2 = 0.25f;
 FOVEA_CONST float kReconPlaneTol = 0.03f;
 FOVEA_CONST float kReconDistTol = 0.25f;  // and |Δp| < this·depth (other surfaces far along the plane)
-// Cell-size awareness: a tap from a cell up to kReconCoarseKeep times the sample's cell size
-// (linear) counts fully, beyond that less, and not at all from kReconCoarseReject on. Smooth
-// pursuit changes sizes by < 1.25 per frame at 2.5°/frame; a saccade by far more.
-FOVEA_CONST float kReconCoarseKeep = 1.25f;
-FOVEA_CONST float kReconCoarseReject = 2.0f;
 
 // Material codes in the validation data (.w of the position): >= 0 a surface, -1 the sky
 // (position = direction), -2 no sample, <= -3 an emitter (−3 − material): emission is not
@@ -49,11 +44,13 @@ FOVEA_CONST float kReconEmitterBase = -3.0f;
 
 struct ReconAccumulatePush {
   FOVEA_UINT cells, has_history, indirect_fresh, pad;  // indirect_fresh = 0: reuse history only
-  float alpha_min, pad1, pad2, pad3;                   // EMA floor (BMFR Phase I: 0.2)
+  float alpha_min;                                     // EMA floor (BMFR Phase I: 0.2)
+  float coarse_keep, coarse_reject, pad1;              // cell-size test (ReconSettings, rg_coarse_weight)
 };
 
 struct ReconSharePush {
-  FOVEA_UINT cells, enabled, pad0, pad1;
+  FOVEA_UINT cells, enabled;
+  float coarse_keep, coarse_reject;  // as ReconAccumulatePush
 };
 
 struct ReconBmfrPush {

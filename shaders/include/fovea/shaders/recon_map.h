@@ -181,6 +181,23 @@ void rg_taps(ReconGrid m, vec2 uv, out uvec4 idx, out vec4 w) {
   }
 }
 
+// Cell k of mapping m next to cell j: dc columns over (false beyond the grid), then dr rows
+// from the row at j's φ in that column (φ wraps on full rings; false beyond the raster or the
+// ends of a column packed to its visible arc).
+bool rg_neighbour(ReconGrid m, uint j, int dc, int dr, out uint k) {
+  k = j;
+  uint pcols = m.g.padded_columns, col = j % pcols;
+  int cc = int(col) + dc;
+  if (cc < 0 || cc >= int(m.g.columns)) return false;
+  float t = rg_row_to_t(m, col, float(j / pcols) + 0.5);
+  int rows = int(max(rg_rows(m, uint(cc)), 1u));
+  int rr = int(floor(rg_row_coord(m, uint(cc), t))) + dr;
+  if (rg_wraps(m, uint(cc))) rr = (rr % rows + rows) % rows;
+  else if (rr < 0 || rr >= rows) return false;
+  k = uint(rr) * pcols + uint(cc);
+  return true;
+}
+
 // Where the centre of the current frame's cell `col` lies in mapping m, given the grid
 // coordinate uv in m of the cell's (jittered) sample: the current jitter (cells of `cur`) is
 // taken off, so taps read cells whose accumulated content stands for their centres (TAA's
@@ -204,12 +221,12 @@ float rg_cell_size(ReconGrid m, uint c) {
 }
 
 // Weight of a tap whose cell (index `tap` of mapping m) is `ratio` = its size / the sample's
-// own cell size: 1 up to kReconCoarseKeep, falling linearly to 0 at kReconCoarseReject. A
+// own cell size: 1 up to `keep`, falling linearly to 0 at `reject` (ReconSettings). A
 // coarser cell holds a blurred estimate (after a saccade the new fovea lands on old
 // periphery); reusing it would keep the fovea blurred for many frames.
-float rg_coarse_weight(ReconGrid m, uint tap, float own_size) {
+float rg_coarse_weight(ReconGrid m, uint tap, float own_size, float keep, float reject) {
   float ratio = rg_cell_size(m, tap % m.g.padded_columns) / max(own_size, 1e-12);
-  return clamp((kReconCoarseReject - ratio) / (kReconCoarseReject - kReconCoarseKeep), 0.0, 1.0);
+  return clamp((reject - ratio) / max(reject - keep, 1e-6), 0.0, 1.0);
 }
 
 // Tap validity (see kRecon* above). vpos: xyz world position (sky: world direction),
