@@ -15,6 +15,7 @@
 
 #include "fovea/reconstruct/bmfr.hpp"
 #include "fovea/gpu/context.hpp"
+#include "fovea/shaders/pt_scene.h"
 
 namespace fc = fovea::reconstruct;
 namespace fg = fovea::gpu;
@@ -73,11 +74,20 @@ void fit(benchmark::State& state) {
   };
   fg::Buffer p = make("bench.vpos"), n = make("bench.vnrm"), z = make("bench.z"), out = make("bench.fitted"),
              columns = make("bench.columns");  // unread: a raster grid does not wrap
+  // The room's two material codes, both diffuse (white, not metallic).
+  fovea::shaders::PtMaterial white{};
+  white.base_r = white.base_g = white.base_b = 1.0f;
+  white.texture = -1;
+  const std::vector<fovea::shaders::PtMaterial> table{white, white};
+  fg::Buffer materials(ctx, {.size = table.size() * sizeof(white), .usage = fg::BufferUsage::Storage,
+                             .memory = fg::Memory::HostVisible, .name = "bench.materials"});
   p.upload(in.pos);
   n.upload(in.nrm);
   z.upload(in.z);
+  materials.upload(table);
   const fc::BmfrFit bmfr(ctx, options);
-  const fg::DescriptorSet set = bmfr.bind(p, n, z, out, columns);
+  fg::Buffer excess = make("bench.excess");
+  const fg::DescriptorSet set = bmfr.bind(p, n, z, out, columns, materials, excess);
   std::uint32_t frame = 0;
   auto run = [&] {
     ctx.submit_and_wait([&](VkCommandBuffer cmd) {

@@ -5,8 +5,10 @@
 // uniform ±ε noise on the non-constant features (Eq. 7), Householder QR of [T + N | z_r z_g z_b]
 // keeping only R (Q is never formed), back substitution R α = r (Eq. 5) per channel and the
 // weighted sum with the noise-free features (Eq. 6). Cells without a surface sample
-// (clipped, off-screen, padding, sky) and emitters are zero rows: masked out of the regression
-// (the sky and emitters keep their accumulated input).
+// (clipped, off-screen, padding, sky), emitters and surfaces without a diffuse lobe (metals)
+// are zero rows: masked out of the regression, they keep their accumulated input. A metal's
+// indirect diffuse is zero by construction; fitted with its block's diffuse neighbours it
+// took their light (docs/reconstruction.md, glossy-spheres).
 //
 // Workgroup: kGroup invocations (default 256) own 1024/kGroup rows (cells) each, kept in
 // registers for the whole QR; every loop over rows and columns is unrolled so no private
@@ -23,12 +25,15 @@ layout(constant_id = 1) const bool kFp16 = false;
 #include "fovea/shaders/recon_bindings.h"
 #include "fovea/shaders/hash.h"
 #include "fovea/shaders/recon_grid.h"
+#include "fovea/shaders/pt_scene.h"
 
 layout(std430, binding = RECON_BMFR_POS) readonly buffer Pos { vec4 vpos[]; };
 layout(std430, binding = RECON_BMFR_NRM) readonly buffer Nrm { vec4 vnrm[]; };
 layout(std430, binding = RECON_BMFR_Z) readonly buffer Z { vec4 z[]; };
 layout(std430, binding = RECON_BMFR_FITTED) writeonly buffer Fitted { vec4 fitted[]; };
 layout(std430, binding = RECON_BMFR_COLUMNS) readonly buffer Columns { GridColumn columns[]; };
+layout(std430, binding = RECON_BMFR_MATERIALS) readonly buffer Materials { PtMaterial materials[]; };
+layout(std430, binding = RECON_BMFR_EXCESS) writeonly buffer Excess { vec4 excess[]; };
 
 layout(push_constant) uniform Push { ReconBmfrPush pc; };
 
@@ -36,6 +41,7 @@ const uint kRows = 1024u / kGroup;  // rows per invocation
 const uint kM = 10u;          // features
 const uint kCols = 13u;       // features + 3 colour channels
 const uint kVals = 14u;       // reduction width
+const float kOutlier = 8.0;   // inputs above this multiple of their block's mean are outliers
 
 shared float s_partial[kVals][kGroup];
 shared float s_result[kVals];
@@ -59,17 +65,18 @@ void a_set(uint q, uint j, float v) {
   }
 }
 
-// Sum (op 0) or max (op 1) of vals[0..n) over the workgroup; every invocation gets the
-// result. Each invocation stores its values, then invocation j folds value j over the group
-// serially: on lavapipe this beats subgroup reductions (which loop over the lanes of every
-// subgroup for every value) several times over.
-void reduce(inout float vals[kVals], uint n, uint op) {
+// Max (bit j of max_mask set) or sum (clear) of each of vals[0..n) over the workgroup; every
+// invocation gets the results. Each invocation stores its values, then invocation j folds
+// value j over the group serially: on lavapipe this beats subgroup reductions (which loop
+// over the lanes of every subgroup for every value) several times over.
+void reduce(inout float vals[kVals], uint n, uint max_mask) {
   uint tid = gl_LocalInvocationIndex;
   [[unroll]] for (uint j = 0u; j < n; ++j) s_partial[j][tid] = vals[j];
   barrier();
   if (tid < n) {
+    bool is_max = ((max_mask >> tid) & 1u) != 0u;
     float acc = s_partial[tid][0];
-    for (uint g = 1u; g < kGroup; ++g) acc = op == 0u ? acc + s_partial[tid][g] : max(acc, s_partial[tid][g]);
+    for (uint g = 1u; g < kGroup; ++g) acc = is_max ? max(acc, s_partial[tid][g]) : acc + s_partial[tid][g];
     s_result[tid] = acc;
   }
   barrier();
@@ -92,7 +99,7 @@ void householder_column(const uint k) {
         [[unroll]] for (uint j = 0u; j < kCols; ++j) s_rowk[k & 1u][j] = a_get(q, j);
     }
   }
-  reduce(vals, kCols, 0u);
+  reduce(vals, kCols, 0u);  // sums
   float xk = s_rowk[k & 1u][k];
   float norm = sqrt(max(vals[k], 0.0));
   float alpha = xk > 0.0 ? -norm : norm;
@@ -129,6 +136,15 @@ ivec2 cell_of(uint row) {
   return ivec2(x, v < rows - pc.offset_y ? (v % rows + rows) % rows : v + pc.offset_y);
 }
 
+// Material code (vpos.w ≥ 0) of a surface with a diffuse lobe (pt_trace.comp: diffuse
+// albedo = base × (1 − metallic)); codes beyond the table count as diffuse.
+bool has_diffuse(float code) {
+  uint m = uint(code);
+  if (m >= uint(materials.length())) return true;
+  PtMaterial mat = materials[m];
+  return mat.metallic < 1.0 && (mat.texture >= 0 || max(max(mat.base_r, mat.base_g), mat.base_b) > 0.0);
+}
+
 bool inside(ivec2 c) { return c.x >= 0 && c.y >= 0 && c.x < int(pc.padded_columns) && c.y < int(pc.padded_rows); }
 
 void main() {
@@ -137,9 +153,9 @@ void main() {
   vec3 wpos[kRows], zin[kRows];
   float vals[kVals];
 
-  // One max reduction over the valid rows: the position range (max of w and −w), whether
-  // any row is valid, and the largest input value.
-  [[unroll]] for (uint j = 0u; j < kVals; ++j) vals[j] = -3.0e38;
+  // One reduction over the valid rows: maxima of the position range (max of w and −w), of
+  // whether any row is valid and of the input; sums of the input (rgb) and of the rows.
+  [[unroll]] for (uint j = 0u; j < kVals; ++j) vals[j] = j < 8u ? -3.0e38 : 0.0;
   [[unroll]] for (uint q = 0u; q < kRows; ++q) {
     ivec2 c = cell_of(tid + q * kGroup);
     valid[q] = false;
@@ -148,7 +164,7 @@ void main() {
     if (!inside(c)) continue;
     uint i = uint(c.y) * pc.padded_columns + uint(c.x);
     vec4 p = vpos[i];
-    if (p.w < 0.0) continue;  // sky, emitter or no sample
+    if (p.w < 0.0 || !has_diffuse(p.w)) continue;  // sky, emitter, no sample, no diffuse lobe
     valid[q] = true;
     wpos[q] = p.xyz;
     zin[q] = z[i].rgb;
@@ -158,12 +174,21 @@ void main() {
     }
     vals[6] = 1.0;
     vals[7] = max(vals[7], max(max(zin[q].r, zin[q].g), zin[q].b));
+    [[unroll]] for (uint a = 0u; a < 3u; ++a) vals[8u + a] += zin[q][a];
+    vals[11] += 1.0;
   }
-  reduce(vals, 8u, 1u);
+  reduce(vals, 12u, 0xFFu);
   vec3 wmax = vec3(vals[0], vals[1], vals[2]), wmin = -vec3(vals[3], vals[4], vals[5]);
-  // z enters the regression divided by its block maximum (the fit is linear in z, so the
-  // fitted values scale back): every column then stays within fp16 range, fireflies too.
-  float zmax = vals[7] > 0.0 ? vals[7] : 1.0;
+  // Outliers stay out of the fit (deviation from Koskela): the regression sees the input
+  // clamped to kOutlier × its block mean per channel, and each cell's excess goes to the
+  // excess buffer, added back after Phase III (recon_post.comp): no energy is lost and none
+  // is spread. A firefly (e.g. a caustic: floor → glossy sphere → light, 300× the mean at
+  // 1 spp) otherwise lifts its whole block (docs/reconstruction.md, glossy-spheres).
+  vec3 bound = kOutlier * vec3(vals[8], vals[9], vals[10]) / max(vals[11], 1.0);
+  // z enters the regression divided by its (clamped) block maximum (the fit is linear in z,
+  // so the fitted values scale back): every column then stays within fp16 range.
+  float zmax = min(vals[7], max(max(bound.r, bound.g), bound.b));
+  zmax = zmax > 0.0 ? zmax : 1.0;
 
   // Blocks without a surface sample only pass sky through (uniform branch: no barrier inside).
   if (vals[6] < 0.5) {
@@ -172,6 +197,7 @@ void main() {
       if (!inside(c)) continue;
       uint i = uint(c.y) * pc.padded_columns + uint(c.x);
       fitted[i] = rg_no_sample(vpos[i].w) ? vec4(0.0) : z[i];
+      excess[i] = vec4(0.0);
     }
     return;
   }
@@ -191,7 +217,7 @@ void main() {
     vec3 n = vnrm[i].xyz;
     vec3 w = clamp((wpos[q] - mid) * inv_half, -1.0, 1.0);
     feat_n[q] = n;
-    vec3 zz = zin[q] / zmax;
+    vec3 zz = min(zin[q], bound) / zmax;
     float t[kCols] = float[kCols](1.0, n.x, n.y, n.z, w.x, w.y, w.z, w.x * w.x, w.y * w.y, w.z * w.z, zz.r, zz.g, zz.b);
     // Eq. 7: zero-mean uniform noise on the non-constant features, keyed by block, row, feature, frame.
     [[unroll]] for (uint j = 0u; j < kCols; ++j) {
@@ -236,6 +262,7 @@ void main() {
     ivec2 c = cell_of(tid + q * kGroup);
     if (!inside(c)) continue;
     uint i = uint(c.y) * pc.padded_columns + uint(c.x);
+    excess[i] = vec4(valid[q] ? max(zin[q] - bound, vec3(0.0)) : vec3(0.0), 0.0);
     if (!valid[q]) {
       fitted[i] = rg_no_sample(vpos[i].w) ? vec4(0.0) : z[i];
       continue;
@@ -246,6 +273,7 @@ void main() {
     vec3 y = vec3(0.0);
     [[unroll]] for (uint m = 0u; m < kM; ++m) y += vec3(s_coef[0][m], s_coef[1][m], s_coef[2][m]) * t[m];
     y = clamp(y * zmax, vec3(0.0), vec3(1e9));
-    fitted[i] = vec4(isnan(y.r) || isnan(y.g) || isnan(y.b) ? vec3(0.0) : y, 1.0);
+    // .w: the samples behind the input (its count), Phase III's weight for this fit.
+    fitted[i] = vec4(isnan(y.r) || isnan(y.g) || isnan(y.b) ? vec3(0.0) : y, z[i].w);
   }
 }

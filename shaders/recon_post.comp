@@ -1,12 +1,19 @@
 #version 460
 // BMFR Phase III, first half (Koskela et al. 2019 §3.5): the fitted (demodulated) indirect
 // diffuse is accumulated again through the same reprojection taps and accept decisions as
-// Phase I, with α = max(1/n, α_min) (CMA start, then EMA with 10% new data), and Phase I's
-// direct+specular is added back. Deviation from Koskela: direct light (reflections, glossy
-// highlights, contact shadows) never enters the regression, whose features [1, n, w, w²]
-// cannot represent it (docs/reconstruction.md has the measurements); it keeps its own
-// temporal accumulation. The history of this pass holds the sum, so the indirect part of
-// a tap is its sum minus that tap's Phase I direct of the previous frame.
+// Phase I; the sum for TAA adds the fit's outlier excess and Phase I's direct+specular.
+// Deviations from Koskela, measured in docs/reconstruction.md (glossy-spheres):
+// - Direct light (reflections, glossy highlights, contact shadows) never enters the
+//   regression, whose features [1, n, w, w²] cannot represent it; it keeps Phase I's
+//   accumulation and is added back here.
+// - Each frame's fit weighs by the samples behind its input (fitted.w, Phase I's count)
+//   instead of equally (CMA α = 1/n): α = n / (W + n), W the history's accumulated weight
+//   (post.w), floored at α_min (EMA, 10% new data). The first frames' fits, of 1–2 samples
+//   per cell, spread their blocks' noise over whole surfaces; with equal weights frame 0
+//   still weighed 5% after 16 frames, with count weights 0.7%. The history keeps the share
+//   Phase I kept of its own (cell-size test, rounding of the counts).
+// - The outlier excess (recon_bmfr_fit.comp) is already Phase I's temporal mean: accumulated
+//   again it would outlive the same firefly without BMFR several times over.
 // Without denoising the Phase I result (direct + indirect) passes through.
 #extension GL_GOOGLE_include_directive : require
 
@@ -20,34 +27,40 @@ layout(std430, binding = RECON_POST_TAP_IDX) readonly buffer TapIdx { uvec4 tap_
 layout(std430, binding = RECON_POST_TAP_W) readonly buffer TapW { vec4 tap_w[]; };
 layout(std430, binding = RECON_POST_SOURCE) readonly buffer Source { vec4 source[]; };  // fitted indirect, or z without BMFR
 layout(std430, binding = RECON_POST_ACC_DIRECT) readonly buffer AccDirect { vec4 acc_direct[]; };  // .w: Phase I count
-layout(std430, binding = RECON_POST_PREV) readonly buffer PrevPost { vec4 prev_post[]; };
+layout(std430, binding = RECON_POST_PREV) readonly buffer PrevPost { vec4 prev_post[]; };  // accumulated fit, .w weight
 layout(std430, binding = RECON_POST_OUT) writeonly buffer Post { vec4 post[]; };
 layout(std430, binding = RECON_POST_PREV_ACC_DIRECT) readonly buffer PrevAccDirect { vec4 prev_acc_direct[]; };
+layout(std430, binding = RECON_POST_EXCESS) readonly buffer Excess { vec4 excess[]; };  // unread without BMFR
+layout(std430, binding = RECON_POST_SUM) writeonly buffer Sum { vec4 sum[]; };          // TAA's input
 
 layout(push_constant) uniform Push { ReconPostPush pc; };
 
 void main() {
   uint i = gl_GlobalInvocationID.x;
   if (i >= pc.cells) return;
-  if (rg_no_sample(vpos[i].w)) {
+  if (rg_no_sample(vpos[i].w) || pc.denoise == 0u) {
     post[i] = vec4(0.0);
+    sum[i] = rg_no_sample(vpos[i].w) ? vec4(0.0) : vec4(source[i].rgb, 1.0);
     return;
   }
   vec3 c = source[i].rgb;
-  if (pc.denoise == 0u) {
-    post[i] = vec4(c, 1.0);
-    return;
-  }
-  vec3 direct = acc_direct[i].rgb;
+  float n = max(source[i].w, 1.0);
+  vec4 acc = vec4(c, n);
   vec4 w = tap_w[i];
-  float wsum = w.x + w.y + w.z + w.w;
-  if (pc.has_history == 0u || wsum <= 0.0) {
-    post[i] = vec4(c + direct, 1.0);
-    return;
+  if (pc.has_history != 0u && w.x + w.y + w.z + w.w > 0.0) {
+    uvec4 idx = tap_idx[i];
+    vec3 h = vec3(0.0);
+    float hw = 0.0, hd = 0.0;  // the history's weight; Phase I's direct count before its share
+    for (int k = 0; k < 4; ++k) {
+      vec4 p = prev_post[idx[k]];
+      h += w[k] * p.rgb;
+      hw += w[k] * p.w;
+      hd += w[k] * prev_acc_direct[idx[k]].w;
+    }
+    hw *= hd > 0.0 ? clamp((acc_direct[i].w - 1.0) / hd, 0.0, 1.0) : 0.0;
+    float a = max(n / (hw + n), pc.alpha_min);
+    acc = vec4(mix(h, c, a), n / a);
   }
-  uvec4 idx = tap_idx[i];
-  vec3 h = vec3(0.0);
-  for (int k = 0; k < 4; ++k) h += w[k] * max(prev_post[idx[k]].rgb - prev_acc_direct[idx[k]].rgb, vec3(0.0));
-  float a = max(1.0 / max(acc_direct[i].w, 1.0), pc.alpha_min);
-  post[i] = vec4(mix(h, c, a) + direct, 1.0);
+  post[i] = acc;
+  sum[i] = vec4(acc.rgb + excess[i].rgb + acc_direct[i].rgb, 1.0);
 }

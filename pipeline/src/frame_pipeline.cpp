@@ -113,7 +113,8 @@ FramePipeline::FramePipeline(gpu::Context& ctx, const renderer::GpuScene& scene,
   m.accumulation = std::make_unique<reconstruct::Accumulation>(ctx, grids, m.tracer.scene().materials());
   m.gather = std::make_unique<reconstruct::StereoGather>(ctx, grids, *m.accumulation);
   if (settings.denoiser == reconstruct::Denoiser::Bmfr)
-    m.bmfr = std::make_unique<reconstruct::Bmfr>(ctx, grids, *m.accumulation, *m.gather, settings.bmfr_precision);
+    m.bmfr = std::make_unique<reconstruct::Bmfr>(ctx, grids, *m.accumulation, *m.gather,
+                                                  m.tracer.scene().materials(), settings.bmfr_precision);
   m.post = std::make_unique<reconstruct::PostTaa>(ctx, grids, *m.accumulation, *m.gather, m.bmfr.get());
   m.resolve = std::make_unique<reconstruct::Resolve>(ctx, grids, *m.accumulation);
   m.fill(0);

@@ -64,19 +64,21 @@ struct ShareBindings {
 
 struct BmfrBindings {
   FOVEA_BINDING_COUNT(RECON_BMFR_COUNT)
-  Buf pos, nrm, z, fitted, columns;
+  Buf pos, nrm, z, fitted, columns, materials, excess;
   Slots slots() const {
     return {{{RECON_BMFR_POS, pos},
              {RECON_BMFR_NRM, nrm},
              {RECON_BMFR_Z, z},
              {RECON_BMFR_FITTED, fitted},
-             {RECON_BMFR_COLUMNS, columns}}};
+             {RECON_BMFR_COLUMNS, columns},
+             {RECON_BMFR_MATERIALS, materials},
+             {RECON_BMFR_EXCESS, excess}}};
   }
 };
 
 struct PostBindings {
   FOVEA_BINDING_COUNT(RECON_POST_COUNT)
-  Buf pos, tap_idx, tap_w, source, acc_direct, prev, out, prev_acc_direct;
+  Buf pos, tap_idx, tap_w, source, acc_direct, prev, out, prev_acc_direct, excess, sum;
   Slots slots() const {
     return {{{RECON_POST_POS, pos},
              {RECON_POST_TAP_IDX, tap_idx},
@@ -85,7 +87,9 @@ struct PostBindings {
              {RECON_POST_ACC_DIRECT, acc_direct},
              {RECON_POST_PREV, prev},
              {RECON_POST_OUT, out},
-             {RECON_POST_PREV_ACC_DIRECT, prev_acc_direct}}};
+             {RECON_POST_PREV_ACC_DIRECT, prev_acc_direct},
+             {RECON_POST_EXCESS, excess},
+             {RECON_POST_SUM, sum}}};
   }
 };
 

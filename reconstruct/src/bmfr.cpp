@@ -4,6 +4,8 @@
 #include <algorithm>
 #include <string>
 
+#include <glm/vec3.hpp>
+
 #include "bindings.hpp"
 #include "buffers.hpp"
 #include "fovea/core/error.hpp"
@@ -11,6 +13,7 @@
 #include "fovea/gpu/context.hpp"
 #include "fovea/reconstruct/stages.hpp"
 #include "fovea/shaders/grid_params.h"
+#include "fovea/shaders/pt_scene.h"
 #include "fovea/shaders/recon_grid.h"
 
 namespace fovea::reconstruct {
@@ -35,8 +38,9 @@ BmfrFit::BmfrFit(gpu::Context& ctx, const BmfrOptions& options)
            gpu::SpecConstant::boolean(1, options.precision == BmfrPrecision::Fp16)})) {}
 
 gpu::DescriptorSet BmfrFit::bind(const gpu::Buffer& vpos, const gpu::Buffer& vnrm, const gpu::Buffer& z,
-                                 const gpu::Buffer& fitted, const gpu::Buffer& columns) const {
-  return make_set(*ctx_, pipeline_, BmfrBindings{&vpos, &vnrm, &z, &fitted, &columns});
+                                 const gpu::Buffer& fitted, const gpu::Buffer& columns,
+                                 const gpu::Buffer& materials, const gpu::Buffer& excess) const {
+  return make_set(*ctx_, pipeline_, BmfrBindings{&vpos, &vnrm, &z, &fitted, &columns, &materials, &excess});
 }
 
 void BmfrFit::record(VkCommandBuffer cmd, const gpu::DescriptorSet& set, BmfrGrid g, std::uint32_t frame,
@@ -51,7 +55,8 @@ void BmfrFit::record(VkCommandBuffer cmd, const gpu::DescriptorSet& set, BmfrGri
 
 std::vector<glm::vec4> BmfrFit::fit(BmfrGrid g, const std::vector<glm::vec4>& vpos, const std::vector<glm::vec4>& vnrm,
                                     const std::vector<glm::vec4>& z, std::uint32_t frame, glm::ivec2 offset,
-                                    float noise, const std::vector<std::uint32_t>& rows) const {
+                                    float noise, const std::vector<std::uint32_t>& rows,
+                                    const std::vector<bool>& metal) const {
   const std::size_t cells = std::size_t(g.padded_columns) * g.padded_rows;
   if (g.padded_columns % 32 || g.padded_rows % 32 || cells == 0 || vpos.size() != cells || vnrm.size() != cells ||
       z.size() != cells)
@@ -69,16 +74,28 @@ std::vector<glm::vec4> BmfrFit::fit(BmfrGrid g, const std::vector<glm::vec4>& vp
     return gpu::Buffer(*ctx_, {.size = cells * 16, .usage = gpu::BufferUsage::Storage,
                                .memory = gpu::Memory::HostVisible, .name = name});
   };
-  gpu::Buffer bp = make("bmfr.vpos"), bn = make("bmfr.vnrm"), bz = make("bmfr.z"), out = make("bmfr.fitted");
+  gpu::Buffer bp = make("bmfr.vpos"), bn = make("bmfr.vnrm"), bz = make("bmfr.z"), out = make("bmfr.fitted"),
+              ex = make("bmfr.excess");
   gpu::Buffer bt(*ctx_, {.size = table.size() * sizeof(shaders::GridColumn), .usage = gpu::BufferUsage::Storage,
                          .memory = gpu::Memory::HostVisible, .name = "bmfr.columns"});
+  shaders::PtMaterial white{};
+  white.base_r = white.base_g = white.base_b = 1.0f;
+  white.texture = -1;
+  std::vector<shaders::PtMaterial> materials(std::max<std::size_t>(metal.size(), 1), white);
+  for (std::size_t m = 0; m < metal.size(); ++m) materials[m].metallic = metal[m] ? 1.0f : 0.0f;
+  gpu::Buffer bm(*ctx_, {.size = materials.size() * sizeof(shaders::PtMaterial), .usage = gpu::BufferUsage::Storage,
+                         .memory = gpu::Memory::HostVisible, .name = "bmfr.materials"});
   bp.upload(vpos);
   bn.upload(vnrm);
   bz.upload(z);
   bt.upload(table);
-  const gpu::DescriptorSet set = bind(bp, bn, bz, out, bt);
+  bm.upload(materials);
+  const gpu::DescriptorSet set = bind(bp, bn, bz, out, bt, bm, ex);
   ctx_->submit_and_wait([&](VkCommandBuffer cmd) { record(cmd, set, g, frame, offset, noise); });
-  return out.download<glm::vec4>();
+  std::vector<glm::vec4> fitted = out.download<glm::vec4>();
+  const std::vector<glm::vec4> excess = ex.download<glm::vec4>();
+  for (std::size_t i = 0; i < cells; ++i) fitted[i] += glm::vec4(glm::vec3(excess[i]), 0.0f);
+  return fitted;
 }
 
 glm::ivec2 bmfr_block_offset(std::uint32_t frame) {
@@ -96,15 +113,16 @@ glm::ivec2 bmfr_block_offset(std::uint32_t frame) {
 namespace fovea::reconstruct {
 
 Bmfr::Bmfr(gpu::Context& ctx, std::span<const EyeGrid> eyes, const Accumulation& acc, const StereoGather& gather,
-           BmfrPrecision precision)
+           const gpu::Buffer& materials, BmfrPrecision precision)
     : fit_(ctx, {.precision = precision}), eyes_(eyes.size()) {
   for (std::size_t i = 0; i < eyes.size(); ++i) {
     Eye& e = eyes_[i];
     e.grid = {eyes[i].padded_columns, eyes[i].padded_rows, eyes[i].polar ? eyes[i].columns : 0};
     e.fitted = storage(ctx, VkDeviceSize(eyes[i].cells) * 16, "recon.fitted");
+    e.excess = storage(ctx, VkDeviceSize(eyes[i].cells) * 16, "recon.excess");
     for (int p = 0; p < 2; ++p)
       e.set[p] = fit_.bind(acc.position(int(i), p), acc.normal(int(i), p), gather.shared(int(i)), e.fitted,
-                           *eyes[i].tables);
+                           *eyes[i].tables, materials, e.excess);
   }
 }
 
@@ -114,7 +132,10 @@ void Bmfr::record(VkCommandBuffer cmd, int parity, std::uint32_t frame, glm::ive
 }
 
 void Bmfr::fill(VkCommandBuffer cmd, std::uint32_t word) const {
-  for (const Eye& e : eyes_) gpu::fill_buffer(cmd, e.fitted, word);
+  for (const Eye& e : eyes_) {
+    gpu::fill_buffer(cmd, e.fitted, word);
+    gpu::fill_buffer(cmd, e.excess, word);
+  }
 }
 
 }  // namespace fovea::reconstruct

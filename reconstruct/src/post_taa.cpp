@@ -21,15 +21,18 @@ PostTaa::PostTaa(gpu::Context& ctx, std::span<const EyeGrid> eyes, const Accumul
       e.post[p] = storage(ctx, VkDeviceSize(g.cells) * 16, "recon.post");
       e.final_[p] = storage(ctx, VkDeviceSize(g.cells) * 16, "recon.final");
     }
+    e.sum = storage(ctx, VkDeviceSize(g.cells) * 16, "recon.post_sum");
     const gpu::Buffer* source = bmfr ? &bmfr->fitted(me) : &gather.z(me);
+    const gpu::Buffer* excess = bmfr ? &bmfr->excess(me) : source;  // unread without BMFR
     for (int p = 0; p < 2; ++p) {
       const int q = 1 - p;
       e.post_set[p] = make_set(ctx, post_,
                                PostBindings{&acc.position(me, p), &acc.tap_index(me), &acc.tap_weight(me), source,
-                                            &acc.direct(me, p), &e.post[q], &e.post[p], &acc.direct(me, q)});
+                                            &acc.direct(me, p), &e.post[q], &e.post[p], &acc.direct(me, q), excess,
+                                            &e.sum});
       e.taa_set[p] = make_set(ctx, taa_,
                               TaaBindings{g.maps, g.tables, &acc.position(me, p), &acc.tap_index(me),
-                                          &acc.tap_weight(me), &e.post[p], g.albedo, &e.final_[q], &e.final_[p]});
+                                          &acc.tap_weight(me), &e.sum, g.albedo, &e.final_[q], &e.final_[p]});
     }
   }
 }
@@ -50,11 +53,13 @@ void PostTaa::record(VkCommandBuffer cmd, int parity, bool history, const ReconS
 }
 
 void PostTaa::fill(VkCommandBuffer cmd, std::uint32_t word) const {
-  for (const Eye& e : eyes_)
+  for (const Eye& e : eyes_) {
     for (int p = 0; p < 2; ++p) {
       gpu::fill_buffer(cmd, e.post[p], word);
       gpu::fill_buffer(cmd, e.final_[p], word);
     }
+    gpu::fill_buffer(cmd, e.sum, word);
+  }
 }
 
 }  // namespace fovea::reconstruct

@@ -2,8 +2,12 @@
 // BMFR Phase II on the GPU (shaders/recon_bmfr_fit.comp): per 32×32 block of a padded grid,
 // the regression of the demodulated input z on the features [1, n, w, w²] and the weighted
 // sum. Inputs per cell (vec4): vpos (world position, .w material; < 0 = no surface),
-// vnrm (normal), z (rgb); output: fitted (rgb, .w = 1). On polar grids the blocks wrap in φ:
-// rows are read modulo each column's row count (the grid's column table).
+// vnrm (normal), z (rgb, .w sample count); outputs: fitted (rgb, .w = z's count) and excess
+// (rgb: the part of z above its block's outlier bound, which the fit did not see; the
+// estimate is fitted + excess). On polar grids the blocks wrap in φ:
+// rows are read modulo each column's row count (the grid's column table). Cells whose
+// material (shaders::PtMaterial of the scene's table, indexed by vpos.w) has no diffuse lobe
+// stay out of the regression and keep z: their indirect diffuse is zero by construction.
 #include <cstdint>
 #include <vector>
 
@@ -38,17 +42,21 @@ struct BmfrOptions {
 class BmfrFit {
  public:
   explicit BmfrFit(gpu::Context& ctx, const BmfrOptions& options = {});
-  // `columns`: the grid's column table (shaders::GridColumn, this frame's first).
+  // `columns`: the grid's column table (shaders::GridColumn, this frame's first);
+  // `materials`: the scene's shaders::PtMaterial table (material codes beyond it count as diffuse).
   gpu::DescriptorSet bind(const gpu::Buffer& vpos, const gpu::Buffer& vnrm, const gpu::Buffer& z,
-                          const gpu::Buffer& fitted, const gpu::Buffer& columns) const;
+                          const gpu::Buffer& fitted, const gpu::Buffer& columns, const gpu::Buffer& materials,
+                          const gpu::Buffer& excess) const;
   // Records the fit; `offset` is the block-grid displacement in [0, 32)².
   void record(VkCommandBuffer cmd, const gpu::DescriptorSet& set, BmfrGrid grid, std::uint32_t frame,
               glm::ivec2 offset, float noise) const;
-  // Upload, fit, download in one submission (tests, tools). `rows`: rows per column of a
-  // polar grid (grid.columns entries) or empty for a raster.
+  // Upload, fit, download in one submission (tests, tools): fitted + excess. `rows`: rows per column of a
+  // polar grid (grid.columns entries) or empty for a raster; `metal`: per material code,
+  // whether it has no diffuse lobe (codes beyond the list: diffuse).
   std::vector<glm::vec4> fit(BmfrGrid grid, const std::vector<glm::vec4>& vpos, const std::vector<glm::vec4>& vnrm,
                              const std::vector<glm::vec4>& z, std::uint32_t frame = 0, glm::ivec2 offset = {0, 0},
-                             float noise = 0.01f, const std::vector<std::uint32_t>& rows = {}) const;
+                             float noise = 0.01f, const std::vector<std::uint32_t>& rows = {},
+                             const std::vector<bool>& metal = {}) const;
 
  private:
   gpu::Context* ctx_;

@@ -80,17 +80,19 @@ class StereoGather {
 
 class Bmfr {
  public:
+  // `materials`: the scene's material table (cells without a diffuse lobe are not fitted).
   Bmfr(gpu::Context& ctx, std::span<const EyeGrid> eyes, const Accumulation& acc, const StereoGather& gather,
-       BmfrPrecision precision);
+       const gpu::Buffer& materials, BmfrPrecision precision);
   void record(VkCommandBuffer cmd, int parity, std::uint32_t frame, glm::ivec2 offset, float noise) const;
   void fill(VkCommandBuffer cmd, std::uint32_t word) const;
 
   const gpu::Buffer& fitted(int eye) const { return eyes_[eye].fitted; }
+  const gpu::Buffer& excess(int eye) const { return eyes_[eye].excess; }
 
  private:
   struct Eye {
     BmfrGrid grid;
-    gpu::Buffer fitted;
+    gpu::Buffer fitted, excess;
     gpu::DescriptorSet set[2];
   };
   BmfrFit fit_;
@@ -111,7 +113,7 @@ class PostTaa {
  private:
   struct Eye {
     std::uint32_t cells = 0;
-    gpu::Buffer post[2], final_[2];
+    gpu::Buffer post[2], sum, final_[2];  // post: accumulated fit (history); sum: + excess + direct
     gpu::DescriptorSet post_set[2], taa_set[2];
   };
   gpu::ComputePipeline post_, taa_;

@@ -47,7 +47,9 @@
 #define RECON_BMFR_Z 2
 #define RECON_BMFR_FITTED 3
 #define RECON_BMFR_COLUMNS 4
-#define RECON_BMFR_COUNT 5
+#define RECON_BMFR_MATERIALS 5
+#define RECON_BMFR_EXCESS 6
+#define RECON_BMFR_COUNT 7
 
 // recon_post.comp (BMFR Phase III)
 #define RECON_POST_POS 0
@@ -58,7 +60,9 @@
 #define RECON_POST_PREV 5
 #define RECON_POST_OUT 6
 #define RECON_POST_PREV_ACC_DIRECT 7
-#define RECON_POST_COUNT 8
+#define RECON_POST_EXCESS 8
+#define RECON_POST_SUM 9
+#define RECON_POST_COUNT 10
 
 // recon_taa.comp
 #define RECON_TAA_POS 2
