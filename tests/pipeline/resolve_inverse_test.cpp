@@ -9,6 +9,7 @@
 // table: the float mapping's precision, not the lookup. Every pixel must land inside the
 // grid: 0 <= u <= columns, 0 <= t <= 1.
 #include <algorithm>
+#include <numbers>
 #include <cmath>
 
 #include "fovea/renderer/scene_io.hpp"
@@ -44,9 +45,16 @@ InverseError compare(const core::SampleDistribution& d, const std::vector<glm::v
       if (!cpu) continue;
       err.u = std::max(err.u, std::abs(double(g.x) - cpu->x));
       const int column = std::clamp(int(cpu->x), 0, d.columns() - 1);
-      const double rows = table[std::size_t(column)].rows;
-      double dr = std::fmod(std::abs(double(g.y) * rows - cpu->y), rows);
-      err.rows = std::max(err.rows, std::min(dr, rows - dr));
+      const auto& col = table[std::size_t(column)];
+      const double rows = col.rows;
+      // The GPU's coordinate is in turns of φ; the CPU's in rows from the start of the
+      // column's arc (rg_row_coord; a full ring's arc is the whole turn and wraps).
+      const double span = 1.0 - double(col.phi_gap) / (2.0 * std::numbers::pi);
+      double t = std::fmod(double(g.y) - double(col.phi0) / (2.0 * std::numbers::pi), 1.0);
+      if (t < 0) t += 1.0;
+      if (t > span) t = t - span < 1.0 - t ? span : 0.0;
+      const double dr = std::abs(t / span * rows - cpu->y);
+      err.rows = std::max(err.rows, col.phi_gap == 0.0f ? std::min(std::fmod(dr, rows), rows - std::fmod(dr, rows)) : dr);
     }
   return err;
 }
