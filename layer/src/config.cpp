@@ -17,17 +17,18 @@ std::string env(const char* name) {
   return v ? v : "";
 }
 
-bool parse_render_mode(const std::string& v, const std::string& where) {
-  if (v == "async") return false;
-  if (v == "lockstep") return true;
-  throw core::InputError(where + ": \"" + v + "\" must be \"async\" or \"lockstep\"");
+// One of two words: true for `yes`, false for `no`; anything else names `where`.
+bool parse_either(const std::string& v, const std::string& where, const char* yes, const char* no) {
+  if (v == yes) return true;
+  if (v == no) return false;
+  throw core::InputError(where + ": \"" + v + "\" must be \"" + yes + "\" or \"" + no + "\"");
 }
 
-bool parse_compositor(const std::string& v, const std::string& where) {
-  if (v == "gpu") return true;
-  if (v == "host") return false;
-  throw core::InputError(where + ": \"" + v + "\" must be \"gpu\" or \"host\"");
+bool parse_render_mode(const std::string& v, const std::string& where) {
+  return parse_either(v, where, "lockstep", "async");
 }
+
+bool parse_compositor(const std::string& v, const std::string& where) { return parse_either(v, where, "gpu", "host"); }
 
 void apply_section(const nlohmann::json& s, const std::string& where, LayerConfig& c) {
   if (!s.is_object()) throw core::InputError(where + ": must be an object");
