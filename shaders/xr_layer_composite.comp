@@ -1,8 +1,9 @@
 #version 450
 // The API layer's composition on the application's device (fovea/shaders/layer_composite.h):
-// the same steps, in the same order, as the host path's resample() and composite() in
-// layer/src/composite.cpp, on packed 8-bit pixels, so kept pixels stay bit-exact; blends
-// decode with the host's table and encode with the sRGB formula (within one 8-bit step).
+// the same steps, in the same order, as the host path's resample(), composite() and
+// composite_depth() in layer/src/composite.cpp, on packed 8-bit pixels, so kept pixels stay
+// bit-exact; blends decode with the host's table and encode with the sRGB formula (within one
+// 8-bit step); depths compare in 32-bit floats (the host in doubles).
 #extension GL_GOOGLE_include_directive : require
 #include "fovea/shaders/layer_composite.h"
 
@@ -18,6 +19,7 @@ layout(std430, set = 0, binding = 1) readonly buffer Traced { uint traced[]; };
 layout(std430, set = 0, binding = 2) readonly buffer App { uint app[]; };
 layout(std430, set = 0, binding = 3) writeonly buffer Out { uint outp[]; };
 layout(std430, set = 0, binding = 4) buffer Background { uint background[2]; };
+layout(std430, set = 0, binding = 5) readonly buffer AppDepth { uint app_depth[]; };
 
 shared uint best_count[kLayerBorderGroup];
 shared uint best_key[kLayerBorderGroup];
@@ -62,6 +64,38 @@ uint encode(float v) {
   v = clamp(v, 0.0, 1.0);
   if (p.srgb != 0u) v = v <= 0.0031308 ? 12.92 * v : 1.055 * pow(v, 1.0 / 2.4) - 0.055;
   return uint(floor(v * 255.0 + 0.5));
+}
+
+// The application's window depth at `texel` of its depth rect, decoded as the host's
+// read_depth() does.
+float window_depth(uint e, int texel) {
+  uint fmt = p.eye[e].depth_format;
+  if (fmt == kLayerDepthD16) {
+    uint byte_offset = p.eye[e].depth_offset + uint(texel) * 2u;
+    return float((app_depth[byte_offset >> 2] >> (8u * (byte_offset & 2u))) & 0xffffu) / 65535.0;
+  }
+  uint word = app_depth[(p.eye[e].depth_offset >> 2) + uint(texel)];
+  if (fmt == kLayerDepthD24) return float(word & 0xffffffu) / 16777215.0;
+  float v = uintBitsToFloat(word);
+  return isnan(v) || isinf(v) ? 1.0 : v;
+}
+
+// composite_depth() for one pixel: whether the application's pixel `a` (at `app_texel`) is
+// nearer than the traced scene (at `traced_texel`; -1: not covered, as far as the sky).
+// Distances compare as their inverses, which the depth range maps to linearly (view_distance()
+// in composite.cpp): no infinities.
+bool app_nearer(uint e, uint a, int app_texel, int traced_texel) {
+  if (channel(a, 3) == 0u) return false;  // also where the application's rect does not reach
+  float d = window_depth(e, app_texel);
+  float lo = p.eye[e].min_depth, hi = p.eye[e].max_depth;
+  // The cleared far end (maxDepth, minDepth with reversed Z): the application drew nothing.
+  bool reversed = p.eye[e].inv_near < p.eye[e].inv_far;
+  if (reversed ? d <= lo : d >= hi) return false;
+  float t = clamp((d - lo) / (hi - lo), 0.0, 1.0);
+  float inv_app = (1.0 - t) * p.eye[e].inv_near + t * p.eye[e].inv_far;
+  float scene = traced_texel >= 0 ? uintBitsToFloat(traced[p.eye[e].traced_depth_offset + uint(traced_texel)]) : 0.0;
+  float inv_scene = scene > 0.0 ? 1.0 / scene : 0.0;  // 0: the sky, infinitely far
+  return inv_app > inv_scene;
 }
 
 void border_pass(uint e) {
@@ -109,28 +143,24 @@ void composite_pass(uint e) {
   int o = g.y * w + g.x;
   vec3 d = pixel_dir(p.eye[e].out_tan, w, h, g.x, g.y);
   // resample(traced, traced_view, out_view, to_traced); uncovered: black.
-  uint s = 0u;
-  if (p.eye[e].traced_identity != 0u) {
-    s = traced[p.eye[e].traced_offset + uint(o)];
-  } else {
+  int traced_texel = o;
+  if (p.eye[e].traced_identity == 0u) {
     float r[9] = p.eye[e].to_traced;
     vec3 rd = vec3(r[0] * d.x + r[1] * d.y + r[2] * d.z, r[3] * d.x + r[4] * d.y + r[5] * d.z,
                    r[6] * d.x + r[7] * d.y + r[8] * d.z);
-    int t = dir_texel(p.eye[e].traced_tan, p.eye[e].traced_w, p.eye[e].traced_h, rd);
-    if (t >= 0) s = traced[p.eye[e].traced_offset + uint(t)];
+    traced_texel = dir_texel(p.eye[e].traced_tan, p.eye[e].traced_w, p.eye[e].traced_h, rd);
   }
+  uint s = traced_texel >= 0 ? traced[p.eye[e].traced_offset + uint(traced_texel)] : 0u;
   s = (s & 0xffffffu) | 0xff000000u;
   if (p.mode != kLayerSceneOnly) {
     // resample(app, app_view, out_view): the application's FOV at its own raster.
-    uint a = 0u;
-    if (p.eye[e].app_identity != 0u) {
-      a = app[p.eye[e].app_offset + uint(o)];
-    } else {
-      int t = dir_texel(p.eye[e].out_tan, p.eye[e].app_w, p.eye[e].app_h, d);
-      if (t >= 0) a = app[p.eye[e].app_offset + uint(t)];
-    }
+    int app_texel = p.eye[e].app_identity != 0u ? o : dir_texel(p.eye[e].out_tan, p.eye[e].app_w, p.eye[e].app_h, d);
+    uint a = app_texel >= 0 ? app[p.eye[e].app_offset + uint(app_texel)] : 0u;
     uint alpha = channel(a, 3);
-    if (p.mode == kLayerAppOnTop) {
+    if (p.mode == kLayerDepth) {
+      // The depths travel with their colour: the same texels (resample_depth()).
+      if (app_nearer(e, a, app_texel, traced_texel)) s = a;
+    } else if (p.mode == kLayerAppOnTop) {
       uint bg = p.auto_background != 0u ? background[e] : p.background;
       bool differs = false;
       for (int c = 0; c < 3; ++c) differs = differs || abs(int(channel(a, c)) - int(channel(bg, c))) > p.tolerance;
