@@ -23,9 +23,11 @@ namespace fovea::layer {
 namespace {
 
 constexpr std::uint32_t kBindings = 6;
+// The composite pass's workgroup.
+constexpr std::uint32_t kGroupX = 32, kGroupY = 8;
 
 struct Push {
-  std::uint32_t eye, pass;
+  std::uint32_t eye;
 };
 
 void set_tan(float out[4], const core::View& v) {
@@ -86,14 +88,23 @@ void AppDevice::enable_gpu_composition() {
     mi.codeSize = spv.size();
     mi.pCode = reinterpret_cast<const std::uint32_t*>(spv.data());
     app_check(vkCreateShaderModule_(device_, &mi, nullptr, &g.shader), "vkCreateShaderModule");
-    VkComputePipelineCreateInfo ci{VK_STRUCTURE_TYPE_COMPUTE_PIPELINE_CREATE_INFO};
-    ci.stage = {VK_STRUCTURE_TYPE_PIPELINE_SHADER_STAGE_CREATE_INFO};
-    ci.stage.stage = VK_SHADER_STAGE_COMPUTE_BIT;
-    ci.stage.module = g.shader;
-    ci.stage.pName = "main";
-    ci.layout = g.layout;
-    app_check(vkCreateComputePipelines_(device_, VK_NULL_HANDLE, 1, &ci, nullptr, &g.pipeline),
-              "vkCreateComputePipelines");
+    // One pipeline per pass (specialisation constants 0: the pass, 1 and 2: the workgroup size).
+    for (const std::uint32_t pass : {shaders::kLayerPassBorder, shaders::kLayerPassComposite}) {
+      const bool border = pass == shaders::kLayerPassBorder;
+      const std::uint32_t values[3] = {pass, border ? shaders::kLayerBorderGroup : kGroupX, border ? 1u : kGroupY};
+      const VkSpecializationMapEntry entries[3] = {{0, 0, 4}, {1, 4, 4}, {2, 8, 4}};
+      const VkSpecializationInfo spec{3, entries, sizeof values, values};
+      VkComputePipelineCreateInfo ci{VK_STRUCTURE_TYPE_COMPUTE_PIPELINE_CREATE_INFO};
+      ci.stage = {VK_STRUCTURE_TYPE_PIPELINE_SHADER_STAGE_CREATE_INFO};
+      ci.stage.stage = VK_SHADER_STAGE_COMPUTE_BIT;
+      ci.stage.module = g.shader;
+      ci.stage.pName = "main";
+      ci.stage.pSpecializationInfo = &spec;
+      ci.layout = g.layout;
+      app_check(vkCreateComputePipelines_(device_, VK_NULL_HANDLE, 1, &ci, nullptr,
+                                          pass == shaders::kLayerPassBorder ? &g.border_pipeline : &g.pipeline),
+                "vkCreateComputePipelines");
+    }
     const VkDescriptorPoolSize size{VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, kBindings};
     VkDescriptorPoolCreateInfo pi{VK_STRUCTURE_TYPE_DESCRIPTOR_POOL_CREATE_INFO};
     pi.maxSets = 1;
@@ -128,6 +139,7 @@ void AppDevice::destroy_gpu() {
   for (Buffer* b : {&g.params, &g.staging, &g.traced, &g.app, &g.app_depth, &g.out, &g.background}) release(*b);
   if (g.pool) vkDestroyDescriptorPool_(device_, g.pool, nullptr);
   if (g.pipeline) vkDestroyPipeline_(device_, g.pipeline, nullptr);
+  if (g.border_pipeline) vkDestroyPipeline_(device_, g.border_pipeline, nullptr);
   if (g.shader) vkDestroyShaderModule_(device_, g.shader, nullptr);
   if (g.layout) vkDestroyPipelineLayout_(device_, g.layout, nullptr);
   if (g.set_layout) vkDestroyDescriptorSetLayout_(device_, g.set_layout, nullptr);
@@ -276,11 +288,11 @@ void AppDevice::composite_gpu(std::int64_t traced_id, const std::array<GpuEye, 2
     const VkMemoryBarrier to_compute = memory_barrier(VK_ACCESS_TRANSFER_WRITE_BIT, VK_ACCESS_SHADER_READ_BIT);
     vkCmdPipelineBarrier_(cb, VK_PIPELINE_STAGE_TRANSFER_BIT, VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT, 0, 1, &to_compute, 0,
                           nullptr, 0, nullptr);
-    vkCmdBindPipeline_(cb, VK_PIPELINE_BIND_POINT_COMPUTE, g.pipeline);
     vkCmdBindDescriptorSets_(cb, VK_PIPELINE_BIND_POINT_COMPUTE, g.layout, 0, 1, &g.set, 0, nullptr);
-    if (rule.mode == Composite::AppOnTop && !rule.background) {
+    if (p.mode == shaders::kLayerAppOnTop && !rule.background) {
+      vkCmdBindPipeline_(cb, VK_PIPELINE_BIND_POINT_COMPUTE, g.border_pipeline);
       for (std::uint32_t e = 0; e < 2; ++e) {
-        const Push push{e, shaders::kLayerPassBorder};
+        const Push push{e};
         vkCmdPushConstants_(cb, g.layout, VK_SHADER_STAGE_COMPUTE_BIT, 0, sizeof push, &push);
         vkCmdDispatch_(cb, 1, 1, 1);
       }
@@ -288,10 +300,13 @@ void AppDevice::composite_gpu(std::int64_t traced_id, const std::array<GpuEye, 2
       vkCmdPipelineBarrier_(cb, VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT, VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT, 0, 1, &border,
                             0, nullptr, 0, nullptr);
     }
+    vkCmdBindPipeline_(cb, VK_PIPELINE_BIND_POINT_COMPUTE, g.pipeline);
     for (std::uint32_t e = 0; e < 2; ++e) {
-      const Push push{e, shaders::kLayerPassComposite};
+      const Push push{e};
       vkCmdPushConstants_(cb, g.layout, VK_SHADER_STAGE_COMPUTE_BIT, 0, sizeof push, &push);
-      vkCmdDispatch_(cb, (std::uint32_t(p.eye[e].out_w) + 7) / 8, (std::uint32_t(p.eye[e].out_h) + 7) / 8, 1);
+      vkCmdDispatch_(cb, (std::uint32_t(p.eye[e].out_w) + kGroupX - 1) / kGroupX,
+                    (std::uint32_t(p.eye[e].out_h) + kGroupY * shaders::kLayerRowsPerInvocation - 1) /
+                        (kGroupY * shaders::kLayerRowsPerInvocation), 1);
     }
     const VkMemoryBarrier to_transfer = memory_barrier(VK_ACCESS_SHADER_WRITE_BIT, VK_ACCESS_TRANSFER_READ_BIT);
     vkCmdPipelineBarrier_(cb, VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT, VK_PIPELINE_STAGE_TRANSFER_BIT, 0, 1, &to_transfer,

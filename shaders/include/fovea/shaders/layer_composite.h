@@ -22,11 +22,14 @@ FOVEA_CONST FOVEA_UINT kLayerDepth = 3u;
 FOVEA_CONST FOVEA_UINT kLayerDepthD16 = 1u;   // 16-bit UNORM, two per word
 FOVEA_CONST FOVEA_UINT kLayerDepthD24 = 2u;   // 24-bit UNORM in the low bits of a word
 FOVEA_CONST FOVEA_UINT kLayerDepthD32F = 3u;  // float (non-finite: the far plane)
-// Push constant `pass`: the border pass finds AppOnTop's background (the most frequent colour
-// on the application image's border, one workgroup per eye), the composite pass writes out.
+// Specialisation constant 0, the pass: the border pass finds AppOnTop's background (the most
+// frequent colour on the application image's border, one workgroup per eye), the composite
+// pass writes out. Push constant: the eye.
 FOVEA_CONST FOVEA_UINT kLayerPassBorder = 0u;
 FOVEA_CONST FOVEA_UINT kLayerPassComposite = 1u;
 FOVEA_CONST FOVEA_UINT kLayerBorderGroup = 64u;
+// The composite pass: each invocation writes this many rows of its column.
+FOVEA_CONST FOVEA_UINT kLayerRowsPerInvocation = 16u;
 
 // One eye. A view is its tangent-plane extents at z = -1 (left, right, up, down) and raster;
 // a direction of the output view turns into the traced view's by `to_traced` (row-major 3x3,
