@@ -129,6 +129,28 @@ struct Mode {
   bool srgb;
 };
 
+// Eye `e` of geometry `g` (the right eye turned the other way), the traced frame `traced`.
+EyeComposition eye_of(const Geometry& g, const Pixels8& traced, std::size_t e) {
+  EyeComposition c;
+  c.traced = &traced;
+  c.traced_view = core::View(g.traced_fov, g.traced_w, g.traced_h);
+  c.out_view = core::View(g.app_fov, g.traced_w, g.traced_h);
+  c.to_traced = yaw(e == 0 ? g.yaw_deg : -g.yaw_deg);
+  c.app_view = core::View(g.app_fov, g.app_w, g.app_h);
+  return c;
+}
+
+// The GPU composition of `jobs`, its targets read back; it copies no application image to the host.
+std::vector<Pixels8> composite_on_gpu(AppDevice& dev, std::int64_t traced_id, const std::array<AppDevice::GpuEye, 2>& jobs,
+                                      const CompositionRule& rule, const Geometry& g) {
+  const std::int64_t readbacks = dev.host_readbacks();
+  dev.composite_gpu(traced_id, jobs, rule);
+  dev.finish();
+  EXPECT_EQ(dev.host_readbacks(), readbacks) << "the GPU path copied application images to the host";
+  return dev.read({{jobs[0].target, 0, {{0, 0}, {g.traced_w, g.traced_h}}},
+                   {jobs[1].target, 0, {{0, 0}, {g.traced_w, g.traced_h}}}});
+}
+
 class GpuComposite : public test::GpuTest {};
 
 TEST_F(GpuComposite, MatchesTheHostPathPixelByPixel) {
@@ -172,23 +194,12 @@ TEST_F(GpuComposite, MatchesTheHostPathPixelByPixel) {
       std::array<AppDevice::GpuEye, 2> jobs;
       std::array<Pixels8, 2> host;
       for (std::size_t e = 0; e < 2; ++e) {
-        EyeComposition c;
-        c.traced = &traced[e];
-        c.traced_view = core::View(g.traced_fov, g.traced_w, g.traced_h);
-        c.out_view = core::View(g.app_fov, g.traced_w, g.traced_h);
-        c.to_traced = yaw(e == 0 ? g.yaw_deg : -g.yaw_deg);
-        c.app_view = core::View(g.app_fov, g.app_w, g.app_h);
+        EyeComposition c = eye_of(g, traced[e], e);
         jobs[e] = {c, {app_img[e].get(), 0, {{0, 0}, {g.app_w, g.app_h}}}, std::nullopt, target[e].get()};
         c.app = m.mode == Composite::SceneOnly ? nullptr : &app[e];
         host[e] = compose_eye(c, rule);
       }
-      const std::int64_t readbacks = dev.host_readbacks();
-      dev.composite_gpu(++traced_id, jobs, rule);
-      dev.finish();
-      EXPECT_EQ(dev.host_readbacks(), readbacks) << "the GPU path copied application images to the host";
-      const std::vector<Pixels8> gpu_out =
-          dev.read({{target[0].get(), 0, {{0, 0}, {g.traced_w, g.traced_h}}},
-                    {target[1].get(), 0, {{0, 0}, {g.traced_w, g.traced_h}}}});
+      const std::vector<Pixels8> gpu_out = composite_on_gpu(dev, ++traced_id, jobs, rule, g);
       for (std::size_t e = 0; e < 2; ++e) {
         ASSERT_EQ(gpu_out[e].data.size(), host[e].data.size());
         const auto [exact, rounding, other] = differences(gpu_out[e], host[e]);
@@ -314,12 +325,7 @@ TEST_F(GpuComposite, ByDepthMatchesTheHostPath) {
       std::array<Pixels8, 2> host;
       std::array<std::int64_t, 2> host_kept{};
       for (std::size_t e = 0; e < 2; ++e) {
-        EyeComposition c;
-        c.traced = &traced[e];
-        c.traced_view = core::View(g.traced_fov, g.traced_w, g.traced_h);
-        c.out_view = core::View(g.app_fov, g.traced_w, g.traced_h);
-        c.to_traced = yaw(e == 0 ? g.yaw_deg : -g.yaw_deg);
-        c.app_view = core::View(g.app_fov, g.app_w, g.app_h);
+        EyeComposition c = eye_of(g, traced[e], e);
         c.traced_depth = &traced_depth[e];
         c.depth_range = dc.range;
         jobs[e] = {c, {app_img[e].get(), 0, rect}, depth[e], target[e].get()};
@@ -332,12 +338,7 @@ TEST_F(GpuComposite, ByDepthMatchesTheHostPath) {
         for (std::size_t i = 0; i < scene.data.size(); i += 4)
           host_kept[e] += std::memcmp(&scene.data[i], &host[e].data[i], 4) != 0;
       }
-      const std::int64_t readbacks = dev.host_readbacks();
-      dev.composite_gpu(++traced_id, jobs, rule);
-      dev.finish();
-      EXPECT_EQ(dev.host_readbacks(), readbacks) << "the GPU path copied application images to the host";
-      const std::vector<Pixels8> gpu_out = dev.read({{target[0].get(), 0, {{0, 0}, {g.traced_w, g.traced_h}}},
-                                                     {target[1].get(), 0, {{0, 0}, {g.traced_w, g.traced_h}}}});
+      const std::vector<Pixels8> gpu_out = composite_on_gpu(dev, ++traced_id, jobs, rule, g);
       for (std::size_t e = 0; e < 2; ++e) {
         const std::size_t n = host[e].data.size() / 4;
         // Not vacuous: the application is in front in some pixels and behind the scene or
