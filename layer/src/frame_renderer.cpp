@@ -295,21 +295,31 @@ class PathTraceRenderer final : public FrameRenderer {
     req.action_gaze = in.action_gaze;
     req.get_visibility_mask = in.get_visibility_mask;
     req.visibility_mask_generation = in.visibility_mask_generation;
-    std::shared_ptr<const TracedFrame> frame;
     {
-      std::unique_lock lock(mutex_);
-      if (!error_.empty()) throw std::runtime_error("the render thread failed: " + error_);
-      req.id = next_request_++;
-      pending_ = req;  // replaces a request the thread has not picked up: only the newest views count
-      wake_.notify_all();
-      if (config_.lockstep) {
-        constexpr auto kLimit = std::chrono::minutes(10);
-        if (!done_.wait_for(lock, kLimit, [&] { return !error_.empty() || (newest_ && newest_->id >= req.id); }))
-          throw std::runtime_error("lockstep rendering: the render thread did not finish a frame in 10 minutes");
+      // Asynchronous: never wait for the render thread. At its low priority it may hold the
+      // mailbox while it waits for a core (priority inversion); a frame that finds the mailbox
+      // taken shows the frame seen last and does not hand its views over (the next frame's are
+      // newer anyway).
+      std::unique_lock lock(mutex_, std::defer_lock);
+      if (config_.lockstep)
+        lock.lock();
+      else
+        static_cast<void>(lock.try_lock());
+      if (lock.owns_lock()) {
         if (!error_.empty()) throw std::runtime_error("the render thread failed: " + error_);
+        req.id = next_request_++;
+        pending_ = req;  // replaces a request the thread has not picked up: only the newest views count
+        wake_.notify_all();
+        if (config_.lockstep) {
+          constexpr auto kLimit = std::chrono::minutes(10);
+          if (!done_.wait_for(lock, kLimit, [&] { return !error_.empty() || (newest_ && newest_->id >= req.id); }))
+            throw std::runtime_error("lockstep rendering: the render thread did not finish a frame in 10 minutes");
+          if (!error_.empty()) throw std::runtime_error("the render thread failed: " + error_);
+        }
+        seen_ = newest_;
       }
-      frame = newest_;
     }
+    const std::shared_ptr<const TracedFrame> frame = seen_;
     if (!frame) return nullptr;  // nothing traced yet: the application's own frame
     const auto t0 = std::chrono::steady_clock::now();
     const XrFrameEndInfo* out = compose(in, *frame, shown);
@@ -565,6 +575,8 @@ class PathTraceRenderer final : public FrameRenderer {
   std::string error_;  // the render thread's failure (it has stopped)
   bool stop_ = false;
   std::int64_t next_request_ = 0;
+  // The newest finished frame xrEndFrame saw (the application's thread only).
+  std::shared_ptr<const TracedFrame> seen_;
   std::thread thread_;
 
   // xrEndFrame's composition (the application's thread).

@@ -275,11 +275,15 @@ TEST(LayerConfig, Compositor) {
 
 TEST(LayerConfig, RenderPriority) {
   const RenderPriority d = parse_config(R"({"default": {"scene": "cornell"}})", "cfg.json", "App").render_priority;
-  EXPECT_TRUE(d.idle);
-  const RenderPriority n = parse_config(R"({"default": {"render_priority": 19}})", "cfg.json", "App").render_priority;
+  EXPECT_FALSE(d.idle);
+  EXPECT_EQ(d.nice, 19);
+  const RenderPriority n = parse_config(R"({"default": {"render_priority": 7}})", "cfg.json", "App").render_priority;
   EXPECT_FALSE(n.idle);
-  EXPECT_EQ(n.nice, 19);
-  EXPECT_EQ(render_priority_name(n), "nice 19");
+  EXPECT_EQ(n.nice, 7);
+  EXPECT_EQ(render_priority_name(n), "nice 7");
+  EXPECT_EQ(render_priority_name(parse_config(R"({"default": {"render_priority": "idle"}})", "cfg.json", "App")
+                                     .render_priority),
+            "SCHED_IDLE");
   EXPECT_TRUE(parse_config(R"({"default": {"render_priority": 5}, "applications": {"App": {"render_priority": "idle"}}})",
                            "cfg.json", "App")
                   .render_priority.idle);
