@@ -3,10 +3,11 @@
 // thread never touches the application's queue), and publishes each finished frame read back
 // and encoded in the application's format. xrEndFrame takes the newest finished frame,
 // reprojects it by rotation to the submitted view orientations and composites the
-// application's projection views over it into the layer's swapchains: by a compute pass on the
-// application's device (the traced frame uploaded once per traced frame, the application's
-// images never leave the device), or, where that device cannot or the configuration says so
-// (and for depth compositing), on the host after reading the application's images back.
+// application's projection views over it (by depth when it chains usable depth) into the
+// layer's swapchains: by a compute pass on the application's device (the traced frame uploaded
+// once per traced frame, the application's images never leave the device), or, where that
+// device cannot or the configuration says so, on the host after reading the application's
+// images back.
 #include "frame_renderer.hpp"
 
 #include <pthread.h>
