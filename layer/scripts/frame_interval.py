@@ -9,7 +9,10 @@ Variants (--variants, comma-separated): `pass` (no scene), `host` / `gpu` (`corn
 FOVEA_LAYER_COMPOSITOR), optionally suffixed `:PRIORITY` (FOVEA_LAYER_RENDER_PRIORITY: `idle`
 or a nice value), e.g. `gpu:idle,gpu:19`. Interval: consecutive `wait_return_ns` of
 `layer_timing.jsonl` after the first 10 frames where both frames were replaced (pass-through:
-all); `xrEndFrame`: `cpu_ms.end_frame` of those replaced frames (pass-through: all). The load
+all); `xrEndFrame`: `cpu_ms.end_frame` of those replaced frames (pass-through: all); CPU per
+frame: the process's threads' CPU time (/proc, sampled every 0.25 s) over the frames, split
+into the application's threads (its Vulkan device's included) and the lowered ones (the render
+thread and its device's), which does not depend on the machine's load as much. The load
 average (1 min) is read before and after each run: other work on the machine shows in every
 figure, so compare the variants within one repetition.
 """
@@ -30,6 +33,26 @@ def loadavg():
 def percentile(values, q):
     s = sorted(values)
     return s[min(len(s) - 1, int(q * len(s)))]
+
+
+def thread_cpu(pid):
+    """CPU seconds per thread of `pid` so far: {tid: (seconds, lowered)}, lowered = SCHED_IDLE or
+    nice > 0 (the render thread and the device threads it created)."""
+    out = {}
+    tick = os.sysconf("SC_CLK_TCK")
+    try:
+        tids = os.listdir(f"/proc/{pid}/task")
+    except OSError:
+        return out
+    for tid in tids:
+        try:
+            with open(f"/proc/{pid}/task/{tid}/stat") as f:
+                fields = f.read().rsplit(")", 1)[1].split()
+        except OSError:
+            continue  # the thread ended meanwhile
+        # Fields from 3 (state) on: utime 14, stime 15, nice 19, policy 41 (proc(5)).
+        out[tid] = ((int(fields[11]) + int(fields[12])) / tick, int(fields[38]) == 5 or int(fields[16]) > 0)
+    return out
 
 
 def summarise(path):
@@ -80,8 +103,17 @@ def run(variant, args, rep):
         # hello_xr quits at the end of its input: the pipe stays open until it exits.
         p = subprocess.Popen(["hello_xr", "-g", "Vulkan2"], env=env, stdin=subprocess.PIPE, stdout=log,
                              stderr=subprocess.STDOUT)
+        # The threads' CPU time, sampled until the process exits (a thread's last sample stands
+        # for it: Linux forgets ended threads' times).
+        cpu = {}
         try:
-            code = p.wait(timeout=args.timeout)
+            deadline = time.monotonic() + args.timeout
+            while p.poll() is None:
+                if time.monotonic() > deadline:
+                    raise subprocess.TimeoutExpired(p.args, args.timeout)
+                cpu.update(thread_cpu(p.pid))
+                time.sleep(0.25)
+            code = p.returncode
         except subprocess.TimeoutExpired:
             p.kill()
             p.wait()
@@ -92,6 +124,8 @@ def run(variant, args, rep):
         raise SystemExit(f"{variant}: hello_xr exited with {code} (log: {out}/hello_xr.log)")
     s = summarise(os.path.join(out, "layer_timing.jsonl"))
     s["load"] = (load_before, loadavg())
+    s["cpu_app"] = sum(c for c, lowered in cpu.values() if not lowered) * 1e3 / args.frames
+    s["cpu_render"] = sum(c for c, lowered in cpu.values() if lowered) * 1e3 / args.frames
     return s
 
 
@@ -107,14 +141,16 @@ def main():
     args = ap.parse_args()
     variants = args.variants.split(",")
     print(f"| {args.display}, {args.frames} frames | rep | interval median / mean / p95 (ms) "
-          "| xrEndFrame median / mean (ms) | replaced / traced | host read-backs | load avg before → after |")
-    print("|---|---|---|---|---|---|---|")
+          "| xrEndFrame median / mean (ms) | CPU per frame: application / render (ms) "
+          "| replaced / traced | host read-backs | load avg before → after |")
+    print("|---|---|---|---|---|---|---|---|")
     for rep in range(1, args.reps + 1):
         for v in variants:
             t0 = time.monotonic()
             s = run(v, args, rep)
             print(f"| {v} | {rep} | {s['interval_median']:.2f} / {s['interval_mean']:.2f} / {s['interval_p95']:.2f} "
-                  f"| {s['end_median']:.3f} / {s['end_mean']:.3f} | {s['replaced']}/{s['traced']} "
+                  f"| {s['end_median']:.3f} / {s['end_mean']:.3f} | {s['cpu_app']:.2f} / {s['cpu_render']:.2f} "
+                  f"| {s['replaced']}/{s['traced']} "
                   f"| {s['host_readbacks']} | {s['load'][0]:.1f} → {s['load'][1]:.1f} |", flush=True)
             print(f"  ({v}, repetition {rep}: {time.monotonic() - t0:.0f} s)", file=sys.stderr, flush=True)
 
