@@ -219,16 +219,7 @@ std::vector<std::vector<float>> AppDevice::read_depth(const std::vector<AppDepth
   reserve(download_, total, VK_BUFFER_USAGE_TRANSFER_DST_BIT);
   ++host_readbacks_;
   queue_->run([&](VkCommandBuffer cb) {
-    for (std::size_t i = 0; i < reads.size(); ++i) {
-      const AppDepth& r = reads[i];
-      // Layout transitions cover every aspect of a combined depth/stencil image.
-      const VkImageAspectFlags aspects =
-          VK_IMAGE_ASPECT_DEPTH_BIT | (has_stencil(r.format) ? VK_IMAGE_ASPECT_STENCIL_BIT : 0);
-      record_download(cb, {r.image, r.array_index, VK_IMAGE_LAYOUT_DEPTH_STENCIL_ATTACHMENT_OPTIMAL,
-                           VK_ACCESS_DEPTH_STENCIL_ATTACHMENT_WRITE_BIT | VK_ACCESS_TRANSFER_WRITE_BIT, aspects,
-                           VK_IMAGE_ASPECT_DEPTH_BIT, r.rect, offsets[i]},
-                      download_.buffer);
-    }
+    for (std::size_t i = 0; i < reads.size(); ++i) record_download(cb, depth_download(reads[i], offsets[i]), download_.buffer);
     record_host_read_barrier(cb);
   });
   std::vector<std::vector<float>> out;
@@ -242,6 +233,14 @@ std::vector<std::vector<float>> AppDevice::read_depth(const std::vector<AppDepth
     out.push_back(std::move(d));
   }
   return out;
+}
+
+AppDevice::Download AppDevice::depth_download(const AppDepth& d, VkDeviceSize offset) {
+  // Layout transitions cover every aspect of a combined depth/stencil image.
+  const VkImageAspectFlags aspects = VK_IMAGE_ASPECT_DEPTH_BIT | (has_stencil(d.format) ? VK_IMAGE_ASPECT_STENCIL_BIT : 0);
+  return {d.image, d.array_index, VK_IMAGE_LAYOUT_DEPTH_STENCIL_ATTACHMENT_OPTIMAL,
+          VK_ACCESS_DEPTH_STENCIL_ATTACHMENT_WRITE_BIT | VK_ACCESS_TRANSFER_WRITE_BIT, aspects,
+          VK_IMAGE_ASPECT_DEPTH_BIT, d.rect, offset};
 }
 
 void AppDevice::write(const std::vector<VkImage>& images, const std::vector<const Pixels8*>& pixels) {

@@ -7,6 +7,7 @@
 #include <array>
 #include <cstdint>
 #include <memory>
+#include <optional>
 #include <vector>
 
 #include <vulkan/vulkan.h>
@@ -56,15 +57,18 @@ class AppDevice {
   void enable_gpu_composition();
   bool gpu_composition() const { return gpu_ != nullptr; }
   struct GpuEye {
-    EyeComposition composition;  // `traced` is uploaded only when `traced_id` changed; `app` unused
-    Read app;                    // the application's projection view (unused in scene-only mode)
-    VkImage target;              // written whole (out_view's raster), ends in COLOR_ATTACHMENT_OPTIMAL
+    // `traced` (and `traced_depth`) are uploaded only when `traced_id` changed; `app` and
+    // `app_depth` unused (the images below are read on the device).
+    EyeComposition composition;
+    Read app;                      // the application's projection view (unused in scene-only mode)
+    std::optional<AppDepth> depth;  // its depth, when compositing by depth (with composition.traced_depth)
+    VkImage target;                // written whole (out_view's raster), ends in COLOR_ATTACHMENT_OPTIMAL
   };
   // Two submissions on the session queue. The first (waited for, bounded) uploads the traced
-  // frame if new and copies the application's rects into a device buffer, so its images are
-  // free again on return; the second (not waited for: the runtime's later work on this queue
-  // comes after it) runs the composition pass and copies the results into the targets. The
-  // next call first waits for it.
+  // frame if new and copies the application's rects (and depth rects) into device buffers, so
+  // its images are free again on return; the second (not waited for: the runtime's later work
+  // on this queue comes after it) runs the composition pass and copies the results into the
+  // targets. The next call first waits for it.
   void composite_gpu(std::int64_t traced_id, const std::array<GpuEye, 2>& eyes, const CompositionRule& rule);
   // Waits for a composition pass still running (before its targets are destroyed).
   void finish();
@@ -92,6 +96,8 @@ class AppDevice {
     VkDeviceSize offset;
   };
   void record_download(VkCommandBuffer cb, const Download& d, VkBuffer buffer);
+  // The depth aspect of an application's depth rect (DEPTH_STENCIL_ATTACHMENT_OPTIMAL).
+  static Download depth_download(const AppDepth& d, VkDeviceSize offset);
   void record_host_read_barrier(VkCommandBuffer cb);
   // `buffer` at `offset` (width x height 4-byte texels) into the whole image, its old contents
   // discarded; the image ends in COLOR_ATTACHMENT_OPTIMAL.
@@ -111,12 +117,13 @@ class AppDevice {
     VkShaderModule shader = VK_NULL_HANDLE;
     VkDescriptorSetLayout set_layout = VK_NULL_HANDLE;
     VkPipelineLayout layout = VK_NULL_HANDLE;
-    VkPipeline pipeline = VK_NULL_HANDLE;
+    VkPipeline pipeline = VK_NULL_HANDLE, border_pipeline = VK_NULL_HANDLE;  // the composite and border passes
     VkDescriptorPool pool = VK_NULL_HANDLE;
     VkDescriptorSet set = VK_NULL_HANDLE;
     Buffer params, staging;                 // host-visible
-    Buffer traced, app, out, background;    // device-local
-    std::int64_t uploaded = -1;             // the traced frame in `traced`
+    Buffer traced, app, app_depth, out, background;  // device-local
+    std::int64_t uploaded = -1;                       // the traced frame in `traced`
+    bool uploaded_depth = false;                      // with its depths
   };
   std::unique_ptr<Gpu> gpu_;
   std::unique_ptr<xrcommon::ForeignQueue> pass_;  // the composition pass's submissions

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstring>
 #include <limits>
 #include <map>
 #include <stdexcept>
@@ -164,7 +165,22 @@ Pixels8 compose_eye(const EyeComposition& eye, const CompositionRule& rule) {
   Pixels8 out = reproject_traced(eye);
   if (!eye.app) return out;
   const Pixels8 a = resample(*eye.app, eye.app_view, eye.out_view);
-  composite(out, a, rule.mode, rule.background ? *rule.background : border_colour(*eye.app), rule.blend);
+  if (eye.by_depth())
+    composite_depth(out, resample_depth(*eye.traced_depth, eye.traced_view, eye.out_view, eye.to_traced), a,
+                    resample_depth(*eye.app_depth, eye.app_view, eye.out_view), eye.depth_range);
+  else
+    composite(out, a, rule.mode, rule.background ? *rule.background : border_colour(*eye.app), rule.blend);
+  return out;
+}
+
+// resample() moves 4-byte texels by direction, so each float travels as its bytes.
+std::vector<float> resample_depth(const std::vector<float>& depth, const core::View& from, const core::View& to,
+                                  const glm::dquat& to_from) {
+  Pixels8 packed{from.width(), from.height(), std::vector<std::uint8_t>(depth.size() * 4)};
+  std::memcpy(packed.data.data(), depth.data(), packed.data.size());
+  const Pixels8 moved = resample(packed, from, to, to_from);
+  std::vector<float> out(moved.data.size() / 4);
+  std::memcpy(out.data(), moved.data.data(), moved.data.size());
   return out;
 }
 

@@ -73,6 +73,14 @@ LayerBlend layer_blend(XrCompositionLayerFlags flags, PixelFormat fmt);
 std::int64_t composite(Pixels8& scene, const Pixels8& app, Composite mode, std::array<std::uint8_t, 3> background,
                        const LayerBlend& blend, int tolerance = 2);
 
+// The mapping of the application's depth values (XrCompositionLayerDepthInfoKHR): window
+// depth min_depth lies at view distance near_z, max_depth at far_z. near_z > far_z is
+// reversed Z; either plane may be +infinity (an infinite far plane).
+struct DepthRange {
+  float min_depth = 0, max_depth = 1;
+  float near_z = 0.1f, far_z = 100;
+};
+
 // One eye of a frame's composition: the traced frame (in `traced_view`'s raster) reprojected
 // by rotation into `out_view` (the submitted FOV at the traced raster; `to_traced` =
 // conj(q_traced) * q_submitted), opaque black where it does not reach, then the application's
@@ -85,6 +93,13 @@ struct EyeComposition {
   glm::dquat to_traced{1, 0, 0, 0};
   const Pixels8* app = nullptr;  // null: the scene only
   core::View app_view;
+  // Compositing by depth (composite_depth) instead of the rule, when both are set with `app`:
+  // the traced frame's view distances (traced_view's raster, FramePipeline::depth), reprojected
+  // with its colour, and the application's window depths (app_view's raster) with their range.
+  const std::vector<float>* traced_depth = nullptr;
+  const std::vector<float>* app_depth = nullptr;
+  DepthRange depth_range;
+  bool by_depth() const { return app && traced_depth && app_depth; }
 };
 // How the application's pixels are combined: the configured mode, AppOnTop's background
 // (unset: border_colour() of the application's image), the layer flags' blending.
@@ -95,16 +110,10 @@ struct CompositionRule {
 };
 // The traced frame reprojected into out_view, alpha 255 everywhere.
 Pixels8 reproject_traced(const EyeComposition& eye);
-// reproject_traced, then composite() by `rule` (the scene alone without `app`).
+// reproject_traced, then composite_depth() when eye.by_depth(), else composite() by `rule`
+// (the scene alone without `app`).
 Pixels8 compose_eye(const EyeComposition& eye, const CompositionRule& rule);
 
-// The mapping of the application's depth values (XrCompositionLayerDepthInfoKHR): window
-// depth min_depth lies at view distance near_z, max_depth at far_z. near_z > far_z is
-// reversed Z; either plane may be +infinity (an infinite far plane).
-struct DepthRange {
-  float min_depth = 0, max_depth = 1;
-  float near_z = 0.1f, far_z = 100;
-};
 // View-space distance along -Z of window depth `d` under a perspective projection: its
 // normalised depth t = (d - min_depth) / (max_depth - min_depth) is affine in 1/z,
 // 1/z = (1 - t)/near_z + t/far_z. +infinity at an infinite plane; throws std::runtime_error
@@ -118,5 +127,9 @@ double view_distance(float d, const DepthRange& range);
 // alpha at 0 keep the scene. Returns how many pixels show the application.
 std::int64_t composite_depth(Pixels8& scene, const std::vector<float>& scene_depth, const Pixels8& app,
                              const std::vector<float>& app_depth, const DepthRange& range);
+
+// Per-pixel floats (depths) resampled like resample() moves pixels; 0 where not covered.
+std::vector<float> resample_depth(const std::vector<float>& depth, const core::View& from, const core::View& to,
+                                  const glm::dquat& to_from = glm::dquat(1, 0, 0, 0));
 
 }  // namespace fovea::layer

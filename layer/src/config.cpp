@@ -30,6 +30,14 @@ bool parse_render_mode(const std::string& v, const std::string& where) {
 
 bool parse_compositor(const std::string& v, const std::string& where) { return parse_either(v, where, "gpu", "host"); }
 
+RenderPriority parse_render_priority(const std::string& v, const std::string& where) {
+  if (v == "idle") return {true, 19};
+  // A whole number 0..19 (no sign, no spaces): nice values below the default are not the layer's to take.
+  if (!v.empty() && v.size() <= 2 && v.find_first_not_of("0123456789") == std::string::npos && std::stoi(v) <= 19)
+    return {false, std::stoi(v)};
+  throw core::InputError(where + ": \"" + v + "\" must be \"idle\" or a nice value 0..19");
+}
+
 void apply_section(const nlohmann::json& s, const std::string& where, LayerConfig& c) {
   if (!s.is_object()) throw core::InputError(where + ": must be an object");
   for (const auto& [key, v] : s.items()) {
@@ -46,6 +54,8 @@ void apply_section(const nlohmann::json& s, const std::string& where, LayerConfi
       else throw core::InputError(field + ": must be \"app-on-top\", \"alpha\" or \"scene-only\"");
     } else if (key == "compositor") {
       c.gpu_compositor = parse_compositor(v.is_string() ? v.get<std::string>() : v.dump(), field);
+    } else if (key == "render_priority") {
+      c.render_priority = parse_render_priority(v.is_string() ? v.get<std::string>() : v.dump(), field);
     } else if (key == "render") {
       c.lockstep = parse_render_mode(v.is_string() ? v.get<std::string>() : v.dump(), field);
     } else if (key == "app_background") {
@@ -67,12 +77,16 @@ void apply_section(const nlohmann::json& s, const std::string& where, LayerConfi
       }
       c.app_background = rgb;
     } else {
-      throw core::InputError(field + ": unknown key (scene, composite, app_background, gaze, render, compositor)");
+      throw core::InputError(field + ": unknown key (scene, composite, app_background, gaze, render, compositor, render_priority)");
     }
   }
 }
 
 }  // namespace
+
+std::string render_priority_name(const RenderPriority& p) {
+  return p.idle ? "SCHED_IDLE" : "nice " + std::to_string(p.nice);
+}
 
 const char* composite_name(Composite c) {
   switch (c) {
@@ -123,6 +137,8 @@ LayerConfig load_config(const std::string& application) {
   if (!env("FOVEA_LAYER_RENDER").empty()) c.lockstep = parse_render_mode(env("FOVEA_LAYER_RENDER"), "FOVEA_LAYER_RENDER");
   if (!env("FOVEA_LAYER_COMPOSITOR").empty())
     c.gpu_compositor = parse_compositor(env("FOVEA_LAYER_COMPOSITOR"), "FOVEA_LAYER_COMPOSITOR");
+  if (!env("FOVEA_LAYER_RENDER_PRIORITY").empty())
+    c.render_priority = parse_render_priority(env("FOVEA_LAYER_RENDER_PRIORITY"), "FOVEA_LAYER_RENDER_PRIORITY");
   return c;
 }
 

@@ -2,10 +2,11 @@
 // The layer's configuration for one application. Sources, later ones winning:
 //   $XDG_CONFIG_HOME/fovea/layer.json (else ~/.config/fovea/layer.json):
 //     {"default": {...}, "applications": {"<XrApplicationInfo::applicationName>": {...}}}
-//     with keys "scene", "composite", "app_background", "gaze", "render", "compositor" (an
-//     application's section over "default");
+//     with keys "scene", "composite", "app_background", "gaze", "render", "compositor",
+//     "render_priority" (an application's section over "default");
 //   env FOVEA_LAYER_SCENE, then FOVEA_SCENE (the scene); FOVEA_GAZE (the gaze source);
-//   FOVEA_LAYER_RENDER (the render mode); FOVEA_LAYER_COMPOSITOR (where compositing runs).
+//   FOVEA_LAYER_RENDER (the render mode); FOVEA_LAYER_COMPOSITOR (where compositing runs);
+//   FOVEA_LAYER_RENDER_PRIORITY (the render thread's CPU priority).
 #include <array>
 #include <optional>
 #include <string>
@@ -18,6 +19,15 @@ enum class Composite {
   Alpha,      // the application's pixels over the scene by their alpha
   SceneOnly,  // the scene alone (comparisons)
 };
+
+// The render thread's CPU scheduling. Default nice 19: SCHED_IDLE starves the path tracer on
+// a loaded host (no traced frame in 2500 frames at load 19 on two cores) and its threads can
+// hold process-wide locks (the address space's, the allocator's) the application then waits for.
+struct RenderPriority {
+  bool idle = false;  // SCHED_IDLE; else SCHED_OTHER at `nice`
+  int nice = 19;
+};
+std::string render_priority_name(const RenderPriority& p);
 
 struct LayerConfig {
   std::string scene;  // renderer::load_scene name or path; empty: none (pass-through)
@@ -34,6 +44,10 @@ struct LayerConfig {
   // "compositor": "gpu" (true): a compute pass on the application's device, the host path
   // when that device cannot run it; "host" (false): always the host round trip.
   bool gpu_compositor = true;
+  // "render_priority": a nice value 0..19 (SCHED_OTHER; default 19) or "idle" (SCHED_IDLE) for the render
+  // thread and the threads of the device it creates (Linux threads inherit both), so that on a
+  // CPU device the path tracer runs below the application's threads.
+  RenderPriority render_priority;
 };
 
 // Throws core::InputError naming the file and field for a malformed configuration file.

@@ -3,12 +3,15 @@
 // thread never touches the application's queue), and publishes each finished frame read back
 // and encoded in the application's format. xrEndFrame takes the newest finished frame,
 // reprojects it by rotation to the submitted view orientations and composites the
-// application's projection views over it into the layer's swapchains: by a compute pass on the
-// application's device (the traced frame uploaded once per traced frame, the application's
-// images never leave the device), or, where that device cannot or the configuration says so
-// (and for depth compositing), on the host after reading the application's images back.
+// application's projection views over it (by depth when it chains usable depth) into the
+// layer's swapchains: by a compute pass on the application's device (the traced frame uploaded
+// once per traced frame, the application's images never leave the device), or, where that
+// device cannot or the configuration says so, on the host after reading the application's
+// images back.
 #include "frame_renderer.hpp"
 
+#include <pthread.h>
+#include <sched.h>
 #include <sys/resource.h>
 #include <sys/syscall.h>
 #include <unistd.h>
@@ -104,19 +107,6 @@ core::StereoViews submitted_views(const std::vector<AppView>& v) {
   return s;
 }
 
-// The application's window depths resampled into the scene's raster like its colour:
-// resample moves 4-byte texels by direction, so each float travels as its bytes (pixels the
-// application did not cover read 0, where the colour's alpha 0 already keeps the scene).
-std::vector<float> resample_depth(const std::vector<float>& depth, const core::View& app_view,
-                                  const core::View& scene_view, const glm::dquat& scene_to_app = glm::dquat(1, 0, 0, 0)) {
-  Pixels8 packed{app_view.width(), app_view.height(), std::vector<std::uint8_t>(depth.size() * 4)};
-  std::memcpy(packed.data.data(), depth.data(), packed.data.size());
-  const Pixels8 moved = resample(packed, app_view, scene_view, scene_to_app);
-  std::vector<float> out(moved.data.size() / 4);
-  std::memcpy(out.data(), moved.data.data(), moved.data.size());
-  return out;
-}
-
 // What the application thread hands the render thread: the newest submitted views and gaze.
 struct TraceRequest {
   std::int64_t id = 0;
@@ -156,10 +146,11 @@ class PathTracer {
     reconstruct::ReconSettings settings;
     settings.share = reconstruct::StereoShare::Gather;
     pipeline_ = std::make_unique<pipeline::FramePipeline>(*ctx_, *gpu_scene_, views_, core::DistributionParams{}, settings);
-    FOVEA_LAYER_INFO("rendering scene \"%s\" (from %s) at %dx%d per eye on %s, composite %s, gaze %s, render %s",
+    FOVEA_LAYER_INFO("rendering scene \"%s\" (from %s) at %dx%d per eye on %s, composite %s, gaze %s, render %s, "
+                     "render thread %s",
                      config_.scene.c_str(), config_.origin.c_str(), display.width, display.height,
                      ctx_->info().name.c_str(), composite_name(config_.composite), gaze_->describe().c_str(),
-                     config_.lockstep ? "lockstep" : "async");
+                     config_.lockstep ? "lockstep" : "async", render_priority_name(config_.render_priority).c_str());
   }
 
   std::shared_ptr<const TracedFrame> trace(const TraceRequest& in) {
@@ -247,10 +238,19 @@ class PathTracer {
   std::unique_ptr<pipeline::FramePipeline> pipeline_;
 };
 
-// The angle (degrees) of a rotation.
-// The render thread's nice value (19 is the lowest priority).
-constexpr int kRenderNice = 10;
+// The calling thread's scheduling set to `p`; the reason on failure, else empty.
+std::string lower_priority(const RenderPriority& p) {
+  const auto tid = static_cast<pid_t>(syscall(SYS_gettid));
+  if (p.idle) {
+    const sched_param none{};
+    if (sched_setscheduler(tid, SCHED_IDLE, &none) != 0) return std::strerror(errno);
+  } else if (setpriority(PRIO_PROCESS, static_cast<id_t>(tid), p.nice) != 0) {
+    return std::strerror(errno);
+  }
+  return {};
+}
 
+// The angle (degrees) of a rotation.
 double rotation_deg(const glm::dquat& q) {
   return glm::degrees(2.0 * std::acos(std::min(1.0, std::abs(q.w))));
 }
@@ -296,21 +296,31 @@ class PathTraceRenderer final : public FrameRenderer {
     req.action_gaze = in.action_gaze;
     req.get_visibility_mask = in.get_visibility_mask;
     req.visibility_mask_generation = in.visibility_mask_generation;
-    std::shared_ptr<const TracedFrame> frame;
     {
-      std::unique_lock lock(mutex_);
-      if (!error_.empty()) throw std::runtime_error("the render thread failed: " + error_);
-      req.id = next_request_++;
-      pending_ = req;  // replaces a request the thread has not picked up: only the newest views count
-      wake_.notify_all();
-      if (config_.lockstep) {
-        constexpr auto kLimit = std::chrono::minutes(10);
-        if (!done_.wait_for(lock, kLimit, [&] { return !error_.empty() || (newest_ && newest_->id >= req.id); }))
-          throw std::runtime_error("lockstep rendering: the render thread did not finish a frame in 10 minutes");
+      // Asynchronous: never wait for the render thread. At its low priority it may hold the
+      // mailbox while it waits for a core (priority inversion); a frame that finds the mailbox
+      // taken shows the frame seen last and does not hand its views over (the next frame's are
+      // newer anyway).
+      std::unique_lock lock(mutex_, std::defer_lock);
+      if (config_.lockstep)
+        lock.lock();
+      else
+        static_cast<void>(lock.try_lock());
+      if (lock.owns_lock()) {
         if (!error_.empty()) throw std::runtime_error("the render thread failed: " + error_);
+        req.id = next_request_++;
+        pending_ = req;  // replaces a request the thread has not picked up: only the newest views count
+        wake_.notify_all();
+        if (config_.lockstep) {
+          constexpr auto kLimit = std::chrono::minutes(10);
+          if (!done_.wait_for(lock, kLimit, [&] { return !error_.empty() || (newest_ && newest_->id >= req.id); }))
+            throw std::runtime_error("lockstep rendering: the render thread did not finish a frame in 10 minutes");
+          if (!error_.empty()) throw std::runtime_error("the render thread failed: " + error_);
+        }
+        seen_ = newest_;
       }
-      frame = newest_;
     }
+    const std::shared_ptr<const TracedFrame> frame = seen_;
     if (!frame) return nullptr;  // nothing traced yet: the application's own frame
     const auto t0 = std::chrono::steady_clock::now();
     const XrFrameEndInfo* out = compose(in, *frame, shown);
@@ -325,12 +335,17 @@ class PathTraceRenderer final : public FrameRenderer {
   };
 
   void run() {
-    // Below the application's threads: on a CPU device (lavapipe) the path tracer would
-    // otherwise take the cores the application's frame loop needs. Linux nice values are per
-    // thread and inherited by the threads this one creates (the render device's workers).
-    if (setpriority(PRIO_PROCESS, static_cast<id_t>(syscall(SYS_gettid)), kRenderNice) != 0)
-      FOVEA_LAYER_WARN("render thread: cannot lower its priority (%s); it competes with the application's threads",
-                       std::strerror(errno));
+    pthread_setname_np(pthread_self(), "fovea-render");
+    // Below the application's threads, before the render device exists: on a CPU device
+    // (lavapipe) the device's worker threads do the path tracing and would otherwise take the
+    // cores the application's frame loop needs. Linux threads inherit the scheduling policy and
+    // the per-thread nice value of the thread that creates them, and lavapipe creates its
+    // rasteriser and compute threads with the VkInstance's physical device and the VkDevice
+    // (gpu::Context, created below on this thread). The composition pass runs on the
+    // application's device, whose threads keep the application's priority.
+    if (const std::string failed = lower_priority(config_.render_priority); !failed.empty())
+      FOVEA_LAYER_WARN("render thread: cannot set %s (%s); it competes with the application's threads",
+                       render_priority_name(config_.render_priority).c_str(), failed.c_str());
     std::unique_ptr<PathTracer> tracer;
     try {
       tracer = std::make_unique<PathTracer>(config_, scene_, views_in_, display_, format_, session_);
@@ -346,8 +361,10 @@ class PathTraceRenderer final : public FrameRenderer {
         }
         std::shared_ptr<const TracedFrame> f = tracer->trace(req);
         {
+          // The frame it replaces is freed after the unlock: at a low priority this thread
+          // may wait long for a core, and the application must never wait for it on the lock.
           std::lock_guard lock(mutex_);
-          newest_ = std::move(f);
+          newest_.swap(f);
         }
         done_.notify_all();
       }
@@ -368,9 +385,8 @@ class PathTraceRenderer final : public FrameRenderer {
     shown.done_ns = f.done_ns;
     shown.times = f.times;
     const bool scene_only = config_.composite == Composite::SceneOnly;
-    // Compositing by depth runs on the host.
-    const bool depth = !scene_only && (in.app_views[0].depth || in.app_views[1].depth);
-    const bool on_gpu = app_.gpu_composition() && !depth;
+    const bool by_depth = !scene_only && composite_by_depth(in);
+    const bool on_gpu = app_.gpu_composition();
     const std::int64_t readbacks = app_.host_readbacks();
     std::array<EyeComposition, 2> eyes;
     for (int e = 0; e < 2; ++e) {
@@ -382,6 +398,10 @@ class PathTraceRenderer final : public FrameRenderer {
       c.to_traced = glm::conjugate(f.orientation[ei]) * to_pose(in.app_views[ei].pose).orientation;
       c.app_view = core::View(to_fov(in.app_views[ei].fov), in.app_views[ei].rect.extent.width,
                               in.app_views[ei].rect.extent.height);
+      if (by_depth) {
+        c.traced_depth = &f.depth[ei];
+        c.depth_range = in.app_views[ei].depth->range;
+      }
       shown.reprojected_deg = std::max(shown.reprojected_deg, rotation_deg(c.to_traced));
     }
     CompositionRule rule;
@@ -404,10 +424,11 @@ class PathTraceRenderer final : public FrameRenderer {
     if (on_gpu) {
       std::array<AppDevice::GpuEye, 2> jobs;
       for (std::size_t e = 0; e < 2; ++e)
-        jobs[e] = {eyes[e], {in.app_views[e].image, in.app_views[e].array_index, in.app_views[e].rect}, targets[e]};
+        jobs[e] = {eyes[e], {in.app_views[e].image, in.app_views[e].array_index, in.app_views[e].rect},
+                   by_depth ? in.app_views[e].depth : std::nullopt, targets[e]};
       app_.composite_gpu(f.id, jobs, rule);
     } else {
-      compose_on_host(in, f, eyes, rule, targets);
+      compose_on_host(in, eyes, rule, targets);
     }
     shown.composited_on_gpu = on_gpu;
     shown.host_readbacks = app_.host_readbacks() - readbacks;
@@ -441,36 +462,32 @@ class PathTraceRenderer final : public FrameRenderer {
     return &frame_;
   }
 
-  // The host path: the application's images read back, composited on the CPU (by depth when
-  // it chained usable depth), uploaded into `targets`.
-  void compose_on_host(const FrameInput& in, const TracedFrame& f, std::array<EyeComposition, 2>& eyes,
-                       const CompositionRule& rule, const std::vector<VkImage>& targets) {
+  // The host path: the application's images (and depths, when compositing by depth) read
+  // back, composited on the CPU, uploaded into `targets`.
+  void compose_on_host(const FrameInput& in, std::array<EyeComposition, 2>& eyes, const CompositionRule& rule,
+                       const std::vector<VkImage>& targets) {
     std::vector<AppDevice::Read> reads;
     for (const AppView& v : in.app_views) reads.push_back({v.image, v.array_index, v.rect});
     const std::vector<Pixels8> app = rule.mode == Composite::SceneOnly ? std::vector<Pixels8>{} : app_.read(reads);
-    const std::vector<std::vector<float>> app_depth = app.empty() ? std::vector<std::vector<float>>{} : read_depth(in);
+    const std::vector<std::vector<float>> app_depth =
+        eyes[0].traced_depth ? app_.read_depth({*in.app_views[0].depth, *in.app_views[1].depth})
+                             : std::vector<std::vector<float>>{};
     std::array<Pixels8, 2> out;
     for (std::size_t e = 0; e < 2; ++e) {
       EyeComposition& c = eyes[e];
       c.app = app.empty() ? nullptr : &app[e];
-      if (!app_depth.empty() && !f.depth[e].empty()) {
-        out[e] = reproject_traced(c);
-        composite_depth(out[e], resample_depth(f.depth[e], c.traced_view, c.out_view, c.to_traced),
-                        resample(app[e], c.app_view, c.out_view), resample_depth(app_depth[e], c.app_view, c.out_view),
-                        in.app_views[e].depth->range);
-      } else {
-        out[e] = compose_eye(c, rule);
-      }
+      c.app_depth = app_depth.empty() ? nullptr : &app_depth[e];
+      out[e] = compose_eye(c, rule);
     }
     app_.write(targets, {&out[0], &out[1]});
   }
 
-  // The application's window depths of both views, when it chained depth to both and the layer
-  // can use it (a format it decodes, the colour rect's size); else nothing and the configured
+  // Whether this frame composites by depth: the application chained depth to both views and
+  // the layer can use it (a format it decodes, the colour rect's size); else the configured
   // mode composites. The decision is logged once.
-  std::vector<std::vector<float>> read_depth(const FrameInput& in) {
+  bool composite_by_depth(const FrameInput& in) {
     const AppView &l = in.app_views[0], &r = in.app_views[1];
-    if (!l.depth && !r.depth) return {};
+    if (!l.depth && !r.depth) return false;
     std::string why;
     if (!l.depth || !r.depth) why = "depth is chained to one view only";
     for (std::size_t i = 0; i < 2 && why.empty(); ++i) {
@@ -488,8 +505,7 @@ class PathTraceRenderer final : public FrameRenderer {
                          composite_name(config_.composite));
       depth_noted_ = true;
     }
-    if (!why.empty()) return {};
-    return app_.read_depth({*l.depth, *r.depth});
+    return why.empty();
   }
 
   // At the first stereo frame: the layer's swapchains in the application's format for its
@@ -560,6 +576,8 @@ class PathTraceRenderer final : public FrameRenderer {
   std::string error_;  // the render thread's failure (it has stopped)
   bool stop_ = false;
   std::int64_t next_request_ = 0;
+  // The newest finished frame xrEndFrame saw (the application's thread only).
+  std::shared_ptr<const TracedFrame> seen_;
   std::thread thread_;
 
   // xrEndFrame's composition (the application's thread).

@@ -9,11 +9,20 @@
 #include <condition_variable>
 #include <cstdlib>
 #include <deque>
+#include <filesystem>
 #include <fstream>
+#include <iterator>
+#include <map>
 #include <mutex>
 #include <set>
+#include <sstream>
 #include <string>
 #include <thread>
+#include <vector>
+
+#include <sched.h>
+#include <sys/syscall.h>
+#include <unistd.h>
 
 #include <gtest/gtest.h>
 #include <nlohmann/json.hpp>
@@ -27,7 +36,33 @@ namespace {
 constexpr const char* kVariables[] = {"XR_API_LAYER_PATH", "XR_ENABLE_API_LAYERS", "FOVEA_LAYER_OUT",
                                       "FOVEA_LAYER_LOG_FILE", "FOVEA_SCENE", "FOVEA_LAYER_SCENE",
                                       "XDG_CONFIG_HOME", "FOVEA_LAYER_RENDER", "FOVEA_LAYER_TEST_RENDER_DELAY_MS",
-                                      "FOVEA_LAYER_COMPOSITOR"};
+                                      "FOVEA_LAYER_COMPOSITOR", "FOVEA_LAYER_RENDER_PRIORITY"};
+
+// A thread of this process as /proc/self/task/<tid>/stat shows it.
+struct ThreadInfo {
+  std::string name;
+  int nice = 0;
+  int policy = 0;  // SCHED_OTHER 0, SCHED_IDLE 5
+};
+std::map<int, ThreadInfo> threads() {
+  std::map<int, ThreadInfo> out;
+  for (const auto& entry : std::filesystem::directory_iterator("/proc/self/task")) {
+    std::ifstream in(entry.path() / "stat");
+    std::string stat((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+    const auto open = stat.find('('), close = stat.rfind(')');
+    if (open == std::string::npos || close == std::string::npos) continue;  // the thread ended meanwhile
+    ThreadInfo t;
+    t.name = stat.substr(open + 1, close - open - 1);
+    // After the name: field 3 (state) onwards; nice is field 19, policy field 41 (proc(5)).
+    std::istringstream rest(stat.substr(close + 2));
+    std::vector<std::string> f{std::istream_iterator<std::string>(rest), std::istream_iterator<std::string>()};
+    if (f.size() < 39) continue;
+    t.nice = std::stoi(f[16]);
+    t.policy = std::stoi(f[38]);
+    out[std::stoi(entry.path().filename().string())] = t;
+  }
+  return out;
+}
 
 std::vector<nlohmann::json> records(const std::string& file) {
   std::vector<nlohmann::json> out;
@@ -51,6 +86,7 @@ class AsyncLayer : public XrTest, public ::testing::WithParamInterface<const cha
     setenv("FOVEA_SCENE", "cornell", 1);
     unsetenv("FOVEA_LAYER_SCENE");
     unsetenv("FOVEA_LAYER_RENDER");  // the default: asynchronous
+    unsetenv("FOVEA_LAYER_RENDER_PRIORITY");  // the default: nice 19
     setenv("FOVEA_LAYER_COMPOSITOR", GetParam(), 1);
     // Far slower than a frame interval: the application must not notice.
     setenv("FOVEA_LAYER_TEST_RENDER_DELAY_MS", "700", 1);
@@ -87,6 +123,8 @@ TEST_P(AsyncLayer, PipelinedFramesOnTwoThreadsNeverWaitForTheRenderThread) {
             XR_SUCCESS);
   const auto w = int32_t(vcv[0].recommendedImageRectWidth), h = int32_t(vcv[0].recommendedImageRectHeight);
   for (XrSwapchain& sc : eye_) sc = color_swapchain(uint32_t(w), uint32_t(h));
+  // The application's threads, its Vulkan device's among them, before the render thread exists.
+  const std::map<int, ThreadInfo> app_threads = threads();
 
   // Until the records show three distinct traced frames (the first is the renderer's set-up):
   // the waiter runs one frame ahead of the submitting thread.
@@ -219,6 +257,41 @@ TEST_P(AsyncLayer, PipelinedFramesOnTwoThreadsNeverWaitForTheRenderThread) {
   EXPECT_NE(log.find(gpu ? "composition: on the GPU" : "composition: on the host (configured)"), std::string::npos)
       << log;
   EXPECT_EQ(log.find("internal failure"), std::string::npos) << log;
+
+  // CPU priority: the render thread and the threads of the device it created (lavapipe's
+  // rasteriser threads, "llvmpipe-N", and its compute workers, which inherit the name
+  // "fovea-render") run at nice 19; the application's threads, its device's included, keep
+  // theirs (Mesa's disk-cache threads lower themselves to SCHED_IDLE whoever creates them).
+  const auto lowered = [](const ThreadInfo& t) { return t.policy == SCHED_OTHER && t.nice == 19; };
+  const std::map<int, ThreadInfo> now = threads();
+  const ThreadInfo me = now.at(int(syscall(SYS_gettid)));
+  EXPECT_EQ(me.policy, SCHED_OTHER);
+  EXPECT_EQ(me.nice, app_threads.at(int(syscall(SYS_gettid))).nice);
+  int render = 0, render_device = 0, app_device = 0;
+  for (const auto& [tid, t] : now) {
+    const bool rasteriser = t.name.rfind("llvmpipe-", 0) == 0;
+    if (app_threads.count(tid)) {
+      if (t.name.find("disk$") == std::string::npos) {
+        EXPECT_EQ(t.policy, app_threads.at(tid).policy) << t.name << " " << tid;
+        EXPECT_EQ(t.nice, app_threads.at(tid).nice) << t.name << " " << tid;
+      }
+      app_device += rasteriser;
+      continue;
+    }
+    if (t.name == "fovea-render") {
+      ++render;
+      EXPECT_TRUE(lowered(t)) << "the render thread or a device thread it created: " << tid << " nice " << t.nice;
+    }
+    if (rasteriser) {
+      ++render_device;
+      EXPECT_TRUE(lowered(t)) << "the render device's " << t.name << " " << tid << " nice " << t.nice;
+    }
+  }
+  EXPECT_GE(render, 1);
+  if (app_device > 0) {  // lavapipe: as many rasteriser threads per device, compute workers too
+    EXPECT_EQ(render_device, app_device) << "one device's rasteriser threads each";
+    EXPECT_GT(render, 1) << "the render device's compute workers";
+  }
 
   // Teardown while the render thread is inside a render's delay: it is woken and joined.
   for (XrSwapchain& sc : eye_) {

@@ -302,6 +302,8 @@ TEST_P(DepthApp, NearHalfShowsTheAppFarHalfShowsTheScene) {
   std::string line, last;
   while (std::getline(timing, line)) last = line;
   EXPECT_NE(last.find("\"replaced\":true"), std::string::npos) << last;
+  // By depth on the application's device (the default compositor): no image reaches the host.
+  EXPECT_NE(last.find("\"composited_on_gpu\":true,\"host_readbacks\":0"), std::string::npos) << last;
 
   // Below the layer: the replaced frame keeps the application's chains but the depth.
   const std::string bias_type = std::to_string(int(XR_TYPE_COMPOSITION_LAYER_COLOR_SCALE_BIAS_KHR));

@@ -5,6 +5,10 @@
 #include <algorithm>
 #include <array>
 #include <cstdint>
+#include <cmath>
+#include <cstring>
+#include <limits>
+#include <optional>
 #include <random>
 #include <string>
 #include <vector>
@@ -13,24 +17,27 @@
 
 #include "app_device.hpp"
 #include "composite.hpp"
+#include "fovea/gpu/buffer.hpp"
 #include "gpu_fixture.hpp"
 
 namespace fovea::layer {
 namespace {
 
-// A colour image the way a runtime hands out swapchain images: device-local, transfer
-// source and destination, colour attachment.
+// An image the way a runtime hands out swapchain images: device-local, transfer source and
+// destination, colour (or, for a depth format, depth/stencil) attachment.
 class TestImage {
  public:
-  TestImage(gpu::Context& ctx, int w, int h) : device_(ctx.device()) {
+  TestImage(gpu::Context& ctx, int w, int h, VkFormat format = VK_FORMAT_R8G8B8A8_UNORM) : device_(ctx.device()) {
+    const bool depth = format == VK_FORMAT_D16_UNORM || format == VK_FORMAT_D32_SFLOAT;
     VkImageCreateInfo ci{VK_STRUCTURE_TYPE_IMAGE_CREATE_INFO};
     ci.imageType = VK_IMAGE_TYPE_2D;
-    ci.format = VK_FORMAT_R8G8B8A8_UNORM;
+    ci.format = format;
     ci.extent = {std::uint32_t(w), std::uint32_t(h), 1};
     ci.mipLevels = ci.arrayLayers = 1;
     ci.samples = VK_SAMPLE_COUNT_1_BIT;
     ci.tiling = VK_IMAGE_TILING_OPTIMAL;
-    ci.usage = VK_IMAGE_USAGE_TRANSFER_SRC_BIT | VK_IMAGE_USAGE_TRANSFER_DST_BIT | VK_IMAGE_USAGE_COLOR_ATTACHMENT_BIT;
+    ci.usage = VK_IMAGE_USAGE_TRANSFER_SRC_BIT | VK_IMAGE_USAGE_TRANSFER_DST_BIT |
+               (depth ? VK_IMAGE_USAGE_DEPTH_STENCIL_ATTACHMENT_BIT : VK_IMAGE_USAGE_COLOR_ATTACHMENT_BIT);
     EXPECT_EQ(vkCreateImage(device_, &ci, nullptr, &image_), VK_SUCCESS);
     VkMemoryRequirements req;
     vkGetImageMemoryRequirements(device_, image_, &req);
@@ -89,6 +96,20 @@ Pixels8 random_app(std::mt19937& rng, int w, int h, std::array<std::uint8_t, 3> 
   return p;
 }
 
+// Pixels equal, off by one 8-bit step in some channel, off by more.
+struct Differences {
+  std::size_t exact = 0, rounding = 0, other = 0;
+};
+Differences differences(const Pixels8& a, const Pixels8& b) {
+  Differences d;
+  for (std::size_t i = 0; i < a.data.size() && i < b.data.size(); i += 4) {
+    int worst = 0;
+    for (std::size_t c = 0; c < 4; ++c) worst = std::max(worst, std::abs(int(a.data[i + c]) - int(b.data[i + c])));
+    (worst == 0 ? d.exact : worst == 1 ? d.rounding : d.other)++;
+  }
+  return d;
+}
+
 glm::dquat yaw(double deg) { return glm::angleAxis(glm::radians(deg), glm::dvec3(0, 1, 0)); }
 
 struct Geometry {
@@ -107,6 +128,28 @@ struct Mode {
   XrCompositionLayerFlags flags;
   bool srgb;
 };
+
+// Eye `e` of geometry `g` (the right eye turned the other way), the traced frame `traced`.
+EyeComposition eye_of(const Geometry& g, const Pixels8& traced, std::size_t e) {
+  EyeComposition c;
+  c.traced = &traced;
+  c.traced_view = core::View(g.traced_fov, g.traced_w, g.traced_h);
+  c.out_view = core::View(g.app_fov, g.traced_w, g.traced_h);
+  c.to_traced = yaw(e == 0 ? g.yaw_deg : -g.yaw_deg);
+  c.app_view = core::View(g.app_fov, g.app_w, g.app_h);
+  return c;
+}
+
+// The GPU composition of `jobs`, its targets read back; it copies no application image to the host.
+std::vector<Pixels8> composite_on_gpu(AppDevice& dev, std::int64_t traced_id, const std::array<AppDevice::GpuEye, 2>& jobs,
+                                      const CompositionRule& rule, const Geometry& g) {
+  const std::int64_t readbacks = dev.host_readbacks();
+  dev.composite_gpu(traced_id, jobs, rule);
+  dev.finish();
+  EXPECT_EQ(dev.host_readbacks(), readbacks) << "the GPU path copied application images to the host";
+  return dev.read({{jobs[0].target, 0, {{0, 0}, {g.traced_w, g.traced_h}}},
+                   {jobs[1].target, 0, {{0, 0}, {g.traced_w, g.traced_h}}}});
+}
 
 class GpuComposite : public test::GpuTest {};
 
@@ -151,32 +194,15 @@ TEST_F(GpuComposite, MatchesTheHostPathPixelByPixel) {
       std::array<AppDevice::GpuEye, 2> jobs;
       std::array<Pixels8, 2> host;
       for (std::size_t e = 0; e < 2; ++e) {
-        EyeComposition c;
-        c.traced = &traced[e];
-        c.traced_view = core::View(g.traced_fov, g.traced_w, g.traced_h);
-        c.out_view = core::View(g.app_fov, g.traced_w, g.traced_h);
-        c.to_traced = yaw(e == 0 ? g.yaw_deg : -g.yaw_deg);
-        c.app_view = core::View(g.app_fov, g.app_w, g.app_h);
-        jobs[e] = {c, {app_img[e].get(), 0, {{0, 0}, {g.app_w, g.app_h}}}, target[e].get()};
+        EyeComposition c = eye_of(g, traced[e], e);
+        jobs[e] = {c, {app_img[e].get(), 0, {{0, 0}, {g.app_w, g.app_h}}}, std::nullopt, target[e].get()};
         c.app = m.mode == Composite::SceneOnly ? nullptr : &app[e];
         host[e] = compose_eye(c, rule);
       }
-      const std::int64_t readbacks = dev.host_readbacks();
-      dev.composite_gpu(++traced_id, jobs, rule);
-      dev.finish();
-      EXPECT_EQ(dev.host_readbacks(), readbacks) << "the GPU path copied application images to the host";
-      const std::vector<Pixels8> gpu_out =
-          dev.read({{target[0].get(), 0, {{0, 0}, {g.traced_w, g.traced_h}}},
-                    {target[1].get(), 0, {{0, 0}, {g.traced_w, g.traced_h}}}});
+      const std::vector<Pixels8> gpu_out = composite_on_gpu(dev, ++traced_id, jobs, rule, g);
       for (std::size_t e = 0; e < 2; ++e) {
         ASSERT_EQ(gpu_out[e].data.size(), host[e].data.size());
-        std::size_t exact = 0, rounding = 0, other = 0;
-        for (std::size_t i = 0; i < host[e].data.size(); i += 4) {
-          int worst = 0;
-          for (int c = 0; c < 4; ++c) worst = std::max(worst, std::abs(int(gpu_out[e].data[i + std::size_t(c)]) -
-                                                                     int(host[e].data[i + std::size_t(c)])));
-          (worst == 0 ? exact : worst == 1 ? rounding : other)++;
-        }
+        const auto [exact, rounding, other] = differences(gpu_out[e], host[e]);
         const std::size_t n = host[e].data.size() / 4;
         // Not vacuous: the application's pixels show in every mode but scene-only.
         EXPECT_LE(double(other), g.boundary_fraction * double(n)) << "eye " << e << ": " << other << " of " << n;
@@ -186,6 +212,145 @@ TEST_F(GpuComposite, MatchesTheHostPathPixelByPixel) {
         // Off by one only where the shader's sRGB/linear encoding rounds differently.
         EXPECT_LE(double(rounding), 0.02 * double(n)) << "eye " << e;
         EXPECT_GT(exact, n / 2) << "eye " << e;
+      }
+    }
+  }
+}
+
+// The window depth of view distance `z` (+infinity: the infinite plane) under `r`: the inverse
+// of view_distance(), t = (1/z - 1/near) / (1/far - 1/near).
+float window_depth(double z, const DepthRange& r) {
+  const auto inverse = [](double v) { return std::isinf(v) ? 0.0 : 1.0 / v; };
+  const double t = (inverse(z) - inverse(r.near_z)) / (inverse(r.far_z) - inverse(r.near_z));
+  return float(r.min_depth + t * (double(r.max_depth) - r.min_depth));
+}
+
+// `depths` (window depths, row-major) written into the depth aspect of `image`, which ends in
+// DEPTH_STENCIL_ATTACHMENT_OPTIMAL as a runtime hands out depth swapchain images.
+void fill_depth(gpu::Context& ctx, VkImage image, VkFormat format, int w, int h, const std::vector<float>& depths) {
+  const bool d16 = format == VK_FORMAT_D16_UNORM;
+  std::vector<std::byte> bytes(depths.size() * (d16 ? 2 : 4));
+  for (std::size_t i = 0; i < depths.size(); ++i) {
+    if (d16) {
+      const auto v = std::uint16_t(std::lround(std::clamp(depths[i], 0.0f, 1.0f) * 65535.0f));
+      std::memcpy(&bytes[i * 2], &v, 2);
+    } else {
+      std::memcpy(&bytes[i * 4], &depths[i], 4);
+    }
+  }
+  gpu::Buffer staging(ctx, {VkDeviceSize(bytes.size()), gpu::BufferUsage::TransferSrc, gpu::Memory::HostVisible,
+                            "depth staging"});
+  std::memcpy(staging.mapped().data(), bytes.data(), bytes.size());
+  ctx.submit_and_wait([&](VkCommandBuffer cb) {
+    VkImageMemoryBarrier b{VK_STRUCTURE_TYPE_IMAGE_MEMORY_BARRIER};
+    b.srcQueueFamilyIndex = b.dstQueueFamilyIndex = VK_QUEUE_FAMILY_IGNORED;
+    b.image = image;
+    b.subresourceRange = {VK_IMAGE_ASPECT_DEPTH_BIT, 0, 1, 0, 1};
+    b.oldLayout = VK_IMAGE_LAYOUT_UNDEFINED;
+    b.newLayout = VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL;
+    b.dstAccessMask = VK_ACCESS_TRANSFER_WRITE_BIT;
+    vkCmdPipelineBarrier(cb, VK_PIPELINE_STAGE_TOP_OF_PIPE_BIT, VK_PIPELINE_STAGE_TRANSFER_BIT, 0, 0, nullptr, 0,
+                         nullptr, 1, &b);
+    VkBufferImageCopy c{};
+    c.imageSubresource = {VK_IMAGE_ASPECT_DEPTH_BIT, 0, 0, 1};
+    c.imageExtent = {std::uint32_t(w), std::uint32_t(h), 1};
+    vkCmdCopyBufferToImage(cb, staging.handle(), image, VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL, 1, &c);
+    b.oldLayout = VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL;
+    b.newLayout = VK_IMAGE_LAYOUT_DEPTH_STENCIL_ATTACHMENT_OPTIMAL;
+    b.srcAccessMask = VK_ACCESS_TRANSFER_WRITE_BIT;
+    b.dstAccessMask = VK_ACCESS_DEPTH_STENCIL_ATTACHMENT_READ_BIT | VK_ACCESS_DEPTH_STENCIL_ATTACHMENT_WRITE_BIT;
+    vkCmdPipelineBarrier(cb, VK_PIPELINE_STAGE_TRANSFER_BIT, VK_PIPELINE_STAGE_EARLY_FRAGMENT_TESTS_BIT, 0, 0, nullptr,
+                         0, nullptr, 1, &b);
+  });
+}
+
+struct DepthCase {
+  const char* name;
+  VkFormat format;
+  DepthRange range;
+};
+
+// Compositing by depth (the application chains XrCompositionLayerDepthInfoKHR) on the GPU
+// against the host path: random traced colours and view distances (some sky), the
+// application's pixels (some transparent) at random distances in front of and behind the
+// scene and at its cleared far plane, for D32_SFLOAT, D16_UNORM, a partial and a reversed
+// infinite range; same views, and a 4° reprojection with a resampled application image.
+TEST_F(GpuComposite, ByDepthMatchesTheHostPath) {
+  const core::Fov fov{-0.7, 0.6, 0.65, -0.7};
+  const Geometry geometries[] = {
+      {"same views", 40, 36, 40, 36, fov, fov, 0.0, 0.0},
+      {"reprojected and resampled", 40, 36, 52, 44, fov, {-0.72, 0.61, 0.66, -0.69}, 4.0, 0.02},
+  };
+  constexpr float kInf = std::numeric_limits<float>::infinity();
+  const DepthCase cases[] = {
+      {"D32_SFLOAT", VK_FORMAT_D32_SFLOAT, {0.0f, 1.0f, 0.1f, 100.0f}},
+      {"D16_UNORM", VK_FORMAT_D16_UNORM, {0.0f, 1.0f, 0.05f, 20.0f}},
+      {"D32_SFLOAT, partial range", VK_FORMAT_D32_SFLOAT, {0.2f, 0.8f, 0.1f, 50.0f}},
+      {"D32_SFLOAT, reversed infinite", VK_FORMAT_D32_SFLOAT, {0.0f, 1.0f, kInf, 0.05f}},
+  };
+  const VulkanBinding vk{ctx().instance(), ctx().physical_device(), ctx().device(), ctx().queue_family(), 0};
+  AppDevice dev(vk);
+  ASSERT_NO_THROW(dev.enable_gpu_composition());
+  std::mt19937 rng(4321);
+  std::uniform_real_distribution<double> distance(0.3, 5.0);
+  std::int64_t traced_id = 100;
+  for (const Geometry& g : geometries) {
+    TestImage app_img[2] = {{ctx(), g.app_w, g.app_h}, {ctx(), g.app_w, g.app_h}};
+    TestImage target[2] = {{ctx(), g.traced_w, g.traced_h}, {ctx(), g.traced_w, g.traced_h}};
+    for (const DepthCase& dc : cases) {
+      SCOPED_TRACE(std::string(g.name) + ", " + dc.name);
+      TestImage depth_img[2] = {{ctx(), g.app_w, g.app_h, dc.format}, {ctx(), g.app_w, g.app_h, dc.format}};
+      // The cleared far end: maxDepth, minDepth with reversed Z.
+      const bool reversed = dc.range.near_z > dc.range.far_z;
+      const float cleared = reversed ? dc.range.min_depth : dc.range.max_depth;
+      std::array<Pixels8, 2> traced, app;
+      std::array<std::vector<float>, 2> traced_depth, app_window;
+      for (std::size_t e = 0; e < 2; ++e) {
+        traced[e] = random_scene(rng, g.traced_w, g.traced_h);
+        app[e] = random_app(rng, g.app_w, g.app_h, {30, 60, 90});
+        for (int i = 0; i < g.traced_w * g.traced_h; ++i)
+          traced_depth[e].push_back(rng() % 8u == 0 ? 0.0f : float(distance(rng)));  // 0: sky
+        for (int i = 0; i < g.app_w * g.app_h; ++i)
+          app_window.at(e).push_back(rng() % 4u == 0 ? cleared : window_depth(distance(rng), dc.range));
+        fill_depth(ctx(), depth_img[e].get(), dc.format, g.app_w, g.app_h, app_window[e]);
+      }
+      dev.write({app_img[0].get(), app_img[1].get()}, {&app[0], &app[1]});
+      const XrRect2Di rect{{0, 0}, {g.app_w, g.app_h}};
+      const std::array<AppDepth, 2> depth{AppDepth{depth_img[0].get(), dc.format, rect, 0, dc.range},
+                                          AppDepth{depth_img[1].get(), dc.format, rect, 0, dc.range}};
+      // The host path: the depths read back and decoded, composited on the CPU.
+      const std::vector<std::vector<float>> decoded = dev.read_depth({depth[0], depth[1]});
+      CompositionRule rule;  // ignored by depth (the configured mode, app-on-top)
+      std::array<AppDevice::GpuEye, 2> jobs;
+      std::array<Pixels8, 2> host;
+      std::array<std::int64_t, 2> host_kept{};
+      for (std::size_t e = 0; e < 2; ++e) {
+        EyeComposition c = eye_of(g, traced[e], e);
+        c.traced_depth = &traced_depth[e];
+        c.depth_range = dc.range;
+        jobs[e] = {c, {app_img[e].get(), 0, rect}, depth[e], target[e].get()};
+        c.app = &app[e];
+        c.app_depth = &decoded[e];
+        ASSERT_TRUE(c.by_depth());
+        host[e] = compose_eye(c, rule);
+        host_kept[e] = 0;
+        const Pixels8 scene = reproject_traced(c);
+        for (std::size_t i = 0; i < scene.data.size(); i += 4)
+          host_kept[e] += std::memcmp(&scene.data[i], &host[e].data[i], 4) != 0;
+      }
+      const std::vector<Pixels8> gpu_out = composite_on_gpu(dev, ++traced_id, jobs, rule, g);
+      for (std::size_t e = 0; e < 2; ++e) {
+        const std::size_t n = host[e].data.size() / 4;
+        // Not vacuous: the application is in front in some pixels and behind the scene or
+        // cleared in others.
+        EXPECT_GT(host_kept[e], std::int64_t(n / 20)) << "eye " << e;
+        EXPECT_LT(host_kept[e], std::int64_t(n / 2)) << "eye " << e;
+        const auto [exact, rounding, other] = differences(gpu_out[e], host[e]);
+        // Kept or scene pixels, no blending: identical but where a pixel takes its
+        // neighbour's source at a boundary of the reprojection or resampling (float against
+        // double), or a depth comparison falls within float rounding of a tie (none here).
+        EXPECT_EQ(rounding, 0u) << "eye " << e;
+        EXPECT_LE(double(other), g.boundary_fraction * double(n)) << "eye " << e << ": " << other << " of " << n;
       }
     }
   }

@@ -273,6 +273,37 @@ TEST(LayerConfig, Compositor) {
   unsetenv("FOVEA_LAYER_COMPOSITOR");
 }
 
+TEST(LayerConfig, RenderPriority) {
+  const RenderPriority d = parse_config(R"({"default": {"scene": "cornell"}})", "cfg.json", "App").render_priority;
+  EXPECT_FALSE(d.idle);
+  EXPECT_EQ(d.nice, 19);
+  const RenderPriority n = parse_config(R"({"default": {"render_priority": 7}})", "cfg.json", "App").render_priority;
+  EXPECT_FALSE(n.idle);
+  EXPECT_EQ(n.nice, 7);
+  EXPECT_EQ(render_priority_name(n), "nice 7");
+  EXPECT_EQ(render_priority_name(parse_config(R"({"default": {"render_priority": "idle"}})", "cfg.json", "App")
+                                     .render_priority),
+            "SCHED_IDLE");
+  EXPECT_TRUE(parse_config(R"({"default": {"render_priority": 5}, "applications": {"App": {"render_priority": "idle"}}})",
+                           "cfg.json", "App")
+                  .render_priority.idle);
+  for (const char* bad : {"20", "-1", "\"low\"", "1.5", "\" 3\""}) {
+    try {
+      parse_config(std::string(R"({"default": {"render_priority": )") + bad + "}}", "cfg.json", "App");
+      FAIL() << bad << " accepted";
+    } catch (const core::InputError& e) {
+      EXPECT_NE(std::string(e.what()).find("cfg.json: default.render_priority"), std::string::npos) << e.what();
+      EXPECT_NE(std::string(e.what()).find("\"idle\" or a nice value 0..19"), std::string::npos) << e.what();
+    }
+  }
+  setenv("XDG_CONFIG_HOME", "/nonexistent-fovea-config", 1);
+  setenv("FOVEA_LAYER_RENDER_PRIORITY", "10", 1);
+  EXPECT_EQ(load_config("App").render_priority.nice, 10);
+  setenv("FOVEA_LAYER_RENDER_PRIORITY", "nice", 1);
+  EXPECT_THROW(load_config("App"), core::InputError);
+  unsetenv("FOVEA_LAYER_RENDER_PRIORITY");
+}
+
 // A raw HID capture configured as the layer's gaze is a recording: at display times on the
 // host clock the fovea follows it from the first frame on (it used to be taken for a live
 // device and froze on its last sample).

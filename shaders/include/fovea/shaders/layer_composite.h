@@ -14,11 +14,22 @@ namespace fovea::shaders {
 FOVEA_CONST FOVEA_UINT kLayerAppOnTop = 0u;
 FOVEA_CONST FOVEA_UINT kLayerAlpha = 1u;
 FOVEA_CONST FOVEA_UINT kLayerSceneOnly = 2u;
-// Push constant `pass`: the border pass finds AppOnTop's background (the most frequent colour
-// on the application image's border, one workgroup per eye), the composite pass writes out.
+// By depth (the application chained XrCompositionLayerDepthInfoKHR): the application's pixel
+// where its surface is nearer than the traced scene's (composite_depth in composite.hpp).
+FOVEA_CONST FOVEA_UINT kLayerDepth = 3u;
+// LayerCompositeEye.depth_format: how the application's depth texels are packed by a buffer
+// copy of the depth aspect.
+FOVEA_CONST FOVEA_UINT kLayerDepthD16 = 1u;   // 16-bit UNORM, two per word
+FOVEA_CONST FOVEA_UINT kLayerDepthD24 = 2u;   // 24-bit UNORM in the low bits of a word
+FOVEA_CONST FOVEA_UINT kLayerDepthD32F = 3u;  // float (non-finite: the far plane)
+// Specialisation constant 0, the pass: the border pass finds AppOnTop's background (the most
+// frequent colour on the application image's border, one workgroup per eye), the composite
+// pass writes out. Push constant: the eye.
 FOVEA_CONST FOVEA_UINT kLayerPassBorder = 0u;
 FOVEA_CONST FOVEA_UINT kLayerPassComposite = 1u;
 FOVEA_CONST FOVEA_UINT kLayerBorderGroup = 64u;
+// The composite pass: each invocation writes this many rows of its column.
+FOVEA_CONST FOVEA_UINT kLayerRowsPerInvocation = 16u;
 
 // One eye. A view is its tangent-plane extents at z = -1 (left, right, up, down) and raster;
 // a direction of the output view turns into the traced view's by `to_traced` (row-major 3x3,
@@ -31,6 +42,12 @@ struct LayerCompositeEye {
   FOVEA_INT out_w, out_h, traced_w, traced_h, app_w, app_h;
   FOVEA_UINT traced_offset, app_offset, out_offset;  // in pixels, into the three buffers
   FOVEA_UINT traced_identity, app_identity;
+  // kLayerDepth: the traced frame's view distances follow both eyes' colour in Traced
+  // (`traced_depth_offset`, floats); the application's window depths are in AppDepth at byte
+  // `depth_offset` (a multiple of 4) in `depth_format`, mapped to distances by their range
+  // (XrCompositionLayerDepthInfoKHR: minDepth at nearZ, maxDepth at farZ; 1/plane, 0 at infinity).
+  FOVEA_UINT traced_depth_offset, depth_format, depth_offset;
+  float min_depth, max_depth, inv_near, inv_far;
 };
 
 struct LayerCompositeParams {
@@ -44,8 +61,8 @@ struct LayerCompositeParams {
 };
 
 #ifdef __cplusplus
-static_assert(sizeof(LayerCompositeEye) == 112);
-static_assert(sizeof(LayerCompositeParams) == 2 * 112 + 32 + 256 * 4);
+static_assert(sizeof(LayerCompositeEye) == 140);
+static_assert(sizeof(LayerCompositeParams) == 2 * 140 + 32 + 256 * 4);
 }  // namespace fovea::shaders
 #endif
 #endif

@@ -1,0 +1,159 @@
+#!/usr/bin/env python3
+"""The application's frame interval through the layer: hello_xr -g Vulkan2 on the Fovea
+runtime (realtime pacing), pass-through against path tracing with a scene, one session per
+variant, the variants interleaved and repeated. Prints one Markdown table row per run.
+
+  eval "$(./x env)"; python3 layer/scripts/frame_interval.py --display small --frames 2500 --reps 3
+
+Variants (--variants, comma-separated): `pass` (no scene), `host` / `gpu` (`cornell`,
+FOVEA_LAYER_COMPOSITOR), optionally suffixed `:PRIORITY` (FOVEA_LAYER_RENDER_PRIORITY: `idle`
+or a nice value), e.g. `gpu:idle,gpu:19`. Interval: consecutive `wait_return_ns` of
+`layer_timing.jsonl` after the first 10 frames where both frames were replaced (pass-through:
+all); `xrEndFrame`: `cpu_ms.end_frame` of those replaced frames (pass-through: all); CPU per
+frame: the process's threads' CPU time (/proc, sampled every 0.25 s) over the frames, split
+into the application's threads (its Vulkan device's included) and the lowered ones (the render
+thread and its device's), which does not depend on the machine's load as much. The load
+average (1 min) is read before and after each run: other work on the machine shows in every
+figure, so compare the variants within one repetition.
+"""
+import argparse
+import json
+import os
+import statistics
+import subprocess
+import sys
+import time
+
+
+def loadavg():
+    with open("/proc/loadavg") as f:
+        return float(f.read().split()[0])
+
+
+def percentile(values, q):
+    s = sorted(values)
+    return s[min(len(s) - 1, int(q * len(s)))]
+
+
+def thread_cpu(pid):
+    """CPU seconds per thread of `pid` so far: {tid: (seconds, lowered)}, lowered = SCHED_IDLE or
+    nice > 0 (the render thread and the device threads it created)."""
+    out = {}
+    tick = os.sysconf("SC_CLK_TCK")
+    try:
+        tids = os.listdir(f"/proc/{pid}/task")
+    except OSError:
+        return out
+    for tid in tids:
+        try:
+            with open(f"/proc/{pid}/task/{tid}/stat") as f:
+                fields = f.read().rsplit(")", 1)[1].split()
+        except OSError:
+            continue  # the thread ended meanwhile
+        # Fields from 3 (state) on: utime 14, stime 15, nice 19, policy 41 (proc(5)).
+        out[tid] = ((int(fields[11]) + int(fields[12])) / tick, int(fields[38]) == 5 or int(fields[16]) > 0)
+    return out
+
+
+def summarise(path):
+    records = [json.loads(line) for line in open(path) if line.strip()][10:]
+    replacing = any(r["replaced"] for r in records)
+    kept = [r for r in records if r["replaced"] or not replacing]
+    interval = [(b["wait_return_ns"] - a["wait_return_ns"]) / 1e6 for a, b in zip(records, records[1:])
+                if not replacing or (a["replaced"] and b["replaced"])]
+    end = [r["cpu_ms"]["end_frame"] for r in kept]
+    if not interval or not end:
+        raise SystemExit(f"{path}: too few frames to measure ({len(records)} records after the first 10)")
+    return {
+        "interval_median": statistics.median(interval), "interval_mean": statistics.mean(interval),
+        "interval_p95": percentile(interval, 0.95), "end_median": statistics.median(end),
+        "end_mean": statistics.mean(end), "frames": len(records), "replaced": sum(r["replaced"] for r in records),
+        "traced": len({r["traced_frame"] for r in records if r["replaced"]}),
+        "host_readbacks": sum(r.get("host_readbacks", 0) for r in kept),
+    }
+
+
+def run(variant, args, rep):
+    kind, _, priority = variant.partition(":")
+    if kind not in ("pass", "host", "gpu"):
+        raise SystemExit(f"--variants: unknown variant {variant!r} (pass, host, gpu, optionally :idle or :NICE)")
+    out = os.path.abspath(os.path.join(args.out, f"{args.display}-{variant.replace(':', '-')}-{rep}"))
+    os.makedirs(out, exist_ok=True)
+    for name in ("layer_timing.jsonl", "timing.jsonl"):
+        if os.path.exists(os.path.join(out, name)):
+            os.remove(os.path.join(out, name))
+    env = dict(os.environ)
+    env.update({
+        "XR_RUNTIME_JSON": os.path.join(args.build, "runtime/fovea_runtime.json"),
+        "FOVEA_EXIT_AFTER_FRAMES": str(args.frames), "FOVEA_RUNTIME_OUT": out,
+        "FOVEA_RUNTIME_PNG_EVERY": "1000000", "FOVEA_DISPLAY": args.display,
+        "XDG_CONFIG_HOME": os.path.join(out, "no-config"),
+        "XR_API_LAYER_PATH": os.path.join(args.build, "layer/explicit"),
+        "XR_ENABLE_API_LAYERS": "XR_APILAYER_FOVEA_path_tracing", "FOVEA_LAYER_OUT": out,
+        "FOVEA_SCENE": "" if kind == "pass" else "cornell",
+    })
+    for k in ("FOVEA_LAYER_SCENE", "FOVEA_LAYER_COMPOSITOR", "FOVEA_LAYER_RENDER_PRIORITY", "FOVEA_LAYER_RENDER"):
+        env.pop(k, None)
+    if kind != "pass":
+        env["FOVEA_LAYER_COMPOSITOR"] = kind
+    if priority:
+        env["FOVEA_LAYER_RENDER_PRIORITY"] = priority
+    load_before = loadavg()
+    with open(os.path.join(out, "hello_xr.log"), "w") as log:
+        # hello_xr quits at the end of its input: the pipe stays open until it exits.
+        p = subprocess.Popen(["hello_xr", "-g", "Vulkan2"], env=env, stdin=subprocess.PIPE, stdout=log,
+                             stderr=subprocess.STDOUT)
+        # The threads' CPU time, sampled until the process exits (a thread's last sample stands
+        # for it: Linux forgets ended threads' times).
+        cpu = {}
+        try:
+            deadline = time.monotonic() + args.timeout
+            while p.poll() is None:
+                if time.monotonic() > deadline:
+                    raise subprocess.TimeoutExpired(p.args, args.timeout)
+                cpu.update(thread_cpu(p.pid))
+                time.sleep(0.25)
+            code = p.returncode
+        except subprocess.TimeoutExpired:
+            p.kill()
+            p.wait()
+            raise SystemExit(f"{variant}: hello_xr did not exit within {args.timeout} s (log: {out}/hello_xr.log)")
+        finally:
+            p.stdin.close()
+    if code != 0:
+        raise SystemExit(f"{variant}: hello_xr exited with {code} (log: {out}/hello_xr.log)")
+    s = summarise(os.path.join(out, "layer_timing.jsonl"))
+    s["load"] = (load_before, loadavg())
+    s["cpu_app"] = sum(c for c, lowered in cpu.values() if not lowered) * 1e3 / args.frames
+    s["cpu_render"] = sum(c for c, lowered in cpu.values() if lowered) * 1e3 / args.frames
+    return s
+
+
+def main():
+    ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    ap.add_argument("--display", default="small")
+    ap.add_argument("--frames", type=int, default=2500)
+    ap.add_argument("--reps", type=int, default=3)
+    ap.add_argument("--variants", default="pass,gpu")
+    ap.add_argument("--build", default="build/release")
+    ap.add_argument("--out", default="out/interval")
+    ap.add_argument("--timeout", type=float, default=1800)
+    args = ap.parse_args()
+    variants = args.variants.split(",")
+    print(f"| {args.display}, {args.frames} frames | rep | interval median / mean / p95 (ms) "
+          "| xrEndFrame median / mean (ms) | CPU per frame: application / render (ms) "
+          "| replaced / traced | host read-backs | load avg before → after |")
+    print("|---|---|---|---|---|---|---|---|")
+    for rep in range(1, args.reps + 1):
+        for v in variants:
+            t0 = time.monotonic()
+            s = run(v, args, rep)
+            print(f"| {v} | {rep} | {s['interval_median']:.2f} / {s['interval_mean']:.2f} / {s['interval_p95']:.2f} "
+                  f"| {s['end_median']:.3f} / {s['end_mean']:.3f} | {s['cpu_app']:.2f} / {s['cpu_render']:.2f} "
+                  f"| {s['replaced']}/{s['traced']} "
+                  f"| {s['host_readbacks']} | {s['load'][0]:.1f} → {s['load'][1]:.1f} |", flush=True)
+            print(f"  ({v}, repetition {rep}: {time.monotonic() - t0:.0f} s)", file=sys.stderr, flush=True)
+
+
+if __name__ == "__main__":
+    main()
