@@ -79,6 +79,19 @@ core::Image blur_image(FramePipeline& pipeline, core::Eye eye, const core::Image
   return pipeline.image(eye);
 }
 
+std::vector<glm::vec4> blur_grid(FramePipeline& pipeline, core::Eye eye, const std::vector<glm::vec4>& grid) {
+  auto& m = Access::impl(pipeline);
+  const int i = m.index(eye, "blur_grid");
+  if (grid.size() != m.eyes[std::size_t(i)]->cells)
+    throw core::InputError("blur_grid: grid size differs from the padded grid");
+  m.write_mappings();
+  m.resolve->level0(i).upload(grid);
+  m.ctx.submit_and_wait([&](VkCommandBuffer cmd) { m.resolve->record_grid_blur(cmd, m.settings); });
+  std::vector<glm::vec4> out = m.resolve->level0(i).download<glm::vec4>();
+  out.resize(grid.size());
+  return out;
+}
+
 ResolveKernelTimes time_resolve(FramePipeline& pipeline, bool blur) {
   auto& m = Access::impl(pipeline);
   const auto time = [&](auto&& record) {
@@ -99,9 +112,12 @@ ResolveKernelTimes time_resolve(FramePipeline& pipeline, bool blur) {
     for (std::size_t i = 0; i < m.eyes.size(); ++i) finals.push_back(&m.post->final_color(int(i), m.parity));
     m.resolve->record_copy(cmd, finals);
   });
+  KernelTime grid_blur;
+  if (blur) grid_blur = time([&](VkCommandBuffer cmd) { m.resolve->record_grid_blur(cmd, m.settings); });
   t.mip = time([&](VkCommandBuffer cmd) { m.resolve->record_mips(cmd); });
   t.resample = time([&](VkCommandBuffer cmd) { m.resolve->record_resample(cmd, m.parity); });
   if (blur) t.blur = time([&](VkCommandBuffer cmd) { m.resolve->record_blur(cmd, m.settings); });
+  t.blur.gpu_ms += grid_blur.gpu_ms, t.blur.cpu_ms += grid_blur.cpu_ms;
   return t;
 }
 
