@@ -7,6 +7,7 @@
 // in degrees directly.
 #include <algorithm>
 #include <cmath>
+#include <memory>
 #include <numbers>
 
 #include "fovea/core/acuity.hpp"
@@ -36,18 +37,31 @@ core::DistributionParams cartesian() {
   dp.kind = core::DistributionKind::Cartesian;
   return dp;
 }
+
+// One frame of the Cornell box, gaze at the view centre, on a width×height raster with the
+// blur's MAR₀ = mar_deg: the mapping the blur kernels read.
+struct BlurRig {
+  BlurRig(fovea::gpu::Context& ctx, int width, int height, double mar_deg, const core::DistributionParams& dp)
+      : scene(renderer::load_scene("cornell")), gs(ctx, scene), display(fovea::test::display_of_size(width, height)) {
+    settings.denoiser = reconstruct::Denoiser::None;
+    settings.blur_mar_fovea_deg = mar_deg;
+    p = std::make_unique<pipeline::FramePipeline>(ctx, gs, core::stereo_views(display), dp, settings,
+                                                  renderer::PathConfig{}, true);
+    p->render(core::eye_poses(scene.camera, display.ipd_m), {glm::dvec3(0, 0, -1), glm::dvec3(0, 0, -1)}, 0);
+  }
+  renderer::Scene scene;
+  renderer::GpuScene gs;
+  core::DisplayPreset display;
+  reconstruct::ReconSettings settings;
+  std::unique_ptr<pipeline::FramePipeline> p;
+};
 }  // namespace
 
 TEST_F(GpuTest, BlurWidthFollowsTheAcuityModelAcrossEccentricities) {
-  const renderer::Scene scene = renderer::load_scene("cornell");
-  renderer::GpuScene gs(ctx(), scene);
-  const core::DisplayPreset display = fovea::test::display_of_size(640, 720);
-  reconstruct::ReconSettings s;
-  s.denoiser = reconstruct::Denoiser::None;
   // 16′ instead of 1′ scales every σ by 16, into whole pixels on this raster (1.7–13 px).
-  s.blur_mar_fovea_deg = 16.0 / 60.0;
-  pipeline::FramePipeline p(ctx(), gs, core::stereo_views(display), cartesian(), s, {}, true);
-  p.render(core::eye_poses(scene.camera, display.ipd_m), {glm::dvec3(0, 0, -1), glm::dvec3(0, 0, -1)}, 0);
+  BlurRig rig(ctx(), 640, 720, 16.0 / 60.0, cartesian());
+  pipeline::FramePipeline& p = *rig.p;
+  const reconstruct::ReconSettings& s = rig.settings;
   const core::View v = p.view(core::Eye::Left);
   for (double e : {20.0, 30.0, 40.0, 45.0}) {
     const glm::dvec3 dir = glm::normalize(glm::dvec3(std::tan(e * M_PI / 180), 0, -1));
@@ -78,13 +92,8 @@ TEST_F(GpuTest, BlurWidthFollowsTheAcuityModelAcrossEccentricities) {
 
 TEST_F(GpuTest, BlurLeavesTheFoveaAndNearPeripheryUntouchedAtTheModelsScale) {
   // With MAR₀ = 1′ σ stays below 0.5 px out to ~30° on this raster: those pixels pass unchanged.
-  const renderer::Scene scene = renderer::load_scene("cornell");
-  renderer::GpuScene gs(ctx(), scene);
-  const core::DisplayPreset display = fovea::test::display_of_size(320, 360);
-  reconstruct::ReconSettings s;
-  s.denoiser = reconstruct::Denoiser::None;
-  pipeline::FramePipeline p(ctx(), gs, core::stereo_views(display), cartesian(), s, {}, true);
-  p.render(core::eye_poses(scene.camera, display.ipd_m), {glm::dvec3(0, 0, -1), glm::dvec3(0, 0, -1)}, 0);
+  BlurRig rig(ctx(), 320, 360, reconstruct::kMarFoveaDeg, cartesian());
+  pipeline::FramePipeline& p = *rig.p;
   const core::View v = p.view(core::Eye::Left);
   core::Image img(v.width(), v.height());
   for (int y = 0; y < img.height; ++y)
@@ -103,14 +112,9 @@ TEST_F(GpuTest, BlurLeavesTheFoveaAndNearPeripheryUntouchedAtTheModelsScale) {
 }
 
 TEST_F(GpuTest, GridBlurWidthFollowsTheAcuityModelInDegrees) {
-  const renderer::Scene scene = renderer::load_scene("cornell");
-  renderer::GpuScene gs(ctx(), scene);
-  const core::DisplayPreset display = fovea::test::display_of_size(640, 720);
-  reconstruct::ReconSettings s;
-  s.denoiser = reconstruct::Denoiser::None;
-  s.blur_mar_fovea_deg = 16.0 / 60.0;  // σ of 1–4 cells on this grid at 20–45°
-  pipeline::FramePipeline p(ctx(), gs, core::stereo_views(display), {}, s, {}, true);
-  p.render(core::eye_poses(scene.camera, display.ipd_m), {glm::dvec3(0, 0, -1), glm::dvec3(0, 0, -1)}, 0);
+  BlurRig rig(ctx(), 640, 720, 16.0 / 60.0, {});  // σ of 1–4 cells on this grid at 20–45°
+  pipeline::FramePipeline& p = *rig.p;
+  const reconstruct::ReconSettings& s = rig.settings;
   const core::SampleDistribution& d = p.distribution(core::Eye::Left);
   const auto& table = d.column_table();
   const auto mid = [&](int c) { return 0.5 * (double(table[std::size_t(c)].r0) + double(table[std::size_t(c)].r1)); };
@@ -152,20 +156,12 @@ TEST_F(GpuTest, GridBlurWidthFollowsTheAcuityModelInDegrees) {
 TEST_F(GpuTest, GridBlurLeavesCellsWhoseKernelIsBelowHalfACellUntouched) {
   // At the model's scale (MAR₀ = 1′) σ is below half a cell on every column of this grid:
   // the grid-space pass must not change a cell (nor be recorded at all).
-  const renderer::Scene scene = renderer::load_scene("cornell");
-  renderer::GpuScene gs(ctx(), scene);
-  const core::DisplayPreset display = fovea::test::display_of_size(320, 360);
-  reconstruct::ReconSettings s;
-  s.denoiser = reconstruct::Denoiser::None;
-  pipeline::FramePipeline p(ctx(), gs, core::stereo_views(display), {}, s, {}, true);
-  p.render(core::eye_poses(scene.camera, display.ipd_m), {glm::dvec3(0, 0, -1), glm::dvec3(0, 0, -1)}, 0);
-  const core::SampleDistribution& d = p.distribution(core::Eye::Left);
+  BlurRig rig(ctx(), 320, 360, reconstruct::kMarFoveaDeg, {});
+  const core::SampleDistribution& d = rig.p->distribution(core::Eye::Left);
   std::vector<glm::vec4> grid(std::size_t(d.padded_columns()) * d.padded_rows());
   for (std::size_t i = 0; i < grid.size(); ++i) grid[i] = glm::vec4(float((i * 7) % 5), 0, 0, 1);  // cell-scale detail
-  EXPECT_EQ(pipeline::testing::blur_grid(p, core::Eye::Left, grid), grid);
+  EXPECT_EQ(pipeline::testing::blur_grid(*rig.p, core::Eye::Left, grid), grid);
   // With MAR₀ = 16′ the outer columns are blurred (the same pass is live).
-  s.blur_mar_fovea_deg = 16.0 / 60.0;
-  pipeline::FramePipeline q(ctx(), gs, core::stereo_views(display), {}, s, {}, true);
-  q.render(core::eye_poses(scene.camera, display.ipd_m), {glm::dvec3(0, 0, -1), glm::dvec3(0, 0, -1)}, 0);
-  EXPECT_NE(pipeline::testing::blur_grid(q, core::Eye::Left, grid), grid);
+  BlurRig wide(ctx(), 320, 360, 16.0 / 60.0, {});
+  EXPECT_NE(pipeline::testing::blur_grid(*wide.p, core::Eye::Left, grid), grid);
 }
