@@ -18,6 +18,7 @@ layout(std430, binding = RECON_BLUR_SRC) readonly buffer Src { vec4 src[]; };
 layout(std430, binding = RECON_BLUR_DST) writeonly buffer Dst { vec4 dst[]; };
 
 #include "fovea/shaders/recon_map.h"
+#include "fovea/shaders/recon_blur.h"
 
 layout(push_constant) uniform Push { ReconBlurPush pc; };
 
@@ -36,8 +37,7 @@ void main() {
   float e = atan(sqrt(max(1.0 - cos_e * cos_e, 0.0)), cos_e) * (180.0 / kRgPi);
   bool vertical = pc.vertical != 0u;
   float deg_per_px = rg_pixel_angle(m, t, vertical) * (180.0 / kRgPi);
-  float acuity = e <= 5.79 ? 1.0 : 7.49 / ((0.3 * e + 1.0) * (0.3 * e + 1.0));
-  float sigma = min(pc.sigma_fovea_deg / acuity / max(deg_per_px, 1e-6), pc.max_sigma_px);
+  float sigma = min(rg_blur_sigma_deg(e, pc.sigma_fovea_deg) / max(deg_per_px, 1e-6), pc.max_sigma_px);
   if (sigma < pc.min_sigma_px) {
     dst[i] = src[i];
     return;

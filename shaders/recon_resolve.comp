@@ -32,50 +32,53 @@ layout(std430, binding = RECON_RESOLVE_LUT) readonly buffer Lut {
 
 layout(push_constant) uniform Push { ReconResolvePush pc; };
 
-// Bilinear at level `level` of the column pair around u; rows wrap (full polar rings, r0 in
-// [-1, rows) and r1 in [0, rows]: one conditional add/subtract, no integer division) or clamp
-// (the raster, and columns packed to their visible arc).
-vec4 fetch_level(ReconGrid m, vec2 uv, uint level) {
-  float uc = uv.x - 0.5;
-  float c0f = floor(uc);
-  float fx = uc - c0f;
-  float scale = float(1u << level);
-  uint base = level_offset[level];
-  vec4 acc = vec4(0.0);
-  for (int i = 0; i < 2; ++i) {
-    uint c = uint(clamp(int(c0f) + i, 0, int(m.g.columns) - 1));
-    uint full = max(rg_rows(m, c), 1u);
-    int rows = int((full + (1u << level) - 1u) >> level);
-    float vr = rg_row_coord(m, c, uv.y) / scale - 0.5;
-    float r0f = floor(vr);
-    float fy = vr - r0f;
-    int r0 = int(r0f), r1 = r0 + 1;
-    if (rg_wraps(m, c)) {
-      r0 += r0 < 0 ? rows : 0;
-      r1 -= r1 >= rows ? rows : 0;
-    } else {
-      r0 = clamp(r0, 0, rows - 1);
-      r1 = clamp(r1, 0, rows - 1);
-    }
-    float wc = i == 0 ? 1.0 - fx : fx;
-    acc += wc * ((1.0 - fy) * mips[base + uint(r0) * m.g.padded_columns + c] +
-                 fy * mips[base + uint(r1) * m.g.padded_columns + c]);
-  }
-  return acc;
+// One column of the bilinear pair: its table entry is read once per pixel, and every level
+// and the depth reuse its rows, wrap and level-0 row coordinate.
+struct ColumnTap {
+  uint c;
+  int rows;
+  bool wraps;       // full ring: rows wrap (r0 in [-1, rows), r1 in [0, rows]); else clamp
+  float v;          // row coordinate of the pixel's φ at level 0 (cell centres at +0.5)
+  float turn_rows;  // rows over a full turn at the column's spacing (the LOD's unit)
+};
+
+ColumnTap column_tap(ReconGrid m, int ci, float t) {
+  ColumnTap k;
+  k.c = uint(clamp(ci, 0, int(m.g.columns) - 1));
+  GridColumn col = rg_column(m, k.c);
+  k.rows = int(max(col.rows, 1u));
+  k.wraps = m.g.family != kFamilyCartesian && col.phi_gap == 0.0;
+  k.v = rg_row_coord_of(col, t);
+  k.turn_rows = float(col.rows) / (1.0 - col.phi_gap / (2.0 * kRgPi));
+  return k;
 }
 
-// Footprint of the pixel along φ in rows of column c (the LOD's argument): a pixel of angular
-// size δ (the larger of its two sides) at eccentricity e spans δ / (2π sin e) of the circle
-// (angular polar); at radius r one pixel spans 1 / (2π r) (screen polar).
-float phi_footprint(ReconGrid m, vec2 t, vec3 d, vec2 px, vec2 uv) {
-  uint c = uint(clamp(int(uv.x), 0, int(m.g.columns) - 1));
-  float rows = rg_turn_rows(m, c);
+// Linear in φ between the two rows of column k at level `level`.
+vec4 fetch_column(ColumnTap k, uint level, uint base, uint pcols) {
+  int r0, r1;
+  float fy;
+  rg_row_pair((k.rows + (1 << level) - 1) >> level, k.wraps, k.v / float(1u << level), r0, r1, fy);
+  return (1.0 - fy) * mips[base + uint(r0) * pcols + k.c] + fy * mips[base + uint(r1) * pcols + k.c];
+}
+
+// Bilinear at level `level` of the column pair (bilinear in ρ between two columns of
+// different row counts, each at its own row coordinate of the same φ).
+vec4 fetch_level(ReconGrid m, ColumnTap k0, ColumnTap k1, float fx, uint level) {
+  uint base = level_offset[level];
+  return (1.0 - fx) * fetch_column(k0, level, base, m.g.padded_columns) + fx * fetch_column(k1, level, base, m.g.padded_columns);
+}
+
+// Footprint of the pixel along φ in rows of its column (turn_rows; the LOD's argument): a
+// pixel of angular size δ (the larger of its two sides) at eccentricity e spans
+// δ / (2π sin e) of the circle (angular polar); at radius r one pixel spans 1 / (2π r)
+// (screen polar).
+float phi_footprint(ReconGrid m, vec2 t, vec3 d, vec2 px, float turn_rows) {
   if (m.g.family == kFamilyAngularPolar) {
     float delta = max(rg_pixel_angle(m, t, false), rg_pixel_angle(m, t, true));
-    return delta * rows / (2.0 * kRgPi * max(length(cross(d, rg_gaze(m))), 1e-6));
+    return delta * turn_rows / (2.0 * kRgPi * max(length(cross(d, rg_gaze(m))), 1e-6));
   }
   float r = length(px - vec2(m.g.gaze_px_x, m.g.gaze_px_y));
-  return rows / (2.0 * kRgPi * max(r, 1e-6));
+  return turn_rows / (2.0 * kRgPi * max(r, 1e-6));
 }
 
 void main() {
@@ -87,8 +90,13 @@ void main() {
   vec2 t = rg_pixel_tan(m, px);
   vec3 d = normalize(vec3(t, -1.0));
   vec2 uv = rg_grid_coord(m, d, px);
+  float uc = uv.x - 0.5;
+  float c0f = floor(uc);
+  float fx = uc - c0f;
+  ColumnTap k0 = column_tap(m, int(c0f), uv.y), k1 = column_tap(m, int(c0f) + 1, uv.y);
+  ColumnTap near = fx >= 0.5 ? k1 : k0;  // the column of floor(u), clamped
   float lod = 0.0;
-  if (pc.levels > 1u && polar) lod = clamp(log2(max(phi_footprint(m, t, d, px, uv), 1.0)), 0.0, float(pc.levels - 1u));
+  if (pc.levels > 1u && polar && near.c < pc.lod_columns) lod = clamp(log2(max(phi_footprint(m, t, d, px, near.turn_rows), 1.0)), 0.0, float(pc.levels - 1u));
   uint i = p.y * pc.width + p.x;
   if (pc.grid_coords != 0u) {
     screen[i] = vec4(uv, lod, 0.0);
@@ -96,14 +104,12 @@ void main() {
   }
   uint l0 = uint(floor(lod));
   float f = lod - float(l0);
-  vec4 v = fetch_level(m, uv, l0);
-  if (f > 0.0 && l0 + 1u < pc.levels) v = mix(v, fetch_level(m, uv, l0 + 1u), f);
+  vec4 v = fetch_level(m, k0, k1, fx, l0);
+  if (f > 0.0 && l0 + 1u < pc.levels) v = mix(v, fetch_level(m, k0, k1, fx, l0 + 1u), f);
   screen[i] = v.w > 1e-6 ? vec4(v.rgb / v.w, 1.0) : vec4(0.0, 0.0, 0.0, 1.0);
 
-  uint c = uint(clamp(int(floor(uv.x)), 0, int(m.g.columns) - 1));
-  uint rows = max(rg_rows(m, c), 1u);
-  uint r = min(uint(max(floor(rg_row_coord(m, c, uv.y)), 0.0)), rows - 1u);
-  vec4 s = vpos[r * m.g.padded_columns + c];
+  uint r = min(uint(max(floor(near.v), 0.0)), uint(near.rows) - 1u);
+  vec4 s = vpos[r * m.g.padded_columns + near.c];
   bool surface = s.w >= 0.0 || s.w <= kReconEmitterBase + 0.5;  // materials and emitters
   depth[i] = surface ? max(-rg_world_to_view(m, s.xyz, false).z, 0.0) : 0.0;
 }

@@ -191,6 +191,8 @@ FrameTimes FramePipeline::render(const std::array<core::Pose, 2>& eye_pose, cons
     for (std::size_t i = 0; i < m.eyes.size(); ++i) finals.push_back(&m.post->final_color(int(i), p));
     m.resolve->record_copy(cmd, finals);
     m.timer.stage(cmd, "resolve");
+    if (m.settings.blur) m.resolve->record_grid_blur(cmd, m.settings);
+    m.timer.stage(cmd, "grid_blur");
     m.resolve->record_mips(cmd);
     m.timer.stage(cmd, "mip");
     m.resolve->record_resample(cmd, p);
@@ -211,12 +213,13 @@ FrameTimes FramePipeline::render(const std::array<core::Pose, 2>& eye_pose, cons
       const double ms = double(s.duration_ns()) * 1e-6;
       if (s.name == "grid") t.grid.gpu_ms += ms;
       else if (s.name == "trace") t.trace.gpu_ms += ms;
-      else if (s.name == "resolve" || s.name == "mip" || s.name == "resample" || s.name == "blur") t.resolve.gpu_ms += ms;
+      else if (s.name == "resolve" || s.name == "grid_blur" || s.name == "mip" || s.name == "resample" || s.name == "blur")
+        t.resolve.gpu_ms += ms;
       else t.reconstruct.gpu_ms += ms;
       if (s.name == "bmfr_fit") t.bmfr_fit_gpu_ms = ms;
       if (s.name == "mip") t.mip_gpu_ms = ms;
       if (s.name == "resample") t.resample_gpu_ms = ms;
-      if (s.name == "blur") t.blur_gpu_ms = ms;
+      if (s.name == "blur" || s.name == "grid_blur") t.blur_gpu_ms += ms;
     }
   }
   return t;

@@ -45,13 +45,23 @@ void fill_buffers(FramePipeline& pipeline, std::uint32_t word) {
   pipeline.reset();
 }
 
-core::Image resolve_grid(FramePipeline& pipeline, core::Eye eye, const std::vector<glm::vec4>& grid, bool blur) {
+namespace {
+// Writes the current mappings and a grid image into level 0 of eye `eye`'s mip chain; the
+// eye's index. `who` names the caller in the error for a grid of the wrong size.
+int upload_level0(FramePipeline& pipeline, core::Eye eye, const std::vector<glm::vec4>& grid, const char* who) {
   auto& m = Access::impl(pipeline);
-  const int i = m.index(eye, "resolve_grid");
+  const int i = m.index(eye, who);
   if (grid.size() != m.eyes[std::size_t(i)]->cells)
-    throw core::InputError("resolve_grid: grid size differs from the padded grid");
+    throw core::InputError(std::string(who) + ": grid size differs from the padded grid");
   m.write_mappings();
   m.resolve->level0(i).upload(grid);
+  return i;
+}
+}  // namespace
+
+core::Image resolve_grid(FramePipeline& pipeline, core::Eye eye, const std::vector<glm::vec4>& grid, bool blur) {
+  auto& m = Access::impl(pipeline);
+  upload_level0(pipeline, eye, grid, "resolve_grid");
   m.ctx.submit_and_wait([&](VkCommandBuffer cmd) { m.resolve->record_resolve(cmd, m.parity, blur, m.settings); });
   return pipeline.image(eye);
 }
@@ -79,6 +89,15 @@ core::Image blur_image(FramePipeline& pipeline, core::Eye eye, const core::Image
   return pipeline.image(eye);
 }
 
+std::vector<glm::vec4> blur_grid(FramePipeline& pipeline, core::Eye eye, const std::vector<glm::vec4>& grid) {
+  auto& m = Access::impl(pipeline);
+  const int i = upload_level0(pipeline, eye, grid, "blur_grid");
+  m.ctx.submit_and_wait([&](VkCommandBuffer cmd) { m.resolve->record_grid_blur(cmd, m.settings); });
+  std::vector<glm::vec4> out = m.resolve->level0(i).download<glm::vec4>();
+  out.resize(grid.size());
+  return out;
+}
+
 ResolveKernelTimes time_resolve(FramePipeline& pipeline, bool blur) {
   auto& m = Access::impl(pipeline);
   const auto time = [&](auto&& record) {
@@ -99,9 +118,12 @@ ResolveKernelTimes time_resolve(FramePipeline& pipeline, bool blur) {
     for (std::size_t i = 0; i < m.eyes.size(); ++i) finals.push_back(&m.post->final_color(int(i), m.parity));
     m.resolve->record_copy(cmd, finals);
   });
+  KernelTime grid_blur;
+  if (blur) grid_blur = time([&](VkCommandBuffer cmd) { m.resolve->record_grid_blur(cmd, m.settings); });
   t.mip = time([&](VkCommandBuffer cmd) { m.resolve->record_mips(cmd); });
   t.resample = time([&](VkCommandBuffer cmd) { m.resolve->record_resample(cmd, m.parity); });
   if (blur) t.blur = time([&](VkCommandBuffer cmd) { m.resolve->record_blur(cmd, m.settings); });
+  t.blur.gpu_ms += grid_blur.gpu_ms, t.blur.cpu_ms += grid_blur.cpu_ms;
   return t;
 }
 

@@ -1,7 +1,8 @@
-// Resolve to the display (shaders/recon_mip.comp, recon_radius_lut.comp, recon_resolve.comp
-// with the display-space depth, recon_blur.comp).
+// Resolve to the display (shaders/recon_grid_blur.comp, recon_mip.comp, recon_radius_lut.comp,
+// recon_resolve.comp with the display-space depth, recon_blur.comp).
 #include <algorithm>
 #include <cmath>
+#include <cstring>
 #include <numbers>
 
 #include "bindings.hpp"
@@ -27,12 +28,72 @@ float blur_skip_cos(const ReconSettings& s, double ppd) {
   }
   return float(std::cos(lo * std::numbers::pi / 180));
 }
+
+// The current mapping of an eye, read from its host-visible mapping buffer (GridMapping
+// writes it before the frame is recorded).
+shaders::ReconGrid current_map(const gpu::Buffer& maps) {
+  shaders::ReconGrid m{};
+  std::memcpy(&m, maps.mapped().data() + shaders::kReconCurrent * sizeof(m), sizeof(m));
+  return m;
+}
+
+bool grid_space_blur(const shaders::ReconGrid& m) { return m.g.family == shaders::kFamilyAngularPolar; }
+
+// The first column of an angular polar mapping whose acuity kernel (recon_grid_blur.comp) is
+// at least min_sigma_px cells wide across or along it, or `columns` when none is: the blur
+// passes start there (σ in cells grows outwards; columns beyond it below the limit are copied).
+std::uint32_t first_blurred_column(const shaders::ReconGrid& m, const gpu::Buffer& tables, const ReconSettings& s) {
+  const auto* table = reinterpret_cast<const shaders::GridColumn*>(tables.mapped().data()) + m.table_offset;
+  for (std::uint32_t c = 0; c < m.g.columns; ++c) {
+    const shaders::GridColumn& col = table[c];
+    const double e = 0.5 * (double(col.r0) + double(col.r1));
+    const double arc = 1.0 - double(col.phi_gap) / (2 * std::numbers::pi);
+    const double row_deg = 360.0 * std::sin(e * std::numbers::pi / 180) * arc / std::max(col.rows, 1u);
+    const double sigma = blur_sigma_deg(e, s.blur_mar_fovea_deg);
+    if (sigma >= s.blur_min_sigma_px * std::min(double(col.r1 - col.r0), row_deg)) return c;
+  }
+  return m.g.columns;
+}
+
+// Which part of the φ-mip chain the resample can reach this frame. A pixel in column c (its
+// radius in [r0, r1]) has a footprint along φ of at most
+//   F_c = δ·turn_rows / (2π·min(sin r0, sin r1))   (angular; δ the raster's largest pixel
+//   angle, bounded by the tangent-space step)   or   turn_rows / (2π·r0)   (screen polar)
+// rows (recon_resolve.comp, phi_footprint), so its LOD log2(F) needs level L only where
+// F_c > 2^(L−1). Level L is built for the columns up to the last such one plus its
+// neighbour (the bilinear pair); the resample computes the LOD only below lod_columns.
+struct MipReach {
+  std::vector<std::uint32_t> columns;  // per level ≥ 1: columns [0, n) to build (0: none)
+  std::uint32_t lod_columns = 0;       // columns whose pixels can have a LOD > 0
+};
+
+MipReach mip_reach(const shaders::ReconGrid& m, const gpu::Buffer& tables, std::uint32_t levels) {
+  MipReach reach;
+  reach.columns.assign(levels, 0);
+  if (m.g.family == shaders::kFamilyCartesian) return reach;
+  const auto* table = reinterpret_cast<const shaders::GridColumn*>(tables.mapped().data()) + m.table_offset;
+  const double delta = std::max((m.g.tan_right - m.g.tan_left) / m.g.width, (m.g.tan_up - m.g.tan_down) / m.g.height);
+  constexpr double kDeg = std::numbers::pi / 180;
+  for (std::uint32_t c = 0; c < m.g.columns; ++c) {
+    const shaders::GridColumn& col = table[c];
+    const double turn_rows = col.rows / (1.0 - double(col.phi_gap) / (2 * std::numbers::pi));
+    const double f = m.g.family == shaders::kFamilyAngularPolar
+                         ? delta * turn_rows / (2 * std::numbers::pi * std::min(std::sin(col.r0 * kDeg), std::sin(col.r1 * kDeg)))
+                         : turn_rows / (2 * std::numbers::pi * col.r0);
+    if (!(f > 1.0)) continue;  // also a NaN-free guard: r0 = 0 gives +inf, which counts
+    reach.lod_columns = c + 1;
+    for (std::uint32_t l = 1; l < levels && f > std::ldexp(1.0, int(l) - 1); ++l)
+      reach.columns[l] = std::min(c + 2, m.g.padded_columns);
+  }
+  return reach;
+}
 }  // namespace
 
 Resolve::Resolve(gpu::Context& ctx, std::span<const EyeGrid> eyes, const Accumulation& acc)
     : mip_(kernel<MipBindings, shaders::ReconMipPush>(ctx, "recon_mip.comp.spv")),
       resolve_(kernel<ResolveBindings, shaders::ReconResolvePush>(ctx, "recon_resolve.comp.spv")),
       blur_(kernel<BlurBindings, shaders::ReconBlurPush>(ctx, "recon_blur.comp.spv")),
+      grid_blur_(kernel<BlurBindings, shaders::ReconGridBlurPush>(ctx, "recon_grid_blur.comp.spv")),
       lut_(kernel<RadiusLutBindings, shaders::ReconResolvePush>(ctx, "recon_radius_lut.comp.spv")),
       eyes_(eyes.size()) {
   for (std::size_t i = 0; i < eyes.size(); ++i) {
@@ -43,6 +104,8 @@ Resolve::Resolve(gpu::Context& ctx, std::span<const EyeGrid> eyes, const Accumul
     e.height = g.height;
     e.padded_columns = g.padded_columns;
     e.polar = g.polar;
+    e.maps = g.maps;
+    e.tables = g.tables;
     e.max_pixels_per_deg = g.max_pixels_per_deg;
     // φ-only mip chain (polar grids): level l has ceil(rows / 2^l) rows.
     std::uint32_t rows = g.padded_rows, offset = 0;
@@ -68,6 +131,11 @@ Resolve::Resolve(gpu::Context& ctx, std::span<const EyeGrid> eyes, const Accumul
                                                                  &acc.position(int(i), p), &e.depth, &e.lut});
     e.blur_h = make_set(ctx, blur_, BlurBindings{g.maps, g.tables, &e.screen_a, &e.screen_b});
     e.blur_v = make_set(ctx, blur_, BlurBindings{g.maps, g.tables, &e.screen_b, &e.screen_a});
+    if (g.polar) {  // grid-space blur: level 0 -> grid_tmp (across columns) -> level 0 (along φ)
+      e.grid_tmp = storage(ctx, VkDeviceSize(g.padded_rows) * g.padded_columns * 16, "recon.grid_blur_tmp");
+      e.grid_blur_rho = make_set(ctx, grid_blur_, BlurBindings{g.maps, g.tables, &e.mips, &e.grid_tmp});
+      e.grid_blur_phi = make_set(ctx, grid_blur_, BlurBindings{g.maps, g.tables, &e.grid_tmp, &e.mips});
+    }
   }
 }
 
@@ -84,19 +152,50 @@ void Resolve::record_copy(VkCommandBuffer cmd, std::span<const gpu::Buffer* cons
 }
 
 void Resolve::record_resolve(VkCommandBuffer cmd, int parity, bool blur, const ReconSettings& s) const {
+  if (blur) record_grid_blur(cmd, s);
   record_mips(cmd);
   record_resample(cmd, parity);
   if (blur) record_blur(cmd, s);
 }
 
+void Resolve::record_grid_blur(VkCommandBuffer cmd, const ReconSettings& s) const {
+  std::vector<std::uint32_t> first(eyes_.size(), 0);
+  bool any = false;
+  for (std::size_t i = 0; i < eyes_.size(); ++i) {
+    const shaders::ReconGrid m = current_map(*eyes_[i].maps);
+    first[i] = grid_space_blur(m) ? first_blurred_column(m, *eyes_[i].tables, s) : m.g.columns;
+    any = any || first[i] < m.g.columns;
+  }
+  if (!any) return;  // the acuity kernel is below min σ in every cell: nothing to blur
+  for (int pass = 0; pass < 2; ++pass) {
+    for (std::size_t i = 0; i < eyes_.size(); ++i) {
+      const Eye& e = eyes_[i];
+      const std::uint32_t columns = current_map(*e.maps).g.columns;
+      if (first[i] >= columns) continue;
+      const shaders::ReconGridBlurPush push{first[i], std::uint32_t(pass), 0, 0,
+                                            float(blur_sigma_deg(0.0, s.blur_mar_fovea_deg)),
+                                            float(s.blur_min_sigma_px), float(s.blur_max_sigma_px), 0};
+      grid_blur_.run(cmd, {pass == 0 ? &e.grid_blur_rho : &e.grid_blur_phi}, push, columns - first[i], e.level_rows[0]);
+    }
+    gpu::compute_to_compute(cmd);
+  }
+}
+
 void Resolve::record_mips(VkCommandBuffer cmd) const {
+  std::vector<MipReach> reach;
+  for (const Eye& e : eyes_) reach.push_back(mip_reach(current_map(*e.maps), *e.tables, e.levels));
   for (std::uint32_t l = 0; l + 1 < max_levels(); ++l) {
-    for (const Eye& e : eyes_) {
-      if (l + 1 >= e.levels) continue;
+    bool any = false;
+    for (std::size_t i = 0; i < eyes_.size(); ++i) {
+      const Eye& e = eyes_[i];
+      const std::uint32_t columns = l + 1 < e.levels ? reach[i].columns[l + 1] : 0;
+      if (columns == 0) continue;
       const shaders::ReconMipPush push{e.padded_columns, e.level_rows[l], e.level_rows[l + 1], l, e.level_offset[l],
                                        e.level_offset[l + 1], 0, 0};
-      mip_.run(cmd, {&e.mip_set}, push, e.padded_columns, e.level_rows[l + 1]);
+      mip_.run(cmd, {&e.mip_set}, push, columns, e.level_rows[l + 1]);
+      any = true;
     }
+    if (!any) break;
     gpu::compute_to_compute(cmd);
   }
 }
@@ -105,15 +204,19 @@ void Resolve::record_resample(VkCommandBuffer cmd, int parity, bool grid_coords)
   for (const Eye& e : eyes_)
     if (e.polar) lut_.run(cmd, {&e.lut_set}, shaders::ReconResolvePush{}, shaders::kReconRadiusLutSize + 2);
   gpu::compute_to_compute(cmd);
-  for (const Eye& e : eyes_)
-    resolve_.run(cmd, {&e.resolve_set[parity]}, shaders::ReconResolvePush{e.width, e.height, e.levels, grid_coords ? 1u : 0u}, e.width,
+  for (const Eye& e : eyes_) {
+    const std::uint32_t lod_columns = mip_reach(current_map(*e.maps), *e.tables, e.levels).lod_columns;
+    resolve_.run(cmd, {&e.resolve_set[parity]},
+                 shaders::ReconResolvePush{e.width, e.height, e.levels, grid_coords ? 1u : 0u, lod_columns, 0, 0, 0}, e.width,
                  e.height);
+  }
   gpu::compute_to_compute(cmd);
 }
 
 void Resolve::record_blur(VkCommandBuffer cmd, const ReconSettings& s) const {
   for (int pass = 0; pass < 2; ++pass) {
     for (const Eye& e : eyes_) {
+      if (grid_space_blur(current_map(*e.maps))) continue;  // blurred in grid space (record_grid_blur)
       const shaders::ReconBlurPush push{e.width, e.height, std::uint32_t(pass), 0,
                                         float(blur_sigma_deg(0.0, s.blur_mar_fovea_deg)), float(s.blur_min_sigma_px),
                                         float(s.blur_max_sigma_px), blur_skip_cos(s, e.max_pixels_per_deg)};
@@ -125,7 +228,8 @@ void Resolve::record_blur(VkCommandBuffer cmd, const ReconSettings& s) const {
 
 void Resolve::fill(VkCommandBuffer cmd, std::uint32_t word) const {
   for (const Eye& e : eyes_)
-    for (const gpu::Buffer* b : {&e.mips, &e.screen_a, &e.screen_b, &e.depth, &e.lut}) gpu::fill_buffer(cmd, *b, word);
+    for (const gpu::Buffer* b : {&e.mips, &e.screen_a, &e.screen_b, &e.depth, &e.lut, &e.grid_tmp})
+      if (b->size() > 0) gpu::fill_buffer(cmd, *b, word);
 }
 
 }  // namespace fovea::reconstruct

@@ -38,13 +38,17 @@ core::Image resolve_grid(FramePipeline& p, core::Eye e, const std::vector<glm::v
 // mapping; for measuring the kernel.
 core::Image blur_image(FramePipeline& p, core::Eye e, const core::Image& image);
 
+// Runs only the grid-space peripheral blur (angular polar grids) on a grid image in the padded
+// grid layout with eye `e`'s current mapping; the blurred grid. For measuring the kernel.
+std::vector<glm::vec4> blur_grid(FramePipeline& p, core::Eye e, const std::vector<glm::vec4>& grid);
+
 // Per display pixel of eye `e` (row-major), the grid coordinate the resolve samples with the
 // current mapping: (u = column coordinate, t = φ/2π or y/height, LOD, 0).
 std::vector<glm::vec4> resolve_grid_coords(FramePipeline& p, core::Eye e);
 
 // Resolving the last frame again, one submission per part (the grid image's copy into the
 // mip chain, the φ-mip chain, the resample with the display-space depth, the optional
-// blur): per part the GPU milliseconds
+// blur in grid space and on the display, counted together): per part the GPU milliseconds
 // (timestamps; 0 without them) and the process's CPU milliseconds over the submission (all
 // threads: on a CPU device the work itself, which other processes on the machine do not
 // inflate the way they inflate elapsed time). For the resolve benchmark.

@@ -125,10 +125,13 @@ class Resolve {
   Resolve(gpu::Context& ctx, std::span<const EyeGrid> eyes, const Accumulation& acc);
   // Copies a grid image into level 0 (transfer; the caller orders its writes before).
   void record_copy(VkCommandBuffer cmd, std::span<const gpu::Buffer* const> grid_images) const;
-  // Mips from level 0, resolve, optional blur: into the screen buffers; the resample also
-  // writes the depth of the nearest sample per display pixel from the positions of
-  // `parity`. The three kernels are also recorded one by one (per-kernel timestamps).
+  // Optional blur of level 0 in grid space, mips from level 0, resolve, optional blur: into
+  // the screen buffers; the resample also writes the depth of the nearest sample per display
+  // pixel from the positions of `parity`. The kernels are also recorded one by one
+  // (per-kernel timestamps). The peripheral blur runs in grid space on angular polar grids
+  // (record_grid_blur, before the mips) and on the display for the others (record_blur).
   void record_resolve(VkCommandBuffer cmd, int parity, bool blur, const ReconSettings& settings) const;
+  void record_grid_blur(VkCommandBuffer cmd, const ReconSettings& settings) const;
   void record_mips(VkCommandBuffer cmd) const;
   // grid_coords: each pixel's grid coordinate (u, t, LOD, 0) instead of its colour (tests).
   void record_resample(VkCommandBuffer cmd, int parity, bool grid_coords = false) const;
@@ -145,12 +148,13 @@ class Resolve {
     std::uint32_t cells = 0, width = 0, height = 0, padded_columns = 0, levels = 1;
     bool polar = true;
     double max_pixels_per_deg = 0;
+    const gpu::Buffer *maps = nullptr, *tables = nullptr;  // host-visible (GridMapping)
     std::vector<std::uint32_t> level_rows, level_offset;
-    gpu::Buffer mips, offsets, screen_a, screen_b, depth, lut;
-    gpu::DescriptorSet mip_set, lut_set, resolve_set[2], blur_h, blur_v;
+    gpu::Buffer mips, offsets, screen_a, screen_b, depth, lut, grid_tmp;
+    gpu::DescriptorSet mip_set, lut_set, resolve_set[2], blur_h, blur_v, grid_blur_rho, grid_blur_phi;
   };
   std::uint32_t max_levels() const;
-  gpu::ComputePipeline mip_, resolve_, blur_, lut_;
+  gpu::ComputePipeline mip_, resolve_, blur_, grid_blur_, lut_;
   std::vector<Eye> eyes_;
 };
 

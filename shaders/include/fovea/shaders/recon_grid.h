@@ -72,6 +72,7 @@ struct ReconMipPush {
 
 struct ReconResolvePush {
   FOVEA_UINT width, height, levels, grid_coords;  // grid_coords = 1: write (u, t, LOD, 0) per pixel, for tests
+  FOVEA_UINT lod_columns, pad0, pad1, pad2;       // pixels of columns >= lod_columns have LOD 0 (Resolve, mip_reach)
 };
 
 // Radius -> column lookup table of the current mapping (recon_radius_lut.comp builds it per
@@ -90,12 +91,22 @@ struct ReconBlurPush {
   float sigma_fovea_deg, min_sigma_px, max_sigma_px, cos_skip;  // σ(e) = σ_fovea / m(e) degrees; cos e > cos_skip: σ < min
 };
 
+// Grid-space peripheral blur of an angular polar grid (recon_grid_blur.comp): one pass over
+// columns [first_column, columns) of the current mapping, across columns (along ρ) or, with
+// phi_pass, along the rows of each column; σ in cells from the acuity model and the cells'
+// angular size, cells below min_sigma_cells copied.
+struct ReconGridBlurPush {
+  FOVEA_UINT first_column, phi_pass, pad0, pad1;
+  float sigma_fovea_deg, min_sigma_cells, max_sigma_cells, pad2;
+};
 #ifdef __cplusplus
 static_assert(sizeof(ReconGrid) == 192);
+static_assert(sizeof(ReconGridBlurPush) == 32);
 static_assert(sizeof(ReconAccumulatePush) == 32);
 static_assert(sizeof(ReconBmfrPush) == 32);
 static_assert(sizeof(ReconPostPush) == 32);
 static_assert(sizeof(ReconMipPush) == 32);
+static_assert(sizeof(ReconResolvePush) == 32);
 static_assert(sizeof(ReconBlurPush) == 32);
 static_assert(sizeof(ReconRadiusLutHeader) == 16);
 }  // namespace fovea::shaders

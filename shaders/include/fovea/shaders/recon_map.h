@@ -76,13 +76,17 @@ float rg_arc_turns(ReconGrid m, uint c) {
 // Rows column c would have over a full turn at its spacing along φ.
 float rg_turn_rows(ReconGrid m, uint c) { return float(rg_rows(m, c)) / rg_arc_turns(m, c); }
 
-// Continuous row coordinate in column c (cell centres at +0.5) of grid coordinate t (φ / 2π
-// on polar grids): φ from the start of the column's arc; a point in a packed column's gap
-// (off the view) snaps to the nearer end of its arc (core PolarDistribution::screen_to_grid).
-float rg_row_coord(ReconGrid m, uint c, float t) {
-  float rows = float(rg_rows(m, c));
-  if (m.g.family == kFamilyCartesian) return t * rows;
-  GridColumn col = tables[m.table_offset + c];
+// Column c's table entry; for the Cartesian raster a full "ring" of the raster's rows (no
+// gap), so the helpers below that take an entry serve every family.
+GridColumn rg_column(ReconGrid m, uint c) {
+  if (m.g.family == kFamilyCartesian) return GridColumn(float(c), float(c + 1u), m.g.rows, 0.0, 0.0, 0.0, 0.0, 0.0);
+  return tables[m.table_offset + c];
+}
+
+// rg_row_coord below for a column entry read once (rg_column): kernels that need several
+// of a column's properties load its entry a single time.
+float rg_row_coord_of(GridColumn col, float t) {
+  float rows = float(col.rows);
   if (col.phi_gap == 0.0) return t * rows;
   float span = 1.0 - col.phi_gap / (2.0 * kRgPi);
   float x = fract(t - col.phi0 / (2.0 * kRgPi));
@@ -90,12 +94,36 @@ float rg_row_coord(ReconGrid m, uint c, float t) {
   return x / span * rows;
 }
 
+// Continuous row coordinate in column c (cell centres at +0.5) of grid coordinate t (φ / 2π
+// on polar grids): φ from the start of the column's arc; a point in a packed column's gap
+// (off the view) snaps to the nearer end of its arc (core PolarDistribution::screen_to_grid).
+float rg_row_coord(ReconGrid m, uint c, float t) { return rg_row_coord_of(rg_column(m, c), t); }
+
 // Grid coordinate t of row coordinate v of column c (the inverse of rg_row_coord).
+float rg_row_to_t_of(GridColumn col, float v) {
+  return fract(col.phi0 / (2.0 * kRgPi) + v / float(max(col.rows, 1u)) * (1.0 - col.phi_gap / (2.0 * kRgPi)));
+}
 float rg_row_to_t(ReconGrid m, uint c, float v) {
-  float rows = float(max(rg_rows(m, c), 1u));
-  if (m.g.family == kFamilyCartesian) return v / rows;
-  GridColumn col = tables[m.table_offset + c];
-  return fract(col.phi0 / (2.0 * kRgPi) + v / rows * rg_arc_turns(m, c));
+  if (m.g.family == kFamilyCartesian) return v / float(max(m.g.rows, 1u));
+  return rg_row_to_t_of(tables[m.table_offset + c], v);
+}
+
+// The two rows of a column of `rows` rows around row coordinate v (cell centres at +0.5)
+// and the weight f of r1: a full ring wraps (v in [0, rows]: one conditional add/subtract,
+// no integer division), a packed column or the raster clamps.
+void rg_row_pair(int rows, bool wraps, float v, out int r0, out int r1, out float f) {
+  float vr = v - 0.5;
+  float r0f = floor(vr);
+  f = vr - r0f;
+  r0 = int(r0f);
+  r1 = r0 + 1;
+  if (wraps) {
+    r0 += r0 < 0 ? rows : 0;
+    r1 -= r1 >= rows ? rows : 0;
+  } else {
+    r0 = clamp(r0, 0, rows - 1);
+    r1 = clamp(r1, 0, rows - 1);
+  }
 }
 
 // The last column i in [range.x, range.y) with r0(i) <= r (range.x when none; the columns'
