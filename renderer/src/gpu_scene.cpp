@@ -57,7 +57,9 @@ GpuScene::GpuScene(gpu::Context& ctx, const Scene& s, const BvhOptions& bvh_opti
                            ") does not offer ray queries (VK_KHR_acceleration_structure + VK_KHR_ray_query); "
                            "use --trace compute or auto");
   const auto t0 = std::chrono::steady_clock::now();
-  const Bvh bvh = build_bvh(s.positions, bvh_options);
+  BvhOptions options = bvh_options;
+  if (!options.eye) options.eye = glm::vec3(s.camera.position);
+  const Bvh bvh = build_bvh(s.positions, options);
   stats_.build_ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
   const std::size_t n = bvh.order.size();
 
