@@ -236,15 +236,20 @@ class Builder {
     // so a node around the eye takes its best cone whenever one splits it.
     if (!rays.empty()) {
       Split cones;
+      Aabb cone_box[6];
+      std::uint32_t cone_count[6] = {};
+      for (std::uint32_t i = begin; i < end; ++i) {
+        const Prim& p = prims_[order_[i]];
+        const int c = cone(p);
+        cone_box[c].grow(p.box);
+        ++cone_count[c];
+      }
       for (int c = 0; c < 6; ++c) {
-        Aabb in, out;
-        std::uint32_t n_in = 0;
-        for (std::uint32_t i = begin; i < end; ++i) {
-          const Prim& p = prims_[order_[i]];
-          const bool inside = cone(p) == c;
-          (inside ? in : out).grow(p.box);
-          n_in += inside;
-        }
+        const Aabb& in = cone_box[c];
+        Aabb out;
+        for (int o = 0; o < 6; ++o)
+          if (o != c) out.grow(cone_box[o]);
+        const std::uint32_t n_in = cone_count[c];
         if (n_in == 0 || n_in == end - begin) continue;
         std::size_t hits_in = 0, hits_out = 0;
         for (const std::uint32_t r : rays) {
