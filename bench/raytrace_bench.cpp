@@ -118,6 +118,12 @@ void BM_PrimaryRays(benchmark::State& state, const char* scene, fr::Tracing trac
             [&] { rc.trace(fr::RayQuery::Closest, repeat); });
   state.counters["triangles"] = double(g.stats().triangles);
   if (g.tracing() == fr::Tracing::Compute) {
+    // Which tree was kept (bvh.hpp), what it cost to build, and the sample rays' work in it
+    // and in the plain SAH tree.
+    state.counters["ray_guided"] = g.stats().bvh_ray_guided ? 1.0 : 0.0;
+    state.counters["bvh_build_ms"] = g.stats().build_ms;
+    state.counters["sample_work"] = g.stats().bvh_ray_cost;
+    state.counters["sah_sample_work"] = g.stats().bvh_sah_ray_cost;
     fr::Raycaster counting(context(), g, true);
     counting.set_rays(f.rays);
     const fr::TraversalStats t = counting.traversal_stats();
@@ -125,6 +131,15 @@ void BM_PrimaryRays(benchmark::State& state, const char* scene, fr::Tracing trac
     state.counters["tris/ray"] = t.triangles;
     state.counters["nodes/subgroup"] = t.subgroup_nodes;  // the most any ray of its subgroup visited
     state.counters["tris/subgroup"] = t.subgroup_triangles;
+    // The same rays in the plain SAH tree, for comparison.
+    fr::BvhOptions sah_only;
+    sah_only.ray_samples = 0;
+    const fr::GpuScene plain(context(), f.scene, sah_only, tracing);
+    fr::Raycaster plain_counting(context(), plain, true);
+    plain_counting.set_rays(f.rays);
+    const fr::TraversalStats p = plain_counting.traversal_stats();
+    state.counters["sah_nodes/ray"] = p.nodes;
+    state.counters["sah_tris/ray"] = p.triangles;
   }
 }
 

@@ -57,7 +57,12 @@ GpuScene::GpuScene(gpu::Context& ctx, const Scene& s, const BvhOptions& bvh_opti
                            ") does not offer ray queries (VK_KHR_acceleration_structure + VK_KHR_ray_query); "
                            "use --trace compute or auto");
   const auto t0 = std::chrono::steady_clock::now();
-  const Bvh bvh = build_bvh(s.positions, bvh_options);
+  // The compute traversal gets the tree built for the rays from the scene camera; with ray
+  // queries the nodes go unused (and the triangle order stays the SAH tree's).
+  const bool ray_queries = tracing != Tracing::Compute && ctx.features().ray_query;
+  BvhOptions options = bvh_options;
+  if (!options.eye && !ray_queries) options.eye = glm::vec3(s.camera.position);
+  const Bvh bvh = build_bvh(s.positions, options);
   stats_.build_ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
   const std::size_t n = bvh.order.size();
 
@@ -133,8 +138,11 @@ GpuScene::GpuScene(gpu::Context& ctx, const Scene& s, const BvhOptions& bvh_opti
   stats_.nodes = std::uint32_t(bvh.nodes.size());
   stats_.bvh_depth = bvh.depth;
   stats_.bvh_sah_cost = bvh.sah_cost;
+  stats_.bvh_ray_guided = bvh.ray_guided;
+  stats_.bvh_ray_cost = bvh.ray_cost;
+  stats_.bvh_sah_ray_cost = bvh.sah_ray_cost;
 
-  if (tracing != Tracing::Compute && ctx.features().ray_query) {
+  if (ray_queries) {
     // The triangles in BVH order, so a ray query's primitive index addresses tris[] as
     // the compute traversal's hits do.
     std::vector<float> vertices;

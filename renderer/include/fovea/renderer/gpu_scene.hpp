@@ -30,6 +30,8 @@ struct GpuSceneStats {
   std::uint32_t triangles = 0, nodes = 0, lights = 0, textures = 0;
   int bvh_depth = 0;
   double bvh_sah_cost = 0;
+  bool bvh_ray_guided = false;  // the tree built for the scene's rays was kept (bvh.hpp)
+  double bvh_ray_cost = 0, bvh_sah_ray_cost = 0;  // Bvh::ray_cost, sah_ray_cost
   double build_ms = 0;  // CPU BVH build
   double accel_build_ms = 0;       // acceleration-structure build (ray queries), wall clock
   std::uint64_t accel_bytes = 0;   // its storage, both levels
