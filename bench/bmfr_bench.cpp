@@ -178,7 +178,7 @@ void chain(benchmark::State& state, const char* scene_name) {
 
 BENCHMARK(fit)
     ->ArgNames({"workgroup", "fp16"})
-    ->ArgsProduct({{64, 128, 256, 512}, {0, 1}})
+    ->ArgsProduct({{8, 16, 32, 64, 256}, {0, 1}})
     ->Unit(benchmark::kMillisecond)
     ->UseRealTime()
     ->MinTime(1.0);
