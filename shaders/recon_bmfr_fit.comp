@@ -14,7 +14,7 @@
 // Householder QR, same R up to row signs): one reduction of its 85 upper entries instead of
 // one per Householder column, each invocation summing its rows' outer products as it
 // streams them; on lavapipe the QR's ten reduction rounds and its rows held in registers
-// across them were most of the chain's time (docs/reconstruction.md, "Workgroup design").
+// across them were the chain's largest cost (docs/reconstruction.md, "Workgroup design").
 // The normal equations square the condition number, so every non-constant feature is
 // shifted by its block mean first (the constant feature spans any shift: the fit is the
 // same): without the shift a planar block's n (constant up to ε) would lose the ε that
@@ -58,8 +58,15 @@ const uint kMasked = 0x80000000u;   // s_cell: a zero row (no sample, sky, emitt
 
 // Row k and column j of each Gram entry, so the row update is one flat unrolled loop: with
 // nested k, j loops llvmpipe left the 85 sums partly dynamically indexed (3× the fit's time).
-const uint kGramK[kGram] = uint[kGram](0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 1, 1, 1, 1, 1, 1, 1, 1, 1, 1, 1, 1, 2, 2, 2, 2, 2, 2, 2, 2, 2, 2, 2, 3, 3, 3, 3, 3, 3, 3, 3, 3, 3, 4, 4, 4, 4, 4, 4, 4, 4, 4, 5, 5, 5, 5, 5, 5, 5, 5, 6, 6, 6, 6, 6, 6, 6, 7, 7, 7, 7, 7, 7, 8, 8, 8, 8, 8, 9, 9, 9, 9);
-const uint kGramJ[kGram] = uint[kGram](0, 1, 2, 3, 4, 5, 6, 7, 8, 9, 10, 11, 12, 1, 2, 3, 4, 5, 6, 7, 8, 9, 10, 11, 12, 2, 3, 4, 5, 6, 7, 8, 9, 10, 11, 12, 3, 4, 5, 6, 7, 8, 9, 10, 11, 12, 4, 5, 6, 7, 8, 9, 10, 11, 12, 5, 6, 7, 8, 9, 10, 11, 12, 6, 7, 8, 9, 10, 11, 12, 7, 8, 9, 10, 11, 12, 8, 9, 10, 11, 12, 9, 10, 11, 12);
+const uint kGramK[kGram] = uint[kGram](
+    0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 1, 1, 1, 1, 1, 1, 1, 1, 1, 1, 1, 1, 2, 2, 2, 2, 2, 2, 2,
+    2, 2, 2, 2, 3, 3, 3, 3, 3, 3, 3, 3, 3, 3, 4, 4, 4, 4, 4, 4, 4, 4, 4, 5, 5, 5, 5, 5, 5, 5, 5, 6,
+    6, 6, 6, 6, 6, 6, 7, 7, 7, 7, 7, 7, 8, 8, 8, 8, 8, 9, 9, 9, 9);
+const uint kGramJ[kGram] = uint[kGram](
+    0, 1, 2, 3, 4, 5, 6, 7, 8, 9, 10, 11, 12, 1, 2, 3, 4, 5, 6, 7, 8, 9, 10, 11, 12, 2, 3, 4, 5, 6,
+    7, 8, 9, 10, 11, 12, 3, 4, 5, 6, 7, 8, 9, 10, 11, 12, 4, 5, 6, 7, 8, 9, 10, 11, 12, 5, 6, 7, 8,
+    9, 10, 11, 12, 6, 7, 8, 9, 10, 11, 12, 7, 8, 9, 10, 11, 12, 8, 9, 10, 11, 12, 9, 10, 11, 12);
+
 shared float s_partial[kChunk][kGroup];
 shared float s_result[kGram];
 shared float s_r[kM][kCols];
