@@ -1,24 +1,41 @@
-// BMFR fit (shaders/recon_bmfr_fit.comp) on a synthetic 1280×720 grid: one eye, the
-// resolution of the BMFR paper's timings, inputs resident on the device. Wall time of one
-// submission holding the fit only (upload and download excluded). The scene is a room
-// corner (three walls and a floor, positions in metres) with noisy radiance, so every
-// block has valid rows, several normals and rank-deficient planar parts.
-//   LP_NUM_THREADS=2 fovea_bench_bmfr [--benchmark_filter=...]
+// BMFR at 1280×720 per eye, the resolution of the BMFR paper's timings (PoCL reference:
+// ~480 ms per frame on 2 cores).
+// - fit: the fit (shaders/recon_bmfr_fit.comp) alone on a synthetic grid, one eye, inputs
+//   resident on the device; wall time of one submission holding the fit only. The scene is
+//   a room corner (three walls and a floor, positions in metres) with noisy radiance, so
+//   every block has valid rows, several normals and rank-deficient planar parts.
+// - Chain/<scene>: the whole reconstruction before the resolve (Phase I accumulation, stereo
+//   gather, fit, Phase III, TAA) of a stereo Cartesian 1280×720 frame of a shipped scene after
+//   two frames of history, each pass in its own submission (pipeline/testing.hpp). The
+//   benchmark's time is the GPU time of the chain per eye (timestamps, both eyes / 2);
+//   counters per pass and eye: <pass>_ms (GPU) and <pass>_cpu_ms (the process's CPU time,
+//   lavapipe's work, which other load inflates less than elapsed time), load1 the load average.
+//   LP_NUM_THREADS=2 fovea_bench_bmfr [--benchmark_filter=...] [--benchmark_repetitions=N]
 #include <benchmark/benchmark.h>
 
 #include <cmath>
+#include <cstdlib>
+#include <ctime>
 #include <random>
+#include <string>
 #include <vector>
 
 #include <glm/vec3.hpp>
 #include <glm/geometric.hpp>
 
-#include "fovea/reconstruct/bmfr.hpp"
+#include "fovea/core/display.hpp"
+#include "fovea/core/stereo_views.hpp"
 #include "fovea/gpu/context.hpp"
+#include "fovea/pipeline/frame_pipeline.hpp"
+#include "fovea/pipeline/testing.hpp"
+#include "fovea/reconstruct/bmfr.hpp"
+#include "fovea/renderer/gpu_scene.hpp"
+#include "fovea/renderer/scene_io.hpp"
 #include "fovea/shaders/pt_scene.h"
 
 namespace fc = fovea::reconstruct;
 namespace fg = fovea::gpu;
+namespace fp = fovea::pipeline;
 
 namespace {
 
@@ -28,6 +45,17 @@ constexpr std::uint32_t kPadded = (kHeight + 31) / 32 * 32;
 fg::Context& context() {
   static fg::Context ctx;
   return ctx;
+}
+
+double process_cpu_ms() {
+  timespec ts{};
+  clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &ts);
+  return double(ts.tv_sec) * 1e3 + double(ts.tv_nsec) * 1e-6;
+}
+
+double load1() {
+  double l[1] = {0};
+  return getloadavg(l, 1) == 1 ? l[0] : 0.0;
 }
 
 struct Inputs {
@@ -95,20 +123,67 @@ void fit(benchmark::State& state) {
     });
   };
   run();  // lavapipe compiles the shader at its first dispatch
+  const double cpu0 = process_cpu_ms();
   for (auto _ : state) {
     run();
     ++frame;
   }
+  state.counters["cpu_ms"] = (process_cpu_ms() - cpu0) / double(state.iterations());
   state.counters["blocks"] = double((kWidth / 32 + 1) * (kPadded / 32 + 1));
+  state.counters["load1"] = load1();
+}
+
+// The chain on a stereo 1280×720 Cartesian frame (fov ±50° × ±31°, no lens: every cell is
+// reconstructed), gaze straight ahead, default settings (BMFR, gather sharing).
+void chain(benchmark::State& state, const char* scene_name) {
+  fovea::core::DisplayPreset d;
+  d.name = "hd720";
+  d.width = int(kWidth);
+  d.height = int(kHeight);
+  d.fov_left = fovea::core::Fov::from_degrees(-50, 50, 31, -31);
+  d.fov_right = d.fov_left.mirrored();
+  const fovea::renderer::Scene scene = fovea::renderer::load_scene(scene_name);
+  const fovea::renderer::GpuScene gpu_scene(context(), scene);
+  fovea::core::DistributionParams dp;
+  dp.kind = fovea::core::DistributionKind::Cartesian;
+  fp::FramePipeline p(context(), gpu_scene, fovea::core::stereo_views(d), dp, fc::ReconSettings{});
+  const glm::dvec3 ahead(0, 0, -1);
+  std::uint32_t frame = 0;
+  for (; frame < 3; ++frame) p.render(fovea::core::eye_poses(scene.camera, d.ipd_m), {ahead, ahead}, frame);
+  fp::testing::time_reconstruct(p, frame);  // compiles the kernels not yet run with history
+  fp::testing::ReconKernelTimes sum;
+  const auto add = [](fp::testing::KernelTime& a, const fp::testing::KernelTime& b) {
+    a.gpu_ms += b.gpu_ms, a.cpu_ms += b.cpu_ms;
+  };
+  for (auto _ : state) {
+    const fp::testing::ReconKernelTimes t = fp::testing::time_reconstruct(p, frame++);
+    state.SetIterationTime((t.accumulate.gpu_ms + t.share.gpu_ms + t.fit.gpu_ms + t.post.gpu_ms + t.taa.gpu_ms) *
+                           0.5e-3);
+    add(sum.accumulate, t.accumulate), add(sum.share, t.share), add(sum.fit, t.fit), add(sum.post, t.post),
+        add(sum.taa, t.taa);
+  }
+  const double per_eye = 0.5 / double(state.iterations());
+  double cpu = 0;
+  for (const auto& [name, k] : {std::pair{"accumulate", sum.accumulate}, std::pair{"share", sum.share},
+                                std::pair{"fit", sum.fit}, std::pair{"post", sum.post}, std::pair{"taa", sum.taa}}) {
+    state.counters[std::string(name) + "_ms"] = k.gpu_ms * per_eye;
+    state.counters[std::string(name) + "_cpu_ms"] = k.cpu_ms * per_eye;
+    cpu += k.cpu_ms * per_eye;
+  }
+  state.counters["chain_cpu_ms"] = cpu;
+  state.counters["load1"] = load1();
 }
 
 }  // namespace
 
 BENCHMARK(fit)
     ->ArgNames({"workgroup", "fp16"})
-    ->ArgsProduct({{64, 128, 256, 512}, {0, 1}})
+    ->ArgsProduct({{8, 16, 32, 64, 256}, {0, 1}})
     ->Unit(benchmark::kMillisecond)
     ->UseRealTime()
     ->MinTime(1.0);
+
+BENCHMARK_CAPTURE(chain, cornell, "cornell")->UseManualTime()->Unit(benchmark::kMillisecond)->Iterations(4);
+BENCHMARK_CAPTURE(chain, default, "default")->UseManualTime()->Unit(benchmark::kMillisecond)->Iterations(4);
 
 BENCHMARK_MAIN();

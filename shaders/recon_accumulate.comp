@@ -46,10 +46,14 @@ layout(push_constant) uniform Push { ReconAccumulatePush pc; };
 // as the surface now hit was seen within a cell of it. A disocclusion has no such neighbour.
 bool seen_near(ReconGrid m, uint j, vec4 here, vec3 n, float depth) {
   if (rg_no_sample(prev_pos[j].w)) return false;
+  if (rg_tap_valid(here, n, depth, prev_pos[j], prev_nrm[j].xyz)) return true;  // the cell itself: the usual case
+  RgCell cell = rg_cell(m, j);
   for (int dc = -1; dc <= 1; ++dc)
     for (int dr = -1; dr <= 1; ++dr) {
       uint k;
-      if (rg_neighbour(m, j, dc, dr, k) && rg_tap_valid(here, n, depth, prev_pos[k], prev_nrm[k].xyz)) return true;
+      if ((dc != 0 || dr != 0) && rg_neighbour_of(m, cell, dc, dr, k) &&
+          rg_tap_valid(here, n, depth, prev_pos[k], prev_nrm[k].xyz))
+        return true;
     }
   return false;
 }

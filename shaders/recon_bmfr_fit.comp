@@ -2,25 +2,33 @@
 // BMFR Phase II (Koskela et al. 2019 §3.3–3.4) on one 32×32 block of the grid per
 // workgroup: features T = [1, n, w, w²] (M = 10, Eq. 8) with the world position w scaled per
 // block to [−1, 1] before squaring (so w² cannot overflow whatever the scene's units),
-// uniform ±ε noise on the non-constant features (Eq. 7), Householder QR of [T + N | z_r z_g z_b]
-// keeping only R (Q is never formed), back substitution R α = r (Eq. 5) per channel and the
-// weighted sum with the noise-free features (Eq. 6). Cells without a surface sample
-// (clipped, off-screen, padding, sky), emitters and surfaces without a diffuse lobe (metals)
-// are zero rows: masked out of the regression, they keep their accumulated input. A metal's
-// indirect diffuse is zero by construction; fitted with its block's diffuse neighbours it
-// took their light (docs/reconstruction.md, glossy-spheres).
+// uniform ±ε noise on the non-constant features (Eq. 7), the least-squares fit of
+// z_r z_g z_b on T + N (Eq. 5) and the weighted sum with the noise-free features (Eq. 6).
+// Cells without a surface sample (clipped, off-screen, padding, sky), emitters and surfaces
+// without a diffuse lobe (metals) are zero rows: masked out of the regression, they keep
+// their accumulated input. A metal's indirect diffuse is zero by construction; fitted with
+// its block's diffuse neighbours it took their light (docs/reconstruction.md, glossy-spheres).
 //
-// Workgroup: kGroup invocations (default 256) own 1024/kGroup rows (cells) each, kept in
-// registers for the whole QR; every loop over rows and columns is unrolled so no private
-// array is indexed dynamically. One reduction round per Householder column: ‖x‖² and every
-// x·a_j at once, since v = x − αe_k gives v·a_j = x·a_j − α·a_j[k]. Measured alternatives:
-// docs/reconstruction.md.
+// The R of the QR of [T + N | z] (Eq. 5's triangular system) comes from the Cholesky
+// factorisation of the Gram matrix [T + N | z]ᵀ[T + N | z] (deviation from the paper's
+// Householder QR, same R up to row signs): one reduction of its 85 upper entries instead of
+// one per Householder column, each invocation summing its rows' outer products as it
+// streams them; on lavapipe the QR's ten reduction rounds and its rows held in registers
+// across them were the chain's largest cost (docs/reconstruction.md, "Workgroup design").
+// The normal equations square the condition number, so every non-constant feature is
+// shifted by its block mean first (the constant feature spans any shift: the fit is the
+// same): without the shift a planar block's n (constant up to ε) would lose the ε that
+// regularises it to cancellation in fp32. Pivots whose column lies within 10⁻⁵ (squared
+// sine) of the previous columns' span are dropped (zero coefficient).
+//
+// Workgroup: kGroup invocations (default 8: one 8-wide SIMD row on lavapipe) loop over
+// 1024/kGroup rows each; a row's grid cell and validity are kept in shared memory.
 #extension GL_GOOGLE_include_directive : require
 #extension GL_EXT_control_flow_attributes : require
 
 layout(local_size_x_id = 0) in;
-layout(constant_id = 0) const uint kGroup = 256u;  // invocations per block (divides 1024)
-layout(constant_id = 1) const bool kFp16 = false;
+layout(constant_id = 0) const uint kGroup = 8u;  // invocations per block (divides 1024)
+layout(constant_id = 1) const bool kFp16 = false;   // features rounded to fp16 (the paper's storage)
 
 #include "fovea/shaders/recon_bindings.h"
 #include "fovea/shaders/hash.h"
@@ -38,87 +46,57 @@ layout(std430, binding = RECON_BMFR_EXCESS) writeonly buffer Excess { vec4 exces
 layout(push_constant) uniform Push { ReconBmfrPush pc; };
 
 const uint kRows = 1024u / kGroup;  // rows per invocation
-const uint kM = 10u;          // features
-const uint kCols = 13u;       // features + 3 colour channels
-const uint kVals = 14u;       // reduction width
-const float kOutlier = 8.0;   // inputs above this multiple of their block's mean are outliers
+const uint kM = 10u;                // features
+const uint kCols = 13u;             // features + 3 colour channels
+const uint kGram = 85u;             // Gram entries (k, j), k < kM, k <= j < kCols
+// Values reduced per round: the partial sums of a round fit in 24 KB of shared memory.
+const uint kChunk = kGroup * kGram <= 6144u ? kGram : 6144u / kGroup;
+const float kOutlier = 8.0;         // inputs above this multiple of their block's mean are outliers
+const float kPivot = 1e-5;          // smallest squared sine between a column and the span before it
+const uint kOutside = 0xFFFFFFFFu;  // s_cell: the row's cell is off the grid
+const uint kMasked = 0x80000000u;   // s_cell: a zero row (no sample, sky, emitter, no diffuse lobe)
 
-shared float s_partial[kVals][kGroup];
-shared float s_result[kVals];
-shared float s_rowk[2][kCols];
+// Row k and column j of each Gram entry, so the row update is one flat unrolled loop: with
+// nested k, j loops llvmpipe left the 85 sums partly dynamically indexed (3× the fit's time).
+const uint kGramK[kGram] = uint[kGram](
+    0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 1, 1, 1, 1, 1, 1, 1, 1, 1, 1, 1, 1, 2, 2, 2, 2, 2, 2, 2,
+    2, 2, 2, 2, 3, 3, 3, 3, 3, 3, 3, 3, 3, 3, 4, 4, 4, 4, 4, 4, 4, 4, 4, 5, 5, 5, 5, 5, 5, 5, 5, 6,
+    6, 6, 6, 6, 6, 6, 7, 7, 7, 7, 7, 7, 8, 8, 8, 8, 8, 9, 9, 9, 9);
+const uint kGramJ[kGram] = uint[kGram](
+    0, 1, 2, 3, 4, 5, 6, 7, 8, 9, 10, 11, 12, 1, 2, 3, 4, 5, 6, 7, 8, 9, 10, 11, 12, 2, 3, 4, 5, 6,
+    7, 8, 9, 10, 11, 12, 3, 4, 5, 6, 7, 8, 9, 10, 11, 12, 4, 5, 6, 7, 8, 9, 10, 11, 12, 5, 6, 7, 8,
+    9, 10, 11, 12, 6, 7, 8, 9, 10, 11, 12, 7, 8, 9, 10, 11, 12, 8, 9, 10, 11, 12, 9, 10, 11, 12);
+
+shared float s_partial[kChunk][kGroup];
+shared float s_result[kGram];
 shared float s_r[kM][kCols];
 shared float s_coef[3][kM];
+shared uint s_cell[1024];
 
-// The block's rows of [T + N | z], fp32 or fp16 pairs (kFp16); the unused one is dead code.
-float A[kRows][kCols];
-uint A16[kRows][(kCols + 1u) / 2u];
+// Index of Gram entry (k, j), j >= k, in row-major order of the upper rows.
+uint gram_index(uint k, uint j) { return k * kCols - (k * (k - 1u)) / 2u + (j - k); }
 
-float a_get(uint q, uint j) { return kFp16 ? unpackHalf2x16(A16[q][j >> 1u])[j & 1u] : A[q][j]; }
-
-void a_set(uint q, uint j, float v) {
-  if (kFp16) {
-    vec2 h = unpackHalf2x16(A16[q][j >> 1u]);
-    h[j & 1u] = v;
-    A16[q][j >> 1u] = packHalf2x16(h);
-  } else {
-    A[q][j] = v;
-  }
-}
-
-// Max (bit j of max_mask set) or sum (clear) of each of vals[0..n) over the workgroup; every
-// invocation gets the results. Each invocation stores its values, then invocation j folds
-// value j over the group serially: on lavapipe this beats subgroup reductions (which loop
-// over the lanes of every subgroup for every value) several times over.
-void reduce(inout float vals[kVals], uint n, uint max_mask) {
+// Max (bit j of max_mask set) or sum (clear) of each of vals[0..n) over the workgroup, in
+// rounds of kChunk values: each invocation stores its values, then invocation v folds value
+// v over the group serially (on lavapipe several times faster than subgroup reductions,
+// which loop over the lanes of every subgroup for every value). Results in s_result.
+void reduce(inout float vals[kGram], const uint n, const uint max_mask) {
   uint tid = gl_LocalInvocationIndex;
-  [[unroll]] for (uint j = 0u; j < n; ++j) s_partial[j][tid] = vals[j];
-  barrier();
-  if (tid < n) {
-    bool is_max = ((max_mask >> tid) & 1u) != 0u;
-    float acc = s_partial[tid][0];
-    for (uint g = 1u; g < kGroup; ++g) acc = is_max ? max(acc, s_partial[tid][g]) : acc + s_partial[tid][g];
-    s_result[tid] = acc;
+  for (uint base = 0u; base < n; base += kChunk) {
+    [[unroll]] for (uint j = 0u; j < n; ++j)
+      if (j >= base && j < base + kChunk) s_partial[j - base][tid] = vals[j];
+    barrier();
+    for (uint v = tid; v < kChunk && base + v < n; v += kGroup) {
+      bool is_max = base + v < 32u && ((max_mask >> (base + v)) & 1u) != 0u;
+      float acc = s_partial[v][0];
+      for (uint g = 1u; g < kGroup; ++g) acc = is_max ? max(acc, s_partial[v][g]) : acc + s_partial[v][g];
+      s_result[base + v] = acc;
+    }
+    barrier();
   }
-  barrier();
-  [[unroll]] for (uint j = 0u; j < n; ++j) vals[j] = s_result[j];
 }
 
-// Householder step on column k of the block (rows >= k): one reduction gives ‖x‖² and
-// every x·a_j; v = x − αe_k, so v·a_j = x·a_j − α a_j[k]; a_j −= 2(v·a_j)/(v·v) v. Row k of
-// R goes to s_r.
-void householder_column(const uint k) {
-  uint tid = gl_LocalInvocationIndex;
-  float vals[kVals];
-  [[unroll]] for (uint j = 0u; j < kVals; ++j) vals[j] = 0.0;
-  [[unroll]] for (uint q = 0u; q < kRows; ++q) {
-    uint row = tid + q * kGroup;
-    if (row >= k) {
-      float x = a_get(q, k);
-      [[unroll]] for (uint j = k; j < kCols; ++j) vals[j] += x * a_get(q, j);
-      if (row == k)
-        [[unroll]] for (uint j = 0u; j < kCols; ++j) s_rowk[k & 1u][j] = a_get(q, j);
-    }
-  }
-  reduce(vals, kCols, 0u);  // sums
-  float xk = s_rowk[k & 1u][k];
-  float norm = sqrt(max(vals[k], 0.0));
-  float alpha = xk > 0.0 ? -norm : norm;
-  float vtv = 2.0 * (vals[k] - alpha * xk);
-  float beta[kCols];
-  [[unroll]] for (uint j = 0u; j < kCols; ++j)
-    beta[j] = (j > k && vtv > 1e-30) ? 2.0 * (vals[j] - alpha * s_rowk[k & 1u][j]) / vtv : 0.0;
-  if (tid == 0u) {
-    [[unroll]] for (uint j = 0u; j < kCols; ++j)
-      s_r[k][j] = j < k ? 0.0 : (j == k ? (vtv > 1e-30 ? alpha : xk) : s_rowk[k & 1u][j] - beta[j] * (xk - alpha));
-  }
-  [[unroll]] for (uint q = 0u; q < kRows; ++q) {
-    uint row = tid + q * kGroup;
-    if (row >= k) {
-      float v = row == k ? xk - alpha : a_get(q, k);
-      [[unroll]] for (uint j = k + 1u; j < kCols; ++j) a_set(q, j, a_get(q, j) - beta[j] * v);
-    }
-  }
-}
+float to_storage(float v) { return kFp16 ? unpackHalf2x16(packHalf2x16(vec2(v, 0.0))).x : v; }
 
 // The grid cell of one of the block's rows. On polar grids φ is cyclic: the displaced block
 // rows v ∈ [−offset_y, padded_rows − offset_y) of column x take its rows modulo their count
@@ -147,55 +125,79 @@ bool has_diffuse(float code) {
 
 bool inside(ivec2 c) { return c.x >= 0 && c.y >= 0 && c.x < int(pc.padded_columns) && c.y < int(pc.padded_rows); }
 
+// Cholesky factor R of the block's Gram matrix (in s_result) into s_r, then back substitution
+// R α = r per channel (Eq. 5) into s_coef; one invocation. Dropped pivots (dependent
+// features the noise did not lift) leave a zero row and a zero coefficient.
+void solve() {
+  for (uint k = 0u; k < kM; ++k) {
+    float gkk = s_result[gram_index(k, k)];
+    float d = gkk;
+    for (uint i = 0u; i < k; ++i) d -= s_r[i][k] * s_r[i][k];
+    bool keep = gkk > 1e-30 && d > kPivot * gkk;
+    float rkk = keep ? sqrt(d) : 0.0;
+    s_r[k][k] = rkk;
+    for (uint j = k + 1u; j < kCols; ++j) {
+      float a = s_result[gram_index(k, j)];
+      for (uint i = 0u; i < k; ++i) a -= s_r[i][k] * s_r[i][j];
+      s_r[k][j] = keep ? a / rkk : 0.0;
+    }
+  }
+  for (uint c = 0u; c < 3u; ++c)
+    for (int k = int(kM) - 1; k >= 0; --k) {
+      float acc = s_r[k][kM + c];
+      for (uint j = uint(k) + 1u; j < kM; ++j) acc -= s_r[k][j] * s_coef[c][j];
+      float a = s_r[k][k] > 0.0 ? acc / s_r[k][k] : 0.0;
+      s_coef[c][k] = (isnan(a) || isinf(a)) ? 0.0 : a;
+    }
+}
+
 void main() {
   uint tid = gl_LocalInvocationIndex;
-  bool valid[kRows];
-  vec3 wpos[kRows], zin[kRows];
-  float vals[kVals];
+  float vals[kGram];
 
-  // One reduction over the valid rows: maxima of the position range (max of w and −w), of
-  // whether any row is valid and of the input; sums of the input (rgb) and of the rows.
-  [[unroll]] for (uint j = 0u; j < kVals; ++j) vals[j] = j < 8u ? -3.0e38 : 0.0;
-  [[unroll]] for (uint q = 0u; q < kRows; ++q) {
-    ivec2 c = cell_of(tid + q * kGroup);
-    valid[q] = false;
-    wpos[q] = vec3(0.0);
-    zin[q] = vec3(0.0);
+  // Pass 1, one reduction over the valid rows: maxima of the position range (max of w and
+  // −w), of whether any row is valid and of the input; sums of the input (rgb) and of the rows.
+  [[unroll]] for (uint j = 0u; j < kGram; ++j) vals[j] = j < 8u ? -3.0e38 : 0.0;
+  [[dont_unroll]] for (uint q = 0u; q < kRows; ++q) {
+    uint row = tid + q * kGroup;
+    ivec2 c = cell_of(row);
+    s_cell[row] = kOutside;
     if (!inside(c)) continue;
     uint i = uint(c.y) * pc.padded_columns + uint(c.x);
+    s_cell[row] = i | kMasked;
     vec4 p = vpos[i];
     if (p.w < 0.0 || !has_diffuse(p.w)) continue;  // sky, emitter, no sample, no diffuse lobe
-    valid[q] = true;
-    wpos[q] = p.xyz;
-    zin[q] = z[i].rgb;
+    s_cell[row] = i;
+    vec3 zin = z[i].rgb;
     [[unroll]] for (uint a = 0u; a < 3u; ++a) {
       vals[a] = max(vals[a], p[a]);
       vals[3u + a] = max(vals[3u + a], -p[a]);
     }
     vals[6] = 1.0;
-    vals[7] = max(vals[7], max(max(zin[q].r, zin[q].g), zin[q].b));
-    [[unroll]] for (uint a = 0u; a < 3u; ++a) vals[8u + a] += zin[q][a];
+    vals[7] = max(vals[7], max(max(zin.r, zin.g), zin.b));
+    [[unroll]] for (uint a = 0u; a < 3u; ++a) vals[8u + a] += zin[a];
     vals[11] += 1.0;
   }
   reduce(vals, 12u, 0xFFu);
-  vec3 wmax = vec3(vals[0], vals[1], vals[2]), wmin = -vec3(vals[3], vals[4], vals[5]);
+  vec3 wmax = vec3(s_result[0], s_result[1], s_result[2]), wmin = -vec3(s_result[3], s_result[4], s_result[5]);
+  float any_valid = s_result[6], count = max(s_result[11], 1.0);
   // Outliers stay out of the fit (deviation from Koskela): the regression sees the input
   // clamped to kOutlier × its block mean per channel, and each cell's excess goes to the
   // excess buffer, added back after Phase III (recon_post.comp): no energy is lost and none
   // is spread. A firefly (e.g. a caustic: floor → glossy sphere → light, 300× the mean at
   // 1 spp) otherwise lifts its whole block (docs/reconstruction.md, glossy-spheres).
-  vec3 bound = kOutlier * vec3(vals[8], vals[9], vals[10]) / max(vals[11], 1.0);
+  vec3 bound = kOutlier * vec3(s_result[8], s_result[9], s_result[10]) / count;
   // z enters the regression divided by its (clamped) block maximum (the fit is linear in z,
   // so the fitted values scale back): every column then stays within fp16 range.
-  float zmax = min(vals[7], max(max(bound.r, bound.g), bound.b));
+  float zmax = min(s_result[7], max(max(bound.r, bound.g), bound.b));
   zmax = zmax > 0.0 ? zmax : 1.0;
 
   // Blocks without a surface sample only pass sky through (uniform branch: no barrier inside).
-  if (vals[6] < 0.5) {
-    [[unroll]] for (uint q = 0u; q < kRows; ++q) {
-      ivec2 c = cell_of(tid + q * kGroup);
-      if (!inside(c)) continue;
-      uint i = uint(c.y) * pc.padded_columns + uint(c.x);
+  if (any_valid < 0.5) {
+    [[dont_unroll]] for (uint q = 0u; q < kRows; ++q) {
+      uint cell = s_cell[tid + q * kGroup];
+      if (cell == kOutside) continue;
+      uint i = cell & ~kMasked;
       fitted[i] = rg_no_sample(vpos[i].w) ? vec4(0.0) : z[i];
       excess[i] = vec4(0.0);
     }
@@ -206,74 +208,70 @@ void main() {
   vec3 half_range = 0.5 * (wmax - wmin);
   vec3 inv_half = vec3(half_range.x > 1e-6 ? 1.0 / half_range.x : 0.0, half_range.y > 1e-6 ? 1.0 / half_range.y : 0.0,
                        half_range.z > 1e-6 ? 1.0 / half_range.z : 0.0);
-  vec3 feat_n[kRows];
-  [[unroll]] for (uint q = 0u; q < kRows; ++q) {
+
+  // Pass 2: block means of the features n, w, w² (the shifts).
+  [[unroll]] for (uint j = 0u; j < kGram; ++j) vals[j] = 0.0;
+  [[dont_unroll]] for (uint q = 0u; q < kRows; ++q) {
+    uint cell = s_cell[tid + q * kGroup];
+    if (cell >= kMasked) continue;
+    vec3 n = vnrm[cell].xyz;
+    vec3 w = clamp((vpos[cell].xyz - mid) * inv_half, -1.0, 1.0);
+    [[unroll]] for (uint a = 0u; a < 3u; ++a) {
+      vals[a] += n[a];
+      vals[3u + a] += w[a];
+      vals[6u + a] += w[a] * w[a];
+    }
+  }
+  reduce(vals, 9u, 0u);
+  vec3 mean_n = vec3(s_result[0], s_result[1], s_result[2]) / count;
+  vec3 mean_w = vec3(s_result[3], s_result[4], s_result[5]) / count;
+  vec3 mean_w2 = vec3(s_result[6], s_result[7], s_result[8]) / count;
+
+  // Pass 3: the Gram matrix of [T + N | z], streamed row by row.
+  [[unroll]] for (uint j = 0u; j < kGram; ++j) vals[j] = 0.0;
+  [[dont_unroll]] for (uint q = 0u; q < kRows; ++q) {
     uint row = tid + q * kGroup;
-    [[unroll]] for (uint j = 0u; j < kCols; ++j) a_set(q, j, 0.0);
-    feat_n[q] = vec3(0.0);
-    if (!valid[q]) continue;
-    ivec2 c = cell_of(row);
-    uint i = uint(c.y) * pc.padded_columns + uint(c.x);
-    vec3 n = vnrm[i].xyz;
-    vec3 w = clamp((wpos[q] - mid) * inv_half, -1.0, 1.0);
-    feat_n[q] = n;
-    vec3 zz = min(zin[q], bound) / zmax;
-    float t[kCols] = float[kCols](1.0, n.x, n.y, n.z, w.x, w.y, w.z, w.x * w.x, w.y * w.y, w.z * w.z, zz.r, zz.g, zz.b);
+    uint cell = s_cell[row];
+    if (cell >= kMasked) continue;
+    vec3 n = vnrm[cell].xyz - mean_n;
+    vec3 w = clamp((vpos[cell].xyz - mid) * inv_half, -1.0, 1.0);
+    vec3 w2 = w * w - mean_w2;
+    w -= mean_w;
+    vec3 zz = min(z[cell].rgb, bound) / zmax;
+    float t[kCols] = float[kCols](1.0, n.x, n.y, n.z, w.x, w.y, w.z, w2.x, w2.y, w2.z, zz.r, zz.g, zz.b);
     // Eq. 7: zero-mean uniform noise on the non-constant features, keyed by block, row, feature, frame.
-    [[unroll]] for (uint j = 0u; j < kCols; ++j) {
+    [[unroll]] for (uint j = 1u; j < kCols; ++j) {
       float noise = 0.0;
-      if (j >= 1u && j < kM)
-        noise = pc.noise * (2.0 * hash_to_unit(hash3(gl_WorkGroupID.x * 1024u + row, j, pc.frame)) - 1.0);
-      a_set(q, j, t[j] + noise);
+      if (j < kM) noise = pc.noise * (2.0 * hash_to_unit(hash3(gl_WorkGroupID.x * 1024u + row, j, pc.frame)) - 1.0);
+      t[j] = to_storage(t[j] + noise);
     }
+    [[unroll]] for (uint e = 0u; e < kGram; ++e) vals[e] += t[kGramK[e]] * t[kGramJ[e]];
   }
-
-  // Householder QR, one call per column: after inlining every index into A is a constant
-  // (llvmpipe turns dynamically indexed private arrays into per-lane memory traffic).
-  householder_column(0u);
-  householder_column(1u);
-  householder_column(2u);
-  householder_column(3u);
-  householder_column(4u);
-  householder_column(5u);
-  householder_column(6u);
-  householder_column(7u);
-  householder_column(8u);
-  householder_column(9u);
+  reduce(vals, kGram, 0u);
+  if (tid == 0u) solve();
   barrier();
 
-  // Back substitution (Eq. 5), one invocation per channel. Near-zero pivots (dependent
-  // features the noise did not lift) get a zero coefficient instead of a division.
-  if (tid < 3u) {
-    float diag_max = 0.0;
-    [[unroll]] for (uint k = 0u; k < kM; ++k) diag_max = max(diag_max, abs(s_r[k][k]));
-    [[unroll]] for (int k = int(kM) - 1; k >= 0; --k) {
-      float acc = s_r[k][kM + tid];
-      [[unroll]] for (uint j = uint(k) + 1u; j < kM; ++j) acc -= s_r[k][j] * s_coef[tid][j];
-      float d = s_r[k][k];
-      float a = abs(d) > 1e-5 * diag_max && abs(d) > 1e-12 ? acc / d : 0.0;
-      s_coef[tid][k] = (isnan(a) || isinf(a)) ? 0.0 : a;
-    }
-  }
-  barrier();
-
-  // Weighted sum with the noise-free (scaled) features (Eq. 6); negative fits clamp to 0.
-  [[unroll]] for (uint q = 0u; q < kRows; ++q) {
-    ivec2 c = cell_of(tid + q * kGroup);
-    if (!inside(c)) continue;
-    uint i = uint(c.y) * pc.padded_columns + uint(c.x);
-    excess[i] = vec4(valid[q] ? max(zin[q] - bound, vec3(0.0)) : vec3(0.0), 0.0);
-    if (!valid[q]) {
-      fitted[i] = rg_no_sample(vpos[i].w) ? vec4(0.0) : z[i];
+  // Pass 4: weighted sum with the noise-free (shifted) features (Eq. 6); negative fits clamp to 0.
+  [[dont_unroll]] for (uint q = 0u; q < kRows; ++q) {
+    uint cell = s_cell[tid + q * kGroup];
+    if (cell == kOutside) continue;
+    uint i = cell & ~kMasked;
+    vec4 zi = z[i];
+    if (cell >= kMasked) {
+      fitted[i] = rg_no_sample(vpos[i].w) ? vec4(0.0) : zi;
+      excess[i] = vec4(0.0);
       continue;
     }
-    vec3 n = feat_n[q];
-    vec3 w = clamp((wpos[q] - mid) * inv_half, -1.0, 1.0);
-    float t[kM] = float[kM](1.0, n.x, n.y, n.z, w.x, w.y, w.z, w.x * w.x, w.y * w.y, w.z * w.z);
+    excess[i] = vec4(max(zi.rgb - bound, vec3(0.0)), 0.0);
+    vec3 n = vnrm[i].xyz - mean_n;
+    vec3 w = clamp((vpos[i].xyz - mid) * inv_half, -1.0, 1.0);
+    vec3 w2 = w * w - mean_w2;
+    w -= mean_w;
+    float t[kM] = float[kM](1.0, n.x, n.y, n.z, w.x, w.y, w.z, w2.x, w2.y, w2.z);
     vec3 y = vec3(0.0);
     [[unroll]] for (uint m = 0u; m < kM; ++m) y += vec3(s_coef[0][m], s_coef[1][m], s_coef[2][m]) * t[m];
     y = clamp(y * zmax, vec3(0.0), vec3(1e9));
     // .w: the samples behind the input (its count), Phase III's weight for this fit.
-    fitted[i] = vec4(isnan(y.r) || isnan(y.g) || isnan(y.b) ? vec3(0.0) : y, z[i].w);
+    fitted[i] = vec4(isnan(y.r) || isnan(y.g) || isnan(y.b) ? vec3(0.0) : y, zi.w);
   }
 }

@@ -50,10 +50,11 @@ void main() {
   }
   ReconGrid m = maps[kReconCurrent];
   vec3 lo = vec3(3.0e38), hi = vec3(-3.0e38);
+  RgCell cell = rg_cell(m, i);
   for (int dc = -1; dc <= 1; ++dc)
     for (int dr = -1; dr <= 1; ++dr) {
       uint j;
-      if (!rg_neighbour(m, i, dc, dr, j) || rg_no_sample(vpos[j].w)) continue;
+      if (!rg_neighbour_of(m, cell, dc, dr, j) || rg_no_sample(vpos[j].w)) continue;
       vec3 y = to_ycocg(remodulated(j));
       lo = min(lo, y);
       hi = max(hi, y);

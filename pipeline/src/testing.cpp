@@ -98,20 +98,26 @@ std::vector<glm::vec4> blur_grid(FramePipeline& pipeline, core::Eye eye, const s
   return out;
 }
 
+namespace {
+// One submission holding what `record` records: its GPU time (timestamps) and the process's CPU time.
+template <class Impl, class Record>
+KernelTime time_submission(Impl& m, Record&& record) {
+  KernelTime t;
+  const double cpu0 = process_cpu_ms();
+  m.ctx.submit_and_wait([&](VkCommandBuffer cmd) {
+    m.timer.begin(cmd);
+    record(cmd);
+    m.timer.stage(cmd, "kernel");
+  });
+  t.cpu_ms = process_cpu_ms() - cpu0;
+  if (const auto stages = m.timer.read()) t.gpu_ms = double(stages->front().duration_ns()) * 1e-6;
+  return t;
+}
+}  // namespace
+
 ResolveKernelTimes time_resolve(FramePipeline& pipeline, bool blur) {
   auto& m = Access::impl(pipeline);
-  const auto time = [&](auto&& record) {
-    KernelTime t;
-    const double cpu0 = process_cpu_ms();
-    m.ctx.submit_and_wait([&](VkCommandBuffer cmd) {
-      m.timer.begin(cmd);
-      record(cmd);
-      m.timer.stage(cmd, "kernel");
-    });
-    t.cpu_ms = process_cpu_ms() - cpu0;
-    if (const auto stages = m.timer.read()) t.gpu_ms = double(stages->front().duration_ns()) * 1e-6;
-    return t;
-  };
+  const auto time = [&](auto&& record) { return time_submission(m, record); };
   ResolveKernelTimes t;
   t.copy = time([&](VkCommandBuffer cmd) {
     std::vector<const gpu::Buffer*> finals;
@@ -124,6 +130,33 @@ ResolveKernelTimes time_resolve(FramePipeline& pipeline, bool blur) {
   t.resample = time([&](VkCommandBuffer cmd) { m.resolve->record_resample(cmd, m.parity); });
   if (blur) t.blur = time([&](VkCommandBuffer cmd) { m.resolve->record_blur(cmd, m.settings); });
   t.blur.gpu_ms += grid_blur.gpu_ms, t.blur.cpu_ms += grid_blur.cpu_ms;
+  return t;
+}
+
+ReconKernelTimes time_reconstruct(FramePipeline& pipeline, std::uint32_t frame) {
+  auto& m = Access::impl(pipeline);
+  if (m.frames_done == 0) throw core::InputError("time_reconstruct: no frame rendered yet");
+  const auto time = [&](auto&& record) { return time_submission(m, record); };
+  const int p = m.parity;
+  const bool history = m.frames_done > 1;
+  const bool stereo = m.eyes.size() == 2;
+  const bool fresh[2] = {true, true};
+  m.write_mappings();
+  ReconKernelTimes t;
+  t.accumulate = time([&](VkCommandBuffer cmd) {
+    m.accumulation->record(cmd, p, history, std::span(fresh, m.eyes.size()), m.settings);
+  });
+  t.share = time([&](VkCommandBuffer cmd) {
+    m.gather->record(cmd, p, stereo && m.settings.share != reconstruct::StereoShare::Off, m.settings);
+  });
+  if (m.bmfr)
+    t.fit = time([&](VkCommandBuffer cmd) {
+      m.bmfr->record(cmd, p, frame,
+                     m.settings.block_offsets ? reconstruct::bmfr_block_offset(frame) : glm::ivec2(0),
+                     m.settings.noise);
+    });
+  t.post = time([&](VkCommandBuffer cmd) { m.post->record_post(cmd, p, history, m.settings); });
+  t.taa = time([&](VkCommandBuffer cmd) { m.post->record_taa(cmd, p, history, m.settings); });
   return t;
 }
 

@@ -37,14 +37,28 @@ PostTaa::PostTaa(gpu::Context& ctx, std::span<const EyeGrid> eyes, const Accumul
   }
 }
 
+namespace {
+shaders::ReconPostPush post_push(bool history, const ReconSettings& s) {
+  return {0, history ? 1u : 0u, s.denoiser == Denoiser::Bmfr ? 1u : 0u, 0, s.post_alpha_min, s.taa_alpha, 0, 0};
+}
+}  // namespace
+
 void PostTaa::record(VkCommandBuffer cmd, int parity, bool history, const ReconSettings& s) const {
-  const bool bmfr = s.denoiser == Denoiser::Bmfr;
-  shaders::ReconPostPush push{0, history ? 1u : 0u, bmfr ? 1u : 0u, 0, s.post_alpha_min, s.taa_alpha, 0, 0};
+  record_post(cmd, parity, history, s);
+  record_taa(cmd, parity, history, s);
+}
+
+void PostTaa::record_post(VkCommandBuffer cmd, int parity, bool history, const ReconSettings& s) const {
+  shaders::ReconPostPush push = post_push(history, s);
   for (const Eye& e : eyes_) {
     push.cells = e.cells;
     post_.run(cmd, {&e.post_set[parity]}, push, e.cells);
   }
   gpu::compute_to_compute(cmd);
+}
+
+void PostTaa::record_taa(VkCommandBuffer cmd, int parity, bool history, const ReconSettings& s) const {
+  shaders::ReconPostPush push = post_push(history, s);
   for (const Eye& e : eyes_) {
     push.cells = e.cells;
     taa_.run(cmd, {&e.taa_set[parity]}, push, e.cells);

@@ -60,4 +60,12 @@ struct ResolveKernelTimes {
 };
 ResolveKernelTimes time_resolve(FramePipeline& p, bool blur);
 
+// Reconstructing the last frame again the same way, one submission per pass (Phase I
+// accumulation, stereo gather, BMFR fit — zero without BMFR —, Phase III, TAA), both eyes;
+// the history is the one the last frame read. For the BMFR chain benchmark.
+struct ReconKernelTimes {
+  KernelTime accumulate, share, fit, post, taa;
+};
+ReconKernelTimes time_reconstruct(FramePipeline& p, std::uint32_t frame);
+
 }  // namespace fovea::pipeline::testing

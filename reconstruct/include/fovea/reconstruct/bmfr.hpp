@@ -1,8 +1,9 @@
 #pragma once
 // BMFR Phase II on the GPU (shaders/recon_bmfr_fit.comp): per 32×32 block of a padded grid,
-// the regression of the demodulated input z on the features [1, n, w, w²] and the weighted
-// sum. Inputs per cell (vec4): vpos (world position, .w material; < 0 = no surface),
-// vnrm (normal), z (rgb, .w sample count); outputs: fitted (rgb, .w = z's count) and excess
+// the regression of the demodulated input z on the features [1, n, w, w²] (least squares via
+// the Cholesky factor of the block's Gram matrix) and the weighted sum. Inputs per cell
+// (vec4): vpos (world position, .w material; < 0 = no surface), vnrm (normal), z (rgb, .w
+// sample count); outputs: fitted (rgb, .w = z's count) and excess
 // (rgb: the part of z above its block's outlier bound, which the fit did not see; the
 // estimate is fitted + excess). On polar grids the blocks wrap in φ:
 // rows are read modulo each column's row count (the grid's column table). Cells whose
@@ -27,16 +28,16 @@ struct BmfrGrid {
   std::uint32_t columns = 0;
 };
 
-// Storage of the block's regression matrix [T + N | z] during the QR: fp32, or fp16 (the
-// BMFR paper's temporary storage type; w is scaled to [−1, 1] before squaring, so no
-// feature exceeds the fp16 range). Arithmetic is fp32 in both.
+// Precision of the regression's features and input: fp32, or rounded to fp16 (the BMFR
+// paper's storage type for them; w is scaled to [−1, 1] before squaring and z by its block
+// maximum, so no value exceeds the fp16 range). Sums and the solve are fp32 in both.
 enum class BmfrPrecision { Fp32, Fp16 };
 
-inline constexpr std::uint32_t kBmfrDefaultWorkgroup = 256;
+inline constexpr std::uint32_t kBmfrDefaultWorkgroup = 8;
 
 struct BmfrOptions {
   BmfrPrecision precision = BmfrPrecision::Fp32;
-  std::uint32_t workgroup = 0;  // invocations per block: 8..512 dividing 1024 (shared memory); 0: default
+  std::uint32_t workgroup = 0;  // invocations per block: 8..512 dividing 1024; 0: default (8)
 };
 
 class BmfrFit {

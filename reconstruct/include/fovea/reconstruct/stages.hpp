@@ -105,6 +105,9 @@ class PostTaa {
   PostTaa(gpu::Context& ctx, std::span<const EyeGrid> eyes, const Accumulation& acc, const StereoGather& gather,
           const Bmfr* bmfr);
   void record(VkCommandBuffer cmd, int parity, bool history, const ReconSettings& settings) const;
+  // The two halves of record (Phase III, then TAA), each followed by its barrier; for timing.
+  void record_post(VkCommandBuffer cmd, int parity, bool history, const ReconSettings& settings) const;
+  void record_taa(VkCommandBuffer cmd, int parity, bool history, const ReconSettings& settings) const;
   void fill(VkCommandBuffer cmd, std::uint32_t word) const;
 
   // Remodulated output in grid space (.w = 1 where a sample exists).

@@ -209,21 +209,39 @@ void rg_taps(ReconGrid m, vec2 uv, out uvec4 idx, out vec4 w) {
   }
 }
 
-// Cell k of mapping m next to cell j: dc columns over (false beyond the grid), then dr rows
-// from the row at j's φ in that column (φ wraps on full rings; false beyond the raster or the
-// ends of a column packed to its visible arc).
-bool rg_neighbour(ReconGrid m, uint j, int dc, int dr, out uint k) {
-  k = j;
+// A cell of mapping m as its neighbourhood needs it: its column and the grid coordinate t
+// of its centre (computed once for the 3×3 neighbours: the index division and the φ of the
+// row were most of a neighbourhood's cost on lavapipe).
+struct RgCell {
+  uint col;
+  float t;
+};
+
+RgCell rg_cell(ReconGrid m, uint j) {
   uint pcols = m.g.padded_columns, col = j % pcols;
-  int cc = int(col) + dc;
+  return RgCell(col, rg_row_to_t(m, col, float(j / pcols) + 0.5));
+}
+
+// Cell k of mapping m next to cell c: dc columns over (false beyond the grid), then dr rows
+// from the row at c's φ in that column (φ wraps on full rings; false beyond the raster or the
+// ends of a column packed to its visible arc).
+bool rg_neighbour_of(ReconGrid m, RgCell c, int dc, int dr, out uint k) {
+  k = 0u;
+  int cc = int(c.col) + dc;
   if (cc < 0 || cc >= int(m.g.columns)) return false;
-  float t = rg_row_to_t(m, col, float(j / pcols) + 0.5);
   int rows = int(max(rg_rows(m, uint(cc)), 1u));
-  int rr = int(floor(rg_row_coord(m, uint(cc), t))) + dr;
+  int rr = int(floor(rg_row_coord(m, uint(cc), c.t))) + dr;
   if (rg_wraps(m, uint(cc))) rr = (rr % rows + rows) % rows;
   else if (rr < 0 || rr >= rows) return false;
-  k = uint(rr) * pcols + uint(cc);
+  k = uint(rr) * m.g.padded_columns + uint(cc);
   return true;
+}
+
+// The same next to cell j.
+bool rg_neighbour(ReconGrid m, uint j, int dc, int dr, out uint k) {
+  bool found = rg_neighbour_of(m, rg_cell(m, j), dc, dr, k);
+  if (!found) k = j;
+  return found;
 }
 
 // Where the centre of the current frame's cell `col` lies in mapping m, given the grid
