@@ -348,9 +348,9 @@ int run(std::vector<std::string> argv) {
                  {"seconds", seconds},
                  {"device", {{"name", ctx.info().name}, {"driver", ctx.info().driver}}}};
   char notebuf[256];
-  std::snprintf(notebuf, sizeof notebuf, "%s %.0f Hz, tracker %s %.0f Hz delay %.1f ms jitter %.1f ms, render %s",
-                display.name.c_str(), display.refresh_hz, tp.name.c_str(), tp.rate_hz, core::ns_to_ms(tp.delay_ns),
-                core::ns_to_ms(tp.jitter_ns), fixed_cost ? "fixed" : "measured");
+  std::snprintf(notebuf, sizeof notebuf, "%s %.0f Hz, budget %.2f, tracker %s %.0f Hz delay %.1f ms jitter %.1f ms, render %s",
+                display.name.c_str(), display.refresh_hz, render_options.distribution.budget, tp.name.c_str(), tp.rate_hz,
+                core::ns_to_ms(tp.delay_ns), core::ns_to_ms(tp.jitter_ns), fixed_cost ? "fixed" : "measured");
   std::vector<std::string> plots = latency::write_plots(out.string(), sim.records, &sim, notebuf);
 
   // The comparisons replay the main run's costs frame by frame, so every run has the same

@@ -214,7 +214,7 @@ std::vector<std::string> write_sweep_plots(const std::string& dir, const std::ve
   c.series = {med, p95};
   save(dir, "sweep_error.png", c, written);
   sweep::Chart q;
-  q.title = "Injected latency vs fovea quality";
+  q.title = "Injected latency vs quality where the user looks, after saccades";
   q.note = note;
   q.x_label = "injected latency (ms)";
   q.y_label = "fovea PSNR, tone-mapped (dB)";
@@ -223,8 +223,8 @@ std::vector<std::string> write_sweep_plots(const std::string& dir, const std::ve
     if (!p.fovea_psnr_db) continue;
     ps.points.push_back({p.inject_ms, *p.fovea_psnr_db});
     fl.points.push_back({p.inject_ms, *p.fovea_hdr_flip});
-    ps.label = "PSNR within " + fmt(p.quality_radius_deg) + " deg of the true gaze at photon time, after saccades";
-    fl.label = "HDR-FLIP within " + fmt(p.quality_radius_deg) + " deg of the true gaze at photon time, after saccades";
+    ps.label = "PSNR, " + fmt(p.quality_radius_deg) + " deg around the true gaze";
+    fl.label = "HDR-FLIP, " + fmt(p.quality_radius_deg) + " deg around the true gaze";
   }
   if (!ps.points.empty()) {
     q.series = {ps};
