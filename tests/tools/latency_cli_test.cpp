@@ -58,6 +58,36 @@ TEST(LatencyCli, SimulationThenItsRecords) {
   fs::remove_all(again);
 }
 
+// Where the user looks after a saccade, a stale fovea leaves the periphery's sparse samples:
+// with strong foveation the quality within a few degrees of the true gaze at photon time is
+// lower with 100 ms injected than with none. A 128x144 panel with fove0's optics, 0.05 of its
+// pixels traced; the same frames and seeds at both points, so only the gaze differs. The
+// main run is not rendered (a fixed render time): the sweep renders what it scores.
+TEST(LatencyCli, QualityWhereTheUserLooksFallsWithInjectedLatency) {
+  const std::string dir = fovea::test::temp_dir("latency_quality");
+  std::ofstream(dir + "/panel.json") << R"({"name": "panel", "width": 128, "height": 144, "refresh_hz": 70,
+    "fov_deg": {"left": -50, "right": 50, "up": 53.28, "down": -53.28}})";
+  const auto r = run_fovea("latency --display " + dir + "/panel.json --seconds 1.2 --render-time 10ms --budget 0.05 "
+                           "--gaze 'synthetic:3?task=search&rate=1000&noise=0&dropouts=0' --inject-latency 0,50,100 "
+                           "--quality-at 0,100 --quality-frames 4 --quality-radius 4 --reference-spp 16 "
+                           "--reference-cache off --no-main-render --quiet --out " + dir + "/out");
+  ASSERT_EQ(r.status, 0) << r.err;
+  const auto j = nlohmann::json::parse(r.out);
+  ASSERT_EQ(j["sweep"].size(), 3u);
+  EXPECT_FALSE(j["sweep"][1].contains("fovea_quality"));  // not in --quality-at
+  const auto& q0 = j["sweep"][0]["fovea_quality"];
+  const auto& q100 = j["sweep"][2]["fovea_quality"];
+  ASSERT_GE(q0["saccades"].get<int>(), 1);
+  EXPECT_EQ(q0["frames"], q100["frames"]);
+  EXPECT_GT(q0["psnr_db"].get<double>(), q100["psnr_db"].get<double>());
+  EXPECT_LT(q0["hdr_flip"].get<double>(), q100["hdr_flip"].get<double>());
+  EXPECT_EQ(j["config"]["budget"].get<double>(), 0.05);
+  EXPECT_FALSE(j["render_cost"]["main_run_rendered"].get<bool>());
+  EXPECT_EQ(j["render_cost"]["measured_ms"]["n"], 0);
+  for (const char* f : {"sweep_quality.png", "sweep_flip.png"}) EXPECT_TRUE(fs::exists(fs::path(dir) / "out" / f)) << f;
+  fs::remove_all(dir);
+}
+
 TEST(LatencyCli, BadInputExitsTwoNamingIt) {
   const std::string dir = fovea::test::temp_dir("latency_bad");
   const std::string bad = dir + "/bad.jsonl";
@@ -74,6 +104,10 @@ TEST(LatencyCli, BadInputExitsTwoNamingIt) {
       {"latency --predict sideways", "--predict"},
       {"latency --scan-out diagonal", "diagonal"},
       {"latency --gaze 'synthetic:1?tracker=fove0'", "--tracker-delay"},
+      {"latency --inject-latency 0,50 --quality-at 25", "--quality-at"},
+      {"latency --quality-radius 0", "--quality-radius"},
+      {"latency --budget 2", "--budget"},
+      {"latency --no-main-render", "--no-main-render"},
   };
   for (const auto& c : cases) {
     const auto r = run_fovea(c.args + " --out " + dir + "/out");

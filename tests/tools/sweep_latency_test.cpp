@@ -94,10 +94,10 @@ TEST(SweepLatency, PlanRefusesKeysTheCommandDoesNotHave) {
     }
     return std::string("no error");
   };
-  json budget = latency_part();
-  budget["budget"] = 0.3;  // a render option, not a latency one
-  EXPECT_NE(error(budget).find("bad.json: key \"budget\": unknown key"), std::string::npos) << error(budget);
-  EXPECT_NE(error(budget).find("`fovea latency` option"), std::string::npos);
+  json render_only = latency_part();
+  render_only["distribution"] = "cartesian-uniform";  // a render option, not a latency one
+  EXPECT_NE(error(render_only).find("bad.json: key \"distribution\": unknown key"), std::string::npos) << error(render_only);
+  EXPECT_NE(error(render_only).find("`fovea latency` option"), std::string::npos);
   EXPECT_NE(error(json::parse(R"({"command": "replay"})")).find("key \"command\""), std::string::npos);
   EXPECT_NE(error(json::parse(R"({"command": ["latency", "render"]})")).find("one command name"), std::string::npos);
   // Through the program: the real `fovea latency --help` options.
@@ -106,10 +106,10 @@ TEST(SweepLatency, PlanRefusesKeysTheCommandDoesNotHave) {
   const auto ok = test::run_fovea("sweep plan " + dir + "/s.json --out " + dir + "/plan.jsonl");
   ASSERT_EQ(ok.status, 0) << ok.err;
   EXPECT_EQ(json::parse(ok.out)["jobs"], 6);
-  core::write_file_atomic(dir + "/bad.json", budget.dump());
+  core::write_file_atomic(dir + "/bad.json", render_only.dump());
   const auto bad = test::run_fovea("sweep plan " + dir + "/bad.json --out " + dir + "/plan.jsonl");
   EXPECT_EQ(bad.status, 2);
-  EXPECT_NE(bad.err.find("\"budget\""), std::string::npos) << bad.err;
+  EXPECT_NE(bad.err.find("\"distribution\""), std::string::npos) << bad.err;
   fs::remove_all(dir);
 }
 

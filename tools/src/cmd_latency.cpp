@@ -17,10 +17,10 @@
 #include "fovea/core/error.hpp"
 #include "fovea/core/image.hpp"
 #include "fovea/core/metrics.hpp"
-#include "fovea/renderer/reference.hpp"
 #include "fovea/renderer/scene_io.hpp"
 #include "fovea/xrcommon/timing_writer.hpp"
 #include "latency/analysis.hpp"
+#include "reference_cache.hpp"
 #include "render_setup.hpp"
 
 namespace fovea::tools {
@@ -52,14 +52,17 @@ Prints the summary JSON on stdout; writes into --out:
   stages.png           CDFs of each stage's CPU and GPU time
   foveal_error.png     foveal error at photon time over time, saccade onsets marked
   sweep_error.png      injected latency vs foveal error (median, p95)
-  sweep_quality.png    injected latency vs tone-mapped PSNR and LDR-FLIP in the fovea
-                       after saccades (--quality-frames > 0)
+  sweep_quality.png    injected latency vs tone-mapped PSNR where the user looks after
+                       saccades (--quality-frames > 0)
+  sweep_flip.png       the same with HDR-FLIP
 
   --scene S             cornell | furnace | glossy-spheres | stereo-occluders | default,
                         or a .gltf/.glb/.obj file [default]
   --display NAME|FILE   display preset or JSON: raster, FOV, refresh [small]
   --gaze SRC            the true eye: recording or synthetic:<seed>[?...] (docs/gaze.md)
                         [synthetic:1?task=search&rate=1000&noise=0&dropouts=0]
+  --budget B            grid samples as a fraction of display pixels: the foveation's
+                        strength (visual-polar; docs/visual-polar.md) [0.39]
   --tracker PRESET      eye-tracker model preset: fove0 | ideal [fove0]
   --tracker-delay T     delay from measurement to delivery [preset's]
   --jitter T            extra delivery delay, uniform in [0, T] [preset's]
@@ -70,6 +73,9 @@ Prints the summary JSON on stdout; writes into --out:
   --seconds S           scenario length [2]
   --render-time T       fixed render cost per frame instead of the measured CPU time
                         (reproducible runs); the pipeline still renders every frame
+  --no-main-render      with --render-time: the main run's frames are not rendered (its
+                        records have no stage times; the comparisons and the sweep are the
+                        same), for a quality sweep alone at a display where frames are dear
   --scan-out M          global | rolling [global]
   --persistence T       how long a row stays lit [0]
   --inject-latency LIST injected latencies for the sweep, e.g. 0,25ms,50,100 ("none": no
@@ -77,7 +83,13 @@ Prints the summary JSON on stdout; writes into --out:
   --quality-frames N    fovea quality of each sweep point at the N frames shown after the
                         end of every saccade of at least 5 deg, each rendered from 3 frames
                         before its onset on (0: no quality) [8]
-  --reference-spp N     samples per pixel of the quality reference [64]
+  --quality-at LIST     the injected latencies whose quality is measured, a subset of
+                        --inject-latency ("all") [all]
+  --quality-radius DEG  quality within this angle of the true gaze at photon time [2.5]
+  --reference-spp N     at most N samples per pixel of the converged reference [64]
+  --reference-error X   stop the reference at this per-pixel relative standard error [0.02]
+  --reference-cache DIR|off  where references are cached, shared with `fovea render` and
+                        `fovea reference` [$XDG_CACHE_HOME/fovea/references]
   --records FILE        analyse timing records instead of simulating
   --out DIR             output directory [out/latency]
   --quiet               no progress on stderr
@@ -130,18 +142,20 @@ int run_records(const Args& args, const fs::path& out) {
   return 0;
 }
 
-// Fovea quality after saccades, of frames rendered for `sim`'s gaze: for every saccade of at
-// least 5 deg the pipeline renders from `warm` frames before its onset on (from a reset
-// history) and scores the `count` frames shown first after its end, where latency decides
-// whether the fovea is there yet: tone-mapped PSNR and LDR-FLIP within 2.5 deg of the true
-// gaze at photon time, against the converged reference (left eye). Frame f is always
-// rendered with seed f, so sweep points differ by their gaze only, not by their noise.
+// The quality where the user looks after saccades, of frames rendered for `sim`'s gaze: for
+// every saccade of at least 5 deg the pipeline renders from `warm` frames before its onset
+// on (from a reset history) and scores the `count` frames shown first after its end, where
+// latency decides whether the fovea is there yet: tone-mapped PSNR, HDR-FLIP and LDR-FLIP
+// within `radius_deg` of the true gaze at the frame's photon time, against the converged
+// reference (left eye). Frame f is always rendered with seed f, so sweep points differ by
+// their gaze, not by their noise.
 struct Quality {
-  double psnr = 0, flip = 0;
+  double psnr = 0, hdr_flip = 0, ldr_flip = 0;
   int frames = 0, saccades = 0;
 };
 Quality fovea_quality(pipeline::FramePipeline& pipe, const std::array<core::Pose, 2>& poses,
-                      const latency::Simulation& sim, std::size_t count, std::size_t warm, const core::Image& reference) {
+                      const latency::Simulation& sim, std::size_t count, std::size_t warm, double radius_deg,
+                      const core::Image& reference) {
   Quality q;
   const core::View view = pipe.view(core::Eye::Left);
   const auto first_shown_from = [&](core::TimeNs t) {
@@ -161,16 +175,17 @@ Quality fovea_quality(pipeline::FramePipeline& pipe, const std::array<core::Pose
       if (f < landed || !truth) continue;
       const std::vector<float> ecc = core::eccentricity_map(view, *truth);
       std::vector<float> w(ecc.size());
-      for (std::size_t i = 0; i < ecc.size(); ++i) w[i] = ecc[i] <= 2.5f ? 1.0f : 0.0f;
+      for (std::size_t i = 0; i < ecc.size(); ++i) w[i] = ecc[i] <= radius_deg ? 1.0f : 0.0f;
       const double ppd = std::sqrt(view.pixels_per_deg2(*truth));
       const core::Scores sc = core::pool(core::error_maps(pipe.image(core::Eye::Left), reference, ppd), w);
       if (sc.weight <= 0) continue;  // the true gaze is off the view
       q.psnr += sc.psnr;
-      q.flip += sc.ldr_flip;
+      q.hdr_flip += sc.hdr_flip;
+      q.ldr_flip += sc.ldr_flip;
       ++q.frames;
     }
   }
-  if (q.frames) q.psnr /= q.frames, q.flip /= q.frames;
+  if (q.frames) q.psnr /= q.frames, q.hdr_flip /= q.frames, q.ldr_flip /= q.frames;
   return q;
 }
 
@@ -190,10 +205,11 @@ int run(std::vector<std::string> argv) {
     }
   const std::vector<std::string> sim_options{"scene", "display", "gaze", "tracker", "tracker-delay", "jitter", "rate",
                                              "predict", "seconds", "render-time", "scan-out", "persistence",
-                                             "inject-latency", "quality-frames", "reference-spp"};
+                                             "inject-latency", "quality-frames", "reference-spp", "budget",
+                                             "quality-at", "quality-radius", "reference-error", "reference-cache"};
   std::vector<std::string> valued = sim_options;
   valued.insert(valued.end(), {"records", "out"});
-  const Args args(argv, valued, {"quiet"});
+  const Args args(argv, valued, {"quiet", "no-main-render"});
   const fs::path out(args.str("out", "out/latency"));
   if (args.has("records")) {
     for (const auto& o : sim_options)
@@ -219,6 +235,8 @@ int run(std::vector<std::string> argv) {
   if (args.has("rate")) tracker.rate_hz = args.num("rate", 0);
   std::optional<core::TimeNs> fixed_cost;
   if (auto t = args.opt("render-time")) fixed_cost = core::parse_duration_ns(*t, "--render-time");
+  const bool main_render = !args.has("no-main-render");
+  if (!main_render && !fixed_cost) throw core::InputError("--no-main-render needs --render-time: the cost of a frame not rendered is unknown");
   latency::Scenario sc;
   sc.display.refresh_hz = display.refresh_hz;
   sc.display.scan_out = xrcommon::parse_scan_out(args.str("scan-out", "global"));
@@ -230,6 +248,27 @@ int run(std::vector<std::string> argv) {
   if (quality_frames < 0 || quality_frames > 1000) throw core::InputError("--quality-frames must be in 0..1000");
   const long ref_spp = args.integer("reference-spp", 64);
   if (ref_spp < 1 || ref_spp > 65536) throw core::InputError("--reference-spp must be in 1..65536");
+  const double ref_error = args.num("reference-error", 0.02);
+  if (!(ref_error >= 0) || !std::isfinite(ref_error)) throw core::InputError("--reference-error must be >= 0");
+  const auto cache_opt = args.opt("reference-cache");
+  const std::string ref_cache = reference_cache_arg(cache_opt ? &*cache_opt : nullptr);
+  const double radius = args.num("quality-radius", 2.5);
+  if (!(radius > 0 && radius <= 90)) throw core::InputError("--quality-radius must be in (0, 90] degrees");
+  // The points whose quality is rendered: each costs its frames again on the device.
+  std::vector<core::TimeNs> quality_at = injected;
+  if (const auto q = args.opt("quality-at"); q && *q != "all") {
+    quality_at = parse_latency_list(*q);
+    for (core::TimeNs t : quality_at)
+      if (std::find(injected.begin(), injected.end(), t) == injected.end())
+        throw core::InputError("--quality-at: " + std::to_string(core::ns_to_ms(t)) + " ms is not in --inject-latency");
+  }
+  RenderSetupOptions render_options;
+  render_options.distribution.budget = args.num("budget", render_options.distribution.budget);
+  try {
+    render_options.distribution.validate();
+  } catch (const core::InputError& e) {
+    throw core::InputError(std::string("--") + e.what());  // "--budget: must be in ..."
+  }
   const std::string gaze_uri = args.str("gaze", kDefaultGaze);
   devices::SourceOptions so;
   so.display = display;
@@ -241,7 +280,7 @@ int run(std::vector<std::string> argv) {
   for (const auto& w : scene.warnings) std::cerr << "warning: " << w << "\n";
   fs::create_directories(out);
   // The defaults of `fovea render`: distribution, reconstruction, tracing, the hidden area culled.
-  RenderSetup setup(scene, display, {});
+  RenderSetup setup(scene, display, render_options);
   gpu::Context& ctx = setup.ctx;
   const std::array<core::Pose, 2>& poses = setup.poses;
   pipeline::FramePipeline& pipe = setup.pipeline;
@@ -251,8 +290,13 @@ int run(std::vector<std::string> argv) {
   std::vector<core::TimeNs> measured;  // the cost each frame was given
   std::vector<double> pipeline_ms;     // what each frame took here
   const latency::RenderFn render = [&](std::int64_t f, const std::array<glm::dvec3, 2>& gaze) {
-    const pipeline::FrameTimes t = pipe.render(poses, gaze, std::uint32_t(f));
     latency::FrameWork w;
+    if (!main_render) {
+      w.cost_ns = *fixed_cost;
+      measured.push_back(w.cost_ns);
+      return w;
+    }
+    const pipeline::FrameTimes t = pipe.render(poses, gaze, std::uint32_t(f));
     w.cost_ns = fixed_cost ? *fixed_cost : core::ms_to_ns(t.cpu_ms());
     measured.push_back(w.cost_ns);
     pipeline_ms.push_back(t.cpu_ms());
@@ -286,6 +330,7 @@ int run(std::vector<std::string> argv) {
   j["render_cost"] = {{"source", fixed_cost ? "fixed" : "measured"},
                       {"ms", latency::to_json(cost)},
                       {"measured_ms", latency::to_json(took)},
+                      {"main_run_rendered", main_render},
                       {"note", cost_text}};
   const devices::TrackerParams& tp = model->params();
   j["config"] = {{"scene", args.str("scene", "default")},
@@ -299,12 +344,13 @@ int run(std::vector<std::string> argv) {
                               {"jitter_ms", core::ns_to_ms(tp.jitter_ns)}, {"noise_deg", tp.noise_deg},
                               {"dropout", tp.dropout}}},
                  {"predict", predict},
+                 {"budget", render_options.distribution.budget},
                  {"seconds", seconds},
                  {"device", {{"name", ctx.info().name}, {"driver", ctx.info().driver}}}};
   char notebuf[256];
-  std::snprintf(notebuf, sizeof notebuf, "%s %.0f Hz, tracker %s %.0f Hz delay %.1f ms jitter %.1f ms, render %s",
-                display.name.c_str(), display.refresh_hz, tp.name.c_str(), tp.rate_hz, core::ns_to_ms(tp.delay_ns),
-                core::ns_to_ms(tp.jitter_ns), fixed_cost ? "fixed" : "measured");
+  std::snprintf(notebuf, sizeof notebuf, "%s %.0f Hz, budget %.2f, tracker %s %.0f Hz delay %.1f ms jitter %.1f ms, render %s",
+                display.name.c_str(), display.refresh_hz, render_options.distribution.budget, tp.name.c_str(), tp.rate_hz,
+                core::ns_to_ms(tp.delay_ns), core::ns_to_ms(tp.jitter_ns), fixed_cost ? "fixed" : "measured");
   std::vector<std::string> plots = latency::write_plots(out.string(), sim.records, &sim, notebuf);
 
   // The comparisons replay the main run's costs frame by frame, so every run has the same
@@ -329,12 +375,19 @@ int run(std::vector<std::string> argv) {
   if (!injected.empty()) {
     std::optional<core::Image> reference;
     const std::size_t warm = 3;
-    if (quality_frames > 0) {
-      renderer::ReferenceOptions o;
-      o.path.spp = std::uint32_t(std::min<long>(ref_spp, 16));
-      o.max_spp = std::uint32_t(ref_spp);
-      if (!quiet) std::fprintf(stderr, "reference, %ld spp...\n", ref_spp);
-      reference = renderer::render_reference(ctx, setup.gpu_scene, pipe.view(core::Eye::Left), core::Eye::Left, o).image;
+    if (quality_frames > 0 && !quality_at.empty()) {
+      ReferenceRequest req;
+      req.scene = args.str("scene", "default");
+      req.settings.max_spp = std::uint32_t(ref_spp);
+      req.settings.until_pixel_rel_error = ref_error;
+      req.cache_dir = ref_cache;
+      if (!quiet) std::fprintf(stderr, "reference, up to %ld spp...\n", ref_spp);
+      CachedReference ref = cached_reference(ctx, setup.gpu_scene, pipe.view(core::Eye::Left), core::Eye::Left, req);
+      j["quality_reference"] = {{"spp", ref.result.spp},
+                                {"pixel_rel_error", ref.result.pixel_rel_error},
+                                {"key", ref.key},
+                                {"from_cache", ref.from_cache}};
+      reference = std::move(ref.result.image);
     }
     std::vector<latency::SweepPoint> points;
     nlohmann::json sweep = nlohmann::json::array();
@@ -355,13 +408,15 @@ int run(std::vector<std::string> argv) {
                            {"foveal_error_deg", p.error},
                            {"recovery_ms_median", p.recovery_median_ms},
                            {"saccades_recovered", p.recovered}};
-      if (reference) {
+      if (reference && std::find(quality_at.begin(), quality_at.end(), inj) != quality_at.end()) {
         if (!quiet) std::fprintf(stderr, "quality at +%.0f ms...\n", p.inject_ms);
-        const Quality q = fovea_quality(pipe, poses, s, std::size_t(quality_frames), warm, *reference);
+        const Quality q = fovea_quality(pipe, poses, s, std::size_t(quality_frames), warm, radius, *reference);
         if (q.frames) {
           p.fovea_psnr_db = q.psnr;
-          p.fovea_flip = q.flip;
-          pj["fovea_quality"] = {{"psnr_db", q.psnr}, {"ldr_flip", q.flip}, {"frames", q.frames}, {"saccades", q.saccades}};
+          p.fovea_hdr_flip = q.hdr_flip;
+          p.quality_radius_deg = radius;
+          pj["fovea_quality"] = {{"psnr_db", q.psnr},      {"hdr_flip", q.hdr_flip}, {"ldr_flip", q.ldr_flip},
+                                 {"radius_deg", radius}, {"frames", q.frames},     {"saccades", q.saccades}};
         }
       }
       points.push_back(p);

@@ -214,16 +214,24 @@ std::vector<std::string> write_sweep_plots(const std::string& dir, const std::ve
   c.series = {med, p95};
   save(dir, "sweep_error.png", c, written);
   sweep::Chart q;
-  q.title = "Injected latency vs fovea quality";
+  q.title = "Injected latency vs quality where the user looks, after saccades";
   q.note = note;
   q.x_label = "injected latency (ms)";
   q.y_label = "fovea PSNR, tone-mapped (dB)";
-  sweep::Series ps{"fovea PSNR (2.5 deg around the true gaze)", sweep::palette(0), {}, true, true, {}};
-  for (const SweepPoint& p : points)
-    if (p.fovea_psnr_db) ps.points.push_back({p.inject_ms, *p.fovea_psnr_db});
+  sweep::Series ps{"", sweep::palette(0), {}, true, true, {}}, fl{"", sweep::palette(1), {}, true, true, {}};
+  for (const SweepPoint& p : points) {
+    if (!p.fovea_psnr_db) continue;
+    ps.points.push_back({p.inject_ms, *p.fovea_psnr_db});
+    fl.points.push_back({p.inject_ms, *p.fovea_hdr_flip});
+    ps.label = "PSNR, " + fmt(p.quality_radius_deg) + " deg around the true gaze";
+    fl.label = "HDR-FLIP, " + fmt(p.quality_radius_deg) + " deg around the true gaze";
+  }
   if (!ps.points.empty()) {
     q.series = {ps};
     save(dir, "sweep_quality.png", q, written);
+    q.y_label = "fovea HDR-FLIP (lower is better)";
+    q.series = {fl};
+    save(dir, "sweep_flip.png", q, written);
   }
   return written;
 }

@@ -49,9 +49,12 @@ struct SweepPoint {
   double gaze_to_photon_median_ms = 0;
   double recovery_median_ms = 0;
   std::size_t recovered = 0;
-  std::optional<double> fovea_psnr_db, fovea_flip;  // quality against the reference at the true gaze
+  // Quality against the converged reference within quality_radius_deg of the true gaze.
+  std::optional<double> fovea_psnr_db, fovea_hdr_flip;
+  double quality_radius_deg = 0;
 };
-// sweep_error.png (foveal error vs injected latency) and, with quality, sweep_quality.png.
+// sweep_error.png (foveal error vs injected latency) and, with quality, sweep_quality.png
+// (tone-mapped PSNR) and sweep_flip.png (HDR-FLIP).
 std::vector<std::string> write_sweep_plots(const std::string& dir, const std::vector<SweepPoint>& points,
                                            const std::string& note);
 
