@@ -4,10 +4,11 @@
 // block to [−1, 1] before squaring (so w² cannot overflow whatever the scene's units),
 // uniform ±ε noise on the non-constant features (Eq. 7), the least-squares fit of
 // z_r z_g z_b on T + N (Eq. 5) and the weighted sum with the noise-free features (Eq. 6).
-// Cells without a surface sample (clipped, off-screen, padding, sky), emitters and surfaces
-// without a diffuse lobe (metals) are zero rows: masked out of the regression, they keep
-// their accumulated input. A metal's indirect diffuse is zero by construction; fitted with
-// its block's diffuse neighbours it took their light (docs/reconstruction.md, glossy-spheres).
+// Cells without a surface sample (clipped, off-screen, padding, sky), emitters, surfaces
+// without a diffuse lobe (metals) and cells straddling a surface edge are zero rows: masked
+// out of the regression, they keep their accumulated input. A metal's indirect diffuse is
+// zero by construction; fitted with its block's diffuse neighbours it took their light
+// (docs/reconstruction.md, glossy-spheres).
 //
 // The R of the QR of [T + N | z] (Eq. 5's triangular system) comes from the Cholesky
 // factorisation of the Gram matrix [T + N | z]ᵀ[T + N | z] (deviation from the paper's
@@ -39,11 +40,13 @@ layout(std430, binding = RECON_BMFR_POS) readonly buffer Pos { vec4 vpos[]; };
 layout(std430, binding = RECON_BMFR_NRM) readonly buffer Nrm { vec4 vnrm[]; };
 layout(std430, binding = RECON_BMFR_Z) readonly buffer Z { vec4 z[]; };
 layout(std430, binding = RECON_BMFR_FITTED) writeonly buffer Fitted { vec4 fitted[]; };
-layout(std430, binding = RECON_BMFR_COLUMNS) readonly buffer Columns { GridColumn columns[]; };
+layout(std430, binding = RECON_BMFR_COLUMNS) readonly buffer Columns { GridColumn tables[]; };
 layout(std430, binding = RECON_BMFR_MATERIALS) readonly buffer Materials { PtMaterial materials[]; };
 layout(std430, binding = RECON_BMFR_EXCESS) writeonly buffer Excess { vec4 excess[]; };
 
 layout(push_constant) uniform Push { ReconBmfrPush pc; };
+
+#include "fovea/shaders/recon_map.h"
 
 const uint kRows = 1024u / kGroup;  // rows per invocation
 const uint kM = 10u;                // features
@@ -109,8 +112,8 @@ ivec2 cell_of(uint row) {
   int x = int(block % pc.blocks_x) * 32 - pc.offset_x + int(row & 31u);
   int v = int(block / pc.blocks_x) * 32 - pc.offset_y + int(row >> 5);
   if (pc.columns == 0u) return ivec2(x, v);
-  int rows = x >= 0 && x < int(pc.columns) ? int(columns[x].rows) : 0;
-  if (rows > 0 && columns[x].phi_gap > 0.0) rows = int(pc.padded_rows);  // a packed arc: its ends do not meet
+  int rows = x >= 0 && x < int(pc.columns) ? int(tables[x].rows) : 0;
+  if (rows > 0 && tables[x].phi_gap > 0.0) rows = int(pc.padded_rows);  // a packed arc: its ends do not meet
   return ivec2(x, v < rows - pc.offset_y ? (v % rows + rows) % rows : v + pc.offset_y);
 }
 
@@ -121,6 +124,32 @@ bool has_diffuse(float code) {
   if (m >= uint(materials.length())) return true;
   PtMaterial mat = materials[m];
   return mat.metallic < 1.0 && (mat.texture >= 0 || max(max(mat.base_r, mat.base_g), mat.base_b) > 0.0);
+}
+
+// Whether cell i's area straddles a surface edge: a 3×3 grid neighbour (this frame's samples)
+// holds a surface the history test (rg_tap_valid) would not take for i's own. With sub-cell
+// jitter Phase I keeps the history of such a cell over the samples of both sides (its area
+// mean: recon_accumulate.comp, seen_near), and that mix is no function of the features of the
+// side the sample hit now: fitted with its block it biased the fit at silhouettes, and the
+// fit put the surface's full light where the cell's area is partly background (cornell,
+// 58–60°, docs/reconstruction.md). An edge inside the cell's area always has a neighbour's
+// sample on its other side, since all cells share the frame's jitter.
+bool straddles(uint i) {
+  ReconGrid m;  // this frame's grid as recon_map.h reads it (the column table at offset 0)
+  m.g.family = pc.columns > 0u ? kFamilyAngularPolar : kFamilyCartesian;
+  m.g.columns = pc.columns > 0u ? pc.columns : pc.padded_columns;
+  m.g.rows = pc.padded_rows;
+  m.g.padded_columns = pc.padded_columns;
+  m.table_offset = 0u;
+  vec4 here = vpos[i], nd = vnrm[i];
+  for (int dc = -1; dc <= 1; ++dc)
+    for (int dr = -1; dr <= 1; ++dr) {
+      uint k;
+      if ((dc != 0 || dr != 0) && rg_neighbour(m, i, dc, dr, k) && !rg_no_sample(vpos[k].w) &&
+          !rg_tap_valid(here, nd.xyz, nd.w, vpos[k], vnrm[k].xyz))
+        return true;
+    }
+  return false;
 }
 
 bool inside(ivec2 c) { return c.x >= 0 && c.y >= 0 && c.x < int(pc.padded_columns) && c.y < int(pc.padded_rows); }
@@ -166,7 +195,7 @@ void main() {
     uint i = uint(c.y) * pc.padded_columns + uint(c.x);
     s_cell[row] = i | kMasked;
     vec4 p = vpos[i];
-    if (p.w < 0.0 || !has_diffuse(p.w)) continue;  // sky, emitter, no sample, no diffuse lobe
+    if (p.w < 0.0 || !has_diffuse(p.w) || straddles(i)) continue;  // sky, emitter, no sample, metal, edge
     s_cell[row] = i;
     vec3 zin = z[i].rgb;
     [[unroll]] for (uint a = 0u; a < 3u; ++a) {

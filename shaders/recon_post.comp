@@ -62,5 +62,5 @@ void main() {
     acc = vec4(mix(h, c, a), n / a);
   }
   post[i] = acc;
-  sum[i] = vec4(acc.rgb + excess[i].rgb + acc_direct[i].rgb, 1.0);
+  sum[i] = vec4(acc.rgb + excess[i].rgb + acc_direct[i].rgb, acc_direct[i].w);  // .w: TAA's CMA start
 }

@@ -3,6 +3,19 @@
 // in Visual-Polar space, since screen-space TAA would jitter too much in the fovea): the
 // reprojected history (same taps as Phase I) is clamped to the YCoCg min/max of the cell's
 // 3×3 grid neighbourhood (neighbouring columns at the same φ) and blended with α_taa.
+// Deviations from the BMFR reference code, measured in docs/reconstruction.md:
+// - Clamp and blend act on c / (1 + luma(c)) (Karis 2014's perceptual weighting; the
+//   reference code runs its TAA on clipped, tone-mapped colour): with sub-cell jitter a cell
+//   straddling an emitter and a dark surface in front of it averages their linear radiance,
+//   which the emitter dominates (thin occluders vanished; stereo-occluders 36–54°).
+// - α = max(1/n, α_taa), n the cell's Phase I sample count: a history that just started over
+//   (disocclusion, a saccade's new fovea) is averaged evenly like Phase I's, instead of its
+//   first noisy frame keeping weight 0.8.
+// - The current sample's weight falls with its jitter offset from the cell centre (Gaussian,
+//   σ = kCentreSigma cells; Karis 2014 weights current samples by a reconstruction filter of
+//   their distance to the pixel centre): the history converges to a centre-weighted mean of
+//   the cell instead of its box mean, which the resolve's tent between cells blurs further
+//   (docs/reconstruction.md, "Jitter and reprojection"; stereo-occluders 40–42°).
 // .w = 1 marks cells holding a sample (the resolve renormalises over them).
 #extension GL_GOOGLE_include_directive : require
 
@@ -27,10 +40,17 @@ layout(std430, binding = RECON_TAA_FINAL) writeonly buffer Final { vec4 final_co
 
 layout(push_constant) uniform Push { ReconPostPush pc; };
 
+const float kCentreSigma = 0.25;
+
 vec3 to_ycocg(vec3 c) {
   return vec3(0.25 * c.r + 0.5 * c.g + 0.25 * c.b, 0.5 * c.r - 0.5 * c.b, -0.25 * c.r + 0.5 * c.g - 0.25 * c.b);
 }
 vec3 from_ycocg(vec3 y) { return vec3(y.x + y.y - y.z, y.x + y.z, y.x - y.y - y.z); }
+
+// The perceptual weighting and its inverse (luma(c / (1 + luma c)) < 1).
+float luma(vec3 c) { return dot(c, vec3(0.2126, 0.7152, 0.0722)); }
+vec3 compress(vec3 c) { return c / (1.0 + luma(c)); }
+vec3 expand(vec3 c) { return c / max(1.0 - luma(c), 1e-6); }
 
 vec3 remodulated(uint i) { return post[i].rgb * max(albedo[i].rgb, vec3(kPtMinDemodAlbedo)); }
 
@@ -55,13 +75,15 @@ void main() {
     for (int dr = -1; dr <= 1; ++dr) {
       uint j;
       if (!rg_neighbour_of(m, cell, dc, dr, j) || rg_no_sample(vpos[j].w)) continue;
-      vec3 y = to_ycocg(remodulated(j));
+      vec3 y = to_ycocg(compress(remodulated(j)));
       lo = min(lo, y);
       hi = max(hi, y);
     }
   uvec4 idx = tap_idx[i];
   vec3 h = vec3(0.0);
-  for (int k = 0; k < 4; ++k) h += w[k] * prev_final[idx[k]].rgb;
+  for (int k = 0; k < 4; ++k) h += w[k] * compress(prev_final[idx[k]].rgb);
   h = from_ycocg(clamp(to_ycocg(h), lo, hi));
-  final_color[i] = vec4(max(mix(h, c, pc.taa_alpha), vec3(0.0)), 1.0);
+  vec2 jitter = vec2(m.g.jitter_u, m.g.jitter_v);  // the sample's offset from the cell centre (cells)
+  float a = max(1.0 / max(post[i].w, 1.0), pc.taa_alpha) * exp(-dot(jitter, jitter) / (2.0 * kCentreSigma * kCentreSigma));
+  final_color[i] = vec4(max(expand(mix(h, compress(c), a)), vec3(0.0)), 1.0);
 }

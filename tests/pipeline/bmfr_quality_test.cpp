@@ -5,7 +5,6 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
-#include <cstdlib>
 #include <string>
 
 #include "fovea/core/flip.hpp"
@@ -90,24 +89,9 @@ void expect_bmfr_not_worse(fovea::gpu::Context& ctx, const char* scene_name) {
 }  // namespace
 
 TEST_F(GpuTest, BmfrNotWorseThanNoDenoiserDefault) { expect_bmfr_not_worse(ctx(), "default"); }
-// Known failures, kept visible as skips until fixed (docs/reconstruction.md, "Per-scene
-// status"): with sub-cell jitter on (the default) BMFR is worse than no denoiser in one outer
-// band on cornell (58-60 deg, HDR-FLIP +0.016 +- 0.005) and glossy-spheres (54-56 deg,
-// tone-mapped MSE +0.00058 +- 0.00019), and on stereo-occluders in its outermost band (60-62
-// deg, 68 pixels). Every other band of these scenes passes. FOVEA_RUN_KNOWN_FAILURES=1 runs them.
-bool known_failures_skipped() { return !std::getenv("FOVEA_RUN_KNOWN_FAILURES"); }
-TEST_F(GpuTest, BmfrNotWorseThanNoDenoiserCornell) {
-  if (known_failures_skipped()) GTEST_SKIP() << "known failure (FOVEA_RUN_KNOWN_FAILURES=1 runs it)";
-  expect_bmfr_not_worse(ctx(), "cornell");
-}
-TEST_F(GpuTest, BmfrNotWorseThanNoDenoiserGlossySpheres) {
-  if (known_failures_skipped()) GTEST_SKIP() << "known failure (FOVEA_RUN_KNOWN_FAILURES=1 runs it)";
-  expect_bmfr_not_worse(ctx(), "glossy-spheres");
-}
-TEST_F(GpuTest, BmfrNotWorseThanNoDenoiserStereoOccluders) {
-  if (known_failures_skipped()) GTEST_SKIP() << "known failure (FOVEA_RUN_KNOWN_FAILURES=1 runs it)";
-  expect_bmfr_not_worse(ctx(), "stereo-occluders");
-}
+TEST_F(GpuTest, BmfrNotWorseThanNoDenoiserCornell) { expect_bmfr_not_worse(ctx(), "cornell"); }
+TEST_F(GpuTest, BmfrNotWorseThanNoDenoiserGlossySpheres) { expect_bmfr_not_worse(ctx(), "glossy-spheres"); }
+TEST_F(GpuTest, BmfrNotWorseThanNoDenoiserStereoOccluders) { expect_bmfr_not_worse(ctx(), "stereo-occluders"); }
 
 // Blocks wrap in φ: the fit has no seam at φ = 0. On the outermost columns (all of the same
 // row count, so a row boundary is one φ), the luminance step of the fitted indirect diffuse

@@ -146,8 +146,11 @@ TEST_F(GpuTest, FoveaIsSharpWithinThreeFramesAfterA40DegreeSaccade) {
 // the cell-size test (keep/reject at 10⁹), sub-cell jitter on (the default), both denoisers.
 // 4 samples per cell and frame: the measure (gradient energy) counts noise as detail, and at
 // 1 spp a fovea that starts over is "sharper" than the converged control by its noise alone.
-// Printed as the table's rows; asserts the mechanism: with the test the fovea's history
-// starts over at the jump, without it the coarse history is kept.
+// Printed as the table's rows; asserts the mechanism (with the test the fovea's history
+// starts over at the jump, without it the coarse history is kept) and, with the test, the
+// fovea near the control: within 10% from the third frame after the jump without a
+// denoiser (the goal); BMFR does not reach the goal (1.205 at the third frame, 1.100 at the
+// eighth; docs/reconstruction.md), asserted is its measured state, within 15% from the sixth.
 TEST_F(GpuTest, SaccadeRecoveryCurveOnTheDefaultScene) {
   const renderer::Scene scene = renderer::load_scene("default");
   renderer::GpuScene gs(ctx(), scene);
@@ -182,6 +185,10 @@ TEST_F(GpuTest, SaccadeRecoveryCurveOnTheDefaultScene) {
         const double count = fovea_history(jump);
         std::printf(" %.3f (%.2f)", r, count);
         EXPECT_TRUE(std::isfinite(r));
+        const bool none = denoiser == reconstruct::Denoiser::None;
+        if (check && f >= (none ? 2 : 5)) {
+          EXPECT_NEAR(r, 1.0, none ? 0.1 : 0.15) << reconstruct::denoiser_name(denoiser) << ", frame " << f + 1;
+        }
         if (f == 0) {
           if (check) {
             EXPECT_LT(count, 1.05);

@@ -2,6 +2,7 @@
 // on a static Cornell box.
 #include "fovea/reconstruct/bmfr.hpp"
 
+#include <cmath>
 #include <map>
 #include <memory>
 #include <random>
@@ -27,7 +28,8 @@ struct Inputs {
   Inputs() : pos(kSide * kSide), nrm(kSide * kSide), z(kSide * kSide) {}
 };
 
-// A wall: positions on the plane z = −3, constant normal, noisy constant radiance.
+// A wall: positions on the plane z = −3 seen from the origin, constant normal, noisy constant
+// radiance.
 Inputs flat_wall(float value, unsigned seed, double scale = 1.0, glm::dvec3 origin = {0, 0, 0}) {
   Inputs in;
   std::mt19937 rng(seed);
@@ -37,7 +39,7 @@ Inputs flat_wall(float value, unsigned seed, double scale = 1.0, glm::dvec3 orig
       const std::size_t i = y * kSide + x;
       const glm::dvec3 p = origin + scale * glm::dvec3(x * 0.01, y * 0.01, -3.0);
       in.pos[i] = glm::vec4(glm::vec3(p), 1.0f);
-      in.nrm[i] = {0, 0, 1, 0};
+      in.nrm[i] = {0, 0, 1, float(std::sqrt(glm::dot(p, p)))};  // .w: the depth (edge test)
       in.z[i] = glm::vec4(glm::vec3(value * noise(rng)), 1.0f);
     }
   return in;

@@ -2,13 +2,15 @@
 // BMFR Phase II on the GPU (shaders/recon_bmfr_fit.comp): per 32×32 block of a padded grid,
 // the regression of the demodulated input z on the features [1, n, w, w²] (least squares via
 // the Cholesky factor of the block's Gram matrix) and the weighted sum. Inputs per cell
-// (vec4): vpos (world position, .w material; < 0 = no surface), vnrm (normal), z (rgb, .w
-// sample count); outputs: fitted (rgb, .w = z's count) and excess
+// (vec4): vpos (world position, .w material; < 0 = no surface), vnrm (normal, .w the distance
+// to the eye), z (rgb, .w sample count); outputs: fitted (rgb, .w = z's count) and excess
 // (rgb: the part of z above its block's outlier bound, which the fit did not see; the
 // estimate is fitted + excess). On polar grids the blocks wrap in φ:
 // rows are read modulo each column's row count (the grid's column table). Cells whose
 // material (shaders::PtMaterial of the scene's table, indexed by vpos.w) has no diffuse lobe
-// stay out of the regression and keep z: their indirect diffuse is zero by construction.
+// stay out of the regression and keep z: their indirect diffuse is zero by construction; so
+// do cells next to a surface edge (a 3×3 neighbour that the history's validity test would not
+// take for the same surface), whose jittered history mixes both sides.
 #include <cstdint>
 #include <vector>
 

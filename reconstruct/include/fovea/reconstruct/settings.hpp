@@ -31,7 +31,7 @@ struct ReconSettings {
   StereoShare share = StereoShare::Off;
   float alpha_min = 0.2f;        // BMFR Phase I EMA floor
   float post_alpha_min = 0.1f;   // BMFR Phase III EMA floor
-  float taa_alpha = 0.2f;        // TAA blend (Karis 2014 / BMFR reference)
+  float taa_alpha = 0.2f;        // TAA blend floor (Karis 2014, BMFR), times the jitter's centre weight
   // Cell-size awareness of history and other-eye taps: a tap from a cell up to coarse_keep
   // times the sample's cell size (linear) counts fully, beyond that less, not at all from
   // coarse_reject on. Smooth pursuit changes sizes by < 1.25 per frame at 2.5°/frame; a
