@@ -16,11 +16,12 @@
 namespace fovea::tools {
 
 // What the image depends on besides scene and view; every field is part of the cache key.
+// Start from reference_defaults(scene) to share entries with `render` and `reference`.
 struct ReferenceSettings {
   std::uint32_t max_spp = 256;
   std::uint32_t batch = 16;
   int bounces = -1;  // < 0: unbounded, Russian roulette alone from rr_start
-  std::uint32_t rr_start = 1;
+  std::uint32_t rr_start = 3;
   double until_rel_error = 0;        // image-mean luminance; 0: off
   double until_pixel_rel_error = 0;  // RMS of the per-pixel standard errors; 0: off
 };
