@@ -1,7 +1,8 @@
 // `fovea render`'s quality metrics and references: the report's tone-mapped, FLIP, fovea,
 // foveated, per-band and flicker fields; more samples score better; a render compared with
 // itself scores FLIP 0; the reference cache (second run reads it, a changed scene byte
-// changes the key); a sweep renders a reference shared by its jobs once.
+// changes the key, `render` and `reference` share entries, damaged entries are rendered
+// again); a sweep renders a reference shared by its jobs once.
 #include <cmath>
 #include <filesystem>
 #include <fstream>
@@ -149,6 +150,71 @@ TEST(ReferenceCache, SecondRunReadsTheCacheAndASceneByteChangesTheKey) {
                            "--reference-cache " + dir + "/cache --out " + dir + "/d.exr");
   ASSERT_EQ(r.status, 0) << r.err;
   EXPECT_NE(json::parse(r.out)["key"], changed["key"]);
+  fs::remove_all(dir);
+}
+
+// `fovea reference` and `fovea render --reference SPP` share defaults, keys and cache
+// entries, in both directions; the render's reference error is part of the key.
+TEST(ReferenceCache, RenderAndReferenceCommandsReuseEachOthersEntries) {
+  const std::string dir = fovea::test::temp_dir("refshare");
+  const std::string cache = " --reference-cache " + dir + "/cache";
+  const auto reference = [&](const std::string& eye, const std::string& extra) {
+    const auto r = run_fovea("reference --display tiny --scene cornell --eye " + eye + " --spp 8 --quiet" + extra + cache +
+                             " --out " + dir + "/" + eye + ".exr");
+    EXPECT_EQ(r.status, 0) << r.err;
+    return json::parse(r.out);
+  };
+  const json left = reference("left", "");
+  EXPECT_FALSE(left["cached"].get<bool>());
+  const json a = render("--frames 1 --gaze synthetic:3 --reference 8" + cache, dir + "/a");
+  const json& ref = a["metrics"]["reference"];
+  EXPECT_TRUE(ref["left"]["cached"].get<bool>()) << "render did not reuse the reference command's entry";
+  EXPECT_EQ(ref["left"]["key"], left["key"]);
+  EXPECT_FALSE(ref["right"]["cached"].get<bool>());
+  // The settings the key hashes, reported: the albedo rule's bounces, the default error.
+  EXPECT_EQ(ref["left"]["settings"]["bounces"], left["bounces"]);
+  EXPECT_EQ(ref["left"]["settings"]["rr_start"], left["rr_start"]);
+  EXPECT_EQ(ref["left"]["settings"]["until_pixel_rel_error"].get<double>(), 0.02);
+  // The other way round: the right eye, rendered by `render`, is read by `reference`.
+  const json right = reference("right", " --until-pixel-rel-error 0.02");
+  EXPECT_TRUE(right["cached"].get<bool>());
+  EXPECT_EQ(right["key"], ref["right"]["key"]);
+  // Another error target is another reference.
+  const json b = render("--frames 1 --gaze synthetic:3 --reference 8 --reference-error 0.05" + cache, dir + "/b");
+  EXPECT_FALSE(b["metrics"]["reference"]["left"]["cached"].get<bool>());
+  EXPECT_NE(b["metrics"]["reference"]["left"]["key"], left["key"]);
+  EXPECT_EQ(b["metrics"]["reference"]["left"]["settings"]["until_pixel_rel_error"].get<double>(), 0.05);
+  fs::remove_all(dir);
+}
+
+// A damaged entry (truncated image, unreadable or foreign description) is reported on
+// stderr, rendered again and replaced; the run succeeds.
+TEST(ReferenceCache, DamagedEntriesAreReportedAndRenderedAgain) {
+  const std::string dir = fovea::test::temp_dir("refdamage");
+  const std::string args = "reference --display tiny --scene cornell --spp 4 --quiet --reference-cache " + dir +
+                           "/cache --out " + dir + "/out.exr";
+  const auto first = run_fovea(args);
+  ASSERT_EQ(first.status, 0) << first.err;
+  const json made = json::parse(first.out);
+  const std::string entry = dir + "/cache/" + made["key"].get<std::string>();
+  const auto damage = [&](const std::string& file, const std::string& bytes) {
+    std::ofstream(file, std::ios::binary | std::ios::trunc) << bytes;
+    const auto r = run_fovea(args);
+    EXPECT_EQ(r.status, 0) << file << ": " << r.err;
+    EXPECT_NE(r.err.find("damaged reference cache entry"), std::string::npos) << file << ": " << r.err;
+    EXPECT_NE(r.err.find(made["key"].get<std::string>()), std::string::npos) << r.err;
+    const json j = json::parse(r.out);
+    EXPECT_FALSE(j["cached"].get<bool>()) << file;
+    EXPECT_EQ(j["key"], made["key"]);
+    EXPECT_EQ(j["mean_rgb"], made["mean_rgb"]) << "the same seeds render the same reference";
+    // Replaced: the next run reads it without complaint.
+    const auto again = run_fovea(args);
+    EXPECT_TRUE(json::parse(again.out)["cached"].get<bool>()) << file << ": " << again.err;
+    EXPECT_EQ(again.err.find("damaged"), std::string::npos) << again.err;
+  };
+  damage(entry + ".exr", "not an image");
+  damage(entry + ".json", "{\"key\": ");
+  damage(entry + ".json", R"({"format": "fovea-reference", "key": "0123456789abcdef", "identity": {}})");
   fs::remove_all(dir);
 }
 

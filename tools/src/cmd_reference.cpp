@@ -29,7 +29,9 @@ its description F.json (key, settings, statistics; what `fovea render --referenc
 checks) and a tone-mapped PNG (same name, other extension), and prints JSON:
 {"spp", "mean_rgb", "rel_error", "pixel_rel_error", "seconds", "key", "cached"}.
 The result is kept in a cache keyed by the scene's bytes, the view, these settings and the
-renderer; the same request again reads it instead of rendering.
+renderer; the same request again reads it instead of rendering. The defaults are those of
+`fovea render --reference SPP` (--spp SPP --until-pixel-rel-error as its --reference-error),
+so either command reuses the other's references.
 
   --scene S             cornell | furnace | glossy-spheres | stereo-occluders | default,
                         or a .gltf/.glb/.obj file [default]
@@ -39,9 +41,9 @@ renderer; the same request again reads it instead of rendering.
   --display NAME|FILE   display preset (fove0, vive, modern, small, tiny) or JSON [small]
   --eye left|right      which eye; it sits ipd/2 beside the scene's camera [left]
   --spp N               samples per pixel to stop at [256]
-  --until-rel-error X   stop once the image mean's relative standard error is <= X (> 0)
+  --until-rel-error X   stop once the image mean's relative standard error is <= X; 0: off [0]
   --until-pixel-rel-error X  stop once the RMS of the per-pixel standard errors over the
-                        mean luminance is <= X (> 0)
+                        mean luminance is <= X; 0: off [0.02]
   --batch N             samples per pixel per progressive pass [16]
   --bounces N|auto      BSDF-sampled bounces after the primary hit; -1 = unlimited
                         (with Russian roulette); auto: from the scene's albedo, until a
@@ -85,19 +87,21 @@ int run(std::vector<std::string> argv) {
   png.replace_extension(".png");
 
   const renderer::Scene scene = renderer::load_scene(args.str("scene", "default"));
-  const renderer::PathConfig from_albedo = renderer::albedo_path_config(renderer::albedo_stats(scene));
+  const ReferenceSettings defaults = reference_defaults(scene);
   const auto int_or_auto = [&](const char* name, long automatic) {
     return args.str(name, "auto") == "auto" ? automatic : args.integer(name, automatic);
   };
-  const long spp = args.integer("spp", 256), batch = args.integer("batch", 16),
-             bounces = int_or_auto("bounces", from_albedo.max_bounces), rr = int_or_auto("rr-start", from_albedo.rr_start);
+  const long spp = args.integer("spp", defaults.max_spp), batch = args.integer("batch", defaults.batch),
+             bounces = int_or_auto("bounces", defaults.bounces), rr = int_or_auto("rr-start", defaults.rr_start);
   if (spp < 1 || spp > (1L << 24)) throw core::InputError("--spp must be in 1..16777216");
   if (batch < 1 || batch > 4096) throw core::InputError("--batch must be in 1..4096");
   if (bounces < -1 || bounces > 256) throw core::InputError("--bounces must be -1 (unlimited) or 0..256");
   if (rr < 0 || rr > 1000) throw core::InputError("--rr-start must be in 0..1000");
-  const double until = args.num("until-rel-error", 0), until_pixel = args.num("until-pixel-rel-error", 0);
-  if (!(until >= 0)) throw core::InputError("--until-rel-error must be > 0");
-  if (!(until_pixel >= 0)) throw core::InputError("--until-pixel-rel-error must be > 0");
+  const double until = args.num("until-rel-error", defaults.until_rel_error),
+               until_pixel = args.num("until-pixel-rel-error", defaults.until_pixel_rel_error);
+  if (!(until >= 0) || !std::isfinite(until)) throw core::InputError("--until-rel-error must be >= 0 (0: off)");
+  if (!(until_pixel >= 0) || !std::isfinite(until_pixel))
+    throw core::InputError("--until-pixel-rel-error must be >= 0 (0: off)");
   const auto cache_opt = args.opt("reference-cache");
   const std::string cache = reference_cache_arg(cache_opt ? &*cache_opt : nullptr);
 
@@ -112,6 +116,7 @@ int run(std::vector<std::string> argv) {
   renderer::GpuScene gs(ctx, scene, {}, tracing);
   ReferenceRequest req;
   req.scene = args.str("scene", "default");
+  req.settings = defaults;
   req.settings.max_spp = std::uint32_t(spp);
   req.settings.batch = std::uint32_t(batch);
   req.settings.bounces = int(bounces);

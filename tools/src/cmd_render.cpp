@@ -91,11 +91,13 @@ With no options: a short demo on the shipped scene and gaze.
   --no-cull             trace the lens' hidden area too
   --reference SPP|DIR   SPP: converged reference of the last frame (full global illumination,
                         at most SPP samples per pixel, see --reference-error), from the
-                        cache or rendered into it; DIR: load reference_left.exr and
-                        reference_right.exr written by `fovea reference` (checked to show
-                        this scene and view)
+                        cache or rendered into it: the reference of `fovea reference --spp
+                        SPP --until-pixel-rel-error X` with its other defaults (bounces and
+                        Russian roulette from the scene's albedo), the same cache entry;
+                        DIR: load reference_left.exr and reference_right.exr written by
+                        `fovea reference` (checked to show this scene and view)
   --reference-error X   stop the reference once its per-pixel relative standard error
-                        (RMS over the pixels, over the mean luminance) is <= X [0.02]
+                        (RMS over the pixels, over the mean luminance) is <= X; 0: off [0.02]
   --reference-cache DIR|off  where references are cached [$XDG_CACHE_HOME/fovea/references]
   --png-every N         write PNGs of every N-th frame (0: last frame only) [1]
   --no-marker           do not mark the gaze in the PNGs
@@ -231,7 +233,7 @@ int run(std::vector<std::string> argv) {
   const std::string ref_dir = ref_is_spp ? "" : ref_arg;
   if (!ref_dir.empty() && !fs::is_directory(ref_dir))
     throw core::InputError("--reference: \"" + ref_dir + "\" is neither a sample count nor a directory");
-  const double ref_error = args.num("reference-error", 0.02);
+  const double ref_error = args.num("reference-error", kDefaultPixelRelError);
   if (!(ref_error >= 0) || !std::isfinite(ref_error)) throw core::InputError("--reference-error must be >= 0");
   const auto cache_opt = args.opt("reference-cache");
   const std::string ref_cache = reference_cache_arg(cache_opt ? &*cache_opt : nullptr);
@@ -288,6 +290,13 @@ int run(std::vector<std::string> argv) {
   const std::array<core::Pose, 2>& poses = setup.poses;
   pipeline::FramePipeline& pipeline = setup.pipeline;
 
+  // The same settings as `fovea reference --spp SPP --until-pixel-rel-error X`: one cache.
+  ReferenceRequest ref_request;
+  ref_request.scene = scene_arg;
+  ref_request.settings = reference_defaults(scene);
+  ref_request.settings.max_spp = std::uint32_t(ref_spp);
+  ref_request.settings.until_pixel_rel_error = ref_error;
+  ref_request.cache_dir = ref_cache;
   // A loaded reference is checked before the frames are paid for.
   std::array<std::optional<CachedReference>, 2> loaded;
   if (!ref_dir.empty())
@@ -425,20 +434,16 @@ int run(std::vector<std::string> argv) {
       if (loaded[e]) {
         ref = std::move(*loaded[e]);
       } else {
-        ReferenceRequest req;
-        req.scene = scene_arg;
-        req.settings.max_spp = std::uint32_t(ref_spp);
-        req.settings.until_pixel_rel_error = ref_error;
-        req.cache_dir = ref_cache;
         if (bar) std::fprintf(stderr, "reference %s eye, up to %ld spp...\n", name, ref_spp);
-        ref = cached_reference(ctx, gpu_scene, v, eye, req);
+        ref = cached_reference(ctx, gpu_scene, v, eye, ref_request);
         write_reference((out_dir / (std::string("reference_") + name + ".exr")).string(), ref);
       }
       ref_info[name] = {{"spp", ref.result.spp},
                         {"pixel_rel_error", ref.result.pixel_rel_error},
                         {"rel_error", ref.result.rel_error},
                         {"key", ref.key},
-                        {"cached", ref.from_cache}};
+                        {"cached", ref.from_cache},
+                        {"settings", nlohmann::json::parse(ref.identity).value("settings", nlohmann::json())}};
       add_quality(s, last[e], ref.result.image, ecc, ppd);
     }
     j["summary"][name] = s;

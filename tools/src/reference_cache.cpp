@@ -3,6 +3,7 @@
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
+#include <iostream>
 #include <sstream>
 
 #include <nlohmann/json.hpp>
@@ -93,8 +94,12 @@ json read_json(const std::string& path) {
 // The image and statistics of a described reference; `where` names it in errors.
 CachedReference load(const std::string& exr, const json& meta, const std::string& where) {
   CachedReference r;
+  int width = 0, height = 0;
   try {
     r.key = meta.at("key").get<std::string>();
+    const json& view = meta.at("identity").at("view");
+    width = view.at("width").get<int>();
+    height = view.at("height").get<int>();
     r.identity = meta.at("identity").dump();
     r.result.spp = meta.at("spp").get<std::uint32_t>();
     r.result.rel_error = meta.at("rel_error").get<double>();
@@ -108,14 +113,22 @@ CachedReference load(const std::string& exr, const json& meta, const std::string
   if (r.key != hex64(sweep::fnv1a64(r.identity)))
     throw core::InputError(where + ": its key does not match its recorded identity");
   r.result.image = renderer::read_exr(exr);
-  const auto& v = meta["identity"]["view"];
-  if (r.result.image.width != v.value("width", -1) || r.result.image.height != v.value("height", -1))
+  if (r.result.image.width != width || r.result.image.height != height)
     throw core::InputError(exr + ": image size differs from its description");
   r.from_cache = true;
   return r;
 }
 
 }  // namespace
+
+ReferenceSettings reference_defaults(const renderer::Scene& scene) {
+  const renderer::PathConfig a = renderer::albedo_path_config(renderer::albedo_stats(scene));
+  ReferenceSettings s;
+  s.bounces = a.max_bounces;
+  s.rr_start = a.rr_start;
+  s.until_pixel_rel_error = kDefaultPixelRelError;
+  return s;
+}
 
 std::string default_reference_cache() {
   if (const char* x = std::getenv("XDG_CACHE_HOME"); x && *x) return (fs::path(x) / "fovea" / "references").string();
@@ -137,13 +150,16 @@ CachedReference cached_reference(gpu::Context& ctx, const renderer::GpuScene& sc
   const std::string text = id.dump();
   const std::string key = hex64(sweep::fnv1a64(text));
   const fs::path exr = fs::path(req.cache_dir) / (key + ".exr");
-  if (!req.cache_dir.empty() && fs::exists(sidecar(exr.string()))) {
-    // A damaged or foreign entry is rendered again and replaced, never trusted.
+  const std::string meta_path = sidecar(exr.string());
+  if (!req.cache_dir.empty() && fs::exists(meta_path)) {
+    // A damaged or foreign entry is reported, rendered again and replaced, never trusted.
     try {
-      const json meta = read_json(sidecar(exr.string()));
-      if (meta.value("key", "") == key && meta.contains("identity") && meta["identity"].dump() == text)
-        return load(exr.string(), meta, sidecar(exr.string()));
-    } catch (const core::InputError&) {
+      const json meta = read_json(meta_path);
+      if (meta.value("key", "") != key || !meta.contains("identity") || meta["identity"].dump() != text)
+        throw core::InputError(meta_path + ": describes another reference than its name's key " + key);
+      return load(exr.string(), meta, meta_path);
+    } catch (const core::InputError& e) {
+      std::cerr << "warning: damaged reference cache entry, rendering it again: " << e.what() << "\n";
     }
   }
   renderer::ReferenceOptions o;
@@ -158,8 +174,13 @@ CachedReference cached_reference(gpu::Context& ctx, const renderer::GpuScene& sc
   r.key = key;
   r.identity = text;
   if (!req.cache_dir.empty()) {
-    fs::create_directories(req.cache_dir);
-    write_reference(exr.string(), r);
+    // The reference is good without its cache entry: an unwritable cache costs the next run.
+    try {
+      fs::create_directories(req.cache_dir);
+      write_reference(exr.string(), r);
+    } catch (const std::exception& e) {
+      std::cerr << "warning: reference not cached in " << req.cache_dir << ": " << e.what() << "\n";
+    }
   }
   return r;
 }

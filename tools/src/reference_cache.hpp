@@ -2,24 +2,35 @@
 // Converged references of one eye, cached on disk so that runs and sweep jobs do not pay for
 // them again. An entry is <key>.exr (linear RGBA, float) with <key>.json beside it, which
 // records the key, everything the key hashes and the stop statistics; the JSON is written
-// last, so an entry without it is incomplete and ignored. docs/metrics.md, "Reference".
+// last, so an entry without it is incomplete and ignored. `fovea reference` and `fovea render
+// --reference SPP` both come here with reference_defaults(), so either reuses the other's
+// entries. docs/metrics.md, "Reference".
 #include <cstdint>
 #include <functional>
 #include <string>
 
 #include "fovea/core/view.hpp"
 #include "fovea/renderer/reference.hpp"
+#include "fovea/renderer/scene.hpp"
 
 namespace fovea::tools {
 
+// What the image depends on besides scene and view; every field is part of the cache key.
+// Start from reference_defaults(scene) to share entries with `render` and `reference`.
 struct ReferenceSettings {
   std::uint32_t max_spp = 256;
   std::uint32_t batch = 16;
-  int bounces = -1;             // unbounded, Russian roulette from rr_start
+  int bounces = -1;  // < 0: unbounded, Russian roulette alone from rr_start
   std::uint32_t rr_start = 3;
-  double until_rel_error = 0;        // image-mean luminance
-  double until_pixel_rel_error = 0;  // RMS of the per-pixel standard errors
+  double until_rel_error = 0;        // image-mean luminance; 0: off
+  double until_pixel_rel_error = 0;  // RMS of the per-pixel standard errors; 0: off
 };
+
+// The defaults both commands share: 256 spp in batches of 16, bounces and Russian roulette
+// from the scene's albedo (renderer::albedo_path_config), stop once the per-pixel relative
+// error is <= 0.02.
+inline constexpr double kDefaultPixelRelError = 0.02;
+ReferenceSettings reference_defaults(const renderer::Scene& scene);
 
 // `dir` empty: no cache. `scene` is the --scene argument (a file's bytes are hashed).
 struct ReferenceRequest {
