@@ -378,6 +378,7 @@ int run(std::vector<std::string> argv) {
     if (quality_frames > 0 && !quality_at.empty()) {
       ReferenceRequest req;
       req.scene = args.str("scene", "default");
+      req.settings = reference_defaults(scene);  // the settings of `fovea render`/`reference`: one cache
       req.settings.max_spp = std::uint32_t(ref_spp);
       req.settings.until_pixel_rel_error = ref_error;
       req.cache_dir = ref_cache;
