@@ -7,6 +7,7 @@
 #include <array>
 #include <cstdint>
 #include <memory>
+#include <mutex>
 #include <optional>
 #include <vector>
 
@@ -64,13 +65,14 @@ class AppDevice {
     std::optional<AppDepth> depth;  // its depth, when compositing by depth (with composition.traced_depth)
     VkImage target;                // written whole (out_view's raster), ends in COLOR_ATTACHMENT_OPTIMAL
   };
-  // Two submissions on the session queue. The first (waited for, bounded) uploads the traced
-  // frame if new and copies the application's rects (and depth rects) into device buffers, so
-  // its images are free again on return; the second (not waited for: the runtime's later work
-  // on this queue comes after it) runs the composition pass and copies the results into the
-  // targets. The next call first waits for it.
+  // One submission on the session queue, not waited for: it uploads the traced frame if new,
+  // copies the application's rects (and depth rects) into device buffers, runs the
+  // composition pass and copies the results into the targets. Later work on the queue (the
+  // application's next rendering into its images, the runtime's reads) comes after it; the
+  // next call first waits for it.
   void composite_gpu(std::int64_t traced_id, const std::array<GpuEye, 2>& eyes, const CompositionRule& rule);
-  // Waits for a composition pass still running (before its targets are destroyed).
+  // Waits for a composition pass still running (before the images it reads or writes are
+  // destroyed: the application's swapchains, the targets).
   void finish();
 
  private:
@@ -127,6 +129,9 @@ class AppDevice {
   };
   std::unique_ptr<Gpu> gpu_;
   std::unique_ptr<xrcommon::ForeignQueue> pass_;  // the composition pass's submissions
+  // pass_ between xrEndFrame's composition and finish() from xrDestroySwapchain, which an
+  // application may call on another thread.
+  std::mutex pass_mutex_;
   void destroy_gpu();
 
 #define FOVEA_APP_VK(X)                                                                                          \

@@ -281,6 +281,8 @@ class PathTraceRenderer final : public FrameRenderer {
       if (e.swapchain != XR_NULL_HANDLE) next_.xrDestroySwapchain(e.swapchain);
   }
 
+  void finish_composition() override { app_.finish(); }
+
   const XrFrameEndInfo* end_frame(const FrameInput& in, Shown& shown) override {
     if (in.app_views.size() != 2) return nullptr;  // only stereo projection layers are replaced
     if (!thread_.joinable()) start(in);

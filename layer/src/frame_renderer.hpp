@@ -109,6 +109,9 @@ class FrameRenderer {
   // unchanged (not a stereo projection, nothing finished yet). Throws on failure, also the
   // render thread's; the layer then disables itself for the session.
   virtual const XrFrameEndInfo* end_frame(const FrameInput& in, Shown& shown) = 0;
+  // Waits for the composition work still reading the application's swapchain images (its
+  // last pass runs after xrEndFrame returns): before the application destroys one.
+  virtual void finish_composition() = 0;
 };
 
 // Null when no scene is configured; throws when one is configured but cannot be loaded or

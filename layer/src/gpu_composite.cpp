@@ -129,6 +129,7 @@ void AppDevice::enable_gpu_composition() {
 }
 
 void AppDevice::finish() {
+  std::lock_guard lock(pass_mutex_);
   if (pass_) pass_->wait();
 }
 
@@ -149,6 +150,7 @@ void AppDevice::destroy_gpu() {
 void AppDevice::composite_gpu(std::int64_t traced_id, const std::array<GpuEye, 2>& eyes, const CompositionRule& rule) {
   if (!gpu_) throw std::logic_error("composite_gpu: GPU composition was not enabled");
   Gpu& g = *gpu_;
+  std::lock_guard lock(pass_mutex_);
   pass_->wait();  // the previous frame's pass reads the buffers rewritten below
   const bool with_app = rule.mode != Composite::SceneOnly;
   // By depth when both eyes bring the application's depth image and the traced depths.
@@ -259,7 +261,16 @@ void AppDevice::composite_gpu(std::int64_t traced_id, const std::array<GpuEye, 2
   }
   vkUpdateDescriptorSets_(device_, kBindings, writes, 0, nullptr);
 
-  queue_->run([&](VkCommandBuffer cb) {
+  if (upload) {
+    g.uploaded = traced_id;
+    g.uploaded_depth = by_depth;
+  }
+  // One submission, not waited for here: the copies of the application's images end with a
+  // barrier whose second scope spans every later submission on the queue, so the
+  // application's next rendering into them waits for the copies on the device, and the
+  // runtime waits for the session queue's work before it reads the layer's images (as for
+  // any application's). xrEndFrame then costs the recording and the submission only.
+  pass_->submit([&](VkCommandBuffer cb) {
     if (upload) {
       const VkBufferCopy region{0, 0, traced_bytes};
       vkCmdCopyBuffer_(cb, g.staging.buffer, g.traced.buffer, 1, &region);
@@ -277,14 +288,7 @@ void AppDevice::composite_gpu(std::int64_t traced_id, const std::array<GpuEye, 2
         const AppDepth& d = *eyes[e].depth;
         record_download(cb, depth_download(d, VkDeviceSize(p.eye[e].depth_offset)), g.app_depth.buffer);
       }
-  });
-  if (upload) {
-    g.uploaded = traced_id;
-    g.uploaded_depth = by_depth;
-  }
-  pass_->submit([&](VkCommandBuffer cb) {
-    // After the copies of the earlier submission (a barrier's first scope spans earlier
-    // submissions on the queue); the parameters' host writes are visible through the submission.
+    // After the copies above; the parameters' host writes are visible through the submission.
     const VkMemoryBarrier to_compute = memory_barrier(VK_ACCESS_TRANSFER_WRITE_BIT, VK_ACCESS_SHADER_READ_BIT);
     vkCmdPipelineBarrier_(cb, VK_PIPELINE_STAGE_TRANSFER_BIT, VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT, 0, 1, &to_compute, 0,
                           nullptr, 0, nullptr);

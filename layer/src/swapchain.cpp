@@ -1,6 +1,7 @@
 // Swapchain intercepts: forwarded (creation with the transfer-source usage added); the layer records each swapchain's images
 // (enumerated by the layer itself at creation: an application need not enumerate them to
 // submit them) and which one was released last (what the application submits in xrEndFrame).
+// Acquisition and destruction first wait for a composition pass still reading the images.
 #include <vector>
 
 #include "layer.hpp"
@@ -12,6 +13,26 @@ namespace {
 const Dispatch* next_for_swapchain(XrSwapchain sc) {
   auto it = layer().swapchains.find(sc);
   return next_for_session(it == layer().swapchains.end() ? XrSession(XR_NULL_HANDLE) : it->second.session);
+}
+
+// The renderer of the swapchain's session, if it has one (under Layer::mutex).
+std::shared_ptr<FrameRenderer> renderer_for_swapchain(XrSwapchain sc) {
+  const auto it = layer().swapchains.find(sc);
+  if (it == layer().swapchains.end()) return nullptr;
+  const auto s = layer().sessions.find(it->second.session);
+  return s == layer().sessions.end() ? nullptr : s->second.renderer;
+}
+
+// The last composition pass may still read the application's images on the device after
+// xrEndFrame returned: an image is given back to the application (acquired) or destroyed
+// only after it. Outside Layer::mutex; usually long finished, so no wait.
+void finish_composition(FrameRenderer* renderer, const char* call) {
+  if (!renderer) return;
+  try {
+    renderer->finish_composition();
+  } catch (const std::exception& e) {
+    FOVEA_LAYER_ERROR("%s: the last composition pass did not finish: %s", call, e.what());
+  }
 }
 
 }  // namespace
@@ -56,12 +77,15 @@ XrResult intercept::xrCreateSwapchain(XrSession session, const XrSwapchainCreate
 
 XrResult intercept::xrDestroySwapchain(XrSwapchain swapchain) {
   PFN_xrDestroySwapchain next = nullptr;
+  std::shared_ptr<FrameRenderer> renderer;
   {
     std::lock_guard lock(layer().mutex);
     const Dispatch* d = next_for_swapchain(swapchain);
     if (!d) return XR_ERROR_HANDLE_INVALID;
     next = d->xrDestroySwapchain;
+    renderer = renderer_for_swapchain(swapchain);
   }
+  finish_composition(renderer.get(), __func__);
   const XrResult r = next(swapchain);
   if (XR_SUCCEEDED(r)) {
     std::lock_guard lock(layer().mutex);
@@ -73,12 +97,15 @@ XrResult intercept::xrDestroySwapchain(XrSwapchain swapchain) {
 XrResult intercept::xrAcquireSwapchainImage(XrSwapchain swapchain, const XrSwapchainImageAcquireInfo* info,
                                             uint32_t* index) {
   PFN_xrAcquireSwapchainImage next = nullptr;
+  std::shared_ptr<FrameRenderer> renderer;
   {
     std::lock_guard lock(layer().mutex);
     const Dispatch* d = next_for_swapchain(swapchain);
     if (!d) return XR_ERROR_HANDLE_INVALID;
     next = d->xrAcquireSwapchainImage;
+    renderer = renderer_for_swapchain(swapchain);
   }
+  finish_composition(renderer.get(), __func__);
   const XrResult r = next(swapchain, info, index);
   if (XR_SUCCEEDED(r)) {
     std::lock_guard lock(layer().mutex);
