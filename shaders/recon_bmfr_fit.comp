@@ -135,7 +135,9 @@ bool has_diffuse(float code) {
 // 58–60°, docs/reconstruction.md). An edge inside the cell's area always has a neighbour's
 // sample on its other side, since all cells share the frame's jitter.
 bool straddles(uint i) {
-  ReconGrid m;  // this frame's grid as recon_map.h reads it (the column table at offset 0)
+  // This frame's grid as recon_map.h reads it (the column table at offset 0); rg_neighbour
+  // tells only Cartesian from polar families apart, so every polar grid reads as angular.
+  ReconGrid m;
   m.g.family = pc.columns > 0u ? kFamilyAngularPolar : kFamilyCartesian;
   m.g.columns = pc.columns > 0u ? pc.columns : pc.padded_columns;
   m.g.rows = pc.padded_rows;

@@ -25,7 +25,7 @@ std::shared_ptr<FrameRenderer> renderer_for_swapchain(XrSwapchain sc) {
 
 // The last composition pass may still read the application's images on the device after
 // xrEndFrame returned: an image is given back to the application (acquired) or destroyed
-// only after it. Outside Layer::mutex; usually long finished, so no wait.
+// only after it. Outside Layer::mutex.
 void finish_composition(FrameRenderer* renderer, const char* call) {
   if (!renderer) return;
   try {
