@@ -56,6 +56,7 @@ struct PtRayPre {
   vec3 org;
   float tmin;
   vec3 inv;  // 1 / dir with zero components replaced by ±1e-20 (no 0·∞ in slabs)
+  bvec3 neg;  // inv < 0: the slab is entered at the box's upper plane
   int kx, ky, kz;
   vec3 shear;  // Woop et al. 2013 (JCGT 2(1)) shear constants Sx, Sy, Sz
 };
@@ -86,6 +87,7 @@ PtRayPre pt_prepare(vec3 org, vec3 dir, float tmin) {
   }
   r.shear = vec3(pt_axis(dir, r.kx) / dz, pt_axis(dir, r.ky) / dz, 1.0 / dz);
   for (int i = 0; i < 3; ++i) r.inv[i] = 1.0 / (a[i] > 1e-20 ? dir[i] : (dir[i] < 0.0 ? -1e-20 : 1e-20));
+  r.neg = lessThan(r.inv, vec3(0.0));
   return r;
 }
 
@@ -156,16 +158,20 @@ bool pt_traverse(vec3 org, vec3 dir, float tmin, float tmax, bool any_hit, out P
   while (true) {
     const PtBvhNode b = pt_node(n);
     PT_STAT(pt_stat_nodes);
-    const int e = int(b.exponents);
-    const vec3 step = ldexp(vec3(1.0), ivec3(bitfieldExtract(e, 0, 8), bitfieldExtract(e, 8, 8), bitfieldExtract(e, 16, 8)));
-    const vec4 t0x = (pt_planes(b.origin_x, step.x, b.lo_x) - r.org.x) * r.inv.x;
-    const vec4 t1x = (pt_planes(b.origin_x, step.x, b.hi_x) - r.org.x) * r.inv.x;
-    const vec4 t0y = (pt_planes(b.origin_y, step.y, b.lo_y) - r.org.y) * r.inv.y;
-    const vec4 t1y = (pt_planes(b.origin_y, step.y, b.hi_y) - r.org.y) * r.inv.y;
-    const vec4 t0z = (pt_planes(b.origin_z, step.z, b.lo_z) - r.org.z) * r.inv.z;
-    const vec4 t1z = (pt_planes(b.origin_z, step.z, b.hi_z) - r.org.z) * r.inv.z;
-    const vec4 enter = max(max(min(t0x, t1x), min(t0y, t1y)), max(min(t0z, t1z), vec4(r.tmin)));
-    const vec4 leave = min(min(max(t0x, t1x), max(t0y, t1y)), min(max(t0z, t1z), vec4(hit.t))) * kPtBoxFarScale;
+    // Step 2^e built from its bits (e is clamped to the normal range by the builder).
+    const uvec3 e = (uvec3(b.exponents) >> uvec3(0u, 8u, 16u)) & 0xFFu;
+    const vec3 step = uintBitsToFloat(uvec3((ivec3(e << 24u) >> 24) + 127) << 23u);
+    // Near and far planes chosen by the direction's sign once per axis instead of min/max
+    // of both slab distances per box: the same distances (rounding is monotonic), 12 fewer
+    // vector operations per node.
+    const vec4 t0x = (pt_planes(b.origin_x, step.x, r.neg.x ? b.hi_x : b.lo_x) - r.org.x) * r.inv.x;
+    const vec4 t1x = (pt_planes(b.origin_x, step.x, r.neg.x ? b.lo_x : b.hi_x) - r.org.x) * r.inv.x;
+    const vec4 t0y = (pt_planes(b.origin_y, step.y, r.neg.y ? b.hi_y : b.lo_y) - r.org.y) * r.inv.y;
+    const vec4 t1y = (pt_planes(b.origin_y, step.y, r.neg.y ? b.lo_y : b.hi_y) - r.org.y) * r.inv.y;
+    const vec4 t0z = (pt_planes(b.origin_z, step.z, r.neg.z ? b.hi_z : b.lo_z) - r.org.z) * r.inv.z;
+    const vec4 t1z = (pt_planes(b.origin_z, step.z, r.neg.z ? b.lo_z : b.hi_z) - r.org.z) * r.inv.z;
+    const vec4 enter = max(max(t0x, t0y), max(t0z, vec4(r.tmin)));
+    const vec4 leave = min(min(t1x, t1y), min(t1z, vec4(hit.t))) * kPtBoxFarScale;
     const uvec4 child = uvec4(b.child[0], b.child[1], b.child[2], b.child[3]);
     const uvec4 count = (uvec4(b.counts) >> uvec4(0u, 8u, 16u, 24u)) & 0xFFu;
     const bvec4 overlap = bvec4(uvec4(lessThanEqual(enter, leave)) * uvec4(notEqual(child, uvec4(kPtNoHit))));
