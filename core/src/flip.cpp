@@ -66,6 +66,14 @@ glm::dvec3 unit_rgb(const glm::vec4& p) {
 
 glm::dvec3 hunt(glm::dvec3 lab) { return {lab.x, 0.01 * lab.x * lab.y, 0.01 * lab.x * lab.z}; }
 
+// Filter radii in pixels: the CSF's widest Gaussian to 3σ, the feature detector's σ = w/2 to 3σ.
+int csf_radius(double ppd) {
+  const double pi = std::numbers::pi;
+  return int(std::ceil(3.0 * std::sqrt(kCsfMaxB / (2.0 * pi * pi)) * ppd));
+}
+double feature_sigma(double ppd) { return 0.5 * kFeatureWidthDeg * ppd; }
+int feature_radius(double ppd) { return int(std::ceil(3.0 * feature_sigma(ppd))); }
+
 // A W×H plane, convolved separably with clamp-to-edge borders.
 struct Plane {
   int w = 0, h = 0;
@@ -109,7 +117,7 @@ std::vector<glm::dvec3> filtered_hunt_lab(const Image& img, double ppd) {
     for (int ch = 0; ch < 3; ++ch) opp[ch].v[i] = o[ch];
   }
   const double pi = std::numbers::pi;
-  const int r = int(std::ceil(3.0 * std::sqrt(kCsfMaxB / (2.0 * pi * pi)) * ppd));
+  const int r = csf_radius(ppd);
   for (int ch = 0; ch < 3; ++ch) {
     // Σ_i c_i·G_i(x)G_i(y) normalised to unit sum; each Gaussian term separably.
     Plane acc{w, h, std::vector<double>(img.pixels.size(), 0.0)};
@@ -142,8 +150,8 @@ struct Features {
   std::vector<double> edge, point;
 };
 Features features(const Image& img, double ppd) {
-  const double sigma = 0.5 * kFeatureWidthDeg * ppd;
-  const int r = int(std::ceil(3.0 * sigma));
+  const double sigma = feature_sigma(ppd);
+  const int r = feature_radius(ppd);
   std::vector<double> g(std::size_t(2 * r + 1)), d = g, p = g;
   double gs = 0;
   for (int k = -r; k <= r; ++k) {
@@ -211,10 +219,17 @@ std::vector<float> ldr_flip(const Image& test, const Image& reference, double pp
   return out;
 }
 
-HdrFlip hdr_flip_exposures(const Image& reference) {
+int flip_support_px(double ppd) { return std::max(csf_radius(ppd), feature_radius(ppd)); }
+
+HdrFlip hdr_flip_exposures(const Image& reference, const std::vector<bool>& valid) {
   if (reference.pixels.empty()) throw InputError("hdr_flip: empty reference image");
-  std::vector<double> y(reference.pixels.size());
-  for (std::size_t i = 0; i < y.size(); ++i) y[i] = luminance(reference.pixels[i]);
+  if (!valid.empty() && valid.size() != reference.pixels.size())
+    throw InputError("hdr_flip: the valid-pixel mask's size differs from the reference's");
+  std::vector<double> y;
+  y.reserve(reference.pixels.size());
+  for (std::size_t i = 0; i < reference.pixels.size(); ++i)
+    if (valid.empty() || valid[i]) y.push_back(luminance(reference.pixels[i]));
+  if (y.empty()) throw InputError("hdr_flip: the reference has no valid pixel");
   const double ymax = *std::max_element(y.begin(), y.end());
   HdrFlip h;
   h.exposures = 2;
@@ -234,9 +249,9 @@ HdrFlip hdr_flip_exposures(const Image& reference) {
   return h;
 }
 
-HdrFlip hdr_flip(const Image& test, const Image& reference, double ppd) {
+HdrFlip hdr_flip(const Image& test, const Image& reference, double ppd, const std::vector<bool>& valid) {
   require_inputs(test, reference, ppd, "hdr_flip");
-  HdrFlip h = hdr_flip_exposures(reference);
+  HdrFlip h = hdr_flip_exposures(reference, valid);
   h.error.assign(reference.pixels.size(), 0.0f);
   for (int i = 0; i < h.exposures; ++i) {
     const double c = h.start_exposure + i * (h.stop_exposure - h.start_exposure) / (h.exposures - 1);

@@ -104,7 +104,7 @@ double ssim(const Image& a, const Image& b) { return weighted_mean(ssim_map(a, b
 
 std::vector<float> ssim_map(const Image& a, const Image& b) {
   require_same_size(a, b, "ssim");
-  constexpr int kR = 5;  // 11×11 window
+  constexpr int kR = kSsimRadius;
   constexpr double kSigma = 1.5, kC1 = 0.01 * 0.01, kC2 = 0.03 * 0.03;
   double w1[2 * kR + 1];
   for (int k = -kR; k <= kR; ++k) w1[k + kR] = std::exp(-0.5 * k * k / (kSigma * kSigma));
@@ -212,7 +212,8 @@ double foveated_psnr(const Image& a, const Image& b, const View& view, glm::dvec
   return psnr(variable_gaussian(a, sigma), variable_gaussian(b, sigma));
 }
 
-ErrorMaps error_maps(const Image& test, const Image& reference, double ppd, double exposure) {
+ErrorMaps error_maps(const Image& test, const Image& reference, double ppd, double exposure,
+                     const std::vector<bool>& valid) {
   require_same_size(test, reference, "error_maps");
   ErrorMaps m;
   const std::size_t n = test.pixels.size();
@@ -232,8 +233,35 @@ ErrorMaps error_maps(const Image& test, const Image& reference, double ppd, doub
   }
   m.ssim = ssim_map(test, reference);
   m.ldr_flip = ldr_flip(tonemap_linear(test, exposure), tonemap_linear(reference, exposure), ppd);
-  m.hdr_flip = hdr_flip(test, reference, ppd).error;
+  m.hdr_flip = hdr_flip(test, reference, ppd, valid).error;
   return m;
+}
+
+int error_map_support_px(double ppd) { return std::max(kSsimRadius, flip_support_px(ppd)); }
+
+std::vector<bool> scorable_pixels(const std::vector<bool>& valid, int width, int height, int radius) {
+  if (width < 1 || height < 1 || valid.size() != std::size_t(width) * std::size_t(height))
+    throw InputError("scorable_pixels: mask size differs from " + std::to_string(width) + "x" + std::to_string(height));
+  if (radius < 0) throw InputError("scorable_pixels: radius must be >= 0");
+  // Erosion by a (2r+1)² square, separably: a pixel stays when its row segment, then its
+  // column segment of row results, holds no invalid pixel. Running counts of invalid pixels
+  // keep it linear in the image size.
+  const auto erode = [&](const std::vector<bool>& in, bool along_x) {
+    std::vector<bool> out(in.size());
+    const int lines = along_x ? height : width, n = along_x ? width : height;
+    for (int l = 0; l < lines; ++l) {
+      const auto at = [&](int k) { return along_x ? std::size_t(l) * width + k : std::size_t(k) * width + l; };
+      int bad = 0;  // invalid pixels in [k − r, k + r] ∩ [0, n)
+      for (int k = 0; k < std::min(radius, n); ++k) bad += in[at(k)] ? 0 : 1;
+      for (int k = 0; k < n; ++k) {
+        if (k + radius < n) bad += in[at(k + radius)] ? 0 : 1;
+        if (k - radius - 1 >= 0) bad -= in[at(k - radius - 1)] ? 0 : 1;
+        out[at(k)] = bad == 0;
+      }
+    }
+    return out;
+  };
+  return erode(erode(valid, true), false);
 }
 
 double weighted_mean(const std::vector<float>& map, const std::vector<float>& weights) {

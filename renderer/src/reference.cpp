@@ -3,6 +3,7 @@
 #include <unistd.h>
 
 #include <chrono>
+#include <cstdio>
 #include <cstdlib>
 #include <cmath>
 #include <filesystem>
@@ -19,7 +20,40 @@ namespace fovea::renderer {
 namespace {
 double luminance(glm::dvec3 c) { return 0.2126 * c.x + 0.7152 * c.y + 0.0722 * c.z; }
 constexpr double kPixelEpsilon = 0.01;  // core::kRelMseEpsilon
+
+std::string number(double v) {
+  char buf[32];
+  std::snprintf(buf, sizeof buf, "%.6g", v);
+  return buf;
+}
 }  // namespace
+
+std::vector<bool> window_coverage(const ReferenceWindow& window, const core::View& view, const std::string& what) {
+  const std::size_t n = std::size_t(view.width()) * std::size_t(view.height());
+  if (window.whole()) return std::vector<bool>(n, true);
+  std::vector<bool> inside(n, false);
+  for (std::size_t k = 0; k < window.discs.size(); ++k) {
+    const WindowDisc& d = window.discs[k];
+    const std::string name = window.discs.size() > 1 ? what + ", disc " + std::to_string(k + 1) : what;
+    const double len = glm::length(d.centre);
+    if (!std::isfinite(len) || !(len > 0))
+      throw core::InputError(name + ": the centre must be a finite, non-zero view-space direction");
+    if (!std::isfinite(d.radius_deg) || !(d.radius_deg > 0) || d.radius_deg > 180)
+      throw core::InputError(name + ": the radius must be in (0, 180] degrees, got " + number(d.radius_deg));
+    const glm::dvec3 c = d.centre / len;
+    std::size_t hits = 0;
+    for (int y = 0; y < view.height(); ++y)
+      for (int x = 0; x < view.width(); ++x)
+        if (core::angle_deg(view.pixel_to_dir({x + 0.5, y + 0.5}), c) <= d.radius_deg) {
+          inside[std::size_t(y) * std::size_t(view.width()) + std::size_t(x)] = true;
+          ++hits;
+        }
+    if (hits == 0)
+      throw core::InputError(name + ": off the view, no pixel centre lies within " + number(d.radius_deg) + " deg of (" +
+                             number(c.x) + ", " + number(c.y) + ", " + number(c.z) + ")");
+  }
+  return inside;
+}
 
 ReferenceResult render_reference(gpu::Context& ctx, const GpuScene& scene, const core::View& view, core::Eye eye,
                                  const ReferenceOptions& o, const std::function<void(const ReferenceProgress&)>& progress) {
@@ -28,8 +62,16 @@ ReferenceResult render_reference(gpu::Context& ctx, const GpuScene& scene, const
     throw core::InputError("reference: --until-rel-error must be a finite number >= 0");
   if (!(o.until_pixel_rel_error >= 0) || !std::isfinite(o.until_pixel_rel_error))
     throw core::InputError("reference: the per-pixel relative error target must be a finite number >= 0");
+  const std::vector<bool> covered = window_coverage(o.window, view, "reference window");
+  // The pixels the statistics and the image cover; the others are flagged, which the tracer
+  // skips (the flag says why: outside the part of the view asked for).
+  std::vector<std::size_t> inside;
+  for (std::size_t i = 0; i < covered.size(); ++i)
+    if (covered[i]) inside.push_back(i);
   const auto t0 = std::chrono::steady_clock::now();
-  const auto grid = cartesian_grid(view);
+  auto grid = cartesian_grid(view);
+  for (std::size_t i = 0; i < grid.size(); ++i)
+    if (!covered[i]) grid[i].flags = shaders::kCellOffscreen;
   gpu::Buffer g(ctx, {grid.size() * sizeof(shaders::GridSample), gpu::BufferUsage::Storage, gpu::Memory::DeviceLocal,
                       "reference.grid"});
   g.upload(grid);
@@ -53,20 +95,22 @@ ReferenceResult render_reference(gpu::Context& ctx, const GpuScene& scene, const
     ctx.submit_and_wait([&](VkCommandBuffer cmd) { pt.record(cmd, out, view, eye, batches, c, 0); });
     pixels = out.radiance().download<glm::vec4>();
     glm::dvec3 mean(0);
-    for (const auto& p : pixels) mean += glm::dvec3(p);
-    mean /= double(pixels.size());
+    for (std::size_t i : inside) mean += glm::dvec3(pixels[i]);
+    mean /= double(inside.size());
     batch_means.push_back(luminance(mean));
-    pix_sum.resize(pixels.size(), 0.0);
-    pix_sq.resize(pixels.size(), 0.0);
-    for (std::size_t i = 0; i < pixels.size(); ++i) {
-      const double y = luminance(glm::dvec3(pixels[i]));
-      pix_sum[i] += y;
-      pix_sq[i] += y * y;
+    // Indexed by the position in `inside`.
+    pix_sum.resize(inside.size(), 0.0);
+    pix_sq.resize(inside.size(), 0.0);
+    for (std::size_t k = 0; k < inside.size(); ++k) {
+      const double y = luminance(glm::dvec3(pixels[inside[k]]));
+      pix_sum[k] += y;
+      pix_sq[k] += y * y;
     }
-    // Running mean of the batches on the host, weighted by their sample counts.
-    if (r.image.pixels.empty()) r.image = core::Image(view.width(), view.height());
+    // Running mean of the batches on the host, weighted by their sample counts; pixels
+    // outside the window stay RGBA 0, alpha 0 marking them not traced.
+    if (r.image.pixels.empty()) r.image = core::Image(view.width(), view.height(), glm::vec4(0));
     const double w = double(c.spp) / double(r.spp + c.spp);
-    for (std::size_t i = 0; i < pixels.size(); ++i) {
+    for (std::size_t i : inside) {
       glm::vec4& acc = r.image.pixels[i];
       acc = glm::vec4(glm::mix(glm::dvec3(acc), glm::dvec3(pixels[i]), w), 1.0f);
     }
@@ -85,10 +129,10 @@ ReferenceResult render_reference(gpu::Context& ctx, const GpuScene& scene, const
       // form of core/metrics, ε = 0.01 keeps dark pixels finite); batches differ in size only
       // in the last one, where the unweighted variance errs on the unconverged side.
       double rel2 = 0;
-      for (std::size_t i = 0; i < pix_sum.size(); ++i) {
-        const double pm = pix_sum[i] / double(B);
-        const double se2 = std::max(0.0, pix_sq[i] / double(B) - pm * pm) / double(B - 1);
-        const double acc = luminance(glm::dvec3(r.image.pixels[i]));
+      for (std::size_t k = 0; k < pix_sum.size(); ++k) {
+        const double pm = pix_sum[k] / double(B);
+        const double se2 = std::max(0.0, pix_sq[k] / double(B) - pm * pm) / double(B - 1);
+        const double acc = luminance(glm::dvec3(r.image.pixels[inside[k]]));
         rel2 += se2 / (acc * acc + kPixelEpsilon);
       }
       r.pixel_rel_error = std::sqrt(rel2 / double(std::max<std::size_t>(pix_sum.size(), 1)));
@@ -100,8 +144,8 @@ ReferenceResult render_reference(gpu::Context& ctx, const GpuScene& scene, const
       break;
   }
   glm::dvec3 mean(0);
-  for (const auto& p : r.image.pixels) mean += glm::dvec3(p);
-  r.mean_rgb = mean / double(r.image.pixels.size());
+  for (std::size_t i : inside) mean += glm::dvec3(r.image.pixels[i]);
+  r.mean_rgb = mean / double(inside.size());
   // One batch: no spread to estimate from.
   if (std::isnan(r.rel_error)) r.rel_error = 0;
   if (std::isnan(r.pixel_rel_error)) r.pixel_rel_error = 0;

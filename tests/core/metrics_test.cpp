@@ -1,5 +1,6 @@
 #include "fovea/core/metrics.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <random>
 
@@ -193,4 +194,81 @@ TEST(Metrics, FlickerIsTheTemporalStdOfToneMappedLuma) {
   for (float f : core::flicker_map({a, a, a})) EXPECT_NEAR(f, 0.0f, 1e-7f);
   EXPECT_THROW(core::flicker_map({a}), core::InputError);
   EXPECT_THROW(core::flicker_map({a, core::Image(4, 4)}), core::InputError);
+}
+
+// The erosion behind partial-reference scoring, against a brute-force neighbourhood scan:
+// a pixel is scorable when every pixel of its (2r+1)² square inside the image is valid.
+TEST(Metrics, ScorablePixelsAreTheValidMaskErodedBySquares) {
+  const int w = 23, h = 17;
+  std::mt19937 rng(5);
+  std::vector<bool> valid(std::size_t(w) * h);
+  for (int y = 0; y < h; ++y)
+    for (int x = 0; x < w; ++x) valid[std::size_t(y) * w + x] = (x - 11) * (x - 11) + (y - 8) * (y - 8) < 60 || rng() % 9 == 0;
+  for (int r : {0, 1, 2, 5, 30}) {
+    const std::vector<bool> s = core::scorable_pixels(valid, w, h, r);
+    for (int y = 0; y < h; ++y)
+      for (int x = 0; x < w; ++x) {
+        bool all = true;
+        for (int v = std::max(0, y - r); v <= std::min(h - 1, y + r); ++v)
+          for (int u = std::max(0, x - r); u <= std::min(w - 1, x + r); ++u) all = all && valid[std::size_t(v) * w + u];
+        EXPECT_EQ(s[std::size_t(y) * w + x], all) << "r " << r << " at " << x << "," << y;
+      }
+  }
+  // Every pixel valid: the image border clips the neighbourhood, nothing is lost.
+  const std::vector<bool> full(std::size_t(w) * h, true);
+  EXPECT_EQ(core::scorable_pixels(full, w, h, 5), full);
+  EXPECT_EQ(core::scorable_pixels({true}, 1, 1, 5), std::vector<bool>{true});
+  EXPECT_THROW(core::scorable_pixels(full, w + 1, h, 1), core::InputError);
+  // The support: SSIM's 11×11 window at low density, FLIP's CSF filter at the paper's 67 ppd.
+  EXPECT_EQ(core::error_map_support_px(10.0), core::kSsimRadius);
+  EXPECT_EQ(core::error_map_support_px(67.0), core::flip_support_px(67.0));
+  EXPECT_EQ(core::flip_support_px(67.0), 10);  // ⌈3·√(0.04 / 2π²)·67⌉
+}
+
+// A reference that holds only a window: wherever the window holds a pixel's whole
+// neighbourhood, every error map equals the one against a reference complete everywhere
+// (HDR-FLIP when both take their exposure range from the window); at the window's edge
+// they differ, so the margin is needed.
+TEST(Metrics, PartialReferenceGivesTheWholeReferencesMapsWhereItHoldsTheNeighbourhood) {
+  const int w = 40, h = 36;
+  core::Image whole = noisy(gradient(w, h), 0.2, 1);
+  for (auto& p : whole.pixels) p = glm::abs(p) * 3.0f;  // HDR
+  const core::Image test = noisy(whole, 0.1, 2);
+  std::vector<bool> valid(whole.pixels.size());
+  core::Image partial = whole;
+  for (int y = 0; y < h; ++y)
+    for (int x = 0; x < w; ++x) {
+      const std::size_t i = std::size_t(y) * w + x;
+      valid[i] = (x - 18) * (x - 18) + (y - 20) * (y - 20) <= 14 * 14;
+      if (!valid[i]) partial.pixels[i] = glm::vec4(0);  // not traced
+    }
+  const double ppd = 30.0;
+  const std::vector<bool> scorable = core::scorable_pixels(valid, w, h, core::error_map_support_px(ppd));
+  const core::ErrorMaps p = core::error_maps(test, partial, ppd, 0.0, valid);
+  const core::ErrorMaps f = core::error_maps(test, whole, ppd, 0.0, valid);
+  const core::ErrorMaps f_own = core::error_maps(test, whole, ppd);  // exposures from every pixel
+  std::size_t inside = 0, edge_differs = 0;
+  for (std::size_t i = 0; i < scorable.size(); ++i) {
+    if (!scorable[i]) {
+      edge_differs += valid[i] && p.ssim[i] != f.ssim[i];
+      continue;
+    }
+    ++inside;
+    EXPECT_EQ(p.squared_error[i], f_own.squared_error[i]) << i;
+    EXPECT_EQ(p.ssim[i], f_own.ssim[i]) << i;
+    EXPECT_EQ(p.rel_mse[i], f_own.rel_mse[i]) << i;
+    EXPECT_EQ(p.ldr_flip[i], f_own.ldr_flip[i]) << i;
+    EXPECT_EQ(p.hdr_flip[i], f.hdr_flip[i]) << i;
+  }
+  EXPECT_GT(inside, 100u);
+  EXPECT_GT(edge_differs, 0u);
+  // The exposure range of the window's pixels is that of an image of those pixels alone.
+  core::Image held(int(std::count(valid.begin(), valid.end(), true)), 1);
+  for (std::size_t i = 0, k = 0; i < valid.size(); ++i)
+    if (valid[i]) held.pixels[k++] = whole.pixels[i];
+  const core::HdrFlip a = core::hdr_flip_exposures(partial, valid), b = core::hdr_flip_exposures(held);
+  EXPECT_EQ(a.start_exposure, b.start_exposure);
+  EXPECT_EQ(a.stop_exposure, b.stop_exposure);
+  EXPECT_EQ(a.exposures, b.exposures);
+  EXPECT_THROW(core::hdr_flip_exposures(partial, std::vector<bool>(valid.size(), false)), core::InputError);
 }

@@ -7,6 +7,7 @@
 #include <filesystem>
 #include <fstream>
 #include <string>
+#include <vector>
 
 #include <gtest/gtest.h>
 #include <nlohmann/json.hpp>
@@ -262,6 +263,134 @@ TEST(RenderBudget, RefusedBudgetsExitTwoAndLinearFalloffRenders) {
   // Traced: the kept cells minus the lens' hidden ones, so at most the budget (+5%).
   EXPECT_LT(j["samples_traced_per_eye"].get<double>(), 1.05 * 0.5 * 64 * 72);
   EXPECT_GT(j["samples_traced_per_eye"].get<double>(), 0.3 * 64 * 72);
+  fs::remove_all(dir);
+}
+
+// A window reference scores the fovea and the bands whose pixels and SSIM/FLIP
+// neighbourhoods it holds exactly as the whole view's reference with the same samples (HDR-FLIP
+// aside: its exposure range comes from the window); the other bands, the whole image and the
+// acuity-weighted scores are null with notes. A whole-view entry serves a window request.
+TEST(ReferenceWindow, BandsInsideScoreAsWithTheWholeReferenceAndTheOthersAreMissing) {
+  const std::string dir = fovea::test::temp_dir("refwindow");
+  const std::string common = "--frames 2 --gaze " + fixed_gaze(dir) + " --reference 4 --reference-error 0";
+  const json whole = render(common + " --reference-cache " + dir + "/cache", dir + "/whole");
+  const json served = render(common + " --reference-window 40 --reference-cache " + dir + "/cache", dir + "/served");
+  const json part = render(common + " --reference-window 40 --reference-cache off", dir + "/part");
+  for (const char* eye : {"left", "right"}) {
+    const json& wref = whole["metrics"]["reference"][eye];
+    EXPECT_TRUE(wref["window"].is_null());
+    EXPECT_EQ(wref["hdr_flip_exposures"]["from"], "whole image");
+    const json& sref = served["metrics"]["reference"][eye];
+    EXPECT_TRUE(sref["cached"].get<bool>()) << eye;
+    EXPECT_EQ(sref["key"], wref["key"]);
+    EXPECT_TRUE(sref["window"].is_null());
+    EXPECT_EQ(served["summary"][eye]["psnr"], whole["summary"][eye]["psnr"]);
+
+    const json& pref = part["metrics"]["reference"][eye];
+    EXPECT_FALSE(pref["cached"].get<bool>());
+    EXPECT_NE(pref["key"], wref["key"]);
+    ASSERT_EQ(pref["window"].size(), 1u);
+    EXPECT_EQ(pref["window"][0]["radius_deg"].get<double>(), 40.0);
+    EXPECT_EQ(pref["hdr_flip_exposures"]["from"], "window");
+    const json& s = part["summary"][eye];
+    const json& w = whole["summary"][eye];
+    // Centred on the scored gaze.
+    const json& g = s["gaze"];
+    const double len = std::hypot(g[0].get<double>(), g[1].get<double>(), g[2].get<double>());
+    for (int k = 0; k < 3; ++k) EXPECT_NEAR(pref["window"][0]["centre"][k].get<double>(), g[k].get<double>() / len, 1e-12);
+    for (const char* prefix : {"", "foveated_"})
+      for (const char* k : kScores) EXPECT_TRUE(s[std::string(prefix) + k].is_null()) << eye << " " << prefix << k;
+    EXPECT_TRUE(s["linear_psnr"].is_null());
+    ASSERT_TRUE(s.contains("quality_notes"));
+    EXPECT_NE(s["quality_notes"][0].get<std::string>().find("window"), std::string::npos);
+    for (const char* k : {"psnr", "ssim", "rel_mse", "ldr_flip"})
+      EXPECT_EQ(s[std::string("fovea_") + k], w[std::string("fovea_") + k]) << eye << " fovea_" << k;
+    ASSERT_EQ(s["bands"].size(), w["bands"].size());
+    int scored = 0, missing = 0;
+    for (std::size_t b = 0; b < s["bands"].size(); ++b) {
+      const json &pb = s["bands"][b], &wb = w["bands"][b];
+      EXPECT_EQ(pb["e_min"], wb["e_min"]);
+      EXPECT_EQ(pb["pixels"], wb["pixels"]);
+      if (pb["psnr"].is_null()) {
+        ++missing;
+        for (const char* k : kScores) EXPECT_TRUE(pb[k].is_null()) << k;
+        EXPECT_NE(pb["missing"].get<std::string>().find("lacks pixels of this band"), std::string::npos);
+        continue;
+      }
+      ++scored;
+      EXPECT_EQ(missing, 0) << "a band inside follows a missing one";
+      for (const char* k : {"psnr", "ssim", "rel_mse", "ldr_flip"}) EXPECT_EQ(pb[k], wb[k]) << eye << " band " << b << " " << k;
+      EXPECT_GE(pb["hdr_flip"].get<double>(), 0.0);
+      EXPECT_LE(pb["hdr_flip"].get<double>(), 1.0);
+    }
+    // tiny: 0.47 pixels per degree, so SSIM's 5-pixel margin is ~11 deg of the 40.
+    EXPECT_GE(scored, 3) << eye;
+    EXPECT_GE(missing, 10) << eye;
+  }
+  // The window references the render wrote, read back as a directory, score the same.
+  const json again = render("--frames 2 --gaze " + fixed_gaze(dir) + " --reference " + dir + "/part", dir + "/again");
+  EXPECT_EQ(again["summary"], part["summary"]);
+  fs::remove_all(dir);
+}
+
+// The window is part of the key: the same window again reads the cache, another window or
+// the whole view renders; an entry of the whole view serves a window, never the reverse.
+TEST(ReferenceCache, TheWindowIsPartOfTheKeyAndOnlyTheWholeViewServesWindows) {
+  const std::string dir = fovea::test::temp_dir("refwinkey");
+  const auto reference = [&](const std::string& out, const std::string& window) {
+    const auto r = run_fovea("reference --display tiny --scene cornell --spp 4 --quiet --reference-cache " + dir +
+                             "/cache --out " + dir + "/" + out + (window.empty() ? "" : " --window '" + window + "'"));
+    EXPECT_EQ(r.status, 0) << window << ": " << r.err;
+    return json::parse(r.out);
+  };
+  const json a = reference("a.exr", "0,0,-1@30");
+  EXPECT_FALSE(a["cached"].get<bool>());
+  EXPECT_EQ(a["window"][0]["radius_deg"].get<double>(), 30.0);
+  EXPECT_GT(a["pixels"].get<int>(), 0);
+  EXPECT_LT(a["pixels"].get<int>(), 64 * 72);
+  EXPECT_EQ(read_json(dir + "/a.json")["identity"]["window"], a["window"]);
+  const json again = reference("a2.exr", "0,0,-2@30");  // the same direction, another length
+  EXPECT_TRUE(again["cached"].get<bool>());
+  EXPECT_EQ(again["key"], a["key"]);
+  const json wider = reference("b.exr", "0,0,-1@31");
+  EXPECT_FALSE(wider["cached"].get<bool>());
+  EXPECT_NE(wider["key"], a["key"]);
+  const json two = reference("c.exr", "0,0,-1@30;px:0,0@10");
+  EXPECT_FALSE(two["cached"].get<bool>());
+  EXPECT_EQ(two["window"].size(), 2u);
+  EXPECT_GT(two["pixels"].get<int>(), a["pixels"].get<int>());
+  const json whole = reference("w.exr", "");
+  EXPECT_FALSE(whole["cached"].get<bool>()) << "a window served the whole view";
+  EXPECT_TRUE(whole["window"].is_null());
+  EXPECT_EQ(whole["pixels"].get<int>(), 64 * 72);
+  EXPECT_FALSE(read_json(dir + "/w.json")["identity"].contains("window"));
+  for (const json& k : {a["key"], wider["key"], two["key"]}) EXPECT_NE(whole["key"], k);
+  const json served = reference("d.exr", "0.1,0,-1@20");
+  EXPECT_TRUE(served["cached"].get<bool>());
+  EXPECT_EQ(served["key"], whole["key"]);
+  EXPECT_TRUE(served["window"].is_null());
+  fs::remove_all(dir);
+}
+
+TEST(ReferenceWindow, BadWindowsExitTwoNamingTheOption) {
+  const std::string dir = fovea::test::temp_dir("refwinbad");
+  for (const char* spec : {"0,0,-1@0", "0,0,-1@-2", "0,0,-1@nan", "0,0,-1@200", "nan,0,-1@5", "0,0,0@5", "0,0,1@10",
+                           "px:-400,-400@2", "0,0@5", "0,0,-1", "x,0,-1@5", "0,0,-1@5;0,0,1@5", ""}) {
+    const auto r = run_fovea("reference --display tiny --scene cornell --spp 1 --quiet --reference-cache off --window '" +
+                             std::string(spec) + "' --out " + dir + "/x.exr");
+    EXPECT_EQ(r.status, 2) << spec;
+    EXPECT_NE(r.err.find("--window"), std::string::npos) << spec << ": " << r.err;
+  }
+  EXPECT_FALSE(fs::exists(dir + "/x.exr"));
+  for (const std::string& args : std::vector<std::string>{"--reference 4 --reference-window 0", "--reference 4 --reference-window nan",
+                                 "--reference 4 --reference-window=-5", "--reference 4 --reference-window 200",
+                                 "--reference-window 10", "--reference " + dir + " --reference-window 10"}) {
+    const auto r = run_fovea("render --display tiny --scene cornell --frames 1 --quiet --reference-cache off " + args +
+                             " --out " + dir + "/r");
+    EXPECT_EQ(r.status, 2) << args;
+    EXPECT_NE(r.err.find("--reference-window"), std::string::npos) << args << ": " << r.err;
+    EXPECT_FALSE(fs::exists(dir + "/r/report.json")) << args;
+  }
   fs::remove_all(dir);
 }
 

@@ -1,4 +1,5 @@
 // fovea reference: progressive Cartesian path-traced reference image of one eye.
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
@@ -27,9 +28,14 @@ sample per pixel and pass) until --spp samples per pixel, or earlier once a rela
 standard error falls to its target. Writes the linear image as OpenEXR (32-bit float),
 its description F.json (key, settings, statistics; what `fovea render --reference DIR`
 checks) and a tone-mapped PNG (same name, other extension), and prints JSON:
-{"spp", "mean_rgb", "rel_error", "pixel_rel_error", "seconds", "key", "cached"}.
-The result is kept in a cache keyed by the scene's bytes, the view, these settings and the
-renderer; the same request again reads it instead of rendering. The defaults are those of
+{"spp", "mean_rgb", "rel_error", "pixel_rel_error", "seconds", "key", "cached", "window",
+"pixels"}.
+With --window only the pixels of the window are traced (the stop rules and statistics are
+over them); the EXR's alpha is 1 on them and 0 elsewhere (RGB 0, not traced), the JSON
+records the window, and `fovea render --reference DIR` scores only what they cover.
+The result is kept in a cache keyed by the scene's bytes, the view, these settings, the
+window and the renderer; the same request again reads it instead of rendering, and an entry
+of the whole view with the same settings serves a window request. The defaults are those of
 `fovea render --reference SPP` (--spp SPP --until-pixel-rel-error as its --reference-error),
 so either command reuses the other's references.
 
@@ -50,6 +56,10 @@ so either command reuses the other's references.
                         path keeps at most 0.1% of its light [auto]
   --rr-start N|auto     bounce from which Russian roulette applies; auto: once the mean
                         throughput is halved, from the scene's mean albedo [auto]
+  --window DISC[;DISC...]  render only the union of discs, DISC = CENTRE@R: the pixels
+                        whose centre lies within R degrees of CENTRE, a view-space direction
+                        X,Y,Z (-Z forward, +Y up; `fovea render` reports each eye's gaze)
+                        or a display pixel px:X,Y (origin top-left) [the whole view]
   --reference-cache DIR|off  the cache [$XDG_CACHE_HOME/fovea/references]
   --out F               output path ending in .exr or .png (all three are written)
   --quiet               no progress bar
@@ -75,7 +85,7 @@ int run(std::vector<std::string> argv) {
       return 0;
     }
   const Args args(argv, {"scene", "display", "eye", "spp", "until-rel-error", "until-pixel-rel-error", "batch", "bounces", "rr-start",
-                         "reference-cache", "out", "trace"},
+                         "reference-cache", "out", "trace", "window"},
                   {"quiet"});
   const auto out = args.opt("out");
   if (!out) throw core::InputError("--out F.exr|F.png is required (see --help)");
@@ -111,6 +121,8 @@ int run(std::vector<std::string> argv) {
   for (const auto& w : scene.warnings) std::cerr << "warning: " << w << "\n";
 
   const core::View view = core::stereo_views(display, scene.camera)[eye];
+  renderer::ReferenceWindow window;
+  if (auto w = args.opt("window")) window = parse_window(*w, view, "--window");
 
   gpu::Context ctx;
   renderer::GpuScene gs(ctx, scene, {}, tracing);
@@ -123,6 +135,7 @@ int run(std::vector<std::string> argv) {
   req.settings.rr_start = std::uint32_t(rr);
   req.settings.until_rel_error = until;
   req.settings.until_pixel_rel_error = until_pixel;
+  req.window = window;
   req.cache_dir = cache;
   const bool bar = !args.has("quiet") && stderr_is_tty();
   const CachedReference c = cached_reference(ctx, gs, view, eye, req, [&](const renderer::ReferenceProgress& p) {
@@ -143,6 +156,9 @@ int run(std::vector<std::string> argv) {
   j["seconds"] = r.seconds;
   j["key"] = c.key;
   j["cached"] = c.from_cache;
+  // What the image holds: a whole-view entry may have served a window request.
+  j["window"] = window_json(c.window);
+  j["pixels"] = c.valid.empty() ? r.image.pixels.size() : std::size_t(std::count(c.valid.begin(), c.valid.end(), true));
   std::cout << j.dump() << "\n";
   return 0;
 }

@@ -98,6 +98,13 @@ With no options: a short demo on the shipped scene and gaze.
                         `fovea reference` (checked to show this scene and view)
   --reference-error X   stop the reference once its per-pixel relative standard error
                         (RMS over the pixels, over the mean luminance) is <= X; 0: off [0.02]
+  --reference-window DEG  with --reference SPP: each eye's reference traces only the pixels
+                        within DEG degrees of that eye's gaze in the last frame (the scored
+                        one; `fovea reference --window X,Y,Z@DEG`, the same cache entry)
+                        [the whole view]. A reference that holds a window (this, or a DIR
+                        written with --window) scores only the bands, and the fovea, whose
+                        pixels and SSIM/FLIP neighbourhoods it holds; the others, the whole
+                        image and foveated_* are null, with a note in quality_notes
   --reference-cache DIR|off  where references are cached [$XDG_CACHE_HOME/fovea/references]
   --png-every N         write PNGs of every N-th frame (0: last frame only) [1]
   --no-marker           do not mark the gaze in the PNGs
@@ -173,21 +180,83 @@ std::vector<float> fovea_weights(const std::vector<float>& ecc) {
   return w;
 }
 
-// Quality of `img` against `ref`: whole image, fovea, acuity-weighted and per band.
-void add_quality(nlohmann::json& s, const core::Image& img, const core::Image& ref, const std::vector<float>& ecc,
-                 double ppd) {
-  const core::ErrorMaps maps = core::error_maps(img, ref, ppd, kExposure);
-  s.update(scores_json(core::pool(maps), ""));
-  s.update(scores_json(core::pool(maps, fovea_weights(ecc)), "fovea_"));
-  s.update(scores_json(core::pool(maps, core::foveation_weights(ecc)), "foveated_"));
-  s["linear_psnr"] = core::psnr(img, ref);  // linear HDR, peak 1: dominated by emitters
+nlohmann::json missing_scores(const std::string& prefix) {
+  nlohmann::json j;
+  for (const char* k : {"psnr", "ssim", "rel_mse", "ldr_flip", "hdr_flip"}) j[prefix + k] = nullptr;
+  return j;
+}
+
+// Quality of `img` against `ref`: whole image, fovea, acuity-weighted and per band. A
+// reference that holds only a window (`valid`, one flag per pixel; empty: every pixel)
+// scores a region only when it holds every pixel the region's error maps read (the region
+// and error_map_support_px around it), so those scores are the ones a whole reference with
+// the same pixels gives; the other regions are null, never scored against the untraced
+// zeros, with a note in quality_notes.
+void add_quality(nlohmann::json& s, const core::Image& img, const core::Image& ref, const std::vector<bool>& valid,
+                 const std::vector<float>& ecc, double ppd) {
+  const core::ErrorMaps maps = core::error_maps(img, ref, ppd, kExposure, valid);
+  const auto band_of = [](float e) {  // band_scores' [k·w, (k+1)·w)
+    int k = std::max(0, int(e / kBandDeg));
+    while (k > 0 && e < k * kBandDeg) --k;
+    while (e >= (k + 1) * kBandDeg) ++k;
+    return k;
+  };
+  // What a missing pixel takes away: the whole image and the acuity weights (nowhere 0)
+  // always, the fovea and the bands where it falls.
+  bool whole = true, fovea = true;
+  std::vector<bool> band_ok;
+  const int support = core::error_map_support_px(ppd);
+  if (!valid.empty()) {
+    const std::vector<bool> scorable = core::scorable_pixels(valid, img.width, img.height, support);
+    for (std::size_t i = 0; i < scorable.size(); ++i) {
+      if (scorable[i] || !std::isfinite(ecc[i])) continue;
+      whole = false;
+      if (ecc[i] <= core::acuity::kFoveaDeg) fovea = false;
+      const int k = band_of(ecc[i]);
+      if (band_ok.size() <= std::size_t(k)) band_ok.resize(std::size_t(k) + 1, true);
+      band_ok[std::size_t(k)] = false;
+    }
+  }
+  nlohmann::json notes = nlohmann::json::array();
+  const std::size_t held = valid.empty() ? valid.size() : std::size_t(std::count(valid.begin(), valid.end(), true));
+  char lacks[160];
+  std::snprintf(lacks, sizeof lacks, "the reference is a window of %.2f%% of the pixels and lacks", 100.0 * double(held) /
+                double(std::max<std::size_t>(valid.size(), 1)));
+  const std::string margin = " or within " + std::to_string(support) + " px of them (the SSIM and FLIP neighbourhoods)";
+  if (whole) {
+    s.update(scores_json(core::pool(maps), ""));
+    s.update(scores_json(core::pool(maps, core::foveation_weights(ecc)), "foveated_"));
+    s["linear_psnr"] = core::psnr(img, ref);  // linear HDR, peak 1: dominated by emitters
+  } else {
+    s.update(missing_scores(""));
+    s.update(missing_scores("foveated_"));
+    s["linear_psnr"] = nullptr;
+    notes.push_back(std::string("whole-image (psnr, ssim, rel_mse, ldr_flip, hdr_flip, linear_psnr) and acuity-weighted "
+                                "(foveated_*) scores not computed: ") + lacks + " pixels they need");
+  }
+  if (fovea) {
+    s.update(scores_json(core::pool(maps, fovea_weights(ecc)), "fovea_"));
+  } else {
+    s.update(missing_scores("fovea_"));
+    notes.push_back(std::string("fovea_* not computed: ") + lacks + " pixels of the fovea" + margin);
+  }
   nlohmann::json bands = nlohmann::json::array();
+  int missing = 0;
   for (const core::BandScores& b : core::band_scores(maps, ecc, kBandDeg)) {
     nlohmann::json o = {{"e_min", b.e_min}, {"e_max", b.e_max}, {"pixels", b.pixels}};
-    o.update(scores_json(b.scores, ""));
+    const std::size_t k = std::size_t(std::llround(b.e_min / kBandDeg));
+    if (k < band_ok.size() && !band_ok[k]) {
+      o.update(missing_scores(""));
+      o["missing"] = std::string(lacks) + " pixels of this band" + margin;
+      ++missing;
+    } else {
+      o.update(scores_json(b.scores, ""));
+    }
     bands.push_back(o);
   }
   s["bands"] = bands;
+  if (missing) notes.push_back(std::to_string(missing) + " bands not computed (null, see their \"missing\")");
+  if (!notes.empty()) s["quality_notes"] = notes;
 }
 
 // Flicker of the still frames: whole image, fovea, acuity-weighted and per band.
@@ -220,8 +289,8 @@ int run(std::vector<std::string> argv) {
     }
   const Args args(argv,
                   {"scene", "display", "gaze", "frames", "distribution", "budget", "jitter", "denoiser", "bmfr-precision",
-                   "stereo-share", "reference", "reference-error", "reference-cache", "png-every", "out", "screen",
-                   "trace"},
+                   "stereo-share", "reference", "reference-error", "reference-cache", "reference-window", "png-every",
+                   "out", "screen", "trace"},
                   {"no-blur", "no-cull", "no-marker", "quiet"});
   const long frames = args.integer("frames", 24);
   if (frames < 1 || frames > 100000) throw core::InputError("--frames must be in 1..100000");
@@ -237,6 +306,10 @@ int run(std::vector<std::string> argv) {
   if (!(ref_error >= 0) || !std::isfinite(ref_error)) throw core::InputError("--reference-error must be >= 0");
   const auto cache_opt = args.opt("reference-cache");
   const std::string ref_cache = reference_cache_arg(cache_opt ? &*cache_opt : nullptr);
+  if (args.has("reference-window") && ref_spp == 0)
+    throw core::InputError("--reference-window: only with --reference SPP (a DIR reference brings its own window)");
+  const bool ref_window = args.has("reference-window");
+  const double ref_window_deg = args.num("reference-window", 0);
   const long png_every = args.integer("png-every", 1);
   if (png_every < 0) throw core::InputError("--png-every must be >= 0");
   const core::DisplayPreset display = core::load_display(args.str("display", "small"));
@@ -297,7 +370,11 @@ int run(std::vector<std::string> argv) {
   ref_request.settings.max_spp = std::uint32_t(ref_spp);
   ref_request.settings.until_pixel_rel_error = ref_error;
   ref_request.cache_dir = ref_cache;
-  // A loaded reference is checked before the frames are paid for.
+  // A loaded reference and the window's radius are checked before the frames are paid for
+  // (the gaze is inside the view: a disc at its centre stands for it).
+  if (ref_window)
+    renderer::window_coverage({{{pipeline.view(core::Eye::Left).centre_dir(), ref_window_deg}}},
+                              pipeline.view(core::Eye::Left), "--reference-window");
   std::array<std::optional<CachedReference>, 2> loaded;
   if (!ref_dir.empty())
     for (int e = 0; e < 2; ++e) {
@@ -427,6 +504,7 @@ int run(std::vector<std::string> argv) {
     const glm::dvec3 g = pipeline.distribution(eye).gaze();
     const std::vector<float> ecc = core::eccentricity_map(v, g);
     nlohmann::json s;
+    s["gaze"] = {g.x, g.y, g.z};  // view space, as the grid used it
     s["temporal_error"] = frames > 1 ? te_sum[e] / double(frames - 1) : 0.0;
     if (still[e].size() >= 2) add_flicker(s, still[e], ecc);
     if (ref_spp > 0 || !ref_dir.empty()) {
@@ -435,7 +513,9 @@ int run(std::vector<std::string> argv) {
         ref = std::move(*loaded[e]);
       } else {
         if (bar) std::fprintf(stderr, "reference %s eye, up to %ld spp...\n", name, ref_spp);
-        ref = cached_reference(ctx, gpu_scene, v, eye, ref_request);
+        ReferenceRequest req = ref_request;
+        if (ref_window) req.window.discs = {{g, ref_window_deg}};
+        ref = cached_reference(ctx, gpu_scene, v, eye, req);
         write_reference((out_dir / (std::string("reference_") + name + ".exr")).string(), ref);
       }
       ref_info[name] = {{"spp", ref.result.spp},
@@ -443,8 +523,15 @@ int run(std::vector<std::string> argv) {
                         {"rel_error", ref.result.rel_error},
                         {"key", ref.key},
                         {"cached", ref.from_cache},
-                        {"settings", nlohmann::json::parse(ref.identity).value("settings", nlohmann::json())}};
-      add_quality(s, last[e], ref.result.image, ecc, ppd);
+                        {"seconds", ref.result.seconds},
+                        {"settings", nlohmann::json::parse(ref.identity).value("settings", nlohmann::json())},
+                        {"window", window_json(ref.window)}};
+      const core::HdrFlip range = core::hdr_flip_exposures(ref.result.image, ref.valid);
+      ref_info[name]["hdr_flip_exposures"] = {{"start", range.start_exposure},
+                                              {"stop", range.stop_exposure},
+                                              {"count", range.exposures},
+                                              {"from", ref.valid.empty() ? "whole image" : "window"}};
+      add_quality(s, last[e], ref.result.image, ref.valid, ecc, ppd);
     }
     j["summary"][name] = s;
   }

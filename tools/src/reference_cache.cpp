@@ -4,6 +4,7 @@
 #include <filesystem>
 #include <fstream>
 #include <iostream>
+#include <optional>
 #include <sstream>
 
 #include <nlohmann/json.hpp>
@@ -65,18 +66,32 @@ json view_identity(const core::View& v, core::Eye eye) {
           {"orientation", {p.orientation.w, p.orientation.x, p.orientation.y, p.orientation.z}}};
 }
 
-json identity(const std::string& scene, const core::View& v, core::Eye eye, const ReferenceSettings& s) {
-  return {{"format", kFormat},
-          {"renderer", renderer_digest()},
-          {"scene", scene_digest(scene)},
-          {"view", view_identity(v, eye)},
-          {"settings",
-           {{"max_spp", s.max_spp},
-            {"batch", s.batch},
-            {"bounces", s.bounces},
-            {"rr_start", s.rr_start},
-            {"until_rel_error", s.until_rel_error},
-            {"until_pixel_rel_error", s.until_pixel_rel_error}}}};
+// A reference of the whole view has no "window": its keys are those from before windows.
+json identity(const std::string& scene, const core::View& v, core::Eye eye, const ReferenceSettings& s,
+              const renderer::ReferenceWindow& window = {}) {
+  json id = {{"format", kFormat},
+             {"renderer", renderer_digest()},
+             {"scene", scene_digest(scene)},
+             {"view", view_identity(v, eye)},
+             {"settings",
+              {{"max_spp", s.max_spp},
+               {"batch", s.batch},
+               {"bounces", s.bounces},
+               {"rr_start", s.rr_start},
+               {"until_rel_error", s.until_rel_error},
+               {"until_pixel_rel_error", s.until_pixel_rel_error}}}};
+  if (!window.whole()) id["window"] = window_json(window);
+  return id;
+}
+
+renderer::ReferenceWindow window_of(const json& identity) {
+  renderer::ReferenceWindow w;
+  if (!identity.contains("window")) return w;
+  for (const json& d : identity.at("window")) {
+    const json& c = d.at("centre");
+    w.discs.push_back({{c.at(0).get<double>(), c.at(1).get<double>(), c.at(2).get<double>()}, d.at("radius_deg").get<double>()});
+  }
+  return w;
 }
 
 std::string sidecar(const std::string& exr) { return fs::path(exr).replace_extension(".json").string(); }
@@ -107,6 +122,7 @@ CachedReference load(const std::string& exr, const json& meta, const std::string
     r.result.seconds = meta.at("seconds").get<double>();
     const auto& m = meta.at("mean_rgb");
     r.result.mean_rgb = {m.at(0).get<double>(), m.at(1).get<double>(), m.at(2).get<double>()};
+    r.window = window_of(meta.at("identity"));
   } catch (const json::exception& e) {
     throw core::InputError(where + ": not a reference description (" + e.what() + ")");
   }
@@ -119,7 +135,89 @@ CachedReference load(const std::string& exr, const json& meta, const std::string
   return r;
 }
 
+// A window reference's pixels: those of its window on `view`, which its alpha must mark (1
+// inside, 0 outside); a reference of the whole view is valid everywhere.
+void check_coverage(CachedReference& r, const core::View& view, const std::string& where) {
+  r.valid.clear();
+  if (r.window.whole()) return;
+  std::vector<bool> valid = renderer::window_coverage(r.window, view, where + ": window");
+  for (std::size_t i = 0; i < valid.size(); ++i)
+    if (r.result.image.pixels[i].w != (valid[i] ? 1.0f : 0.0f))
+      throw core::InputError(where + ": the image's alpha does not mark its window's pixels (pixel " + std::to_string(i) +
+                             ")");
+  r.valid = std::move(valid);
+}
+
+// The cache entry `key`, when present and sound; a damaged or foreign entry is reported
+// (`then`: what happens instead) and ignored, never trusted.
+std::optional<CachedReference> lookup(const std::string& dir, const std::string& key, const std::string& text,
+                                      const core::View& view, const char* then) {
+  const fs::path exr = fs::path(dir) / (key + ".exr");
+  const std::string meta_path = sidecar(exr.string());
+  if (dir.empty() || !fs::exists(meta_path)) return std::nullopt;
+  try {
+    const json meta = read_json(meta_path);
+    if (meta.value("key", "") != key || !meta.contains("identity") || meta["identity"].dump() != text)
+      throw core::InputError(meta_path + ": describes another reference than its name's key " + key);
+    CachedReference r = load(exr.string(), meta, meta_path);
+    check_coverage(r, view, exr.string());
+    return r;
+  } catch (const core::InputError& e) {
+    std::cerr << "warning: damaged reference cache entry, " << then << ": " << e.what() << "\n";
+  }
+  return std::nullopt;
+}
+
 }  // namespace
+
+renderer::ReferenceWindow parse_window(const std::string& spec, const core::View& view, const std::string& option) {
+  const auto numbers = [&](const std::string& text, std::size_t n, const std::string& disc) {
+    std::vector<double> v;
+    std::stringstream ss(text);
+    std::string part;
+    while (std::getline(ss, part, ',')) {
+      char* end = nullptr;
+      v.push_back(std::strtod(part.c_str(), &end));
+      if (part.empty() || *end != '\0')
+        throw core::InputError(option + ": \"" + part + "\" in \"" + disc + "\" is not a number");
+    }
+    if (v.size() != n || (!text.empty() && text.back() == ','))
+      throw core::InputError(option + ": \"" + disc + "\" needs " + std::to_string(n) + " comma-separated numbers before @");
+    return v;
+  };
+  renderer::ReferenceWindow w;
+  std::stringstream ss(spec);
+  std::string disc;
+  while (std::getline(ss, disc, ';')) {
+    const std::size_t at = disc.rfind('@');
+    if (at == std::string::npos)
+      throw core::InputError(option + ": \"" + disc + "\" is not X,Y,Z@RADIUS or px:X,Y@RADIUS (degrees)");
+    const std::string centre = disc.substr(0, at);
+    renderer::WindowDisc d;
+    d.radius_deg = numbers(disc.substr(at + 1), 1, disc)[0];
+    if (centre.rfind("px:", 0) == 0) {
+      const auto p = numbers(centre.substr(3), 2, disc);
+      d.centre = view.pixel_to_dir({p[0], p[1]});
+    } else {
+      const auto c = numbers(centre, 3, disc);
+      d.centre = {c[0], c[1], c[2]};
+    }
+    w.discs.push_back(d);
+  }
+  if (w.discs.empty()) throw core::InputError(option + ": expected X,Y,Z@RADIUS or px:X,Y@RADIUS, got \"" + spec + "\"");
+  renderer::window_coverage(w, view, option);
+  return w;
+}
+
+json window_json(const renderer::ReferenceWindow& window) {
+  if (window.whole()) return nullptr;
+  json discs = json::array();
+  for (const renderer::WindowDisc& d : window.discs) {
+    const glm::dvec3 c = d.centre / glm::length(d.centre);
+    discs.push_back({{"centre", {c.x, c.y, c.z}}, {"radius_deg", d.radius_deg}});
+  }
+  return discs;
+}
 
 ReferenceSettings reference_defaults(const renderer::Scene& scene) {
   const renderer::PathConfig a = renderer::albedo_path_config(renderer::albedo_stats(scene));
@@ -146,22 +244,19 @@ std::string reference_cache_arg(const std::string* value) {
 CachedReference cached_reference(gpu::Context& ctx, const renderer::GpuScene& scene, const core::View& view,
                                  core::Eye eye, const ReferenceRequest& req,
                                  const std::function<void(const renderer::ReferenceProgress&)>& progress) {
-  const json id = identity(req.scene, view, eye, req.settings);
-  const std::string text = id.dump();
+  // The window is checked before the cache is: a bad one is bad input, not a miss.
+  std::vector<bool> valid = renderer::window_coverage(req.window, view, "reference window");
+  const std::string text = identity(req.scene, view, eye, req.settings, req.window).dump();
   const std::string key = hex64(sweep::fnv1a64(text));
-  const fs::path exr = fs::path(req.cache_dir) / (key + ".exr");
-  const std::string meta_path = sidecar(exr.string());
-  if (!req.cache_dir.empty() && fs::exists(meta_path)) {
-    // A damaged or foreign entry is reported, rendered again and replaced, never trusted.
-    try {
-      const json meta = read_json(meta_path);
-      if (meta.value("key", "") != key || !meta.contains("identity") || meta["identity"].dump() != text)
-        throw core::InputError(meta_path + ": describes another reference than its name's key " + key);
-      return load(exr.string(), meta, meta_path);
-    } catch (const core::InputError& e) {
-      std::cerr << "warning: damaged reference cache entry, rendering it again: " << e.what() << "\n";
-    }
+  if (auto hit = lookup(req.cache_dir, key, text, view, "rendering it again")) return std::move(*hit);
+  // The whole view with the same settings holds every pixel of any window; the reverse
+  // never serves.
+  if (!req.window.whole()) {
+    const std::string whole = identity(req.scene, view, eye, req.settings).dump();
+    if (auto hit = lookup(req.cache_dir, hex64(sweep::fnv1a64(whole)), whole, view, "rendering the window instead"))
+      return std::move(*hit);
   }
+  const fs::path exr = fs::path(req.cache_dir) / (key + ".exr");
   renderer::ReferenceOptions o;
   o.path.spp = std::max<std::uint32_t>(1, std::min(req.settings.batch, req.settings.max_spp));
   o.path.max_bounces = req.settings.bounces;
@@ -169,10 +264,13 @@ CachedReference cached_reference(gpu::Context& ctx, const renderer::GpuScene& sc
   o.max_spp = req.settings.max_spp;
   o.until_rel_error = req.settings.until_rel_error;
   o.until_pixel_rel_error = req.settings.until_pixel_rel_error;
+  o.window = req.window;
   CachedReference r;
   r.result = renderer::render_reference(ctx, scene, view, eye, o, progress);
   r.key = key;
   r.identity = text;
+  r.window = req.window;
+  if (!req.window.whole()) r.valid = std::move(valid);
   if (!req.cache_dir.empty()) {
     // The reference is good without its cache entry: an unwritable cache costs the next run.
     try {
@@ -210,6 +308,7 @@ CachedReference read_reference(const std::string& exr, const std::string& scene,
     if (have.value(part, json()) != want[part])
       throw core::InputError(meta_path + ": a reference of another " + part + " (" + have.value(part, json()).dump() +
                              ", this render needs " + want[part].dump() + ")");
+  check_coverage(r, view, exr);
   return r;
 }
 

@@ -8,6 +8,9 @@
 #include <cstdint>
 #include <functional>
 #include <string>
+#include <vector>
+
+#include <nlohmann/json_fwd.hpp>
 
 #include "fovea/core/view.hpp"
 #include "fovea/renderer/reference.hpp"
@@ -32,10 +35,13 @@ struct ReferenceSettings {
 inline constexpr double kDefaultPixelRelError = 0.02;
 ReferenceSettings reference_defaults(const renderer::Scene& scene);
 
-// `dir` empty: no cache. `scene` is the --scene argument (a file's bytes are hashed).
+// `dir` empty: no cache. `scene` is the --scene argument (a file's bytes are hashed). A
+// window (part of the key) renders only its pixels; an entry of the whole view with the
+// same settings serves it too.
 struct ReferenceRequest {
   std::string scene;
   ReferenceSettings settings;
+  renderer::ReferenceWindow window;
   std::string cache_dir;
 };
 
@@ -44,7 +50,18 @@ struct CachedReference {
   std::string key;         // 16 hex digits
   std::string identity;    // the canonical JSON the key hashes
   bool from_cache = false;
+  renderer::ReferenceWindow window;  // what the image holds (whole: every pixel)
+  std::vector<bool> valid;           // per pixel, the window's; empty when whole
 };
+
+// A window given on the command line as DISC[;DISC...], DISC = CENTRE@RADIUS (degrees),
+// CENTRE = X,Y,Z (a view-space direction: -Z forward, +Y up) or px:X,Y (a display pixel
+// position of `view`, origin top-left, y down). Checked against `view`: InputError naming
+// `option` for bad syntax, bad numbers and discs off the view.
+renderer::ReferenceWindow parse_window(const std::string& spec, const core::View& view, const std::string& option);
+
+// The window as JSON, [{"centre": [x, y, z] (unit), "radius_deg": r}, ...]; null when whole.
+nlohmann::json window_json(const renderer::ReferenceWindow& window);
 
 // $XDG_CACHE_HOME/fovea/references, else $HOME/.cache/fovea/references, else
 // out/reference-cache.
@@ -59,7 +76,8 @@ CachedReference cached_reference(gpu::Context& ctx, const renderer::GpuScene& sc
 // Writes `exr` and its description `<exr without extension>.json` (atomically, JSON last).
 void write_reference(const std::string& exr, const CachedReference& ref);
 // Reads a reference written by write_reference and checks that it shows `view` of `scene`
-// from `eye` (InputError naming the file otherwise).
+// from `eye`, and for a window that its alpha marks the window's pixels (InputError naming
+// the file otherwise).
 CachedReference read_reference(const std::string& exr, const std::string& scene, const core::View& view, core::Eye eye);
 
 }  // namespace fovea::tools

@@ -22,6 +22,10 @@ double flip_ppd(const View& view);
 // Symmetric in its arguments. Throws InputError on size mismatch or ppd ≤ 0.
 std::vector<float> ldr_flip(const Image& test, const Image& reference, double ppd = kFlipDefaultPpd);
 
+// The radius in pixels of the neighbourhood LDR- and HDR-FLIP read around a pixel: the
+// widest of the CSF filters and the feature detector at `ppd`.
+int flip_support_px(double ppd);
+
 struct HdrFlip {
   std::vector<float> error;  // per pixel, the maximum LDR-FLIP over the exposures
   double start_exposure = 0, stop_exposure = 0;
@@ -29,13 +33,17 @@ struct HdrFlip {
 };
 // HDR-FLIP of linear HDR RGB images: exposures c_start…c_stop (from the reference's maximum
 // and median luminance, Andersson et al. 2021 Sec. 3), each pair tone mapped with
-// tonemap_linear (tonemap.hpp), LDR-FLIP per exposure, per-pixel maximum.
-HdrFlip hdr_flip(const Image& test, const Image& reference, double ppd = kFlipDefaultPpd);
+// tonemap_linear (tonemap.hpp), LDR-FLIP per exposure, per-pixel maximum. `valid` (one
+// flag per pixel; empty: all) limits the pixels the exposure range is taken from, for a
+// reference that holds only part of the image.
+HdrFlip hdr_flip(const Image& test, const Image& reference, double ppd = kFlipDefaultPpd,
+                 const std::vector<bool>& valid = {});
 
 // The exposure range alone: c = log2(t⁻¹(0.85) / Y) for Y = max and median luminance of the
-// reference (a median of 0 falls back to the smallest positive luminance), N = max(2,
-// ⌈c_stop − c_start⌉) exposures spaced evenly including both ends.
-HdrFlip hdr_flip_exposures(const Image& reference);
+// reference's valid pixels (a median of 0 falls back to the smallest positive luminance),
+// N = max(2, ⌈c_stop − c_start⌉) exposures spaced evenly including both ends. InputError
+// when no pixel is valid.
+HdrFlip hdr_flip_exposures(const Image& reference, const std::vector<bool>& valid = {});
 
 // The colour pipeline's constituents, exposed for tests (inputs linear RGB in [0, 1]):
 // Hunt-adjusted CIELab (L, 0.01·L·a, 0.01·L·b) and the HyAB distance |ΔL| + ‖Δ(a, b)‖.

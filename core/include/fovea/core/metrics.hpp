@@ -56,7 +56,8 @@ double foveated_psnr(const Image& a, const Image& b, const View& view, glm::dvec
 // the borders.
 Image variable_gaussian(const Image& img, const std::vector<float>& sigma_px);
 
-// SSIM index per pixel (the map ssim() averages).
+// SSIM index per pixel (the map ssim() averages); its window reaches kSsimRadius pixels.
+constexpr int kSsimRadius = 5;  // 11×11
 std::vector<float> ssim_map(const Image& a, const Image& b);
 
 // Per-pixel error maps of `test` against `reference` (linear HDR RGB, equal sizes).
@@ -68,7 +69,20 @@ struct ErrorMaps {
   std::vector<float> hdr_flip;       // HDR-FLIP (flip.hpp) of the linear images
 };
 constexpr double kRelMseEpsilon = 0.01;
-ErrorMaps error_maps(const Image& test, const Image& reference, double ppd, double exposure = 0.0);
+// `valid` (one flag per pixel, empty: all): the reference's pixels that hold values; only
+// HDR-FLIP's exposure range reads it (from the valid pixels' luminance). Where a pixel's
+// neighbourhood (error_map_support_px) is all valid, its maps are those of any reference
+// that agrees on the valid pixels.
+ErrorMaps error_maps(const Image& test, const Image& reference, double ppd, double exposure = 0.0,
+                     const std::vector<bool>& valid = {});
+
+// The radius in pixels of the square neighbourhood error_maps reads around a pixel: SSIM's
+// window and FLIP's filters at `ppd`.
+int error_map_support_px(double ppd);
+// The pixels whose (2·radius+1)² neighbourhood, clipped to the image, is all valid (an
+// erosion of `valid`, width × height, row-major): with radius = error_map_support_px the
+// pixels whose error maps a partial reference gives exactly.
+std::vector<bool> scorable_pixels(const std::vector<bool>& valid, int width, int height, int radius);
 
 // Weighted means of the maps (weights ≥ 0, one per pixel; empty: all 1). PSNR comes from
 // the weighted MSE (peak 1, kPsnrIdentical when it vanishes), the others are means. A zero

@@ -4,6 +4,7 @@
 #include <cstdint>
 #include <functional>
 #include <string>
+#include <vector>
 
 #include <glm/vec3.hpp>
 
@@ -13,11 +14,30 @@
 
 namespace fovea::renderer {
 
+// The part of a view a reference renders: the union of discs on the view sphere, each the
+// pixels whose centre lies within radius_deg of a view-space direction (the gaze, say).
+// No discs: the whole view.
+struct WindowDisc {
+  glm::dvec3 centre{0, 0, -1};  // view space, any finite non-zero length
+  double radius_deg = 0;        // in (0, 180]
+};
+struct ReferenceWindow {
+  std::vector<WindowDisc> discs;
+  bool whole() const { return discs.empty(); }
+};
+
+// One flag per pixel of `view`'s raster (row-major): its centre inside a disc of `window`
+// (all true for the whole view). InputError starting with `what` (the input's name) for a
+// disc with a non-finite or zero centre, a radius outside (0, 180] or not finite, or one
+// that holds no pixel centre of the view.
+std::vector<bool> window_coverage(const ReferenceWindow& window, const core::View& view, const std::string& what);
+
 struct ReferenceOptions {
   PathConfig path;                  // path.spp = samples per batch; jitter is forced on
   std::uint32_t max_spp = 256;      // stop at this many samples per pixel
   double until_rel_error = 0;       // > 0: stop earlier once rel_error <= this (>= 4 batches)
   double until_pixel_rel_error = 0; // > 0: stop earlier once pixel_rel_error <= this (>= 4 batches)
+  ReferenceWindow window;           // the pixels traced; the others are never traced
 };
 
 struct ReferenceProgress {
@@ -27,8 +47,9 @@ struct ReferenceProgress {
   double seconds = 0;
 };
 
+// Every statistic is over the window's pixels.
 struct ReferenceResult {
-  core::Image image;  // linear radiance, alpha 1
+  core::Image image;  // linear radiance, alpha 1 in the window; outside it RGBA 0 (not traced)
   std::uint32_t spp = 0;
   glm::dvec3 mean_rgb{0};
   // Relative standard error of the image-mean luminance, from the spread of the
