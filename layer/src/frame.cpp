@@ -190,6 +190,7 @@ XrResult intercept::xrEndFrame(XrSession session, const XrFrameEndInfo* info) {
       t.reprojected_deg = shown.reprojected_deg;
       t.composited_on_gpu = shown.composited_on_gpu;
       t.host_readbacks = shown.host_readbacks;
+      t.shown = shown;
       t.render = shown.times;
     }
     std::lock_guard lock(s.frames->mutex);

@@ -51,7 +51,12 @@ void FrameLog::write(const FrameTimes& t) {
              {"traced_done_ns", t.traced_done_ns},
              {"traced_age_ns", t.traced_frame >= 0 ? t.display_time_ns - t.traced_for_ns : std::int64_t(0)},
              {"reprojected_deg", std::isfinite(t.reprojected_deg) ? t.reprojected_deg : 0.0},
-             {"composited_on_gpu", t.composited_on_gpu}, {"host_readbacks", t.host_readbacks}};
+             {"composited_on_gpu", t.composited_on_gpu}, {"host_readbacks", t.host_readbacks},
+             // The GPU composition's work on the application's thread (counts so far).
+             {"traced_slot", std::int64_t(t.shown.traced_slot)}, {"recordings", t.shown.recordings},
+             {"descriptor_updates", t.shown.descriptor_updates}, {"pass_waits", t.shown.pass_waits},
+             {"acquire_ms", t.shown.acquire_ms}, {"compose_ms", t.shown.compose_ms},
+             {"release_ms", t.shown.release_ms}};
   if (!writer_.write(r)) FOVEA_LAYER_WARN("%s", writer_.error().c_str());
 }
 

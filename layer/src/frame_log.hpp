@@ -29,6 +29,7 @@ struct FrameTimes {
   // Where the shown frame was composited, and how many application images went to the host.
   bool composited_on_gpu = false;
   std::int64_t host_readbacks = 0;
+  Shown shown;  // the rest of what the frame renderer reported (its slot, counters and split)
   RenderTimes render;     // the frame renderer's split of the traced frame (zero without one)
 };
 
