@@ -91,14 +91,16 @@ class AppDevice {
   // One submission on the session queue, not waited for: copies the application's rects
   // (and depth rects) into device buffers, runs the composition pass on the traced frame in
   // `slot` and copies the results into the targets. The command buffer is recorded once per
-  // combination of images and rects (and kept); a frame writes its parameters into that
-  // command buffer's own block of a persistently mapped buffer and submits it, waiting only
-  // when that command buffer is still in flight. Later work on the queue (the application's
+  // combination of images and rects (and kept; a second copy is recorded while the first is
+  // still in flight, up to kPasses in all); a frame writes its parameters into that command
+  // buffer's own block of a persistently mapped buffer and submits it, waiting only when every
+  // pass is in flight. Later work on the queue (the application's
   // next rendering into its images, the runtime's reads) comes after it. Slots retired since
   // the last call are released once no pending pass reads them.
   void composite_gpu(int slot, const std::array<GpuEye, 2>& eyes, const CompositionRule& rule);
   // Waits for the pending passes that read or write `image` (before the application gets it
-  // back: an acquisition); returns how many it waited for. Others keep running.
+  // back: an acquisition); returns how many submitted passes named it and had not been seen
+  // finished (polled; waited for only while still in flight). Others keep running.
   int finish_image(VkImage image);
   // Waits for the passes naming any of `images` and forgets their command buffers (before the
   // images are destroyed: a recorded command buffer must not outlive them).
@@ -110,12 +112,15 @@ class AppDevice {
   // thread, which may need a slot.
   void release_retired_slots();
   // The GPU path's work on the application's thread so far: command buffers recorded,
-  // descriptor set updates, host waits for a pass in flight. Recording and descriptor updates
-  // happen at the first frame and when images or buffer sizes change, not per frame.
-  struct GpuCounters {
-    std::int64_t recordings = 0, descriptor_updates = 0, pass_waits = 0, submissions = 0;
+  // descriptor set updates, submissions, and host waits for a pass still in flight (its
+  // fence polled unsignalled first): by composite_gpu for a pass it must reuse, by
+  // finish_image for the acquired image. Recording and descriptor updates happen at the first
+  // frames and when images or buffer sizes change, not per frame.
+  struct GpuStats {
+    std::int64_t recordings = 0, descriptor_updates = 0, submissions = 0, reuse_waits = 0, acquire_waits = 0;
+    double submit_ms = 0;  // the last composite_gpu's vkQueueSubmit (lavapipe does work in it)
   };
-  GpuCounters gpu_counters() const;
+  GpuStats gpu_stats() const;
 
  private:
   struct Buffer {
@@ -194,15 +199,15 @@ class AppDevice {
     std::uint64_t clock = 0;
     std::optional<bool> decode_srgb;  // what `decode` holds
     std::array<float, 256> decode{};
-    GpuCounters counters;
+    GpuStats counters;
   };
   std::unique_ptr<Gpu> gpu_;
   // gpu_'s passes between xrEndFrame's composition and the waits of xrAcquireSwapchainImage
   // and xrDestroySwapchain, which an application may call on another thread.
   mutable std::mutex pass_mutex_;
   void destroy_gpu();
-  // Waits for a pass's fence (bounded) if it is pending.
-  void wait_pass(Pass& p);
+  // Waits for a pass's fence (bounded) if it is still in flight, counting the wait in `waits`.
+  void wait_pass(Pass& p, std::int64_t& waits);
   bool pass_pending(Pass& p);  // polls without waiting
   void record_pass(Pass& p, std::size_t index);
   void reserve_gpu_buffers(VkDeviceSize app_bytes, VkDeviceSize depth_bytes);

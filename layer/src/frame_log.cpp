@@ -54,9 +54,10 @@ void FrameLog::write(const FrameTimes& t) {
              {"composited_on_gpu", t.composited_on_gpu}, {"host_readbacks", t.host_readbacks},
              // The GPU composition's work on the application's thread (counts so far).
              {"traced_slot", std::int64_t(t.shown.traced_slot)}, {"recordings", t.shown.recordings},
-             {"descriptor_updates", t.shown.descriptor_updates}, {"pass_waits", t.shown.pass_waits},
+             {"descriptor_updates", t.shown.descriptor_updates}, {"reuse_waits", t.shown.reuse_waits},
+             {"acquire_waits", t.shown.acquire_waits},
              {"acquire_ms", t.shown.acquire_ms}, {"compose_ms", t.shown.compose_ms},
-             {"release_ms", t.shown.release_ms}};
+             {"release_ms", t.shown.release_ms}, {"submit_ms", t.shown.submit_ms}};
   if (!writer_.write(r)) FOVEA_LAYER_WARN("%s", writer_.error().c_str());
 }
 

@@ -463,10 +463,12 @@ class PathTraceRenderer final : public FrameRenderer {
       if (!f.slot) throw std::logic_error("a traced frame without a slot on the GPU path");
       app_.composite_gpu(f.slot->slot(), jobs, rule);
       shown.traced_slot = f.slot->slot();
-      const AppDevice::GpuCounters n = app_.gpu_counters();
+      const AppDevice::GpuStats n = app_.gpu_stats();
       shown.recordings = n.recordings;
       shown.descriptor_updates = n.descriptor_updates;
-      shown.pass_waits = n.pass_waits;
+      shown.reuse_waits = n.reuse_waits;
+      shown.acquire_waits = n.acquire_waits;
+      shown.submit_ms = n.submit_ms;
     } else {
       compose_on_host(in, eyes, rule, targets);
     }

@@ -97,13 +97,14 @@ struct Shown {
   std::int64_t host_readbacks = 0;  // application images this xrEndFrame copied to the host
   // The GPU path: the traced-frame slot the render thread wrote the shown frame into (-1:
   // none), and the composition's work on the application's thread so far (cumulative):
-  // command buffers recorded, descriptor set updates, host waits for a pass in flight.
+  // command buffers recorded, descriptor set updates, host waits for a pass in flight
+  // (AppDevice::GpuStats).
   int traced_slot = -1;
-  std::int64_t recordings = 0, descriptor_updates = 0, pass_waits = 0;
+  std::int64_t recordings = 0, descriptor_updates = 0, reuse_waits = 0, acquire_waits = 0;
   // This xrEndFrame's composition split (ms): the layer's swapchain images acquired and waited
   // for, the composition (the GPU pass's parameters and submission, or the host path), the
-  // images released.
-  double acquire_ms = 0, compose_ms = 0, release_ms = 0;
+  // images released; and the GPU composition's vkQueueSubmit, part of compose_ms.
+  double acquire_ms = 0, compose_ms = 0, release_ms = 0, submit_ms = 0;
 };
 
 // Renders on its own thread: end_frame() hands the submitted views and gaze over and shows

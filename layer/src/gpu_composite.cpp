@@ -9,6 +9,7 @@
 // the first frame with the same images, so xrEndFrame writes the frame's parameters and
 // submits. Nothing of the application's images reaches the host.
 #include <algorithm>
+#include <chrono>
 #include <cmath>
 #include <cstring>
 #include <stdexcept>
@@ -211,9 +212,9 @@ float* AppDevice::slot_depth(int slot, int eye) const {
                                   (std::size_t(slot) * 4 + 2 + std::size_t(eye)) * px * 4);
 }
 
-AppDevice::GpuCounters AppDevice::gpu_counters() const {
+AppDevice::GpuStats AppDevice::gpu_stats() const {
   std::lock_guard lock(pass_mutex_);
-  return gpu_ ? gpu_->counters : GpuCounters{};
+  return gpu_ ? gpu_->counters : GpuStats{};
 }
 
 void AppDevice::release_retired(bool wait) {
@@ -224,7 +225,7 @@ void AppDevice::release_retired(bool wait) {
     bool read = false;
     for (Pass& p : g.passes) {
       if (p.slot != s) continue;
-      if (wait) wait_pass(p);
+      if (wait) wait_pass(p, g.counters.reuse_waits);
       read = read || pass_pending(p);
     }
     if (read) continue;
@@ -247,9 +248,9 @@ bool AppDevice::pass_pending(Pass& p) {
   return false;
 }
 
-void AppDevice::wait_pass(Pass& p) {
-  if (!p.pending) return;
-  ++gpu_->counters.pass_waits;
+void AppDevice::wait_pass(Pass& p, std::int64_t& waits) {
+  if (!pass_pending(p)) return;
+  ++waits;
   const VkResult r = vkWaitForFences_(device_, 1, &p.fence, VK_TRUE, kTimeoutNs);
   if (r == VK_TIMEOUT)
     throw std::runtime_error("a composition pass did not finish on the application's device in " +
@@ -261,7 +262,7 @@ void AppDevice::wait_pass(Pass& p) {
 void AppDevice::finish() {
   std::lock_guard lock(pass_mutex_);
   if (gpu_)
-    for (Pass& p : gpu_->passes) wait_pass(p);
+    for (Pass& p : gpu_->passes) wait_pass(p, gpu_->counters.reuse_waits);
 }
 
 int AppDevice::finish_image(VkImage image) {
@@ -270,7 +271,7 @@ int AppDevice::finish_image(VkImage image) {
   if (gpu_)
     for (Pass& p : gpu_->passes)
       if (p.pending && p.key.names(image)) {
-        wait_pass(p);
+        wait_pass(p, gpu_->counters.acquire_waits);
         ++waited;
       }
   return waited;
@@ -281,7 +282,7 @@ void AppDevice::forget_images(const std::vector<VkImage>& images) {
   if (!gpu_) return;
   for (Pass& p : gpu_->passes)
     if (p.recorded && std::any_of(images.begin(), images.end(), [&](VkImage i) { return p.key.names(i); })) {
-      wait_pass(p);
+      wait_pass(p, gpu_->counters.reuse_waits);
       p.recorded = false;
     }
 }
@@ -314,7 +315,7 @@ void AppDevice::reserve_gpu_buffers(VkDeviceSize app_bytes, VkDeviceSize depth_b
   // A buffer grows (the first frame, or larger application rects): nothing may use the old
   // one, and the set, and so every recorded pass, names the new one.
   for (Pass& p : g.passes) {
-    wait_pass(p);
+    wait_pass(p, g.counters.reuse_waits);
     p.recorded = false;
   }
   constexpr VkBufferUsageFlags dst = VK_BUFFER_USAGE_STORAGE_BUFFER_BIT | VK_BUFFER_USAGE_TRANSFER_DST_BIT;
@@ -495,21 +496,38 @@ void AppDevice::composite_gpu(int slot, const std::array<GpuEye, 2>& eyes, const
   std::memcpy(p.decode, g.decode.data(), sizeof p.decode);
 
   reserve_gpu_buffers(l.app_bytes, l.depth_bytes);
-  // The pass recorded for these images, else a fresh or the least recently used one,
-  // re-recorded. Its previous submission must be done before its command buffer and its
-  // parameter block are reused: the only host wait, and only while it is still in flight.
-  std::size_t index = kPasses;
+  // A pass recorded for these images and no longer in flight. Else, if one is recorded for
+  // them but in flight, a second copy in a pass never recorded, or (none left) a wait for the
+  // least recently used copy: copies never evict each other, so recordings stop once there
+  // are enough. Images never seen: a pass not in flight, the least recently used, recorded
+  // for them (or, every pass in flight, the least recently used one after a wait). A pass's
+  // previous submission must be done before its command buffer and parameter block are
+  // reused: the only host wait.
+  const auto older = [&](std::size_t i, std::size_t j) {  // unrecorded first, then least recently used
+    const Pass &a = g.passes[i], &b = g.passes[j];
+    return a.recorded != b.recorded ? !a.recorded : a.used < b.used;
+  };
+  std::size_t index = kPasses, fresh = kPasses, idle = kPasses, same = kPasses, any = kPasses;
+  // The passes recorded for these images first: in the steady state one of them is idle, and
+  // only their fences are polled.
   for (std::size_t i = 0; i < kPasses && index == kPasses; ++i)
-    if (g.passes[i].recorded && g.passes[i].key == key) index = i;
-  const bool record = index == kPasses;
-  if (record) {
-    index = 0;
-    for (std::size_t i = 1; i < kPasses; ++i)
-      if (!g.passes[i].recorded ? g.passes[index].recorded : g.passes[index].recorded && g.passes[i].used < g.passes[index].used)
-        index = i;
+    if (g.passes[i].recorded && g.passes[i].key == key && !pass_pending(g.passes[i])) index = i;
+  for (std::size_t i = 0; i < kPasses && index == kPasses; ++i) {
+    const bool matches = g.passes[i].recorded && g.passes[i].key == key;
+    const bool in_flight = matches || pass_pending(g.passes[i]);  // the matching ones were polled above
+    if (!g.passes[i].recorded && fresh == kPasses) fresh = i;
+    if (!in_flight && (idle == kPasses || older(i, idle))) idle = i;
+    if (matches && (same == kPasses || older(i, same))) same = i;
+    if (any == kPasses || older(i, any)) any = i;
+  }
+  bool record = false;
+  if (index == kPasses) {
+    const std::size_t copy = same != kPasses ? fresh : idle;
+    record = copy != kPasses || same == kPasses;
+    index = copy != kPasses ? copy : same != kPasses ? same : any;
   }
   Pass& pass = g.passes[index];
-  if (pass_pending(pass)) wait_pass(pass);
+  wait_pass(pass, g.counters.reuse_waits);
   if (record) {
     pass.key = key;
     record_pass(pass, index);
@@ -519,7 +537,9 @@ void AppDevice::composite_gpu(int slot, const std::array<GpuEye, 2>& eyes, const
   VkSubmitInfo si{VK_STRUCTURE_TYPE_SUBMIT_INFO};
   si.commandBufferCount = 1;
   si.pCommandBuffers = &pass.cb;
+  const auto t_submit = std::chrono::steady_clock::now();
   app_check(vkQueueSubmit_(queue_handle_, 1, &si, pass.fence), "vkQueueSubmit");
+  g.counters.submit_ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t_submit).count();
   pass.pending = true;
   pass.slot = slot;
   pass.used = ++g.clock;

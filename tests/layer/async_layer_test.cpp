@@ -254,9 +254,10 @@ TEST_P(AsyncLayer, PipelinedFramesOnTwoThreadsNeverWaitForTheRenderThread) {
       // The render thread wrote the traced frame into a slot of the application's device
       // memory (no frame copied on this thread); the composition's command buffers were
       // recorded once per combination of images (three images per swapchain, acquired in
-      // turn) and its descriptor set written once, not per frame.
+      // turn; a second copy while one is in flight), at most the 8 kept, and its descriptor
+      // set written once, not per frame.
       EXPECT_GE(r["traced_slot"].get<std::int64_t>(), 0) << r.dump();
-      EXPECT_LE(r["recordings"].get<std::int64_t>(), 3) << r.dump();
+      EXPECT_LE(r["recordings"].get<std::int64_t>(), 8) << r.dump();
       EXPECT_EQ(r["descriptor_updates"].get<std::int64_t>(), 1) << r.dump();
     } else {
       EXPECT_EQ(r["traced_slot"].get<std::int64_t>(), -1) << r.dump();

@@ -412,35 +412,35 @@ TEST_F(GpuComposite, RecordsOncePerImagesAndWaitsOnlyForPassesOnTheImage) {
       EXPECT_GT(exact, n * 9 / 10) << "eye " << e;
     }
   }
-  AppDevice::GpuCounters n = dev.gpu_counters();
+  AppDevice::GpuStats n = dev.gpu_stats();
   EXPECT_EQ(n.recordings, 1);
   EXPECT_EQ(n.descriptor_updates, 1);
   EXPECT_EQ(n.submissions, 3);
 
-  // A pass submitted on images `a`, not waited for: acquiring `b` waits for nothing, acquiring
-  // a[0] for that pass (whether or not it has finished by then), a[1] then for nothing.
+  // A pass submitted on images `a`, not waited for: acquiring `b` considers no pass, acquiring
+  // a[0] that pass (waited for if still in flight), a[1] then none.
   const Geometry still{"still", 40, 36, 40, 36, fov, fov, 0.0, 0.0};
   const auto jobs = jobs_on(a, still);
   const int slot = write_slot(dev, jobs);
   dev.composite_gpu(slot, jobs, rule);
   dev.traced_slots()->retire(slot);
-  const std::int64_t waits = dev.gpu_counters().pass_waits;
+  const std::int64_t waits = dev.gpu_stats().acquire_waits;
   EXPECT_EQ(dev.finish_image(b[0].get()), 0);
   EXPECT_EQ(dev.finish_image(b[1].get()), 0);
-  EXPECT_EQ(dev.gpu_counters().pass_waits, waits) << "a pass on other images was waited for";
+  EXPECT_EQ(dev.gpu_stats().acquire_waits, waits) << "a pass on other images was waited for";
   EXPECT_EQ(dev.finish_image(a[0].get()), 1);
-  EXPECT_EQ(dev.finish_image(a[1].get()), 0);
-  EXPECT_EQ(dev.gpu_counters().pass_waits, waits + 1);
+  EXPECT_EQ(dev.finish_image(a[1].get()), 0);  // that pass is known finished now
+  EXPECT_LE(dev.gpu_stats().acquire_waits, waits + 1);
 
   // Other images: recorded once more; images forgotten (their swapchain destroyed) are
   // recorded afresh when they come back.
   composite_on_gpu(dev, jobs_on(b, still), rule, still);
   composite_on_gpu(dev, jobs_on(b, still), rule, still);
-  EXPECT_EQ(dev.gpu_counters().recordings, 2);
+  EXPECT_EQ(dev.gpu_stats().recordings, 2);
   dev.forget_images({b[0].get(), b[1].get()});
   composite_on_gpu(dev, jobs_on(b, still), rule, still);
   composite_on_gpu(dev, jobs_on(a, still), rule, still);
-  n = dev.gpu_counters();
+  n = dev.gpu_stats();
   EXPECT_EQ(n.recordings, 3);
   EXPECT_EQ(n.descriptor_updates, 1);
 }
