@@ -171,12 +171,14 @@ XrResult intercept::xrEndFrame(XrSession session, const XrFrameEndInfo* info) {
       shown = Shown{};
     }
   }
+  const std::int64_t t_down = now_ns();
   const XrResult r = s.next->xrEndFrame(session, submit);
   const std::int64_t t_return = now_ns();
   if (record) {
     FrameTimes& t = *record;
     t.end_call_ns = t_call;
     t.end_return_ns = t_return;
+    t.end_down_ns = t_down;
     t.layers = info->layerCount;
     t.projection_views = 0;
     for (uint32_t i = 0; info->layers && i < info->layerCount; ++i)

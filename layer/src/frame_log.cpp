@@ -37,6 +37,7 @@ void FrameLog::write(const FrameTimes& t) {
   r.set_frame_calls(t.wait_call_ns, t.wait_return_ns, t.begin_ns, t.end_call_ns, t.end_return_ns);
   r.cpu_ms = {{"app", double(t.end_call_ns - t.begin_ns) * 1e-6},
               {"end_frame", double(t.end_return_ns - t.end_call_ns) * 1e-6},
+              {"end_frame_layer", double(t.end_down_ns - t.end_call_ns) * 1e-6},
               {"gaze", rt.gaze_cpu},
               {"grid", rt.grid_cpu},
               {"submit", rt.submit_cpu},

@@ -18,6 +18,7 @@ struct FrameTimes {
   std::int64_t wait_call_ns = 0, wait_return_ns = 0;
   std::int64_t begin_ns = 0;
   std::int64_t end_call_ns = 0, end_return_ns = 0;  // around the call down the chain
+  std::int64_t end_down_ns = 0;  // the call down the chain began (the layer's own work before it)
   std::uint32_t layers = 0, projection_views = 0;
   bool replaced = false;  // a frame renderer replaced the application's layers
   // The path-traced frame shown (-1: none finished yet, or no renderer): its number, the
