@@ -185,16 +185,7 @@ XrResult intercept::xrEndFrame(XrSession session, const XrFrameEndInfo* info) {
       if (info->layers[i] && info->layers[i]->type == XR_TYPE_COMPOSITION_LAYER_PROJECTION)
         t.projection_views += reinterpret_cast<const XrCompositionLayerProjection*>(info->layers[i])->viewCount;
     t.replaced = submit != info;
-    if (t.replaced) {
-      t.traced_frame = shown.frame;
-      t.traced_for_ns = shown.traced_for_ns;
-      t.traced_done_ns = shown.done_ns;
-      t.reprojected_deg = shown.reprojected_deg;
-      t.composited_on_gpu = shown.composited_on_gpu;
-      t.host_readbacks = shown.host_readbacks;
-      t.shown = shown;
-      t.render = shown.times;
-    }
+    if (t.replaced) t.shown = shown;
     std::lock_guard lock(s.frames->mutex);
     s.frames->log.write(t);
   }

@@ -27,7 +27,7 @@ void FrameLog::open(const std::string& dir) {
 
 void FrameLog::write(const FrameTimes& t) {
   if (!writer_.is_open()) return;
-  const RenderTimes& rt = t.render;
+  const RenderTimes& rt = t.shown.times;
   xrcommon::TimingRecord r;
   r.source = "layer";
   r.frame = t.frame;
@@ -48,11 +48,11 @@ void FrameLog::write(const FrameTimes& t) {
              {"replaced", t.replaced},                {"render_ms", rt.total},
              {"transfer_ms", rt.transfer},            {"samples_hidden", rt.samples_hidden},
              // Which path-traced frame this displayed frame shows (asynchronous rendering).
-             {"traced_frame", t.traced_frame},        {"traced_for_ns", t.traced_for_ns},
-             {"traced_done_ns", t.traced_done_ns},
-             {"traced_age_ns", t.traced_frame >= 0 ? t.display_time_ns - t.traced_for_ns : std::int64_t(0)},
-             {"reprojected_deg", std::isfinite(t.reprojected_deg) ? t.reprojected_deg : 0.0},
-             {"composited_on_gpu", t.composited_on_gpu}, {"host_readbacks", t.host_readbacks},
+             {"traced_frame", t.shown.frame},         {"traced_for_ns", t.shown.traced_for_ns},
+             {"traced_done_ns", t.shown.done_ns},
+             {"traced_age_ns", t.shown.frame >= 0 ? t.display_time_ns - t.shown.traced_for_ns : std::int64_t(0)},
+             {"reprojected_deg", std::isfinite(t.shown.reprojected_deg) ? t.shown.reprojected_deg : 0.0},
+             {"composited_on_gpu", t.shown.composited_on_gpu}, {"host_readbacks", t.shown.host_readbacks},
              // The GPU composition's work on the application's thread (counts so far).
              {"traced_slot", std::int64_t(t.shown.traced_slot)}, {"recordings", t.shown.recordings},
              {"descriptor_updates", t.shown.descriptor_updates}, {"reuse_waits", t.shown.reuse_waits},
