@@ -37,7 +37,8 @@ def percentile(values, q):
 
 def thread_cpu(pid):
     """CPU seconds per thread of `pid` so far: {tid: (seconds, lowered)}, lowered = SCHED_IDLE or
-    nice > 0 (the render thread and the device threads it created)."""
+    nicer than the process's main thread (the render thread and the device threads it created;
+    relative, so that the split holds when the whole run is started under `nice`)."""
     out = {}
     tick = os.sysconf("SC_CLK_TCK")
     try:
@@ -51,8 +52,9 @@ def thread_cpu(pid):
         except OSError:
             continue  # the thread ended meanwhile
         # Fields from 3 (state) on: utime 14, stime 15, nice 19, policy 41 (proc(5)).
-        out[tid] = ((int(fields[11]) + int(fields[12])) / tick, int(fields[38]) == 5 or int(fields[16]) > 0)
-    return out
+        out[tid] = ((int(fields[11]) + int(fields[12])) / tick, int(fields[38]) == 5, int(fields[16]))
+    main_nice = out[str(pid)][2] if str(pid) in out else 0
+    return {tid: (cpu, idle or nice > main_nice) for tid, (cpu, idle, nice) in out.items()}
 
 
 def summarise(path):

@@ -1,5 +1,6 @@
 #include "app_device.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <cstring>
 #include <stdexcept>
@@ -81,6 +82,12 @@ AppDevice::AppDevice(const VulkanBinding& vk) : device_(vk.device), queue_family
   FOVEA_APP_VK(FOVEA_APP_VK_LOAD)
 #undef FOVEA_APP_VK_LOAD
   props(vk.physical_device, &memory_);
+  if (const auto device_props = reinterpret_cast<PFN_vkGetPhysicalDeviceProperties>(
+          vkGetInstanceProcAddr(vk.instance, "vkGetPhysicalDeviceProperties"))) {
+    VkPhysicalDeviceProperties dp{};
+    device_props(vk.physical_device, &dp);
+    storage_alignment_ = std::max<VkDeviceSize>(dp.limits.minStorageBufferOffsetAlignment, 1);
+  }
   if (const auto families = reinterpret_cast<PFN_vkGetPhysicalDeviceQueueFamilyProperties>(
           vkGetInstanceProcAddr(vk.instance, "vkGetPhysicalDeviceQueueFamilyProperties"))) {
     std::uint32_t n = 0;
@@ -111,7 +118,7 @@ void AppDevice::release(Buffer& b) {
   b = Buffer{};
 }
 
-void AppDevice::reserve(Buffer& b, VkDeviceSize size, VkBufferUsageFlags usage, bool host) {
+void AppDevice::reserve(Buffer& b, VkDeviceSize size, VkBufferUsageFlags usage, bool host, bool prefer_device_local) {
   if (b.size >= size) return;
   release(b);
   VkBufferCreateInfo bi{VK_STRUCTURE_TYPE_BUFFER_CREATE_INFO};
@@ -125,8 +132,12 @@ void AppDevice::reserve(Buffer& b, VkDeviceSize size, VkBufferUsageFlags usage, 
   const VkMemoryPropertyFlags want = host ? VK_MEMORY_PROPERTY_HOST_VISIBLE_BIT | VK_MEMORY_PROPERTY_HOST_COHERENT_BIT
                                           : VK_MEMORY_PROPERTY_DEVICE_LOCAL_BIT;
   std::uint32_t type = ~0u;
-  for (std::uint32_t i = 0; i < memory_.memoryTypeCount && type == ~0u; ++i)
-    if ((req.memoryTypeBits & (1u << i)) && (memory_.memoryTypes[i].propertyFlags & want) == want) type = i;
+  const auto find = [&](VkMemoryPropertyFlags flags) {
+    for (std::uint32_t i = 0; i < memory_.memoryTypeCount && type == ~0u; ++i)
+      if ((req.memoryTypeBits & (1u << i)) && (memory_.memoryTypes[i].propertyFlags & flags) == flags) type = i;
+  };
+  if (prefer_device_local) find(want | VK_MEMORY_PROPERTY_DEVICE_LOCAL_BIT);
+  find(want);
   if (type == ~0u) {
     release(b);
     throw std::runtime_error(std::string("the application's device has no ") +

@@ -19,6 +19,7 @@
 #include "composite.hpp"
 #include "fovea/xrcommon/foreign_queue.hpp"
 #include "frame_renderer.hpp"
+#include "traced_slots.hpp"
 
 namespace fovea::layer {
 
@@ -27,6 +28,19 @@ void app_check(VkResult r, const char* what);
 
 // D16_UNORM, X8_D24_UNORM_PACK32, D24_UNORM_S8_UINT, D32_SFLOAT, D32_SFLOAT_S8_UINT.
 bool depth_format_supported(VkFormat f);
+
+// What a pre-recorded GPU composition pass (AppDevice::composite_gpu) was recorded for: a frame
+// whose images, rects and steps match submits it again.
+struct CompositionPassKey {
+  std::array<VkImage, 2> app{}, target{}, depth{};
+  std::array<std::array<std::int32_t, 4>, 2> app_rect{}, depth_rect{};  // x, y, width, height
+  std::array<std::uint32_t, 2> app_layer{}, depth_layer{};
+  std::array<VkFormat, 2> depth_format{};
+  std::array<std::int32_t, 2> out_w{}, out_h{};
+  bool with_app = false, by_depth = false, border = false;
+  bool operator==(const CompositionPassKey&) const = default;
+  bool names(VkImage image) const;
+};
 
 class AppDevice {
  public:
@@ -53,27 +67,60 @@ class AppDevice {
   std::int64_t host_readbacks() const { return host_readbacks_; }
 
   // Composition on this device (gpu_composite.cpp), without the host round trip: prepares the
-  // compute pass on the session queue; throws std::runtime_error with the reason when the
-  // device cannot run it (the session queue's family has no compute, no memory type).
-  void enable_gpu_composition();
+  // compute pass on the session queue and `slots` slots for path-traced frames of
+  // `traced_width` x `traced_height` per eye in host-visible memory of this device; throws
+  // std::runtime_error with the reason when the device cannot run it (the session queue's
+  // family has no compute, no memory type).
+  void enable_gpu_composition(int traced_width, int traced_height, int slots = 3);
   bool gpu_composition() const { return gpu_ != nullptr; }
+  // The traced-frame slots (null before enable_gpu_composition). A thread that claimed slot `s`
+  // writes its frame at slot_colour(s, eye) (4-byte pixels in the swapchain's encoding,
+  // row-major) and slot_depth(s, eye) (FramePipeline::depth's view distances): persistently
+  // mapped, so the render thread writes them without a call on this device.
+  std::shared_ptr<SlotPool> traced_slots() const;
+  std::uint8_t* slot_colour(int slot, int eye) const;
+  float* slot_depth(int slot, int eye) const;
   struct GpuEye {
-    // `traced` (and `traced_depth`) are uploaded only when `traced_id` changed; `app` and
-    // `app_depth` unused (the images below are read on the device).
+    // The views and the rotation; the traced pixels come from the slot, `traced`, `app` and
+    // `app_depth` are unused (the images below are read on the device).
     EyeComposition composition;
     Read app;                      // the application's projection view (unused in scene-only mode)
-    std::optional<AppDepth> depth;  // its depth, when compositing by depth (with composition.traced_depth)
+    std::optional<AppDepth> depth;  // its depth: compositing by depth (both eyes), with the slot's depths
     VkImage target;                // written whole (out_view's raster), ends in COLOR_ATTACHMENT_OPTIMAL
   };
-  // One submission on the session queue, not waited for: it uploads the traced frame if new,
-  // copies the application's rects (and depth rects) into device buffers, runs the
-  // composition pass and copies the results into the targets. Later work on the queue (the
-  // application's next rendering into its images, the runtime's reads) comes after it; the
-  // next call first waits for it.
-  void composite_gpu(std::int64_t traced_id, const std::array<GpuEye, 2>& eyes, const CompositionRule& rule);
-  // Waits for a composition pass still running (before the images it reads or writes are
-  // destroyed: the application's swapchains, the targets).
+  // One submission on the session queue, not waited for: copies the application's rects
+  // (and depth rects) into device buffers, runs the composition pass on the traced frame in
+  // `slot` and copies the results into the targets. The command buffer is recorded once per
+  // combination of images and rects (and kept; a second copy is recorded while the first is
+  // still in flight, up to kPasses in all); a frame writes its parameters into that command
+  // buffer's own block of a persistently mapped buffer and submits it, waiting only when every
+  // pass is in flight. Later work on the queue (the application's
+  // next rendering into its images, the runtime's reads) comes after it. Slots retired since
+  // the last call are released once no pending pass reads them.
+  void composite_gpu(int slot, const std::array<GpuEye, 2>& eyes, const CompositionRule& rule);
+  // Waits for the pending passes that read or write `image` (before the application gets it
+  // back: an acquisition); returns how many submitted passes named it and had not been seen
+  // finished (polled; waited for only while still in flight). Others keep running.
+  int finish_image(VkImage image);
+  // Waits for the passes naming any of `images` and forgets their command buffers (before the
+  // images are destroyed: a recorded command buffer must not outlive them).
+  void forget_images(const std::vector<VkImage>& images);
+  // Waits for every composition pass still running.
   void finish();
+  // Gives the slots whose frames are gone back to the render thread, waiting for the passes
+  // that read them (composite_gpu does so without waiting): before waiting for the render
+  // thread, which may need a slot.
+  void release_retired_slots();
+  // The GPU path's work on the application's thread so far: command buffers recorded,
+  // descriptor set updates, submissions, and host waits for a pass still in flight (its
+  // fence polled unsignalled first): by composite_gpu for a pass it must reuse, by
+  // finish_image for the acquired image. Recording and descriptor updates happen at the first
+  // frames and when images or buffer sizes change, not per frame.
+  struct GpuStats {
+    std::int64_t recordings = 0, descriptor_updates = 0, submissions = 0, reuse_waits = 0, acquire_waits = 0;
+    double submit_ms = 0;  // the last composite_gpu's vkQueueSubmit (lavapipe does work in it)
+  };
+  GpuStats gpu_stats() const;
 
  private:
   struct Buffer {
@@ -82,8 +129,11 @@ class AppDevice {
     void* mapped = nullptr;  // host-visible buffers only
     VkDeviceSize size = 0;
   };
-  // At least `size` bytes: host-visible and coherent (mapped), or device-local when `host` is false.
-  void reserve(Buffer& b, VkDeviceSize size, VkBufferUsageFlags usage, bool host = true);
+  // At least `size` bytes: host-visible and coherent (mapped), or device-local when `host` is
+  // false; `prefer_device_local` picks host-visible memory that is device-local too when the
+  // device has it (what a shader reads every frame).
+  void reserve(Buffer& b, VkDeviceSize size, VkBufferUsageFlags usage, bool host = true,
+               bool prefer_device_local = false);
   void release(Buffer& b);
   // One region of an attachment image copied into `buffer` at `offset`: transition to
   // TRANSFER_SRC after the application's writes, copy `copy_aspect`, transition back.
@@ -113,8 +163,22 @@ class AppDevice {
   std::unique_ptr<xrcommon::ForeignQueue> queue_;  // the session queue, bounded waits
   Buffer download_, upload_;
   VkPhysicalDeviceMemoryProperties memory_{};
+  VkDeviceSize storage_alignment_ = 256;  // minStorageBufferOffsetAlignment
   std::int64_t host_readbacks_ = 0;
   // The composition pass's objects (gpu_composite.cpp).
+  using PassKey = CompositionPassKey;
+  // A pre-recorded composition pass: its command buffer, fence and parameter block (the
+  // block of the same index in Gpu::params).
+  struct Pass {
+    PassKey key;
+    bool recorded = false;
+    bool pending = false;    // submitted, its fence not yet seen signalled
+    int slot = -1;           // the traced slot its last submission reads
+    std::uint64_t used = 0;  // when it was last submitted (Gpu::clock), for eviction
+    VkCommandBuffer cb = VK_NULL_HANDLE;
+    VkFence fence = VK_NULL_HANDLE;
+  };
+  static constexpr std::size_t kPasses = 8;
   struct Gpu {
     VkShaderModule shader = VK_NULL_HANDLE;
     VkDescriptorSetLayout set_layout = VK_NULL_HANDLE;
@@ -122,26 +186,46 @@ class AppDevice {
     VkPipeline pipeline = VK_NULL_HANDLE, border_pipeline = VK_NULL_HANDLE;  // the composite and border passes
     VkDescriptorPool pool = VK_NULL_HANDLE;
     VkDescriptorSet set = VK_NULL_HANDLE;
-    Buffer params, staging;                 // host-visible
-    Buffer traced, app, app_depth, out, background;  // device-local
-    std::int64_t uploaded = -1;                       // the traced frame in `traced`
-    bool uploaded_depth = false;                      // with its depths
+    VkCommandPool commands = VK_NULL_HANDLE;
+    bool set_written = false;  // the set names the current buffers
+    Buffer params;             // host-visible: one parameter block per pass, `params_stride` apart
+    VkDeviceSize params_stride = 0;
+    Buffer traced;             // host-visible: the traced-frame slots, written by the render thread
+    Buffer app, app_depth, out, background;  // device-local
+    int traced_w = 0, traced_h = 0;
+    std::shared_ptr<SlotPool> slots;
+    std::uint32_t retiring = 0;  // retired slots still read by a pending pass
+    std::array<Pass, kPasses> passes;
+    std::uint64_t clock = 0;
+    std::optional<bool> decode_srgb;  // what `decode` holds
+    std::array<float, 256> decode{};
+    GpuStats counters;
   };
   std::unique_ptr<Gpu> gpu_;
-  std::unique_ptr<xrcommon::ForeignQueue> pass_;  // the composition pass's submissions
-  // pass_ between xrEndFrame's composition and finish() from xrDestroySwapchain, which an
-  // application may call on another thread.
-  std::mutex pass_mutex_;
+  // gpu_'s passes between xrEndFrame's composition and the waits of xrAcquireSwapchainImage
+  // and xrDestroySwapchain, which an application may call on another thread.
+  mutable std::mutex pass_mutex_;
   void destroy_gpu();
+  // Waits for a pass's fence (bounded) if it is still in flight, counting the wait in `waits`.
+  void wait_pass(Pass& p, std::int64_t& waits);
+  bool pass_pending(Pass& p);  // polls without waiting
+  void record_pass(Pass& p, std::size_t index);
+  void reserve_gpu_buffers(VkDeviceSize app_bytes, VkDeviceSize depth_bytes);
+  // Slots retired since the last call, or still read then, released when no pending pass
+  // reads them (after waiting for those passes with `wait`). Under pass_mutex_.
+  void release_retired(bool wait);
 
 #define FOVEA_APP_VK(X)                                                                                          \
   X(vkGetDeviceQueue) X(vkCmdPipelineBarrier) X(vkCmdCopyImageToBuffer) X(vkCmdCopyBufferToImage)             \
   X(vkCreateBuffer) X(vkDestroyBuffer) X(vkGetBufferMemoryRequirements) X(vkAllocateMemory) X(vkFreeMemory)     \
-  X(vkBindBufferMemory) X(vkMapMemory) X(vkUnmapMemory) X(vkCmdCopyBuffer) X(vkCreateShaderModule)             \
+  X(vkBindBufferMemory) X(vkMapMemory) X(vkUnmapMemory) X(vkCreateShaderModule)                              \
   X(vkDestroyShaderModule) X(vkCreateDescriptorSetLayout) X(vkDestroyDescriptorSetLayout)                       \
   X(vkCreatePipelineLayout) X(vkDestroyPipelineLayout) X(vkCreateComputePipelines) X(vkDestroyPipeline)         \
   X(vkCreateDescriptorPool) X(vkDestroyDescriptorPool) X(vkAllocateDescriptorSets) X(vkUpdateDescriptorSets)    \
-  X(vkCmdBindPipeline) X(vkCmdBindDescriptorSets) X(vkCmdPushConstants) X(vkCmdDispatch)
+  X(vkCmdBindPipeline) X(vkCmdBindDescriptorSets) X(vkCmdPushConstants) X(vkCmdDispatch)                     \
+  X(vkCreateCommandPool) X(vkDestroyCommandPool) X(vkAllocateCommandBuffers) X(vkBeginCommandBuffer)           \
+  X(vkEndCommandBuffer) X(vkQueueSubmit) X(vkCreateFence) X(vkDestroyFence) X(vkWaitForFences) X(vkResetFences) \
+  X(vkGetFenceStatus)
 #define FOVEA_APP_VK_MEMBER(name) PFN_##name name##_ = nullptr;
   FOVEA_APP_VK(FOVEA_APP_VK_MEMBER)
 #undef FOVEA_APP_VK_MEMBER

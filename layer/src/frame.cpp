@@ -171,27 +171,21 @@ XrResult intercept::xrEndFrame(XrSession session, const XrFrameEndInfo* info) {
       shown = Shown{};
     }
   }
+  const std::int64_t t_down = now_ns();
   const XrResult r = s.next->xrEndFrame(session, submit);
   const std::int64_t t_return = now_ns();
   if (record) {
     FrameTimes& t = *record;
     t.end_call_ns = t_call;
     t.end_return_ns = t_return;
+    t.end_down_ns = t_down;
     t.layers = info->layerCount;
     t.projection_views = 0;
     for (uint32_t i = 0; info->layers && i < info->layerCount; ++i)
       if (info->layers[i] && info->layers[i]->type == XR_TYPE_COMPOSITION_LAYER_PROJECTION)
         t.projection_views += reinterpret_cast<const XrCompositionLayerProjection*>(info->layers[i])->viewCount;
     t.replaced = submit != info;
-    if (t.replaced) {
-      t.traced_frame = shown.frame;
-      t.traced_for_ns = shown.traced_for_ns;
-      t.traced_done_ns = shown.done_ns;
-      t.reprojected_deg = shown.reprojected_deg;
-      t.composited_on_gpu = shown.composited_on_gpu;
-      t.host_readbacks = shown.host_readbacks;
-      t.render = shown.times;
-    }
+    if (t.replaced) t.shown = shown;
     std::lock_guard lock(s.frames->mutex);
     s.frames->log.write(t);
   }

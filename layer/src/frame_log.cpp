@@ -27,7 +27,7 @@ void FrameLog::open(const std::string& dir) {
 
 void FrameLog::write(const FrameTimes& t) {
   if (!writer_.is_open()) return;
-  const RenderTimes& rt = t.render;
+  const RenderTimes& rt = t.shown.times;
   xrcommon::TimingRecord r;
   r.source = "layer";
   r.frame = t.frame;
@@ -37,6 +37,7 @@ void FrameLog::write(const FrameTimes& t) {
   r.set_frame_calls(t.wait_call_ns, t.wait_return_ns, t.begin_ns, t.end_call_ns, t.end_return_ns);
   r.cpu_ms = {{"app", double(t.end_call_ns - t.begin_ns) * 1e-6},
               {"end_frame", double(t.end_return_ns - t.end_call_ns) * 1e-6},
+              {"end_frame_layer", double(t.end_down_ns - t.end_call_ns) * 1e-6},
               {"gaze", rt.gaze_cpu},
               {"grid", rt.grid_cpu},
               {"submit", rt.submit_cpu},
@@ -47,11 +48,17 @@ void FrameLog::write(const FrameTimes& t) {
              {"replaced", t.replaced},                {"render_ms", rt.total},
              {"transfer_ms", rt.transfer},            {"samples_hidden", rt.samples_hidden},
              // Which path-traced frame this displayed frame shows (asynchronous rendering).
-             {"traced_frame", t.traced_frame},        {"traced_for_ns", t.traced_for_ns},
-             {"traced_done_ns", t.traced_done_ns},
-             {"traced_age_ns", t.traced_frame >= 0 ? t.display_time_ns - t.traced_for_ns : std::int64_t(0)},
-             {"reprojected_deg", std::isfinite(t.reprojected_deg) ? t.reprojected_deg : 0.0},
-             {"composited_on_gpu", t.composited_on_gpu}, {"host_readbacks", t.host_readbacks}};
+             {"traced_frame", t.shown.frame},         {"traced_for_ns", t.shown.traced_for_ns},
+             {"traced_done_ns", t.shown.done_ns},
+             {"traced_age_ns", t.shown.frame >= 0 ? t.display_time_ns - t.shown.traced_for_ns : std::int64_t(0)},
+             {"reprojected_deg", std::isfinite(t.shown.reprojected_deg) ? t.shown.reprojected_deg : 0.0},
+             {"composited_on_gpu", t.shown.composited_on_gpu}, {"host_readbacks", t.shown.host_readbacks},
+             // The GPU composition's work on the application's thread (counts so far).
+             {"traced_slot", std::int64_t(t.shown.traced_slot)}, {"recordings", t.shown.recordings},
+             {"descriptor_updates", t.shown.descriptor_updates}, {"reuse_waits", t.shown.reuse_waits},
+             {"acquire_waits", t.shown.acquire_waits},
+             {"acquire_ms", t.shown.acquire_ms}, {"compose_ms", t.shown.compose_ms},
+             {"release_ms", t.shown.release_ms}, {"submit_ms", t.shown.submit_ms}};
   if (!writer_.write(r)) FOVEA_LAYER_WARN("%s", writer_.error().c_str());
 }
 

@@ -18,18 +18,12 @@ struct FrameTimes {
   std::int64_t wait_call_ns = 0, wait_return_ns = 0;
   std::int64_t begin_ns = 0;
   std::int64_t end_call_ns = 0, end_return_ns = 0;  // around the call down the chain
+  std::int64_t end_down_ns = 0;  // the call down the chain began (the layer's own work before it)
   std::uint32_t layers = 0, projection_views = 0;
   bool replaced = false;  // a frame renderer replaced the application's layers
-  // The path-traced frame shown (-1: none finished yet, or no renderer): its number, the
-  // display time it was traced for (its age is display_time_ns - traced_for_ns), when it
-  // finished, and the head rotation reprojected since (degrees, the larger of the two eyes).
-  std::int64_t traced_frame = -1;
-  std::int64_t traced_for_ns = 0, traced_done_ns = 0;
-  double reprojected_deg = 0;
-  // Where the shown frame was composited, and how many application images went to the host.
-  bool composited_on_gpu = false;
-  std::int64_t host_readbacks = 0;
-  RenderTimes render;     // the frame renderer's split of the traced frame (zero without one)
+  // What the frame renderer showed (Shown's defaults when not replaced: no traced frame, -1):
+  // the path-traced frame, where it was composited, its render's split and this frame's.
+  Shown shown;
 };
 
 class FrameLog {

@@ -118,7 +118,9 @@ struct TraceRequest {
   std::uint64_t visibility_mask_generation = 0;
 };
 
-// A finished path-traced frame, encoded in the application's swapchain format.
+// A finished path-traced frame, encoded in the application's swapchain format: in `colour`
+// and `depth` (the host path), or in a slot of the application's device memory (the GPU path),
+// retired when the frame goes.
 struct TracedFrame {
   std::int64_t id = 0;
   XrTime traced_for = 0;
@@ -126,6 +128,7 @@ struct TracedFrame {
   std::array<glm::dquat, 2> orientation{};  // the views' orientations it was traced for (the application's space)
   std::array<Pixels8, 2> colour;
   std::array<std::vector<float>, 2> depth;  // view distances (FramePipeline::depth); empty in scene-only mode
+  std::unique_ptr<SlotLease> slot;           // the GPU path: colour and depth are there instead
   RenderTimes times;
 };
 
@@ -138,9 +141,11 @@ std::int64_t monotonic_ns() {
 // for the scene upload and shader setup either.
 class PathTracer {
  public:
+  // `slots`: the GPU composition's traced-frame slots, which finished frames are written into
+  // (null: the host path, frames kept in host memory).
   PathTracer(const LayerConfig& config, const renderer::Scene& scene, const core::StereoViews& views,
-             const core::DisplayPreset& display, VkFormat format, XrSession session)
-      : config_(config), scene_(scene), views_(views), format_(format), session_(session),
+             const core::DisplayPreset& display, VkFormat format, XrSession session, const AppDevice* slots)
+      : config_(config), scene_(scene), views_(views), format_(format), session_(session), slots_(slots),
         gaze_(std::make_unique<LayerGaze>(config.gaze, display)), ctx_(std::make_unique<gpu::Context>()),
         gpu_scene_(std::make_unique<renderer::GpuScene>(*ctx_, scene_)) {
     reconstruct::ReconSettings settings;
@@ -153,6 +158,7 @@ class PathTracer {
                      config_.lockstep ? "lockstep" : "async", render_priority_name(config_.render_priority).c_str());
   }
 
+  // Null when stopped while waiting for a free slot.
   std::shared_ptr<const TracedFrame> trace(const TraceRequest& in) {
     auto f = std::make_shared<TracedFrame>();
     RenderTimes& times = f->times;
@@ -195,6 +201,22 @@ class PathTracer {
       f->colour[std::size_t(e)] = encode_scene(pipeline_->image(core::Eye(e)), pixel_format(format_));
       if (config_.composite != Composite::SceneOnly) f->depth[std::size_t(e)] = pipeline_->depth(core::Eye(e));
     }
+    if (slots_) {
+      // Into the application's device memory here, so that xrEndFrame copies no frame. The
+      // slot is free: no pass reads it until the frame is published.
+      const std::shared_ptr<SlotPool> pool = slots_->traced_slots();
+      const int slot = pool->claim();
+      if (slot < 0) return nullptr;
+      f->slot = std::make_unique<SlotLease>(pool, slot);
+      for (int e = 0; e < 2; ++e) {
+        const auto ei = std::size_t(e);
+        std::memcpy(slots_->slot_colour(slot, e), f->colour[ei].data.data(), f->colour[ei].data.size());
+        if (!f->depth[ei].empty())
+          std::memcpy(slots_->slot_depth(slot, e), f->depth[ei].data(), f->depth[ei].size() * sizeof(float));
+        f->colour[ei] = {};
+        f->depth[ei] = {};
+      }
+    }
     times.readback_cpu = ms_since(r0);
     times.total = ms_since(t0);
     f->id = in.id;
@@ -229,6 +251,7 @@ class PathTracer {
   const core::StereoViews views_;
   const VkFormat format_;
   const XrSession session_;
+  const AppDevice* slots_;
   std::unique_ptr<LayerGaze> gaze_;
   bool gaze_from_action_ = false;
   std::optional<std::uint64_t> mask_generation_;  // of the mask fetched last (none yet)
@@ -271,6 +294,7 @@ class PathTraceRenderer final : public FrameRenderer {
       stop_ = true;
     }
     wake_.notify_all();
+    if (const auto slots = app_.traced_slots()) slots->stop();  // a render thread waiting for a slot
     if (thread_.joinable()) thread_.join();
     try {
       app_.finish();  // a composition pass may still write the swapchain images destroyed below
@@ -281,7 +305,8 @@ class PathTraceRenderer final : public FrameRenderer {
       if (e.swapchain != XR_NULL_HANDLE) next_.xrDestroySwapchain(e.swapchain);
   }
 
-  void finish_composition() override { app_.finish(); }
+  int finish_composition(VkImage image) override { return app_.finish_image(image); }
+  void forget_images(const std::vector<VkImage>& images) override { app_.forget_images(images); }
 
   const XrFrameEndInfo* end_frame(const FrameInput& in, Shown& shown) override {
     if (in.app_views.size() != 2) return nullptr;  // only stereo projection layers are replaced
@@ -314,6 +339,8 @@ class PathTraceRenderer final : public FrameRenderer {
         pending_ = req;  // replaces a request the thread has not picked up: only the newest views count
         wake_.notify_all();
         if (config_.lockstep) {
+          // The render thread may need a slot that only this thread gives back.
+          app_.release_retired_slots();
           constexpr auto kLimit = std::chrono::minutes(10);
           if (!done_.wait_for(lock, kLimit, [&] { return !error_.empty() || (newest_ && newest_->id >= req.id); }))
             throw std::runtime_error("lockstep rendering: the render thread did not finish a frame in 10 minutes");
@@ -350,7 +377,8 @@ class PathTraceRenderer final : public FrameRenderer {
                        render_priority_name(config_.render_priority).c_str(), failed.c_str());
     std::unique_ptr<PathTracer> tracer;
     try {
-      tracer = std::make_unique<PathTracer>(config_, scene_, views_in_, display_, format_, session_);
+      tracer = std::make_unique<PathTracer>(config_, scene_, views_in_, display_, format_, session_,
+                                            app_.gpu_composition() ? &app_ : nullptr);
       for (;;) {
         TraceRequest req;
         {
@@ -362,6 +390,7 @@ class PathTraceRenderer final : public FrameRenderer {
           pending_.reset();
         }
         std::shared_ptr<const TracedFrame> f = tracer->trace(req);
+        if (!f) return;  // stopped
         {
           // The frame it replaces is freed after the unlock: at a low priority this thread
           // may wait long for a core, and the application must never wait for it on the lock.
@@ -413,6 +442,7 @@ class PathTraceRenderer final : public FrameRenderer {
                                                     std::uint8_t((*config_.app_background)[1]),
                                                     std::uint8_t((*config_.app_background)[2])};
     rule.blend = layer_blend(in.app_frame->layers[in.projection_layer]->layerFlags, pixel_format(format_));
+    const auto t_acquire = std::chrono::steady_clock::now();
     std::vector<VkImage> targets;
     for (Eye& eye : eyes_) {
       std::uint32_t index = 0;
@@ -423,18 +453,31 @@ class PathTraceRenderer final : public FrameRenderer {
       if (index >= eye.images.size()) throw std::runtime_error("the runtime acquired an unknown swapchain image");
       targets.push_back(eye.images[index]);
     }
+    const auto t_compose = std::chrono::steady_clock::now();
+    shown.acquire_ms = std::chrono::duration<double, std::milli>(t_compose - t_acquire).count();
     if (on_gpu) {
       std::array<AppDevice::GpuEye, 2> jobs;
       for (std::size_t e = 0; e < 2; ++e)
         jobs[e] = {eyes[e], {in.app_views[e].image, in.app_views[e].array_index, in.app_views[e].rect},
                    by_depth ? in.app_views[e].depth : std::nullopt, targets[e]};
-      app_.composite_gpu(f.id, jobs, rule);
+      if (!f.slot) throw std::logic_error("a traced frame without a slot on the GPU path");
+      app_.composite_gpu(f.slot->slot(), jobs, rule);
+      shown.traced_slot = f.slot->slot();
+      const AppDevice::GpuStats n = app_.gpu_stats();
+      shown.recordings = n.recordings;
+      shown.descriptor_updates = n.descriptor_updates;
+      shown.reuse_waits = n.reuse_waits;
+      shown.acquire_waits = n.acquire_waits;
+      shown.submit_ms = n.submit_ms;
     } else {
       compose_on_host(in, eyes, rule, targets);
     }
     shown.composited_on_gpu = on_gpu;
     shown.host_readbacks = app_.host_readbacks() - readbacks;
+    const auto t_release = std::chrono::steady_clock::now();
+    shown.compose_ms = std::chrono::duration<double, std::milli>(t_release - t_compose).count();
     for (Eye& eye : eyes_) xr_check(next_.xrReleaseSwapchainImage(eye.swapchain, nullptr), "xrReleaseSwapchainImage");
+    shown.release_ms = ms_since(t_release);
 
     // The application's frame with its stereo projection layer replaced by the layer's.
     const auto* app_proj = reinterpret_cast<const XrCompositionLayerProjection*>(in.app_frame->layers[in.projection_layer]);
@@ -548,7 +591,7 @@ class PathTraceRenderer final : public FrameRenderer {
       FOVEA_LAYER_INFO("composition: on the host (configured)");
     } else {
       try {
-        app_.enable_gpu_composition();
+        app_.enable_gpu_composition(views_in_[core::Eye::Left].width(), views_in_[core::Eye::Left].height());
         FOVEA_LAYER_INFO("composition: on the GPU (a compute pass on the application's device, session queue family %u)",
                          vk_queue_family_);
       } catch (const std::exception& e) {

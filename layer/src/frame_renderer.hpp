@@ -95,6 +95,16 @@ struct Shown {
   RenderTimes times;                // its render's split; `transfer` is this xrEndFrame's composition
   bool composited_on_gpu = false;   // a compute pass on the application's device (else the host path)
   std::int64_t host_readbacks = 0;  // application images this xrEndFrame copied to the host
+  // The GPU path: the traced-frame slot the render thread wrote the shown frame into (-1:
+  // none), and the composition's work on the application's thread so far (cumulative):
+  // command buffers recorded, descriptor set updates, host waits for a pass in flight
+  // (AppDevice::GpuStats).
+  int traced_slot = -1;
+  std::int64_t recordings = 0, descriptor_updates = 0, reuse_waits = 0, acquire_waits = 0;
+  // This xrEndFrame's composition split (ms): the layer's swapchain images acquired and waited
+  // for, the composition (the GPU pass's parameters and submission, or the host path), the
+  // images released; and the GPU composition's vkQueueSubmit, part of compose_ms.
+  double acquire_ms = 0, compose_ms = 0, release_ms = 0, submit_ms = 0;
 };
 
 // Renders on its own thread: end_frame() hands the submitted views and gaze over and shows
@@ -109,9 +119,13 @@ class FrameRenderer {
   // unchanged (not a stereo projection, nothing finished yet). Throws on failure, also the
   // render thread's; the layer then disables itself for the session.
   virtual const XrFrameEndInfo* end_frame(const FrameInput& in, Shown& shown) = 0;
-  // Waits for the composition work still reading the application's swapchain images (its
-  // last pass runs after xrEndFrame returns): before the application destroys one.
-  virtual void finish_composition() = 0;
+  // Waits for the composition passes still reading `image`, an application's swapchain image
+  // it has just acquired (a pass runs after xrEndFrame returns); passes on other images keep
+  // running. Returns how many it waited for.
+  virtual int finish_composition(VkImage image) = 0;
+  // Waits for the composition work naming any of `images` and forgets what was recorded for
+  // them: before the application destroys their swapchain.
+  virtual void forget_images(const std::vector<VkImage>& images) = 0;
 };
 
 // Null when no scene is configured; throws when one is configured but cannot be loaded or

@@ -1,11 +1,15 @@
 // The layer's composition as a compute pass on the application's device (AppDevice::composite_gpu):
 // xr_layer_composite.comp runs resample() and composite() of composite.cpp on packed 8-bit
-// pixels in device buffers. Per traced frame its two eye images are uploaded once; per
-// application frame one submission on the session queue copies the application's projection
-// views into a buffer (the TRANSFER_SRC usage the layer requests), finds AppOnTop's background
-// on the border, composites both eyes and copies the results into the layer's swapchain
-// images. Nothing of the application's images reaches the host.
+// pixels in device buffers. The render thread writes each traced frame into a slot of a
+// persistently mapped host-visible buffer of this device, which the pass reads directly (no
+// copy of a frame on the application's thread). Per application frame one submission on the
+// session queue copies the application's projection views into a buffer (the TRANSFER_SRC
+// usage the layer requests), finds AppOnTop's background on the border, composites both eyes
+// and copies the results into the layer's swapchain images; its command buffer was recorded at
+// the first frame with the same images, so xrEndFrame writes the frame's parameters and
+// submits. Nothing of the application's images reaches the host.
 #include <algorithm>
+#include <chrono>
 #include <cmath>
 #include <cstring>
 #include <stdexcept>
@@ -25,6 +29,8 @@ namespace {
 constexpr std::uint32_t kBindings = 6;
 // The composite pass's workgroup.
 constexpr std::uint32_t kGroupX = 32, kGroupY = 8;
+// A lost or hung device fails the session instead of hanging the application's call.
+constexpr std::uint64_t kTimeoutNs = 10'000'000'000;
 
 struct Push {
   std::uint32_t eye;
@@ -52,6 +58,9 @@ std::uint32_t depth_packing(VkFormat f) {
 
 float inverse_plane(float z) { return std::isinf(z) ? 0.0f : float(1.0 / double(z)); }
 
+std::array<std::int32_t, 4> rect_key(const XrRect2Di& r) { return {r.offset.x, r.offset.y, r.extent.width, r.extent.height}; }
+XrRect2Di rect_of(const std::array<std::int32_t, 4>& k) { return {{k[0], k[1]}, {k[2], k[3]}}; }
+
 VkMemoryBarrier memory_barrier(VkAccessFlags src, VkAccessFlags dst) {
   VkMemoryBarrier b{VK_STRUCTURE_TYPE_MEMORY_BARRIER};
   b.srcAccessMask = src;
@@ -59,20 +68,55 @@ VkMemoryBarrier memory_barrier(VkAccessFlags src, VkAccessFlags dst) {
   return b;
 }
 
+// Where a pass's inputs and outputs lie in the composition buffers (pixels; depth: bytes),
+// from what the pass was recorded for.
+struct PassLayout {
+  std::array<std::uint32_t, 2> app_offset{}, depth_offset{}, out_offset{};
+  VkDeviceSize app_bytes = 0, depth_bytes = 0;
+};
+
+PassLayout layout_of(const CompositionPassKey& k) {
+  PassLayout l;
+  std::uint32_t app_px = 0, out_px = 0;
+  for (std::size_t e = 0; e < 2; ++e) {
+    l.app_offset[e] = app_px;
+    l.out_offset[e] = out_px;
+    if (k.with_app) app_px += std::uint32_t(k.app_rect[e][2] * k.app_rect[e][3]);
+    out_px += std::uint32_t(k.out_w[e] * k.out_h[e]);
+    l.depth_offset[e] = std::uint32_t(l.depth_bytes);
+    if (k.by_depth)  // offsets stay multiples of 4 (buffer copies of depth aspects require it)
+      l.depth_bytes += (VkDeviceSize(k.depth_rect[e][2]) * VkDeviceSize(k.depth_rect[e][3]) *
+                            (depth_packing(k.depth_format[e]) == shaders::kLayerDepthD16 ? 2 : 4) + 3) &
+                       ~VkDeviceSize(3);
+  }
+  l.app_bytes = VkDeviceSize(app_px) * 4;
+  return l;
+}
+
 }  // namespace
 
-void AppDevice::enable_gpu_composition() {
+bool CompositionPassKey::names(VkImage image) const {
+  for (std::size_t e = 0; e < 2; ++e)
+    if (target[e] == image || (with_app && app[e] == image) || (by_depth && depth[e] == image)) return true;
+  return false;
+}
+
+void AppDevice::enable_gpu_composition(int traced_width, int traced_height, int slots) {
   if (gpu_) return;
   if (!family_has_compute_)
     throw std::runtime_error("the session's queue family " + std::to_string(queue_family_) + " has no compute");
+  if (traced_width <= 0 || traced_height <= 0)
+    throw std::runtime_error("enable_gpu_composition: an empty traced raster");
   const auto spv = shaders::find("xr_layer_composite.comp.spv");
   if (spv.empty()) throw std::runtime_error("xr_layer_composite.comp.spv is not embedded");
   gpu_ = std::make_unique<Gpu>();
   Gpu& g = *gpu_;
   try {
+    // Binding 0, the parameters: a dynamic offset names the pass's own block.
     VkDescriptorSetLayoutBinding b[kBindings]{};
     for (std::uint32_t i = 0; i < kBindings; ++i)
-      b[i] = {i, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, 1, VK_SHADER_STAGE_COMPUTE_BIT, nullptr};
+      b[i] = {i, i == 0 ? VK_DESCRIPTOR_TYPE_STORAGE_BUFFER_DYNAMIC : VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, 1,
+              VK_SHADER_STAGE_COMPUTE_BIT, nullptr};
     VkDescriptorSetLayoutCreateInfo li{VK_STRUCTURE_TYPE_DESCRIPTOR_SET_LAYOUT_CREATE_INFO};
     li.bindingCount = kBindings;
     li.pBindings = b;
@@ -105,39 +149,155 @@ void AppDevice::enable_gpu_composition() {
                                           pass == shaders::kLayerPassBorder ? &g.border_pipeline : &g.pipeline),
                 "vkCreateComputePipelines");
     }
-    const VkDescriptorPoolSize size{VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, kBindings};
+    const VkDescriptorPoolSize sizes[2] = {{VK_DESCRIPTOR_TYPE_STORAGE_BUFFER_DYNAMIC, 1},
+                                           {VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, kBindings - 1}};
     VkDescriptorPoolCreateInfo pi{VK_STRUCTURE_TYPE_DESCRIPTOR_POOL_CREATE_INFO};
     pi.maxSets = 1;
-    pi.poolSizeCount = 1;
-    pi.pPoolSizes = &size;
+    pi.poolSizeCount = 2;
+    pi.pPoolSizes = sizes;
     app_check(vkCreateDescriptorPool_(device_, &pi, nullptr, &g.pool), "vkCreateDescriptorPool");
     VkDescriptorSetAllocateInfo ai{VK_STRUCTURE_TYPE_DESCRIPTOR_SET_ALLOCATE_INFO};
     ai.descriptorPool = g.pool;
     ai.descriptorSetCount = 1;
     ai.pSetLayouts = &g.set_layout;
     app_check(vkAllocateDescriptorSets_(device_, &ai, &g.set), "vkAllocateDescriptorSets");
+    // Command buffers re-recorded in place when their images change.
+    VkCommandPoolCreateInfo cpi{VK_STRUCTURE_TYPE_COMMAND_POOL_CREATE_INFO};
+    cpi.flags = VK_COMMAND_POOL_CREATE_RESET_COMMAND_BUFFER_BIT;
+    cpi.queueFamilyIndex = queue_family_;
+    app_check(vkCreateCommandPool_(device_, &cpi, nullptr, &g.commands), "vkCreateCommandPool");
+    std::array<VkCommandBuffer, kPasses> cbs{};
+    VkCommandBufferAllocateInfo cai{VK_STRUCTURE_TYPE_COMMAND_BUFFER_ALLOCATE_INFO};
+    cai.commandPool = g.commands;
+    cai.level = VK_COMMAND_BUFFER_LEVEL_PRIMARY;
+    cai.commandBufferCount = std::uint32_t(kPasses);
+    app_check(vkAllocateCommandBuffers_(device_, &cai, cbs.data()), "vkAllocateCommandBuffers");
+    for (std::size_t i = 0; i < kPasses; ++i) {
+      g.passes[i].cb = cbs[i];
+      const VkFenceCreateInfo fi{VK_STRUCTURE_TYPE_FENCE_CREATE_INFO};
+      app_check(vkCreateFence_(device_, &fi, nullptr, &g.passes[i].fence), "vkCreateFence");
+    }
     constexpr VkBufferUsageFlags storage = VK_BUFFER_USAGE_STORAGE_BUFFER_BIT;
-    reserve(g.params, sizeof(shaders::LayerCompositeParams), storage);
+    g.params_stride = (sizeof(shaders::LayerCompositeParams) + storage_alignment_ - 1) / storage_alignment_ * storage_alignment_;
+    reserve(g.params, g.params_stride * kPasses, storage);
+    g.traced_w = traced_width;
+    g.traced_h = traced_height;
+    g.slots = std::make_shared<SlotPool>(slots);
+    // Per slot both eyes' colour, then both eyes' view distances: 4 bytes per pixel each.
+    reserve(g.traced, VkDeviceSize(slots) * 4 * VkDeviceSize(traced_width) * VkDeviceSize(traced_height) * 4, storage,
+            true, true);
+    reserve(g.out, 2 * VkDeviceSize(traced_width) * VkDeviceSize(traced_height) * 4,
+            storage | VK_BUFFER_USAGE_TRANSFER_SRC_BIT, false);
     reserve(g.background, 2 * sizeof(std::uint32_t), storage, false);
-    constexpr std::uint64_t kTimeoutNs = 10'000'000'000;
-    pass_ = std::make_unique<xrcommon::ForeignQueue>(device_, get_device_proc_, queue_family_, queue_handle_, kTimeoutNs,
-                                                     "the application's device");
   } catch (...) {
     destroy_gpu();
     throw;
   }
 }
 
+std::shared_ptr<SlotPool> AppDevice::traced_slots() const { return gpu_ ? gpu_->slots : nullptr; }
+
+std::uint8_t* AppDevice::slot_colour(int slot, int eye) const {
+  if (!gpu_ || slot < 0 || slot >= gpu_->slots->slots() || eye < 0 || eye > 1)
+    throw std::logic_error("slot_colour: no such slot");
+  const std::size_t px = std::size_t(gpu_->traced_w) * std::size_t(gpu_->traced_h);
+  return static_cast<std::uint8_t*>(gpu_->traced.mapped) + (std::size_t(slot) * 4 + std::size_t(eye)) * px * 4;
+}
+
+float* AppDevice::slot_depth(int slot, int eye) const {
+  if (!gpu_ || slot < 0 || slot >= gpu_->slots->slots() || eye < 0 || eye > 1)
+    throw std::logic_error("slot_depth: no such slot");
+  const std::size_t px = std::size_t(gpu_->traced_w) * std::size_t(gpu_->traced_h);
+  return reinterpret_cast<float*>(static_cast<std::uint8_t*>(gpu_->traced.mapped) +
+                                  (std::size_t(slot) * 4 + 2 + std::size_t(eye)) * px * 4);
+}
+
+AppDevice::GpuStats AppDevice::gpu_stats() const {
+  std::lock_guard lock(pass_mutex_);
+  return gpu_ ? gpu_->counters : GpuStats{};
+}
+
+void AppDevice::release_retired(bool wait) {
+  Gpu& g = *gpu_;
+  g.retiring |= g.slots->take_retired();
+  for (int s = 0; s < g.slots->slots(); ++s) {
+    if (!(g.retiring & (1u << s))) continue;
+    bool read = false;
+    for (Pass& p : g.passes) {
+      if (p.slot != s) continue;
+      if (wait) wait_pass(p, g.counters.reuse_waits);
+      read = read || pass_pending(p);
+    }
+    if (read) continue;
+    g.retiring &= ~(1u << s);
+    g.slots->release(s);
+  }
+}
+
+void AppDevice::release_retired_slots() {
+  std::lock_guard lock(pass_mutex_);
+  if (gpu_) release_retired(true);
+}
+
+bool AppDevice::pass_pending(Pass& p) {
+  if (!p.pending) return false;
+  const VkResult r = vkGetFenceStatus_(device_, p.fence);
+  if (r == VK_NOT_READY) return true;
+  app_check(r, "vkGetFenceStatus");
+  p.pending = false;
+  return false;
+}
+
+void AppDevice::wait_pass(Pass& p, std::int64_t& waits) {
+  if (!pass_pending(p)) return;
+  ++waits;
+  const VkResult r = vkWaitForFences_(device_, 1, &p.fence, VK_TRUE, kTimeoutNs);
+  if (r == VK_TIMEOUT)
+    throw std::runtime_error("a composition pass did not finish on the application's device in " +
+                             std::to_string(kTimeoutNs / 1'000'000) + " ms");
+  app_check(r, "vkWaitForFences");
+  p.pending = false;
+}
+
 void AppDevice::finish() {
   std::lock_guard lock(pass_mutex_);
-  if (pass_) pass_->wait();
+  if (gpu_)
+    for (Pass& p : gpu_->passes) wait_pass(p, gpu_->counters.reuse_waits);
+}
+
+int AppDevice::finish_image(VkImage image) {
+  std::lock_guard lock(pass_mutex_);
+  int waited = 0;
+  if (gpu_)
+    for (Pass& p : gpu_->passes)
+      if (p.pending && p.key.names(image)) {
+        wait_pass(p, gpu_->counters.acquire_waits);
+        ++waited;
+      }
+  return waited;
+}
+
+void AppDevice::forget_images(const std::vector<VkImage>& images) {
+  std::lock_guard lock(pass_mutex_);
+  if (!gpu_) return;
+  for (Pass& p : gpu_->passes)
+    if (p.recorded && std::any_of(images.begin(), images.end(), [&](VkImage i) { return p.key.names(i); })) {
+      wait_pass(p, gpu_->counters.reuse_waits);
+      p.recorded = false;
+    }
 }
 
 void AppDevice::destroy_gpu() {
-  pass_.reset();  // waits for a pass still running: it uses the buffers below
   if (!gpu_) return;
   Gpu& g = *gpu_;
-  for (Buffer* b : {&g.params, &g.staging, &g.traced, &g.app, &g.app_depth, &g.out, &g.background}) release(*b);
+  for (Pass& p : g.passes) {
+    // Its command buffer and the buffers below must not be in use when they go; a failed
+    // wait leaves nothing better to do.
+    if (p.pending) vkWaitForFences_(device_, 1, &p.fence, VK_TRUE, kTimeoutNs);
+    if (p.fence) vkDestroyFence_(device_, p.fence, nullptr);
+  }
+  if (g.commands) vkDestroyCommandPool_(device_, g.commands, nullptr);  // frees the command buffers
+  for (Buffer* b : {&g.params, &g.traced, &g.app, &g.app_depth, &g.out, &g.background}) release(*b);
   if (g.pool) vkDestroyDescriptorPool_(device_, g.pool, nullptr);
   if (g.pipeline) vkDestroyPipeline_(device_, g.pipeline, nullptr);
   if (g.border_pipeline) vkDestroyPipeline_(device_, g.border_pipeline, nullptr);
@@ -147,67 +307,175 @@ void AppDevice::destroy_gpu() {
   gpu_.reset();
 }
 
-void AppDevice::composite_gpu(std::int64_t traced_id, const std::array<GpuEye, 2>& eyes, const CompositionRule& rule) {
+void AppDevice::reserve_gpu_buffers(VkDeviceSize app_bytes, VkDeviceSize depth_bytes) {
+  Gpu& g = *gpu_;
+  app_bytes = std::max<VkDeviceSize>(app_bytes, 4);
+  depth_bytes = std::max<VkDeviceSize>(depth_bytes, 4);
+  if (g.set_written && g.app.size >= app_bytes && g.app_depth.size >= depth_bytes) return;
+  // A buffer grows (the first frame, or larger application rects): nothing may use the old
+  // one, and the set, and so every recorded pass, names the new one.
+  for (Pass& p : g.passes) {
+    wait_pass(p, g.counters.reuse_waits);
+    p.recorded = false;
+  }
+  constexpr VkBufferUsageFlags dst = VK_BUFFER_USAGE_STORAGE_BUFFER_BIT | VK_BUFFER_USAGE_TRANSFER_DST_BIT;
+  reserve(g.app, app_bytes, dst, false);
+  reserve(g.app_depth, depth_bytes, dst, false);
+  const Buffer* bound[kBindings] = {&g.params, &g.traced, &g.app, &g.out, &g.background, &g.app_depth};
+  VkDescriptorBufferInfo infos[kBindings];
+  VkWriteDescriptorSet writes[kBindings];
+  for (std::uint32_t i = 0; i < kBindings; ++i) {
+    infos[i] = {bound[i]->buffer, 0, i == 0 ? VkDeviceSize(sizeof(shaders::LayerCompositeParams)) : VK_WHOLE_SIZE};
+    writes[i] = {VK_STRUCTURE_TYPE_WRITE_DESCRIPTOR_SET};
+    writes[i].dstSet = g.set;
+    writes[i].dstBinding = i;
+    writes[i].descriptorCount = 1;
+    writes[i].descriptorType = i == 0 ? VK_DESCRIPTOR_TYPE_STORAGE_BUFFER_DYNAMIC : VK_DESCRIPTOR_TYPE_STORAGE_BUFFER;
+    writes[i].pBufferInfo = &infos[i];
+  }
+  vkUpdateDescriptorSets_(device_, kBindings, writes, 0, nullptr);
+  ++g.counters.descriptor_updates;
+  g.set_written = true;
+}
+
+void AppDevice::record_pass(Pass& pass, std::size_t index) {
+  Gpu& g = *gpu_;
+  const PassKey& k = pass.key;
+  const PassLayout l = layout_of(k);
+  const VkCommandBuffer cb = pass.cb;
+  const VkCommandBufferBeginInfo bi{VK_STRUCTURE_TYPE_COMMAND_BUFFER_BEGIN_INFO};
+  app_check(vkBeginCommandBuffer_(cb, &bi), "vkBeginCommandBuffer");
+  // The copies of the application's images end with a barrier whose second scope spans every
+  // later submission on the queue, so the application's next rendering into them waits for
+  // the copies on the device, and the runtime waits for the session queue's work before it
+  // reads the layer's images (as for any application's).
+  if (k.with_app)
+    for (std::size_t e = 0; e < 2; ++e)
+      record_download(cb,
+                      {k.app[e], k.app_layer[e], VK_IMAGE_LAYOUT_COLOR_ATTACHMENT_OPTIMAL,
+                       VK_ACCESS_COLOR_ATTACHMENT_WRITE_BIT | VK_ACCESS_SHADER_WRITE_BIT | VK_ACCESS_TRANSFER_WRITE_BIT,
+                       VK_IMAGE_ASPECT_COLOR_BIT, VK_IMAGE_ASPECT_COLOR_BIT, rect_of(k.app_rect[e]),
+                       VkDeviceSize(l.app_offset[e]) * 4},
+                      g.app.buffer);
+  if (k.by_depth)
+    for (std::size_t e = 0; e < 2; ++e)
+      record_download(cb,
+                      depth_download({k.depth[e], k.depth_format[e], rect_of(k.depth_rect[e]), k.depth_layer[e], {}},
+                                     VkDeviceSize(l.depth_offset[e])),
+                      g.app_depth.buffer);
+  // After the copies above; the host's writes (the parameters, the traced slot) are visible
+  // through the submission.
+  const VkMemoryBarrier to_compute = memory_barrier(VK_ACCESS_TRANSFER_WRITE_BIT, VK_ACCESS_SHADER_READ_BIT);
+  vkCmdPipelineBarrier_(cb, VK_PIPELINE_STAGE_TRANSFER_BIT, VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT, 0, 1, &to_compute, 0,
+                        nullptr, 0, nullptr);
+  const std::uint32_t params_offset = std::uint32_t(g.params_stride * index);
+  vkCmdBindDescriptorSets_(cb, VK_PIPELINE_BIND_POINT_COMPUTE, g.layout, 0, 1, &g.set, 1, &params_offset);
+  if (k.border) {
+    vkCmdBindPipeline_(cb, VK_PIPELINE_BIND_POINT_COMPUTE, g.border_pipeline);
+    for (std::uint32_t e = 0; e < 2; ++e) {
+      const Push push{e};
+      vkCmdPushConstants_(cb, g.layout, VK_SHADER_STAGE_COMPUTE_BIT, 0, sizeof push, &push);
+      vkCmdDispatch_(cb, 1, 1, 1);
+    }
+    const VkMemoryBarrier border = memory_barrier(VK_ACCESS_SHADER_WRITE_BIT, VK_ACCESS_SHADER_READ_BIT);
+    vkCmdPipelineBarrier_(cb, VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT, VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT, 0, 1, &border,
+                          0, nullptr, 0, nullptr);
+  }
+  vkCmdBindPipeline_(cb, VK_PIPELINE_BIND_POINT_COMPUTE, g.pipeline);
+  for (std::uint32_t e = 0; e < 2; ++e) {
+    const Push push{e};
+    vkCmdPushConstants_(cb, g.layout, VK_SHADER_STAGE_COMPUTE_BIT, 0, sizeof push, &push);
+    vkCmdDispatch_(cb, (std::uint32_t(k.out_w[e]) + kGroupX - 1) / kGroupX,
+                  (std::uint32_t(k.out_h[e]) + kGroupY * shaders::kLayerRowsPerInvocation - 1) /
+                      (kGroupY * shaders::kLayerRowsPerInvocation), 1);
+  }
+  const VkMemoryBarrier to_transfer = memory_barrier(VK_ACCESS_SHADER_WRITE_BIT, VK_ACCESS_TRANSFER_READ_BIT);
+  vkCmdPipelineBarrier_(cb, VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT, VK_PIPELINE_STAGE_TRANSFER_BIT, 0, 1, &to_transfer, 0,
+                        nullptr, 0, nullptr);
+  for (std::size_t e = 0; e < 2; ++e)
+    record_upload(cb, g.out.buffer, VkDeviceSize(l.out_offset[e]) * 4, k.target[e], k.out_w[e], k.out_h[e]);
+  app_check(vkEndCommandBuffer_(cb), "vkEndCommandBuffer");
+  pass.recorded = true;
+  ++g.counters.recordings;
+}
+
+void AppDevice::composite_gpu(int slot, const std::array<GpuEye, 2>& eyes, const CompositionRule& rule) {
   if (!gpu_) throw std::logic_error("composite_gpu: GPU composition was not enabled");
   Gpu& g = *gpu_;
   std::lock_guard lock(pass_mutex_);
-  pass_->wait();  // the previous frame's pass reads the buffers rewritten below
+  if (slot < 0 || slot >= g.slots->slots()) throw std::logic_error("composite_gpu: no such traced slot");
+  release_retired(false);
+
   const bool with_app = rule.mode != Composite::SceneOnly;
-  // By depth when both eyes bring the application's depth image and the traced depths.
-  const bool by_depth = with_app && eyes[0].depth && eyes[1].depth && eyes[0].composition.traced_depth &&
-                        eyes[1].composition.traced_depth;
-  auto& p = *static_cast<shaders::LayerCompositeParams*>(g.params.mapped);
-  std::uint32_t traced_px = 0, app_px = 0, out_px = 0;
-  VkDeviceSize depth_bytes = 0;
+  // By depth when both eyes bring the application's depth image (the slot holds the traced depths).
+  const bool by_depth = with_app && eyes[0].depth && eyes[1].depth;
+  PassKey key;
+  key.with_app = with_app;
+  key.by_depth = by_depth;
+  key.border = with_app && !by_depth && rule.mode == Composite::AppOnTop && !rule.background;
+  shaders::LayerCompositeParams p{};
+  const std::uint32_t traced_px = std::uint32_t(g.traced_w * g.traced_h);
+  for (std::size_t e = 0; e < 2; ++e) {
+    const EyeComposition& c = eyes[e].composition;
+    if (c.traced_view.width() != g.traced_w || c.traced_view.height() != g.traced_h ||
+        c.out_view.width() != g.traced_w || c.out_view.height() != g.traced_h)
+      throw std::logic_error("composite_gpu: the views differ from the traced slots' raster");
+    const XrRect2Di& r = eyes[e].app.rect;
+    if (with_app && (r.extent.width <= 0 || r.extent.height <= 0 || r.offset.x < 0 || r.offset.y < 0))
+      throw std::runtime_error("a submitted imageRect is empty or negative");
+    key.target[e] = eyes[e].target;
+    key.out_w[e] = c.out_view.width();
+    key.out_h[e] = c.out_view.height();
+    if (with_app) {
+      key.app[e] = eyes[e].app.image;
+      key.app_rect[e] = rect_key(r);
+      key.app_layer[e] = eyes[e].app.array_layer;
+    }
+    if (by_depth) {
+      const AppDepth& d = *eyes[e].depth;
+      if (d.rect.extent.width != r.extent.width || d.rect.extent.height != r.extent.height || d.rect.offset.x < 0 ||
+          d.rect.offset.y < 0)
+        throw std::runtime_error("a submitted depth imageRect differs in size from its colour imageRect");
+      depth_packing(d.format);  // throws for a format without a decoding
+      key.depth[e] = d.image;
+      key.depth_rect[e] = rect_key(d.rect);
+      key.depth_layer[e] = d.array_index;
+      key.depth_format[e] = d.format;
+    }
+  }
+  const PassLayout l = layout_of(key);
   for (std::size_t e = 0; e < 2; ++e) {
     const EyeComposition& c = eyes[e].composition;
     shaders::LayerCompositeEye& pe = p.eye[e];
-    const XrExtent2Di app_size = eyes[e].app.rect.extent;
-    if (with_app && (app_size.width <= 0 || app_size.height <= 0 || eyes[e].app.rect.offset.x < 0 ||
-                     eyes[e].app.rect.offset.y < 0))
-      throw std::runtime_error("a submitted imageRect is empty or negative");
     set_tan(pe.out_tan, c.out_view);
     set_tan(pe.traced_tan, c.traced_view);
     const glm::dmat3 r = glm::mat3_cast(c.to_traced);
     for (int row = 0; row < 3; ++row)
       for (int col = 0; col < 3; ++col) pe.to_traced[row * 3 + col] = float(r[col][row]);  // glm: column-major
-    pe.out_w = c.out_view.width();
-    pe.out_h = c.out_view.height();
-    pe.traced_w = c.traced_view.width();
-    pe.traced_h = c.traced_view.height();
-    pe.app_w = with_app ? app_size.width : 0;
-    pe.app_h = with_app ? app_size.height : 0;
-    pe.traced_offset = traced_px;
-    pe.app_offset = app_px;
-    pe.out_offset = out_px;
+    pe.out_w = key.out_w[e];
+    pe.out_h = key.out_h[e];
+    pe.traced_w = g.traced_w;
+    pe.traced_h = g.traced_h;
+    pe.app_w = key.app_rect[e][2];
+    pe.app_h = key.app_rect[e][3];
+    // The slot: both eyes' colour, then both eyes' distances (slot_colour, slot_depth).
+    pe.traced_offset = (std::uint32_t(slot) * 4 + std::uint32_t(e)) * traced_px;
+    pe.traced_depth_offset = (std::uint32_t(slot) * 4 + 2 + std::uint32_t(e)) * traced_px;
+    pe.app_offset = l.app_offset[e];
+    pe.out_offset = l.out_offset[e];
     // resample()'s shortcut, taken alike: a copy without resampling.
     pe.traced_identity = resample_copies(c.traced_view, pe.traced_w, pe.traced_h, c.out_view, c.to_traced);
     pe.app_identity = with_app && resample_copies(c.app_view, pe.app_w, pe.app_h, c.out_view);
-    pe.depth_format = pe.depth_offset = 0;
     if (by_depth) {
       const AppDepth& d = *eyes[e].depth;
-      if (d.rect.extent.width != app_size.width || d.rect.extent.height != app_size.height || d.rect.offset.x < 0 ||
-          d.rect.offset.y < 0)
-        throw std::runtime_error("a submitted depth imageRect differs in size from its colour imageRect");
-      if (c.traced_depth->size() != std::size_t(pe.traced_w) * std::size_t(pe.traced_h))
-        throw std::logic_error("composite_gpu: the traced depths differ from its view's raster");
       pe.depth_format = depth_packing(d.format);
-      pe.depth_offset = std::uint32_t(depth_bytes);
-      // Offsets stay multiples of 4 (buffer copies of depth aspects require it).
-      depth_bytes += (VkDeviceSize(app_size.width) * VkDeviceSize(app_size.height) *
-                          (pe.depth_format == shaders::kLayerDepthD16 ? 2 : 4) + 3) & ~VkDeviceSize(3);
+      pe.depth_offset = l.depth_offset[e];
       pe.min_depth = d.range.min_depth;
       pe.max_depth = d.range.max_depth;
       pe.inv_near = inverse_plane(d.range.near_z);
       pe.inv_far = inverse_plane(d.range.far_z);
     }
-    traced_px += std::uint32_t(pe.traced_w * pe.traced_h);
-    app_px += std::uint32_t(pe.app_w * pe.app_h);
-    out_px += std::uint32_t(pe.out_w * pe.out_h);
   }
-  // The traced depths follow both eyes' colour.
-  p.eye[0].traced_depth_offset = traced_px;
-  p.eye[1].traced_depth_offset = traced_px + std::uint32_t(p.eye[0].traced_w * p.eye[0].traced_h);
   p.mode = by_depth                         ? shaders::kLayerDepth
            : rule.mode == Composite::AppOnTop ? shaders::kLayerAppOnTop
            : rule.mode == Composite::Alpha    ? shaders::kLayerAlpha
@@ -220,105 +488,62 @@ void AppDevice::composite_gpu(std::int64_t traced_id, const std::array<GpuEye, 2
   p.source_alpha = rule.blend.source_alpha;
   p.premultiplied = rule.blend.premultiplied;
   p.srgb = rule.blend.srgb;
-  for (int i = 0; i < 256; ++i) p.decode[i] = rule.blend.srgb ? core::srgb_decode(float(i) / 255.0f) : float(i) / 255.0f;
-
-  constexpr VkBufferUsageFlags storage = VK_BUFFER_USAGE_STORAGE_BUFFER_BIT;
-  // The traced colour, then (by depth) its depths: 4 bytes per pixel each.
-  const VkDeviceSize traced_bytes = VkDeviceSize(traced_px) * 4 * (by_depth ? 2 : 1);
-  // A new traced frame, its depths needed for the first time, or a buffer that has to grow
-  // (first use): its contents are uploaded.
-  const bool upload = traced_id != g.uploaded || (by_depth && !g.uploaded_depth) || g.traced.size < traced_bytes;
-  if (upload) {
-    reserve(g.staging, traced_bytes, VK_BUFFER_USAGE_TRANSFER_SRC_BIT);
-    auto* staging = static_cast<std::uint8_t*>(g.staging.mapped);
-    for (std::size_t e = 0; e < 2; ++e) {
-      const Pixels8& t = *eyes[e].composition.traced;
-      if (t.width != p.eye[e].traced_w || t.height != p.eye[e].traced_h)
-        throw std::logic_error("composite_gpu: the traced image differs from its view's raster");
-      std::memcpy(staging + std::size_t(p.eye[e].traced_offset) * 4, t.data.data(), t.data.size());
-      if (by_depth)
-        std::memcpy(staging + std::size_t(p.eye[e].traced_depth_offset) * 4, eyes[e].composition.traced_depth->data(),
-                    eyes[e].composition.traced_depth->size() * sizeof(float));
-    }
+  if (g.decode_srgb != rule.blend.srgb) {
+    for (int i = 0; i < 256; ++i)
+      g.decode[std::size_t(i)] = rule.blend.srgb ? core::srgb_decode(float(i) / 255.0f) : float(i) / 255.0f;
+    g.decode_srgb = rule.blend.srgb;
   }
-  reserve(g.traced, traced_bytes, storage | VK_BUFFER_USAGE_TRANSFER_DST_BIT, false);
-  reserve(g.app, std::max<VkDeviceSize>(VkDeviceSize(app_px) * 4, 4), storage | VK_BUFFER_USAGE_TRANSFER_DST_BIT, false);
-  reserve(g.app_depth, std::max<VkDeviceSize>(depth_bytes, 4), storage | VK_BUFFER_USAGE_TRANSFER_DST_BIT, false);
-  reserve(g.out, VkDeviceSize(out_px) * 4, storage | VK_BUFFER_USAGE_TRANSFER_SRC_BIT, false);
+  std::memcpy(p.decode, g.decode.data(), sizeof p.decode);
 
-  // Buffers may have been reallocated: the set names the current ones.
-  const Buffer* bound[kBindings] = {&g.params, &g.traced, &g.app, &g.out, &g.background, &g.app_depth};
-  VkDescriptorBufferInfo infos[kBindings];
-  VkWriteDescriptorSet writes[kBindings];
-  for (std::uint32_t i = 0; i < kBindings; ++i) {
-    infos[i] = {bound[i]->buffer, 0, VK_WHOLE_SIZE};
-    writes[i] = {VK_STRUCTURE_TYPE_WRITE_DESCRIPTOR_SET};
-    writes[i].dstSet = g.set;
-    writes[i].dstBinding = i;
-    writes[i].descriptorCount = 1;
-    writes[i].descriptorType = VK_DESCRIPTOR_TYPE_STORAGE_BUFFER;
-    writes[i].pBufferInfo = &infos[i];
+  reserve_gpu_buffers(l.app_bytes, l.depth_bytes);
+  // A pass recorded for these images and no longer in flight. Else, if one is recorded for
+  // them but in flight, a second copy in a pass never recorded, or (none left) a wait for the
+  // least recently used copy: copies never evict each other, so recordings stop once there
+  // are enough. Images never seen: a pass not in flight, the least recently used, recorded
+  // for them (or, every pass in flight, the least recently used one after a wait). A pass's
+  // previous submission must be done before its command buffer and parameter block are
+  // reused: the only host wait.
+  const auto older = [&](std::size_t i, std::size_t j) {  // unrecorded first, then least recently used
+    const Pass &a = g.passes[i], &b = g.passes[j];
+    return a.recorded != b.recorded ? !a.recorded : a.used < b.used;
+  };
+  std::size_t index = kPasses, fresh = kPasses, idle = kPasses, same = kPasses, any = kPasses;
+  // The passes recorded for these images first: in the steady state one of them is idle, and
+  // only their fences are polled.
+  for (std::size_t i = 0; i < kPasses && index == kPasses; ++i)
+    if (g.passes[i].recorded && g.passes[i].key == key && !pass_pending(g.passes[i])) index = i;
+  for (std::size_t i = 0; i < kPasses && index == kPasses; ++i) {
+    const bool matches = g.passes[i].recorded && g.passes[i].key == key;
+    const bool in_flight = matches || pass_pending(g.passes[i]);  // the matching ones were polled above
+    if (!g.passes[i].recorded && fresh == kPasses) fresh = i;
+    if (!in_flight && (idle == kPasses || older(i, idle))) idle = i;
+    if (matches && (same == kPasses || older(i, same))) same = i;
+    if (any == kPasses || older(i, any)) any = i;
   }
-  vkUpdateDescriptorSets_(device_, kBindings, writes, 0, nullptr);
-
-  if (upload) {
-    g.uploaded = traced_id;
-    g.uploaded_depth = by_depth;
+  bool record = false;
+  if (index == kPasses) {
+    const std::size_t copy = same != kPasses ? fresh : idle;
+    record = copy != kPasses || same == kPasses;
+    index = copy != kPasses ? copy : same != kPasses ? same : any;
   }
-  // One submission, not waited for here: the copies of the application's images end with a
-  // barrier whose second scope spans every later submission on the queue, so the
-  // application's next rendering into them waits for the copies on the device, and the
-  // runtime waits for the session queue's work before it reads the layer's images (as for
-  // any application's). xrEndFrame then costs the recording and the submission only.
-  pass_->submit([&](VkCommandBuffer cb) {
-    if (upload) {
-      const VkBufferCopy region{0, 0, traced_bytes};
-      vkCmdCopyBuffer_(cb, g.staging.buffer, g.traced.buffer, 1, &region);
-    }
-    if (with_app)
-      for (std::size_t e = 0; e < 2; ++e)
-        record_download(cb,
-                        {eyes[e].app.image, eyes[e].app.array_layer, VK_IMAGE_LAYOUT_COLOR_ATTACHMENT_OPTIMAL,
-                         VK_ACCESS_COLOR_ATTACHMENT_WRITE_BIT | VK_ACCESS_SHADER_WRITE_BIT | VK_ACCESS_TRANSFER_WRITE_BIT,
-                         VK_IMAGE_ASPECT_COLOR_BIT, VK_IMAGE_ASPECT_COLOR_BIT, eyes[e].app.rect,
-                         VkDeviceSize(p.eye[e].app_offset) * 4},
-                        g.app.buffer);
-    if (by_depth)
-      for (std::size_t e = 0; e < 2; ++e) {
-        const AppDepth& d = *eyes[e].depth;
-        record_download(cb, depth_download(d, VkDeviceSize(p.eye[e].depth_offset)), g.app_depth.buffer);
-      }
-    // After the copies above; the parameters' host writes are visible through the submission.
-    const VkMemoryBarrier to_compute = memory_barrier(VK_ACCESS_TRANSFER_WRITE_BIT, VK_ACCESS_SHADER_READ_BIT);
-    vkCmdPipelineBarrier_(cb, VK_PIPELINE_STAGE_TRANSFER_BIT, VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT, 0, 1, &to_compute, 0,
-                          nullptr, 0, nullptr);
-    vkCmdBindDescriptorSets_(cb, VK_PIPELINE_BIND_POINT_COMPUTE, g.layout, 0, 1, &g.set, 0, nullptr);
-    if (p.mode == shaders::kLayerAppOnTop && !rule.background) {
-      vkCmdBindPipeline_(cb, VK_PIPELINE_BIND_POINT_COMPUTE, g.border_pipeline);
-      for (std::uint32_t e = 0; e < 2; ++e) {
-        const Push push{e};
-        vkCmdPushConstants_(cb, g.layout, VK_SHADER_STAGE_COMPUTE_BIT, 0, sizeof push, &push);
-        vkCmdDispatch_(cb, 1, 1, 1);
-      }
-      const VkMemoryBarrier border = memory_barrier(VK_ACCESS_SHADER_WRITE_BIT, VK_ACCESS_SHADER_READ_BIT);
-      vkCmdPipelineBarrier_(cb, VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT, VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT, 0, 1, &border,
-                            0, nullptr, 0, nullptr);
-    }
-    vkCmdBindPipeline_(cb, VK_PIPELINE_BIND_POINT_COMPUTE, g.pipeline);
-    for (std::uint32_t e = 0; e < 2; ++e) {
-      const Push push{e};
-      vkCmdPushConstants_(cb, g.layout, VK_SHADER_STAGE_COMPUTE_BIT, 0, sizeof push, &push);
-      vkCmdDispatch_(cb, (std::uint32_t(p.eye[e].out_w) + kGroupX - 1) / kGroupX,
-                    (std::uint32_t(p.eye[e].out_h) + kGroupY * shaders::kLayerRowsPerInvocation - 1) /
-                        (kGroupY * shaders::kLayerRowsPerInvocation), 1);
-    }
-    const VkMemoryBarrier to_transfer = memory_barrier(VK_ACCESS_SHADER_WRITE_BIT, VK_ACCESS_TRANSFER_READ_BIT);
-    vkCmdPipelineBarrier_(cb, VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT, VK_PIPELINE_STAGE_TRANSFER_BIT, 0, 1, &to_transfer,
-                          0, nullptr, 0, nullptr);
-    for (std::size_t e = 0; e < 2; ++e)
-      record_upload(cb, g.out.buffer, VkDeviceSize(p.eye[e].out_offset) * 4, eyes[e].target, p.eye[e].out_w,
-                    p.eye[e].out_h);
-  });
+  Pass& pass = g.passes[index];
+  wait_pass(pass, g.counters.reuse_waits);
+  if (record) {
+    pass.key = key;
+    record_pass(pass, index);
+  }
+  std::memcpy(static_cast<std::uint8_t*>(g.params.mapped) + g.params_stride * index, &p, sizeof p);
+  app_check(vkResetFences_(device_, 1, &pass.fence), "vkResetFences");
+  VkSubmitInfo si{VK_STRUCTURE_TYPE_SUBMIT_INFO};
+  si.commandBufferCount = 1;
+  si.pCommandBuffers = &pass.cb;
+  const auto t_submit = std::chrono::steady_clock::now();
+  app_check(vkQueueSubmit_(queue_handle_, 1, &si, pass.fence), "vkQueueSubmit");
+  g.counters.submit_ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t_submit).count();
+  pass.pending = true;
+  pass.slot = slot;
+  pass.used = ++g.clock;
+  ++g.counters.submissions;
 }
 
 }  // namespace fovea::layer

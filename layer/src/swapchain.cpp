@@ -1,7 +1,8 @@
 // Swapchain intercepts: forwarded (creation with the transfer-source usage added); the layer records each swapchain's images
 // (enumerated by the layer itself at creation: an application need not enumerate them to
 // submit them) and which one was released last (what the application submits in xrEndFrame).
-// Acquisition and destruction first wait for a composition pass still reading the images.
+// An acquired image is returned once no composition pass reads it any more; destruction first
+// waits for the passes naming the swapchain's images.
 #include <vector>
 
 #include "layer.hpp"
@@ -23,16 +24,23 @@ std::shared_ptr<FrameRenderer> renderer_for_swapchain(XrSwapchain sc) {
   return s == layer().sessions.end() ? nullptr : s->second.renderer;
 }
 
-// The last composition pass may still read the application's images on the device after
-// xrEndFrame returned: an image is given back to the application (acquired) or destroyed
-// only after it. Outside Layer::mutex.
-void finish_composition(FrameRenderer* renderer, const char* call) {
+// A composition pass may still read the application's images on the device after xrEndFrame
+// returned: an image is given back to the application (acquired) or destroyed only after the
+// passes that read it. Outside Layer::mutex.
+template <typename Wait>
+void finish_composition(FrameRenderer* renderer, const char* call, Wait wait) {
   if (!renderer) return;
   try {
-    renderer->finish_composition();
+    wait(*renderer);
   } catch (const std::exception& e) {
-    FOVEA_LAYER_ERROR("%s: the last composition pass did not finish: %s", call, e.what());
+    FOVEA_LAYER_ERROR("%s: a composition pass did not finish: %s", call, e.what());
   }
+}
+
+// The images of swapchain `sc` (under Layer::mutex).
+std::vector<VkImage> swapchain_images(XrSwapchain sc) {
+  const auto it = layer().swapchains.find(sc);
+  return it == layer().swapchains.end() ? std::vector<VkImage>{} : it->second.images;
 }
 
 }  // namespace
@@ -78,14 +86,16 @@ XrResult intercept::xrCreateSwapchain(XrSession session, const XrSwapchainCreate
 XrResult intercept::xrDestroySwapchain(XrSwapchain swapchain) {
   PFN_xrDestroySwapchain next = nullptr;
   std::shared_ptr<FrameRenderer> renderer;
+  std::vector<VkImage> images;
   {
     std::lock_guard lock(layer().mutex);
     const Dispatch* d = next_for_swapchain(swapchain);
     if (!d) return XR_ERROR_HANDLE_INVALID;
     next = d->xrDestroySwapchain;
     renderer = renderer_for_swapchain(swapchain);
+    images = swapchain_images(swapchain);
   }
-  finish_composition(renderer.get(), __func__);
+  finish_composition(renderer.get(), __func__, [&](FrameRenderer& r) { r.forget_images(images); });
   const XrResult r = next(swapchain);
   if (XR_SUCCEEDED(r)) {
     std::lock_guard lock(layer().mutex);
@@ -105,12 +115,20 @@ XrResult intercept::xrAcquireSwapchainImage(XrSwapchain swapchain, const XrSwapc
     next = d->xrAcquireSwapchainImage;
     renderer = renderer_for_swapchain(swapchain);
   }
-  finish_composition(renderer.get(), __func__);
   const XrResult r = next(swapchain, info, index);
   if (XR_SUCCEEDED(r)) {
-    std::lock_guard lock(layer().mutex);
-    auto it = layer().swapchains.find(swapchain);
-    if (it != layer().swapchains.end()) it->second.acquired.push_back(*index);
+    VkImage image = VK_NULL_HANDLE;
+    {
+      std::lock_guard lock(layer().mutex);
+      auto it = layer().swapchains.find(swapchain);
+      if (it != layer().swapchains.end()) {
+        it->second.acquired.push_back(*index);
+        if (*index < it->second.images.size()) image = it->second.images[*index];
+      }
+    }
+    // Only the passes that read this image: the application may render into it once acquired.
+    if (image != VK_NULL_HANDLE)
+      finish_composition(renderer.get(), __func__, [&](FrameRenderer& fr) { fr.finish_composition(image); });
   }
   return r;
 }

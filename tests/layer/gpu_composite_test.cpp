@@ -140,11 +140,26 @@ EyeComposition eye_of(const Geometry& g, const Pixels8& traced, std::size_t e) {
   return c;
 }
 
+// The traced frame of `jobs` (and its depths, when compositing by depth) written into a free
+// slot, as the render thread does; the slot, retired once the caller has composited it.
+int write_slot(AppDevice& dev, const std::array<AppDevice::GpuEye, 2>& jobs) {
+  const int slot = dev.traced_slots()->claim();
+  EXPECT_GE(slot, 0);
+  for (int e = 0; e < 2; ++e) {
+    const EyeComposition& c = jobs[std::size_t(e)].composition;
+    std::memcpy(dev.slot_colour(slot, e), c.traced->data.data(), c.traced->data.size());
+    if (c.traced_depth) std::memcpy(dev.slot_depth(slot, e), c.traced_depth->data(), c.traced_depth->size() * sizeof(float));
+  }
+  return slot;
+}
+
 // The GPU composition of `jobs`, its targets read back; it copies no application image to the host.
-std::vector<Pixels8> composite_on_gpu(AppDevice& dev, std::int64_t traced_id, const std::array<AppDevice::GpuEye, 2>& jobs,
+std::vector<Pixels8> composite_on_gpu(AppDevice& dev, const std::array<AppDevice::GpuEye, 2>& jobs,
                                       const CompositionRule& rule, const Geometry& g) {
   const std::int64_t readbacks = dev.host_readbacks();
-  dev.composite_gpu(traced_id, jobs, rule);
+  const int slot = write_slot(dev, jobs);
+  dev.composite_gpu(slot, jobs, rule);
+  dev.traced_slots()->retire(slot);  // released by a later composite_gpu, its pass done
   dev.finish();
   EXPECT_EQ(dev.host_readbacks(), readbacks) << "the GPU path copied application images to the host";
   return dev.read({{jobs[0].target, 0, {{0, 0}, {g.traced_w, g.traced_h}}},
@@ -172,9 +187,8 @@ TEST_F(GpuComposite, MatchesTheHostPathPixelByPixel) {
   };
   const VulkanBinding vk{ctx().instance(), ctx().physical_device(), ctx().device(), ctx().queue_family(), 0};
   AppDevice dev(vk);
-  ASSERT_NO_THROW(dev.enable_gpu_composition());
+  ASSERT_NO_THROW(dev.enable_gpu_composition(40, 36));
   std::mt19937 rng(1234);
-  std::int64_t traced_id = 0;
   for (const Geometry& g : geometries) {
     TestImage app_img[2] = {{ctx(), g.app_w, g.app_h}, {ctx(), g.app_w, g.app_h}};
     TestImage target[2] = {{ctx(), g.traced_w, g.traced_h}, {ctx(), g.traced_w, g.traced_h}};
@@ -199,7 +213,7 @@ TEST_F(GpuComposite, MatchesTheHostPathPixelByPixel) {
         c.app = m.mode == Composite::SceneOnly ? nullptr : &app[e];
         host[e] = compose_eye(c, rule);
       }
-      const std::vector<Pixels8> gpu_out = composite_on_gpu(dev, ++traced_id, jobs, rule, g);
+      const std::vector<Pixels8> gpu_out = composite_on_gpu(dev, jobs, rule, g);
       for (std::size_t e = 0; e < 2; ++e) {
         ASSERT_EQ(gpu_out[e].data.size(), host[e].data.size());
         const auto [exact, rounding, other] = differences(gpu_out[e], host[e]);
@@ -290,10 +304,9 @@ TEST_F(GpuComposite, ByDepthMatchesTheHostPath) {
   };
   const VulkanBinding vk{ctx().instance(), ctx().physical_device(), ctx().device(), ctx().queue_family(), 0};
   AppDevice dev(vk);
-  ASSERT_NO_THROW(dev.enable_gpu_composition());
+  ASSERT_NO_THROW(dev.enable_gpu_composition(40, 36));
   std::mt19937 rng(4321);
   std::uniform_real_distribution<double> distance(0.3, 5.0);
-  std::int64_t traced_id = 100;
   for (const Geometry& g : geometries) {
     TestImage app_img[2] = {{ctx(), g.app_w, g.app_h}, {ctx(), g.app_w, g.app_h}};
     TestImage target[2] = {{ctx(), g.traced_w, g.traced_h}, {ctx(), g.traced_w, g.traced_h}};
@@ -338,7 +351,7 @@ TEST_F(GpuComposite, ByDepthMatchesTheHostPath) {
         for (std::size_t i = 0; i < scene.data.size(); i += 4)
           host_kept[e] += std::memcmp(&scene.data[i], &host[e].data[i], 4) != 0;
       }
-      const std::vector<Pixels8> gpu_out = composite_on_gpu(dev, ++traced_id, jobs, rule, g);
+      const std::vector<Pixels8> gpu_out = composite_on_gpu(dev, jobs, rule, g);
       for (std::size_t e = 0; e < 2; ++e) {
         const std::size_t n = host[e].data.size() / 4;
         // Not vacuous: the application is in front in some pixels and behind the scene or
@@ -354,6 +367,82 @@ TEST_F(GpuComposite, ByDepthMatchesTheHostPath) {
       }
     }
   }
+}
+
+// The application's thread records a composition pass once per set of images and then only
+// writes each frame's parameters and submits it: three frames on the same images with their
+// own traced frames and head rotations need one recording and one descriptor update, and each
+// matches the host path (stale parameters would not). Waiting for an acquired image waits only
+// for the passes that read it.
+TEST_F(GpuComposite, RecordsOncePerImagesAndWaitsOnlyForPassesOnTheImage) {
+  const core::Fov fov{-0.7, 0.6, 0.65, -0.7};
+  const VulkanBinding vk{ctx().instance(), ctx().physical_device(), ctx().device(), ctx().queue_family(), 0};
+  AppDevice dev(vk);
+  ASSERT_NO_THROW(dev.enable_gpu_composition(40, 36));
+  std::mt19937 rng(99);
+  const std::array<std::uint8_t, 3> clear{30, 60, 90};
+  TestImage a[2] = {{ctx(), 40, 36}, {ctx(), 40, 36}}, b[2] = {{ctx(), 40, 36}, {ctx(), 40, 36}};
+  TestImage target[2] = {{ctx(), 40, 36}, {ctx(), 40, 36}};
+  std::array<Pixels8, 2> app_a{random_app(rng, 40, 36, clear), random_app(rng, 40, 36, clear)};
+  std::array<Pixels8, 2> app_b{random_app(rng, 40, 36, clear), random_app(rng, 40, 36, clear)};
+  dev.write({a[0].get(), a[1].get(), b[0].get(), b[1].get()}, {&app_a[0], &app_a[1], &app_b[0], &app_b[1]});
+  CompositionRule rule;
+  rule.blend = layer_blend(0, {false, false});
+  std::array<Pixels8, 2> traced;
+  const auto jobs_on = [&](TestImage (&img)[2], const Geometry& g) {
+    std::array<AppDevice::GpuEye, 2> jobs;
+    for (std::size_t e = 0; e < 2; ++e)
+      jobs[e] = {eye_of(g, traced[e], e), {img[e].get(), 0, {{0, 0}, {40, 36}}}, std::nullopt, target[e].get()};
+    return jobs;
+  };
+  for (int frame = 0; frame < 3; ++frame) {
+    SCOPED_TRACE("frame " + std::to_string(frame));
+    const Geometry g{"turning", 40, 36, 40, 36, fov, fov, 2.0 * frame, 0.02};
+    for (Pixels8& t : traced) t = random_scene(rng, 40, 36);
+    const auto jobs = jobs_on(a, g);
+    const std::vector<Pixels8> gpu_out = composite_on_gpu(dev, jobs, rule, g);
+    for (std::size_t e = 0; e < 2; ++e) {
+      EyeComposition c = jobs[e].composition;
+      c.app = &app_a[e];
+      const Pixels8 host = compose_eye(c, rule);
+      const auto [exact, rounding, other] = differences(gpu_out[e], host);
+      const std::size_t n = host.data.size() / 4;
+      EXPECT_LE(double(other), g.boundary_fraction * double(n)) << "eye " << e << ": " << other << " of " << n;
+      EXPECT_EQ(rounding, 0u) << "eye " << e;
+      EXPECT_GT(exact, n * 9 / 10) << "eye " << e;
+    }
+  }
+  AppDevice::GpuStats n = dev.gpu_stats();
+  EXPECT_EQ(n.recordings, 1);
+  EXPECT_EQ(n.descriptor_updates, 1);
+  EXPECT_EQ(n.submissions, 3);
+
+  // A pass submitted on images `a`, not waited for: acquiring `b` considers no pass, acquiring
+  // a[0] that pass (waited for if still in flight), a[1] then none.
+  const Geometry still{"still", 40, 36, 40, 36, fov, fov, 0.0, 0.0};
+  const auto jobs = jobs_on(a, still);
+  const int slot = write_slot(dev, jobs);
+  dev.composite_gpu(slot, jobs, rule);
+  dev.traced_slots()->retire(slot);
+  const std::int64_t waits = dev.gpu_stats().acquire_waits;
+  EXPECT_EQ(dev.finish_image(b[0].get()), 0);
+  EXPECT_EQ(dev.finish_image(b[1].get()), 0);
+  EXPECT_EQ(dev.gpu_stats().acquire_waits, waits) << "a pass on other images was waited for";
+  EXPECT_EQ(dev.finish_image(a[0].get()), 1);
+  EXPECT_EQ(dev.finish_image(a[1].get()), 0);  // that pass is known finished now
+  EXPECT_LE(dev.gpu_stats().acquire_waits, waits + 1);
+
+  // Other images: recorded once more; images forgotten (their swapchain destroyed) are
+  // recorded afresh when they come back.
+  composite_on_gpu(dev, jobs_on(b, still), rule, still);
+  composite_on_gpu(dev, jobs_on(b, still), rule, still);
+  EXPECT_EQ(dev.gpu_stats().recordings, 2);
+  dev.forget_images({b[0].get(), b[1].get()});
+  composite_on_gpu(dev, jobs_on(b, still), rule, still);
+  composite_on_gpu(dev, jobs_on(a, still), rule, still);
+  n = dev.gpu_stats();
+  EXPECT_EQ(n.recordings, 3);
+  EXPECT_EQ(n.descriptor_updates, 1);
 }
 
 }  // namespace

@@ -3,6 +3,7 @@
 #include <cmath>
 #include <cstdlib>
 #include <limits>
+#include <thread>
 #include <vector>
 
 #include <gtest/gtest.h>
@@ -15,6 +16,7 @@
 #include "frame_queue.hpp"
 #include "gaze_input.hpp"
 #include "next_chain.hpp"
+#include "traced_slots.hpp"
 
 namespace fovea::layer {
 namespace {
@@ -236,6 +238,36 @@ TEST(LayerFrameQueue, PipelinedFramesKeepTheirOwnRecords) {
   // An application that waits without ever ending keeps a bounded queue.
   for (int i = 0; i < 100; ++i) q.waited(1000 + i, 0, 0);
   EXPECT_EQ(q.in_flight(), FrameQueue::kMaxInFlight);
+}
+
+// The traced-frame slots between the render thread and the application's thread: a slot is
+// claimed once, comes back only when the application's thread releases it after its frame was
+// retired, and a render thread waiting for one is woken by a release or by stop().
+TEST(LayerSlotPool, SlotsComeBackOnlyWhenReleased) {
+  EXPECT_THROW(SlotPool(0), std::invalid_argument);
+  EXPECT_THROW(SlotPool(SlotPool::kMaxSlots + 1), std::invalid_argument);
+  auto pool = std::make_shared<SlotPool>(3);
+  const int a = pool->claim(), b = pool->claim(), c = pool->claim();
+  EXPECT_EQ(std::vector<int>({a, b, c}), std::vector<int>({0, 1, 2}));
+  EXPECT_EQ(pool->take_retired(), 0u);
+  {
+    SlotLease lease(pool, b);  // a frame in slot b, gone at the end of the scope
+    EXPECT_EQ(lease.slot(), b);
+  }
+  EXPECT_EQ(pool->take_retired(), 1u << b);
+  EXPECT_EQ(pool->take_retired(), 0u);  // taken once
+  // No slot is free until the application's thread releases one: the render thread waits.
+  int claimed = -2;
+  std::thread render([&] { claimed = pool->claim(); });
+  pool->release(b);
+  render.join();
+  EXPECT_EQ(claimed, b);
+  std::thread stopped([&] { claimed = pool->claim(); });
+  pool->stop();
+  stopped.join();
+  EXPECT_EQ(claimed, -1);
+  pool->release(a);
+  EXPECT_EQ(pool->claim(), -1) << "claims fail once stopped";
 }
 
 TEST(LayerConfig, RenderMode) {
