@@ -5,7 +5,8 @@
 #
 #   tools/fove0-compare.sh [OUT]        (from the source tree, after ./x build)
 #
-# Environment: FOVEA (the binary) [build/release/tools/fovea]; FRAMES [3]; REF_SPP, REF_BATCH
+# Environment: FOVEA (the binary) [build/release/tools/fovea]; FRAMES [3]; BUDGET: Visual-Polar's
+# --budget [its default]; REF_SPP, REF_BATCH
 # [8, 2]: the reference's samples per pixel and batch (it also stops at a per-pixel relative
 # error of 0.02); REF_DIR: use reference_{left,right}.exr from there instead (any written by
 # `fovea reference` for this scene and view). The reference goes through the reference cache
@@ -19,6 +20,8 @@ FRAMES=${FRAMES:-3}
 PRESET=${PRESET:-fove0}  # another display preset, for trying the script quickly
 REF_SPP=${REF_SPP:-8}
 REF_BATCH=${REF_BATCH:-2}
+vp_budget=()
+[[ -n ${BUDGET:-} ]] && vp_budget=(--budget "$BUDGET")
 command -v python3 >/dev/null || { echo "fove0-compare: python3 is needed for the table" >&2; exit 2; }
 [[ -x $FOVEA ]] || { echo "fove0-compare: no fovea binary at $FOVEA (./x build, or set FOVEA)" >&2; exit 2; }
 [[ -n ${VK_ICD_FILENAMES:-} ]] || eval "$(./x env)"
@@ -40,8 +43,10 @@ loads=()
 for dist in visual-polar cartesian; do
   echo "$dist, $FRAMES frames (load $(load))..." >&2
   loads+=("$(load)")
+  budget=()
+  [[ $dist == visual-polar ]] && budget=("${vp_budget[@]}")
   "$FOVEA" render --display "$PRESET" --scene default --frames "$FRAMES" --distribution $dist --png-every 0 --quiet \
-    --reference "$ref" --out "$OUT/$dist" >/dev/null
+    "${budget[@]}" --reference "$ref" --out "$OUT/$dist" >/dev/null
 done
 loads+=("$(load)")
 
@@ -72,6 +77,7 @@ print(f"reference: {ref}; left {ri['left']['spp']} spp, per-pixel rel. error {ri
       f"(key {ri['right']['key']})")
 print(f"device: {rep['cartesian']['device']['name']} ({rep['cartesian']['device']['driver']}); "
       f"load average (1/5/15 min) before VP, before Cartesian, after: {' | '.join(loads)}")
+print(f"visual-polar budget {rep['visual-polar']['config']['budget']}")
 print(f"median of {rep['cartesian']['frames']} frames, both eyes, ms; quality of the last frame, both eyes "
       "(PSNR tone-mapped, pooled by MSE; HDR-FLIP mean), bands in degrees of eccentricity")
 cols = ["traced/eye", "trace", "reconstruct", "resolve", "trace+recon", "frame GPU", "frame CPU+GPU"]
