@@ -1,0 +1,163 @@
+// Where a foveated frame's trace and reconstruction time goes, per sample distribution
+// (docs/reconstruction.md, "Whole frame on fove0"): the `default` scene on a display preset
+// with the lens' hidden area skipped, gaze at the centre, both eyes, the default
+// reconstruction with stereo gather. Per configuration it prints the grid's cells and traced
+// cells, and how the path tracer's invocations (cell n in invocation n) fall into SIMD
+// vectors of LANES lanes: vectors with a traced cell ("busy"), those among them that also
+// hold skipped cells ("mixed": a SIMD device such as lavapipe pays a vector's slowest lane
+// for all its lanes), and the mean diagonal of the display box a busy vector's samples span
+// (how far apart the rays it traces in lockstep start). Then per round and configuration
+// the second frame's GPU ms: trace, the reconstruction kernels (timed again one submission
+// each, testing::time_reconstruct), resolve and frame, and the trace ms per 1000 traced
+// samples. Rounds interleave the configurations, so load on a shared machine spreads over
+// all of them; compare configurations within a round.
+//   fovea_bench_trace_cost [DISPLAY [ROUNDS [LANES]]]     defaults: fove0 1 8
+#include <algorithm>
+#include <cstdio>
+#include <cstdlib>
+#include <string>
+#include <vector>
+
+#include <glm/geometric.hpp>
+#include <glm/vec2.hpp>
+
+#include "fovea/core/display.hpp"
+#include "fovea/core/error.hpp"
+#include "fovea/core/eye_optics.hpp"
+#include "fovea/core/stereo_views.hpp"
+#include "fovea/gpu/context.hpp"
+#include "fovea/pipeline/frame_pipeline.hpp"
+#include "fovea/pipeline/testing.hpp"
+#include "fovea/renderer/gpu_scene.hpp"
+#include "fovea/renderer/scene_io.hpp"
+
+namespace fc = fovea::core;
+namespace fp = fovea::pipeline;
+namespace fr = fovea::renderer;
+
+namespace {
+
+struct Config {
+  fc::DistributionKind kind;
+  double budget;  // 0: the distribution's default
+  std::string name() const {
+    std::string n = fc::distribution_name(kind);
+    if (budget > 0) n += " " + std::to_string(budget).substr(0, 4);
+    return n;
+  }
+};
+
+struct Vectors {
+  long busy = 0, mixed = 0;
+  double extent_px = 0;  // mean over the busy vectors
+};
+
+Vectors vectors(const std::vector<fovea::shaders::GridSample>& grid, std::size_t lanes) {
+  Vectors v;
+  double extent = 0;
+  for (std::size_t start = 0; start < grid.size(); start += lanes) {
+    glm::vec2 lo(1e30f), hi(-1e30f);
+    int traced = 0, n = 0;
+    for (std::size_t i = start; i < std::min(grid.size(), start + lanes); ++i, ++n) {
+      const auto& g = grid[i];
+      if (g.flags != 0) continue;
+      ++traced;
+      lo = glm::min(lo, glm::vec2(g.screen_x, g.screen_y));
+      hi = glm::max(hi, glm::vec2(g.screen_x, g.screen_y));
+    }
+    if (traced == 0) continue;
+    ++v.busy;
+    v.mixed += traced < n ? 1 : 0;
+    extent += glm::length(hi - lo);
+  }
+  v.extent_px = v.busy ? extent / double(v.busy) : 0;
+  return v;
+}
+
+// The 1-minute load average (Linux), 0 where it cannot be read: printed next to each time.
+double load_average() {
+  double load = 0;
+  if (std::FILE* f = std::fopen("/proc/loadavg", "r")) {
+    if (std::fscanf(f, "%lf", &load) != 1) load = 0;
+    std::fclose(f);
+  }
+  return load;
+}
+
+long positive(const char* arg, const char* what) {
+  char* end = nullptr;
+  const long v = std::strtol(arg, &end, 10);
+  if (!end || *end || v < 1 || v > 1000) throw fc::InputError(std::string(what) + " must be an integer in 1..1000");
+  return v;
+}
+
+int run(int argc, char** argv) {
+  const std::string display_name = argc > 1 ? argv[1] : "fove0";
+  const long rounds = argc > 2 ? positive(argv[2], "ROUNDS") : 1;
+  const long lanes = argc > 3 ? positive(argv[3], "LANES") : 8;
+  const fc::DisplayPreset display = fc::load_display(display_name);
+  fovea::gpu::Context ctx;
+  const fr::Scene scene = fr::load_scene("default");
+  const fr::GpuScene gs(ctx, scene);
+  const auto poses = fc::eye_poses(scene.camera, display.ipd_m);
+  const glm::dvec3 gaze(0, 0, -1);
+  // Visual-Polar at its default budget and two lower ones; a uniform raster with as many
+  // samples as the default Visual-Polar grid (the same count, spread evenly and coherently);
+  // full resolution.
+  const fc::DistributionParams defaults;
+  const Config configs[] = {{fc::DistributionKind::VisualPolar, 0},
+                            {fc::DistributionKind::VisualPolar, 0.25},
+                            {fc::DistributionKind::VisualPolar, 0.2},
+                            {fc::DistributionKind::CartesianUniform, defaults.budget},
+                            {fc::DistributionKind::Cartesian, 1}};
+  fovea::reconstruct::ReconSettings settings;
+  settings.share = fovea::reconstruct::StereoShare::Gather;
+  std::printf("%s, default scene, gaze at the centre, hidden area skipped, both eyes; %s; %ld-lane vectors\n",
+              display_name.c_str(), ctx.info().name.c_str(), lanes);
+  std::printf("| configuration | cells / eye | traced / eye | busy vectors | mixed vectors | busy vector extent, px |\n"
+              "|---|---|---|---|---|---|\n");
+  std::vector<std::string> rows;
+  for (long round = 0; round < rounds; ++round)
+    for (const Config& c : configs) {
+      fc::DistributionParams dp;
+      dp.kind = c.kind;
+      if (c.budget > 0) dp.budget = c.budget;
+      fp::FramePipeline p(ctx, gs, fc::stereo_views(display), dp, settings);
+      for (fc::Eye e : {fc::Eye::Left, fc::Eye::Right}) p.set_visibility(e, fc::EyeOptics(display, e).view_mask());
+      // Frame 0 has no history; the second frame is the one a running session pays.
+      p.render(poses, {gaze, gaze}, 0);
+      const fp::FrameTimes t = p.render(poses, {gaze, gaze}, 1);
+      const fp::testing::ReconKernelTimes r = fp::testing::time_reconstruct(p, 1);
+      const long long traced = p.traced_cells(fc::Eye::Left) + p.traced_cells(fc::Eye::Right);
+      if (round == 0) {
+        const auto grid = p.grid_samples(fc::Eye::Left);
+        const Vectors v = vectors(grid, std::size_t(lanes));
+        std::printf("| %s | %zu | %lld | %ld | %ld | %.1f |\n", c.name().c_str(), grid.size(),
+                    static_cast<long long>(p.traced_cells(fc::Eye::Left)), v.busy, v.mixed, v.extent_px);
+      }
+      char row[512];
+      std::snprintf(row, sizeof row,
+                    "| %ld | %s | %.2f | %.0f | %.0f | %.0f | %.0f | %.0f | %.0f | %.0f | %.0f | %.0f | %.2f |", round + 1,
+                    c.name().c_str(), load_average(), t.trace.gpu_ms, r.accumulate.gpu_ms,
+                    r.share.gpu_ms, r.fit.gpu_ms, r.post.gpu_ms, r.taa.gpu_ms, t.reconstruct.gpu_ms, t.resolve.gpu_ms,
+                    t.gpu_ms(), 1000.0 * t.trace.gpu_ms / double(traced));
+      rows.emplace_back(row);
+      std::fflush(stdout);
+    }
+  std::printf("\nGPU ms of the second frame, both eyes (reconstruction kernels timed again, one submission each)\n");
+  std::printf("| round | configuration | load | trace | accumulate | share | BMFR fit | post | TAA | reconstruct (frame) |"
+              " resolve | frame | trace ms per 1000 samples |\n|---|---|---|---|---|---|---|---|---|---|---|---|---|\n");
+  for (const auto& row : rows) std::printf("%s\n", row.c_str());
+  return 0;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  try {
+    return run(argc, argv);
+  } catch (const fc::InputError& e) {
+    std::fprintf(stderr, "fovea_bench_trace_cost: %s\n", e.what());
+    return 2;
+  }
+}
