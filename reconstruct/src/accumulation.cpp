@@ -63,19 +63,22 @@ StereoGather::StereoGather(gpu::Context& ctx, std::span<const EyeGrid> eyes, con
     e.cells = g.cells;
     e.shared = storage(ctx, VkDeviceSize(g.cells) * 16, "recon.shared_indirect");
     e.z = storage(ctx, VkDeviceSize(g.cells) * 16, "recon.z");
+    e.edge = storage(ctx, VkDeviceSize(g.cells) * 4, "recon.edge");
     const int me = int(i), other = eyes.size() == 2 ? 1 - me : me;  // one eye gathers from itself (unused)
     for (int p = 0; p < 2; ++p)
       e.set[p] = make_set(ctx, kernel_,
                           ShareBindings{g.maps, g.tables, &acc.position(me, p), &acc.normal(me, p), &acc.direct(me, p),
                                         &acc.indirect(me, p), &acc.position(other, p), &acc.normal(other, p),
-                                        &acc.indirect(other, p), &e.shared, &e.z});
+                                        &acc.indirect(other, p), &e.shared, &e.z, &e.edge});
   }
 }
 
 void StereoGather::record(VkCommandBuffer cmd, int parity, bool share, const ReconSettings& s) const {
   for (const Eye& e : eyes_)
     kernel_.run(cmd, {&e.set[parity]},
-                shaders::ReconSharePush{e.cells, share ? 1u : 0u, s.coarse_keep, s.coarse_reject}, e.cells);
+                shaders::ReconSharePush{e.cells, share ? 1u : 0u, s.coarse_keep, s.coarse_reject,
+                                        s.denoiser == Denoiser::Bmfr ? 1u : 0u, 0, 0, 0},
+                e.cells);
   gpu::compute_to_compute(cmd);
 }
 
@@ -83,6 +86,7 @@ void StereoGather::fill(VkCommandBuffer cmd, std::uint32_t word) const {
   for (const Eye& e : eyes_) {
     gpu::fill_buffer(cmd, e.shared, word);
     gpu::fill_buffer(cmd, e.z, word);
+    gpu::fill_buffer(cmd, e.edge, word);
   }
 }
 

@@ -46,7 +46,7 @@ struct AccumulateBindings {
 
 struct ShareBindings {
   FOVEA_BINDING_COUNT(RECON_SHARE_COUNT)
-  Buf maps, tables, pos, nrm, acc_direct, acc_indirect, other_pos, other_nrm, other_indirect, shared, z;
+  Buf maps, tables, pos, nrm, acc_direct, acc_indirect, other_pos, other_nrm, other_indirect, shared, z, edge;
   Slots slots() const {
     return {{{RECON_MAPS, maps},
              {RECON_TABLES, tables},
@@ -58,13 +58,14 @@ struct ShareBindings {
              {RECON_SHARE_OTHER_NRM, other_nrm},
              {RECON_SHARE_OTHER_INDIRECT, other_indirect},
              {RECON_SHARE_SHARED, shared},
-             {RECON_SHARE_Z, z}}};
+             {RECON_SHARE_Z, z},
+             {RECON_SHARE_EDGE, edge}}};
   }
 };
 
 struct BmfrBindings {
   FOVEA_BINDING_COUNT(RECON_BMFR_COUNT)
-  Buf pos, nrm, z, fitted, columns, materials, excess;
+  Buf pos, nrm, z, fitted, columns, materials, excess, edge;
   Slots slots() const {
     return {{{RECON_BMFR_POS, pos},
              {RECON_BMFR_NRM, nrm},
@@ -72,7 +73,8 @@ struct BmfrBindings {
              {RECON_BMFR_FITTED, fitted},
              {RECON_BMFR_COLUMNS, columns},
              {RECON_BMFR_MATERIALS, materials},
-             {RECON_BMFR_EXCESS, excess}}};
+             {RECON_BMFR_EXCESS, excess},
+             {RECON_BMFR_EDGE, edge}}};
   }
 };
 

@@ -39,7 +39,8 @@
 #define RECON_SHARE_OTHER_INDIRECT 8
 #define RECON_SHARE_SHARED 9
 #define RECON_SHARE_Z 10
-#define RECON_SHARE_COUNT 11
+#define RECON_SHARE_EDGE 11
+#define RECON_SHARE_COUNT 12
 
 // recon_bmfr_fit.comp (BMFR Phase II)
 #define RECON_BMFR_POS 0
@@ -49,7 +50,8 @@
 #define RECON_BMFR_COLUMNS 4
 #define RECON_BMFR_MATERIALS 5
 #define RECON_BMFR_EXCESS 6
-#define RECON_BMFR_COUNT 7
+#define RECON_BMFR_EDGE 7
+#define RECON_BMFR_COUNT 8
 
 // recon_post.comp (BMFR Phase III)
 #define RECON_POST_POS 0

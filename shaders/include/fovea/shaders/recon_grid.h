@@ -51,6 +51,7 @@ struct ReconAccumulatePush {
 struct ReconSharePush {
   FOVEA_UINT cells, enabled;
   float coarse_keep, coarse_reject;  // as ReconAccumulatePush
+  FOVEA_UINT edges, pad0, pad1, pad2;  // edges = 1: flag the cells on a surface edge (BMFR's fit reads them)
 };
 
 struct ReconBmfrPush {
@@ -103,6 +104,7 @@ struct ReconGridBlurPush {
 static_assert(sizeof(ReconGrid) == 192);
 static_assert(sizeof(ReconGridBlurPush) == 32);
 static_assert(sizeof(ReconAccumulatePush) == 32);
+static_assert(sizeof(ReconSharePush) == 32);
 static_assert(sizeof(ReconBmfrPush) == 32);
 static_assert(sizeof(ReconPostPush) == 32);
 static_assert(sizeof(ReconMipPush) == 32);
