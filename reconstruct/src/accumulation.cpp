@@ -20,6 +20,7 @@ Accumulation::Accumulation(gpu::Context& ctx, std::span<const EyeGrid> eyes, con
       e.indirect[p] = storage(ctx, v4, "recon.acc_indirect");
       e.pos[p] = storage(ctx, v4, "recon.vpos");
       e.nrm[p] = storage(ctx, v4, "recon.vnrm");
+      e.restart[p] = storage(ctx, VkDeviceSize(g.cells) * 4, "recon.restart");
     }
     e.tap_idx = storage(ctx, v4, "recon.tap_idx");
     e.tap_w = storage(ctx, v4, "recon.tap_w");
@@ -29,7 +30,7 @@ Accumulation::Accumulation(gpu::Context& ctx, std::span<const EyeGrid> eyes, con
                           AccumulateBindings{g.maps, g.tables, g.samples, g.direct, g.indirect, g.normal_depth,
                                              g.position_material, &e.direct[q], &e.indirect[q], &e.pos[q], &e.nrm[q],
                                              &e.direct[p], &e.indirect[p], &e.pos[p], &e.nrm[p], &e.tap_idx, &e.tap_w,
-                                             &materials});
+                                             &materials, &e.restart[q], &e.restart[p]});
     }
   }
 }
@@ -49,7 +50,8 @@ void Accumulation::record(VkCommandBuffer cmd, int parity, bool history, std::sp
 void Accumulation::fill(VkCommandBuffer cmd, std::uint32_t word) const {
   for (const Eye& e : eyes_) {
     for (int p = 0; p < 2; ++p)
-      for (const gpu::Buffer* b : {&e.direct[p], &e.indirect[p], &e.pos[p], &e.nrm[p]}) gpu::fill_buffer(cmd, *b, word);
+      for (const gpu::Buffer* b : {&e.direct[p], &e.indirect[p], &e.pos[p], &e.nrm[p], &e.restart[p]})
+        gpu::fill_buffer(cmd, *b, word);
     gpu::fill_buffer(cmd, e.tap_idx, word);
     gpu::fill_buffer(cmd, e.tap_w, word);
   }

@@ -47,11 +47,13 @@ class Accumulation {
   const gpu::Buffer& normal(int eye, int parity) const { return eyes_[eye].nrm[parity]; }
   const gpu::Buffer& tap_index(int eye) const { return eyes_[eye].tap_idx; }
   const gpu::Buffer& tap_weight(int eye) const { return eyes_[eye].tap_w; }
+  // Frames since the history was rejected for coarse cells (float per cell; 0: none recent).
+  const gpu::Buffer& restart(int eye, int parity) const { return eyes_[eye].restart[parity]; }
 
  private:
   struct Eye {
     std::uint32_t cells = 0;
-    gpu::Buffer direct[2], indirect[2], pos[2], nrm[2], tap_idx, tap_w;
+    gpu::Buffer direct[2], indirect[2], pos[2], nrm[2], restart[2], tap_idx, tap_w;
     gpu::DescriptorSet set[2];
   };
   gpu::ComputePipeline kernel_;

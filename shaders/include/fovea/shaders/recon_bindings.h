@@ -27,7 +27,9 @@
 #define RECON_ACC_TAP_IDX 15
 #define RECON_ACC_TAP_W 16
 #define RECON_ACC_MATERIALS 17
-#define RECON_ACC_COUNT 18
+#define RECON_ACC_PREV_RESTART 18
+#define RECON_ACC_OUT_RESTART 19
+#define RECON_ACC_COUNT 20
 
 // recon_share.comp (stereo gather of indirect diffuse)
 #define RECON_SHARE_POS 2
@@ -74,7 +76,9 @@
 #define RECON_TAA_ALBEDO 6
 #define RECON_TAA_PREV_FINAL 7
 #define RECON_TAA_FINAL 8
-#define RECON_TAA_COUNT 9
+#define RECON_TAA_NRM 9
+#define RECON_TAA_RESTART 10
+#define RECON_TAA_COUNT 11
 
 // recon_mip.comp
 #define RECON_MIP_MIPS 2
