@@ -35,6 +35,8 @@ layout(std430, binding = RECON_ACC_OUT_NRM) writeonly buffer Nrm { vec4 vnrm[]; 
 layout(std430, binding = RECON_ACC_TAP_IDX) writeonly buffer TapIdx { uvec4 tap_idx[]; };
 layout(std430, binding = RECON_ACC_TAP_W) writeonly buffer TapW { vec4 tap_w[]; };
 layout(std430, binding = RECON_ACC_MATERIALS) readonly buffer Materials { PtMaterial materials[]; };
+layout(std430, binding = RECON_ACC_PREV_RESTART) readonly buffer PrevRestart { float prev_restart[]; };
+layout(std430, binding = RECON_ACC_OUT_RESTART) writeonly buffer Restart { float restart[]; };
 
 #include "fovea/shaders/recon_map.h"
 
@@ -69,6 +71,7 @@ void main() {
     vnrm[i] = vec4(0.0);
     tap_idx[i] = uvec4(0u);
     tap_w[i] = vec4(0.0);
+    restart[i] = 0.0;
     return;
   }
   ReconGrid cur = maps[kReconCurrent];
@@ -91,6 +94,7 @@ void main() {
   uvec4 idx = uvec4(0u);
   vec4 w = vec4(0.0);
   float confidence = 0.0;  // the history's share: valid taps, less for coarser cells
+  float since = 0.0;       // frames since a restart for coarse cells (kReconRestartFrames)
   if (pc.has_history != 0u && maps[kReconPrevious].valid != 0u) {
     ReconGrid prev = maps[kReconPrevious];
     vec2 uv;
@@ -110,14 +114,20 @@ void main() {
         for (int k = 0; k < 4; ++k) {
           hd += w[k] * prev_direct[idx[k]];
           hi += w[k] * prev_indirect[idx[k]];
+          if (w[k] > 0.0) since = max(since, prev_restart[idx[k]]);
         }
       } else {
         w = vec4(0.0);
       }
+      // A history mostly rejected as too coarse starts a restart window; a kept one carries
+      // its window on. Never at a still gaze (same cell sizes).
+      if (valid > 0.0 && kept < 0.5 * valid) since = 1.0;
+      else since = since > 0.0 && since < kReconRestartFrames ? since + 1.0 : 0.0;
     }
   }
   tap_idx[i] = idx;
   tap_w[i] = w;
+  restart[i] = since;
   // Counts are fetched with the same weights and rounded (BMFR §3.2); a partly coarse
   // history counts for its share only, which raises α.
   hd.w *= confidence;

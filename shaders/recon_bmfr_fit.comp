@@ -5,7 +5,8 @@
 // uniform ±ε noise on the non-constant features (Eq. 7), the least-squares fit of
 // z_r z_g z_b on T + N (Eq. 5) and the weighted sum with the noise-free features (Eq. 6).
 // Cells without a surface sample (clipped, off-screen, padding, sky), emitters, surfaces
-// without a diffuse lobe (metals) and cells straddling a surface edge are zero rows: masked
+// without a diffuse lobe (metals) and cells straddling a surface edge (flagged by the stereo
+// gather, recon_share.comp) are zero rows: masked
 // out of the regression, they keep their accumulated input. A metal's indirect diffuse is
 // zero by construction; fitted with its block's diffuse neighbours it took their light
 // (docs/reconstruction.md, glossy-spheres).
@@ -43,10 +44,9 @@ layout(std430, binding = RECON_BMFR_FITTED) writeonly buffer Fitted { vec4 fitte
 layout(std430, binding = RECON_BMFR_COLUMNS) readonly buffer Columns { GridColumn tables[]; };
 layout(std430, binding = RECON_BMFR_MATERIALS) readonly buffer Materials { PtMaterial materials[]; };
 layout(std430, binding = RECON_BMFR_EXCESS) writeonly buffer Excess { vec4 excess[]; };
+layout(std430, binding = RECON_BMFR_EDGE) readonly buffer Edge { uint edge[]; };  // 1: on a surface edge
 
 layout(push_constant) uniform Push { ReconBmfrPush pc; };
-
-#include "fovea/shaders/recon_map.h"
 
 const uint kRows = 1024u / kGroup;  // rows per invocation
 const uint kM = 10u;                // features
@@ -126,34 +126,6 @@ bool has_diffuse(float code) {
   return mat.metallic < 1.0 && (mat.texture >= 0 || max(max(mat.base_r, mat.base_g), mat.base_b) > 0.0);
 }
 
-// Whether cell i's area straddles a surface edge: a 3×3 grid neighbour (this frame's samples)
-// holds a surface the history test (rg_tap_valid) would not take for i's own. With sub-cell
-// jitter Phase I keeps the history of such a cell over the samples of both sides (its area
-// mean: recon_accumulate.comp, seen_near), and that mix is no function of the features of the
-// side the sample hit now: fitted with its block it biased the fit at silhouettes, and the
-// fit put the surface's full light where the cell's area is partly background (cornell,
-// 58–60°, docs/reconstruction.md). An edge inside the cell's area always has a neighbour's
-// sample on its other side, since all cells share the frame's jitter.
-bool straddles(uint i) {
-  // This frame's grid as recon_map.h reads it (the column table at offset 0); rg_neighbour
-  // tells only Cartesian from polar families apart, so every polar grid reads as angular.
-  ReconGrid m;
-  m.g.family = pc.columns > 0u ? kFamilyAngularPolar : kFamilyCartesian;
-  m.g.columns = pc.columns > 0u ? pc.columns : pc.padded_columns;
-  m.g.rows = pc.padded_rows;
-  m.g.padded_columns = pc.padded_columns;
-  m.table_offset = 0u;
-  vec4 here = vpos[i], nd = vnrm[i];
-  for (int dc = -1; dc <= 1; ++dc)
-    for (int dr = -1; dr <= 1; ++dr) {
-      uint k;
-      if ((dc != 0 || dr != 0) && rg_neighbour(m, i, dc, dr, k) && !rg_no_sample(vpos[k].w) &&
-          !rg_tap_valid(here, nd.xyz, nd.w, vpos[k], vnrm[k].xyz))
-        return true;
-    }
-  return false;
-}
-
 bool inside(ivec2 c) { return c.x >= 0 && c.y >= 0 && c.x < int(pc.padded_columns) && c.y < int(pc.padded_rows); }
 
 // Cholesky factor R of the block's Gram matrix (in s_result) into s_r, then back substitution
@@ -197,7 +169,7 @@ void main() {
     uint i = uint(c.y) * pc.padded_columns + uint(c.x);
     s_cell[row] = i | kMasked;
     vec4 p = vpos[i];
-    if (p.w < 0.0 || !has_diffuse(p.w) || straddles(i)) continue;  // sky, emitter, no sample, metal, edge
+    if (p.w < 0.0 || !has_diffuse(p.w) || edge[i] != 0u) continue;  // sky, emitter, no sample, metal, edge
     s_cell[row] = i;
     vec3 zin = z[i].rgb;
     [[unroll]] for (uint a = 0u; a < 3u; ++a) {

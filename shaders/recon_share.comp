@@ -4,7 +4,10 @@
 // the other eye's grid, bilinear over the taps that pass the same validity test as the
 // temporal reprojection (jitter taken off, coarser cells down-weighted), and combines it with
 // its own, weighted by sample counts. Direct and specular light are view dependent and never
-// shared. Also writes z = direct + indirect, the demodulated input of the regression.
+// shared. Also writes z = direct + indirect, the demodulated input of the regression, and —
+// with BMFR — which cells straddle a surface edge, which the regression leaves out
+// (recon_bmfr_fit.comp): this pass is the first to hold every cell's validation data of the
+// frame, and the fit's workgroups would read each cell's neighbourhood in a per-block loop.
 #extension GL_GOOGLE_include_directive : require
 
 layout(local_size_x = 64) in;
@@ -24,10 +27,44 @@ layout(std430, binding = RECON_SHARE_OTHER_NRM) readonly buffer OtherNrm { vec4 
 layout(std430, binding = RECON_SHARE_OTHER_INDIRECT) readonly buffer OtherIndirect { vec4 other_indirect[]; };
 layout(std430, binding = RECON_SHARE_SHARED) writeonly buffer Shared { vec4 shared_indirect[]; };
 layout(std430, binding = RECON_SHARE_Z) writeonly buffer Z { vec4 z[]; };
+layout(std430, binding = RECON_SHARE_EDGE) writeonly buffer Edge { uint edge[]; };  // 1: on a surface edge
 
 #include "fovea/shaders/recon_map.h"
 
 layout(push_constant) uniform Push { ReconSharePush pc; };
+
+// Whether cell i's area straddles a surface edge: a 3×3 grid neighbour (this frame's samples)
+// holds a surface the history test (rg_tap_valid) would not take for i's own. With sub-cell
+// jitter Phase I keeps the history of such a cell over the samples of both sides (its area
+// mean: recon_accumulate.comp, seen_near), and that mix is no function of the features of the
+// side the sample hit now: fitted with its block it biased the fit at silhouettes, and the
+// fit put the surface's full light where the cell's area is partly background (cornell,
+// 58–60°, docs/reconstruction.md). An edge inside the cell's area always has a neighbour's
+// sample on its other side, since all cells share the frame's jitter. The neighbours are
+// rg_neighbour_of's, with each neighbouring column's entry and row read once for its three
+// rows (most cells are no edge and test all eight).
+bool straddles(ReconGrid m, uint i, vec4 here, vec4 nd) {
+  RgCell cell = rg_cell(m, i);
+  for (int dc = -1; dc <= 1; ++dc) {
+    int cc = int(cell.col) + dc;
+    if (cc < 0 || cc >= int(m.g.columns)) continue;
+    GridColumn col = rg_column(m, uint(cc));
+    int rows = int(max(col.rows, 1u));
+    bool wraps = m.g.family != kFamilyCartesian && col.phi_gap == 0.0;
+    int r0 = int(floor(rg_row_coord_of(col, cell.t)));
+    for (int dr = -1; dr <= 1; ++dr) {
+      int rr = r0 + dr;
+      if (dc == 0 && dr == 0) continue;
+      if (rr < 0 || rr >= rows) {
+        if (!wraps) continue;
+        rr = (rr % rows + rows) % rows;
+      }
+      uint k = uint(rr) * m.g.padded_columns + uint(cc);
+      if (!rg_no_sample(vpos[k].w) && !rg_tap_valid(here, nd.xyz, nd.w, vpos[k], vnrm[k].xyz)) return true;
+    }
+  }
+  return false;
+}
 
 void main() {
   uint i = gl_GlobalInvocationID.x;
@@ -37,8 +74,11 @@ void main() {
   if (rg_no_sample(here.w)) {
     shared_indirect[i] = vec4(0.0);
     z[i] = vec4(0.0);
+    edge[i] = 0u;
     return;
   }
+  // Only surfaces are fitted (sky and emitters, w < 0, keep their input anyway).
+  edge[i] = pc.edges != 0u && here.w >= 0.0 && straddles(maps[kReconCurrent], i, here, vnrm[i]) ? 1u : 0u;
   vec4 result = own;
   if (pc.enabled != 0u && maps[kReconOther].valid != 0u) {
     ReconGrid other = maps[kReconOther];

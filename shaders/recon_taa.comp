@@ -16,6 +16,13 @@
 //   their distance to the pixel centre): the history converges to a centre-weighted mean of
 //   the cell instead of its box mean, which the resolve's tent between cells blurs further
 //   (docs/reconstruction.md, "Jitter and reprojection"; stereo-occluders 40–42°).
+// - In the frames after Phase I rejected a cell's history as too coarse (a saccade's new
+//   fovea; kReconRestartFrames, never at a still gaze) the current input is first averaged
+//   with the 3×3 grid neighbours that pass the history's validity test (same surface), and
+//   for the first kRestartFollow of them shown without TAA's history: the new fovea starts
+//   over with a few samples per cell against a fixed gaze's long history, and TAA kept its
+//   first, noisiest frames for long (α ≈ 0.5 g at n = 2), so the fovea stayed off the fixed
+//   gaze's for 8 frames (docs/reconstruction.md, "Saccade recovery curve").
 // .w = 1 marks cells holding a sample (the resolve renormalises over them).
 #extension GL_GOOGLE_include_directive : require
 
@@ -35,12 +42,15 @@ layout(std430, binding = RECON_TAA_POST) readonly buffer Post { vec4 post[]; };
 layout(std430, binding = RECON_TAA_ALBEDO) readonly buffer Albedo { vec4 albedo[]; };
 layout(std430, binding = RECON_TAA_PREV_FINAL) readonly buffer PrevFinal { vec4 prev_final[]; };
 layout(std430, binding = RECON_TAA_FINAL) writeonly buffer Final { vec4 final_color[]; };
+layout(std430, binding = RECON_TAA_NRM) readonly buffer Nrm { vec4 vnrm[]; };
+layout(std430, binding = RECON_TAA_RESTART) readonly buffer Restart { float restart[]; };  // Phase I's window
 
 #include "fovea/shaders/recon_map.h"
 
 layout(push_constant) uniform Push { ReconPostPush pc; };
 
 const float kCentreSigma = 0.25;
+const float kRestartFollow = 4.0;  // restart frames in which TAA shows Phase III's (averaged) input
 
 vec3 to_ycocg(vec3 c) {
   return vec3(0.25 * c.r + 0.5 * c.g + 0.25 * c.b, 0.5 * c.r - 0.5 * c.b, -0.25 * c.r + 0.5 * c.g - 0.25 * c.b);
@@ -61,15 +71,18 @@ void main() {
     final_color[i] = vec4(0.0);
     return;
   }
-  vec3 c = remodulated(i);
-  vec4 w = tap_w[i];
-  float wsum = w.x + w.y + w.z + w.w;
-  if (pc.denoise == 0u || pc.has_history == 0u || wsum <= 0.0) {
-    final_color[i] = vec4(c, 1.0);
+  if (pc.denoise == 0u) {
+    final_color[i] = vec4(remodulated(i), 1.0);
     return;
   }
+  vec4 w = tap_w[i];
+  bool history = pc.has_history != 0u && w.x + w.y + w.z + w.w > 0.0;
+  float since = restart[i];  // frames since Phase I restarted the cell's history (0: none recent)
   ReconGrid m = maps[kReconCurrent];
   vec3 lo = vec3(3.0e38), hi = vec3(-3.0e38);
+  vec4 here = vpos[i], nd = vnrm[i];
+  vec3 avg = post[i].rgb;
+  float avg_w = 1.0;
   RgCell cell = rg_cell(m, i);
   for (int dc = -1; dc <= 1; ++dc)
     for (int dr = -1; dr <= 1; ++dr) {
@@ -78,7 +91,16 @@ void main() {
       vec3 y = to_ycocg(compress(remodulated(j)));
       lo = min(lo, y);
       hi = max(hi, y);
+      if (since > 0.0 && (dc != 0 || dr != 0) && rg_tap_valid(here, nd.xyz, nd.w, vpos[j], vnrm[j].xyz)) {
+        avg += post[j].rgb;  // the same surface's demodulated input
+        avg_w += 1.0;
+      }
     }
+  vec3 c = avg / avg_w * max(albedo[i].rgb, vec3(kPtMinDemodAlbedo));
+  if (!history || (since > 0.0 && since <= kRestartFollow)) {
+    final_color[i] = vec4(c, 1.0);
+    return;
+  }
   uvec4 idx = tap_idx[i];
   vec3 h = vec3(0.0);
   for (int k = 0; k < 4; ++k) h += w[k] * compress(prev_final[idx[k]].rgb);

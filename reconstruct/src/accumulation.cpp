@@ -20,6 +20,7 @@ Accumulation::Accumulation(gpu::Context& ctx, std::span<const EyeGrid> eyes, con
       e.indirect[p] = storage(ctx, v4, "recon.acc_indirect");
       e.pos[p] = storage(ctx, v4, "recon.vpos");
       e.nrm[p] = storage(ctx, v4, "recon.vnrm");
+      e.restart[p] = storage(ctx, VkDeviceSize(g.cells) * 4, "recon.restart");
     }
     e.tap_idx = storage(ctx, v4, "recon.tap_idx");
     e.tap_w = storage(ctx, v4, "recon.tap_w");
@@ -29,7 +30,7 @@ Accumulation::Accumulation(gpu::Context& ctx, std::span<const EyeGrid> eyes, con
                           AccumulateBindings{g.maps, g.tables, g.samples, g.direct, g.indirect, g.normal_depth,
                                              g.position_material, &e.direct[q], &e.indirect[q], &e.pos[q], &e.nrm[q],
                                              &e.direct[p], &e.indirect[p], &e.pos[p], &e.nrm[p], &e.tap_idx, &e.tap_w,
-                                             &materials});
+                                             &materials, &e.restart[q], &e.restart[p]});
     }
   }
 }
@@ -49,7 +50,8 @@ void Accumulation::record(VkCommandBuffer cmd, int parity, bool history, std::sp
 void Accumulation::fill(VkCommandBuffer cmd, std::uint32_t word) const {
   for (const Eye& e : eyes_) {
     for (int p = 0; p < 2; ++p)
-      for (const gpu::Buffer* b : {&e.direct[p], &e.indirect[p], &e.pos[p], &e.nrm[p]}) gpu::fill_buffer(cmd, *b, word);
+      for (const gpu::Buffer* b : {&e.direct[p], &e.indirect[p], &e.pos[p], &e.nrm[p], &e.restart[p]})
+        gpu::fill_buffer(cmd, *b, word);
     gpu::fill_buffer(cmd, e.tap_idx, word);
     gpu::fill_buffer(cmd, e.tap_w, word);
   }
@@ -63,19 +65,22 @@ StereoGather::StereoGather(gpu::Context& ctx, std::span<const EyeGrid> eyes, con
     e.cells = g.cells;
     e.shared = storage(ctx, VkDeviceSize(g.cells) * 16, "recon.shared_indirect");
     e.z = storage(ctx, VkDeviceSize(g.cells) * 16, "recon.z");
+    e.edge = storage(ctx, VkDeviceSize(g.cells) * 4, "recon.edge");
     const int me = int(i), other = eyes.size() == 2 ? 1 - me : me;  // one eye gathers from itself (unused)
     for (int p = 0; p < 2; ++p)
       e.set[p] = make_set(ctx, kernel_,
                           ShareBindings{g.maps, g.tables, &acc.position(me, p), &acc.normal(me, p), &acc.direct(me, p),
                                         &acc.indirect(me, p), &acc.position(other, p), &acc.normal(other, p),
-                                        &acc.indirect(other, p), &e.shared, &e.z});
+                                        &acc.indirect(other, p), &e.shared, &e.z, &e.edge});
   }
 }
 
 void StereoGather::record(VkCommandBuffer cmd, int parity, bool share, const ReconSettings& s) const {
   for (const Eye& e : eyes_)
     kernel_.run(cmd, {&e.set[parity]},
-                shaders::ReconSharePush{e.cells, share ? 1u : 0u, s.coarse_keep, s.coarse_reject}, e.cells);
+                shaders::ReconSharePush{e.cells, share ? 1u : 0u, s.coarse_keep, s.coarse_reject,
+                                        s.denoiser == Denoiser::Bmfr ? 1u : 0u, 0, 0, 0},
+                e.cells);
   gpu::compute_to_compute(cmd);
 }
 
@@ -83,6 +88,7 @@ void StereoGather::fill(VkCommandBuffer cmd, std::uint32_t word) const {
   for (const Eye& e : eyes_) {
     gpu::fill_buffer(cmd, e.shared, word);
     gpu::fill_buffer(cmd, e.z, word);
+    gpu::fill_buffer(cmd, e.edge, word);
   }
 }
 

@@ -21,7 +21,7 @@ using Buf = const gpu::Buffer*;
 struct AccumulateBindings {
   FOVEA_BINDING_COUNT(RECON_ACC_COUNT)
   Buf maps, tables, samples, direct, indirect, normal_depth, position_material, prev_direct, prev_indirect, prev_pos,
-      prev_nrm, out_direct, out_indirect, out_pos, out_nrm, tap_idx, tap_w, materials;
+      prev_nrm, out_direct, out_indirect, out_pos, out_nrm, tap_idx, tap_w, materials, prev_restart, out_restart;
   Slots slots() const {
     return {{{RECON_MAPS, maps},
              {RECON_TABLES, tables},
@@ -40,13 +40,15 @@ struct AccumulateBindings {
              {RECON_ACC_OUT_NRM, out_nrm},
              {RECON_ACC_TAP_IDX, tap_idx},
              {RECON_ACC_TAP_W, tap_w},
-             {RECON_ACC_MATERIALS, materials}}};
+             {RECON_ACC_MATERIALS, materials},
+             {RECON_ACC_PREV_RESTART, prev_restart},
+             {RECON_ACC_OUT_RESTART, out_restart}}};
   }
 };
 
 struct ShareBindings {
   FOVEA_BINDING_COUNT(RECON_SHARE_COUNT)
-  Buf maps, tables, pos, nrm, acc_direct, acc_indirect, other_pos, other_nrm, other_indirect, shared, z;
+  Buf maps, tables, pos, nrm, acc_direct, acc_indirect, other_pos, other_nrm, other_indirect, shared, z, edge;
   Slots slots() const {
     return {{{RECON_MAPS, maps},
              {RECON_TABLES, tables},
@@ -58,13 +60,14 @@ struct ShareBindings {
              {RECON_SHARE_OTHER_NRM, other_nrm},
              {RECON_SHARE_OTHER_INDIRECT, other_indirect},
              {RECON_SHARE_SHARED, shared},
-             {RECON_SHARE_Z, z}}};
+             {RECON_SHARE_Z, z},
+             {RECON_SHARE_EDGE, edge}}};
   }
 };
 
 struct BmfrBindings {
   FOVEA_BINDING_COUNT(RECON_BMFR_COUNT)
-  Buf pos, nrm, z, fitted, columns, materials, excess;
+  Buf pos, nrm, z, fitted, columns, materials, excess, edge;
   Slots slots() const {
     return {{{RECON_BMFR_POS, pos},
              {RECON_BMFR_NRM, nrm},
@@ -72,7 +75,8 @@ struct BmfrBindings {
              {RECON_BMFR_FITTED, fitted},
              {RECON_BMFR_COLUMNS, columns},
              {RECON_BMFR_MATERIALS, materials},
-             {RECON_BMFR_EXCESS, excess}}};
+             {RECON_BMFR_EXCESS, excess},
+             {RECON_BMFR_EDGE, edge}}};
   }
 };
 
@@ -95,7 +99,7 @@ struct PostBindings {
 
 struct TaaBindings {
   FOVEA_BINDING_COUNT(RECON_TAA_COUNT)
-  Buf maps, tables, pos, tap_idx, tap_w, post, albedo, prev_final, final_color;
+  Buf maps, tables, pos, tap_idx, tap_w, post, albedo, prev_final, final_color, nrm, restart;
   Slots slots() const {
     return {{{RECON_MAPS, maps},
              {RECON_TABLES, tables},
@@ -105,7 +109,9 @@ struct TaaBindings {
              {RECON_TAA_POST, post},
              {RECON_TAA_ALBEDO, albedo},
              {RECON_TAA_PREV_FINAL, prev_final},
-             {RECON_TAA_FINAL, final_color}}};
+             {RECON_TAA_FINAL, final_color},
+             {RECON_TAA_NRM, nrm},
+             {RECON_TAA_RESTART, restart}}};
   }
 };
 

@@ -39,8 +39,9 @@ BmfrFit::BmfrFit(gpu::Context& ctx, const BmfrOptions& options)
 
 gpu::DescriptorSet BmfrFit::bind(const gpu::Buffer& vpos, const gpu::Buffer& vnrm, const gpu::Buffer& z,
                                  const gpu::Buffer& fitted, const gpu::Buffer& columns,
-                                 const gpu::Buffer& materials, const gpu::Buffer& excess) const {
-  return make_set(*ctx_, pipeline_, BmfrBindings{&vpos, &vnrm, &z, &fitted, &columns, &materials, &excess});
+                                 const gpu::Buffer& materials, const gpu::Buffer& excess,
+                                 const gpu::Buffer& edge) const {
+  return make_set(*ctx_, pipeline_, BmfrBindings{&vpos, &vnrm, &z, &fitted, &columns, &materials, &excess, &edge});
 }
 
 void BmfrFit::record(VkCommandBuffer cmd, const gpu::DescriptorSet& set, BmfrGrid g, std::uint32_t frame,
@@ -56,10 +57,10 @@ void BmfrFit::record(VkCommandBuffer cmd, const gpu::DescriptorSet& set, BmfrGri
 std::vector<glm::vec4> BmfrFit::fit(BmfrGrid g, const std::vector<glm::vec4>& vpos, const std::vector<glm::vec4>& vnrm,
                                     const std::vector<glm::vec4>& z, std::uint32_t frame, glm::ivec2 offset,
                                     float noise, const std::vector<std::uint32_t>& rows,
-                                    const std::vector<bool>& metal) const {
+                                    const std::vector<bool>& metal, const std::vector<std::uint32_t>& edge) const {
   const std::size_t cells = std::size_t(g.padded_columns) * g.padded_rows;
   if (g.padded_columns % 32 || g.padded_rows % 32 || cells == 0 || vpos.size() != cells || vnrm.size() != cells ||
-      z.size() != cells)
+      z.size() != cells || (!edge.empty() && edge.size() != cells))
     throw core::InputError("bmfr: inputs must cover a grid of whole 32x32 blocks");
   if (rows.size() != g.columns || g.columns > g.padded_columns)
     throw core::InputError("bmfr: need one row count per column of a polar grid (" + std::to_string(g.columns) +
@@ -85,12 +86,15 @@ std::vector<glm::vec4> BmfrFit::fit(BmfrGrid g, const std::vector<glm::vec4>& vp
   for (std::size_t m = 0; m < metal.size(); ++m) materials[m].metallic = metal[m] ? 1.0f : 0.0f;
   gpu::Buffer bm(*ctx_, {.size = materials.size() * sizeof(shaders::PtMaterial), .usage = gpu::BufferUsage::Storage,
                          .memory = gpu::Memory::HostVisible, .name = "bmfr.materials"});
+  gpu::Buffer be(*ctx_, {.size = cells * 4, .usage = gpu::BufferUsage::Storage, .memory = gpu::Memory::HostVisible,
+                         .name = "bmfr.edge"});
+  be.upload(edge.empty() ? std::vector<std::uint32_t>(cells, 0u) : edge);
   bp.upload(vpos);
   bn.upload(vnrm);
   bz.upload(z);
   bt.upload(table);
   bm.upload(materials);
-  const gpu::DescriptorSet set = bind(bp, bn, bz, out, bt, bm, ex);
+  const gpu::DescriptorSet set = bind(bp, bn, bz, out, bt, bm, ex, be);
   ctx_->submit_and_wait([&](VkCommandBuffer cmd) { record(cmd, set, g, frame, offset, noise); });
   std::vector<glm::vec4> fitted = out.download<glm::vec4>();
   const std::vector<glm::vec4> excess = ex.download<glm::vec4>();
@@ -122,7 +126,7 @@ Bmfr::Bmfr(gpu::Context& ctx, std::span<const EyeGrid> eyes, const Accumulation&
     e.excess = storage(ctx, VkDeviceSize(eyes[i].cells) * 16, "recon.excess");
     for (int p = 0; p < 2; ++p)
       e.set[p] = fit_.bind(acc.position(int(i), p), acc.normal(int(i), p), gather.shared(int(i)), e.fitted,
-                           *eyes[i].tables, materials, e.excess);
+                           *eyes[i].tables, materials, e.excess, gather.edge(int(i)));
   }
 }
 

@@ -9,8 +9,9 @@
 // rows are read modulo each column's row count (the grid's column table). Cells whose
 // material (shaders::PtMaterial of the scene's table, indexed by vpos.w) has no diffuse lobe
 // stay out of the regression and keep z: their indirect diffuse is zero by construction; so
-// do cells next to a surface edge (a 3×3 neighbour that the history's validity test would not
-// take for the same surface), whose jittered history mixes both sides.
+// do the cells flagged as on a surface edge (edge, uint per cell; the stereo gather flags a
+// cell with a 3×3 neighbour that the history's validity test would not take for the same
+// surface), whose jittered history mixes both sides.
 #include <cstdint>
 #include <vector>
 
@@ -46,20 +47,23 @@ class BmfrFit {
  public:
   explicit BmfrFit(gpu::Context& ctx, const BmfrOptions& options = {});
   // `columns`: the grid's column table (shaders::GridColumn, this frame's first);
-  // `materials`: the scene's shaders::PtMaterial table (material codes beyond it count as diffuse).
+  // `materials`: the scene's shaders::PtMaterial table (material codes beyond it count as diffuse);
+  // `edge`: uint per cell, non-zero for a cell on a surface edge.
   gpu::DescriptorSet bind(const gpu::Buffer& vpos, const gpu::Buffer& vnrm, const gpu::Buffer& z,
                           const gpu::Buffer& fitted, const gpu::Buffer& columns, const gpu::Buffer& materials,
-                          const gpu::Buffer& excess) const;
+                          const gpu::Buffer& excess, const gpu::Buffer& edge) const;
   // Records the fit; `offset` is the block-grid displacement in [0, 32)².
   void record(VkCommandBuffer cmd, const gpu::DescriptorSet& set, BmfrGrid grid, std::uint32_t frame,
               glm::ivec2 offset, float noise) const;
   // Upload, fit, download in one submission (tests, tools): fitted + excess. `rows`: rows per column of a
   // polar grid (grid.columns entries) or empty for a raster; `metal`: per material code,
-  // whether it has no diffuse lobe (codes beyond the list: diffuse).
+  // whether it has no diffuse lobe (codes beyond the list: diffuse); `edge`: per cell, non-zero
+  // on a surface edge (empty: none).
   std::vector<glm::vec4> fit(BmfrGrid grid, const std::vector<glm::vec4>& vpos, const std::vector<glm::vec4>& vnrm,
                              const std::vector<glm::vec4>& z, std::uint32_t frame = 0, glm::ivec2 offset = {0, 0},
                              float noise = 0.01f, const std::vector<std::uint32_t>& rows = {},
-                             const std::vector<bool>& metal = {}) const;
+                             const std::vector<bool>& metal = {},
+                             const std::vector<std::uint32_t>& edge = {}) const;
 
  private:
   gpu::Context* ctx_;

@@ -47,11 +47,13 @@ class Accumulation {
   const gpu::Buffer& normal(int eye, int parity) const { return eyes_[eye].nrm[parity]; }
   const gpu::Buffer& tap_index(int eye) const { return eyes_[eye].tap_idx; }
   const gpu::Buffer& tap_weight(int eye) const { return eyes_[eye].tap_w; }
+  // Frames since the history was rejected for coarse cells (float per cell; 0: none recent).
+  const gpu::Buffer& restart(int eye, int parity) const { return eyes_[eye].restart[parity]; }
 
  private:
   struct Eye {
     std::uint32_t cells = 0;
-    gpu::Buffer direct[2], indirect[2], pos[2], nrm[2], tap_idx, tap_w;
+    gpu::Buffer direct[2], indirect[2], pos[2], nrm[2], restart[2], tap_idx, tap_w;
     gpu::DescriptorSet set[2];
   };
   gpu::ComputePipeline kernel_;
@@ -61,17 +63,19 @@ class Accumulation {
 class StereoGather {
  public:
   StereoGather(gpu::Context& ctx, std::span<const EyeGrid> eyes, const Accumulation& acc);
-  // `share`: gather the other eye's indirect diffuse (else z = own direct + indirect).
+  // `share`: gather the other eye's indirect diffuse (else z = own direct + indirect). With
+  // the BMFR denoiser it also flags the cells on a surface edge, which the fit leaves out.
   void record(VkCommandBuffer cmd, int parity, bool share, const ReconSettings& settings) const;
   void fill(VkCommandBuffer cmd, std::uint32_t word) const;
 
   const gpu::Buffer& shared(int eye) const { return eyes_[eye].shared; }
   const gpu::Buffer& z(int eye) const { return eyes_[eye].z; }
+  const gpu::Buffer& edge(int eye) const { return eyes_[eye].edge; }  // uint per cell, 1: on a surface edge
 
  private:
   struct Eye {
     std::uint32_t cells = 0;
-    gpu::Buffer shared, z;
+    gpu::Buffer shared, z, edge;
     gpu::DescriptorSet set[2];
   };
   gpu::ComputePipeline kernel_;

@@ -27,7 +27,9 @@
 #define RECON_ACC_TAP_IDX 15
 #define RECON_ACC_TAP_W 16
 #define RECON_ACC_MATERIALS 17
-#define RECON_ACC_COUNT 18
+#define RECON_ACC_PREV_RESTART 18
+#define RECON_ACC_OUT_RESTART 19
+#define RECON_ACC_COUNT 20
 
 // recon_share.comp (stereo gather of indirect diffuse)
 #define RECON_SHARE_POS 2
@@ -39,7 +41,8 @@
 #define RECON_SHARE_OTHER_INDIRECT 8
 #define RECON_SHARE_SHARED 9
 #define RECON_SHARE_Z 10
-#define RECON_SHARE_COUNT 11
+#define RECON_SHARE_EDGE 11
+#define RECON_SHARE_COUNT 12
 
 // recon_bmfr_fit.comp (BMFR Phase II)
 #define RECON_BMFR_POS 0
@@ -49,7 +52,8 @@
 #define RECON_BMFR_COLUMNS 4
 #define RECON_BMFR_MATERIALS 5
 #define RECON_BMFR_EXCESS 6
-#define RECON_BMFR_COUNT 7
+#define RECON_BMFR_EDGE 7
+#define RECON_BMFR_COUNT 8
 
 // recon_post.comp (BMFR Phase III)
 #define RECON_POST_POS 0
@@ -72,7 +76,9 @@
 #define RECON_TAA_ALBEDO 6
 #define RECON_TAA_PREV_FINAL 7
 #define RECON_TAA_FINAL 8
-#define RECON_TAA_COUNT 9
+#define RECON_TAA_NRM 9
+#define RECON_TAA_RESTART 10
+#define RECON_TAA_COUNT 11
 
 // recon_mip.comp
 #define RECON_MIP_MIPS 2

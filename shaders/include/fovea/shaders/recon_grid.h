@@ -42,6 +42,11 @@ FOVEA_CONST float kReconSky = -1.0f;
 FOVEA_CONST float kReconNoSample = -2.0f;
 FOVEA_CONST float kReconEmitterBase = -3.0f;
 
+// Frames a cell counts as restarted after Phase I rejected its history for coarse cells (a
+// saccade's new fovea): Phase I writes 1 at the restart, +1 per frame after, 0 beyond this
+// or without a restart; TAA treats the window (recon_taa.comp).
+FOVEA_CONST float kReconRestartFrames = 8.0f;
+
 struct ReconAccumulatePush {
   FOVEA_UINT cells, has_history, indirect_fresh, pad;  // indirect_fresh = 0: reuse history only
   float alpha_min;                                     // EMA floor (BMFR Phase I: 0.2)
@@ -51,6 +56,7 @@ struct ReconAccumulatePush {
 struct ReconSharePush {
   FOVEA_UINT cells, enabled;
   float coarse_keep, coarse_reject;  // as ReconAccumulatePush
+  FOVEA_UINT edges, pad0, pad1, pad2;  // edges = 1: flag the cells on a surface edge (BMFR's fit reads them)
 };
 
 struct ReconBmfrPush {
@@ -103,6 +109,7 @@ struct ReconGridBlurPush {
 static_assert(sizeof(ReconGrid) == 192);
 static_assert(sizeof(ReconGridBlurPush) == 32);
 static_assert(sizeof(ReconAccumulatePush) == 32);
+static_assert(sizeof(ReconSharePush) == 32);
 static_assert(sizeof(ReconBmfrPush) == 32);
 static_assert(sizeof(ReconPostPush) == 32);
 static_assert(sizeof(ReconMipPush) == 32);
