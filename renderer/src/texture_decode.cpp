@@ -1,5 +1,7 @@
 #include "texture_decode.hpp"
 
+#include <algorithm>
+#include <iterator>
 #include <limits>
 
 #include <stb/stb_image.h>
@@ -19,6 +21,15 @@ bool decode_texture(std::span<const unsigned char> bytes, const SceneLimits& lim
   if (w > limits.max_texture_size || h > limits.max_texture_size) {
     why = std::to_string(w) + "x" + std::to_string(h) + " is larger than " + std::to_string(limits.max_texture_size) +
           " pixels a side";
+    return false;
+  }
+  // stb's 16-bit readers other than PNG's (PNM with maxval > 255, PSD) trust the header's
+  // size over the bytes present: a short 16-bit PNM overflowed in stbi__convert_16_to_8
+  // (fuzz/regressions/gltf). glTF's images are PNG or JPEG; OBJ scenes use 8-bit formats.
+  static constexpr unsigned char kPng[] = {0x89, 'P', 'N', 'G'};
+  const bool png = bytes.size() >= sizeof kPng && std::equal(std::begin(kPng), std::end(kPng), bytes.begin());
+  if (!png && stbi_is_16_bit_from_memory(bytes.data(), int(bytes.size()))) {
+    why = "a 16-bit image other than PNG (not supported)";
     return false;
   }
   const std::size_t need = std::size_t(w) * std::size_t(h) * 4;
