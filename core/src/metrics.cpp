@@ -289,6 +289,13 @@ Scores pool(const ErrorMaps& maps, const std::vector<float>& weights) {
   return s;
 }
 
+int band_index(float e, double band_deg) {
+  int k = std::max(0, int(e / band_deg));  // the quotient's rounding can land one off
+  while (k > 0 && e < k * band_deg) --k;
+  while (e >= (k + 1) * band_deg) ++k;
+  return k;
+}
+
 std::vector<BandScores> band_scores(const ErrorMaps& maps, const std::vector<float>& ecc, double band_deg) {
   if (ecc.size() != maps.squared_error.size())
     throw InputError("band_scores: eccentricity map size differs from the image size");

@@ -272,3 +272,14 @@ TEST(Metrics, PartialReferenceGivesTheWholeReferencesMapsWhereItHoldsTheNeighbou
   EXPECT_EQ(a.exposures, b.exposures);
   EXPECT_THROW(core::hdr_flip_exposures(partial, std::vector<bool>(valid.size(), false)), core::InputError);
 }
+
+// band_index is the band band_scores puts a pixel in: its [k·w, (k+1)·w) bounds hold e.
+TEST(Metrics, BandIndexAgreesWithTheBandBoundsAtTheirEdges) {
+  for (double w : {2.0, 0.1, 0.3, 5.0})
+    for (int k = 0; k < 200; ++k)
+      for (float e : {float(k * w), std::nextafter(float(k * w), 0.0f), std::nextafter(float(k * w), 1e9f)}) {
+        const int b = core::band_index(e, w);
+        EXPECT_GE(double(e), b * w) << "e " << e << " w " << w;
+        EXPECT_LT(double(e), (b + 1) * w) << "e " << e << " w " << w;
+      }
+}

@@ -195,12 +195,6 @@ nlohmann::json missing_scores(const std::string& prefix) {
 void add_quality(nlohmann::json& s, const core::Image& img, const core::Image& ref, const std::vector<bool>& valid,
                  const std::vector<float>& ecc, double ppd) {
   const core::ErrorMaps maps = core::error_maps(img, ref, ppd, kExposure, valid);
-  const auto band_of = [](float e) {  // band_scores' [k·w, (k+1)·w)
-    int k = std::max(0, int(e / kBandDeg));
-    while (k > 0 && e < k * kBandDeg) --k;
-    while (e >= (k + 1) * kBandDeg) ++k;
-    return k;
-  };
   // What a missing pixel takes away: the whole image and the acuity weights (nowhere 0)
   // always, the fovea and the bands where it falls.
   bool whole = true, fovea = true;
@@ -212,7 +206,7 @@ void add_quality(nlohmann::json& s, const core::Image& img, const core::Image& r
       if (scorable[i] || !std::isfinite(ecc[i])) continue;
       whole = false;
       if (ecc[i] <= core::acuity::kFoveaDeg) fovea = false;
-      const int k = band_of(ecc[i]);
+      const int k = core::band_index(ecc[i], kBandDeg);
       if (band_ok.size() <= std::size_t(k)) band_ok.resize(std::size_t(k) + 1, true);
       band_ok[std::size_t(k)] = false;
     }

@@ -94,6 +94,9 @@ struct Scores {
 Scores pool(const ErrorMaps& maps, const std::vector<float>& weights = {});
 double weighted_mean(const std::vector<float>& map, const std::vector<float>& weights = {});
 
+// The band k with k·w <= e < (k+1)·w, compared in double as band_scores does (e finite, >= 0).
+int band_index(float e, double band_deg);
+
 // Scores per eccentricity band [k·w, (k+1)·w) (empty bands skipped).
 struct BandScores {
   double e_min = 0, e_max = 0;
