@@ -194,9 +194,7 @@ const Dispatch* next_for_session(XrSession session) {
 
 XrResult intercept::xrDestroyInstance(XrInstance instance) {
   PFN_xrDestroyInstance next = nullptr;
-  const Dispatch* d = nullptr;  // the instance's table stays until the call down returns
-  std::vector<ReleasedSession> released;
-  EyeGazeActions gaze;
+  std::vector<std::shared_ptr<FrameRenderer>> renderers;
   {
     // What the layer created on the instance's handles goes first, while they are alive: the
     // sessions' renderers (swapchains, frees on the application's device), eye-gaze spaces
@@ -204,17 +202,13 @@ XrResult intercept::xrDestroyInstance(XrInstance instance) {
     std::lock_guard lock(layer().mutex);
     auto it = layer().instances.find(instance);
     if (it == layer().instances.end()) return XR_ERROR_HANDLE_INVALID;
-    d = &it->second.next;
+    const Dispatch& d = it->second.next;
     for (auto& [handle, session] : layer().sessions)
-      if (session.instance == instance) released.push_back(release_session(session));
-    gaze = it->second.gaze;
-    it->second.gaze = {};
-    next = d->xrDestroyInstance;
+      if (session.instance == instance) renderers.push_back(release_session(session, d));
+    destroy_eye_gaze_actions(d, it->second.gaze);
+    next = d.xrDestroyInstance;
   }
-  // The render threads joined (they locate the gaze spaces), their swapchains and the spaces
-  // destroyed, then the action set, all while the instance lives.
-  for (ReleasedSession& r : released) finish_release(r, *d);
-  destroy_eye_gaze_actions(*d, gaze);
+  renderers.clear();  // joins the render threads, destroys their swapchains while the instance lives
   const XrResult r = next(instance);
   if (XR_SUCCEEDED(r)) {
     std::lock_guard lock(layer().mutex);

@@ -159,7 +159,10 @@ XrResult intercept::xrEndFrame(XrSession session, const XrFrameEndInfo* info) {
     }
     in.get_visibility_mask = s.get_visibility_mask;
     in.visibility_mask_generation = s.visibility_mask_generation;
-    in.gaze = s.gaze;
+    if (s.gaze.attached()) {
+      in.gaze_from_action = true;
+      in.action_gaze = locate_eye_gaze(*s.next, s.gaze, info->displayTime);
+    }
     try {
       if (const XrFrameEndInfo* replaced = s.renderer->end_frame(in, shown)) submit = replaced;
     } catch (const std::exception& e) {

@@ -112,7 +112,6 @@ struct TraceRequest {
   std::int64_t id = 0;
   XrTime display_time = 0;
   std::array<XrPosef, 2> poses{};
-  EyeGazeSession gaze_spaces;  // attached: located by the render thread into the two below
   bool gaze_from_action = false;
   ActionGaze action_gaze;
   PFN_xrGetVisibilityMaskKHR get_visibility_mask = nullptr;
@@ -320,7 +319,8 @@ class PathTraceRenderer final : public FrameRenderer {
     TraceRequest req;
     req.display_time = in.display_time;
     for (std::size_t e = 0; e < 2; ++e) req.poses[e] = in.app_views[e].pose;
-    req.gaze_spaces = in.gaze;
+    req.gaze_from_action = in.gaze_from_action;
+    req.action_gaze = in.action_gaze;
     req.get_visibility_mask = in.get_visibility_mask;
     req.visibility_mask_generation = in.visibility_mask_generation;
     {
@@ -389,10 +389,6 @@ class PathTraceRenderer final : public FrameRenderer {
           req = *pending_;  // the newest, also when it arrived during the delay
           pending_.reset();
         }
-        // Only the requests traced are located, outside the mailbox: the session's teardown
-        // joins this thread before it destroys the spaces (release_session).
-        req.gaze_from_action = req.gaze_spaces.attached();
-        if (req.gaze_from_action) req.action_gaze = locate_eye_gaze(next_, req.gaze_spaces, req.display_time);
         std::shared_ptr<const TracedFrame> f = tracer->trace(req);
         if (!f) return;  // stopped
         {

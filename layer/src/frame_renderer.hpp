@@ -18,7 +18,6 @@
 
 #include "composite.hpp"
 #include "config.hpp"
-#include "eye_gaze.hpp"
 #include "gaze_input.hpp"
 
 namespace fovea::layer {
@@ -61,11 +60,10 @@ struct FrameInput {
   std::vector<AppView> app_views;  // the first stereo projection layer's views
   std::uint32_t projection_layer = 0;  // its index in app_frame->layers
   const XrFrameEndInfo* app_frame = nullptr;
-  // The layer's eye-gaze action's spaces, once attached: the render thread locates the gaze
-  // at the display time of the views it traces (not the application's thread: the call down
-  // took about 30 µs of its xrEndFrame). Without them the renderer's devices/ source
+  // The layer's eye-gaze action, once attached. Without it the renderer's devices/ source
   // (FOVEA_GAZE) is used.
-  EyeGazeSession gaze;
+  bool gaze_from_action = false;
+  ActionGaze action_gaze;
   // The runtime's hidden area (XR_KHR_visibility_mask), when enabled below: fetched for the
   // stereo views when the generation changes (first frame, each change event).
   PFN_xrGetVisibilityMaskKHR get_visibility_mask = nullptr;

@@ -139,18 +139,12 @@ Layer& layer();
 // application's mistake) the most recent instance's, so the runtime reports the error.
 const Dispatch* next_for_session(XrSession session);
 
-// What the layer created on a session's handles, taken from it under Layer::mutex (the
-// session passes through from then on), for finish_release() to destroy outside it before
-// the session, or its instance, is destroyed below the layer.
-struct ReleasedSession {
-  std::shared_ptr<FrameRenderer> renderer;
-  EyeGazeSession gaze;
-};
-[[nodiscard]] ReleasedSession release_session(SessionState& s);
-// The renderer first (joins the render thread, which locates the eye-gaze space, and destroys
-// the renderer's swapchains and its objects on the application's device), then the eye-gaze
-// spaces.
-void finish_release(ReleasedSession& r, const Dispatch& next);
+// Destroys what the layer created on a session's handles (the eye-gaze spaces) and returns
+// its renderer, for the caller to release outside Layer::mutex (that joins the render thread
+// and destroys the renderer's swapchains and its objects on the application's device) before
+// the session, or its instance, is destroyed below the layer. The session passes through
+// from then on.
+[[nodiscard]] std::shared_ptr<FrameRenderer> release_session(SessionState& s, const Dispatch& next);
 
 // Whether an interaction-profile-changed event of `session` changed nothing the application
 // can see (the layer's eye-gaze binding caused it); updates what the application has seen.

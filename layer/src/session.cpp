@@ -55,31 +55,24 @@ XrResult intercept::xrCreateSession(XrInstance instance, const XrSessionCreateIn
   return r;
 }
 
-ReleasedSession release_session(SessionState& s) {
-  ReleasedSession r{std::move(s.renderer), s.gaze};
-  s.gaze = {};
+std::shared_ptr<FrameRenderer> release_session(SessionState& s, const Dispatch& next) {
+  destroy_eye_gaze_session(next, s.gaze);
   s.disabled = true;
-  return r;
-}
-
-void finish_release(ReleasedSession& r, const Dispatch& next) {
-  r.renderer.reset();
-  destroy_eye_gaze_session(next, r.gaze);
+  return std::move(s.renderer);
 }
 
 XrResult intercept::xrDestroySession(XrSession session) {
   PFN_xrDestroySession next = nullptr;
-  const Dispatch* d = nullptr;  // stable: instances live in a std::map until xrDestroyInstance
-  ReleasedSession released;
+  std::shared_ptr<FrameRenderer> renderer;
   {
     std::lock_guard lock(layer().mutex);
-    d = next_for_session(session);
+    const Dispatch* d = next_for_session(session);
     if (!d) return XR_ERROR_HANDLE_INVALID;
     next = d->xrDestroySession;
     auto it = layer().sessions.find(session);
-    if (it != layer().sessions.end()) released = release_session(it->second);
+    if (it != layer().sessions.end()) renderer = release_session(it->second, *d);
   }
-  finish_release(released, *d);  // while the session lives: its swapchains and spaces go
+  renderer.reset();  // joins the render thread; the swapchains go while the session lives
   const XrResult r = next(session);
   if (XR_SUCCEEDED(r)) {
     std::lock_guard lock(layer().mutex);
