@@ -103,7 +103,8 @@ void FrameLog::write_now(const FrameTimes& t) {
              {"descriptor_updates", t.shown.descriptor_updates}, {"reuse_waits", t.shown.reuse_waits},
              {"acquire_waits", t.shown.acquire_waits},
              {"acquire_ms", t.shown.acquire_ms}, {"compose_ms", t.shown.compose_ms},
-             {"release_ms", t.shown.release_ms}, {"submit_ms", t.shown.submit_ms}};
+             {"release_ms", t.shown.release_ms}, {"submit_ms", t.shown.submit_ms},
+             {"submit_preemptions", t.shown.submit_preemptions}};
   if (!writer_.write(r)) FOVEA_LAYER_WARN("%s", writer_.error().c_str());
 }
 
