@@ -33,7 +33,7 @@ struct FrameTimes {
 
 // Records are formatted and written by the log's own thread at nice 19, not by the
 // application's thread in xrEndFrame: formatting a record and its write(2) took about 65 µs
-// a frame (`small`, lavapipe), as much as the whole call down the chain in pass-through.
+// a frame (`small`, lavapipe), half of pass-through's whole xrEndFrame.
 // write() only appends the record to a buffer; the thread takes the buffer every
 // kFlushPeriod without being woken per frame (a woken thread of the application's priority
 // may take the application's core), so the file lags the frames by up to that period (and
