@@ -15,6 +15,14 @@ into the application's threads (its Vulkan device's included) and the lowered on
 thread and its device's), which does not depend on the machine's load as much. The load
 average (1 min) is read before and after each run: other work on the machine shows in every
 figure, so compare the variants within one repetition.
+
+--split adds a line per run with xrEndFrame's steps, median / mean in microseconds, over the same
+frames: the layer's own work before the call down (`end_frame_layer`), of it the composition's
+`vkQueueSubmit` (`submit_ms`), the rest of it, the call down the chain, and after xrEndFrame
+returned until the application's next xrWaitFrame (the application's own work there; before the
+timing log had its own thread, also the record written on the application's thread); and the
+frames whose submission took over 1 ms, with how many of them lost their core during it
+(`submit_preemptions`).
 """
 import argparse
 import json
@@ -64,6 +72,11 @@ def summarise(path):
     interval = [(b["wait_return_ns"] - a["wait_return_ns"]) / 1e6 for a, b in zip(records, records[1:])
                 if not replacing or (a["replaced"] and b["replaced"])]
     end = [r["cpu_ms"]["end_frame"] for r in kept]
+    layer = [r["cpu_ms"]["end_frame_layer"] for r in kept]
+    submit = [r.get("submit_ms", 0.0) for r in kept]
+    frames = {r["frame"]: r for r in records}
+    after = [(frames[r["frame"] + 1]["wait_call_ns"] - r["end_return_ns"]) / 1e6 for r in kept if r["frame"] + 1 in frames]
+    slow = [r for r in kept if r.get("submit_ms", 0.0) > 1.0]
     if not interval or not end:
         raise SystemExit(f"{path}: too few frames to measure ({len(records)} records after the first 10)")
     return {
@@ -72,6 +85,11 @@ def summarise(path):
         "end_mean": statistics.mean(end), "frames": len(records), "replaced": sum(r["replaced"] for r in records),
         "traced": len({r["traced_frame"] for r in records if r["replaced"]}),
         "host_readbacks": sum(r.get("host_readbacks", 0) for r in kept),
+        "split": {"layer": layer, "submit": submit, "layer_rest": [a - b for a, b in zip(layer, submit)],
+                  "down": [a - b for a, b in zip(end, layer)], "after": after},
+        "slow_submits": len(slow), # (not recorded by older builds)
+        "slow_preempted": sum(1 for r in slow if r["submit_preemptions"] > 0)
+        if all("submit_preemptions" in r for r in slow) else "not recorded",
     }
 
 
@@ -140,6 +158,7 @@ def main():
     ap.add_argument("--build", default="build/release")
     ap.add_argument("--out", default="out/interval")
     ap.add_argument("--timeout", type=float, default=1800)
+    ap.add_argument("--split", action="store_true", help="also print xrEndFrame's steps per run")
     args = ap.parse_args()
     variants = args.variants.split(",")
     print(f"| {args.display}, {args.frames} frames | rep | interval median / mean / p95 (ms) "
@@ -154,6 +173,13 @@ def main():
                   f"| {s['end_median']:.3f} / {s['end_mean']:.3f} | {s['cpu_app']:.2f} / {s['cpu_render']:.2f} "
                   f"| {s['replaced']}/{s['traced']} "
                   f"| {s['host_readbacks']} | {s['load'][0]:.1f} → {s['load'][1]:.1f} |", flush=True)
+            if args.split:
+                us = {k: f"{statistics.median(x) * 1e3:.1f} / {statistics.mean(x) * 1e3:.1f}" if x else "–"
+                      for k, x in s["split"].items()}
+                print(f"|   split (us, median / mean) | {rep} | layer {us['layer']}: submit {us['submit']}, rest "
+                      f"{us['layer_rest']} | down {us['down']} | after the return {us['after']} "
+                      f"| submits > 1 ms: {s['slow_submits']}, preempted in them: {s['slow_preempted']} | | |",
+                      flush=True)
             print(f"  ({v}, repetition {rep}: {time.monotonic() - t0:.0f} s)", file=sys.stderr, flush=True)
 
 

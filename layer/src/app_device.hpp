@@ -119,6 +119,7 @@ class AppDevice {
   struct GpuStats {
     std::int64_t recordings = 0, descriptor_updates = 0, submissions = 0, reuse_waits = 0, acquire_waits = 0;
     double submit_ms = 0;  // the last composite_gpu's vkQueueSubmit (lavapipe does work in it)
+    std::int64_t submit_preemptions = 0;  // the calling thread's involuntary context switches during it
   };
   GpuStats gpu_stats() const;
 

@@ -186,7 +186,6 @@ XrResult intercept::xrEndFrame(XrSession session, const XrFrameEndInfo* info) {
         t.projection_views += reinterpret_cast<const XrCompositionLayerProjection*>(info->layers[i])->viewCount;
     t.replaced = submit != info;
     if (t.replaced) t.shown = shown;
-    std::lock_guard lock(s.frames->mutex);
     s.frames->log.write(t);
   }
   return r;

@@ -1,8 +1,14 @@
 #include "frame_log.hpp"
 
+#include <pthread.h>
+#include <sys/resource.h>
+#include <sys/syscall.h>
 #include <time.h>
+#include <unistd.h>
 
+#include <cerrno>
 #include <cmath>
+#include <cstring>
 
 #include "log.hpp"
 
@@ -14,19 +20,58 @@ std::int64_t now_ns() {
   return std::int64_t(ts.tv_sec) * 1'000'000'000 + ts.tv_nsec;
 }
 
+// About 3.5 s of frames at 72 Hz before write() has to grow a buffer.
+constexpr std::size_t kBufferedRecords = 256;
+
+FrameLog::~FrameLog() {
+  if (!thread_.joinable()) return;
+  {
+    std::lock_guard lock(mutex_);
+    stop_ = true;
+  }
+  stop_cv_.notify_all();
+  thread_.join();
+}
+
 void FrameLog::open(const std::string& dir) {
-  writer_ = xrcommon::TimingWriter();
   if (dir.empty()) return;
   try {
     writer_.open(dir + "/layer_timing.jsonl");
   } catch (const std::exception& e) {
     // Reported, not fatal: the session works, its frames are just not logged.
     FOVEA_LAYER_WARN("%s (FOVEA_LAYER_OUT); frames are not logged", e.what());
+    return;
   }
+  pending_.reserve(kBufferedRecords);
+  thread_ = std::thread([this] { run(); });
 }
 
 void FrameLog::write(const FrameTimes& t) {
-  if (!writer_.is_open()) return;
+  if (!thread_.joinable()) return;
+  std::lock_guard lock(mutex_);
+  pending_.push_back(t);
+}
+
+void FrameLog::run() {
+  pthread_setname_np(pthread_self(), "fovea-log");
+  // Below the application's threads: the log is never urgent.
+  if (setpriority(PRIO_PROCESS, static_cast<id_t>(syscall(SYS_gettid)), 19) != 0)
+    FOVEA_LAYER_WARN("timing log thread: cannot set nice 19 (%s)", std::strerror(errno));
+  std::vector<FrameTimes> batch;
+  batch.reserve(kBufferedRecords);
+  for (bool last = false; !last;) {
+    {
+      std::unique_lock lock(mutex_);
+      last = stop_cv_.wait_for(lock, kFlushPeriod, [&] { return stop_; });
+      batch.swap(pending_);  // pending_ gets the emptied buffer back, its capacity kept
+    }
+    for (const FrameTimes& t : batch) write_now(t);
+    batch.clear();
+  }
+}
+
+void FrameLog::write_now(const FrameTimes& t) {
+  if (!writer_.is_open()) return;  // a write failed earlier (reported then)
   const RenderTimes& rt = t.shown.times;
   xrcommon::TimingRecord r;
   r.source = "layer";
@@ -58,7 +103,8 @@ void FrameLog::write(const FrameTimes& t) {
              {"descriptor_updates", t.shown.descriptor_updates}, {"reuse_waits", t.shown.reuse_waits},
              {"acquire_waits", t.shown.acquire_waits},
              {"acquire_ms", t.shown.acquire_ms}, {"compose_ms", t.shown.compose_ms},
-             {"release_ms", t.shown.release_ms}, {"submit_ms", t.shown.submit_ms}};
+             {"release_ms", t.shown.release_ms}, {"submit_ms", t.shown.submit_ms},
+             {"submit_preemptions", t.shown.submit_preemptions}};
   if (!writer_.write(r)) FOVEA_LAYER_WARN("%s", writer_.error().c_str());
 }
 

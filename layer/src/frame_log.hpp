@@ -2,8 +2,13 @@
 // The layer's per-frame timing log (pass-through measurement): one timing record
 // (fovea/xrcommon/timing_record.hpp) per line in <FOVEA_LAYER_OUT>/layer_timing.jsonl.
 // Times are int64 ns of CLOCK_MONOTONIC.
+#include <chrono>
+#include <condition_variable>
 #include <cstdint>
+#include <mutex>
 #include <string>
+#include <thread>
+#include <vector>
 
 #include "fovea/xrcommon/timing_writer.hpp"
 #include "frame_renderer.hpp"
@@ -26,13 +31,36 @@ struct FrameTimes {
   Shown shown;
 };
 
+// Records are formatted and written by the log's own thread at nice 19, not by the
+// application's thread in xrEndFrame: formatting a record and its write(2) took about 65 µs
+// a frame (`small`, lavapipe), half of pass-through's whole xrEndFrame.
+// write() only appends the record to a buffer; the thread takes the buffer every
+// kFlushPeriod without being woken per frame (a woken thread of the application's priority
+// may take the application's core), so the file lags the frames by up to that period (and
+// longer when the machine leaves the thread no core). The destructor writes what is left.
 class FrameLog {
  public:
-  void open(const std::string& dir);  // empty: no log
+  static constexpr std::chrono::milliseconds kFlushPeriod{50};
+
+  FrameLog() = default;
+  ~FrameLog();
+  FrameLog(const FrameLog&) = delete;
+  FrameLog& operator=(const FrameLog&) = delete;
+
+  void open(const std::string& dir);  // empty: no log; call once, before write()
+  // Any thread. No allocation while the writer keeps up (the buffers keep their capacity).
   void write(const FrameTimes& t);
 
  private:
-  xrcommon::TimingWriter writer_;
+  void run();
+  void write_now(const FrameTimes& t);
+
+  xrcommon::TimingWriter writer_;  // the writer thread's once it runs
+  std::mutex mutex_;
+  std::condition_variable stop_cv_;
+  bool stop_ = false;
+  std::vector<FrameTimes> pending_;  // appended by write(), swapped out by run()
+  std::thread thread_;
 };
 
 }  // namespace fovea::layer

@@ -469,6 +469,7 @@ class PathTraceRenderer final : public FrameRenderer {
       shown.reuse_waits = n.reuse_waits;
       shown.acquire_waits = n.acquire_waits;
       shown.submit_ms = n.submit_ms;
+      shown.submit_preemptions = n.submit_preemptions;
     } else {
       compose_on_host(in, eyes, rule, targets);
     }

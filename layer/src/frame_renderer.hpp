@@ -105,6 +105,7 @@ struct Shown {
   // for, the composition (the GPU pass's parameters and submission, or the host path), the
   // images released; and the GPU composition's vkQueueSubmit, part of compose_ms.
   double acquire_ms = 0, compose_ms = 0, release_ms = 0, submit_ms = 0;
+  std::int64_t submit_preemptions = 0;  // the application's thread lost its core during that vkQueueSubmit
 };
 
 // Renders on its own thread: end_frame() hands the submitted views and gaze over and shows

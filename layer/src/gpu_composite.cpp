@@ -8,6 +8,8 @@
 // and copies the results into the layer's swapchain images; its command buffer was recorded at
 // the first frame with the same images, so xrEndFrame writes the frame's parameters and
 // submits. Nothing of the application's images reaches the host.
+#include <sys/resource.h>
+
 #include <algorithm>
 #include <chrono>
 #include <cmath>
@@ -537,9 +539,15 @@ void AppDevice::composite_gpu(int slot, const std::array<GpuEye, 2>& eyes, const
   VkSubmitInfo si{VK_STRUCTURE_TYPE_SUBMIT_INFO};
   si.commandBufferCount = 1;
   si.pCommandBuffers = &pass.cb;
+  // The involuntary context switches of this thread during the submission: on lavapipe it
+  // wakes the device's queue thread, which runs the pass and may take this thread's core.
+  rusage before{}, after{};
+  getrusage(RUSAGE_THREAD, &before);
   const auto t_submit = std::chrono::steady_clock::now();
   app_check(vkQueueSubmit_(queue_handle_, 1, &si, pass.fence), "vkQueueSubmit");
   g.counters.submit_ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t_submit).count();
+  getrusage(RUSAGE_THREAD, &after);
+  g.counters.submit_preemptions = after.ru_nivcsw - before.ru_nivcsw;
   pass.pending = true;
   pass.slot = slot;
   pass.used = ++g.clock;

@@ -80,8 +80,8 @@ struct SwapchainState {
   std::int64_t last_released = -1;
 };
 
-// A session's frame loop records, under the session's own lock (held only for bookkeeping,
-// never across a render or a call down the chain).
+// A session's frame loop records: the queue under the session's own lock (held only for
+// bookkeeping, never across a render or a call down the chain); the log has its own.
 struct SessionFrames {
   std::mutex mutex;
   FrameQueue queue;

@@ -219,6 +219,66 @@ TEST_P(AsyncLayer, PipelinedFramesOnTwoThreadsNeverWaitForTheRenderThread) {
   EXPECT_EQ(failures, 0);
   ASSERT_GE(traced.size(), 3u) << "the render thread finished fewer than three frames in " << ended << " frames";
 
+  const std::string log = read_text(out_->path() + "/layer.log");
+  EXPECT_NE(log.find("render async"), std::string::npos) << log;
+  EXPECT_NE(log.find(gpu ? "composition: on the GPU" : "composition: on the host (configured)"), std::string::npos)
+      << log;
+  EXPECT_EQ(log.find("internal failure"), std::string::npos) << log;
+
+  // CPU priority: the render thread and the threads of the device it created (lavapipe's
+  // rasteriser threads, "llvmpipe-N", and its compute workers, which inherit the name
+  // "fovea-render") run at nice 19; the application's threads, its device's included, keep
+  // theirs (Mesa's disk-cache threads lower themselves to SCHED_IDLE whoever creates them).
+  const auto lowered = [](const ThreadInfo& t) { return t.policy == SCHED_OTHER && t.nice == 19; };
+  const std::map<int, ThreadInfo> now = threads();
+  const ThreadInfo me = now.at(int(syscall(SYS_gettid)));
+  EXPECT_EQ(me.policy, SCHED_OTHER);
+  EXPECT_EQ(me.nice, app_threads.at(int(syscall(SYS_gettid))).nice);
+  int render = 0, render_device = 0, app_device = 0;
+  int log_writer = 0;
+  for (const auto& [tid, t] : now) {
+    const bool rasteriser = t.name.rfind("llvmpipe-", 0) == 0;
+    // The layer's timing-log writer, started with the session (before the snapshot above):
+    // it lowers itself to nice 19.
+    if (t.name == "fovea-log") {
+      ++log_writer;
+      EXPECT_TRUE(lowered(t)) << "the timing-log thread " << tid << " nice " << t.nice;
+      continue;
+    }
+    if (app_threads.count(tid)) {
+      if (t.name.find("disk$") == std::string::npos) {
+        EXPECT_EQ(t.policy, app_threads.at(tid).policy) << t.name << " " << tid;
+        EXPECT_EQ(t.nice, app_threads.at(tid).nice) << t.name << " " << tid;
+      }
+      app_device += rasteriser;
+      continue;
+    }
+    if (t.name == "fovea-render") {
+      ++render;
+      EXPECT_TRUE(lowered(t)) << "the render thread or a device thread it created: " << tid << " nice " << t.nice;
+    }
+    if (rasteriser) {
+      ++render_device;
+      EXPECT_TRUE(lowered(t)) << "the render device's " << t.name << " " << tid << " nice " << t.nice;
+    }
+  }
+  EXPECT_GE(render, 1);
+  EXPECT_EQ(log_writer, 1);
+  if (app_device > 0) {  // lavapipe: as many rasteriser threads per device, compute workers too
+    EXPECT_EQ(render_device, app_device) << "one device's rasteriser threads each";
+    EXPECT_GT(render, 1) << "the render device's compute workers";
+  }
+
+  // Teardown while the render thread is inside a render's delay: it is woken and joined.
+  for (XrSwapchain& sc : eye_) {
+    EXPECT_EQ(xrDestroySwapchain(sc), XR_SUCCESS);
+    sc = XR_NULL_HANDLE;
+  }
+  EXPECT_EQ(xrDestroySession(session_), XR_SUCCESS);
+  session_ = XR_NULL_HANDLE;
+
+  // The timing log is complete once the session is gone (its writer thread writes what it
+  // still holds; while the session runs the file lags the frames by up to a flush period).
   const auto recs = records(timing());
   ASSERT_GE(recs.size(), std::size_t(ended - 1));
   // Every application frame was ended and logged, far more of them than frames traced: while
@@ -264,54 +324,6 @@ TEST_P(AsyncLayer, PipelinedFramesOnTwoThreadsNeverWaitForTheRenderThread) {
     }
   }
   EXPECT_GT(replaced, 0);
-  const std::string log = read_text(out_->path() + "/layer.log");
-  EXPECT_NE(log.find("render async"), std::string::npos) << log;
-  EXPECT_NE(log.find(gpu ? "composition: on the GPU" : "composition: on the host (configured)"), std::string::npos)
-      << log;
-  EXPECT_EQ(log.find("internal failure"), std::string::npos) << log;
-
-  // CPU priority: the render thread and the threads of the device it created (lavapipe's
-  // rasteriser threads, "llvmpipe-N", and its compute workers, which inherit the name
-  // "fovea-render") run at nice 19; the application's threads, its device's included, keep
-  // theirs (Mesa's disk-cache threads lower themselves to SCHED_IDLE whoever creates them).
-  const auto lowered = [](const ThreadInfo& t) { return t.policy == SCHED_OTHER && t.nice == 19; };
-  const std::map<int, ThreadInfo> now = threads();
-  const ThreadInfo me = now.at(int(syscall(SYS_gettid)));
-  EXPECT_EQ(me.policy, SCHED_OTHER);
-  EXPECT_EQ(me.nice, app_threads.at(int(syscall(SYS_gettid))).nice);
-  int render = 0, render_device = 0, app_device = 0;
-  for (const auto& [tid, t] : now) {
-    const bool rasteriser = t.name.rfind("llvmpipe-", 0) == 0;
-    if (app_threads.count(tid)) {
-      if (t.name.find("disk$") == std::string::npos) {
-        EXPECT_EQ(t.policy, app_threads.at(tid).policy) << t.name << " " << tid;
-        EXPECT_EQ(t.nice, app_threads.at(tid).nice) << t.name << " " << tid;
-      }
-      app_device += rasteriser;
-      continue;
-    }
-    if (t.name == "fovea-render") {
-      ++render;
-      EXPECT_TRUE(lowered(t)) << "the render thread or a device thread it created: " << tid << " nice " << t.nice;
-    }
-    if (rasteriser) {
-      ++render_device;
-      EXPECT_TRUE(lowered(t)) << "the render device's " << t.name << " " << tid << " nice " << t.nice;
-    }
-  }
-  EXPECT_GE(render, 1);
-  if (app_device > 0) {  // lavapipe: as many rasteriser threads per device, compute workers too
-    EXPECT_EQ(render_device, app_device) << "one device's rasteriser threads each";
-    EXPECT_GT(render, 1) << "the render device's compute workers";
-  }
-
-  // Teardown while the render thread is inside a render's delay: it is woken and joined.
-  for (XrSwapchain& sc : eye_) {
-    EXPECT_EQ(xrDestroySwapchain(sc), XR_SUCCESS);
-    sc = XR_NULL_HANDLE;
-  }
-  EXPECT_EQ(xrDestroySession(session_), XR_SUCCESS);
-  session_ = XR_NULL_HANDLE;
 }
 
 INSTANTIATE_TEST_SUITE_P(Compositor, AsyncLayer, ::testing::Values("gpu", "host"),
