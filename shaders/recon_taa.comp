@@ -18,11 +18,14 @@
 //   (docs/reconstruction.md, "Jitter and reprojection"; stereo-occluders 40–42°).
 // - In the frames after Phase I rejected a cell's history as too coarse (a saccade's new
 //   fovea; kReconRestartFrames, never at a still gaze) the current input is first averaged
-//   with the 3×3 grid neighbours that pass the history's validity test (same surface), and
-//   for the first kRestartFollow of them shown without TAA's history: the new fovea starts
-//   over with a few samples per cell against a fixed gaze's long history, and TAA kept its
-//   first, noisiest frames for long (α ≈ 0.5 g at n = 2), so the fovea stayed off the fixed
-//   gaze's for 8 frames (docs/reconstruction.md, "Saccade recovery curve").
+//   with the grid neighbours that pass the history's validity test (same surface): 5×5 in
+//   the first kRestartFollow frames, 3×3 after. The first frame is shown without TAA's
+//   history (it holds the coarse periphery); in the next kRestartFollow − 1 frames TAA is a
+//   running mean weighted by the jitter's centre weight g, α = g / (ḡ·(k − 1) + g) at the
+//   window's frame k (ḡ: g's mean over the cell), so the window's frames count about evenly
+//   and the albedo, re-modulated from each frame's jittered sample, converges to the cell
+//   centre's as with a fixed gaze. The new fovea starts over with a few samples per cell
+//   against a fixed gaze's long history (docs/reconstruction.md, "Saccade recovery curve").
 // .w = 1 marks cells holding a sample (the resolve renormalises over them).
 #extension GL_GOOGLE_include_directive : require
 
@@ -50,7 +53,10 @@ layout(std430, binding = RECON_TAA_RESTART) readonly buffer Restart { float rest
 layout(push_constant) uniform Push { ReconPostPush pc; };
 
 const float kCentreSigma = 0.25;
-const float kRestartFollow = 4.0;  // restart frames in which TAA shows Phase III's (averaged) input
+// ḡ: the mean of exp(−|j|²/(2σ²)) over a uniform jitter j in the cell, (σ√(2π) erf(1/(2√2 σ)))².
+const float kMeanCentre = 0.358;
+const float kRestartFollow = 4.0;  // restart frames with the 5×5 average and TAA's running mean
+const int kRestartReach = 2;       // the 5×5 average's reach (cells)
 
 vec3 to_ycocg(vec3 c) {
   return vec3(0.25 * c.r + 0.5 * c.g + 0.25 * c.b, 0.5 * c.r - 0.5 * c.b, -0.25 * c.r + 0.5 * c.g - 0.25 * c.b);
@@ -84,20 +90,24 @@ void main() {
   vec3 avg = post[i].rgb;
   float avg_w = 1.0;
   RgCell cell = rg_cell(m, i);
-  for (int dc = -1; dc <= 1; ++dc)
-    for (int dr = -1; dr <= 1; ++dr) {
+  bool follow = since > 0.0 && since <= kRestartFollow;  // the window's first frames
+  int reach = follow ? kRestartReach : 1;
+  for (int dc = -reach; dc <= reach; ++dc)
+    for (int dr = -reach; dr <= reach; ++dr) {
       uint j;
       if (!rg_neighbour_of(m, cell, dc, dr, j) || rg_no_sample(vpos[j].w)) continue;
-      vec3 y = to_ycocg(compress(remodulated(j)));
-      lo = min(lo, y);
-      hi = max(hi, y);
+      if (abs(dc) <= 1 && abs(dr) <= 1) {  // the clamp's 3×3 neighbourhood
+        vec3 y = to_ycocg(compress(remodulated(j)));
+        lo = min(lo, y);
+        hi = max(hi, y);
+      }
       if (since > 0.0 && (dc != 0 || dr != 0) && rg_tap_valid(here, nd.xyz, nd.w, vpos[j], vnrm[j].xyz)) {
         avg += post[j].rgb;  // the same surface's demodulated input
         avg_w += 1.0;
       }
     }
   vec3 c = avg / avg_w * max(albedo[i].rgb, vec3(kPtMinDemodAlbedo));
-  if (!history || (since > 0.0 && since <= kRestartFollow)) {
+  if (!history || since == 1.0) {  // nothing to blend, or the history is the coarse periphery's
     final_color[i] = vec4(c, 1.0);
     return;
   }
@@ -106,6 +116,7 @@ void main() {
   for (int k = 0; k < 4; ++k) h += w[k] * compress(prev_final[idx[k]].rgb);
   h = from_ycocg(clamp(to_ycocg(h), lo, hi));
   vec2 jitter = vec2(m.g.jitter_u, m.g.jitter_v);  // the sample's offset from the cell centre (cells)
-  float a = max(1.0 / max(post[i].w, 1.0), pc.taa_alpha) * exp(-dot(jitter, jitter) / (2.0 * kCentreSigma * kCentreSigma));
+  float g = exp(-dot(jitter, jitter) / (2.0 * kCentreSigma * kCentreSigma));
+  float a = follow ? g / (kMeanCentre * (since - 1.0) + g) : max(1.0 / max(post[i].w, 1.0), pc.taa_alpha) * g;
   final_color[i] = vec4(max(expand(mix(h, compress(c), a)), vec3(0.0)), 1.0);
 }
