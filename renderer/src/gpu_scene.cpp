@@ -42,6 +42,8 @@ gpu::ComputePipelineDesc tracer_pipeline(const GpuScene& scene, const char* shad
                                          std::uint32_t push_constant_bytes,
                                          std::vector<gpu::SpecConstant> specialization) {
   const bool rq = scene.tracing() == Tracing::RayQuery;
+  specialization.push_back(gpu::SpecConstant::u32(shaders::kPtSpecBvhStack, scene.bvh_stack()));
+  specialization.push_back(gpu::SpecConstant::u32(shaders::kPtSpecSharedBytes, scene.shared_memory_bytes()));
   gpu::ComputePipelineDesc d{std::string(shader) + (rq ? ".rayquery.comp.spv" : ".comp.spv"), {std::move(set0)},
                              push_constant_bytes, std::move(specialization)};
   if (rq) d.sets.push_back({gpu::Binding::AccelerationStructure});
@@ -137,6 +139,7 @@ GpuScene::GpuScene(gpu::Context& ctx, const Scene& s, const BvhOptions& bvh_opti
   stats_.triangles = std::uint32_t(n);
   stats_.nodes = std::uint32_t(bvh.nodes.size());
   stats_.bvh_depth = bvh.depth;
+  shared_memory_bytes_ = ctx.info().max_shared_memory_bytes;
   stats_.bvh_sah_cost = bvh.sah_cost;
   stats_.bvh_ray_guided = bvh.ray_guided;
   stats_.bvh_ray_cost = bvh.ray_cost;

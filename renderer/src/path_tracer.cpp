@@ -28,8 +28,7 @@ PathTracer::PathTracer(gpu::Context& ctx, const GpuScene& scene, const SceneFeat
                            sizeof(shaders::PtFrameParams),
                            {SpecConstant::boolean(shaders::kPtSpecTextures, f.textures),
                             SpecConstant::boolean(shaders::kPtSpecGlossy, f.glossy),
-                            SpecConstant::boolean(shaders::kPtSpecEmitters, f.emitters),
-                            SpecConstant::u32(shaders::kPtSpecBvhStack, scene.bvh_stack())}));
+                            SpecConstant::boolean(shaders::kPtSpecEmitters, f.emitters)}));
 }
 
 TraceOutputs PathTracer::bind(const gpu::Buffer& grid, std::uint32_t cells) const {

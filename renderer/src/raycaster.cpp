@@ -24,8 +24,7 @@ Raycaster::Raycaster(gpu::Context& ctx, const GpuScene& scene, bool count_traver
       count_traversal_(count_traversal),
       pipeline_(ctx, tracer_pipeline(scene, count_traversal ? "pt_raycast.stats" : "pt_raycast",
                                      std::vector<gpu::Binding>(4, gpu::Binding::StorageBuffer),
-                                     sizeof(shaders::PtRaycastParams),
-                                     {gpu::SpecConstant::u32(shaders::kPtSpecBvhStack, scene.bvh_stack())})) {}
+                                     sizeof(shaders::PtRaycastParams))) {}
 
 TraversalStats Raycaster::traversal_stats() {
   if (!count_traversal_) throw std::logic_error("Raycaster::traversal_stats needs count_traversal");

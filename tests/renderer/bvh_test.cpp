@@ -322,6 +322,34 @@ TEST_F(BvhGpu, DeepTreeEqualsBruteForce) {
   expect_equal_to_brute_force(p, rays, false);
 }
 
+TEST_F(BvhGpu, TreeTooDeepForASharedStackEqualsBruteForce) {
+  // The traversal keeps its stack in shared memory when the workgroup's stacks fit
+  // (pt_traverse.h), else in a private array. Nested triangles halving in size every two
+  // (2^60 down to 2^-14) make a tree of 23 4-wide levels: 69 entries for each of
+  // pt_raycast's 64 invocations (35 KB), more than lavapipe's 32 KB, so this tree takes the
+  // private stack there. Rays start near triangles of their own size (no rounding trouble,
+  // DeepTreeEqualsBruteForce), and those from the origin hit the smallest, deepest one.
+  std::vector<glm::vec3> p;
+  for (int i = 0; i < 150; ++i) {
+    const float s = std::ldexp(1.0f, 60 - i / 2);
+    p.insert(p.end(), {{s, 0, 0}, {s, s * 0.5f, 0}, {s, 0, s * 0.5f}});
+  }
+  const int depth = fr::build_bvh(p).depth;
+  EXPECT_GE(depth, 22);
+  std::printf("%d 4-wide levels: %s stack on %s\n", depth,
+              3u * std::uint32_t(depth) * 64u * 8u <= ctx().info().max_shared_memory_bytes ? "shared" : "private",
+              ctx().info().name.c_str());
+  std::vector<PtRay> rays;
+  for (int i = 0; i < 150; ++i) {
+    const float s = std::ldexp(1.0f, 60 - i / 2), y = 0.25f * s, z = 0.5f * y;
+    rays.push_back(ray({0.0f, y, z}, {1, 0, 0}));           // the smallest triangle around it
+    rays.push_back(ray({0.9f * s, y, z}, {-1, 0, 0}));      // the next smaller one
+    rays.push_back(ray({0.0f, 0.0f, 0.0f}, {s, y, z}));     // its centre-ish from the origin
+    rays.push_back(ray({0.5f * s, 0.1f * s, 0.1f * s}, {1, 0.2f, 0.1f}));
+  }
+  expect_equal_to_brute_force(p, rays, false);
+}
+
 TEST_F(BvhGpu, ClosedMeshIsWatertight) {
   // Rays from the centre of a closed sphere at its vertices and edge midpoints, where
   // non-watertight tests let rays slip between triangles, must all hit.

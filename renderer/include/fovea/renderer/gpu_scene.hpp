@@ -75,11 +75,15 @@ class GpuScene {
   // Traversal stack entries this tree needs (specialization constant kPtSpecBvhStack):
   // at most 3 deferred children per 4-wide level (pt_traverse.h).
   std::uint32_t bvh_stack() const { return 3u * std::uint32_t(stats_.bvh_depth > 0 ? stats_.bvh_depth : 1); }
+  // The device's shared memory per workgroup (kPtSpecSharedBytes): where the stack fits,
+  // the traversal keeps it there.
+  std::uint32_t shared_memory_bytes() const { return shared_memory_bytes_; }
 
  private:
   gpu::Buffer nodes_, triangles_, shading_, materials_, lights_, texture_table_, texels_, ggx_albedo_;
   glm::vec3 environment_{0};
   GpuSceneStats stats_;
+  std::uint32_t shared_memory_bytes_ = 0;
   std::unique_ptr<gpu::TriangleAccel> accel_;  // null: compute traversal
   gpu::DescriptorSetLayout accel_layout_;
   gpu::DescriptorSet accel_set_;

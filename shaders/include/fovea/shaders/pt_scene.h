@@ -16,9 +16,11 @@ FOVEA_CONST FOVEA_UINT kPtBvhMaxLeaf = 255;
 // Traversal stack: at most 3 deferred children per 4-wide level, and a 4-wide tree is
 // never deeper than the binary one.
 FOVEA_CONST FOVEA_UINT kPtBvhStackSize = 3 * kPtBvhMaxDepth;
-// Specialization constant (constant_id) of the shaders that traverse: the stack entries a
-// scene needs, 3 × its 4-wide depth (a smaller private array is cheaper on lavapipe).
+// Specialization constants (constant_id) of the shaders that traverse: the stack entries a
+// scene needs, 3 × its 4-wide depth (a smaller stack is cheaper on lavapipe), and the
+// device's maxComputeSharedMemorySize (the stack goes to shared memory when it fits).
 FOVEA_CONST FOVEA_UINT kPtSpecBvhStack = 16;
+FOVEA_CONST FOVEA_UINT kPtSpecSharedBytes = 17;
 FOVEA_CONST FOVEA_UINT kPtNoHit = 0xFFFFFFFF;
 
 // Compressed 4-wide BVH node, 64 bytes (Ylitie, Karras, Laine 2017, "Efficient incoherent
