@@ -1,16 +1,18 @@
 // Where a foveated frame's trace and reconstruction time goes, per sample distribution
 // (docs/reconstruction.md, "Whole frame on fove0"): the `default` scene on a display preset
 // with the lens' hidden area skipped, gaze at the centre, both eyes, the default
-// reconstruction with stereo gather. Per configuration it prints the grid's cells and traced
-// cells, and how the path tracer's invocations (cell n in invocation n) fall into SIMD
-// vectors of LANES lanes: vectors with a traced cell ("busy"), those among them that also
-// hold skipped cells ("mixed": a SIMD device such as lavapipe pays a vector's slowest lane
-// for all its lanes), and the mean diagonal of the display box a busy vector's samples span
-// (how far apart the rays it traces in lockstep start). Then per round and configuration
-// the second frame's GPU ms: trace, the reconstruction kernels (timed again one submission
-// each, testing::time_reconstruct), resolve and frame, and the trace ms per 1000 traced
-// samples. Rounds interleave the configurations, so load on a shared machine spreads over
-// all of them; compare configurations within a round.
+// reconstruction with stereo gather. Per configuration and trace order (grid: cell n in
+// invocation n; tiles: pt_order.h) it prints the grid's cells and traced cells, and how the
+// path tracer's invocations fall into SIMD vectors of LANES lanes: vectors with a traced cell
+// ("busy"), those among them that also hold skipped cells ("mixed": a SIMD device such as
+// lavapipe pays a vector's slowest lane for all its lanes), and the mean diagonal of the
+// display box a busy vector's samples span (how far apart the rays it traces in lockstep
+// start). Then per round and configuration the second frame's GPU ms: trace, the trace
+// again alone in the order the pipeline picks and in the other one (testing::time_trace,
+// GPU and process CPU ms), the reconstruction kernels (timed again one submission each,
+// testing::time_reconstruct), resolve and frame, and the trace ms per 1000 traced samples.
+// Rounds interleave the configurations, so load on a shared machine spreads over all of
+// them; compare configurations within a round.
 //   fovea_bench_trace_cost [DISPLAY [ROUNDS [LANES]]]     defaults: fove0 1 8
 #include <algorithm>
 #include <cstdio>
@@ -30,6 +32,7 @@
 #include "fovea/pipeline/testing.hpp"
 #include "fovea/renderer/gpu_scene.hpp"
 #include "fovea/renderer/scene_io.hpp"
+#include "fovea/shaders/pt_order.h"
 
 namespace fc = fovea::core;
 namespace fp = fovea::pipeline;
@@ -52,14 +55,16 @@ struct Vectors {
   double extent_px = 0;  // mean over the busy vectors
 };
 
-Vectors vectors(const std::vector<fovea::shaders::GridSample>& grid, std::size_t lanes) {
+// `columns`: the grid's padded column count, for the tile order.
+Vectors vectors(const std::vector<fovea::shaders::GridSample>& grid, std::size_t lanes, fr::TraceOrder order,
+                std::uint32_t columns) {
   Vectors v;
   double extent = 0;
   for (std::size_t start = 0; start < grid.size(); start += lanes) {
     glm::vec2 lo(1e30f), hi(-1e30f);
     int traced = 0, n = 0;
     for (std::size_t i = start; i < std::min(grid.size(), start + lanes); ++i, ++n) {
-      const auto& g = grid[i];
+      const auto& g = grid[order == fr::TraceOrder::Tiles ? fovea::shaders::pt_tile_cell(std::uint32_t(i), columns) : i];
       if (g.flags != 0) continue;
       ++traced;
       lo = glm::min(lo, glm::vec2(g.screen_x, g.screen_y));
@@ -75,6 +80,8 @@ Vectors vectors(const std::vector<fovea::shaders::GridSample>& grid, std::size_t
 }
 
 // The 1-minute load average (Linux), 0 where it cannot be read: printed next to each time.
+const char* order_name(fr::TraceOrder o) { return o == fr::TraceOrder::Tiles ? "tiles" : "grid"; }
+
 double load_average() {
   double load = 0;
   if (std::FILE* f = std::fopen("/proc/loadavg", "r")) {
@@ -114,8 +121,8 @@ int run(int argc, char** argv) {
   settings.share = fovea::reconstruct::StereoShare::Gather;
   std::printf("%s, default scene, gaze at the centre, hidden area skipped, both eyes; %s; %ld-lane vectors\n",
               display_name.c_str(), ctx.info().name.c_str(), lanes);
-  std::printf("| configuration | cells / eye | traced / eye | busy vectors | mixed vectors | busy vector extent, px |\n"
-              "|---|---|---|---|---|---|\n");
+  std::printf("| configuration | order | cells / eye | traced / eye | busy vectors | mixed vectors | busy vector extent, px |\n"
+              "|---|---|---|---|---|---|---|\n");
   std::vector<std::string> rows;
   for (long round = 0; round < rounds; ++round)
     for (const Config& c : configs) {
@@ -124,29 +131,53 @@ int run(int argc, char** argv) {
       if (c.budget > 0) dp.budget = c.budget;
       fp::FramePipeline p(ctx, gs, fc::stereo_views(display), dp, settings);
       for (fc::Eye e : {fc::Eye::Left, fc::Eye::Right}) p.set_visibility(e, fc::EyeOptics(display, e).view_mask());
-      // Frame 0 has no history; the second frame is the one a running session pays.
+      // Frame 0 has no history (and its dispatches compile the shaders); the second frame is
+      // the one a running session pays. Its trace is then timed again alone in both orders,
+      // twice each (ABBA, A alternating between rounds): GPU ms, and the process's CPU ms,
+      // which other processes on a shared machine inflate less than elapsed time.
       p.render(poses, {gaze, gaze}, 0);
       const fp::FrameTimes t = p.render(poses, {gaze, gaze}, 1);
+      const fr::TraceOrder picked = fp::testing::trace_order(p, fc::Eye::Left);
+      const fr::TraceOrder orders[2] = {picked, picked == fr::TraceOrder::Tiles ? fr::TraceOrder::Grid
+                                                                               : fr::TraceOrder::Tiles};
+      fp::testing::KernelTime trace[2];  // sums over the two repetitions
+      const double load0 = load_average();
+      for (int k = 0; k < 4; ++k) {
+        const int which = ((k == 0 || k == 3) ? 0 : 1) ^ int(round % 2);
+        const fp::testing::KernelTime kt = fp::testing::time_trace(p, 1, orders[which]);
+        trace[which].gpu_ms += 0.5 * kt.gpu_ms;
+        trace[which].cpu_ms += 0.5 * kt.cpu_ms;
+      }
+      const double load1 = load_average();
       const fp::testing::ReconKernelTimes r = fp::testing::time_reconstruct(p, 1);
       const long long traced = p.traced_cells(fc::Eye::Left) + p.traced_cells(fc::Eye::Right);
       if (round == 0) {
         const auto grid = p.grid_samples(fc::Eye::Left);
-        const Vectors v = vectors(grid, std::size_t(lanes));
-        std::printf("| %s | %zu | %lld | %ld | %ld | %.1f |\n", c.name().c_str(), grid.size(),
-                    static_cast<long long>(p.traced_cells(fc::Eye::Left)), v.busy, v.mixed, v.extent_px);
+        for (const fr::TraceOrder o : orders) {
+          const Vectors v = vectors(grid, std::size_t(lanes), o, std::uint32_t(p.distribution(fc::Eye::Left).padded_columns()));
+          std::printf("| %s | %s | %zu | %lld | %ld | %ld | %.1f |\n", c.name().c_str(), order_name(o), grid.size(),
+                      static_cast<long long>(p.traced_cells(fc::Eye::Left)), v.busy, v.mixed, v.extent_px);
+        }
       }
-      char row[512];
+      char row[640];
       std::snprintf(row, sizeof row,
-                    "| %ld | %s | %.2f | %.0f | %.0f | %.0f | %.0f | %.0f | %.0f | %.0f | %.0f | %.0f | %.2f |", round + 1,
-                    c.name().c_str(), load_average(), t.trace.gpu_ms, r.accumulate.gpu_ms,
+                    "| %ld | %s | %.2f → %.2f | %.0f | %s | %.0f / %.0f | %s | %.0f / %.0f | %.3f / %.3f | %.0f | %.0f |"
+                    " %.0f | %.0f | %.0f | %.0f | %.0f | %.0f | %.2f |",
+                    round + 1, c.name().c_str(), load0, load1, t.trace.gpu_ms, order_name(orders[0]), trace[0].gpu_ms,
+                    trace[0].cpu_ms, order_name(orders[1]), trace[1].gpu_ms, trace[1].cpu_ms,
+                    trace[1].gpu_ms / trace[0].gpu_ms, trace[1].cpu_ms / trace[0].cpu_ms, r.accumulate.gpu_ms,
                     r.share.gpu_ms, r.fit.gpu_ms, r.post.gpu_ms, r.taa.gpu_ms, t.reconstruct.gpu_ms, t.resolve.gpu_ms,
                     t.gpu_ms(), 1000.0 * t.trace.gpu_ms / double(traced));
       rows.emplace_back(row);
+      std::fprintf(stderr, "%s\n", row);  // progress: a round of fove0 takes minutes under load
       std::fflush(stdout);
     }
-  std::printf("\nGPU ms of the second frame, both eyes (reconstruction kernels timed again, one submission each)\n");
-  std::printf("| round | configuration | load | trace | accumulate | share | BMFR fit | post | TAA | reconstruct (frame) |"
-              " resolve | frame | trace ms per 1000 samples |\n|---|---|---|---|---|---|---|---|---|---|---|---|---|\n");
+  std::printf("\nGPU ms of the second frame, both eyes; its trace again alone in the order the pipeline picks"
+              " and in the other one (GPU / process CPU ms, mean of 2), the reconstruction kernels one submission each\n");
+  std::printf("| round | configuration | load | trace (frame) | order picked | trace GPU / CPU | other order |"
+              " trace GPU / CPU | other / picked, GPU / CPU | accumulate | share | BMFR fit | post | TAA |"
+              " reconstruct (frame) | resolve | frame | trace ms per 1000 samples |\n"
+              "|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|\n");
   for (const auto& row : rows) std::printf("%s\n", row.c_str());
   return 0;
 }

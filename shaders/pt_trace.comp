@@ -8,8 +8,9 @@
 #include "fovea/shaders/grid.h"
 #include "fovea/shaders/pt_scene.h"
 #include "fovea/shaders/pt_trace.h"
+#include "fovea/shaders/pt_order.h"
 
-layout(local_size_x = 64) in;
+layout(local_size_x = 64) in;  // one tile of the tile order (pt_order.h)
 layout(std430, set = 0, binding = 0) readonly buffer Nodes { uvec4 nodes[]; };  // PtBvhNode: pt_node()
 layout(std430, set = 0, binding = 1) readonly buffer Tris { uvec4 tris[]; };    // PtTriangle: pt_tri()
 layout(std430, set = 0, binding = 2) readonly buffer Shading { PtShading shading[]; };
@@ -248,8 +249,11 @@ Sample trace_path(vec3 org, vec3 dir, vec3 forward, inout PtRng rng) {
 }
 
 void main() {
-  const uint idx = gl_GlobalInvocationID.x;
-  if (idx >= pc.cell_count) return;
+  if (gl_GlobalInvocationID.x >= pc.cell_count) return;
+  // The cell, not the invocation, keys the random numbers and the outputs: both orders give
+  // the same buffers.
+  const uint idx = (pc.flags & kPtTileOrder) != 0u ? pt_tile_cell(gl_GlobalInvocationID.x, pc.columns)
+                                                   : gl_GlobalInvocationID.x;
   const GridSample g = cells[idx];
   const bool accumulate = (pc.flags & kPtAccumulate) != 0u && pc.accumulated_samples > 0u;
   if (g.flags != 0u) {

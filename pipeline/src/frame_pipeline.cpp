@@ -49,7 +49,8 @@ std::unique_ptr<EyeState> make_eye(gpu::Context& ctx, renderer::PathTracer& trac
   e->grid_pass = std::make_unique<gpu::GridPass>(ctx);
   e->cells = std::uint32_t(e->dist->padded_columns() * e->dist->padded_rows());
   e->grid = storage(ctx, gpu::GridPass::samples_bytes(*e->dist), "recon.grid");
-  e->trace = tracer.bind(e->grid, e->cells);
+  e->trace = tracer.bind(e->grid, renderer::GridExtent{std::uint32_t(e->dist->padded_columns()),
+                                                      std::uint32_t(e->dist->padded_rows())});
   return e;
 }
 
@@ -171,6 +172,7 @@ FrameTimes FramePipeline::render(const std::array<core::Pose, 2>& eye_pose, cons
       EyeState& e = *m.eyes[i];
       renderer::PathConfig cfg = m.path;
       if (!fresh[i]) cfg.max_bounces = 0;
+      cfg.order = m.trace_order(e);
       m.tracer.record(cmd, e.trace, core::View(e.base_view.fov(), e.base_view.width(), e.base_view.height(), e.pose),
                       e.eye, frame, cfg);
     }

@@ -1,6 +1,7 @@
 #pragma once
 // FramePipeline's state, shared by frame_pipeline.cpp and the test access (testing.cpp).
 #include <memory>
+#include <optional>
 #include <vector>
 
 #include "fovea/gpu/grid_pass.hpp"
@@ -38,6 +39,7 @@ struct FramePipeline::Impl {
   gpu::GpuTimer timer;
   std::uint32_t frames_done = 0;  // frames since the last reset
   int parity = 0;                 // history buffers written by the last frame
+  std::optional<renderer::TraceOrder> forced_order;  // testing::set_trace_order
 
   Impl(gpu::Context& c, const renderer::GpuScene& scene, const renderer::PathConfig& p,
        const reconstruct::ReconSettings& s)
@@ -52,6 +54,13 @@ struct FramePipeline::Impl {
       const EyeState* o = other(*e);
       e->mapping->write(e->pose, o ? &o->pose : nullptr);
     }
+  }
+  // Tile order for polar grids, whose grid-order vectors span radii far apart on the display
+  // (docs/reconstruction.md, "Coherent Visual-Polar vectors"); grid order for Cartesian ones.
+  renderer::TraceOrder trace_order(const EyeState& e) const {
+    if (forced_order) return *forced_order;
+    return e.dist->gpu_params().family != shaders::kFamilyCartesian ? renderer::TraceOrder::Tiles
+                                                                    : renderer::TraceOrder::Grid;
   }
   void fill(std::uint32_t word);
   int index(core::Eye e, const char* what) const;  // throws InputError when `e` is not rendered

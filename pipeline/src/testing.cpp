@@ -45,6 +45,15 @@ void fill_buffers(FramePipeline& pipeline, std::uint32_t word) {
   pipeline.reset();
 }
 
+renderer::TraceOrder trace_order(const FramePipeline& pipeline, core::Eye e) {
+  const auto& m = Access::impl(pipeline);
+  return m.trace_order(*m.eyes[std::size_t(m.index(e, "trace_order"))]);
+}
+
+void set_trace_order(FramePipeline& pipeline, renderer::TraceOrder order) {
+  Access::impl(pipeline).forced_order = order;
+}
+
 namespace {
 // Writes the current mappings and a grid image into level 0 of eye `eye`'s mip chain; the
 // eye's index. `who` names the caller in the error for a grid of the wrong size.
@@ -158,6 +167,18 @@ ReconKernelTimes time_reconstruct(FramePipeline& pipeline, std::uint32_t frame) 
   t.post = time([&](VkCommandBuffer cmd) { m.post->record_post(cmd, p, history, m.settings); });
   t.taa = time([&](VkCommandBuffer cmd) { m.post->record_taa(cmd, p, history, m.settings); });
   return t;
+}
+
+KernelTime time_trace(FramePipeline& pipeline, std::uint32_t frame, renderer::TraceOrder order) {
+  auto& m = Access::impl(pipeline);
+  if (m.frames_done == 0) throw core::InputError("time_trace: no frame rendered yet");
+  renderer::PathConfig cfg = m.path;
+  cfg.order = order;
+  return time_submission(m, [&](VkCommandBuffer cmd) {
+    for (auto& e : m.eyes)
+      m.tracer.record(cmd, e->trace, core::View(e->base_view.fov(), e->base_view.width(), e->base_view.height(), e->pose),
+                      e->eye, frame, cfg);
+  });
 }
 
 }  // namespace fovea::pipeline::testing

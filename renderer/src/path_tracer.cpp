@@ -8,6 +8,7 @@
 
 #include "fovea/core/error.hpp"
 #include "fovea/gpu/barriers.hpp"
+#include "fovea/shaders/pt_order.h"
 #include "tracer_pipeline.hpp"
 
 namespace fovea::renderer {
@@ -29,6 +30,15 @@ PathTracer::PathTracer(gpu::Context& ctx, const GpuScene& scene, const SceneFeat
                            {SpecConstant::boolean(shaders::kPtSpecTextures, f.textures),
                             SpecConstant::boolean(shaders::kPtSpecGlossy, f.glossy),
                             SpecConstant::boolean(shaders::kPtSpecEmitters, f.emitters)}));
+}
+
+TraceOutputs PathTracer::bind(const gpu::Buffer& grid, GridExtent extent) const {
+  if (extent.columns == 0 || extent.rows == 0 || std::uint64_t(extent.columns) * extent.rows > 0xFFFFFFFFu)
+    throw core::InputError("path tracer: grid extent " + std::to_string(extent.columns) + "x" +
+                           std::to_string(extent.rows) + " out of range");
+  TraceOutputs o = bind(grid, extent.columns * extent.rows);
+  o.extent_ = extent;
+  return o;
 }
 
 TraceOutputs PathTracer::bind(const gpu::Buffer& grid, std::uint32_t cells) const {
@@ -76,6 +86,13 @@ void PathTracer::record(VkCommandBuffer cmd, TraceOutputs& out, const core::View
   p.rr_start = c.rr_start;
   p.pixel_tx = float((view.tan_right() - view.tan_left()) / view.width());
   p.pixel_ty = float((view.tan_up() - view.tan_down()) / view.height());
+  p.columns = out.extent_.columns;
+  const bool tiles = c.order == TraceOrder::Tiles;
+  if (tiles && (out.extent_.columns == 0 || out.extent_.columns % shaders::kPtTileColumns != 0 ||
+                out.extent_.rows % shaders::kPtTileRows != 0))
+    throw core::InputError("path tracer: tile order needs a grid of whole " + std::to_string(shaders::kPtTileColumns) +
+                           "x" + std::to_string(shaders::kPtTileRows) + " tiles bound with its extent, not " +
+                           std::to_string(out.extent_.columns) + "x" + std::to_string(out.extent_.rows) + " cells");
   const std::uint32_t spp = std::max<std::uint32_t>(c.spp, 1);
   std::uint64_t done = std::uint64_t(accumulated) * spp;
   for (std::uint32_t first = 0; first < spp; first += shaders::kPtMaxSppPerDispatch) {
@@ -83,7 +100,8 @@ void PathTracer::record(VkCommandBuffer cmd, TraceOutputs& out, const core::View
     p.spp = std::min(spp - first, shaders::kPtMaxSppPerDispatch);
     p.sample_offset = first;
     p.accumulated_samples = std::uint32_t(std::min<std::uint64_t>(done, 0xFFFFFFFFu));
-    p.flags = (c.jitter ? shaders::kPtJitter : 0u) | (done > 0 ? shaders::kPtAccumulate : 0u);
+    p.flags = (c.jitter ? shaders::kPtJitter : 0u) | (done > 0 ? shaders::kPtAccumulate : 0u) |
+              (tiles ? shaders::kPtTileOrder : 0u);
     if (scene_.tracing() == Tracing::RayQuery) pipeline_.run(cmd, {&out.set_, &scene_.ray_query_set()}, p, out.cells_);
     else pipeline_.run(cmd, {&out.set_}, p, out.cells_);
     done += p.spp;

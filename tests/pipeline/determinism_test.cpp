@@ -5,6 +5,7 @@
 #include <cmath>
 #include <cstring>
 #include <string>
+#include <utility>
 
 #include "fovea/renderer/scene_io.hpp"
 #include "gpu_fixture.hpp"
@@ -117,4 +118,29 @@ TEST_F(GpuTest, FramePipelineIsDeterministicWithoutDenoiserAlternating) {
   s.share = reconstruct::StereoShare::Alternate;
   s.blur = false;
   check_determinism(ctx(), "stereo-occluders", s);
+}
+
+// The trace order the pipeline picks (tiles for polar grids, grid order for Cartesian ones)
+// and the other one give bit-identical buffers and images: the cell keys everything.
+TEST_F(GpuTest, FramePipelineTraceOrderChangesNoBufferOrImage) {
+  const renderer::Scene scene = renderer::load_scene("default");
+  renderer::GpuScene gs(ctx(), scene);
+  const core::DisplayPreset display = fovea::test::display_of_size(40, 44);
+  const auto poses = core::eye_poses(scene.camera, display.ipd_m);
+  reconstruct::ReconSettings settings;
+  settings.share = reconstruct::StereoShare::Gather;
+  for (const auto& [kind, picked] : {std::pair{core::DistributionKind::VisualPolar, renderer::TraceOrder::Tiles},
+                                    std::pair{core::DistributionKind::Cartesian, renderer::TraceOrder::Grid}}) {
+    core::DistributionParams dp;
+    dp.kind = kind;
+    pipeline::FramePipeline a(ctx(), gs, core::stereo_views(display), dp, settings);
+    ASSERT_EQ(pipeline::testing::trace_order(a, core::Eye::Right), picked) << core::distribution_name(kind);
+    const Snapshot own = render_sequence(a, poses);
+    pipeline::FramePipeline b(ctx(), gs, core::stereo_views(display), dp, settings);
+    const renderer::TraceOrder other =
+        picked == renderer::TraceOrder::Tiles ? renderer::TraceOrder::Grid : renderer::TraceOrder::Tiles;
+    pipeline::testing::set_trace_order(b, other);
+    ASSERT_EQ(pipeline::testing::trace_order(b, core::Eye::Left), other);
+    expect_identical(own, render_sequence(b, poses), core::distribution_name(kind));
+  }
 }

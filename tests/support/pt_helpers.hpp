@@ -15,15 +15,17 @@ struct Traced {
   std::vector<glm::vec4> radiance, direct, indirect, albedo, normal_depth, position_material;
 };
 
-// `frames` frames of config.spp samples each, averaged on the GPU in one submission.
+// `frames` frames of config.spp samples each, averaged on the GPU in one submission. The grid
+// is bound with `extent` when given (columns > 0; needed by the tile order), else by its size.
 inline Traced trace_grid(gpu::Context& ctx, const renderer::GpuScene& scene,
                          const std::vector<shaders::GridSample>& grid, const core::View& view, core::Eye eye,
-                         const renderer::PathConfig& config, std::uint32_t frames = 1, std::uint32_t first_frame = 0) {
+                         const renderer::PathConfig& config, std::uint32_t frames = 1, std::uint32_t first_frame = 0,
+                         renderer::GridExtent extent = {}) {
   gpu::Buffer g(ctx, {grid.size() * sizeof(shaders::GridSample), gpu::BufferUsage::Storage, gpu::Memory::DeviceLocal,
                       "test.grid"});
   g.upload(grid);
   renderer::PathTracer pt(ctx, scene);
-  renderer::TraceOutputs out = pt.bind(g, std::uint32_t(grid.size()));
+  renderer::TraceOutputs out = extent.columns > 0 ? pt.bind(g, extent) : pt.bind(g, std::uint32_t(grid.size()));
   ctx.submit_and_wait([&](VkCommandBuffer cmd) {
     for (std::uint32_t f = 0; f < frames; ++f) {
       if (f) gpu::compute_to_compute(cmd);

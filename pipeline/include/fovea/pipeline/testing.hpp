@@ -30,6 +30,12 @@ std::vector<glm::vec4> grid_buffer(const FramePipeline& p, core::Eye e, GridBuff
 // no stage reads memory the frames since have not written.
 void fill_buffers(FramePipeline& p, std::uint32_t word);
 
+// The order in which the path tracer takes eye `e`'s cells: the one the pipeline picks for the
+// distribution, or the one set_trace_order forced. set_trace_order makes it take every
+// grid's cells in `order` from the next frame on; for tests and benchmarks of the order.
+renderer::TraceOrder trace_order(const FramePipeline& p, core::Eye e);
+void set_trace_order(FramePipeline& p, renderer::TraceOrder order);
+
 // Resolves a grid image given in the padded grid layout (premultiplied rgb, .w coverage)
 // with eye `e`'s current mapping, optionally blurred; for round-trip tests.
 core::Image resolve_grid(FramePipeline& p, core::Eye e, const std::vector<glm::vec4>& grid, bool blur);
@@ -67,5 +73,10 @@ struct ReconKernelTimes {
   KernelTime accumulate, share, fit, post, taa;
 };
 ReconKernelTimes time_reconstruct(FramePipeline& p, std::uint32_t frame);
+
+// Tracing the last frame's grids again, both eyes in one submission, with the cells taken in
+// `order`, with the pipeline's path configuration (both eyes trace indirect light); `frame`
+// keys the random numbers. For the trace-cost benchmark.
+KernelTime time_trace(FramePipeline& p, std::uint32_t frame, renderer::TraceOrder order);
 
 }  // namespace fovea::pipeline::testing

@@ -21,6 +21,14 @@
 
 namespace fovea::renderer {
 
+// How the invocations of a trace take the grid's cells. Every cell is traced by exactly one
+// invocation in either order, and its index keys the random numbers and the outputs, so the
+// outputs do not depend on the order (docs/renderer.md, "Trace order").
+enum class TraceOrder {
+  Grid,   // invocation n traces cell n: a SIMD vector runs along a row of the grid
+  Tiles,  // tiles of the grid, each SIMD vector down one column (pt_order.h); needs the grid's extents
+};
+
 // Default: the BMFR/P5 configuration (1 sample per cell, primary hit + NEE, one BSDF
 // bounce + NEE, MIS, no Russian roulette).
 struct PathConfig {
@@ -28,6 +36,12 @@ struct PathConfig {
   int max_bounces = 1;            // BSDF-sampled bounces after the primary hit; < 0: unlimited
   std::uint32_t rr_start = 1000;  // bounce from which Russian roulette applies (large: off)
   bool jitter = false;            // spread samples over the cell's footprint (anti-aliasing)
+  TraceOrder order = TraceOrder::Grid;
+};
+
+// A grid's padded extents: cell index = row * columns + column.
+struct GridExtent {
+  std::uint32_t columns = 0, rows = 0;
 };
 
 // Bounce limit and Russian roulette from the scene's albedo (docs/renderer.md), for
@@ -58,6 +72,7 @@ class TraceOutputs {
  private:
   friend class PathTracer;
   std::uint32_t cells_ = 0;
+  GridExtent extent_;  // zero when bound by cell count: grid order only
   gpu::Buffer direct_, indirect_, albedo_, normal_depth_, position_material_, radiance_;
   gpu::DescriptorSet set_;
 };
@@ -69,8 +84,11 @@ class PathTracer {
   PathTracer(gpu::Context& ctx, const GpuScene& scene);
   PathTracer(gpu::Context& ctx, const GpuScene& scene, const SceneFeatures& features);
 
-  // Output buffers for a grid of `cells` GridSample entries held in `grid`.
+  // Output buffers for a grid of `cells` GridSample entries held in `grid` (grid order
+  // only), or of `extent.columns * extent.rows` cells laid out row by row (either order;
+  // tile order needs extents that are whole tiles: core::SampleDistribution's padded ones).
   TraceOutputs bind(const gpu::Buffer& grid, std::uint32_t cells) const;
+  TraceOutputs bind(const gpu::Buffer& grid, GridExtent extent) const;
 
   // Records one frame (split into dispatches of at most kPtMaxSppPerDispatch samples).
   // `view` gives the eye pose (world) and the display raster used for jitter; `frame`

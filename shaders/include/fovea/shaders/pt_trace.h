@@ -27,6 +27,7 @@ FOVEA_CONST FOVEA_UINT kPtHardMaxBounces = 256;
 // flags
 FOVEA_CONST FOVEA_UINT kPtJitter = 1;      // jitter directions over the cell's footprint
 FOVEA_CONST FOVEA_UINT kPtAccumulate = 2;  // running mean with `accumulated_samples` earlier samples
+FOVEA_CONST FOVEA_UINT kPtTileOrder = 4;   // invocations take cells in tile order (pt_order.h)
 
 // Scene features, specialization constants of pt_trace.comp (constant_id): a variant
 // without texture fetches, GGX lobes or light sampling for scenes that do not need them.
@@ -52,7 +53,7 @@ struct PtFrameParams {
   FOVEA_UINT accumulated_samples;  // samples already averaged into the outputs (kPtAccumulate)
   float pixel_tx, pixel_ty;         // tangent-plane size of one display pixel (jitter scale)
   FOVEA_UINT sample_offset;         // index of this dispatch's first sample in the frame (RNG key)
-  FOVEA_UINT pad;
+  FOVEA_UINT columns;               // the grid's padded column count (kPtTileOrder)
 };
 
 #ifdef __cplusplus
