@@ -255,3 +255,62 @@ TEST_F(GpuTest, SaccadeRecoveryCurveOnTheDefaultScene) {
   }
 }
 
+
+// The same goal on the other shipped scenes, BMFR only (the denoiser whose restart window
+// sets the recovery; `none` has no spatial filter): from the third frame after the 40° jump
+// the fovea's sharpness within 10% of the fixed-gaze control. Below 0.9 passes only with a
+// fovea closer to a converged reference than the control's (tone-mapped PSNR and HDR-FLIP):
+// less gradient energy is then less noise, not blur (glossy-spheres: 0.78-0.82 with
+// +1.3 dB, the control's glossy highlights being the noisier). Scores are printed, not
+// bounded otherwise: 8 frames after the jump hold fewer samples than the control's history
+// (stereo-occluders stays 1.1-2.4 dB below it; docs/reconstruction.md).
+class SaccadeRecoveryPerScene : public GpuTest, public ::testing::WithParamInterface<const char*> {};
+
+TEST_P(SaccadeRecoveryPerScene, BmfrRecoversWithinThreeFrames) {
+  const renderer::Scene scene = renderer::load_scene(GetParam());
+  renderer::GpuScene gs(ctx(), scene);
+  core::DisplayPreset display = fovea::test::display_of_size(256, 288);
+  display.fov_left = display.fov_right = core::Fov::from_degrees(-30, 30, 33, -33);
+  const auto poses = core::eye_poses(scene.camera, display.ipd_m);
+  const glm::dvec3 target = gaze_at(kTarget), before = gaze_at(-kTarget);
+  const int settle = 10, after = 8;
+  renderer::PathConfig path;
+  path.spp = 4;
+  reconstruct::ReconSettings s;
+  s.denoiser = reconstruct::Denoiser::Bmfr;
+  pipeline::FramePipeline control(ctx(), gs, core::stereo_views(display), {}, s, path, true);
+  pipeline::FramePipeline jump(ctx(), gs, core::stereo_views(display), {}, s, path, true);
+  FoveaReference ref;
+  std::printf("%s, bmfr: sharpness / control [fovea PSNR dB, HDR-FLIP | the control's] per frame after the jump:",
+              GetParam());
+  for (int f = 0; f < settle + after; ++f) {
+    control.render(poses, {target, target}, std::uint32_t(f));
+    jump.render(poses, f < settle ? std::array{before, before} : std::array{target, target}, std::uint32_t(f));
+    if (ref.image.pixels.empty())  // the view holds the eye's pose once a frame was rendered
+      ref = fovea_reference(ctx(), gs, control.view(core::Eye::Left), target, 1024);
+    if (f < settle) continue;
+    const int k = f - settle + 1;  // frames since the jump
+    const double r = fovea_sharpness(jump.image(core::Eye::Left), jump.view(core::Eye::Left), target) /
+                     fovea_sharpness(control.image(core::Eye::Left), control.view(core::Eye::Left), target);
+    const core::Scores q = fovea_scores(jump.image(core::Eye::Left), ref);
+    const core::Scores qc = fovea_scores(control.image(core::Eye::Left), ref);
+    std::printf(" %.3f [%.2f %.3f | %.2f %.3f]", r, q.psnr, q.hdr_flip, qc.psnr, qc.hdr_flip);
+    ASSERT_TRUE(std::isfinite(r));
+    if (k >= 3) {
+      EXPECT_LE(r, 1.1) << GetParam() << ", frame " << k;
+      if (r < 0.9) {
+        EXPECT_GT(q.psnr, qc.psnr) << GetParam() << ", frame " << k << ": smoother than the control, not better";
+        EXPECT_LT(q.hdr_flip, qc.hdr_flip) << GetParam() << ", frame " << k << ": smoother than the control, not better";
+      }
+    }
+  }
+  std::printf("\n");
+}
+
+INSTANTIATE_TEST_SUITE_P(ShippedScenes, SaccadeRecoveryPerScene,
+                         ::testing::Values("cornell", "glossy-spheres", "stereo-occluders"),
+                         [](const auto& i) {
+                           std::string n = i.param;
+                           std::erase(n, '-');
+                           return n;
+                         });
