@@ -3,6 +3,7 @@
 // and the fovea is as sharp as with a fixed gaze within 3 frames (90 Hz-equivalent count).
 // Albedo detail is re-modulated from the current frame's samples (sharp whatever the
 // history), so the rejection is checked directly on the fovea's history count.
+#include <array>
 #include <cmath>
 
 #include "fovea/core/flip.hpp"
@@ -130,6 +131,23 @@ core::Scores fovea_scores(const core::Image& img, const FoveaReference& ref) {
   return core::pool(core::error_maps(img, ref.image, ref.ppd, 0.0, ref.valid), ref.weights);
 }
 
+// The recovery curves' setting: a shipped scene from its camera, 256×288 at 60°×66° (≈ 4 px/°
+// at the landing point), 4 samples per cell and frame, 10 frames before the jump, 8 after.
+struct CurveSetting {
+  static constexpr int settle = 10, after = 8;
+  renderer::Scene scene;
+  core::DisplayPreset display = fovea::test::display_of_size(256, 288);
+  std::array<core::Pose, 2> poses;
+  glm::dvec3 target = gaze_at(kTarget), before = gaze_at(-kTarget);
+  renderer::PathConfig path;
+
+  explicit CurveSetting(const char* name) : scene(renderer::load_scene(name)) {
+    display.fov_left = display.fov_right = core::Fov::from_degrees(-30, 30, 33, -33);
+    poses = core::eye_poses(scene.camera, display.ipd_m);
+    path.spp = 4;
+  }
+};
+
 }  // namespace
 
 TEST_F(GpuTest, FoveaIsSharpWithinThreeFramesAfterA40DegreeSaccade) {
@@ -189,41 +207,34 @@ TEST_F(GpuTest, FoveaIsSharpWithinThreeFramesAfterA40DegreeSaccade) {
 // 1.129 at the third frame, within 10% only from the fifth), and with BMFR as close to the
 // reference as the control from the second frame (the lower ratio is not blur).
 TEST_F(GpuTest, SaccadeRecoveryCurveOnTheDefaultScene) {
-  const renderer::Scene scene = renderer::load_scene("default");
-  renderer::GpuScene gs(ctx(), scene);
-  core::DisplayPreset display = fovea::test::display_of_size(256, 288);
-  display.fov_left = display.fov_right = core::Fov::from_degrees(-30, 30, 33, -33);
-  const auto poses = core::eye_poses(scene.camera, display.ipd_m);
-  const glm::dvec3 target = gaze_at(kTarget), before = gaze_at(-kTarget);
-  const int settle = 10, after = 8;
-  renderer::PathConfig path;
-  path.spp = 4;
+  const CurveSetting c("default");
+  renderer::GpuScene gs(ctx(), c.scene);
   FoveaReference ref;
   for (const auto denoiser : {reconstruct::Denoiser::None, reconstruct::Denoiser::Bmfr}) {
     reconstruct::ReconSettings s;
     s.denoiser = denoiser;
-    pipeline::FramePipeline control(ctx(), gs, core::stereo_views(display), {}, s, path, true);
-    std::vector<double> sharp(after);
-    std::vector<core::Scores> control_scores(after);
-    for (int f = 0; f < settle + after; ++f) {
-      control.render(poses, {target, target}, std::uint32_t(f));
+    pipeline::FramePipeline control(ctx(), gs, core::stereo_views(c.display), {}, s, c.path, true);
+    std::vector<double> sharp(c.after);
+    std::vector<core::Scores> control_scores(c.after);
+    for (int f = 0; f < c.settle + c.after; ++f) {
+      control.render(c.poses, {c.target, c.target}, std::uint32_t(f));
       if (ref.image.pixels.empty())  // the view holds the eye's pose once a frame was rendered
-        ref = fovea_reference(ctx(), gs, control.view(core::Eye::Left), target, 1024);
-      if (f >= settle) {
-        sharp[std::size_t(f - settle)] =
-            fovea_sharpness(control.image(core::Eye::Left), control.view(core::Eye::Left), target);
-        control_scores[std::size_t(f - settle)] = fovea_scores(control.image(core::Eye::Left), ref);
+        ref = fovea_reference(ctx(), gs, control.view(core::Eye::Left), c.target, 1024);
+      if (f >= c.settle) {
+        sharp[std::size_t(f - c.settle)] =
+            fovea_sharpness(control.image(core::Eye::Left), control.view(core::Eye::Left), c.target);
+        control_scores[std::size_t(f - c.settle)] = fovea_scores(control.image(core::Eye::Left), ref);
       }
     }
     for (const bool check : {true, false}) {
       if (!check) s.coarse_keep = s.coarse_reject = 1e9f;
-      pipeline::FramePipeline jump(ctx(), gs, core::stereo_views(display), {}, s, path, true);
-      for (int f = 0; f < settle; ++f) jump.render(poses, {before, before}, std::uint32_t(f));
+      pipeline::FramePipeline jump(ctx(), gs, core::stereo_views(c.display), {}, s, c.path, true);
+      for (int f = 0; f < c.settle; ++f) jump.render(c.poses, {c.before, c.before}, std::uint32_t(f));
       std::printf("%s, cell-size test %s: sharpness / control (history) per frame after the jump:",
                   reconstruct::denoiser_name(denoiser), check ? "on" : "off");
-      for (int f = 0; f < after; ++f) {
-        jump.render(poses, {target, target}, std::uint32_t(settle + f));
-        const double r = fovea_sharpness(jump.image(core::Eye::Left), jump.view(core::Eye::Left), target) /
+      for (int f = 0; f < c.after; ++f) {
+        jump.render(c.poses, {c.target, c.target}, std::uint32_t(c.settle + f));
+        const double r = fovea_sharpness(jump.image(core::Eye::Left), jump.view(core::Eye::Left), c.target) /
                          sharp[std::size_t(f)];
         const double count = fovea_history(jump);
         const core::Scores q = fovea_scores(jump.image(core::Eye::Left), ref);
@@ -267,31 +278,24 @@ TEST_F(GpuTest, SaccadeRecoveryCurveOnTheDefaultScene) {
 class SaccadeRecoveryPerScene : public GpuTest, public ::testing::WithParamInterface<const char*> {};
 
 TEST_P(SaccadeRecoveryPerScene, BmfrRecoversWithinThreeFrames) {
-  const renderer::Scene scene = renderer::load_scene(GetParam());
-  renderer::GpuScene gs(ctx(), scene);
-  core::DisplayPreset display = fovea::test::display_of_size(256, 288);
-  display.fov_left = display.fov_right = core::Fov::from_degrees(-30, 30, 33, -33);
-  const auto poses = core::eye_poses(scene.camera, display.ipd_m);
-  const glm::dvec3 target = gaze_at(kTarget), before = gaze_at(-kTarget);
-  const int settle = 10, after = 8;
-  renderer::PathConfig path;
-  path.spp = 4;
+  const CurveSetting c(GetParam());
+  renderer::GpuScene gs(ctx(), c.scene);
   reconstruct::ReconSettings s;
   s.denoiser = reconstruct::Denoiser::Bmfr;
-  pipeline::FramePipeline control(ctx(), gs, core::stereo_views(display), {}, s, path, true);
-  pipeline::FramePipeline jump(ctx(), gs, core::stereo_views(display), {}, s, path, true);
+  pipeline::FramePipeline control(ctx(), gs, core::stereo_views(c.display), {}, s, c.path, true);
+  pipeline::FramePipeline jump(ctx(), gs, core::stereo_views(c.display), {}, s, c.path, true);
   FoveaReference ref;
   std::printf("%s, bmfr: sharpness / control [fovea PSNR dB, HDR-FLIP | the control's] per frame after the jump:",
               GetParam());
-  for (int f = 0; f < settle + after; ++f) {
-    control.render(poses, {target, target}, std::uint32_t(f));
-    jump.render(poses, f < settle ? std::array{before, before} : std::array{target, target}, std::uint32_t(f));
+  for (int f = 0; f < c.settle + c.after; ++f) {
+    control.render(c.poses, {c.target, c.target}, std::uint32_t(f));
+    jump.render(c.poses, f < c.settle ? std::array{c.before, c.before} : std::array{c.target, c.target}, std::uint32_t(f));
     if (ref.image.pixels.empty())  // the view holds the eye's pose once a frame was rendered
-      ref = fovea_reference(ctx(), gs, control.view(core::Eye::Left), target, 1024);
-    if (f < settle) continue;
-    const int k = f - settle + 1;  // frames since the jump
-    const double r = fovea_sharpness(jump.image(core::Eye::Left), jump.view(core::Eye::Left), target) /
-                     fovea_sharpness(control.image(core::Eye::Left), control.view(core::Eye::Left), target);
+      ref = fovea_reference(ctx(), gs, control.view(core::Eye::Left), c.target, 1024);
+    if (f < c.settle) continue;
+    const int k = f - c.settle + 1;  // frames since the jump
+    const double r = fovea_sharpness(jump.image(core::Eye::Left), jump.view(core::Eye::Left), c.target) /
+                     fovea_sharpness(control.image(core::Eye::Left), control.view(core::Eye::Left), c.target);
     const core::Scores q = fovea_scores(jump.image(core::Eye::Left), ref);
     const core::Scores qc = fovea_scores(control.image(core::Eye::Left), ref);
     std::printf(" %.3f [%.2f %.3f | %.2f %.3f]", r, q.psnr, q.hdr_flip, qc.psnr, qc.hdr_flip);
