@@ -7,9 +7,11 @@
 #define FOVEA_UINT std::uint32_t
 #define FOVEA_INT std::int32_t
 #define FOVEA_CONST constexpr
+#define FOVEA_FN inline  // a function shared by C++ and GLSL
 #else
 #define FOVEA_UINT uint
 #define FOVEA_INT int
 #define FOVEA_CONST const
+#define FOVEA_FN
 #endif
 #endif

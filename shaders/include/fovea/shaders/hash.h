@@ -6,9 +6,6 @@
 
 #ifdef __cplusplus
 namespace fovea::shaders {
-#define FOVEA_FN inline
-#else
-#define FOVEA_FN
 #endif
 
 // A 32-bit avalanche mix (xor-shift / multiply rounds).
@@ -29,5 +26,4 @@ FOVEA_FN float hash_to_unit(FOVEA_UINT h) { return float(h >> 8) * (1.0f / 16777
 #ifdef __cplusplus
 }  // namespace fovea::shaders
 #endif
-#undef FOVEA_FN
 #endif

@@ -17,9 +17,6 @@
 
 #ifdef __cplusplus
 namespace fovea::shaders {
-#define FOVEA_FN inline
-#else
-#define FOVEA_FN
 #endif
 
 FOVEA_CONST FOVEA_UINT kPtTileRows = 8u;     // one 8-lane vector down a column
@@ -38,5 +35,4 @@ FOVEA_FN FOVEA_UINT pt_tile_cell(FOVEA_UINT n, FOVEA_UINT columns) {
 #ifdef __cplusplus
 }  // namespace fovea::shaders
 #endif
-#undef FOVEA_FN
 #endif
