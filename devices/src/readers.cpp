@@ -1,4 +1,5 @@
 // Streaming readers for recorded gaze. Coordinate conventions per format: docs/gaze.md.
+#include "fovea/core/json.hpp"
 #include "fovea/devices/readers.hpp"
 
 #include <zlib.h>
@@ -234,7 +235,7 @@ class FoveaReader final : public ReaderBase {
       const std::string text = core::read_file_bounded(side_path, 1 << 20);
       core::check_json_nesting(text, side_path, 64);
       try {
-        meta_ = nlohmann::json::parse(text).dump();
+        meta_ = core::parse_json(text).dump();
       } catch (const nlohmann::json::exception& e) {
         throw core::InputError(path + ".json: invalid JSON sidecar: " + e.what());
       }
@@ -521,7 +522,7 @@ class TobiiG3Reader final : public ReaderBase {
   bool parse(const Line& l, GazeSample& out) override {
     nlohmann::json j;
     try {
-      j = nlohmann::json::parse(l.text);
+      j = core::parse_json(l.text);
     } catch (const nlohmann::json::exception&) {
       drop("bad_json");
       return false;
@@ -734,7 +735,7 @@ FoveaCsvWriter::FoveaCsvWriter(const std::string& path, const std::string& metad
 void FoveaCsvWriter::set_metadata(const std::string& metadata_json) {
   nlohmann::json meta;
   try {
-    meta = nlohmann::json::parse(metadata_json.empty() ? "{}" : metadata_json);
+    meta = core::parse_json(metadata_json.empty() ? "{}" : metadata_json);
   } catch (const nlohmann::json::exception& e) {
     throw std::logic_error(std::string("gaze writer metadata: ") + e.what());
   }

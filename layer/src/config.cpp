@@ -8,6 +8,7 @@
 
 #include "fovea/core/error.hpp"
 #include "fovea/core/input_limits.hpp"
+#include "fovea/core/json.hpp"
 
 namespace fovea::layer {
 namespace {
@@ -100,7 +101,7 @@ const char* composite_name(Composite c) {
 LayerConfig parse_config(const std::string& text, const std::string& origin, const std::string& application) {
   nlohmann::json j;
   try {
-    j = nlohmann::json::parse(text);
+    j = core::parse_json(text);
   } catch (const nlohmann::json::exception& e) {
     throw core::InputError(origin + ": not valid JSON: " + e.what());
   }

@@ -30,6 +30,8 @@
 #include "xr_fixture.hpp"
 #include "xr_process.hpp"
 
+#include "fovea/core/json.hpp"
+
 namespace fovea::test {
 namespace {
 
@@ -68,7 +70,7 @@ std::vector<nlohmann::json> records(const std::string& file) {
   std::vector<nlohmann::json> out;
   std::ifstream in(file);
   for (std::string line; std::getline(in, line);)
-    if (!line.empty()) out.push_back(nlohmann::json::parse(line));
+    if (!line.empty()) out.push_back(fovea::core::parse_json(line));
   return out;
 }
 

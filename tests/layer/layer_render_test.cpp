@@ -11,6 +11,7 @@
 #include <nlohmann/json.hpp>
 
 #include "fovea/core/image.hpp"
+#include "fovea/core/json.hpp"
 #include "xr_fixture.hpp"
 #include "xr_process.hpp"
 
@@ -25,7 +26,7 @@ constexpr int kFrames = 4;
 
 // The tiny preset's optics at a raster where hello_xr's cubes cover a few hundred pixels.
 std::string write_display(const std::string& dir) {
-  auto j = nlohmann::json::parse(read_text(std::string(std::getenv("FOVEA_SOURCE_DIR")) + "/data/displays/tiny.json"));
+  auto j = fovea::core::parse_json(read_text(std::string(std::getenv("FOVEA_SOURCE_DIR")) + "/data/displays/tiny.json"));
   j["name"] = "layer-test";
   j["width"] = 128;
   j["height"] = 144;
@@ -95,7 +96,7 @@ TEST(LayerRender, HelloXrCubesCompositedOverThePathTracedScene) {
     std::ifstream in(both.path() + "/layer_timing.jsonl");
     int n = 0, replaced = 0, with_gaze = 0;
     for (std::string line; std::getline(in, line); ++n) {
-      const auto j = nlohmann::json::parse(line);
+      const auto j = fovea::core::parse_json(line);
       // hello_xr submits no layers before the session is visible (after the first frame).
       if (j["projection_views"].get<int>() != 2) continue;
       EXPECT_TRUE(j["replaced"].get<bool>()) << line;

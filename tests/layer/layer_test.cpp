@@ -12,6 +12,8 @@
 #include "xr_fixture.hpp"
 #include "xr_process.hpp"
 
+#include "fovea/core/json.hpp"
+
 namespace fovea::test {
 namespace {
 
@@ -73,7 +75,7 @@ TEST(Layer, PassThroughIsByteIdentical) {
   std::ifstream in(with.path() + "/layer_timing.jsonl");
   std::string line;
   for (int i = 0; std::getline(in, line); ++i) {
-    const auto j = nlohmann::json::parse(line);
+    const auto j = fovea::core::parse_json(line);
     EXPECT_EQ(j["frame"].get<int>(), i);
     EXPECT_FALSE(j["replaced"].get<bool>());
     EXPECT_GE(j["end_return_ns"].get<std::int64_t>(), j["end_call_ns"].get<std::int64_t>());

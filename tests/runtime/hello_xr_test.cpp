@@ -8,6 +8,7 @@
 #include <nlohmann/json.hpp>
 
 #include "fovea/core/image.hpp"
+#include "fovea/core/json.hpp"
 #include "xr_process.hpp"
 
 namespace fovea::test {
@@ -19,7 +20,7 @@ constexpr int kPngEvery = 4;
 std::vector<nlohmann::json> timing(const std::string& out) {
   std::vector<nlohmann::json> v;
   std::ifstream in(out + "/timing.jsonl");
-  for (std::string line; std::getline(in, line);) v.push_back(nlohmann::json::parse(line));
+  for (std::string line; std::getline(in, line);) v.push_back(fovea::core::parse_json(line));
   return v;
 }
 
@@ -204,7 +205,7 @@ TEST(HelloXr, MarkerOnThePanels) {
   ASSERT_EQ(frames.size(), size_t(kFrames));
   std::vector<nlohmann::json> events;
   std::ifstream in(dir.path() + "/marker.jsonl");
-  for (std::string line; std::getline(in, line);) events.push_back(nlohmann::json::parse(line));
+  for (std::string line; std::getline(in, line);) events.push_back(fovea::core::parse_json(line));
   ASSERT_EQ(events.size(), 2u);
   for (size_t i = 0; i < events.size(); ++i) {
     const std::int64_t f = events[i]["frame"].get<std::int64_t>();

@@ -4,6 +4,8 @@
 
 #include "xr_process.hpp"
 
+#include "fovea/core/json.hpp"
+
 namespace fovea::test {
 namespace {
 
@@ -16,7 +18,7 @@ TEST(XrInfo, ReportsRuntimeAndLayer) {
   ASSERT_EQ(r.exit_code, 0) << r.output;
   const auto json_start = r.output.find('{');
   ASSERT_NE(json_start, std::string::npos) << r.output;
-  const auto j = nlohmann::json::parse(r.output.substr(json_start, r.output.rfind('}') - json_start + 1));
+  const auto j = fovea::core::parse_json(r.output.substr(json_start, r.output.rfind('}') - json_start + 1));
   EXPECT_EQ(j["runtime_manifest"]["source"], "XR_RUNTIME_JSON");
   EXPECT_TRUE(j["runtime"]["loads"].get<bool>());
   EXPECT_TRUE(j["runtime"]["is_fovea"].get<bool>());

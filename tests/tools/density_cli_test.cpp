@@ -10,6 +10,7 @@
 #include "fovea/core/display.hpp"
 #include "fovea/core/distribution.hpp"
 #include "fovea/core/image.hpp"
+#include "fovea/core/json.hpp"
 
 using namespace fovea;
 using fovea::test::run_fovea;
@@ -22,7 +23,7 @@ TEST_P(DensityCli, JsonMatchesCpuModel) {
   const std::string dist = GetParam();
   const auto r = run_fovea("density --display small --eye right --gaze 0.3,0.6 --distribution " + dist + " --json");
   ASSERT_EQ(r.status, 0) << r.err;
-  const auto j = nlohmann::json::parse(r.out);
+  const auto j = fovea::core::parse_json(r.out);
 
   const core::View view = core::load_display("small").view(core::Eye::Right);
   core::DistributionParams p;
@@ -80,10 +81,10 @@ TEST(DensityCliOutput, WritesHeatMapAtomically) {
 TEST(DensityCliOutput, ExtremeGazesAreReported) {
   const auto off = run_fovea("density --display tiny --gaze 2,-1 --json");
   ASSERT_EQ(off.status, 0) << off.err;
-  EXPECT_TRUE(nlohmann::json::parse(off.out)["gaze"]["clamped"].get<bool>());
+  EXPECT_TRUE(fovea::core::parse_json(off.out)["gaze"]["clamped"].get<bool>());
   const auto nan = run_fovea("density --display tiny --gaze-dir nan,0,-1 --json");
   ASSERT_EQ(nan.status, 0) << nan.err;
-  EXPECT_TRUE(nlohmann::json::parse(nan.out)["gaze"]["fallback"].get<bool>());
+  EXPECT_TRUE(fovea::core::parse_json(nan.out)["gaze"]["fallback"].get<bool>());
 }
 
 TEST(DensityCliErrors, BadInputExitsWithTwo) {

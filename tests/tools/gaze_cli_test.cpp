@@ -10,6 +10,8 @@
 
 #include "cli.hpp"
 
+#include "fovea/core/json.hpp"
+
 using fovea::test::run_fovea;
 using fovea::test::temp_dir;
 
@@ -35,7 +37,7 @@ std::string shipped(const std::string& name) {
 TEST(GazeCli, InfoListsEventsAndDataQualityAndTakesUriKeys) {
   const auto r = run_fovea("gaze info --events 'replay:" + shipped("default.csv") + "?filters=ivt'");
   ASSERT_EQ(r.status, 0) << r.err;
-  const auto j = nlohmann::json::parse(r.out);
+  const auto j = fovea::core::parse_json(r.out);
   ASSERT_GT(j["events"].size(), 10u);
   std::size_t saccades = 0;
   std::int64_t last = -1;
@@ -66,7 +68,7 @@ TEST(GazeCli, ConvertKeepsTheTimeBaseAndTheMessages) {
                                 "MSG\t5004 target \"A\", onset\n5006\t961.0\t541.0\t1000.0\n");
   const auto r = run_fovea("gaze convert " + asc + " " + dir + "/out.csv --screen 1920x1080@531x299mm@700mm");
   ASSERT_EQ(r.status, 0) << r.err;
-  const auto side = nlohmann::json::parse(slurp(dir + "/out.csv.json"));
+  const auto side = fovea::core::parse_json(slurp(dir + "/out.csv.json"));
   EXPECT_EQ(side["time_base"]["t0_device_time_ns"], 5'002'000'000);
   EXPECT_NEAR(side["screen"]["hfov_deg"].get<double>(), 41.55, 0.01);
   EXPECT_EQ(slurp(dir + "/out.csv.events.csv"),
@@ -109,7 +111,7 @@ TEST(GazeCli, FuzzFindingsGiveExitTwoOrSaneOutput) {
                                                   "9000000000000000000,C,0,0,-1,1,1\n");
   const auto e = run_fovea("gaze info " + ext);
   ASSERT_EQ(e.status, 0) << e.err;
-  const auto ej = nlohmann::json::parse(e.out);
+  const auto ej = fovea::core::parse_json(e.out);
   EXPECT_GE(ej["duration_s"].get<double>(), 0);
   EXPECT_EQ(ej["dropped"]["time_overflow"], 1);
   // (7) one timestamp byte of the shipped capture changed to 2^62 µs: no negative t_ns.

@@ -9,6 +9,8 @@
 
 #include "cli.hpp"
 
+#include "fovea/core/json.hpp"
+
 using fovea::test::run_fovea;
 
 namespace {
@@ -20,7 +22,7 @@ TEST(LatencyCli, SimulationThenItsRecords) {
   const auto r = run_fovea("latency --display tiny --seconds 0.3 --render-time 8ms --inject-latency 0,60ms "
                            "--quality-frames 0 --quiet --out " + dir);
   ASSERT_EQ(r.status, 0) << r.err;
-  const auto j = nlohmann::json::parse(r.out);
+  const auto j = fovea::core::parse_json(r.out);
   EXPECT_EQ(j["mode"], "simulation");
   EXPECT_EQ(j["render_cost"]["source"], "fixed");
   EXPECT_EQ(j["render_cost"]["ms"]["median"].get<double>(), 8.0);
@@ -46,7 +48,7 @@ TEST(LatencyCli, SimulationThenItsRecords) {
   const std::string again = fovea::test::temp_dir("latency_records");
   const auto rec = run_fovea("latency --records " + dir + "/records.jsonl --out " + again);
   ASSERT_EQ(rec.status, 0) << rec.err;
-  const auto k = nlohmann::json::parse(rec.out);
+  const auto k = fovea::core::parse_json(rec.out);
   EXPECT_EQ(k["mode"], "records");
   EXPECT_EQ(k["clock"], "virtual");
   EXPECT_EQ(k["frames"], j["frames"]);
@@ -72,7 +74,7 @@ TEST(LatencyCli, QualityWhereTheUserLooksFallsWithInjectedLatency) {
                            "--quality-at 0,100 --quality-frames 4 --quality-radius 4 --reference-spp 16 "
                            "--reference-cache off --no-main-render --quiet --out " + dir + "/out");
   ASSERT_EQ(r.status, 0) << r.err;
-  const auto j = nlohmann::json::parse(r.out);
+  const auto j = fovea::core::parse_json(r.out);
   ASSERT_EQ(j["sweep"].size(), 3u);
   EXPECT_FALSE(j["sweep"][1].contains("fovea_quality"));  // not in --quality-at
   const auto& q0 = j["sweep"][0]["fovea_quality"];

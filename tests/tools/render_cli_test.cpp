@@ -11,6 +11,8 @@
 
 #include "cli.hpp"
 
+#include "fovea/core/json.hpp"
+
 using fovea::test::run_fovea;
 
 namespace {
@@ -33,7 +35,7 @@ TEST(RenderCli, ReportFramesAndExrOnTheTinyDisplay) {
   ASSERT_EQ(r.status, 0) << r.err;
   EXPECT_EQ(r.err.find("VUID"), std::string::npos) << "validation messages:\n" << r.err;
   std::ifstream in(dir + "/report.json");
-  const auto j = nlohmann::json::parse(in);
+  const auto j = fovea::core::parse_json(in);
   EXPECT_EQ(j["frames"], 3);
   EXPECT_GT(j["samples_traced_per_eye"].get<double>(), 0);
   EXPECT_LT(j["samples_traced_per_eye"].get<double>(), 64 * 72);  // foveated: fewer than the pixels
@@ -72,7 +74,7 @@ TEST(RenderCli, NoCullTracesTheHiddenArea) {
                              "--png-every 0 --denoiser none " + (cull ? "" : "--no-cull ") + "--out " + dir);
     ASSERT_EQ(r.status, 0) << r.err;
     std::ifstream in(dir + "/report.json");
-    const auto j = nlohmann::json::parse(in);
+    const auto j = fovea::core::parse_json(in);
     EXPECT_EQ(j["config"]["cull_hidden_area"].get<bool>(), cull == 1);
     for (const char* eye : {"left", "right"})
       EXPECT_EQ(j["samples_hidden"][eye].get<std::int64_t>() > 0, cull == 1) << eye;

@@ -14,6 +14,8 @@
 
 #include "cli.hpp"
 
+#include "fovea/core/json.hpp"
+
 namespace {
 
 namespace fs = std::filesystem;
@@ -22,7 +24,7 @@ using nlohmann::json;
 
 json read_json(const std::string& path) {
   std::ifstream in(path);
-  return json::parse(in);
+  return fovea::core::parse_json(in);
 }
 
 // A gaze recording that never moves: the scene, head and gaze are still.
@@ -132,7 +134,7 @@ TEST(ReferenceCache, SecondRunReadsTheCacheAndASceneByteChangesTheKey) {
     const auto r = run_fovea("reference --display tiny --scene " + scene + " --spp 4 --batch 2 --quiet --reference-cache " +
                              dir + "/cache --out " + dir + "/" + out);
     EXPECT_EQ(r.status, 0) << r.err;
-    return json::parse(r.out);
+    return fovea::core::parse_json(r.out);
   };
   const json first = reference("a.exr"), second = reference("b.exr");
   EXPECT_FALSE(first["cached"].get<bool>());
@@ -150,7 +152,7 @@ TEST(ReferenceCache, SecondRunReadsTheCacheAndASceneByteChangesTheKey) {
   const auto r = run_fovea("reference --display tiny --scene " + scene + " --spp 4 --batch 2 --bounces 1 --quiet " +
                            "--reference-cache " + dir + "/cache --out " + dir + "/d.exr");
   ASSERT_EQ(r.status, 0) << r.err;
-  EXPECT_NE(json::parse(r.out)["key"], changed["key"]);
+  EXPECT_NE(fovea::core::parse_json(r.out)["key"], changed["key"]);
   fs::remove_all(dir);
 }
 
@@ -163,7 +165,7 @@ TEST(ReferenceCache, RenderAndReferenceCommandsReuseEachOthersEntries) {
     const auto r = run_fovea("reference --display tiny --scene cornell --eye " + eye + " --spp 8 --quiet" + extra + cache +
                              " --out " + dir + "/" + eye + ".exr");
     EXPECT_EQ(r.status, 0) << r.err;
-    return json::parse(r.out);
+    return fovea::core::parse_json(r.out);
   };
   const json left = reference("left", "");
   EXPECT_FALSE(left["cached"].get<bool>());
@@ -196,7 +198,7 @@ TEST(ReferenceCache, DamagedEntriesAreReportedAndRenderedAgain) {
                            "/cache --out " + dir + "/out.exr";
   const auto first = run_fovea(args);
   ASSERT_EQ(first.status, 0) << first.err;
-  const json made = json::parse(first.out);
+  const json made = fovea::core::parse_json(first.out);
   const std::string entry = dir + "/cache/" + made["key"].get<std::string>();
   const auto damage = [&](const std::string& file, const std::string& bytes) {
     std::ofstream(file, std::ios::binary | std::ios::trunc) << bytes;
@@ -204,13 +206,13 @@ TEST(ReferenceCache, DamagedEntriesAreReportedAndRenderedAgain) {
     EXPECT_EQ(r.status, 0) << file << ": " << r.err;
     EXPECT_NE(r.err.find("damaged reference cache entry"), std::string::npos) << file << ": " << r.err;
     EXPECT_NE(r.err.find(made["key"].get<std::string>()), std::string::npos) << r.err;
-    const json j = json::parse(r.out);
+    const json j = fovea::core::parse_json(r.out);
     EXPECT_FALSE(j["cached"].get<bool>()) << file;
     EXPECT_EQ(j["key"], made["key"]);
     EXPECT_EQ(j["mean_rgb"], made["mean_rgb"]) << "the same seeds render the same reference";
     // Replaced: the next run reads it without complaint.
     const auto again = run_fovea(args);
-    EXPECT_TRUE(json::parse(again.out)["cached"].get<bool>()) << file << ": " << again.err;
+    EXPECT_TRUE(fovea::core::parse_json(again.out)["cached"].get<bool>()) << file << ": " << again.err;
     EXPECT_EQ(again.err.find("damaged"), std::string::npos) << again.err;
   };
   damage(entry + ".exr", "not an image");
@@ -341,7 +343,7 @@ TEST(ReferenceCache, TheWindowIsPartOfTheKeyAndOnlyTheWholeViewServesWindows) {
     const auto r = run_fovea("reference --display tiny --scene cornell --spp 4 --quiet --reference-cache " + dir +
                              "/cache --out " + dir + "/" + out + (window.empty() ? "" : " --window '" + window + "'"));
     EXPECT_EQ(r.status, 0) << window << ": " << r.err;
-    return json::parse(r.out);
+    return fovea::core::parse_json(r.out);
   };
   const json a = reference("a.exr", "0,0,-1@30");
   EXPECT_FALSE(a["cached"].get<bool>());

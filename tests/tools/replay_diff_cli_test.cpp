@@ -10,6 +10,8 @@
 
 #include "cli.hpp"
 
+#include "fovea/core/json.hpp"
+
 using fovea::test::run_fovea;
 using fovea::test::temp_dir;
 namespace fs = std::filesystem;
@@ -23,7 +25,7 @@ TEST(ReplayDiffCli, TwoRunsAgreeAndChangesAreFound) {
   std::string line;
   std::size_t frames = 0;
   while (std::getline(in, line)) {
-    const auto j = nlohmann::json::parse(line);
+    const auto j = fovea::core::parse_json(line);
     EXPECT_EQ(j["frame"], frames);
     // The newest real sample behind the frame's fovea: measured at or before the frame's time.
     ASSERT_TRUE(j["gaze"]["sample_ns"].is_number()) << line;
@@ -41,7 +43,7 @@ TEST(ReplayDiffCli, TwoRunsAgreeAndChangesAreFound) {
     return t.str();
   };
   EXPECT_EQ(slurp(a + "/frames.jsonl"), slurp(b + "/frames.jsonl"));
-  const auto times = nlohmann::json::parse(slurp(a + "/frame_times.jsonl").substr(0, slurp(a + "/frame_times.jsonl").find('\n')));
+  const auto times = fovea::core::parse_json(slurp(a + "/frame_times.jsonl").substr(0, slurp(a + "/frame_times.jsonl").find('\n')));
   EXPECT_EQ(times["frame"], 0);
   EXPECT_EQ(times["schema"], "fovea-timing");
   EXPECT_TRUE(times["gpu_ms"].contains("trace"));
@@ -49,7 +51,7 @@ TEST(ReplayDiffCli, TwoRunsAgreeAndChangesAreFound) {
 
   const auto same = run_fovea("replay-diff --json " + a + " " + b);
   ASSERT_EQ(same.status, 0) << same.out << same.err;
-  EXPECT_EQ(nlohmann::json::parse(same.out)["images"].size(), 6u);
+  EXPECT_EQ(fovea::core::parse_json(same.out)["images"].size(), 6u);
 
   // The gaze of frame 1 turned by ~0.06°: found; accepted with a looser tolerance.
   std::ifstream fin(b + "/frames.jsonl");
@@ -57,7 +59,7 @@ TEST(ReplayDiffCli, TwoRunsAgreeAndChangesAreFound) {
   ss << fin.rdbuf();
   std::vector<std::string> lines;
   for (std::string l; std::getline(ss, l);) lines.push_back(l);
-  auto j = nlohmann::json::parse(lines[1]);
+  auto j = fovea::core::parse_json(lines[1]);
   auto& d = j["used_gaze"]["left"];
   d[0] = d[0].get<double>() + 1e-3;
   lines[1] = j.dump();

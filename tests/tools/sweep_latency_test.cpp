@@ -11,6 +11,7 @@
 #include "cli.hpp"
 #include "fovea/core/error.hpp"
 #include "fovea/core/image.hpp"
+#include "fovea/core/json.hpp"
 #include "sweep/plan.hpp"
 #include "sweep/report.hpp"
 
@@ -27,12 +28,12 @@ CommandOptions options() {
 }
 
 json latency_part() {
-  return json::parse(R"({"command": "latency", "scenes": "default", "displays": "tiny", "seconds": 1,
+  return fovea::core::parse_json(R"({"command": "latency", "scenes": "default", "displays": "tiny", "seconds": 1,
                          "tracker-delay": ["0ms", "20ms", "40ms"], "predict": ["none", "landing"]})");
 }
 
 TEST(SweepLatency, PlanExpandsLatencyJobsWithStableIds) {
-  const json file = json::array({json::parse(R"({"scenes": "default", "displays": "tiny", "distribution": ["a", "b"]})"),
+  const json file = json::array({fovea::core::parse_json(R"({"scenes": "default", "displays": "tiny", "distribution": ["a", "b"]})"),
                                  latency_part()});
   const Plan p = expand_sweep(file, "s.json", options());
   ASSERT_EQ(p.jobs.size(), 2u + 3u * 2u);
@@ -98,14 +99,14 @@ TEST(SweepLatency, PlanRefusesKeysTheCommandDoesNotHave) {
   render_only["distribution"] = "cartesian-uniform";  // a render option, not a latency one
   EXPECT_NE(error(render_only).find("bad.json: key \"distribution\": unknown key"), std::string::npos) << error(render_only);
   EXPECT_NE(error(render_only).find("`fovea latency` option"), std::string::npos);
-  EXPECT_NE(error(json::parse(R"({"command": "replay"})")).find("key \"command\""), std::string::npos);
-  EXPECT_NE(error(json::parse(R"({"command": ["latency", "render"]})")).find("one command name"), std::string::npos);
+  EXPECT_NE(error(fovea::core::parse_json(R"({"command": "replay"})")).find("key \"command\""), std::string::npos);
+  EXPECT_NE(error(fovea::core::parse_json(R"({"command": ["latency", "render"]})")).find("one command name"), std::string::npos);
   // Through the program: the real `fovea latency --help` options.
   const std::string dir = test::temp_dir("sweep-latency-plan");
   core::write_file_atomic(dir + "/s.json", latency_part().dump());
   const auto ok = test::run_fovea("sweep plan " + dir + "/s.json --out " + dir + "/plan.jsonl");
   ASSERT_EQ(ok.status, 0) << ok.err;
-  EXPECT_EQ(json::parse(ok.out)["jobs"], 6);
+  EXPECT_EQ(fovea::core::parse_json(ok.out)["jobs"], 6);
   core::write_file_atomic(dir + "/bad.json", render_only.dump());
   const auto bad = test::run_fovea("sweep plan " + dir + "/bad.json --out " + dir + "/plan.jsonl");
   EXPECT_EQ(bad.status, 2);
@@ -138,7 +139,7 @@ TEST(SweepLatency, SummaryMetricsAreReadByKeyName) {
   s.erase("sweep");
   s.erase("fovea_quality");
   EXPECT_EQ(latency_metrics(s).count("fovea_quality.psnr_db"), 0u);
-  EXPECT_EQ(latency_metrics(json::parse(R"({"sweep": [1, {"inject_ms": "0"}]})")).size(), 0u);
+  EXPECT_EQ(latency_metrics(fovea::core::parse_json(R"({"sweep": [1, {"inject_ms": "0"}]})")).size(), 0u);
 }
 
 json render_report(double ms, double psnr) {
@@ -149,7 +150,7 @@ json render_report(double ms, double psnr) {
 TEST(SweepLatency, ReportDrawsLatencyAgainstQualityAndSectionsPerScene) {
   const std::string dir = test::temp_dir("sweep-latency-report");
   const json file = json::array(
-      {json::parse(R"({"scenes": ["cornell", "default"], "distribution": ["a", "b"], "budget": [0.2, 0.4],
+      {fovea::core::parse_json(R"({"scenes": ["cornell", "default"], "distribution": ["a", "b"], "budget": [0.2, 0.4],
                       "report": {"quality": ["fovea_psnr"], "section": "scene"}})"),
        latency_part()});
   const Plan plan = expand_sweep(file, "synthetic.json", options());
@@ -231,7 +232,7 @@ TEST(SweepLatency, ReportDrawsLatencyAgainstQualityAndSectionsPerScene) {
 
   // Fronts per scene and group; the page has a section per scene and the latency section.
   std::ifstream in(dir + "/report/results.json");
-  const json j = json::parse(in);
+  const json j = fovea::core::parse_json(in);
   for (const char* key : {"cornell/a", "cornell/b", "default/a", "default/b"})
     EXPECT_EQ(j["pareto"]["fovea_psnr"][key].size(), 2u) << key;
   std::ifstream page_in(dir + "/page.md");

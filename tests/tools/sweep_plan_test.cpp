@@ -8,6 +8,7 @@
 #include "cli.hpp"
 #include "fovea/core/error.hpp"
 #include "fovea/core/image.hpp"
+#include "fovea/core/json.hpp"
 #include "sweep/plan.hpp"
 
 namespace fovea::sweep {
@@ -22,7 +23,7 @@ std::vector<RenderOption> options() {
 }
 
 json sweep_file() {
-  return json::parse(R"({"scenes": ["cornell", "default"], "displays": "tiny", "frames": 2,
+  return fovea::core::parse_json(R"({"scenes": ["cornell", "default"], "displays": "tiny", "frames": 2,
     "distribution": ["visual-polar", "cartesian", "log-polar"], "budget": {"from": 0.1, "to": 0.3, "step": 0.1},
     "reference": 16, "no-blur": [true, false]})");
 }
@@ -32,7 +33,7 @@ TEST(SweepPlan, FnvMatchesPublishedVectors) {
   EXPECT_EQ(fnv1a64("a"), 0xaf63dc4c8601ec8cULL);
   EXPECT_EQ(fnv1a64("foobar"), 0x85944171f73967e8ULL);
   // Computed independently (Python) over the compact dump {"a":"x","b":1}.
-  EXPECT_EQ(settings_id(json::parse(R"({"b": 1, "a": "x"})")), "1fc46df94e7ae50d");
+  EXPECT_EQ(settings_id(fovea::core::parse_json(R"({"b": 1, "a": "x"})")), "1fc46df94e7ae50d");
 }
 
 TEST(SweepPlan, ExpandsEveryCombinationWithStableIds) {
@@ -99,7 +100,7 @@ TEST(SweepPlan, ReferencesAreSharedPerSceneAndDisplay) {
 
 // A list of sweeps is their union: cartesian without budgets next to budgeted distributions.
 TEST(SweepPlan, AListOfSweepsIsTheirUnion) {
-  const json list = json::parse(R"([
+  const json list = fovea::core::parse_json(R"([
     {"scenes": "cornell", "distribution": ["visual-polar", "log-polar"], "budget": [0.2, 0.3], "reference": 8,
      "report": {"group": "distribution"}},
     {"scenes": "cornell", "distribution": "cartesian", "reference": 8},
@@ -111,7 +112,7 @@ TEST(SweepPlan, AListOfSweepsIsTheirUnion) {
   EXPECT_EQ(p.header["report"]["group"], "distribution");
   EXPECT_EQ(p.header["jobs"], 5);
   try {
-    expand_sweep(json::parse(R"([{"scenes": "cornell"}, {"budgett": 1}])"), "list.json", options());
+    expand_sweep(fovea::core::parse_json(R"([{"scenes": "cornell"}, {"budgett": 1}])"), "list.json", options());
     ADD_FAILURE() << "unknown key accepted";
   } catch (const core::InputError& e) {
     EXPECT_NE(std::string(e.what()).find("list.json[1]"), std::string::npos) << e.what();
@@ -122,7 +123,7 @@ TEST(SweepPlan, AListOfSweepsIsTheirUnion) {
 TEST(SweepPlan, RejectsBadSweepFilesNamingKeyAndFile) {
   auto error = [](const std::string& text) {
     try {
-      expand_sweep(json::parse(text), "bad.json", options());
+      expand_sweep(fovea::core::parse_json(text), "bad.json", options());
     } catch (const core::InputError& e) {
       return std::string(e.what());
     }
@@ -157,7 +158,7 @@ TEST(SweepPlan, PlanFileRoundTripsAndTheProgramUsesRenderOptions) {
                               "reference": 8, "stereo-share": "gather"})");
   const auto r = test::run_fovea("sweep plan " + dir + "/s.json --out " + dir + "/plan.jsonl");
   ASSERT_EQ(r.status, 0) << r.err;
-  EXPECT_EQ(json::parse(r.out)["jobs"], 4);
+  EXPECT_EQ(fovea::core::parse_json(r.out)["jobs"], 4);
   const Plan p = read_plan(dir + "/plan.jsonl");
   EXPECT_EQ(p.jobs.size(), 4u);
   EXPECT_EQ(p.shared.size(), 1u);

@@ -7,6 +7,7 @@
 
 #include "cli.hpp"
 #include "fovea/core/image.hpp"
+#include "fovea/core/json.hpp"
 #include "sweep/plan.hpp"
 #include "sweep/plot.hpp"
 #include "sweep/report.hpp"
@@ -64,7 +65,7 @@ TEST(SweepReport, ParetoFrontOfKnownPoints) {
 TEST(SweepReport, SyntheticSweepGivesKnownFrontsTablesAndPlots) {
   const std::string dir = test::temp_dir("sweep-report");
   const std::vector<RenderOption> opts = {{"distribution", true}, {"budget", true}, {"out", true}, {"quiet", false}};
-  const Plan plan = expand_sweep(json::parse(R"({"distribution": ["a", "b"], "budget": [0.1, 0.2, 0.3, 0.4, 0.5]})"),
+  const Plan plan = expand_sweep(fovea::core::parse_json(R"({"distribution": ["a", "b"], "budget": [0.1, 0.2, 0.3, 0.4, 0.5]})"),
                                  "synthetic.json", opts);
   ASSERT_EQ(plan.jobs.size(), 10u);
   // distribution a, budgets 0.1..0.5: (time, fovea_psnr) as in ParetoFrontOfKnownPoints.
@@ -91,7 +92,7 @@ TEST(SweepReport, SyntheticSweepGivesKnownFrontsTablesAndPlots) {
   ASSERT_EQ(r.status, 0) << r.err;
 
   std::ifstream in(dir + "/report/results.json");
-  const json j = json::parse(in);
+  const json j = fovea::core::parse_json(in);
   EXPECT_EQ(j["counts"]["done"], 8);
   EXPECT_EQ(j["counts"]["failed"], 1);
   EXPECT_EQ(j["counts"]["missing"], 1);

@@ -16,6 +16,7 @@
 
 #include "cli.hpp"
 #include "fovea/core/image.hpp"
+#include "fovea/core/json.hpp"
 #include "sweep/plan.hpp"
 
 namespace fovea::sweep {
@@ -96,7 +97,7 @@ TEST(SweepRun, KilledRunResumesWithOnlyTheUnfinishedJobs) {
 
   const auto r = test::run_fovea("sweep run " + plan + " --jobs 2 --dir " + dir);
   ASSERT_EQ(r.status, 0) << r.err;
-  const json s = json::parse(r.out);
+  const json s = fovea::core::parse_json(r.out);
   EXPECT_EQ(s["skipped"], before.size());
   EXPECT_EQ(s["ran"], all.size() - before.size());
   // Exactly the unfinished jobs ran, each once; the in-flight ones were redone.
@@ -113,7 +114,7 @@ TEST(SweepRun, KilledRunResumesWithOnlyTheUnfinishedJobs) {
   // A third run has nothing to do.
   const auto again = test::run_fovea("sweep run " + plan + " --dir " + dir);
   ASSERT_EQ(again.status, 0) << again.err;
-  EXPECT_EQ(json::parse(again.out)["ran"], 0);
+  EXPECT_EQ(fovea::core::parse_json(again.out)["ran"], 0);
   fs::remove_all(dir);
 }
 
@@ -140,7 +141,7 @@ TEST(SweepRun, ShardsRunEveryJobExactlyOnce) {
       r = test::run_fovea("sweep run " + plan + " --shard " + shard + " --dir " + dir);
     }
     ASSERT_EQ(r.status, 0) << r.err;
-    const json s = json::parse(r.out);
+    const json s = fovea::core::parse_json(r.out);
     EXPECT_EQ(s["shard"], shard);
     total += s["ran"].get<std::size_t>();
   }
@@ -156,10 +157,10 @@ TEST(SweepRun, FailedJobsAreRecordedAndRetried) {
   const std::string plan = write_plan(dir, jobs);
   auto r = test::run_fovea("sweep run " + plan + " --jobs 2 --dir " + dir);
   EXPECT_EQ(r.status, 1);
-  EXPECT_EQ(json::parse(r.out)["failed"], 1);
+  EXPECT_EQ(fovea::core::parse_json(r.out)["failed"], 1);
   std::ifstream in(dir + "/failed/" + jobs[1].id + ".json");
   ASSERT_TRUE(in);
-  const json f = json::parse(in);
+  const json f = fovea::core::parse_json(in);
   EXPECT_EQ(f["exit_code"], 3);
   EXPECT_NE(f["stderr_tail"].get<std::string>().find("boom-1"), std::string::npos);
   EXPECT_EQ(f["settings"]["n"], 1);
@@ -167,7 +168,7 @@ TEST(SweepRun, FailedJobsAreRecordedAndRetried) {
   // The next run skips the two good jobs and tries the failed one again.
   r = test::run_fovea("sweep run " + plan + " --dir " + dir);
   EXPECT_EQ(r.status, 1);
-  EXPECT_EQ(json::parse(r.out)["skipped"], 2);
+  EXPECT_EQ(fovea::core::parse_json(r.out)["skipped"], 2);
   EXPECT_EQ(lines(log).count(jobs[1].id), 2u);
   fs::remove_all(dir);
 }

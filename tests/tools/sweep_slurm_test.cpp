@@ -21,6 +21,7 @@
 #include "cli.hpp"
 #include "fovea/core/error.hpp"
 #include "fovea/core/image.hpp"
+#include "fovea/core/json.hpp"
 #include "sweep/slurm.hpp"
 
 namespace fovea::sweep {
@@ -72,7 +73,7 @@ TEST(SweepSlurm, ScriptsDescribeTheArrayAndTheMerge) {
 
 // Metrics and bands of every job in a report's results.json, timings removed.
 json numbers_without_timings(const fs::path& results) {
-  json j = json::parse(slurp(results));
+  json j = fovea::core::parse_json(slurp(results));
   json out = json::object();
   for (auto& row : j["jobs"]) {
     json m = json::object();
@@ -201,7 +202,7 @@ TEST(SweepSlurm, EndToEndOnARealOneNodeSlurmMatchesALocalRun) {
   }
   const auto sub = test::run_fovea("sweep slurm " + dir + "/slurm-run/plan.jsonl --shards 2 --cpus-per-task 1 --time 10 --submit");
   ASSERT_EQ(sub.status, 0) << sub.err;
-  const json ids = json::parse(sub.out);
+  const json ids = fovea::core::parse_json(sub.out);
   const std::string array = ids["array_job"], merge = ids["merge_job"];
 
   // Meanwhile the same plan locally.
@@ -222,8 +223,8 @@ TEST(SweepSlurm, EndToEndOnARealOneNodeSlurmMatchesALocalRun) {
       << state << "\narray: " << sh_out("scontrol -o show job " + array + " 2>&1") << "\nlogs: "
       << sh_out("cat " + dir + "/slurm-run/slurm/logs/* 2>&1");
   // Both array tasks ran a shard; the merge wrote the report.
-  const json a0 = json::parse(slurp(dir + "/slurm-run/slurm/logs/array_" + array + "_0.out"));
-  const json a1 = json::parse(slurp(dir + "/slurm-run/slurm/logs/array_" + array + "_1.out"));
+  const json a0 = fovea::core::parse_json(slurp(dir + "/slurm-run/slurm/logs/array_" + array + "_0.out"));
+  const json a1 = fovea::core::parse_json(slurp(dir + "/slurm-run/slurm/logs/array_" + array + "_1.out"));
   EXPECT_EQ(a0["shard"], "0/2");
   EXPECT_EQ(a1["shard"], "1/2");
   EXPECT_EQ(a0["ran"].get<int>() + a1["ran"].get<int>(), 2);

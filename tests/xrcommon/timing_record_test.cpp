@@ -11,6 +11,7 @@
 #include <nlohmann/json.hpp>
 
 #include "fovea/core/error.hpp"
+#include "fovea/core/json.hpp"
 #include "fovea/xrcommon/timing_writer.hpp"
 
 namespace fovea::xrcommon {
@@ -50,7 +51,7 @@ TEST(TimingRecord, JsonLineRoundTripsAndHasNoNonFiniteNumbers) {
   EXPECT_EQ(line.find("NaN"), std::string::npos);
   EXPECT_EQ(line.find("nan"), std::string::npos);
   EXPECT_EQ(line.find("inf"), std::string::npos);
-  const auto j = nlohmann::json::parse(line);
+  const auto j = fovea::core::parse_json(line);
   EXPECT_EQ(j["schema"], "fovea-timing");
   EXPECT_EQ(j["version"], kTimingVersion);
   EXPECT_EQ(j["clock"], "virtual");
@@ -67,7 +68,7 @@ TEST(TimingRecord, JsonLineRoundTripsAndHasNoNonFiniteNumbers) {
   EXPECT_EQ(*back.gaze_receive_ns - *back.gaze_sample_ns, 20'000'000);
   EXPECT_EQ(*back.head_pose_target_ns - *back.head_pose_ns, 19'000'000);
   // A version-1 line from before head_pose_target_ns still reads (the field is optional).
-  auto old = nlohmann::json::parse(line);
+  auto old = fovea::core::parse_json(line);
   old.erase("head_pose_target_ns");
   EXPECT_FALSE(parse_timing_record(old.dump(), "old.jsonl:1").head_pose_target_ns.has_value());
   EXPECT_EQ((*back.photon_ns)[1].end, 46);

@@ -21,6 +21,7 @@
 #include "fovea/core/error.hpp"
 #include "fovea/core/image.hpp"
 #include "fovea/core/flip.hpp"
+#include "fovea/core/json.hpp"
 #include "fovea/core/metrics.hpp"
 #include "fovea/devices/foveation_gaze.hpp"
 #include "fovea/devices/readers.hpp"
@@ -518,7 +519,7 @@ int run(std::vector<std::string> argv) {
                         {"key", ref.key},
                         {"cached", ref.from_cache},
                         {"seconds", ref.result.seconds},
-                        {"settings", nlohmann::json::parse(ref.identity).value("settings", nlohmann::json())},
+                        {"settings", core::parse_json(ref.identity).value("settings", nlohmann::json())},
                         {"window", window_json(ref.window)}};
       const core::HdrFlip range = core::hdr_flip_exposures(ref.result.image, ref.valid);
       ref_info[name]["hdr_flip_exposures"] = {{"start", range.start_exposure},

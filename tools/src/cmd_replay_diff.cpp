@@ -14,6 +14,7 @@
 #include "command.hpp"
 #include "fovea/core/error.hpp"
 #include "fovea/core/image.hpp"
+#include "fovea/core/json.hpp"
 #include "fovea/core/metrics.hpp"
 
 namespace fovea::tools {
@@ -40,7 +41,7 @@ std::vector<nlohmann::json> read_frames(const fs::path& dir) {
   for (std::size_t n = 1; std::getline(in, line); ++n) {
     if (line.empty()) continue;
     try {
-      out.push_back(nlohmann::json::parse(line));
+      out.push_back(core::parse_json(line));
     } catch (const nlohmann::json::exception& e) {
       throw core::InputError(p.string() + ":" + std::to_string(n) + ": invalid JSON: " + e.what());
     }

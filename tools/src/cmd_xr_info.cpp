@@ -18,6 +18,7 @@
 
 #include "command.hpp"
 #include "fovea/core/error.hpp"
+#include "fovea/core/json.hpp"
 
 namespace fovea::tools {
 namespace {
@@ -72,7 +73,7 @@ nlohmann::json active_runtime_manifest() {
     j["source"] = source;
     try {
       std::ifstream in(path);
-      const auto m = nlohmann::json::parse(in);
+      const auto m = core::parse_json(in);
       j["library_path"] = m.at("runtime").at("library_path");
       if (m["runtime"].contains("name")) j["name"] = m["runtime"]["name"];
     } catch (const std::exception& e) {

@@ -11,6 +11,7 @@
 
 #include "fovea/core/error.hpp"
 #include "fovea/core/image.hpp"
+#include "fovea/core/json.hpp"
 #include "fovea/shaders/embedded.hpp"
 #include "sweep/plan.hpp"
 
@@ -100,7 +101,7 @@ json read_json(const std::string& path) {
   std::ifstream in(path);
   if (!in) throw core::InputError(path + ": cannot open the reference description");
   try {
-    return json::parse(in);
+    return core::parse_json(in);
   } catch (const json::exception& e) {
     throw core::InputError(path + ": not a reference description (" + e.what() + ")");
   }
@@ -288,7 +289,7 @@ void write_reference(const std::string& exr, const CachedReference& ref) {
   const auto& r = ref.result;
   const json meta = {{"format", "fovea-reference"},
                      {"key", ref.key},
-                     {"identity", json::parse(ref.identity)},
+                     {"identity", core::parse_json(ref.identity)},
                      {"image", fs::path(exr).filename().string()},
                      {"spp", r.spp},
                      {"rel_error", r.rel_error},

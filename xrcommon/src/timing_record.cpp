@@ -1,3 +1,4 @@
+#include "fovea/core/json.hpp"
 #include "fovea/xrcommon/timing_record.hpp"
 
 #include <cmath>
@@ -107,7 +108,7 @@ std::string to_json_line(const TimingRecord& r) {
 TimingRecord parse_timing_record(std::string_view line, const std::string& where) {
   json j;
   try {
-    j = json::parse(line);
+    j = core::parse_json(line);
   } catch (const json::exception& e) {
     throw core::InputError(where + ": not JSON: " + e.what());
   }

@@ -10,6 +10,7 @@
 #include <sstream>
 
 #include "fovea/core/error.hpp"
+#include "fovea/core/json.hpp"
 
 namespace fovea::sweep {
 namespace {
@@ -287,7 +288,7 @@ Plan load_sweep_file(const std::string& path, const CommandOptions& options) {
   if (!in) throw InputError(path + ": cannot open the sweep file");
   json j;
   try {
-    j = json::parse(in);
+    j = core::parse_json(in);
   } catch (const json::parse_error& e) {
     throw InputError(path + ": not valid JSON (" + e.what() + ")");
   }
@@ -322,7 +323,7 @@ Plan read_plan(const std::string& path) {
     if (line.empty()) continue;
     const std::string ctx = path + ":" + std::to_string(n);
     try {
-      const json j = json::parse(line);
+      const json j = core::parse_json(line);
       const std::string type = j.at("type");
       if (type == "sweep") {
         plan.header = j;

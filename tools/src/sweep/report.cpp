@@ -11,6 +11,7 @@
 
 #include "fovea/core/error.hpp"
 #include "fovea/core/image.hpp"
+#include "fovea/core/json.hpp"
 #include "sweep/plot.hpp"
 
 namespace fovea::sweep {
@@ -553,7 +554,7 @@ ReportSummary write_report(const Plan& plan, const ReportOptions& o) {
       if (!in) throw core::InputError(rep.string() + ": finished job without " + rep.filename().string());
       json rj;
       try {
-        rj = json::parse(in);
+        rj = core::parse_json(in);
       } catch (const json::parse_error& e) {
         throw core::InputError(rep.string() + ": not valid JSON (" + e.what() + ")");
       }
@@ -565,14 +566,14 @@ ReportSummary write_report(const Plan& plan, const ReportOptions& o) {
       r.bands = band_metrics(rj);
       std::ifstream tin(dir / j.out / "task.json");
       if (tin) {
-        const json t = json::parse(tin, nullptr, false);
+        const json t = core::parse_json_or_discarded(tin);
         if (t.is_object() && t.contains("seconds") && t["seconds"].is_number()) r.metrics["wall_seconds"] = t["seconds"];
       }
       r.status = "done";
       ++sum.done;
     } else if (fs::exists(dir / "failed" / (j.id + ".json"))) {
       std::ifstream in(dir / "failed" / (j.id + ".json"));
-      const json f = json::parse(in, nullptr, false);
+      const json f = core::parse_json_or_discarded(in);
       failed.push_back(f.is_discarded() ? json{{"id", j.id}} : f);
       r.status = "failed";
       ++sum.failed;
