@@ -1,5 +1,4 @@
 // Streaming readers for recorded gaze. Coordinate conventions per format: docs/gaze.md.
-#include "fovea/core/json.hpp"
 #include "fovea/devices/readers.hpp"
 
 #include <zlib.h>
@@ -18,6 +17,7 @@
 #include "fovea/core/error.hpp"
 #include "fovea/core/input_limits.hpp"
 #include "fovea/core/image.hpp"
+#include "fovea/core/json.hpp"
 #include "line_reader.hpp"
 #include "text.hpp"
 

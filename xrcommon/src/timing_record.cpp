@@ -1,4 +1,3 @@
-#include "fovea/core/json.hpp"
 #include "fovea/xrcommon/timing_record.hpp"
 
 #include <cmath>
@@ -7,6 +6,7 @@
 #include <nlohmann/json.hpp>
 
 #include "fovea/core/error.hpp"
+#include "fovea/core/json.hpp"
 #include "fovea/core/view.hpp"
 
 namespace fovea::xrcommon {
