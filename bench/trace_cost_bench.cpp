@@ -64,7 +64,8 @@ Vectors vectors(const std::vector<fovea::shaders::GridSample>& grid, std::size_t
     glm::vec2 lo(1e30f), hi(-1e30f);
     int traced = 0, n = 0;
     for (std::size_t i = start; i < std::min(grid.size(), start + lanes); ++i, ++n) {
-      const auto& g = grid[order == fr::TraceOrder::Tiles ? fovea::shaders::pt_tile_cell(std::uint32_t(i), columns) : i];
+      const std::uint32_t cells = std::uint32_t(grid.size());
+      const auto& g = grid[order == fr::TraceOrder::Tiles ? fovea::shaders::pt_tile_cell(std::uint32_t(i), columns, cells) : i];
       if (g.flags != 0) continue;
       ++traced;
       lo = glm::min(lo, glm::vec2(g.screen_x, g.screen_y));

@@ -252,7 +252,7 @@ void main() {
   if (gl_GlobalInvocationID.x >= pc.cell_count) return;
   // The cell, not the invocation, keys the random numbers and the outputs: both orders give
   // the same buffers.
-  const uint idx = (pc.flags & kPtTileOrder) != 0u ? pt_tile_cell(gl_GlobalInvocationID.x, pc.columns)
+  const uint idx = (pc.flags & kPtTileOrder) != 0u ? pt_tile_cell(gl_GlobalInvocationID.x, pc.columns, pc.cell_count)
                                                    : gl_GlobalInvocationID.x;
   const GridSample g = cells[idx];
   const bool accumulate = (pc.flags & kPtAccumulate) != 0u && pc.accumulated_samples > 0u;
