@@ -60,11 +60,11 @@ Vectors vectors(const std::vector<fovea::shaders::GridSample>& grid, std::size_t
                 std::uint32_t columns) {
   Vectors v;
   double extent = 0;
+  const std::uint32_t cells = std::uint32_t(grid.size());
   for (std::size_t start = 0; start < grid.size(); start += lanes) {
     glm::vec2 lo(1e30f), hi(-1e30f);
     int traced = 0, n = 0;
     for (std::size_t i = start; i < std::min(grid.size(), start + lanes); ++i, ++n) {
-      const std::uint32_t cells = std::uint32_t(grid.size());
       const auto& g = grid[order == fr::TraceOrder::Tiles ? fovea::shaders::pt_tile_cell(std::uint32_t(i), columns, cells) : i];
       if (g.flags != 0) continue;
       ++traced;

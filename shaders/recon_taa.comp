@@ -25,8 +25,9 @@
 //   window's frame k (ḡ: g's mean over the cell), so the window's frames count about evenly
 //   and the albedo, re-modulated from each frame's jittered sample, converges to the cell
 //   centre's as with a fixed gaze. (With jitter off, g = 1, the newest frame weighs more;
-//   an even mean measured worse, the input already being Phase I's mean of the window.) The new fovea starts over with a few samples per cell
-//   against a fixed gaze's long history (docs/reconstruction.md, "Saccade recovery curve").
+//   an even mean measured worse, the input already being Phase I's mean of the window.)
+//   The new fovea starts over with a few samples per cell against a fixed gaze's long
+//   history (docs/reconstruction.md, "Saccade recovery curve").
 // .w = 1 marks cells holding a sample (the resolve renormalises over them).
 #extension GL_GOOGLE_include_directive : require
 

@@ -240,28 +240,28 @@ TEST(TraceOrder, EveryContiguousPartOfTheWorkgroupsTracesAnEqualShare) {
   namespace core = fovea::core;
   using fovea::shaders::pt_tile_cell;
   for (const char* display : {"small", "fove0"}) {
-  const core::View v = core::load_display(display).view(core::Eye::Left);
-  auto d = core::make_distribution(v, core::DistributionParams{});
-  d->set_frame(v.centre_dir());
-  const auto columns = std::uint32_t(d->padded_columns()), rows = std::uint32_t(d->padded_rows());
-  const std::uint32_t cells = columns * rows, workgroups = cells / 64;
-  std::vector<bool> traced(cells);
-  for (std::uint32_t i = 0; i < cells; ++i) traced[i] = d->sample(int(i % columns), int(i / columns)).flags == 0;
-  for (const std::uint32_t threads : {2u, 3u, 4u, 8u}) {
-    std::vector<double> share(threads, 0.0), row_major(threads, 0.0);
-    const std::uint32_t per = workgroups / threads;  // lp_cs_tpool.c's split (the remainder: one each, last)
-    for (std::uint32_t n = 0; n < per * threads * 64; ++n) {
-      const std::uint32_t part = n / 64 / per;
-      share[part] += traced[pt_tile_cell(n, columns, cells)];
-      const std::uint32_t tile = n / 64, lane = n % 64, across = columns / 8;  // tiles row by row
-      row_major[part] += traced[((tile / across) * 8 + lane % 8) * columns + (tile % across) * 8 + lane / 8];
+    const core::View v = core::load_display(display).view(core::Eye::Left);
+    auto d = core::make_distribution(v, core::DistributionParams{});
+    d->set_frame(v.centre_dir());
+    const auto columns = std::uint32_t(d->padded_columns()), rows = std::uint32_t(d->padded_rows());
+    const std::uint32_t cells = columns * rows, workgroups = cells / 64;
+    std::vector<bool> traced(cells);
+    for (std::uint32_t i = 0; i < cells; ++i) traced[i] = d->sample(int(i % columns), int(i / columns)).flags == 0;
+    for (const std::uint32_t threads : {2u, 3u, 4u, 8u}) {
+      std::vector<double> share(threads, 0.0), row_major(threads, 0.0);
+      const std::uint32_t per = workgroups / threads;  // lp_cs_tpool.c's split (the remainder: one each, last)
+      for (std::uint32_t n = 0; n < per * threads * 64; ++n) {
+        const std::uint32_t part = n / 64 / per;
+        share[part] += traced[pt_tile_cell(n, columns, cells)];
+        const std::uint32_t tile = n / 64, lane = n % 64, across = columns / 8;  // tiles row by row
+        row_major[part] += traced[((tile / across) * 8 + lane % 8) * columns + (tile % across) * 8 + lane / 8];
+      }
+      const auto [lo, hi] = std::minmax_element(share.begin(), share.end());
+      const auto [rlo, rhi] = std::minmax_element(row_major.begin(), row_major.end());
+      std::printf("%s, %u tiles, %u threads: traced cells per part, least / most: %.3f (tiles row by row: %.3f)\n",
+                  display, workgroups, threads, *lo / *hi, *rlo / *rhi);
+      EXPECT_GT(*lo / *hi, 0.85) << display << ", " << threads << " threads";  // row by row: 0.40-0.74
     }
-    const auto [lo, hi] = std::minmax_element(share.begin(), share.end());
-    const auto [rlo, rhi] = std::minmax_element(row_major.begin(), row_major.end());
-    std::printf("%s, %u tiles, %u threads: traced cells per part, least / most: %.3f (tiles row by row: %.3f)\n",
-                display, workgroups, threads, *lo / *hi, *rlo / *rhi);
-    EXPECT_GT(*lo / *hi, 0.85) << display << ", " << threads << " threads";  // row by row: 0.40-0.74
-  }
   }
 }
 

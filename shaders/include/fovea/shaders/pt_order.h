@@ -8,9 +8,9 @@
 // Visual-Polar grid those are 8 rings at the same row index, whose φ differ because each ring
 // has its own row count and arc start: on fove0 a vector's samples span 115 px of the display
 // on average. In tile order the grid is cut into tiles of kPtTileColumns × kPtTileRows cells,
-// one per 64-invocation workgroup (workgroups spread over the grid, below); inside a tile, invocation l
-// traces column l / kPtTileRows, row l % kPtTileRows, so a vector is 8 consecutive rows of one
-// column: 8 neighbours in φ at one radius (11.5 px on fove0).
+// one per 64-invocation workgroup (which workgroup takes which tile: below); inside a tile,
+// invocation l traces column l / kPtTileRows, row l % kPtTileRows, so a vector is 8
+// consecutive rows of one column: 8 neighbours in φ at one radius (11.5 px on fove0).
 #ifndef FOVEA_SHADERS_PT_ORDER_H
 #define FOVEA_SHADERS_PT_ORDER_H
 #include "fovea/shaders/common.h"
