@@ -65,7 +65,8 @@ Vectors vectors(const std::vector<fovea::shaders::GridSample>& grid, std::size_t
     glm::vec2 lo(1e30f), hi(-1e30f);
     int traced = 0, n = 0;
     for (std::size_t i = start; i < std::min(grid.size(), start + lanes); ++i, ++n) {
-      const auto& g = grid[order == fr::TraceOrder::Tiles ? fovea::shaders::pt_tile_cell(std::uint32_t(i), columns, cells) : i];
+      const auto cell = order == fr::TraceOrder::Tiles ? fovea::shaders::pt_tile_cell(std::uint32_t(i), columns, cells) : i;
+      const auto& g = grid[cell];
       if (g.flags != 0) continue;
       ++traced;
       lo = glm::min(lo, glm::vec2(g.screen_x, g.screen_y));

@@ -266,7 +266,6 @@ TEST_F(GpuTest, SaccadeRecoveryCurveOnTheDefaultScene) {
   }
 }
 
-
 // The same goal on the other shipped scenes, BMFR only (the denoiser whose restart window
 // sets the recovery; `none` has no spatial filter): from the third frame after the 40° jump
 // the fovea's sharpness within 10% of the fixed-gaze control. Below 0.9 passes only with a
@@ -289,7 +288,8 @@ TEST_P(SaccadeRecoveryPerScene, BmfrRecoversWithinThreeFrames) {
               GetParam());
   for (int f = 0; f < c.settle + c.after; ++f) {
     control.render(c.poses, {c.target, c.target}, std::uint32_t(f));
-    jump.render(c.poses, f < c.settle ? std::array{c.before, c.before} : std::array{c.target, c.target}, std::uint32_t(f));
+    const glm::dvec3 gaze = f < c.settle ? c.before : c.target;
+    jump.render(c.poses, {gaze, gaze}, std::uint32_t(f));
     if (ref.image.pixels.empty())  // the view holds the eye's pose once a frame was rendered
       ref = fovea_reference(ctx(), gs, control.view(core::Eye::Left), c.target, 1024);
     if (f < c.settle) continue;
@@ -304,7 +304,8 @@ TEST_P(SaccadeRecoveryPerScene, BmfrRecoversWithinThreeFrames) {
       EXPECT_LE(r, 1.1) << GetParam() << ", frame " << k;
       if (r < 0.9) {
         EXPECT_GT(q.psnr, qc.psnr) << GetParam() << ", frame " << k << ": smoother than the control, not better";
-        EXPECT_LT(q.hdr_flip, qc.hdr_flip) << GetParam() << ", frame " << k << ": smoother than the control, not better";
+        EXPECT_LT(q.hdr_flip, qc.hdr_flip)
+            << GetParam() << ", frame " << k << ": smoother than the control, not better";
       }
     }
   }

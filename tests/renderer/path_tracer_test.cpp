@@ -224,7 +224,8 @@ TEST(TraceOrder, TilesCoverEveryCellOnceWithVectorsDownOneColumn) {
       ASSERT_LT(c, columns * rows) << columns << "x" << rows << ", invocation " << n;
       ++hits[c];
       if (n % 8 != 0) {
-        ASSERT_EQ(c, pt_tile_cell(n - 1, columns, columns * rows) + columns) << columns << "x" << rows << ", invocation " << n;
+        ASSERT_EQ(c, pt_tile_cell(n - 1, columns, columns * rows) + columns)
+            << columns << "x" << rows << ", invocation " << n;
       }
     }
     EXPECT_EQ(std::count(hits.begin(), hits.end(), 1), std::ptrdiff_t(hits.size())) << columns << "x" << rows;
