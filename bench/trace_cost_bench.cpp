@@ -84,6 +84,10 @@ Vectors vectors(const std::vector<fovea::shaders::GridSample>& grid, std::size_t
 // The 1-minute load average (Linux), 0 where it cannot be read: printed next to each time.
 const char* order_name(fr::TraceOrder o) { return o == fr::TraceOrder::Tiles ? "tiles" : "grid"; }
 
+// Process CPU time over elapsed GPU time: how many of lavapipe's threads were busy on
+// average (2 when both work to the end of the dispatch).
+double threads_busy(const fp::testing::KernelTime& k) { return k.gpu_ms > 0 ? k.cpu_ms / k.gpu_ms : 0; }
+
 double load_average() {
   double load = 0;
   if (std::FILE* f = std::fopen("/proc/loadavg", "r")) {
@@ -164,11 +168,12 @@ int run(int argc, char** argv) {
       char row[640];
       std::snprintf(row, sizeof row,
                     "| %ld | %s | %.2f → %.2f | %.0f | %s | %.0f / %.0f | %s | %.0f / %.0f | %.3f / %.3f | %.0f | %.0f |"
-                    " %.0f | %.0f | %.0f | %.0f | %.0f | %.0f | %.2f |",
+                    " %.0f | %.0f | %.0f | %.2f / %.2f / %.2f / %.2f / %.2f | %.0f | %.0f | %.0f | %.2f |",
                     round + 1, c.name().c_str(), load0, load1, t.trace.gpu_ms, order_name(orders[0]), trace[0].gpu_ms,
                     trace[0].cpu_ms, order_name(orders[1]), trace[1].gpu_ms, trace[1].cpu_ms,
                     trace[1].gpu_ms / trace[0].gpu_ms, trace[1].cpu_ms / trace[0].cpu_ms, r.accumulate.gpu_ms,
-                    r.share.gpu_ms, r.fit.gpu_ms, r.post.gpu_ms, r.taa.gpu_ms, t.reconstruct.gpu_ms, t.resolve.gpu_ms,
+                    r.share.gpu_ms, r.fit.gpu_ms, r.post.gpu_ms, r.taa.gpu_ms, threads_busy(r.accumulate), threads_busy(r.share), threads_busy(r.fit),
+                    threads_busy(r.post), threads_busy(r.taa), t.reconstruct.gpu_ms, t.resolve.gpu_ms,
                     t.gpu_ms(), 1000.0 * t.trace.gpu_ms / double(traced));
       rows.emplace_back(row);
       std::fprintf(stderr, "%s\n", row);  // progress: a round of fove0 takes minutes under load
@@ -178,8 +183,9 @@ int run(int argc, char** argv) {
               " and in the other one (GPU / process CPU ms, mean of 2), the reconstruction kernels one submission each\n");
   std::printf("| round | configuration | load | trace (frame) | order picked | trace GPU / CPU | other order |"
               " trace GPU / CPU | other / picked, GPU / CPU | accumulate | share | BMFR fit | post | TAA |"
+              " CPU / GPU ms, accumulate / share / fit / post / TAA |"
               " reconstruct (frame) | resolve | frame | trace ms per 1000 samples |\n"
-              "|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|\n");
+              "|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|\n");
   for (const auto& row : rows) std::printf("%s\n", row.c_str());
   return 0;
 }

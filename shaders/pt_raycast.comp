@@ -9,8 +9,8 @@
 #include "fovea/shaders/pt_raycast.h"
 
 layout(local_size_x = 64) in;
-layout(std430, set = 0, binding = 0) readonly buffer Nodes { uvec4 nodes[]; };  // PtBvhNode: pt_node()
-layout(std430, set = 0, binding = 1) readonly buffer Tris { uvec4 tris[]; };    // PtTriangle: pt_tri()
+layout(set = 0, binding = 0) uniform usamplerBuffer nodes;  // PtBvhNode: pt_node()
+layout(set = 0, binding = 1) uniform usamplerBuffer tris;   // PtTriangle: pt_tri()
 layout(std430, set = 0, binding = 2) readonly buffer Rays { PtRay rays[]; };
 layout(std430, set = 0, binding = 3) writeonly buffer Hits { PtHitRecord hits[]; };
 layout(push_constant) uniform Params { PtRaycastParams pc; };

@@ -11,8 +11,8 @@
 #include "fovea/shaders/pt_order.h"
 
 layout(local_size_x = 64) in;  // one tile of the tile order (pt_order.h)
-layout(std430, set = 0, binding = 0) readonly buffer Nodes { uvec4 nodes[]; };  // PtBvhNode: pt_node()
-layout(std430, set = 0, binding = 1) readonly buffer Tris { uvec4 tris[]; };    // PtTriangle: pt_tri()
+layout(set = 0, binding = 0) uniform usamplerBuffer nodes;  // PtBvhNode: pt_node()
+layout(set = 0, binding = 1) uniform usamplerBuffer tris;   // PtTriangle: pt_tri()
 layout(std430, set = 0, binding = 2) readonly buffer Shading { PtShading shading[]; };
 layout(std430, set = 0, binding = 3) readonly buffer Materials { PtMaterial materials[]; };
 layout(std430, set = 0, binding = 4) readonly buffer Lights { PtLight lights[]; };

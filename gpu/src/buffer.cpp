@@ -1,6 +1,7 @@
 #include "fovea/gpu/buffer.hpp"
 
 #include <stdexcept>
+#include <string>
 #include <utility>
 
 #include "fovea/core/error.hpp"
@@ -16,14 +17,34 @@ void check_range(const Buffer& b, VkDeviceSize offset, std::size_t bytes, const 
                             std::to_string(offset) + " exceed the buffer's " + std::to_string(b.size()) + " bytes");
 }
 
+// Bytes per texel of the formats a texel view may have; 0 for any other.
+VkDeviceSize texel_bytes(VkFormat f) {
+  switch (f) {
+    case VK_FORMAT_R32_UINT: case VK_FORMAT_R32_SFLOAT: return 4;
+    case VK_FORMAT_R32G32_UINT: case VK_FORMAT_R32G32_SFLOAT: return 8;
+    case VK_FORMAT_R32G32B32A32_UINT: case VK_FORMAT_R32G32B32A32_SFLOAT: return 16;
+    default: return 0;
+  }
+}
+
 }  // namespace
 
 Buffer::Buffer(Context& ctx, const BufferDesc& desc) : ctx_(&ctx), size_(desc.size) {
   if (desc.size == 0) throw core::InputError("gpu::Buffer '" + desc.name + "': size must be > 0");
+  const bool texels = desc.texel_format != VK_FORMAT_UNDEFINED;
+  const VkDeviceSize texel = texel_bytes(desc.texel_format);
+  if (texels && texel == 0)
+    throw core::InputError("gpu::Buffer '" + desc.name + "': texel format " + std::to_string(desc.texel_format) +
+                           " is not one of R32, R32G32, R32G32B32A32 (UINT or SFLOAT)");
+  if (texels && desc.size / texel > ctx.limits().maxTexelBufferElements)
+    throw core::InputError("gpu::Buffer '" + desc.name + "': " + std::to_string(desc.size / texel) +
+                           " texels, more than this device's texel buffers hold (maxTexelBufferElements " +
+                           std::to_string(ctx.limits().maxTexelBufferElements) + ")");
   const VkDevice dev = ctx.device();
   VkBufferCreateInfo ci{VK_STRUCTURE_TYPE_BUFFER_CREATE_INFO};
   ci.size = desc.size;
   ci.usage = static_cast<VkBufferUsageFlags>(desc.usage | BufferUsage::TransferSrc | BufferUsage::TransferDst);
+  if (texels) ci.usage |= VK_BUFFER_USAGE_UNIFORM_TEXEL_BUFFER_BIT;
   ci.sharingMode = VK_SHARING_MODE_EXCLUSIVE;
   VkBuffer buffer = VK_NULL_HANDLE;
   check(vkCreateBuffer(dev, &ci, nullptr, &buffer), "vkCreateBuffer");
@@ -53,6 +74,15 @@ Buffer::Buffer(Context& ctx, const BufferDesc& desc) : ctx_(&ctx), size_(desc.si
     check(vkMapMemory(dev, memory, 0, VK_WHOLE_SIZE, 0, &p), "vkMapMemory");
     mapped_ = static_cast<std::byte*>(p);
   }
+  if (texels) {
+    VkBufferViewCreateInfo vi{VK_STRUCTURE_TYPE_BUFFER_VIEW_CREATE_INFO};
+    vi.buffer = buffer;
+    vi.format = desc.texel_format;
+    vi.range = desc.size / texel * texel;
+    VkBufferView view = VK_NULL_HANDLE;
+    check(vkCreateBufferView(dev, &vi, nullptr, &view), "vkCreateBufferView");
+    view_ = {dev, view};
+  }
   if (!desc.name.empty()) ctx.set_name(VK_OBJECT_TYPE_BUFFER, reinterpret_cast<std::uint64_t>(buffer), desc.name);
 }
 
@@ -61,11 +91,13 @@ Buffer::Buffer(Buffer&& o) noexcept
       size_(std::exchange(o.size_, 0)),
       mapped_(std::exchange(o.mapped_, nullptr)),
       memory_(std::move(o.memory_)),
-      buffer_(std::move(o.buffer_)) {}
+      buffer_(std::move(o.buffer_)),
+      view_(std::move(o.view_)) {}
 
 Buffer& Buffer::operator=(Buffer&& o) noexcept {
   if (this != &o) {
-    buffer_ = std::move(o.buffer_);  // the buffer goes before the memory it is bound to
+    view_ = std::move(o.view_);      // the view goes before its buffer,
+    buffer_ = std::move(o.buffer_);  // the buffer before the memory it is bound to
     memory_ = std::move(o.memory_);
     ctx_ = std::exchange(o.ctx_, nullptr);
     size_ = std::exchange(o.size_, 0);

@@ -20,6 +20,7 @@ VkDescriptorType vk_type(Binding b) {
     case Binding::StorageImage: return VK_DESCRIPTOR_TYPE_STORAGE_IMAGE;
     case Binding::SampledImage: return VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER;
     case Binding::AccelerationStructure: return VK_DESCRIPTOR_TYPE_ACCELERATION_STRUCTURE_KHR;
+    case Binding::TexelBuffer: return VK_DESCRIPTOR_TYPE_UNIFORM_TEXEL_BUFFER;
   }
   return VK_DESCRIPTOR_TYPE_MAX_ENUM;
 }
@@ -33,6 +34,7 @@ const char* binding_name(Binding b) {
     case Binding::StorageImage: return "storage image";
     case Binding::SampledImage: return "sampled image";
     case Binding::AccelerationStructure: return "acceleration structure";
+    case Binding::TexelBuffer: return "texel buffer";
   }
   return "?";
 }
@@ -84,8 +86,16 @@ void DescriptorSet::expect(std::uint32_t binding, Binding type) const {
 }
 
 DescriptorSet& DescriptorSet::bind(std::uint32_t binding, const Buffer& buffer, VkDeviceSize offset, VkDeviceSize range) {
-  const bool uniform = binding < bindings_.size() && bindings_[binding] == Binding::UniformBuffer;
-  expect(binding, uniform ? Binding::UniformBuffer : Binding::StorageBuffer);
+  const Binding type = binding < bindings_.size() ? bindings_[binding] : Binding::StorageBuffer;
+  if (type == Binding::TexelBuffer) {
+    const VkBufferView view = buffer.texel_view();
+    if (view == VK_NULL_HANDLE)
+      throw core::InputError("gpu::DescriptorSet::bind: binding " + std::to_string(binding) +
+                             " is a texel buffer, and the buffer has no texel format");
+    write(binding, nullptr, nullptr, nullptr, &view);
+    return *this;
+  }
+  expect(binding, type == Binding::UniformBuffer ? Binding::UniformBuffer : Binding::StorageBuffer);
   const VkDescriptorBufferInfo info{buffer.handle(), offset, range};
   write(binding, &info, nullptr);
   return *this;
@@ -131,7 +141,7 @@ DescriptorSet& DescriptorSet::bind(std::uint32_t binding, const TriangleAccel& a
 }
 
 void DescriptorSet::write(std::uint32_t binding, const VkDescriptorBufferInfo* buffer,
-                          const VkDescriptorImageInfo* image, const void* next) {
+                          const VkDescriptorImageInfo* image, const void* next, const VkBufferView* texel) {
   VkWriteDescriptorSet w{VK_STRUCTURE_TYPE_WRITE_DESCRIPTOR_SET, next};
   w.dstSet = set_;
   w.dstBinding = binding;
@@ -139,6 +149,7 @@ void DescriptorSet::write(std::uint32_t binding, const VkDescriptorBufferInfo* b
   w.descriptorType = vk_type(bindings_[binding]);
   w.pBufferInfo = buffer;
   w.pImageInfo = image;
+  w.pTexelBufferView = texel;
   vkUpdateDescriptorSets(pool_.device(), 1, &w, 0, nullptr);
 }
 

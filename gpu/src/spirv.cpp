@@ -18,6 +18,7 @@ constexpr std::uint32_t kOpConstant = 43, kOpConstantComposite = 44, kOpSpecCons
                         kOpSpecConstantComposite = 51;
 constexpr std::uint32_t kModeLocalSize = 17, kModeLocalSizeId = 38;
 constexpr std::uint32_t kDecorationSpecId = 1, kDecorationBuiltIn = 11, kBuiltInWorkgroupSize = 25;
+constexpr std::uint32_t kDimBuffer = 5;  // OpTypeImage's Dim operand for samplerBuffer
 constexpr std::uint32_t kOpTypeImage = 25, kOpTypeSampledImage = 27, kOpTypeArray = 28, kOpTypeRuntimeArray = 29,
                         kOpTypePointer = 32, kOpVariable = 59;
 constexpr std::uint32_t kOpTypeAccelerationStructureKHR = 5341;
@@ -90,7 +91,8 @@ std::vector<DeclaredBinding> descriptor_bindings(std::span<const std::uint32_t> 
   std::unordered_map<std::uint32_t, Pointer> pointers;                  // pointer type id
   std::unordered_map<std::uint32_t, std::uint32_t> element;             // array type id -> element type
   std::unordered_map<std::uint32_t, std::uint32_t> image_sampled;       // image type id -> Sampled operand
-  std::unordered_map<std::uint32_t, bool> sampled_image;                // OpTypeSampledImage ids
+  std::unordered_map<std::uint32_t, bool> buffer_image;                 // image type ids of Dim Buffer
+  std::unordered_map<std::uint32_t, bool> sampled_image;                // OpTypeSampledImage id -> of a Dim Buffer image
   std::unordered_map<std::uint32_t, bool> accel;                        // OpTypeAccelerationStructureKHR ids
   std::vector<std::pair<std::uint32_t, std::uint32_t>> variables;       // (id, pointer type)
   for_each_instruction(words, [&](std::uint32_t op, std::span<const std::uint32_t> w) {
@@ -105,8 +107,9 @@ std::vector<DeclaredBinding> descriptor_bindings(std::span<const std::uint32_t> 
       element[w[1]] = w[2];
     } else if (op == kOpTypeImage && count >= 8) {
       image_sampled[w[1]] = w[7];
+      if (w[3] == kDimBuffer) buffer_image[w[1]] = true;
     } else if (op == kOpTypeSampledImage && count >= 3) {
-      sampled_image[w[1]] = true;
+      sampled_image[w[1]] = buffer_image.count(w[2]) != 0;
     } else if (op == kOpTypeAccelerationStructureKHR && count >= 2) {
       accel[w[1]] = true;
     } else if (op == kOpVariable && count >= 4) {
@@ -131,7 +134,7 @@ std::vector<DeclaredBinding> descriptor_bindings(std::span<const std::uint32_t> 
     } else if (storage == kStorageUniform) {
       d.type = Binding::UniformBuffer;
     } else if (storage == kStorageUniformConstant && sampled_image.count(t)) {
-      d.type = Binding::SampledImage;
+      d.type = sampled_image[t] ? Binding::TexelBuffer : Binding::SampledImage;
     } else if (storage == kStorageUniformConstant && accel.count(t)) {
       d.type = Binding::AccelerationStructure;
     } else if (storage == kStorageUniformConstant && image_sampled.count(t) && image_sampled[t] == 2) {

@@ -15,8 +15,9 @@ namespace fovea::renderer {
 namespace {
 
 template <class T>
-gpu::Buffer upload(gpu::Context& ctx, const std::vector<T>& data, const char* name) {
-  gpu::Buffer b(ctx, {data.size() * sizeof(T), gpu::BufferUsage::Storage, gpu::Memory::DeviceLocal, name});
+gpu::Buffer upload(gpu::Context& ctx, const std::vector<T>& data, const char* name,
+                   VkFormat texel_format = VK_FORMAT_UNDEFINED) {
+  gpu::Buffer b(ctx, {data.size() * sizeof(T), gpu::BufferUsage::Storage, gpu::Memory::DeviceLocal, name, texel_format});
   b.upload(data);
   return b;
 }
@@ -127,8 +128,9 @@ GpuScene::GpuScene(gpu::Context& ctx, const Scene& s, const BvhOptions& bvh_opti
   if (table.empty()) table.push_back({0, 1, 1, 0});
   if (texels.empty()) texels.push_back(0xFFFFFFFFu);
 
-  nodes_ = upload(ctx, bvh.nodes, "pt.bvh_nodes");
-  triangles_ = upload(ctx, tris, "pt.triangles");
+  // Read by every traversal step: texel fetches (pt_traverse.h, pt_node / pt_tri).
+  nodes_ = upload(ctx, bvh.nodes, "pt.bvh_nodes", VK_FORMAT_R32G32B32A32_UINT);
+  triangles_ = upload(ctx, tris, "pt.triangles", VK_FORMAT_R32G32B32A32_UINT);
   shading_ = upload(ctx, shading, "pt.shading");
   materials_ = upload(ctx, mats, "pt.materials");
   lights_ = upload(ctx, lights, "pt.lights");

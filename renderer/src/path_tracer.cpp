@@ -16,6 +16,13 @@ namespace fovea::renderer {
 namespace {
 constexpr int kOutputs = 6;
 constexpr int kBindings = 8 + kOutputs + 1;  // scene, grid, outputs, GGX albedo table
+
+// Bindings 0 and 1 (BVH nodes, triangles) are texel buffers, the rest storage buffers.
+std::vector<gpu::Binding> set0_bindings() {
+  std::vector<gpu::Binding> b(kBindings, gpu::Binding::StorageBuffer);
+  b[0] = b[1] = gpu::Binding::TexelBuffer;
+  return b;
+}
 }  // namespace
 
 PathTracer::PathTracer(gpu::Context& ctx, const GpuScene& scene) : PathTracer(ctx, scene, scene.features()) {}
@@ -25,7 +32,7 @@ PathTracer::PathTracer(gpu::Context& ctx, const GpuScene& scene, const SceneFeat
     throw core::InputError("path tracer: the requested shader features lack some the scene uses");
   using gpu::SpecConstant;
   pipeline_ = gpu::ComputePipeline(
-      ctx, tracer_pipeline(scene, "pt_trace", std::vector<gpu::Binding>(kBindings, gpu::Binding::StorageBuffer),
+      ctx, tracer_pipeline(scene, "pt_trace", set0_bindings(),
                            sizeof(shaders::PtFrameParams),
                            {SpecConstant::boolean(shaders::kPtSpecTextures, f.textures),
                             SpecConstant::boolean(shaders::kPtSpecGlossy, f.glossy),

@@ -23,7 +23,8 @@ Raycaster::Raycaster(gpu::Context& ctx, const GpuScene& scene, bool count_traver
       scene_(checked(scene, count_traversal)),
       count_traversal_(count_traversal),
       pipeline_(ctx, tracer_pipeline(scene, count_traversal ? "pt_raycast.stats" : "pt_raycast",
-                                     std::vector<gpu::Binding>(4, gpu::Binding::StorageBuffer),
+                                     {gpu::Binding::TexelBuffer, gpu::Binding::TexelBuffer, gpu::Binding::StorageBuffer,
+                                      gpu::Binding::StorageBuffer},
                                      sizeof(shaders::PtRaycastParams))) {}
 
 TraversalStats Raycaster::traversal_stats() {

@@ -1,5 +1,6 @@
 #include <cstdint>
 #include <numeric>
+#include <string>
 #include <vector>
 
 #include <glm/vec4.hpp>
@@ -7,6 +8,7 @@
 #include "fovea/core/error.hpp"
 #include "fovea/gpu/barriers.hpp"
 #include "fovea/gpu/buffer.hpp"
+#include "fovea/gpu/descriptors.hpp"
 #include "fovea/gpu/image.hpp"
 #include "gpu_fixture.hpp"
 
@@ -75,6 +77,29 @@ TEST_F(Buffers, MoveTransfersOwnership) {
   EXPECT_TRUE(a.host_visible());
   a = gpu::Buffer(ctx(), {.size = 32});  // releases the first buffer
   EXPECT_EQ(a.size(), 32u);
+}
+
+TEST_F(Buffers, TexelFormatsAreCheckedAndBoundToTexelBindingsOnly) {
+  const gpu::Buffer texels(ctx(), {.size = 64, .name = "texels", .texel_format = VK_FORMAT_R32G32B32A32_UINT});
+  EXPECT_NE(texels.texel_view(), VK_NULL_HANDLE);
+  const gpu::Buffer plain(ctx(), {.size = 64, .name = "plain"});
+  EXPECT_EQ(plain.texel_view(), VK_NULL_HANDLE);
+  const auto message = [](auto&& f) {
+    try {
+      f();
+    } catch (const fovea::core::InputError& e) {
+      return std::string(e.what());
+    }
+    return std::string("no error");
+  };
+  EXPECT_NE(message([&] { gpu::Buffer(ctx(), {.size = 64, .name = "bytes", .texel_format = VK_FORMAT_R8_UNORM}); })
+                .find("'bytes': texel format"),
+            std::string::npos);
+  const gpu::DescriptorSetLayout layout(ctx(), {gpu::Binding::StorageBuffer, gpu::Binding::TexelBuffer});
+  gpu::DescriptorSet set(ctx(), layout);
+  set.bind(0, texels).bind(1, texels);  // a buffer with a view serves both kinds of binding
+  EXPECT_NE(message([&] { set.bind(1, plain); }).find("binding 1 is a texel buffer, and the buffer has no texel format"),
+            std::string::npos);
 }
 
 using Images = GpuTest;

@@ -42,12 +42,20 @@ struct BufferDesc {
   BufferUsage usage = BufferUsage::Storage;
   Memory memory = Memory::DeviceLocal;
   std::string name;  // shown in validation messages
+  // Also readable as a texel buffer (`samplerBuffer` / `usamplerBuffer`, texelFetch) of this
+  // format (R32/R32G32/R32G32B32A32, UINT or SFLOAT): the buffer owns a view of itself that
+  // DescriptorSet binds to Binding::TexelBuffer. lavapipe fetches a texel as one vector
+  // gather, where a storage-buffer load whose address differs per invocation is a loop over
+  // the SIMD lanes with a bounds test per component (docs/gpu.md, "Texel buffers").
+  VkFormat texel_format = VK_FORMAT_UNDEFINED;
 };
 
 class Buffer {
  public:
   Buffer() = default;
   // Transfer usages are always added so upload/download and copies work on any buffer.
+  // Throws core::InputError for an unsupported texel_format or more texels than the
+  // device's maxTexelBufferElements.
   Buffer(Context& ctx, const BufferDesc& desc);
   // Moves leave the source empty (no handle, size 0, not mapped).
   Buffer(Buffer&& o) noexcept;
@@ -55,6 +63,8 @@ class Buffer {
 
   VkBuffer handle() const { return buffer_.get(); }
   VkDeviceSize size() const { return size_; }
+  // The view of the whole buffer as texels of BufferDesc::texel_format (VK_NULL_HANDLE without).
+  VkBufferView texel_view() const { return view_.get(); }
   // For buffers created with BufferUsage::DeviceAddress.
   VkDeviceAddress device_address() const;
   bool host_visible() const { return mapped_ != nullptr; }
@@ -91,6 +101,7 @@ class Buffer {
   std::byte* mapped_ = nullptr;
   DeviceHandle<VkDeviceMemory, vkFreeMemory> memory_;  // declared first: destroyed after the buffer
   DeviceHandle<VkBuffer, vkDestroyBuffer> buffer_;
+  DeviceHandle<VkBufferView, vkDestroyBufferView> view_;  // declared last: destroyed before the buffer
 };
 
 // Records a copy of `bytes` bytes between buffers (whole `src` when bytes == VK_WHOLE_SIZE).

@@ -22,6 +22,7 @@ enum class Binding {
   StorageImage,   // image2D / uimage2D with a format qualifier
   SampledImage,   // sampler2D (combined image sampler)
   AccelerationStructure,  // accelerationStructureEXT (the top level of a TriangleAccel)
+  TexelBuffer,            // samplerBuffer / usamplerBuffer (a Buffer with a texel_format)
 };
 const char* binding_name(Binding b);  // "storage buffer", ... for messages
 
@@ -53,7 +54,9 @@ class DescriptorSet {
   VkDescriptorSet handle() const { return set_; }
 
   // Point a binding at a resource. Throws core::InputError when the binding does not
-  // exist or has another type. Resources must outlive every use of the set.
+  // exist or has another type. Resources must outlive every use of the set. A buffer goes
+  // to a storage, uniform or texel-buffer binding (the last: its whole texel view, which it
+  // must have; offset and range apply to the others).
   DescriptorSet& bind(std::uint32_t binding, const Buffer& buffer, VkDeviceSize offset = 0,
                       VkDeviceSize range = VK_WHOLE_SIZE);
   DescriptorSet& bind(std::uint32_t binding, const Image2D& image);
@@ -66,7 +69,7 @@ class DescriptorSet {
  private:
   void expect(std::uint32_t binding, Binding type) const;
   void write(std::uint32_t binding, const VkDescriptorBufferInfo* buffer, const VkDescriptorImageInfo* image,
-             const void* next = nullptr);
+             const void* next = nullptr, const VkBufferView* texel = nullptr);
 
   std::vector<Binding> bindings_;
   DeviceHandle<VkDescriptorPool, vkDestroyDescriptorPool> pool_;

@@ -56,6 +56,7 @@ class GpuScene {
   GpuScene(gpu::Context& ctx, const Scene& scene, const BvhOptions& bvh = {}, Tracing tracing = Tracing::Auto);
   ~GpuScene();
 
+  // Both also R32G32B32A32_UINT texel buffers (`usamplerBuffer nodes, tris` in the tracers).
   const gpu::Buffer& nodes() const { return nodes_; }
   const gpu::Buffer& triangles() const { return triangles_; }
   const gpu::Buffer& shading() const { return shading_; }

@@ -1,7 +1,7 @@
 // GLSL only: pt_trace_ray, the scene query the tracers call. Compiled with FOVEA_RAYQUERY
 // (the *.rayquery.comp.spv variants) it asks the device's acceleration structure through
 // GL_EXT_ray_query (set 1, binding 0: the top level of the scene's TriangleAccel, whose
-// primitive i is tris[i]); otherwise it is pt_traverse, the compute BVH traversal.
+// primitive i is pt_tri(i)); otherwise it is pt_traverse, the compute BVH traversal.
 // Include after pt_traverse.h. Same semantics either way: closest hit, or any hit when
 // any_hit (shadow rays stop at the first); both faces; every triangle opaque (no alpha
 // test); hit.bary the weights of vertices 1 and 2; hits within (tmin, tmax) (ray queries close

@@ -1,6 +1,6 @@
 // GLSL only: BVH traversal and the watertight ray-triangle test. The including shader
-// declares the storage buffers `uvec4 nodes[]` (PtBvhNode, 4 per node) and `uvec4 tris[]`
-// (PtTriangle, 3 per triangle) first; pt_node() and pt_tri() decode them.
+// declares the texel buffers `usamplerBuffer nodes` (PtBvhNode, 4 texels per node) and
+// `usamplerBuffer tris` (PtTriangle, 3 per triangle) first; pt_node() and pt_tri() decode them.
 #ifndef FOVEA_SHADERS_PT_TRAVERSE_H
 #define FOVEA_SHADERS_PT_TRAVERSE_H
 
@@ -45,11 +45,14 @@ uint pt_stat_nodes = 0u, pt_stat_tris = 0u;
 // keeps rounding in the box test from culling hits.
 const float kPtBoxFarScale = 1.0 + 2.0 * (3.0 * 5.9604645e-8) / (1.0 - 3.0 * 5.9604645e-8);
 
-// Nodes and triangles are read as whole uvec4s: lavapipe loads a struct member by member,
-// each load a loop over the SIMD lanes when the address differs per invocation, so four
-// vec4 loads per node instead of sixteen scalar ones made traversal ~15% faster.
+// Nodes and triangles are read as whole uvec4 texels: lavapipe loads a storage buffer's
+// struct member by member, each load a loop over the SIMD lanes with a bounds test per
+// component when the address differs per invocation; a texel fetch is one vector gather.
+// Four vec4 storage loads per node instead of sixteen scalar ones made traversal ~15%
+// faster, texel fetches instead of those TODO (docs/renderer.md).
 PtBvhNode pt_node(uint n) {
-  const uvec4 a = nodes[4u * n], b = nodes[4u * n + 1u], c = nodes[4u * n + 2u], d = nodes[4u * n + 3u];
+  const int i = int(4u * n);
+  const uvec4 a = texelFetch(nodes, i), b = texelFetch(nodes, i + 1), c = texelFetch(nodes, i + 2), d = texelFetch(nodes, i + 3);
   PtBvhNode r;
   r.origin_x = uintBitsToFloat(a.x);
   r.origin_y = uintBitsToFloat(a.y);
@@ -64,7 +67,8 @@ PtBvhNode pt_node(uint n) {
 }
 
 PtTriangle pt_tri(uint i) {
-  const uvec4 a = tris[3u * i], b = tris[3u * i + 1u], c = tris[3u * i + 2u];
+  const int k = int(3u * i);
+  const uvec4 a = texelFetch(tris, k), b = texelFetch(tris, k + 1), c = texelFetch(tris, k + 2);
   PtTriangle t;
   t.v0_x = uintBitsToFloat(a.x); t.v0_y = uintBitsToFloat(a.y); t.v0_z = uintBitsToFloat(a.z);
   t.material = a.w;
@@ -86,7 +90,7 @@ struct PtRayPre {
 
 struct PtHit {
   float t;
-  uint tri;   // index into tris[]
+  uint tri;   // triangle index (texels 3·tri … 3·tri + 2 of tris)
   vec2 bary;  // weights of vertices 1 and 2
 };
 
@@ -235,7 +239,7 @@ bool pt_brute_force(vec3 org, vec3 dir, float tmin, float tmax, bool any_hit, ou
   hit.tri = kPtNoHit;
   hit.bary = vec2(0.0);
   const PtRayPre r = pt_prepare(org, dir, tmin);
-  const uint count = uint(tris.length()) / 3u;
+  const uint count = uint(textureSize(tris)) / 3u;
   for (uint i = 0u; i < count; ++i)
     if (pt_hit_triangle(r, i, hit.t, hit) && any_hit) return true;
   return hit.tri != kPtNoHit;
