@@ -20,14 +20,14 @@ layout(local_size_x = 64) in;
 layout(std430, binding = RECON_MAPS) readonly buffer Maps { ReconGrid maps[]; };
 layout(std430, binding = RECON_TABLES) readonly buffer Tables { GridColumn tables[]; };
 layout(std430, binding = RECON_ACC_SAMPLES) readonly buffer Samples { GridSample samples[]; };
-layout(std430, binding = RECON_ACC_DIRECT) readonly buffer Direct { vec4 direct[]; };
-layout(std430, binding = RECON_ACC_INDIRECT) readonly buffer Indirect { vec4 indirect[]; };
-layout(std430, binding = RECON_ACC_NORMAL_DEPTH) readonly buffer NormalDepth { vec4 normal_depth[]; };
-layout(std430, binding = RECON_ACC_POSITION_MATERIAL) readonly buffer PositionMaterial { vec4 position_material[]; };
-layout(std430, binding = RECON_ACC_PREV_DIRECT) readonly buffer PrevDirect { vec4 prev_direct[]; };
-layout(std430, binding = RECON_ACC_PREV_INDIRECT) readonly buffer PrevIndirect { vec4 prev_indirect[]; };
-layout(std430, binding = RECON_ACC_PREV_POS) readonly buffer PrevPos { vec4 prev_pos[]; };
-layout(std430, binding = RECON_ACC_PREV_NRM) readonly buffer PrevNrm { vec4 prev_nrm[]; };
+layout(binding = RECON_ACC_DIRECT) uniform samplerBuffer direct;
+layout(binding = RECON_ACC_INDIRECT) uniform samplerBuffer indirect;
+layout(binding = RECON_ACC_NORMAL_DEPTH) uniform samplerBuffer normal_depth;
+layout(binding = RECON_ACC_POSITION_MATERIAL) uniform samplerBuffer position_material;
+layout(binding = RECON_ACC_PREV_DIRECT) uniform samplerBuffer prev_direct;
+layout(binding = RECON_ACC_PREV_INDIRECT) uniform samplerBuffer prev_indirect;
+layout(binding = RECON_ACC_PREV_POS) uniform samplerBuffer prev_pos;
+layout(binding = RECON_ACC_PREV_NRM) uniform samplerBuffer prev_nrm;
 layout(std430, binding = RECON_ACC_OUT_DIRECT) writeonly buffer AccDirect { vec4 acc_direct[]; };
 layout(std430, binding = RECON_ACC_OUT_INDIRECT) writeonly buffer AccIndirect { vec4 acc_indirect[]; };
 layout(std430, binding = RECON_ACC_OUT_POS) writeonly buffer Pos { vec4 vpos[]; };
@@ -35,7 +35,7 @@ layout(std430, binding = RECON_ACC_OUT_NRM) writeonly buffer Nrm { vec4 vnrm[]; 
 layout(std430, binding = RECON_ACC_TAP_IDX) writeonly buffer TapIdx { uvec4 tap_idx[]; };
 layout(std430, binding = RECON_ACC_TAP_W) writeonly buffer TapW { vec4 tap_w[]; };
 layout(std430, binding = RECON_ACC_MATERIALS) readonly buffer Materials { PtMaterial materials[]; };
-layout(std430, binding = RECON_ACC_PREV_RESTART) readonly buffer PrevRestart { float prev_restart[]; };
+layout(binding = RECON_ACC_PREV_RESTART) uniform samplerBuffer prev_restart;
 layout(std430, binding = RECON_ACC_OUT_RESTART) writeonly buffer Restart { float restart[]; };
 
 #include "fovea/shaders/recon_map.h"
@@ -47,14 +47,15 @@ layout(push_constant) uniform Push { ReconAccumulatePush pc; };
 // frame to frame; its history stands for the cell's whole area, so it stays valid as long
 // as the surface now hit was seen within a cell of it. A disocclusion has no such neighbour.
 bool seen_near(ReconGrid m, uint j, vec4 here, vec3 n, float depth) {
-  if (rg_no_sample(prev_pos[j].w)) return false;
-  if (rg_tap_valid(here, n, depth, prev_pos[j], prev_nrm[j].xyz)) return true;  // the cell itself: the usual case
+  if (rg_no_sample(texelFetch(prev_pos, int(j)).w)) return false;
+  // The cell itself: the usual case.
+  if (rg_tap_valid(here, n, depth, texelFetch(prev_pos, int(j)), texelFetch(prev_nrm, int(j)).xyz)) return true;
   RgCell cell = rg_cell(m, j);
   for (int dc = -1; dc <= 1; ++dc)
     for (int dr = -1; dr <= 1; ++dr) {
       uint k;
       if ((dc != 0 || dr != 0) && rg_neighbour_of(m, cell, dc, dr, k) &&
-          rg_tap_valid(here, n, depth, prev_pos[k], prev_nrm[k].xyz))
+          rg_tap_valid(here, n, depth, texelFetch(prev_pos, int(k)), texelFetch(prev_nrm, int(k)).xyz))
         return true;
     }
   return false;
@@ -75,11 +76,11 @@ void main() {
     return;
   }
   ReconGrid cur = maps[kReconCurrent];
-  vec4 pm = position_material[i];
+  vec4 pm = texelFetch(position_material, int(i));
   bool sky = pm.w < 0.0;
   vec3 eye = vec3(cur.eye_x, cur.eye_y, cur.eye_z);
   vec3 p = sky ? normalize(rg_view_to_world_dir(cur, vec3(s.dir_x, s.dir_y, s.dir_z))) : pm.xyz;
-  vec3 n = normal_depth[i].xyz;
+  vec3 n = texelFetch(normal_depth, int(i)).xyz;
   float depth = sky ? 0.0 : length(pm.xyz - eye);
   float code = kReconSky;
   if (!sky) {
@@ -112,9 +113,9 @@ void main() {
         confidence = kept / valid;
         w /= kept;
         for (int k = 0; k < 4; ++k) {
-          hd += w[k] * prev_direct[idx[k]];
-          hi += w[k] * prev_indirect[idx[k]];
-          if (w[k] > 0.0) since = max(since, prev_restart[idx[k]]);
+          hd += w[k] * texelFetch(prev_direct, int(idx[k]));
+          hi += w[k] * texelFetch(prev_indirect, int(idx[k]));
+          if (w[k] > 0.0) since = max(since, texelFetch(prev_restart, int(idx[k])).x);
         }
       } else {
         w = vec4(0.0);
@@ -134,11 +135,11 @@ void main() {
   hi.w *= confidence;
   float nd = min(round(hd.w) + 1.0, 255.0);
   float ad = max(1.0 / nd, pc.alpha_min);
-  acc_direct[i] = vec4(mix(hd.rgb, direct[i].rgb, ad), nd);
+  acc_direct[i] = vec4(mix(hd.rgb, texelFetch(direct, int(i)).rgb, ad), nd);
   if (pc.indirect_fresh != 0u) {
     float ni = min(round(hi.w) + 1.0, 255.0);
     float ai = max(1.0 / ni, pc.alpha_min);
-    acc_indirect[i] = vec4(mix(hi.rgb, indirect[i].rgb, ai), ni);
+    acc_indirect[i] = vec4(mix(hi.rgb, texelFetch(indirect, int(i)).rgb, ai), ni);
   } else {
     acc_indirect[i] = vec4(hi.rgb, round(hi.w));  // not traced this frame: history only
   }

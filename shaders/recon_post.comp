@@ -22,15 +22,15 @@ layout(local_size_x = 64) in;
 #include "fovea/shaders/recon_bindings.h"
 #include "fovea/shaders/recon_grid.h"
 
-layout(std430, binding = RECON_POST_POS) readonly buffer Pos { vec4 vpos[]; };
-layout(std430, binding = RECON_POST_TAP_IDX) readonly buffer TapIdx { uvec4 tap_idx[]; };
-layout(std430, binding = RECON_POST_TAP_W) readonly buffer TapW { vec4 tap_w[]; };
-layout(std430, binding = RECON_POST_SOURCE) readonly buffer Source { vec4 source[]; };  // fitted indirect, or z without BMFR
-layout(std430, binding = RECON_POST_ACC_DIRECT) readonly buffer AccDirect { vec4 acc_direct[]; };  // .w: Phase I count
-layout(std430, binding = RECON_POST_PREV) readonly buffer PrevPost { vec4 prev_post[]; };  // accumulated fit, .w weight
+layout(binding = RECON_POST_POS) uniform samplerBuffer vpos;
+layout(binding = RECON_POST_TAP_IDX) uniform usamplerBuffer tap_idx;
+layout(binding = RECON_POST_TAP_W) uniform samplerBuffer tap_w;
+layout(binding = RECON_POST_SOURCE) uniform samplerBuffer source;  // fitted indirect, or z without BMFR
+layout(binding = RECON_POST_ACC_DIRECT) uniform samplerBuffer acc_direct;  // .w: Phase I count
+layout(binding = RECON_POST_PREV) uniform samplerBuffer prev_post;  // accumulated fit, .w weight
 layout(std430, binding = RECON_POST_OUT) writeonly buffer Post { vec4 post[]; };
-layout(std430, binding = RECON_POST_PREV_ACC_DIRECT) readonly buffer PrevAccDirect { vec4 prev_acc_direct[]; };
-layout(std430, binding = RECON_POST_EXCESS) readonly buffer Excess { vec4 excess[]; };  // unread without BMFR
+layout(binding = RECON_POST_PREV_ACC_DIRECT) uniform samplerBuffer prev_acc_direct;
+layout(binding = RECON_POST_EXCESS) uniform samplerBuffer excess;  // unread without BMFR
 layout(std430, binding = RECON_POST_SUM) writeonly buffer Sum { vec4 sum[]; };          // TAA's input
 
 layout(push_constant) uniform Push { ReconPostPush pc; };
@@ -38,29 +38,30 @@ layout(push_constant) uniform Push { ReconPostPush pc; };
 void main() {
   uint i = gl_GlobalInvocationID.x;
   if (i >= pc.cells) return;
-  if (rg_no_sample(vpos[i].w) || pc.denoise == 0u) {
+  if (rg_no_sample(texelFetch(vpos, int(i)).w) || pc.denoise == 0u) {
     post[i] = vec4(0.0);
-    sum[i] = rg_no_sample(vpos[i].w) ? vec4(0.0) : vec4(source[i].rgb, 1.0);
+    sum[i] = rg_no_sample(texelFetch(vpos, int(i)).w) ? vec4(0.0) : vec4(texelFetch(source, int(i)).rgb, 1.0);
     return;
   }
-  vec3 c = source[i].rgb;
-  float n = max(source[i].w, 1.0);
+  vec3 c = texelFetch(source, int(i)).rgb;
+  float n = max(texelFetch(source, int(i)).w, 1.0);
   vec4 acc = vec4(c, n);
-  vec4 w = tap_w[i];
+  vec4 w = texelFetch(tap_w, int(i));
   if (pc.has_history != 0u && w.x + w.y + w.z + w.w > 0.0) {
-    uvec4 idx = tap_idx[i];
+    uvec4 idx = texelFetch(tap_idx, int(i));
     vec3 h = vec3(0.0);
     float hw = 0.0, hd = 0.0;  // the history's weight; Phase I's direct count before its share
     for (int k = 0; k < 4; ++k) {
-      vec4 p = prev_post[idx[k]];
+      vec4 p = texelFetch(prev_post, int(idx[k]));
       h += w[k] * p.rgb;
       hw += w[k] * p.w;
-      hd += w[k] * prev_acc_direct[idx[k]].w;
+      hd += w[k] * texelFetch(prev_acc_direct, int(idx[k])).w;
     }
-    hw *= hd > 0.0 ? clamp((acc_direct[i].w - 1.0) / hd, 0.0, 1.0) : 0.0;
+    hw *= hd > 0.0 ? clamp((texelFetch(acc_direct, int(i)).w - 1.0) / hd, 0.0, 1.0) : 0.0;
     float a = max(n / (hw + n), pc.alpha_min);
     acc = vec4(mix(h, c, a), n / a);
   }
   post[i] = acc;
-  sum[i] = vec4(acc.rgb + excess[i].rgb + acc_direct[i].rgb, acc_direct[i].w);  // .w: TAA's CMA start
+  vec4 direct = texelFetch(acc_direct, int(i));
+  sum[i] = vec4(acc.rgb + texelFetch(excess, int(i)).rgb + direct.rgb, direct.w);  // .w: TAA's CMA start
 }

@@ -18,13 +18,13 @@ layout(local_size_x = 64) in;
 
 layout(std430, binding = RECON_MAPS) readonly buffer Maps { ReconGrid maps[]; };
 layout(std430, binding = RECON_TABLES) readonly buffer Tables { GridColumn tables[]; };
-layout(std430, binding = RECON_SHARE_POS) readonly buffer Pos { vec4 vpos[]; };
-layout(std430, binding = RECON_SHARE_NRM) readonly buffer Nrm { vec4 vnrm[]; };
-layout(std430, binding = RECON_SHARE_ACC_DIRECT) readonly buffer AccDirect { vec4 acc_direct[]; };
-layout(std430, binding = RECON_SHARE_ACC_INDIRECT) readonly buffer AccIndirect { vec4 acc_indirect[]; };
-layout(std430, binding = RECON_SHARE_OTHER_POS) readonly buffer OtherPos { vec4 other_pos[]; };
-layout(std430, binding = RECON_SHARE_OTHER_NRM) readonly buffer OtherNrm { vec4 other_nrm[]; };
-layout(std430, binding = RECON_SHARE_OTHER_INDIRECT) readonly buffer OtherIndirect { vec4 other_indirect[]; };
+layout(binding = RECON_SHARE_POS) uniform samplerBuffer vpos;
+layout(binding = RECON_SHARE_NRM) uniform samplerBuffer vnrm;
+layout(binding = RECON_SHARE_ACC_DIRECT) uniform samplerBuffer acc_direct;
+layout(binding = RECON_SHARE_ACC_INDIRECT) uniform samplerBuffer acc_indirect;
+layout(binding = RECON_SHARE_OTHER_POS) uniform samplerBuffer other_pos;
+layout(binding = RECON_SHARE_OTHER_NRM) uniform samplerBuffer other_nrm;
+layout(binding = RECON_SHARE_OTHER_INDIRECT) uniform samplerBuffer other_indirect;
 layout(std430, binding = RECON_SHARE_SHARED) writeonly buffer Shared { vec4 shared_indirect[]; };
 layout(std430, binding = RECON_SHARE_Z) writeonly buffer Z { vec4 z[]; };
 layout(std430, binding = RECON_SHARE_EDGE) writeonly buffer Edge { uint edge[]; };  // 1: on a surface edge
@@ -60,7 +60,8 @@ bool straddles(ReconGrid m, uint i, vec4 here, vec4 nd) {
         rr = (rr % rows + rows) % rows;
       }
       uint k = uint(rr) * m.g.padded_columns + uint(cc);
-      if (!rg_no_sample(vpos[k].w) && !rg_tap_valid(here, nd.xyz, nd.w, vpos[k], vnrm[k].xyz)) return true;
+      vec4 there = texelFetch(vpos, int(k));
+      if (!rg_no_sample(there.w) && !rg_tap_valid(here, nd.xyz, nd.w, there, texelFetch(vnrm, int(k)).xyz)) return true;
     }
   }
   return false;
@@ -69,8 +70,8 @@ bool straddles(ReconGrid m, uint i, vec4 here, vec4 nd) {
 void main() {
   uint i = gl_GlobalInvocationID.x;
   if (i >= pc.cells) return;
-  vec4 here = vpos[i];
-  vec4 own = acc_indirect[i];
+  vec4 here = texelFetch(vpos, int(i));
+  vec4 own = texelFetch(acc_indirect, int(i));
   if (rg_no_sample(here.w)) {
     shared_indirect[i] = vec4(0.0);
     z[i] = vec4(0.0);
@@ -78,7 +79,8 @@ void main() {
     return;
   }
   // Only surfaces are fitted (sky and emitters, w < 0, keep their input anyway).
-  edge[i] = pc.edges != 0u && here.w >= 0.0 && straddles(maps[kReconCurrent], i, here, vnrm[i]) ? 1u : 0u;
+  edge[i] =
+      pc.edges != 0u && here.w >= 0.0 && straddles(maps[kReconCurrent], i, here, texelFetch(vnrm, int(i))) ? 1u : 0u;
   vec4 result = own;
   if (pc.enabled != 0u && maps[kReconOther].valid != 0u) {
     ReconGrid other = maps[kReconOther];
@@ -90,13 +92,14 @@ void main() {
       ReconGrid cur = maps[kReconCurrent];
       uint col = i % cur.g.padded_columns;
       rg_taps(other, rg_unjitter(cur, col, other, uv), idx, w);
-      vec4 n = vnrm[i];
+      vec4 n = texelFetch(vnrm, int(i));
       float wsum = 0.0, own_size = rg_cell_size(cur, col);
       vec4 acc = vec4(0.0);
       for (int k = 0; k < 4; ++k) {
-        if (w[k] <= 0.0 || !rg_tap_valid(here, n.xyz, n.w, other_pos[idx[k]], other_nrm[idx[k]].xyz)) continue;
+        int o = int(idx[k]);
+        if (w[k] <= 0.0 || !rg_tap_valid(here, n.xyz, n.w, texelFetch(other_pos, o), texelFetch(other_nrm, o).xyz)) continue;
         w[k] *= rg_coarse_weight(other, idx[k], own_size, pc.coarse_keep, pc.coarse_reject);
-        acc += w[k] * other_indirect[idx[k]];
+        acc += w[k] * texelFetch(other_indirect, int(idx[k]));
         wsum += w[k];
       }
       if (wsum > 1e-4) {
@@ -107,5 +110,5 @@ void main() {
     }
   }
   shared_indirect[i] = result;
-  z[i] = vec4(acc_direct[i].rgb + result.rgb, 1.0);
+  z[i] = vec4(texelFetch(acc_direct, int(i)).rgb + result.rgb, 1.0);
 }

@@ -40,15 +40,15 @@ layout(local_size_x = 64) in;
 
 layout(std430, binding = RECON_MAPS) readonly buffer Maps { ReconGrid maps[]; };
 layout(std430, binding = RECON_TABLES) readonly buffer Tables { GridColumn tables[]; };
-layout(std430, binding = RECON_TAA_POS) readonly buffer Pos { vec4 vpos[]; };
-layout(std430, binding = RECON_TAA_TAP_IDX) readonly buffer TapIdx { uvec4 tap_idx[]; };
-layout(std430, binding = RECON_TAA_TAP_W) readonly buffer TapW { vec4 tap_w[]; };
-layout(std430, binding = RECON_TAA_POST) readonly buffer Post { vec4 post[]; };
-layout(std430, binding = RECON_TAA_ALBEDO) readonly buffer Albedo { vec4 albedo[]; };
-layout(std430, binding = RECON_TAA_PREV_FINAL) readonly buffer PrevFinal { vec4 prev_final[]; };
+layout(binding = RECON_TAA_POS) uniform samplerBuffer vpos;
+layout(binding = RECON_TAA_TAP_IDX) uniform usamplerBuffer tap_idx;
+layout(binding = RECON_TAA_TAP_W) uniform samplerBuffer tap_w;
+layout(binding = RECON_TAA_POST) uniform samplerBuffer post;
+layout(binding = RECON_TAA_ALBEDO) uniform samplerBuffer albedo;
+layout(binding = RECON_TAA_PREV_FINAL) uniform samplerBuffer prev_final;
 layout(std430, binding = RECON_TAA_FINAL) writeonly buffer Final { vec4 final_color[]; };
-layout(std430, binding = RECON_TAA_NRM) readonly buffer Nrm { vec4 vnrm[]; };
-layout(std430, binding = RECON_TAA_RESTART) readonly buffer Restart { float restart[]; };  // Phase I's window
+layout(binding = RECON_TAA_NRM) uniform samplerBuffer vnrm;
+layout(binding = RECON_TAA_RESTART) uniform samplerBuffer restart;  // Phase I's window
 
 #include "fovea/shaders/recon_map.h"
 
@@ -70,12 +70,14 @@ float luma(vec3 c) { return dot(c, vec3(0.2126, 0.7152, 0.0722)); }
 vec3 compress(vec3 c) { return c / (1.0 + luma(c)); }
 vec3 expand(vec3 c) { return c / max(1.0 - luma(c), 1e-6); }
 
-vec3 remodulated(uint i) { return post[i].rgb * max(albedo[i].rgb, vec3(kPtMinDemodAlbedo)); }
+vec3 remodulated(uint i) {
+  return texelFetch(post, int(i)).rgb * max(texelFetch(albedo, int(i)).rgb, vec3(kPtMinDemodAlbedo));
+}
 
 void main() {
   uint i = gl_GlobalInvocationID.x;
   if (i >= pc.cells) return;
-  if (rg_no_sample(vpos[i].w)) {
+  if (rg_no_sample(texelFetch(vpos, int(i)).w)) {
     final_color[i] = vec4(0.0);
     return;
   }
@@ -83,13 +85,13 @@ void main() {
     final_color[i] = vec4(remodulated(i), 1.0);
     return;
   }
-  vec4 w = tap_w[i];
+  vec4 w = texelFetch(tap_w, int(i));
   bool history = pc.has_history != 0u && w.x + w.y + w.z + w.w > 0.0;
-  float since = restart[i];  // frames since Phase I restarted the cell's history (0: none recent)
+  float since = texelFetch(restart, int(i)).x;  // frames since Phase I restarted the cell's history (0: none recent)
   ReconGrid m = maps[kReconCurrent];
   vec3 lo = vec3(3.0e38), hi = vec3(-3.0e38);
-  vec4 here = vpos[i], nd = vnrm[i];
-  vec3 avg = post[i].rgb;
+  vec4 here = texelFetch(vpos, int(i)), nd = texelFetch(vnrm, int(i));
+  vec3 avg = texelFetch(post, int(i)).rgb;
   float avg_w = 1.0;
   RgCell cell = rg_cell(m, i);
   bool follow = since > 0.0 && since <= kRestartFollow;  // the window's first frames
@@ -97,28 +99,30 @@ void main() {
   for (int dc = -reach; dc <= reach; ++dc)
     for (int dr = -reach; dr <= reach; ++dr) {
       uint j;
-      if (!rg_neighbour_of(m, cell, dc, dr, j) || rg_no_sample(vpos[j].w)) continue;
+      if (!rg_neighbour_of(m, cell, dc, dr, j) || rg_no_sample(texelFetch(vpos, int(j)).w)) continue;
       if (abs(dc) <= 1 && abs(dr) <= 1) {  // the clamp's 3×3 neighbourhood
         vec3 y = to_ycocg(compress(remodulated(j)));
         lo = min(lo, y);
         hi = max(hi, y);
       }
-      if (since > 0.0 && (dc != 0 || dr != 0) && rg_tap_valid(here, nd.xyz, nd.w, vpos[j], vnrm[j].xyz)) {
-        avg += post[j].rgb;  // the same surface's demodulated input
+      if (since > 0.0 && (dc != 0 || dr != 0) &&
+          rg_tap_valid(here, nd.xyz, nd.w, texelFetch(vpos, int(j)), texelFetch(vnrm, int(j)).xyz)) {
+        avg += texelFetch(post, int(j)).rgb;  // the same surface's demodulated input
         avg_w += 1.0;
       }
     }
-  vec3 c = avg / avg_w * max(albedo[i].rgb, vec3(kPtMinDemodAlbedo));
+  vec3 c = avg / avg_w * max(texelFetch(albedo, int(i)).rgb, vec3(kPtMinDemodAlbedo));
   if (!history || since == 1.0) {  // nothing to blend, or the history is the coarse periphery's
     final_color[i] = vec4(c, 1.0);
     return;
   }
-  uvec4 idx = tap_idx[i];
+  uvec4 idx = texelFetch(tap_idx, int(i));
   vec3 h = vec3(0.0);
-  for (int k = 0; k < 4; ++k) h += w[k] * compress(prev_final[idx[k]].rgb);
+  for (int k = 0; k < 4; ++k) h += w[k] * compress(texelFetch(prev_final, int(idx[k])).rgb);
   h = from_ycocg(clamp(to_ycocg(h), lo, hi));
   vec2 jitter = vec2(m.g.jitter_u, m.g.jitter_v);  // the sample's offset from the cell centre (cells)
   float g = exp(-dot(jitter, jitter) / (2.0 * kCentreSigma * kCentreSigma));
-  float a = follow ? g / (kMeanCentre * (since - 1.0) + g) : max(1.0 / max(post[i].w, 1.0), pc.taa_alpha) * g;
+  float a = follow ? g / (kMeanCentre * (since - 1.0) + g)
+                   : max(1.0 / max(texelFetch(post, int(i)).w, 1.0), pc.taa_alpha) * g;
   final_color[i] = vec4(max(expand(mix(h, compress(c), a)), vec3(0.0)), 1.0);
 }

@@ -44,20 +44,37 @@ void check_bindings(const std::string& what, std::span<const std::uint32_t> word
                                where(std::uint32_t(s), std::uint32_t(b)) + " that the shader does not declare");
 }
 
+// The embedded shader's SPIR-V words (copied: independent of the embedded arrays' alignment).
+std::vector<std::uint32_t> spirv_words(const std::string& shader, const std::string& what) {
+  const std::span<const std::uint8_t> bytes = shaders::find(shader);
+  if (bytes.empty()) throw core::InputError(what + ": no such embedded shader; known: " + known_shaders());
+  if (bytes.size() % 4 != 0) throw core::InputError(what + ": SPIR-V size is not a multiple of 4");
+  std::vector<std::uint32_t> words(bytes.size() / 4);
+  std::memcpy(words.data(), bytes.data(), bytes.size());
+  return words;
+}
+
 }  // namespace
+
+std::vector<Binding> declared_bindings(const std::string& shader, std::uint32_t set) {
+  const std::string what = "gpu::declared_bindings '" + shader + "'";
+  std::vector<Binding> out;
+  for (const spirv::DeclaredBinding& d : spirv::descriptor_bindings(spirv_words(shader, what))) {
+    if (d.set != set) continue;
+    if (d.binding != out.size())
+      throw core::InputError(what + ": set " + std::to_string(set) + " has no binding " + std::to_string(out.size()));
+    out.push_back(d.type);
+  }
+  return out;
+}
 
 ComputePipeline::ComputePipeline(Context& ctx, const ComputePipelineDesc& desc)
     : shader_(desc.shader), push_bytes_(desc.push_constant_bytes) {
   const std::string what = "gpu::ComputePipeline '" + desc.shader + "'";
-  const std::span<const std::uint8_t> bytes = shaders::find(desc.shader);
-  if (bytes.empty()) throw core::InputError(what + ": no such embedded shader; known: " + known_shaders());
-  if (bytes.size() % 4 != 0) throw core::InputError(what + ": SPIR-V size is not a multiple of 4");
+  const std::vector<std::uint32_t> words = spirv_words(desc.shader, what);
   if (desc.push_constant_bytes % 4 != 0 || desc.push_constant_bytes > ctx.limits().maxPushConstantsSize)
     throw core::InputError(what + ": push_constant_bytes " + std::to_string(desc.push_constant_bytes) +
                            " must be a multiple of 4 and at most " + std::to_string(ctx.limits().maxPushConstantsSize));
-  // The embedded arrays are 4-byte aligned (embed_files.cmake), but copy to be independent of that.
-  std::vector<std::uint32_t> words(bytes.size() / 4);
-  std::memcpy(words.data(), bytes.data(), bytes.size());
   local_size_ = spirv::workgroup_size(words, desc.specialization);
   for (int i = 0; i < 3; ++i) {
     max_groups_[i] = ctx.limits().maxComputeWorkGroupCount[i];
@@ -74,7 +91,7 @@ ComputePipeline::ComputePipeline(Context& ctx, const ComputePipelineDesc& desc)
 
   const VkDevice dev = ctx.device();
   VkShaderModuleCreateInfo mci{VK_STRUCTURE_TYPE_SHADER_MODULE_CREATE_INFO};
-  mci.codeSize = bytes.size();
+  mci.codeSize = words.size() * 4;
   mci.pCode = words.data();
   VkShaderModule module_handle = VK_NULL_HANDLE;
   check(vkCreateShaderModule(dev, &mci, nullptr, &module_handle), "vkCreateShaderModule");

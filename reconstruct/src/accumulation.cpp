@@ -14,16 +14,15 @@ Accumulation::Accumulation(gpu::Context& ctx, std::span<const EyeGrid> eyes, con
     const EyeGrid& g = eyes[i];
     Eye& e = eyes_[i];
     e.cells = g.cells;
-    const VkDeviceSize v4 = VkDeviceSize(g.cells) * 16;
     for (int p = 0; p < 2; ++p) {
-      e.direct[p] = storage(ctx, v4, "recon.acc_direct");
-      e.indirect[p] = storage(ctx, v4, "recon.acc_indirect");
-      e.pos[p] = storage(ctx, v4, "recon.vpos");
-      e.nrm[p] = storage(ctx, v4, "recon.vnrm");
-      e.restart[p] = storage(ctx, VkDeviceSize(g.cells) * 4, "recon.restart");
+      e.direct[p] = cells(ctx, g.cells, "recon.acc_direct");
+      e.indirect[p] = cells(ctx, g.cells, "recon.acc_indirect");
+      e.pos[p] = cells(ctx, g.cells, "recon.vpos");
+      e.nrm[p] = cells(ctx, g.cells, "recon.vnrm");
+      e.restart[p] = cells(ctx, g.cells, "recon.restart", VK_FORMAT_R32_SFLOAT);
     }
-    e.tap_idx = storage(ctx, v4, "recon.tap_idx");
-    e.tap_w = storage(ctx, v4, "recon.tap_w");
+    e.tap_idx = cells(ctx, g.cells, "recon.tap_idx", VK_FORMAT_R32G32B32A32_UINT);
+    e.tap_w = cells(ctx, g.cells, "recon.tap_w");
     for (int p = 0; p < 2; ++p) {
       const int q = 1 - p;  // history read by a frame writing p
       e.set[p] = make_set(ctx, kernel_,
@@ -63,9 +62,9 @@ StereoGather::StereoGather(gpu::Context& ctx, std::span<const EyeGrid> eyes, con
     const EyeGrid& g = eyes[i];
     Eye& e = eyes_[i];
     e.cells = g.cells;
-    e.shared = storage(ctx, VkDeviceSize(g.cells) * 16, "recon.shared_indirect");
-    e.z = storage(ctx, VkDeviceSize(g.cells) * 16, "recon.z");
-    e.edge = storage(ctx, VkDeviceSize(g.cells) * 4, "recon.edge");
+    e.shared = cells(ctx, g.cells, "recon.shared_indirect");
+    e.z = cells(ctx, g.cells, "recon.z");
+    e.edge = cells(ctx, g.cells, "recon.edge", VK_FORMAT_R32_UINT);
     const int me = int(i), other = eyes.size() == 2 ? 1 - me : me;  // one eye gathers from itself (unused)
     for (int p = 0; p < 2; ++p)
       e.set[p] = make_set(ctx, kernel_,

@@ -3,8 +3,9 @@
 // `layout(binding = ...)`, indices from shaders/include/fovea/shaders/recon_bindings.h (the
 // constants the GLSL uses). A struct whose field count differs from the kernel's binding
 // count fails to compile; a slot list that misses or repeats a binding fails at start-up
-// (gpu::DescriptorSet::bind_all), and a layout that differs from the SPIR-V too
-// (gpu::ComputePipeline).
+// (gpu::DescriptorSet::bind_all). Each binding's type is the shader's (kernel() in
+// buffers.hpp): inputs read per cell are texel buffers, so their buffers carry a texel
+// format (cells() in buffers.hpp), or binding them fails at start-up naming the binding.
 #include <array>
 
 #include "fovea/gpu/descriptors.hpp"

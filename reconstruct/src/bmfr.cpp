@@ -122,8 +122,8 @@ Bmfr::Bmfr(gpu::Context& ctx, std::span<const EyeGrid> eyes, const Accumulation&
   for (std::size_t i = 0; i < eyes.size(); ++i) {
     Eye& e = eyes_[i];
     e.grid = {eyes[i].padded_columns, eyes[i].padded_rows, eyes[i].polar ? eyes[i].columns : 0};
-    e.fitted = storage(ctx, VkDeviceSize(eyes[i].cells) * 16, "recon.fitted");
-    e.excess = storage(ctx, VkDeviceSize(eyes[i].cells) * 16, "recon.excess");
+    e.fitted = cells(ctx, eyes[i].cells, "recon.fitted");
+    e.excess = cells(ctx, eyes[i].cells, "recon.excess");
     for (int p = 0; p < 2; ++p)
       e.set[p] = fit_.bind(acc.position(int(i), p), acc.normal(int(i), p), gather.shared(int(i)), e.fitted,
                            *eyes[i].tables, materials, e.excess, gather.edge(int(i)));

@@ -2,7 +2,9 @@
 // Buffer and pipeline helpers shared by the reconstruction stages.
 #include <algorithm>
 #include <cstdint>
+#include <string>
 
+#include "fovea/core/error.hpp"
 #include "fovea/gpu/buffer.hpp"
 #include "fovea/gpu/descriptors.hpp"
 #include "fovea/gpu/pipeline.hpp"
@@ -15,12 +17,25 @@ inline gpu::Buffer storage(gpu::Context& ctx, VkDeviceSize bytes, const char* na
                            .memory = memory, .name = name});
 }
 
-// A kernel whose bindings are all storage buffers, `Bindings::kCount` of them.
+// Per-cell data that later kernels read as texels (`samplerBuffer` / `usamplerBuffer`,
+// texelFetch) and their producer writes as a storage buffer: vec4 (RGBA32F) by default.
+inline gpu::Buffer cells(gpu::Context& ctx, std::uint32_t count, const char* name,
+                         VkFormat format = VK_FORMAT_R32G32B32A32_SFLOAT) {
+  const VkDeviceSize texel = format == VK_FORMAT_R32_SFLOAT || format == VK_FORMAT_R32_UINT ? 4 : 16;
+  return gpu::Buffer(ctx, {.size = std::max<VkDeviceSize>(VkDeviceSize(count) * texel, 16),
+                           .usage = gpu::BufferUsage::Storage, .name = name, .texel_format = format});
+}
+
+// A kernel with `Bindings::kCount` bindings, each the type the shader declares (storage or
+// texel buffer; gpu::declared_bindings), all in set 0.
 template <class Bindings, class Push>
 gpu::ComputePipeline kernel(gpu::Context& ctx, const char* shader, std::vector<gpu::SpecConstant> spec = {}) {
-  return gpu::ComputePipeline(
-      ctx, {.shader = shader, .sets = {std::vector<gpu::Binding>(Bindings::kCount, gpu::Binding::StorageBuffer)},
-            .push_constant_bytes = sizeof(Push), .specialization = std::move(spec)});
+  std::vector<gpu::Binding> set = gpu::declared_bindings(shader);
+  if (set.size() != Bindings::kCount)
+    throw core::InputError(std::string(shader) + " declares " + std::to_string(set.size()) + " bindings, its binding struct " +
+                           std::to_string(Bindings::kCount));
+  return gpu::ComputePipeline(ctx, {.shader = shader, .sets = {std::move(set)}, .push_constant_bytes = sizeof(Push),
+                                    .specialization = std::move(spec)});
 }
 
 // A descriptor set of `p` with every binding of a typed binding struct.

@@ -18,10 +18,10 @@ PostTaa::PostTaa(gpu::Context& ctx, std::span<const EyeGrid> eyes, const Accumul
     const int me = int(i);
     e.cells = g.cells;
     for (int p = 0; p < 2; ++p) {
-      e.post[p] = storage(ctx, VkDeviceSize(g.cells) * 16, "recon.post");
-      e.final_[p] = storage(ctx, VkDeviceSize(g.cells) * 16, "recon.final");
+      e.post[p] = cells(ctx, g.cells, "recon.post");
+      e.final_[p] = cells(ctx, g.cells, "recon.final");
     }
-    e.sum = storage(ctx, VkDeviceSize(g.cells) * 16, "recon.post_sum");
+    e.sum = cells(ctx, g.cells, "recon.post_sum");
     const gpu::Buffer* source = bmfr ? &bmfr->fitted(me) : &gather.z(me);
     const gpu::Buffer* excess = bmfr ? &bmfr->excess(me) : source;  // unread without BMFR
     for (int p = 0; p < 2; ++p) {

@@ -55,8 +55,9 @@ TraceOutputs PathTracer::bind(const gpu::Buffer& grid, std::uint32_t cells) cons
   TraceOutputs o;
   o.cells_ = cells;
   const VkDeviceSize bytes = VkDeviceSize(cells) * sizeof(glm::vec4);
-  auto make = [&](const char* name) {
-    return gpu::Buffer(ctx_, {bytes, gpu::BufferUsage::Storage, gpu::Memory::DeviceLocal, name});
+  auto make = [&](const char* name) {  // also RGBA32F texels for the reconstruction's reads
+    return gpu::Buffer(ctx_, {bytes, gpu::BufferUsage::Storage, gpu::Memory::DeviceLocal, name,
+                              VK_FORMAT_R32G32B32A32_SFLOAT});
   };
   o.direct_ = make("pt.out.direct");
   o.indirect_ = make("pt.out.indirect");

@@ -33,6 +33,11 @@ struct ComputePipelineDesc {
   std::vector<SpecConstant> specialization;
 };
 
+// The descriptor types the embedded `shader` declares in `set`, binding b at index b: for
+// layouts that follow the shader (storage or texel buffer per binding). Throws
+// core::InputError for an unknown shader or a binding number the set skips.
+std::vector<Binding> declared_bindings(const std::string& shader, std::uint32_t set = 0);
+
 class ComputePipeline {
  public:
   ComputePipeline() = default;
