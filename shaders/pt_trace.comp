@@ -13,11 +13,13 @@
 layout(local_size_x = 64) in;  // one tile of the tile order (pt_order.h)
 layout(set = 0, binding = 0) uniform usamplerBuffer nodes;  // PtBvhNode: pt_node()
 layout(set = 0, binding = 1) uniform usamplerBuffer tris;   // PtTriangle: pt_tri()
-layout(std430, set = 0, binding = 2) readonly buffer Shading { PtShading shading[]; };
-layout(std430, set = 0, binding = 3) readonly buffer Materials { PtMaterial materials[]; };
-layout(std430, set = 0, binding = 4) readonly buffer Lights { PtLight lights[]; };
+// Scene data read per path vertex are texel buffers (pt_traverse.h says why): decoded by
+// pt_shading(), pt_material(), pt_light() below.
+layout(set = 0, binding = 2) uniform samplerBuffer shading;    // PtShading: 4 texels each
+layout(set = 0, binding = 3) uniform samplerBuffer materials;  // PtMaterial: 3 texels each
+layout(set = 0, binding = 4) uniform samplerBuffer lights;     // PtLight: 1 texel each
 layout(std430, set = 0, binding = 5) readonly buffer TexTable { PtTextureInfo tex_table[]; };
-layout(std430, set = 0, binding = 6) readonly buffer Texels { uint texels[]; };
+layout(set = 0, binding = 6) uniform usamplerBuffer texels;    // RGBA8 per texel
 layout(std430, set = 0, binding = 7) readonly buffer Grid { GridSample cells[]; };
 layout(std430, set = 0, binding = 8) buffer OutDirect { vec4 out_direct[]; };
 layout(std430, set = 0, binding = 9) buffer OutIndirect { vec4 out_indirect[]; };
@@ -25,7 +27,7 @@ layout(std430, set = 0, binding = 10) buffer OutAlbedo { vec4 out_albedo[]; };
 layout(std430, set = 0, binding = 11) buffer OutNormalDepth { vec4 out_normal_depth[]; };
 layout(std430, set = 0, binding = 12) buffer OutPosMat { vec4 out_position_material[]; };
 layout(std430, set = 0, binding = 13) buffer OutRadiance { vec4 out_radiance[]; };
-layout(std430, set = 0, binding = 14) readonly buffer GgxAlbedo { vec4 ggx_albedo[]; };  // read by pt_sampling.h
+layout(set = 0, binding = 14) uniform samplerBuffer ggx_albedo;  // read by pt_sampling.h
 layout(push_constant) uniform Params { PtFrameParams pc; };
 // What the scene uses (PathTracer sets them from GpuScene::features()); false removes the
 // code: base-colour textures, GGX lobes (all F0 = 0), emission and next-event estimation.
@@ -39,6 +41,24 @@ layout(constant_id = kPtSpecEmitters) const bool kEmitters = true;
 
 const float kPtMaxValue = 1e30;  // clamp so sums of finite samples stay finite
 
+PtShading pt_shading(uint i) {
+  const int k = int(4u * i);
+  const vec4 a = texelFetch(shading, k), b = texelFetch(shading, k + 1), c = texelFetch(shading, k + 2),
+             d = texelFetch(shading, k + 3);
+  return PtShading(a.x, a.y, a.z, a.w, b.x, b.y, b.z, b.w, c.x, c.y, c.z, c.w, d.x, d.y, d.z, d.w);
+}
+
+PtMaterial pt_material(uint i) {
+  const int k = int(3u * i);
+  const vec4 a = texelFetch(materials, k), b = texelFetch(materials, k + 1), c = texelFetch(materials, k + 2);
+  return PtMaterial(a.x, a.y, a.z, floatBitsToInt(a.w), b.x, b.y, b.z, b.w, c.x, c.y, floatBitsToUint(c.z), c.w);
+}
+
+PtLight pt_light(uint i) {
+  const vec4 a = texelFetch(lights, int(i));
+  return PtLight(floatBitsToUint(a.x), a.y, a.z, a.w);
+}
+
 vec3 srgb_to_linear(vec3 c) {
   return mix(c / 12.92, pow((c + 0.055) / 1.055, vec3(2.4)), greaterThan(c, vec3(0.04045)));
 }
@@ -46,7 +66,7 @@ vec3 srgb_to_linear(vec3 c) {
 vec3 texel(PtTextureInfo t, int x, int y) {
   x = clamp(x, 0, int(t.width) - 1);
   y = clamp(y, 0, int(t.height) - 1);
-  return srgb_to_linear(unpackUnorm4x8(texels[t.offset + uint(y) * t.width + uint(x)]).rgb);
+  return srgb_to_linear(unpackUnorm4x8(texelFetch(texels, int(t.offset + uint(y) * t.width + uint(x))).x).rgb);
 }
 
 // Bilinear, repeating, on linear values.
@@ -72,7 +92,7 @@ struct Surface {
 Surface surface(PtHit h, vec3 org, vec3 dir) {
   Surface s;
   const PtTriangle t = pt_tri(h.tri);
-  const PtShading sh = shading[h.tri];
+  const PtShading sh = pt_shading(h.tri);
   const vec3 v0 = vec3(t.v0_x, t.v0_y, t.v0_z), v1 = vec3(t.v1_x, t.v1_y, t.v1_z), v2 = vec3(t.v2_x, t.v2_y, t.v2_z);
   const float w0 = 1.0 - h.bary.x - h.bary.y;
   s.p = w0 * v0 + h.bary.x * v1 + h.bary.y * v2;
@@ -88,7 +108,7 @@ Surface surface(PtHit h, vec3 org, vec3 dir) {
   s.ng = ng;
   s.ns = ns;
   s.material = t.material;
-  const PtMaterial m = materials[t.material];
+  const PtMaterial m = pt_material(t.material);
   s.lit = s.front || m.double_sided != 0u;
   s.base = s.lit ? vec3(m.base_r, m.base_g, m.base_b) : vec3(0.0);
   if (kTextures && m.texture >= 0 && s.lit) {
@@ -101,7 +121,7 @@ Surface surface(PtHit h, vec3 org, vec3 dir) {
 }
 
 PtBsdf bsdf_of(Surface s) {
-  const PtMaterial m = materials[s.material];
+  const PtMaterial m = pt_material(s.material);
   PtBsdf b;
   b.diffuse = s.base * (1.0 - m.metallic);
   b.f0 = kGlossy && s.lit ? mix(vec3(m.specular), s.base, m.metallic) : vec3(0.0);
@@ -123,9 +143,9 @@ vec3 sample_light(Surface s, PtBsdf b, vec3 wo, bool mis, inout PtRng rng) {
   uint lo = 0u, hi = pc.light_count - 1u;
   while (lo < hi) {  // first light whose CDF exceeds ul
     const uint mid = (lo + hi) / 2u;
-    if (lights[mid].cdf > ul) hi = mid; else lo = mid + 1u;
+    if (texelFetch(lights, int(mid)).y > ul) hi = mid; else lo = mid + 1u;  // .y: PtLight::cdf
   }
-  const PtLight l = lights[lo];
+  const PtLight l = pt_light(lo);
   const PtTriangle t = pt_tri(l.triangle);
   const vec3 v0 = vec3(t.v0_x, t.v0_y, t.v0_z), v1 = vec3(t.v1_x, t.v1_y, t.v1_z), v2 = vec3(t.v2_x, t.v2_y, t.v2_z);
   const float su = sqrt(u1);
@@ -136,7 +156,7 @@ vec3 sample_light(Surface s, PtBsdf b, vec3 wo, bool mis, inout PtRng rng) {
   if (!(d2 > 0.0)) return vec3(0.0);
   const float dist = sqrt(d2);
   const vec3 wi = to / dist;
-  const PtMaterial lm = materials[t.material];
+  const PtMaterial lm = pt_material(t.material);
   // Single-sided emitters emit from their front face only, double-sided ones from both.
   const float cos_l = lm.double_sided != 0u ? abs(dot(nl, wi)) : -dot(nl, wi);
   if (cos_l <= 0.0 || dot(s.ng, wi) <= 0.0) return vec3(0.0);

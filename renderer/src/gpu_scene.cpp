@@ -128,15 +128,15 @@ GpuScene::GpuScene(gpu::Context& ctx, const Scene& s, const BvhOptions& bvh_opti
   if (table.empty()) table.push_back({0, 1, 1, 0});
   if (texels.empty()) texels.push_back(0xFFFFFFFFu);
 
-  // Read by every traversal step: texel fetches (pt_traverse.h, pt_node / pt_tri).
+  // Also texel buffers, the tracers' reads (pt_traverse.h says why).
   nodes_ = upload(ctx, bvh.nodes, "pt.bvh_nodes", VK_FORMAT_R32G32B32A32_UINT);
   triangles_ = upload(ctx, tris, "pt.triangles", VK_FORMAT_R32G32B32A32_UINT);
-  shading_ = upload(ctx, shading, "pt.shading");
-  materials_ = upload(ctx, mats, "pt.materials");
-  lights_ = upload(ctx, lights, "pt.lights");
+  shading_ = upload(ctx, shading, "pt.shading", VK_FORMAT_R32G32B32A32_SFLOAT);
+  materials_ = upload(ctx, mats, "pt.materials", VK_FORMAT_R32G32B32A32_SFLOAT);
+  lights_ = upload(ctx, lights, "pt.lights", VK_FORMAT_R32G32B32A32_SFLOAT);
   texture_table_ = upload(ctx, table, "pt.texture_table");
-  texels_ = upload(ctx, texels, "pt.texels");
-  ggx_albedo_ = upload(ctx, ggx_albedo_table(), "pt.ggx_albedo");
+  texels_ = upload(ctx, texels, "pt.texels", VK_FORMAT_R32_UINT);
+  ggx_albedo_ = upload(ctx, ggx_albedo_table(), "pt.ggx_albedo", VK_FORMAT_R32G32B32A32_SFLOAT);
   environment_ = s.environment;
   stats_.triangles = std::uint32_t(n);
   stats_.nodes = std::uint32_t(bvh.nodes.size());

@@ -17,10 +17,11 @@ namespace {
 constexpr int kOutputs = 6;
 constexpr int kBindings = 8 + kOutputs + 1;  // scene, grid, outputs, GGX albedo table
 
-// Bindings 0 and 1 (BVH nodes, triangles) are texel buffers, the rest storage buffers.
+// The scene data read per ray or path vertex are texel buffers (nodes, triangles, shading,
+// materials, lights, texture texels, GGX albedo), the rest storage buffers.
 std::vector<gpu::Binding> set0_bindings() {
   std::vector<gpu::Binding> b(kBindings, gpu::Binding::StorageBuffer);
-  b[0] = b[1] = gpu::Binding::TexelBuffer;
+  for (const int i : {0, 1, 2, 3, 4, 6, kBindings - 1}) b[std::size_t(i)] = gpu::Binding::TexelBuffer;
   return b;
 }
 }  // namespace

@@ -56,7 +56,8 @@ class GpuScene {
   GpuScene(gpu::Context& ctx, const Scene& scene, const BvhOptions& bvh = {}, Tracing tracing = Tracing::Auto);
   ~GpuScene();
 
-  // Both also R32G32B32A32_UINT texel buffers (`usamplerBuffer nodes, tris` in the tracers).
+  // nodes, triangles (R32G32B32A32_UINT), shading, materials, lights, ggx_albedo
+  // (R32G32B32A32_SFLOAT) and texels (R32_UINT) are also texel buffers, as the tracers read them.
   const gpu::Buffer& nodes() const { return nodes_; }
   const gpu::Buffer& triangles() const { return triangles_; }
   const gpu::Buffer& shading() const { return shading_; }

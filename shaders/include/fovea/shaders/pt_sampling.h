@@ -1,7 +1,7 @@
 // GLSL only: the counter-based random numbers and the BSDF (GGX with Smith masking and a
 // multiple-scattering lobe over an energy-compensated Lambert base, glTF
 // metallic-roughness) of the path tracer. The includer
-// declares `vec4 ggx_albedo[]`, the table described with kPtGgxTableSize (pt_scene.h).
+// declares `samplerBuffer ggx_albedo`, the table described with kPtGgxTableSize (pt_scene.h).
 #ifndef FOVEA_SHADERS_PT_SAMPLING_H
 #define FOVEA_SHADERS_PT_SAMPLING_H
 
@@ -78,7 +78,9 @@ vec4 pt_ggx_albedo(float mu, float alpha) {
   const vec2 f = p - vec2(i0);
   const uint row = kPtGgxTableSize;
   const uint k = i0.y * row + i0.x;
-  return mix(mix(ggx_albedo[k], ggx_albedo[k + 1u], f.x), mix(ggx_albedo[k + row], ggx_albedo[k + row + 1u], f.x), f.y);
+  const int i = int(k), r = int(row);
+  return mix(mix(texelFetch(ggx_albedo, i), texelFetch(ggx_albedo, i + 1), f.x),
+             mix(texelFetch(ggx_albedo, i + r), texelFetch(ggx_albedo, i + r + 1), f.x), f.y);
 }
 
 // Multiple scattering of the specular layer (Kulla & Conty 2017, "Revisiting physically
