@@ -18,7 +18,7 @@ layout(local_size_x = 64) in;
 #include "fovea/shaders/recon_grid.h"
 
 layout(std430, binding = RECON_MAPS) readonly buffer Maps { ReconGrid maps[]; };
-layout(std430, binding = RECON_TABLES) readonly buffer Tables { GridColumn tables[]; };
+layout(binding = RECON_TABLES) uniform samplerBuffer tables;  // GridColumn: rg_table()
 layout(std430, binding = RECON_ACC_SAMPLES) readonly buffer Samples { GridSample samples[]; };
 layout(binding = RECON_ACC_DIRECT) uniform samplerBuffer direct;
 layout(binding = RECON_ACC_INDIRECT) uniform samplerBuffer indirect;

@@ -19,7 +19,7 @@ layout(local_size_x = 8, local_size_y = 8) in;
 #include "fovea/shaders/recon_grid.h"
 
 layout(std430, binding = RECON_MAPS) readonly buffer Maps { ReconGrid maps[]; };
-layout(std430, binding = RECON_TABLES) readonly buffer Tables { GridColumn tables[]; };
+layout(binding = RECON_TABLES) uniform samplerBuffer tables;  // GridColumn: rg_table()
 layout(std430, binding = RECON_BLUR_SRC) readonly buffer Src { vec4 src[]; };
 layout(std430, binding = RECON_BLUR_DST) writeonly buffer Dst { vec4 dst[]; };
 
@@ -44,7 +44,7 @@ void main() {
   uint c = pc.first_column + gl_GlobalInvocationID.x, r = gl_GlobalInvocationID.y;
   if (c >= m.g.columns || r >= m.g.padded_rows) return;
   uint i = r * m.g.padded_columns + c;
-  GridColumn col = tables[m.table_offset + c];
+  GridColumn col = rg_table(m.table_offset + c);
   if (r >= col.rows) return;  // beyond the column's rows: no kernel reads these cells
   bool phi_pass = pc.phi_pass != 0u;
   float e = 0.5 * (col.r0 + col.r1);

@@ -13,7 +13,7 @@ layout(local_size_x = 8, local_size_y = 8) in;
 #include "fovea/shaders/recon_grid.h"
 
 layout(std430, binding = RECON_MAPS) readonly buffer Maps { ReconGrid maps[]; };
-layout(std430, binding = RECON_TABLES) readonly buffer Tables { GridColumn tables[]; };
+layout(binding = RECON_TABLES) uniform samplerBuffer tables;  // GridColumn: rg_table()
 layout(std430, binding = RECON_MIP_MIPS) buffer Mips { vec4 mips[]; };
 
 #include "fovea/shaders/recon_map.h"

@@ -15,7 +15,7 @@ layout(local_size_x = 64) in;
 #include "fovea/shaders/recon_grid.h"
 
 layout(std430, binding = RECON_MAPS) readonly buffer Maps { ReconGrid maps[]; };
-layout(std430, binding = RECON_TABLES) readonly buffer Tables { GridColumn tables[]; };
+layout(binding = RECON_TABLES) uniform samplerBuffer tables;  // GridColumn: rg_table()
 layout(std430, binding = RECON_LUT_OUT) writeonly buffer Lut {
   ReconRadiusLutHeader lut_header;
   uint lut[];  // kReconRadiusLutSize + 2 entries
@@ -29,7 +29,7 @@ void main() {
   if (k >= size + 2u) return;
   ReconGrid m = maps[kReconCurrent];
   uint last = m.g.columns - 1u;
-  float scale = float(size) / max(tables[m.table_offset + last].r1, 1e-6);
+  float scale = float(size) / max(rg_table(m.table_offset + last).r1, 1e-6);
   if (k == 0u) lut_header = ReconRadiusLutHeader(scale, size, m.table_offset, 0u);
   lut[k] = k > size ? last : rg_column_of(m, (float(k) - 0.5) / scale, uvec2(0u, m.g.columns));
 }

@@ -16,7 +16,7 @@ layout(local_size_x = 8, local_size_y = 8) in;
 #include "fovea/shaders/recon_grid.h"
 
 layout(std430, binding = RECON_MAPS) readonly buffer Maps { ReconGrid maps[]; };
-layout(std430, binding = RECON_TABLES) readonly buffer Tables { GridColumn tables[]; };
+layout(binding = RECON_TABLES) uniform samplerBuffer tables;  // GridColumn: rg_table()
 layout(std430, binding = RECON_RESOLVE_MIPS) readonly buffer Mips { vec4 mips[]; };
 layout(std430, binding = RECON_RESOLVE_OFFSETS) readonly buffer Offsets { uint level_offset[]; };
 layout(std430, binding = RECON_RESOLVE_SCREEN) writeonly buffer Screen { vec4 screen[]; };

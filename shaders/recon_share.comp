@@ -17,7 +17,7 @@ layout(local_size_x = 64) in;
 #include "fovea/shaders/recon_grid.h"
 
 layout(std430, binding = RECON_MAPS) readonly buffer Maps { ReconGrid maps[]; };
-layout(std430, binding = RECON_TABLES) readonly buffer Tables { GridColumn tables[]; };
+layout(binding = RECON_TABLES) uniform samplerBuffer tables;  // GridColumn: rg_table()
 layout(binding = RECON_SHARE_POS) uniform samplerBuffer vpos;
 layout(binding = RECON_SHARE_NRM) uniform samplerBuffer vnrm;
 layout(binding = RECON_SHARE_ACC_DIRECT) uniform samplerBuffer acc_direct;
@@ -57,7 +57,7 @@ bool straddles(ReconGrid m, uint i, vec4 here, vec4 nd) {
       if (dc == 0 && dr == 0) continue;
       if (rr < 0 || rr >= rows) {
         if (!wraps) continue;
-        rr = (rr % rows + rows) % rows;
+        rr = rg_wrap(rr, rows);
       }
       uint k = uint(rr) * m.g.padded_columns + uint(cc);
       vec4 there = texelFetch(vpos, int(k));

@@ -39,7 +39,7 @@ layout(local_size_x = 64) in;
 #include "fovea/shaders/recon_grid.h"
 
 layout(std430, binding = RECON_MAPS) readonly buffer Maps { ReconGrid maps[]; };
-layout(std430, binding = RECON_TABLES) readonly buffer Tables { GridColumn tables[]; };
+layout(binding = RECON_TABLES) uniform samplerBuffer tables;  // GridColumn: rg_table()
 layout(binding = RECON_TAA_POS) uniform samplerBuffer vpos;
 layout(binding = RECON_TAA_TAP_IDX) uniform usamplerBuffer tap_idx;
 layout(binding = RECON_TAA_TAP_W) uniform samplerBuffer tap_w;

@@ -11,7 +11,8 @@
 # first render traces it (`render --reference SPP --reference-window DEG`), the second reads
 # it from the cache.
 # Environment: FOVEA (the binary) [build/release/tools/fovea]; FRAMES [3]; BUDGET: Visual-Polar's
-# --budget [its default]; REF_WINDOW [7]
+# --budget [its default]; TRACE: both renders' --trace [auto: ray queries where the device
+# has them]; REF_WINDOW [7]
 # (degrees; 0: the whole view, rendered first by `fovea reference`); REF_SPP [256 for a
 # window, 8 for the whole view]: the reference's samples per pixel at most (it stops earlier
 # at a per-pixel relative error of REF_ERROR [0.02]); REF_BATCH [2]: the whole view's batch;
@@ -31,6 +32,7 @@ REF_BATCH=${REF_BATCH:-2}
 REF_ERROR=${REF_ERROR:-0.02}
 vp_budget=()
 [[ -n ${BUDGET:-} ]] && vp_budget=(--budget "$BUDGET")
+TRACE=${TRACE:-auto}
 command -v python3 >/dev/null || { echo "fove0-compare: python3 is needed for the table" >&2; exit 2; }
 [[ -x $FOVEA ]] || { echo "fove0-compare: no fovea binary at $FOVEA (./x build, or set FOVEA)" >&2; exit 2; }
 [[ -n ${VK_ICD_FILENAMES:-} ]] || eval "$(./x env)"
@@ -62,7 +64,7 @@ for dist in visual-polar cartesian; do
   loads+=("$(load)")
   budget=()
   [[ $dist == visual-polar ]] && budget=("${vp_budget[@]}")
-  "$FOVEA" render --display "$PRESET" --scene default --frames "$FRAMES" --distribution $dist --png-every 0 --quiet \
+  "$FOVEA" render --display "$PRESET" --scene default --frames "$FRAMES" --distribution $dist --png-every 0 --quiet --trace "$TRACE" \
     "${budget[@]}" "${reference[@]}" --out "$OUT/$dist" >/dev/null
 done
 loads+=("$(load)")
@@ -105,7 +107,7 @@ print(f"reference: {ref}; left {ri['left']['spp']} spp, per-pixel rel. error {ri
       f"HDR-FLIP exposures from the {ri['left']['hdr_flip_exposures']['from']}")
 print(f"device: {rep['cartesian']['device']['name']} ({rep['cartesian']['device']['driver']}); "
       f"load average (1/5/15 min) before VP, before Cartesian, after: {' | '.join(loads)}")
-print(f"visual-polar budget {rep['visual-polar']['config']['budget']}")
+print(f"visual-polar budget {rep['visual-polar']['config']['budget']}; tracing: {rep['cartesian']['trace']}")
 print(f"median of {rep['cartesian']['frames']} frames, both eyes, ms; quality of the last frame, both eyes "
       "(PSNR tone-mapped, pooled by MSE; HDR-FLIP mean), bands in degrees of eccentricity")
 cols = ["traced/eye", "trace", "reconstruct", "resolve", "trace+recon", "frame GPU", "frame CPU+GPU"]

@@ -46,8 +46,9 @@ GridMapping::GridMapping(gpu::Context& ctx, const core::SampleDistribution& own,
       table_len_(table_len(own)),
       other_table_len_(other ? table_len(*other) : table_len(own)),
       maps_(storage(ctx, 3 * sizeof(ReconGrid), "recon.maps", gpu::Memory::HostVisible)),
-      tables_(storage(ctx, VkDeviceSize(2 * table_len_ + other_table_len_) * sizeof(GridColumn), "recon.tables",
-                      gpu::Memory::HostVisible)) {}
+      tables_(gpu::Buffer(ctx, {.size = VkDeviceSize(2 * table_len_ + other_table_len_) * sizeof(GridColumn),
+                                .memory = gpu::Memory::HostVisible, .name = "recon.tables",
+                                .texel_format = VK_FORMAT_R32G32B32A32_SFLOAT})) {}
 
 void GridMapping::write(const core::Pose& own_pose, const core::Pose* other_pose) {
   ReconGrid m[3] = {recon_grid(*own_, own_pose, 0), prev_, ReconGrid{}};

@@ -1,9 +1,17 @@
 // GLSL only: grid-space mapping helpers of the reconstruction (see recon_grid.h). Include
-// after declaring the mapping and column-table buffers:
-//   buffer ... { ReconGrid maps[]; }  and  buffer ... { GridColumn tables[]; }
+// after declaring the mapping buffer and the column table's texel buffer:
+//   buffer ... { ReconGrid maps[]; }  and  uniform samplerBuffer tables;
 #ifndef FOVEA_SHADERS_RECON_MAP_H
 #define FOVEA_SHADERS_RECON_MAP_H
 const float kRgPi = 3.14159265358979323846;
+
+// Column k of the bound column tables: two RGBA32F texels per GridColumn (read per
+// invocation at a per-invocation column, which lavapipe fetches as one vector gather per
+// texel; docs/gpu.md, "Texel buffers").
+GridColumn rg_table(uint k) {
+  const vec4 a = texelFetch(tables, int(2u * k)), b = texelFetch(tables, int(2u * k + 1u));
+  return GridColumn(a.x, a.y, floatBitsToUint(a.z), a.w, b.x, b.y, b.z, b.w);
+}
 
 vec3 rg_gaze(ReconGrid m) { return vec3(m.g.gaze_x, m.g.gaze_y, m.g.gaze_z); }
 
@@ -46,7 +54,7 @@ bool rg_dir_to_pixel(ReconGrid m, vec3 d, out vec2 px) {
 }
 
 // Rows of column c (the raster's row count for the Cartesian family).
-uint rg_rows(ReconGrid m, uint c) { return m.g.family == kFamilyCartesian ? m.g.rows : tables[m.table_offset + c].rows; }
+uint rg_rows(ReconGrid m, uint c) { return m.g.family == kFamilyCartesian ? m.g.rows : rg_table(m.table_offset + c).rows; }
 
 // Column search range [x, y) for radius r: the whole table, or — in kernels that define
 // RG_RADIUS_LUT and bind the current mapping's radius -> column lookup table
@@ -65,12 +73,12 @@ uvec2 rg_column_range(ReconGrid m, float r) { return uvec2(0u, m.g.columns); }
 // Whether column c's rows wrap in φ: a full polar ring; not a column packed to its visible
 // arc (GridColumn::phi_gap > 0), nor the Cartesian raster.
 bool rg_wraps(ReconGrid m, uint c) {
-  return m.g.family != kFamilyCartesian && tables[m.table_offset + c].phi_gap == 0.0;
+  return m.g.family != kFamilyCartesian && rg_table(m.table_offset + c).phi_gap == 0.0;
 }
 
 // Fraction of the full turn column c's rows cover (1: a full ring or the raster).
 float rg_arc_turns(ReconGrid m, uint c) {
-  return m.g.family == kFamilyCartesian ? 1.0 : 1.0 - tables[m.table_offset + c].phi_gap / (2.0 * kRgPi);
+  return m.g.family == kFamilyCartesian ? 1.0 : 1.0 - rg_table(m.table_offset + c).phi_gap / (2.0 * kRgPi);
 }
 
 // Rows column c would have over a full turn at its spacing along φ.
@@ -80,7 +88,7 @@ float rg_turn_rows(ReconGrid m, uint c) { return float(rg_rows(m, c)) / rg_arc_t
 // gap), so the helpers below that take an entry serve every family.
 GridColumn rg_column(ReconGrid m, uint c) {
   if (m.g.family == kFamilyCartesian) return GridColumn(float(c), float(c + 1u), m.g.rows, 0.0, 0.0, 0.0, 0.0, 0.0);
-  return tables[m.table_offset + c];
+  return rg_table(m.table_offset + c);
 }
 
 // rg_row_coord below for a column entry read once (rg_column): kernels that need several
@@ -105,7 +113,15 @@ float rg_row_to_t_of(GridColumn col, float v) {
 }
 float rg_row_to_t(ReconGrid m, uint c, float v) {
   if (m.g.family == kFamilyCartesian) return v / float(max(m.g.rows, 1u));
-  return rg_row_to_t_of(tables[m.table_offset + c], v);
+  return rg_row_to_t_of(rg_table(m.table_offset + c), v);
+}
+
+// r modulo rows (in [0, rows)) for rows > 0 and |r| < 2^22, without an integer division:
+// lavapipe has no vector integer division and runs one per SIMD lane, where the float
+// quotient is one vector instruction; the guards undo its rounding at exact multiples.
+int rg_wrap(int r, int rows) {
+  r -= rows * int(floor(float(r) / float(rows)));
+  return r < 0 ? r + rows : (r >= rows ? r - rows : r);
 }
 
 // The two rows of a column of `rows` rows around row coordinate v (cell centres at +0.5)
@@ -132,7 +148,7 @@ uint rg_column_of(ReconGrid m, float r, uvec2 range) {
   uint lo = range.x, hi = range.y;
   while (hi - lo > 1u) {
     uint mid = (lo + hi) >> 1;
-    if (tables[m.table_offset + mid].r0 <= r) lo = mid; else hi = mid;
+    if (rg_table(m.table_offset + mid).r0 <= r) lo = mid; else hi = mid;
   }
   return lo;
 }
@@ -141,7 +157,7 @@ uint rg_column_of(ReconGrid m, float r, uvec2 range) {
 // last boundary <= r, linear inside the column, clamped to the table (ρ clamp).
 float rg_radius_to_u(ReconGrid m, float r) {
   uint i = rg_column_of(m, r, rg_column_range(m, r));
-  GridColumn c = tables[m.table_offset + i];
+  GridColumn c = rg_table(m.table_offset + i);
   float w = c.r1 - c.r0;
   return float(i) + (w > 0.0 ? clamp((r - c.r0) / w, 0.0, 1.0) : 0.5);
 }
@@ -195,8 +211,8 @@ void rg_taps(ReconGrid m, vec2 uv, out uvec4 idx, out vec4 w) {
     float fy = vr - r0f;
     int r0 = int(r0f), r1 = r0 + 1;
     if (rg_wraps(m, c)) {
-      r0 = (r0 % int(rows) + int(rows)) % int(rows);
-      r1 = r1 % int(rows);
+      r0 = rg_wrap(r0, int(rows));
+      r1 = rg_wrap(r1, int(rows));
     } else {
       r0 = clamp(r0, 0, int(rows) - 1);
       r1 = clamp(r1, 0, int(rows) - 1);
@@ -231,7 +247,7 @@ bool rg_neighbour_of(ReconGrid m, RgCell c, int dc, int dr, out uint k) {
   if (cc < 0 || cc >= int(m.g.columns)) return false;
   int rows = int(max(rg_rows(m, uint(cc)), 1u));
   int rr = int(floor(rg_row_coord(m, uint(cc), c.t))) + dr;
-  if (rg_wraps(m, uint(cc))) rr = (rr % rows + rows) % rows;
+  if (rg_wraps(m, uint(cc))) rr = rg_wrap(rr, rows);
   else if (rr < 0 || rr >= rows) return false;
   k = uint(rr) * m.g.padded_columns + uint(cc);
   return true;
@@ -259,7 +275,7 @@ vec2 rg_unjitter(ReconGrid cur, uint col, ReconGrid m, vec2 uv) {
 // Cartesian raster, whose cells never change size.
 float rg_cell_size(ReconGrid m, uint c) {
   if (m.g.family == kFamilyCartesian) return 1.0;
-  GridColumn col = tables[m.table_offset + min(c, m.g.columns - 1u)];
+  GridColumn col = rg_table(m.table_offset + min(c, m.g.columns - 1u));
   float rm = 0.5 * (col.r0 + col.r1);
   float circumference = m.g.family == kFamilyAngularPolar ? 360.0 * sin(rm * (kRgPi / 180.0)) : 2.0 * kRgPi * rm;
   float turns = 1.0 - col.phi_gap / (2.0 * kRgPi);
