@@ -14,7 +14,7 @@ layout(local_size_x = 8, local_size_y = 8) in;
 
 layout(std430, binding = RECON_MAPS) readonly buffer Maps { ReconGrid maps[]; };
 layout(binding = RECON_TABLES) uniform samplerBuffer tables;  // GridColumn: rg_table()
-layout(std430, binding = RECON_BLUR_SRC) readonly buffer Src { vec4 src[]; };
+layout(binding = RECON_BLUR_SRC) uniform samplerBuffer src;
 layout(std430, binding = RECON_BLUR_DST) writeonly buffer Dst { vec4 dst[]; };
 
 #include "fovea/shaders/recon_map.h"
@@ -31,7 +31,7 @@ void main() {
   float cos_e = dot(vec3(t, -1.0), g) * inversesqrt(1.0 + dot(t, t));
   uint i = p.y * pc.width + p.x;
   if (cos_e > pc.cos_skip) {  // near the gaze: σ < min_sigma_px on any pixel of this raster
-    dst[i] = src[i];
+    dst[i] = texelFetch(src, int(i));
     return;
   }
   float e = atan(sqrt(max(1.0 - cos_e * cos_e, 0.0)), cos_e) * (180.0 / kRgPi);
@@ -39,7 +39,7 @@ void main() {
   float deg_per_px = rg_pixel_angle(m, t, vertical) * (180.0 / kRgPi);
   float sigma = min(rg_blur_sigma_deg(e, pc.sigma_fovea_deg) / max(deg_per_px, 1e-6), pc.max_sigma_px);
   if (sigma < pc.min_sigma_px) {
-    dst[i] = src[i];
+    dst[i] = texelFetch(src, int(i));
     return;
   }
   int radius = int(ceil(3.0 * sigma));
@@ -50,17 +50,17 @@ void main() {
   // w_k = w_{k-1}·q_{k-1}, q_k = q_{k-1}·exp(2a) (no exp per tap).
   float a = -0.5 / (sigma * sigma);
   float w = 1.0, q = exp(a), q2 = q * q;
-  vec4 acc = src[i];
+  vec4 acc = texelFetch(src, int(i));
   float wsum = 1.0;
   for (int k = 1; k <= radius; ++k) {
     w *= q;
     q *= q2;
     if (pos - k >= 0) {
-      acc += w * src[int(i) - k * stride];
+      acc += w * texelFetch(src, int(int(i) - k * stride));
       wsum += w;
     }
     if (pos + k < n) {
-      acc += w * src[int(i) + k * stride];
+      acc += w * texelFetch(src, int(int(i) + k * stride));
       wsum += w;
     }
   }

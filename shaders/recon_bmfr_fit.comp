@@ -37,14 +37,14 @@ layout(constant_id = 1) const bool kFp16 = false;   // features rounded to fp16 
 #include "fovea/shaders/recon_grid.h"
 #include "fovea/shaders/pt_scene.h"
 
-layout(std430, binding = RECON_BMFR_POS) readonly buffer Pos { vec4 vpos[]; };
-layout(std430, binding = RECON_BMFR_NRM) readonly buffer Nrm { vec4 vnrm[]; };
-layout(std430, binding = RECON_BMFR_Z) readonly buffer Z { vec4 z[]; };
+layout(binding = RECON_BMFR_POS) uniform samplerBuffer vpos;
+layout(binding = RECON_BMFR_NRM) uniform samplerBuffer vnrm;
+layout(binding = RECON_BMFR_Z) uniform samplerBuffer z;
 layout(std430, binding = RECON_BMFR_FITTED) writeonly buffer Fitted { vec4 fitted[]; };
 layout(std430, binding = RECON_BMFR_COLUMNS) readonly buffer Columns { GridColumn tables[]; };
 layout(std430, binding = RECON_BMFR_MATERIALS) readonly buffer Materials { PtMaterial materials[]; };
 layout(std430, binding = RECON_BMFR_EXCESS) writeonly buffer Excess { vec4 excess[]; };
-layout(std430, binding = RECON_BMFR_EDGE) readonly buffer Edge { uint edge[]; };  // 1: on a surface edge
+layout(binding = RECON_BMFR_EDGE) uniform usamplerBuffer edge;  // 1: on a surface edge
 
 layout(push_constant) uniform Push { ReconBmfrPush pc; };
 
@@ -168,10 +168,11 @@ void main() {
     if (!inside(c)) continue;
     uint i = uint(c.y) * pc.padded_columns + uint(c.x);
     s_cell[row] = i | kMasked;
-    vec4 p = vpos[i];
-    if (p.w < 0.0 || !has_diffuse(p.w) || edge[i] != 0u) continue;  // sky, emitter, no sample, metal, edge
+    vec4 p = texelFetch(vpos, int(i));
+    // Sky, emitter, no sample, metal, edge.
+    if (p.w < 0.0 || !has_diffuse(p.w) || texelFetch(edge, int(i)).x != 0u) continue;
     s_cell[row] = i;
-    vec3 zin = z[i].rgb;
+    vec3 zin = texelFetch(z, int(i)).rgb;
     [[unroll]] for (uint a = 0u; a < 3u; ++a) {
       vals[a] = max(vals[a], p[a]);
       vals[3u + a] = max(vals[3u + a], -p[a]);
@@ -201,7 +202,7 @@ void main() {
       uint cell = s_cell[tid + q * kGroup];
       if (cell == kOutside) continue;
       uint i = cell & ~kMasked;
-      fitted[i] = rg_no_sample(vpos[i].w) ? vec4(0.0) : z[i];
+      fitted[i] = rg_no_sample(texelFetch(vpos, int(i)).w) ? vec4(0.0) : texelFetch(z, int(i));
       excess[i] = vec4(0.0);
     }
     return;
@@ -217,8 +218,8 @@ void main() {
   [[dont_unroll]] for (uint q = 0u; q < kRows; ++q) {
     uint cell = s_cell[tid + q * kGroup];
     if (cell >= kMasked) continue;
-    vec3 n = vnrm[cell].xyz;
-    vec3 w = clamp((vpos[cell].xyz - mid) * inv_half, -1.0, 1.0);
+    vec3 n = texelFetch(vnrm, int(cell)).xyz;
+    vec3 w = clamp((texelFetch(vpos, int(cell)).xyz - mid) * inv_half, -1.0, 1.0);
     [[unroll]] for (uint a = 0u; a < 3u; ++a) {
       vals[a] += n[a];
       vals[3u + a] += w[a];
@@ -236,11 +237,11 @@ void main() {
     uint row = tid + q * kGroup;
     uint cell = s_cell[row];
     if (cell >= kMasked) continue;
-    vec3 n = vnrm[cell].xyz - mean_n;
-    vec3 w = clamp((vpos[cell].xyz - mid) * inv_half, -1.0, 1.0);
+    vec3 n = texelFetch(vnrm, int(cell)).xyz - mean_n;
+    vec3 w = clamp((texelFetch(vpos, int(cell)).xyz - mid) * inv_half, -1.0, 1.0);
     vec3 w2 = w * w - mean_w2;
     w -= mean_w;
-    vec3 zz = min(z[cell].rgb, bound) / zmax;
+    vec3 zz = min(texelFetch(z, int(cell)).rgb, bound) / zmax;
     float t[kCols] = float[kCols](1.0, n.x, n.y, n.z, w.x, w.y, w.z, w2.x, w2.y, w2.z, zz.r, zz.g, zz.b);
     // Eq. 7: zero-mean uniform noise on the non-constant features, keyed by block, row, feature, frame.
     [[unroll]] for (uint j = 1u; j < kCols; ++j) {
@@ -259,15 +260,15 @@ void main() {
     uint cell = s_cell[tid + q * kGroup];
     if (cell == kOutside) continue;
     uint i = cell & ~kMasked;
-    vec4 zi = z[i];
+    vec4 zi = texelFetch(z, int(i));
     if (cell >= kMasked) {
-      fitted[i] = rg_no_sample(vpos[i].w) ? vec4(0.0) : zi;
+      fitted[i] = rg_no_sample(texelFetch(vpos, int(i)).w) ? vec4(0.0) : zi;
       excess[i] = vec4(0.0);
       continue;
     }
     excess[i] = vec4(max(zi.rgb - bound, vec3(0.0)), 0.0);
-    vec3 n = vnrm[i].xyz - mean_n;
-    vec3 w = clamp((vpos[i].xyz - mid) * inv_half, -1.0, 1.0);
+    vec3 n = texelFetch(vnrm, int(i)).xyz - mean_n;
+    vec3 w = clamp((texelFetch(vpos, int(i)).xyz - mid) * inv_half, -1.0, 1.0);
     vec3 w2 = w * w - mean_w2;
     w -= mean_w;
     float t[kM] = float[kM](1.0, n.x, n.y, n.z, w.x, w.y, w.z, w2.x, w2.y, w2.z);

@@ -20,7 +20,7 @@ layout(local_size_x = 8, local_size_y = 8) in;
 
 layout(std430, binding = RECON_MAPS) readonly buffer Maps { ReconGrid maps[]; };
 layout(binding = RECON_TABLES) uniform samplerBuffer tables;  // GridColumn: rg_table()
-layout(std430, binding = RECON_BLUR_SRC) readonly buffer Src { vec4 src[]; };
+layout(binding = RECON_BLUR_SRC) uniform samplerBuffer src;
 layout(std430, binding = RECON_BLUR_DST) writeonly buffer Dst { vec4 dst[]; };
 
 #include "fovea/shaders/recon_map.h"
@@ -36,7 +36,7 @@ vec4 column_at(ReconGrid m, uint cc, float t) {
   float f;
   rg_row_pair(int(max(col.rows, 1u)), col.phi_gap == 0.0, rg_row_coord_of(col, t), r0, r1, f);
   uint pcols = m.g.padded_columns;
-  return (1.0 - f) * src[uint(r0) * pcols + cc] + f * src[uint(r1) * pcols + cc];
+  return (1.0 - f) * texelFetch(src, int(uint(r0) * pcols + cc)) + f * texelFetch(src, int(uint(r1) * pcols + cc));
 }
 
 void main() {
@@ -52,14 +52,14 @@ void main() {
   float cell_deg = phi_pass ? 360.0 * sin(e * (kRgPi / 180.0)) * arc / float(col.rows) : col.r1 - col.r0;
   float sigma = min(rg_blur_sigma_deg(e, pc.sigma_fovea_deg) / max(cell_deg, 1e-6), pc.max_sigma_cells);
   if (sigma < pc.min_sigma_cells) {
-    dst[i] = src[i];
+    dst[i] = texelFetch(src, int(i));
     return;
   }
   int radius = int(ceil(3.0 * sigma));
   // Weights exp(a k²), a = -1/(2σ²), by the recurrence of recon_blur.comp.
   float a = -0.5 / (sigma * sigma);
   float w = 1.0, q = exp(a), q2 = q * q;
-  vec4 acc = src[i];
+  vec4 acc = texelFetch(src, int(i));
   float wsum = 1.0;
   if (phi_pass) {
     int rows = int(col.rows);
@@ -72,7 +72,7 @@ void main() {
         int rr = int(r) + s * k;
         if (wraps) rr += rr < 0 ? rows : (rr >= rows ? -rows : 0);
         else if (rr < 0 || rr >= rows) continue;
-        acc += w * src[uint(rr) * m.g.padded_columns + c];
+        acc += w * texelFetch(src, int(uint(rr) * m.g.padded_columns + c));
         wsum += w;
       }
     }

@@ -17,10 +17,10 @@ layout(local_size_x = 8, local_size_y = 8) in;
 
 layout(std430, binding = RECON_MAPS) readonly buffer Maps { ReconGrid maps[]; };
 layout(binding = RECON_TABLES) uniform samplerBuffer tables;  // GridColumn: rg_table()
-layout(std430, binding = RECON_RESOLVE_MIPS) readonly buffer Mips { vec4 mips[]; };
+layout(binding = RECON_RESOLVE_MIPS) uniform samplerBuffer mips;
 layout(std430, binding = RECON_RESOLVE_OFFSETS) readonly buffer Offsets { uint level_offset[]; };
 layout(std430, binding = RECON_RESOLVE_SCREEN) writeonly buffer Screen { vec4 screen[]; };
-layout(std430, binding = RECON_RESOLVE_POS) readonly buffer Pos { vec4 vpos[]; };  // world position, .w material code
+layout(binding = RECON_RESOLVE_POS) uniform samplerBuffer vpos;  // world position, .w material code
 layout(std430, binding = RECON_RESOLVE_DEPTH) writeonly buffer Depth { float depth[]; };
 layout(std430, binding = RECON_RESOLVE_LUT) readonly buffer Lut {
   ReconRadiusLutHeader lut_header;
@@ -58,7 +58,8 @@ vec4 fetch_column(ColumnTap k, uint level, uint base, uint pcols) {
   int r0, r1;
   float fy;
   rg_row_pair((k.rows + (1 << level) - 1) >> level, k.wraps, k.v / float(1u << level), r0, r1, fy);
-  return (1.0 - fy) * mips[base + uint(r0) * pcols + k.c] + fy * mips[base + uint(r1) * pcols + k.c];
+  return (1.0 - fy) * texelFetch(mips, int(base + uint(r0) * pcols + k.c)) +
+         fy * texelFetch(mips, int(base + uint(r1) * pcols + k.c));
 }
 
 // Bilinear at level `level` of the column pair (bilinear in ρ between two columns of
@@ -109,7 +110,7 @@ void main() {
   screen[i] = v.w > 1e-6 ? vec4(v.rgb / v.w, 1.0) : vec4(0.0, 0.0, 0.0, 1.0);
 
   uint r = min(uint(max(floor(near.v), 0.0)), uint(near.rows) - 1u);
-  vec4 s = vpos[r * m.g.padded_columns + near.c];
+  vec4 s = texelFetch(vpos, int(r * m.g.padded_columns + near.c));
   bool surface = s.w >= 0.0 || s.w <= kReconEmitterBase + 0.5;  // materials and emitters
   depth[i] = surface ? max(-rg_world_to_view(m, s.xyz, false).z, 0.0) : 0.0;
 }

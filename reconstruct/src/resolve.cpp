@@ -116,13 +116,13 @@ Resolve::Resolve(gpu::Context& ctx, std::span<const EyeGrid> eyes, const Accumul
       rows = (rows + 1) / 2;
     } while (g.polar && e.level_rows.back() > 1 && e.level_rows.size() < kMaxMipLevels);
     e.levels = std::uint32_t(e.level_rows.size());
-    e.mips = storage(ctx, VkDeviceSize(offset) * 16, "recon.mips");
+    e.mips = cells(ctx, offset, "recon.mips");
     e.offsets = storage(ctx, e.level_offset.size() * 4, "recon.mip_offsets");
     e.offsets.upload(e.level_offset);
-    const VkDeviceSize screen = VkDeviceSize(g.width) * g.height * 16;
-    e.screen_a = storage(ctx, screen, "recon.screen");
-    e.screen_b = storage(ctx, screen, "recon.screen_tmp");
-    e.depth = storage(ctx, screen / 4, "recon.depth");
+    const std::uint32_t pixels = g.width * g.height;
+    e.screen_a = cells(ctx, pixels, "recon.screen");
+    e.screen_b = cells(ctx, pixels, "recon.screen_tmp");
+    e.depth = storage(ctx, VkDeviceSize(pixels) * 4, "recon.depth");
     e.lut = storage(ctx, sizeof(shaders::ReconRadiusLutHeader) + (shaders::kReconRadiusLutSize + 2) * 4, "recon.radius_lut");
     e.mip_set = make_set(ctx, mip_, MipBindings{g.maps, g.tables, &e.mips});
     e.lut_set = make_set(ctx, lut_, RadiusLutBindings{g.maps, g.tables, &e.lut});
@@ -132,7 +132,7 @@ Resolve::Resolve(gpu::Context& ctx, std::span<const EyeGrid> eyes, const Accumul
     e.blur_h = make_set(ctx, blur_, BlurBindings{g.maps, g.tables, &e.screen_a, &e.screen_b});
     e.blur_v = make_set(ctx, blur_, BlurBindings{g.maps, g.tables, &e.screen_b, &e.screen_a});
     if (g.polar) {  // grid-space blur: level 0 -> grid_tmp (across columns) -> level 0 (along φ)
-      e.grid_tmp = storage(ctx, VkDeviceSize(g.padded_rows) * g.padded_columns * 16, "recon.grid_blur_tmp");
+      e.grid_tmp = cells(ctx, g.padded_rows * g.padded_columns, "recon.grid_blur_tmp");
       e.grid_blur_rho = make_set(ctx, grid_blur_, BlurBindings{g.maps, g.tables, &e.mips, &e.grid_tmp});
       e.grid_blur_phi = make_set(ctx, grid_blur_, BlurBindings{g.maps, g.tables, &e.grid_tmp, &e.mips});
     }
