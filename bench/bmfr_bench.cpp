@@ -96,9 +96,9 @@ void fit(benchmark::State& state) {
   fg::Context& ctx = context();
   static const Inputs in = room();
   const std::size_t bytes = in.pos.size() * 16;
-  auto make = [&](const char* name) {
+  auto make = [&](const char* name, VkFormat texels = VK_FORMAT_R32G32B32A32_SFLOAT) {  // the fit's texelFetch
     return fg::Buffer(ctx, {.size = bytes, .usage = fg::BufferUsage::Storage, .memory = fg::Memory::DeviceLocal,
-                            .name = name});
+                            .name = name, .texel_format = texels});
   };
   fg::Buffer p = make("bench.vpos"), n = make("bench.vnrm"), z = make("bench.z"), out = make("bench.fitted"),
              columns = make("bench.columns");  // unread: a raster grid does not wrap
@@ -114,7 +114,7 @@ void fit(benchmark::State& state) {
   z.upload(in.z);
   materials.upload(table);
   const fc::BmfrFit bmfr(ctx, options);
-  fg::Buffer excess = make("bench.excess"), edge = make("bench.edge");
+  fg::Buffer excess = make("bench.excess"), edge = make("bench.edge", VK_FORMAT_R32_UINT);
   edge.upload(std::vector<std::uint32_t>(in.pos.size(), 0u));  // the flags come from the chain's gather: none here
   const fg::DescriptorSet set = bmfr.bind(p, n, z, out, columns, materials, excess, edge);
   std::uint32_t frame = 0;

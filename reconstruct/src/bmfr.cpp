@@ -71,9 +71,10 @@ std::vector<glm::vec4> BmfrFit::fit(BmfrGrid g, const std::vector<glm::vec4>& vp
       throw core::InputError("bmfr: column " + std::to_string(c) + " has more rows than the grid");
     table[c].rows = rows[c];
   }
-  auto make = [&](const char* name) {
+  auto make = [&](const char* name) {  // RGBA32F texels: the fit reads its inputs with texelFetch
     return gpu::Buffer(*ctx_, {.size = cells * 16, .usage = gpu::BufferUsage::Storage,
-                               .memory = gpu::Memory::HostVisible, .name = name});
+                               .memory = gpu::Memory::HostVisible, .name = name,
+                               .texel_format = VK_FORMAT_R32G32B32A32_SFLOAT});
   };
   gpu::Buffer bp = make("bmfr.vpos"), bn = make("bmfr.vnrm"), bz = make("bmfr.z"), out = make("bmfr.fitted"),
               ex = make("bmfr.excess");
@@ -87,7 +88,7 @@ std::vector<glm::vec4> BmfrFit::fit(BmfrGrid g, const std::vector<glm::vec4>& vp
   gpu::Buffer bm(*ctx_, {.size = materials.size() * sizeof(shaders::PtMaterial), .usage = gpu::BufferUsage::Storage,
                          .memory = gpu::Memory::HostVisible, .name = "bmfr.materials"});
   gpu::Buffer be(*ctx_, {.size = cells * 4, .usage = gpu::BufferUsage::Storage, .memory = gpu::Memory::HostVisible,
-                         .name = "bmfr.edge"});
+                         .name = "bmfr.edge", .texel_format = VK_FORMAT_R32_UINT});
   be.upload(edge.empty() ? std::vector<std::uint32_t>(cells, 0u) : edge);
   bp.upload(vpos);
   bn.upload(vnrm);

@@ -48,7 +48,8 @@ class BmfrFit {
   explicit BmfrFit(gpu::Context& ctx, const BmfrOptions& options = {});
   // `columns`: the grid's column table (shaders::GridColumn, this frame's first);
   // `materials`: the scene's shaders::PtMaterial table (material codes beyond it count as diffuse);
-  // `edge`: uint per cell, non-zero for a cell on a surface edge.
+  // `edge`: uint per cell, non-zero for a cell on a surface edge. vpos, vnrm and z are read
+  // as texels and need BufferDesc::texel_format R32G32B32A32_SFLOAT, edge R32_UINT.
   gpu::DescriptorSet bind(const gpu::Buffer& vpos, const gpu::Buffer& vnrm, const gpu::Buffer& z,
                           const gpu::Buffer& fitted, const gpu::Buffer& columns, const gpu::Buffer& materials,
                           const gpu::Buffer& excess, const gpu::Buffer& edge) const;
