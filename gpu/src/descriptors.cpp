@@ -92,6 +92,9 @@ DescriptorSet& DescriptorSet::bind(std::uint32_t binding, const Buffer& buffer, 
     if (view == VK_NULL_HANDLE)
       throw core::InputError("gpu::DescriptorSet::bind: binding " + std::to_string(binding) +
                              " is a texel buffer, and the buffer has no texel format");
+    if (offset != 0 || range != VK_WHOLE_SIZE)
+      throw core::InputError("gpu::DescriptorSet::bind: binding " + std::to_string(binding) +
+                             " is a texel buffer, which binds its whole buffer (no offset or range)");
     write(binding, nullptr, nullptr, nullptr, &view);
     return *this;
   }

@@ -100,6 +100,7 @@ TEST_F(Buffers, TexelFormatsAreCheckedAndBoundToTexelBindingsOnly) {
   set.bind(0, texels).bind(1, texels);  // a buffer with a view serves both kinds of binding
   EXPECT_NE(message([&] { set.bind(1, plain); }).find("binding 1 is a texel buffer, and the buffer has no texel format"),
             std::string::npos);
+  EXPECT_NE(message([&] { set.bind(1, texels, 16); }).find("binds its whole buffer"), std::string::npos);
 }
 
 using Images = GpuTest;
