@@ -15,7 +15,6 @@
 
 #include <cmath>
 #include <cstdlib>
-#include <ctime>
 #include <random>
 #include <string>
 #include <vector>
@@ -23,6 +22,7 @@
 #include <glm/vec3.hpp>
 #include <glm/geometric.hpp>
 
+#include "fovea/core/clock.hpp"
 #include "fovea/core/display.hpp"
 #include "fovea/core/stereo_views.hpp"
 #include "fovea/gpu/context.hpp"
@@ -47,11 +47,7 @@ fg::Context& context() {
   return ctx;
 }
 
-double process_cpu_ms() {
-  timespec ts{};
-  clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &ts);
-  return double(ts.tv_sec) * 1e3 + double(ts.tv_nsec) * 1e-6;
-}
+double process_cpu_ms() { return fovea::core::ns_to_ms(fovea::core::process_cpu_ns()); }
 
 double load1() {
   double l[1] = {0};

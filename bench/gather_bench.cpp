@@ -8,9 +8,9 @@
 //   LP_NUM_THREADS=2 fovea_bench_gather
 #include <benchmark/benchmark.h>
 
-#include <ctime>
 #include <vector>
 
+#include "fovea/core/clock.hpp"
 #include "fovea/gpu/buffer.hpp"
 #include "fovea/gpu/context.hpp"
 #include "fovea/gpu/descriptors.hpp"
@@ -28,11 +28,7 @@ gpu::Context& context() {
   return ctx;
 }
 
-double process_cpu_ms() {
-  timespec t{};
-  clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &t);
-  return double(t.tv_sec) * 1e3 + double(t.tv_nsec) * 1e-6;
-}
+double process_cpu_ms() { return fovea::core::ns_to_ms(fovea::core::process_cpu_ns()); }
 
 struct Push {
   std::uint32_t count, mask, taps, random;

@@ -12,7 +12,6 @@
 #include <chrono>
 #include <cstdio>
 #include <cstdlib>
-#include <ctime>
 #include <map>
 #include <memory>
 #include <string>
@@ -22,6 +21,7 @@
 #include <glm/geometric.hpp>
 #include <glm/gtc/quaternion.hpp>
 
+#include "fovea/core/clock.hpp"
 #include "fovea/core/display.hpp"
 #include "fovea/gpu/context.hpp"
 #include "fovea/gpu/timer.hpp"
@@ -77,11 +77,7 @@ std::map<std::string, double>& results() {  // "<kind>/<scene>" -> rays or sampl
 
 // CPU time of the whole process (every lavapipe and Embree thread), ns: on a machine that
 // other jobs share, rays per CPU-second compare the two tracers more stably than wall time.
-std::int64_t process_cpu_ns() {
-  timespec ts{};
-  clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &ts);
-  return std::int64_t(ts.tv_sec) * 1000000000 + ts.tv_nsec;
-}
+using fovea::core::process_cpu_ns;
 
 // Times `run` (which traces `rays` rays) once per benchmark iteration; records rays per
 // wall-clock second and per process CPU-second under `key` and "cpu:" + key.

@@ -10,7 +10,9 @@
 // start). Then per round and configuration the second frame's GPU ms: trace, the trace
 // again alone in the order the pipeline picks and in the other one (testing::time_trace,
 // GPU and process CPU ms), the reconstruction kernels (timed again one submission each,
-// testing::time_reconstruct), resolve and frame, and the trace ms per 1000 traced samples.
+// testing::time_reconstruct) with each one's process CPU / GPU time (how many of lavapipe's
+// threads were busy on average: 2 for a dispatch split evenly), resolve and frame, and the
+// trace ms per 1000 traced samples.
 // Rounds interleave the configurations, so load on a shared machine spreads over all of
 // them; compare configurations within a round.
 //   fovea_bench_trace_cost [DISPLAY [ROUNDS [LANES]]]     defaults: fove0 1 8

@@ -1,18 +1,13 @@
 #include "fovea/pipeline/testing.hpp"
 
-#include <ctime>
-
+#include "fovea/core/clock.hpp"
 #include "fovea/core/error.hpp"
 #include "frame_pipeline_impl.hpp"
 
 namespace fovea::pipeline::testing {
 
 namespace {
-double process_cpu_ms() {
-  timespec ts{};
-  clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &ts);
-  return double(ts.tv_sec) * 1e3 + double(ts.tv_nsec) * 1e-6;
-}
+double process_cpu_ms() { return core::ns_to_ms(core::process_cpu_ns()); }
 }  // namespace
 
 std::vector<glm::vec4> grid_buffer(const FramePipeline& pipeline, core::Eye eye, GridBuffer which) {
