@@ -17,9 +17,10 @@ void check_range(const Buffer& b, VkDeviceSize offset, std::size_t bytes, const 
                             std::to_string(offset) + " exceed the buffer's " + std::to_string(b.size()) + " bytes");
 }
 
-// Bytes per texel of the formats a texel view may have; 0 for any other.
-VkDeviceSize texel_bytes(VkFormat f) {
-  switch (f) {
+}  // namespace
+
+VkDeviceSize texel_buffer_bytes(VkFormat format) {
+  switch (format) {
     case VK_FORMAT_R32_UINT: case VK_FORMAT_R32_SFLOAT: return 4;
     case VK_FORMAT_R32G32_UINT: case VK_FORMAT_R32G32_SFLOAT: return 8;
     case VK_FORMAT_R32G32B32A32_UINT: case VK_FORMAT_R32G32B32A32_SFLOAT: return 16;
@@ -27,12 +28,10 @@ VkDeviceSize texel_bytes(VkFormat f) {
   }
 }
 
-}  // namespace
-
 Buffer::Buffer(Context& ctx, const BufferDesc& desc) : ctx_(&ctx), size_(desc.size) {
   if (desc.size == 0) throw core::InputError("gpu::Buffer '" + desc.name + "': size must be > 0");
   const bool texels = desc.texel_format != VK_FORMAT_UNDEFINED;
-  const VkDeviceSize texel = texel_bytes(desc.texel_format);
+  const VkDeviceSize texel = texel_buffer_bytes(desc.texel_format);
   if (texels && texel == 0)
     throw core::InputError("gpu::Buffer '" + desc.name + "': texel format " + std::to_string(desc.texel_format) +
                            " is not one of R32, R32G32, R32G32B32A32 (UINT or SFLOAT)");

@@ -21,8 +21,8 @@ inline gpu::Buffer storage(gpu::Context& ctx, VkDeviceSize bytes, const char* na
 // texelFetch) and their producer writes as a storage buffer: vec4 (RGBA32F) by default.
 inline gpu::Buffer cells(gpu::Context& ctx, std::uint32_t count, const char* name,
                          VkFormat format = VK_FORMAT_R32G32B32A32_SFLOAT) {
-  const VkDeviceSize texel = format == VK_FORMAT_R32_SFLOAT || format == VK_FORMAT_R32_UINT ? 4 : 16;
-  return gpu::Buffer(ctx, {.size = std::max<VkDeviceSize>(VkDeviceSize(count) * texel, 16),
+  const VkDeviceSize bytes = VkDeviceSize(count) * gpu::texel_buffer_bytes(format);
+  return gpu::Buffer(ctx, {.size = std::max<VkDeviceSize>(bytes, 16),
                            .usage = gpu::BufferUsage::Storage, .name = name, .texel_format = format});
 }
 

@@ -104,6 +104,10 @@ class Buffer {
   DeviceHandle<VkBufferView, vkDestroyBufferView> view_;  // declared last: destroyed before the buffer
 };
 
+// Bytes per texel of the formats BufferDesc::texel_format takes (R32, R32G32, R32G32B32A32,
+// UINT or SFLOAT); 0 for any other.
+VkDeviceSize texel_buffer_bytes(VkFormat format);
+
 // Records a copy of `bytes` bytes between buffers (whole `src` when bytes == VK_WHOLE_SIZE).
 void copy_buffer(VkCommandBuffer cmd, const Buffer& src, const Buffer& dst, VkDeviceSize bytes = VK_WHOLE_SIZE,
                  VkDeviceSize src_offset = 0, VkDeviceSize dst_offset = 0);
