@@ -37,7 +37,9 @@ layout(std430, binding = RECON_ACC_TAP_W) writeonly buffer TapW { vec4 tap_w[]; 
 layout(std430, binding = RECON_ACC_MATERIALS) readonly buffer Materials { PtMaterial materials[]; };
 layout(binding = RECON_ACC_PREV_RESTART) uniform samplerBuffer prev_restart;
 layout(std430, binding = RECON_ACC_OUT_RESTART) writeonly buffer Restart { float restart[]; };
+layout(binding = RECON_ACC_LUTS) uniform usamplerBuffer radius_luts;
 
+#define RG_RADIUS_LUT
 #include "fovea/shaders/recon_map.h"
 
 layout(push_constant) uniform Push { ReconAccumulatePush pc; };
@@ -51,13 +53,16 @@ bool seen_near(ReconGrid m, uint j, vec4 here, vec3 n, float depth) {
   // The cell itself: the usual case.
   if (rg_tap_valid(here, n, depth, texelFetch(prev_pos, int(j)), texelFetch(prev_nrm, int(j)).xyz)) return true;
   RgCell cell = rg_cell(m, j);
-  for (int dc = -1; dc <= 1; ++dc)
+  for (int dc = -1; dc <= 1; ++dc) {
+    RgColumnNear near;
+    if (!rg_column_next_to(m, cell, dc, near)) continue;
     for (int dr = -1; dr <= 1; ++dr) {
       uint k;
-      if ((dc != 0 || dr != 0) && rg_neighbour_of(m, cell, dc, dr, k) &&
+      if ((dc != 0 || dr != 0) && rg_row_next_to(m, near, dr, k) &&
           rg_tap_valid(here, n, depth, texelFetch(prev_pos, int(k)), texelFetch(prev_nrm, int(k)).xyz))
         return true;
     }
+  }
   return false;
 }
 
@@ -101,12 +106,15 @@ void main() {
     vec2 uv;
     if (rg_world_to_grid(prev, p, sky, uv)) {
       uint col = i % cur.g.padded_columns;
-      rg_taps(prev, rg_unjitter(cur, col, prev, uv), idx, w);
+      uvec2 cols;
+      rg_taps(prev, rg_unjitter(cur, col, prev, uv), idx, w, cols);
       float own = rg_cell_size(cur, col), valid = 0.0, kept = 0.0;
+      vec2 coarse = vec2(rg_coarse_weight(prev, cols.x, own, pc.coarse_keep, pc.coarse_reject),
+                         rg_coarse_weight(prev, cols.y, own, pc.coarse_keep, pc.coarse_reject));
       for (int k = 0; k < 4; ++k) {
         if (w[k] <= 0.0 || !seen_near(prev, idx[k], here, n, depth)) w[k] = 0.0;
         valid += w[k];
-        w[k] *= rg_coarse_weight(prev, idx[k], own, pc.coarse_keep, pc.coarse_reject);
+        w[k] *= coarse[k >> 1];
         kept += w[k];
       }
       if (kept > 1e-4) {

@@ -1,7 +1,7 @@
 #version 460
 // Resolve to the display (P5 §3.4): every display pixel computes its grid coordinate through
-// the current mapping (the column found through the per-frame radius lookup table,
-// recon_radius_lut.comp) and samples the grid — trilinear over the φ-only mip chain
+// the current mapping (the column found through the mapping's radius lookup table,
+// recon_map.h) and samples the grid — trilinear over the φ-only mip chain
 // (bilinear in ρ between the two columns, each with its own row count; φ wraps, ρ clamps).
 // The level comes from the pixel's footprint along φ in rows of its column (analytic). The
 // same grid coordinate gives the display-space depth: the nearest cell's sample's view-space
@@ -22,10 +22,7 @@ layout(std430, binding = RECON_RESOLVE_OFFSETS) readonly buffer Offsets { uint l
 layout(std430, binding = RECON_RESOLVE_SCREEN) writeonly buffer Screen { vec4 screen[]; };
 layout(binding = RECON_RESOLVE_POS) uniform samplerBuffer vpos;  // world position, .w material code
 layout(std430, binding = RECON_RESOLVE_DEPTH) writeonly buffer Depth { float depth[]; };
-layout(std430, binding = RECON_RESOLVE_LUT) readonly buffer Lut {
-  ReconRadiusLutHeader lut_header;
-  uint lut[];
-};
+layout(binding = RECON_RESOLVE_LUTS) uniform usamplerBuffer radius_luts;
 
 #define RG_RADIUS_LUT
 #include "fovea/shaders/recon_map.h"
@@ -47,7 +44,7 @@ ColumnTap column_tap(ReconGrid m, int ci, float t) {
   k.c = uint(clamp(ci, 0, int(m.g.columns) - 1));
   GridColumn col = rg_column(m, k.c);
   k.rows = int(max(col.rows, 1u));
-  k.wraps = m.g.family != kFamilyCartesian && col.phi_gap == 0.0;
+  k.wraps = rg_column_wraps(m, col);
   k.v = rg_row_coord_of(col, t);
   k.turn_rows = float(col.rows) / (1.0 - col.phi_gap / (2.0 * kRgPi));
   return k;

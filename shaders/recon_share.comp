@@ -28,7 +28,9 @@ layout(binding = RECON_SHARE_OTHER_INDIRECT) uniform samplerBuffer other_indirec
 layout(std430, binding = RECON_SHARE_SHARED) writeonly buffer Shared { vec4 shared_indirect[]; };
 layout(std430, binding = RECON_SHARE_Z) writeonly buffer Z { vec4 z[]; };
 layout(std430, binding = RECON_SHARE_EDGE) writeonly buffer Edge { uint edge[]; };  // 1: on a surface edge
+layout(binding = RECON_SHARE_LUTS) uniform usamplerBuffer radius_luts;
 
+#define RG_RADIUS_LUT
 #include "fovea/shaders/recon_map.h"
 
 layout(push_constant) uniform Push { ReconSharePush pc; };
@@ -40,26 +42,16 @@ layout(push_constant) uniform Push { ReconSharePush pc; };
 // side the sample hit now: fitted with its block it biased the fit at silhouettes, and the
 // fit put the surface's full light where the cell's area is partly background (cornell,
 // 58–60°, docs/reconstruction.md). An edge inside the cell's area always has a neighbour's
-// sample on its other side, since all cells share the frame's jitter. The neighbours are
-// rg_neighbour_of's, with each neighbouring column's entry and row read once for its three
-// rows (most cells are no edge and test all eight).
+// sample on its other side, since all cells share the frame's jitter (most cells are no edge
+// and test all eight neighbours).
 bool straddles(ReconGrid m, uint i, vec4 here, vec4 nd) {
   RgCell cell = rg_cell(m, i);
   for (int dc = -1; dc <= 1; ++dc) {
-    int cc = int(cell.col) + dc;
-    if (cc < 0 || cc >= int(m.g.columns)) continue;
-    GridColumn col = rg_column(m, uint(cc));
-    int rows = int(max(col.rows, 1u));
-    bool wraps = m.g.family != kFamilyCartesian && col.phi_gap == 0.0;
-    int r0 = int(floor(rg_row_coord_of(col, cell.t)));
+    RgColumnNear near;
+    if (!rg_column_next_to(m, cell, dc, near)) continue;
     for (int dr = -1; dr <= 1; ++dr) {
-      int rr = r0 + dr;
-      if (dc == 0 && dr == 0) continue;
-      if (rr < 0 || rr >= rows) {
-        if (!wraps) continue;
-        rr = rg_wrap(rr, rows);
-      }
-      uint k = uint(rr) * m.g.padded_columns + uint(cc);
+      uint k;
+      if ((dc == 0 && dr == 0) || !rg_row_next_to(m, near, dr, k)) continue;
       vec4 there = texelFetch(vpos, int(k));
       if (!rg_no_sample(there.w) && !rg_tap_valid(here, nd.xyz, nd.w, there, texelFetch(vnrm, int(k)).xyz)) return true;
     }
@@ -91,14 +83,17 @@ void main() {
       vec4 w;
       ReconGrid cur = maps[kReconCurrent];
       uint col = i % cur.g.padded_columns;
-      rg_taps(other, rg_unjitter(cur, col, other, uv), idx, w);
+      uvec2 cols;
+      rg_taps(other, rg_unjitter(cur, col, other, uv), idx, w, cols);
       vec4 n = texelFetch(vnrm, int(i));
       float wsum = 0.0, own_size = rg_cell_size(cur, col);
+      vec2 coarse = vec2(rg_coarse_weight(other, cols.x, own_size, pc.coarse_keep, pc.coarse_reject),
+                         rg_coarse_weight(other, cols.y, own_size, pc.coarse_keep, pc.coarse_reject));
       vec4 acc = vec4(0.0);
       for (int k = 0; k < 4; ++k) {
         int o = int(idx[k]);
         if (w[k] <= 0.0 || !rg_tap_valid(here, n.xyz, n.w, texelFetch(other_pos, o), texelFetch(other_nrm, o).xyz)) continue;
-        w[k] *= rg_coarse_weight(other, idx[k], own_size, pc.coarse_keep, pc.coarse_reject);
+        w[k] *= coarse[k >> 1];
         acc += w[k] * texelFetch(other_indirect, int(idx[k]));
         wsum += w[k];
       }

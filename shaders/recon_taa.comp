@@ -96,10 +96,12 @@ void main() {
   RgCell cell = rg_cell(m, i);
   bool follow = since > 0.0 && since <= kRestartFollow;  // the window's first frames
   int reach = follow ? kRestartReach : 1;
-  for (int dc = -reach; dc <= reach; ++dc)
+  for (int dc = -reach; dc <= reach; ++dc) {
+    RgColumnNear near;
+    if (!rg_column_next_to(m, cell, dc, near)) continue;
     for (int dr = -reach; dr <= reach; ++dr) {
       uint j;
-      if (!rg_neighbour_of(m, cell, dc, dr, j) || rg_no_sample(texelFetch(vpos, int(j)).w)) continue;
+      if (!rg_row_next_to(m, near, dr, j) || rg_no_sample(texelFetch(vpos, int(j)).w)) continue;
       if (abs(dc) <= 1 && abs(dr) <= 1) {  // the clamp's 3×3 neighbourhood
         vec3 y = to_ycocg(compress(remodulated(j)));
         lo = min(lo, y);
@@ -111,6 +113,7 @@ void main() {
         avg_w += 1.0;
       }
     }
+  }
   vec3 c = avg / avg_w * max(texelFetch(albedo, int(i)).rgb, vec3(kPtMinDemodAlbedo));
   if (!history || since == 1.0) {  // nothing to blend, or the history is the coarse periphery's
     final_color[i] = vec4(c, 1.0);

@@ -29,7 +29,7 @@ Accumulation::Accumulation(gpu::Context& ctx, std::span<const EyeGrid> eyes, con
                           AccumulateBindings{g.maps, g.tables, g.samples, g.direct, g.indirect, g.normal_depth,
                                              g.position_material, &e.direct[q], &e.indirect[q], &e.pos[q], &e.nrm[q],
                                              &e.direct[p], &e.indirect[p], &e.pos[p], &e.nrm[p], &e.tap_idx, &e.tap_w,
-                                             &materials, &e.restart[q], &e.restart[p]});
+                                             &materials, &e.restart[q], &e.restart[p], g.luts});
     }
   }
 }
@@ -70,7 +70,7 @@ StereoGather::StereoGather(gpu::Context& ctx, std::span<const EyeGrid> eyes, con
       e.set[p] = make_set(ctx, kernel_,
                           ShareBindings{g.maps, g.tables, &acc.position(me, p), &acc.normal(me, p), &acc.direct(me, p),
                                         &acc.indirect(me, p), &acc.position(other, p), &acc.normal(other, p),
-                                        &acc.indirect(other, p), &e.shared, &e.z, &e.edge});
+                                        &acc.indirect(other, p), &e.shared, &e.z, &e.edge, g.luts});
   }
 }
 

@@ -22,7 +22,7 @@ using Buf = const gpu::Buffer*;
 struct AccumulateBindings {
   FOVEA_BINDING_COUNT(RECON_ACC_COUNT)
   Buf maps, tables, samples, direct, indirect, normal_depth, position_material, prev_direct, prev_indirect, prev_pos,
-      prev_nrm, out_direct, out_indirect, out_pos, out_nrm, tap_idx, tap_w, materials, prev_restart, out_restart;
+      prev_nrm, out_direct, out_indirect, out_pos, out_nrm, tap_idx, tap_w, materials, prev_restart, out_restart, luts;
   Slots slots() const {
     return {{{RECON_MAPS, maps},
              {RECON_TABLES, tables},
@@ -43,13 +43,14 @@ struct AccumulateBindings {
              {RECON_ACC_TAP_W, tap_w},
              {RECON_ACC_MATERIALS, materials},
              {RECON_ACC_PREV_RESTART, prev_restart},
-             {RECON_ACC_OUT_RESTART, out_restart}}};
+             {RECON_ACC_OUT_RESTART, out_restart},
+             {RECON_ACC_LUTS, luts}}};
   }
 };
 
 struct ShareBindings {
   FOVEA_BINDING_COUNT(RECON_SHARE_COUNT)
-  Buf maps, tables, pos, nrm, acc_direct, acc_indirect, other_pos, other_nrm, other_indirect, shared, z, edge;
+  Buf maps, tables, pos, nrm, acc_direct, acc_indirect, other_pos, other_nrm, other_indirect, shared, z, edge, luts;
   Slots slots() const {
     return {{{RECON_MAPS, maps},
              {RECON_TABLES, tables},
@@ -62,7 +63,8 @@ struct ShareBindings {
              {RECON_SHARE_OTHER_INDIRECT, other_indirect},
              {RECON_SHARE_SHARED, shared},
              {RECON_SHARE_Z, z},
-             {RECON_SHARE_EDGE, edge}}};
+             {RECON_SHARE_EDGE, edge},
+             {RECON_SHARE_LUTS, luts}}};
   }
 };
 
@@ -124,7 +126,7 @@ struct MipBindings {
 
 struct ResolveBindings {
   FOVEA_BINDING_COUNT(RECON_RESOLVE_COUNT)
-  Buf maps, tables, mips, offsets, screen, pos, depth, lut;
+  Buf maps, tables, mips, offsets, screen, pos, depth, luts;
   Slots slots() const {
     return {{{RECON_MAPS, maps},
              {RECON_TABLES, tables},
@@ -133,14 +135,8 @@ struct ResolveBindings {
              {RECON_RESOLVE_SCREEN, screen},
              {RECON_RESOLVE_POS, pos},
              {RECON_RESOLVE_DEPTH, depth},
-             {RECON_RESOLVE_LUT, lut}}};
+             {RECON_RESOLVE_LUTS, luts}}};
   }
-};
-
-struct RadiusLutBindings {
-  FOVEA_BINDING_COUNT(RECON_LUT_COUNT)
-  Buf maps, tables, lut;
-  Slots slots() const { return {{{RECON_MAPS, maps}, {RECON_TABLES, tables}, {RECON_LUT_OUT, lut}}}; }
 };
 
 struct BlurBindings {
@@ -162,6 +158,5 @@ static_assert(sizeof(TaaBindings) == TaaBindings::kCount * sizeof(Buf));
 static_assert(sizeof(MipBindings) == MipBindings::kCount * sizeof(Buf));
 static_assert(sizeof(ResolveBindings) == ResolveBindings::kCount * sizeof(Buf));
 static_assert(sizeof(BlurBindings) == BlurBindings::kCount * sizeof(Buf));
-static_assert(sizeof(RadiusLutBindings) == RadiusLutBindings::kCount * sizeof(Buf));
 
 }  // namespace fovea::reconstruct

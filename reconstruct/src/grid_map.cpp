@@ -38,7 +38,37 @@ void append_table(std::vector<GridColumn>& out, std::vector<GridColumn> t, std::
   t.resize(len, GridColumn{});
   out.insert(out.end(), t.begin(), t.end());
 }
+
+// Mapping m's radius lookup table from its column table, at slot `slot` of `luts`; none
+// (lut_scale 0: the shaders search the whole table) for a Cartesian or absent mapping.
+void put_lut(ReconGrid& m, const std::vector<GridColumn>& table, std::uint32_t slot, std::uint32_t* luts) {
+  m.lut_offset = slot * shaders::kReconRadiusLutEntries;
+  m.lut_scale = 0;
+  if (!m.valid || m.g.family == shaders::kFamilyCartesian) return;
+  const RadiusLut lut = radius_lut(std::span(table).first(std::min<std::size_t>(table.size(), m.g.columns)));
+  if (lut.entries.empty()) return;
+  std::copy(lut.entries.begin(), lut.entries.end(), luts + m.lut_offset);
+  m.lut_scale = lut.scale;
+}
 }  // namespace
+
+RadiusLut radius_lut(std::span<const GridColumn> table) {
+  RadiusLut lut;
+  if (table.empty()) return lut;
+  constexpr std::uint32_t size = shaders::kReconRadiusLutSize;
+  const auto last = std::uint32_t(table.size() - 1);
+  lut.scale = float(size) / std::max(table[last].r1, 1e-6f);
+  lut.entries.resize(shaders::kReconRadiusLutEntries);
+  // The bins' lower bounds rise with k and the columns' r0 with the column: one walk.
+  std::uint32_t c = 0;
+  for (std::uint32_t k = 0; k <= size; ++k) {
+    const double bound = (double(k) - 0.5) / double(lut.scale);
+    while (c < last && double(table[c + 1].r0) <= bound) ++c;
+    lut.entries[k] = c;
+  }
+  lut.entries[size + 1] = last;
+  return lut;
+}
 
 GridMapping::GridMapping(gpu::Context& ctx, const core::SampleDistribution& own, const core::SampleDistribution* other)
     : own_(&own),
@@ -48,12 +78,19 @@ GridMapping::GridMapping(gpu::Context& ctx, const core::SampleDistribution& own,
       maps_(storage(ctx, 3 * sizeof(ReconGrid), "recon.maps", gpu::Memory::HostVisible)),
       tables_(gpu::Buffer(ctx, {.size = VkDeviceSize(2 * table_len_ + other_table_len_) * sizeof(GridColumn),
                                 .memory = gpu::Memory::HostVisible, .name = "recon.tables",
-                                .texel_format = VK_FORMAT_R32G32B32A32_SFLOAT})) {}
+                                .texel_format = VK_FORMAT_R32G32B32A32_SFLOAT})),
+      luts_(gpu::Buffer(ctx, {.size = VkDeviceSize(3) * shaders::kReconRadiusLutEntries * sizeof(std::uint32_t),
+                              .memory = gpu::Memory::HostVisible, .name = "recon.radius_luts",
+                              .texel_format = VK_FORMAT_R32_UINT})) {}
 
 void GridMapping::write(const core::Pose& own_pose, const core::Pose* other_pose) {
   ReconGrid m[3] = {recon_grid(*own_, own_pose, 0), prev_, ReconGrid{}};
   m[1].table_offset = table_len_;
   if (other_ && other_pose) m[2] = recon_grid(*other_, *other_pose, 2 * table_len_);
+  auto* luts = reinterpret_cast<std::uint32_t*>(luts_.mapped().data());
+  put_lut(m[0], own_->column_table(), 0, luts);
+  put_lut(m[1], prev_table_, 1, luts);
+  if (other_ && other_pose) put_lut(m[2], other_->column_table(), 2, luts);
   std::memcpy(maps_.mapped().data(), m, sizeof(m));
   std::vector<GridColumn> t;
   append_table(t, own_->column_table(), table_len_);

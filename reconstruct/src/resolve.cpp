@@ -1,5 +1,5 @@
-// Resolve to the display (shaders/recon_grid_blur.comp, recon_mip.comp, recon_radius_lut.comp,
-// recon_resolve.comp with the display-space depth, recon_blur.comp).
+// Resolve to the display (shaders/recon_grid_blur.comp, recon_mip.comp, recon_resolve.comp
+// with the display-space depth, recon_blur.comp).
 #include <algorithm>
 #include <cmath>
 #include <cstring>
@@ -94,7 +94,6 @@ Resolve::Resolve(gpu::Context& ctx, std::span<const EyeGrid> eyes, const Accumul
       resolve_(kernel<ResolveBindings, shaders::ReconResolvePush>(ctx, "recon_resolve.comp.spv")),
       blur_(kernel<BlurBindings, shaders::ReconBlurPush>(ctx, "recon_blur.comp.spv")),
       grid_blur_(kernel<BlurBindings, shaders::ReconGridBlurPush>(ctx, "recon_grid_blur.comp.spv")),
-      lut_(kernel<RadiusLutBindings, shaders::ReconResolvePush>(ctx, "recon_radius_lut.comp.spv")),
       eyes_(eyes.size()) {
   for (std::size_t i = 0; i < eyes.size(); ++i) {
     const EyeGrid& g = eyes[i];
@@ -123,12 +122,10 @@ Resolve::Resolve(gpu::Context& ctx, std::span<const EyeGrid> eyes, const Accumul
     e.screen_a = cells(ctx, pixels, "recon.screen");
     e.screen_b = cells(ctx, pixels, "recon.screen_tmp");
     e.depth = storage(ctx, VkDeviceSize(pixels) * 4, "recon.depth");
-    e.lut = storage(ctx, sizeof(shaders::ReconRadiusLutHeader) + (shaders::kReconRadiusLutSize + 2) * 4, "recon.radius_lut");
     e.mip_set = make_set(ctx, mip_, MipBindings{g.maps, g.tables, &e.mips});
-    e.lut_set = make_set(ctx, lut_, RadiusLutBindings{g.maps, g.tables, &e.lut});
     for (int p = 0; p < 2; ++p)
       e.resolve_set[p] = make_set(ctx, resolve_, ResolveBindings{g.maps, g.tables, &e.mips, &e.offsets, &e.screen_a,
-                                                                 &acc.position(int(i), p), &e.depth, &e.lut});
+                                                                 &acc.position(int(i), p), &e.depth, g.luts});
     e.blur_h = make_set(ctx, blur_, BlurBindings{g.maps, g.tables, &e.screen_a, &e.screen_b});
     e.blur_v = make_set(ctx, blur_, BlurBindings{g.maps, g.tables, &e.screen_b, &e.screen_a});
     if (g.polar) {  // grid-space blur: level 0 -> grid_tmp (across columns) -> level 0 (along φ)
@@ -201,9 +198,6 @@ void Resolve::record_mips(VkCommandBuffer cmd) const {
 }
 
 void Resolve::record_resample(VkCommandBuffer cmd, int parity, bool grid_coords) const {
-  for (const Eye& e : eyes_)
-    if (e.polar) lut_.run(cmd, {&e.lut_set}, shaders::ReconResolvePush{}, shaders::kReconRadiusLutSize + 2);
-  gpu::compute_to_compute(cmd);
   for (const Eye& e : eyes_) {
     const std::uint32_t lod_columns = mip_reach(current_map(*e.maps), *e.tables, e.levels).lod_columns;
     resolve_.run(cmd, {&e.resolve_set[parity]},
@@ -228,7 +222,7 @@ void Resolve::record_blur(VkCommandBuffer cmd, const ReconSettings& s) const {
 
 void Resolve::fill(VkCommandBuffer cmd, std::uint32_t word) const {
   for (const Eye& e : eyes_)
-    for (const gpu::Buffer* b : {&e.mips, &e.screen_a, &e.screen_b, &e.depth, &e.lut, &e.grid_tmp})
+    for (const gpu::Buffer* b : {&e.mips, &e.screen_a, &e.screen_b, &e.depth, &e.grid_tmp})
       if (b->size() > 0) gpu::fill_buffer(cmd, *b, word);
 }
 

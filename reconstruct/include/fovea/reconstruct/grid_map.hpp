@@ -1,8 +1,10 @@
 #pragma once
 // The per-frame grid mappings the reconstruction kernels read (shaders/include/fovea/shaders/
 // recon_grid.h): per eye, ReconGrid[3] = this frame, the previous frame (reprojection), the
-// other eye (stereo gather), and their column tables, in host-visible buffers.
+// other eye (stereo gather), their column tables and radius lookup tables, in host-visible
+// buffers.
 #include <cstdint>
+#include <span>
 #include <vector>
 
 #include "fovea/core/distribution.hpp"
@@ -17,6 +19,16 @@ namespace fovea::reconstruct {
 shaders::ReconGrid recon_grid(const core::SampleDistribution& d, const core::Pose& eye_pose,
                               std::uint32_t table_offset);
 
+// Radius -> column lookup table of a polar column table (recon_map.h, rg_column_range):
+// kReconRadiusLutEntries entries; entry k <= kReconRadiusLutSize holds the last column
+// whose r0 is <= (k - 0.5) / scale (column 0 when none), the one after it the last column;
+// scale = kReconRadiusLutSize / the last column's outer radius. Empty for an empty table.
+struct RadiusLut {
+  float scale = 0;
+  std::vector<std::uint32_t> entries;
+};
+RadiusLut radius_lut(std::span<const shaders::GridColumn> table);
+
 class GridMapping {
  public:
   // `own` is the eye's distribution, `other` the other eye's (nullptr: one eye).
@@ -29,6 +41,8 @@ class GridMapping {
 
   const gpu::Buffer& maps() const { return maps_; }
   const gpu::Buffer& tables() const { return tables_; }
+  // R32_UINT texels: the radius lookup table of each polar mapping, at its lut_offset.
+  const gpu::Buffer& luts() const { return luts_; }
 
  private:
   const core::SampleDistribution* own_;
@@ -36,7 +50,7 @@ class GridMapping {
   std::uint32_t table_len_ = 1, other_table_len_ = 1;
   shaders::ReconGrid prev_{};
   std::vector<shaders::GridColumn> prev_table_;
-  gpu::Buffer maps_, tables_;
+  gpu::Buffer maps_, tables_, luts_;
 };
 
 }  // namespace fovea::reconstruct

@@ -26,8 +26,9 @@ struct EyeGrid {
   bool polar = true;                   // φ-only mip chain (polar grids) or one level
   std::uint32_t width = 0, height = 0;  // the display raster the grid resolves to
   double max_pixels_per_deg = 0;        // the raster's densest pixels (bounds the blur's reach)
-  const gpu::Buffer* maps = nullptr;    // GridMapping::maps(), tables()
+  const gpu::Buffer* maps = nullptr;    // GridMapping::maps(), tables(), luts()
   const gpu::Buffer* tables = nullptr;
+  const gpu::Buffer* luts = nullptr;
   // The path tracer's per-cell outputs (renderer::TraceOutputs) and the grid itself.
   const gpu::Buffer *samples = nullptr, *direct = nullptr, *indirect = nullptr, *normal_depth = nullptr,
                     *position_material = nullptr, *albedo = nullptr;
@@ -157,11 +158,11 @@ class Resolve {
     double max_pixels_per_deg = 0;
     const gpu::Buffer *maps = nullptr, *tables = nullptr;  // host-visible (GridMapping)
     std::vector<std::uint32_t> level_rows, level_offset;
-    gpu::Buffer mips, offsets, screen_a, screen_b, depth, lut, grid_tmp;
-    gpu::DescriptorSet mip_set, lut_set, resolve_set[2], blur_h, blur_v, grid_blur_rho, grid_blur_phi;
+    gpu::Buffer mips, offsets, screen_a, screen_b, depth, grid_tmp;
+    gpu::DescriptorSet mip_set, resolve_set[2], blur_h, blur_v, grid_blur_rho, grid_blur_phi;
   };
   std::uint32_t max_levels() const;
-  gpu::ComputePipeline mip_, resolve_, blur_, grid_blur_, lut_;
+  gpu::ComputePipeline mip_, resolve_, blur_, grid_blur_;
   std::vector<Eye> eyes_;
 };
 

@@ -9,7 +9,9 @@
 #define FOVEA_SHADERS_RECON_BINDINGS_H
 
 // The grid mappings (ReconGrid[3]: this frame, previous frame, other eye) and their column
-// tables: the same two bindings in every kernel that maps between grid and display.
+// tables: the same two bindings in every kernel that maps between grid and display. Kernels
+// that map display positions to grid coordinates also bind the mappings' radius lookup
+// tables (their *_LUTS binding; recon_map.h, RG_RADIUS_LUT).
 #define RECON_MAPS 0
 #define RECON_TABLES 1
 
@@ -32,7 +34,8 @@
 #define RECON_ACC_MATERIALS 17
 #define RECON_ACC_PREV_RESTART 18
 #define RECON_ACC_OUT_RESTART 19
-#define RECON_ACC_COUNT 20
+#define RECON_ACC_LUTS 20
+#define RECON_ACC_COUNT 21
 
 // recon_share.comp (stereo gather of indirect diffuse)
 #define RECON_SHARE_POS 2
@@ -45,7 +48,8 @@
 #define RECON_SHARE_SHARED 9
 #define RECON_SHARE_Z 10
 #define RECON_SHARE_EDGE 11
-#define RECON_SHARE_COUNT 12
+#define RECON_SHARE_LUTS 12
+#define RECON_SHARE_COUNT 13
 
 // recon_bmfr_fit.comp (BMFR Phase II)
 #define RECON_BMFR_POS 0
@@ -93,12 +97,8 @@
 #define RECON_RESOLVE_SCREEN 4
 #define RECON_RESOLVE_POS 5
 #define RECON_RESOLVE_DEPTH 6
-#define RECON_RESOLVE_LUT 7
+#define RECON_RESOLVE_LUTS 7
 #define RECON_RESOLVE_COUNT 8
-
-// recon_radius_lut.comp (radius -> column lookup table of the current mapping)
-#define RECON_LUT_OUT 2
-#define RECON_LUT_COUNT 3
 
 // recon_blur.comp
 #define RECON_BLUR_SRC 2

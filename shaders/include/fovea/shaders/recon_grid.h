@@ -12,14 +12,17 @@ namespace fovea::shaders {
 #endif
 
 // A grid mapping (core::SampleDistribution::gpu_params) plus the eye's world-to-view
-// transform (rows of the rotation, then the eye position) and where its column table starts
-// in the bound table buffer.
+// transform (rows of the rotation, then the eye position), where its column table starts
+// in the bound table buffer, and where its radius -> column lookup table starts in the bound
+// table of those (lut_scale > 0; 0: none, the column search takes the whole table).
 struct ReconGrid {
   GridParams g;
   float w2v0_x, w2v0_y, w2v0_z, eye_x;
   float w2v1_x, w2v1_y, w2v1_z, eye_y;
   float w2v2_x, w2v2_y, w2v2_z, eye_z;
-  FOVEA_UINT table_offset, valid, pad0, pad1;  // valid = 0: no such mapping (first frame)
+  FOVEA_UINT table_offset, valid;  // valid = 0: no such mapping (first frame)
+  FOVEA_UINT lut_offset;           // first entry of its radius lookup table
+  float lut_scale;                 // that table's bins per radius unit
 };
 
 // Slots of the per-eye mapping buffer.
@@ -81,16 +84,12 @@ struct ReconResolvePush {
   FOVEA_UINT lod_columns, pad0, pad1, pad2;       // pixels of columns >= lod_columns have LOD 0 (Resolve, mip_reach)
 };
 
-// Radius -> column lookup table of the current mapping (recon_radius_lut.comp builds it per
-// frame, the resolve reads it): kReconRadiusLutSize uniform radius bins over the column
-// table's range, each holding the column search's lower bound; + 2 entries, see the shader.
+// Radius -> column lookup table of a polar mapping (reconstruct::radius_lut builds one per
+// mapping and frame; recon_map.h, rg_column_range, reads it): kReconRadiusLutSize uniform
+// radius bins over the column table's range, each holding the column search's lower bound,
+// then 2 entries more (kReconRadiusLutEntries per mapping).
 FOVEA_CONST FOVEA_UINT kReconRadiusLutSize = 4096u;
-struct ReconRadiusLutHeader {
-  float scale;                 // bins per radius unit
-  FOVEA_UINT size;             // bins
-  FOVEA_UINT table_offset;     // the mapping's column table it was built from
-  FOVEA_UINT pad;
-};
+FOVEA_CONST FOVEA_UINT kReconRadiusLutEntries = kReconRadiusLutSize + 2u;
 
 struct ReconBlurPush {
   FOVEA_UINT width, height, vertical, pad0;
@@ -115,7 +114,6 @@ static_assert(sizeof(ReconPostPush) == 32);
 static_assert(sizeof(ReconMipPush) == 32);
 static_assert(sizeof(ReconResolvePush) == 32);
 static_assert(sizeof(ReconBlurPush) == 32);
-static_assert(sizeof(ReconRadiusLutHeader) == 16);
 }  // namespace fovea::shaders
 #else
 bool rg_no_sample(float code) { return abs(code - kReconNoSample) < 0.5; }

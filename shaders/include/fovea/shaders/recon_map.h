@@ -1,6 +1,8 @@
 // GLSL only: grid-space mapping helpers of the reconstruction (see recon_grid.h). Include
 // after declaring the mapping buffer and the column table's texel buffer:
 //   buffer ... { ReconGrid maps[]; }  and  uniform samplerBuffer tables;
+// and, in kernels that define RG_RADIUS_LUT, the mappings' radius lookup tables:
+//   uniform usamplerBuffer radius_luts;
 #ifndef FOVEA_SHADERS_RECON_MAP_H
 #define FOVEA_SHADERS_RECON_MAP_H
 const float kRgPi = 3.14159265358979323846;
@@ -57,42 +59,44 @@ bool rg_dir_to_pixel(ReconGrid m, vec3 d, out vec2 px) {
 uint rg_rows(ReconGrid m, uint c) { return m.g.family == kFamilyCartesian ? m.g.rows : rg_table(m.table_offset + c).rows; }
 
 // Column search range [x, y) for radius r: the whole table, or — in kernels that define
-// RG_RADIUS_LUT and bind the current mapping's radius -> column lookup table
-// (recon_radius_lut.comp) as lut_header / lut[] — the few columns the radius's bin allows,
-// so the search below takes ~1 step instead of log2(columns).
+// RG_RADIUS_LUT and bind radius_luts, for a mapping that has a lookup table — the few
+// columns the radius's bin allows, so the search below takes ~1 step instead of
+// log2(columns). Bin k of the table holds the last column whose r0 is <= (k - 0.5) / scale,
+// so a radius in bin k = floor(r·scale) lies in a column of [lut[k], lut[k + 2]]: the
+// half-bin margins absorb the rounding of r·scale, and the narrowed search finds exactly
+// the column the full search finds (reconstruct::radius_lut).
 #ifdef RG_RADIUS_LUT
 uvec2 rg_column_range(ReconGrid m, float r) {
-  if (m.table_offset != lut_header.table_offset) return uvec2(0u, m.g.columns);  // another mapping's table
-  uint k = min(uint(max(r, 0.0) * lut_header.scale), lut_header.size - 1u);
-  return uvec2(lut[k], lut[k + 2u] + 1u);
+  if (!(m.lut_scale > 0.0)) return uvec2(0u, m.g.columns);
+  const float last = float(kReconRadiusLutSize - 1u);
+  uint k = m.lut_offset + min(uint(clamp(r * m.lut_scale, 0.0, last)), kReconRadiusLutSize - 1u);
+  return uvec2(texelFetch(radius_luts, int(k)).x, texelFetch(radius_luts, int(k + 2u)).x + 1u);
 }
 #else
 uvec2 rg_column_range(ReconGrid m, float r) { return uvec2(0u, m.g.columns); }
 #endif
-
-// Whether column c's rows wrap in φ: a full polar ring; not a column packed to its visible
-// arc (GridColumn::phi_gap > 0), nor the Cartesian raster.
-bool rg_wraps(ReconGrid m, uint c) {
-  return m.g.family != kFamilyCartesian && rg_table(m.table_offset + c).phi_gap == 0.0;
-}
 
 // Fraction of the full turn column c's rows cover (1: a full ring or the raster).
 float rg_arc_turns(ReconGrid m, uint c) {
   return m.g.family == kFamilyCartesian ? 1.0 : 1.0 - rg_table(m.table_offset + c).phi_gap / (2.0 * kRgPi);
 }
 
-// Rows column c would have over a full turn at its spacing along φ.
-float rg_turn_rows(ReconGrid m, uint c) { return float(rg_rows(m, c)) / rg_arc_turns(m, c); }
-
 // Column c's table entry; for the Cartesian raster a full "ring" of the raster's rows (no
-// gap), so the helpers below that take an entry serve every family.
+// gap), so the helpers below that take an entry serve every family. Kernels that need
+// several of a column's properties load its entry a single time.
 GridColumn rg_column(ReconGrid m, uint c) {
   if (m.g.family == kFamilyCartesian) return GridColumn(float(c), float(c + 1u), m.g.rows, 0.0, 0.0, 0.0, 0.0, 0.0);
   return rg_table(m.table_offset + c);
 }
 
-// rg_row_coord below for a column entry read once (rg_column): kernels that need several
-// of a column's properties load its entry a single time.
+// Whether a column's rows wrap in φ: a full polar ring; not a column packed to its visible
+// arc (GridColumn::phi_gap > 0), nor the Cartesian raster.
+bool rg_column_wraps(ReconGrid m, GridColumn col) { return m.g.family != kFamilyCartesian && col.phi_gap == 0.0; }
+bool rg_wraps(ReconGrid m, uint c) { return rg_column_wraps(m, rg_column(m, c)); }
+
+// Continuous row coordinate in a column (cell centres at +0.5) of grid coordinate t (φ / 2π
+// on polar grids): φ from the start of the column's arc; a point in a packed column's gap
+// (off the view) snaps to the nearer end of its arc (core PolarDistribution::screen_to_grid).
 float rg_row_coord_of(GridColumn col, float t) {
   float rows = float(col.rows);
   if (col.phi_gap == 0.0) return t * rows;
@@ -102,12 +106,7 @@ float rg_row_coord_of(GridColumn col, float t) {
   return x / span * rows;
 }
 
-// Continuous row coordinate in column c (cell centres at +0.5) of grid coordinate t (φ / 2π
-// on polar grids): φ from the start of the column's arc; a point in a packed column's gap
-// (off the view) snaps to the nearer end of its arc (core PolarDistribution::screen_to_grid).
-float rg_row_coord(ReconGrid m, uint c, float t) { return rg_row_coord_of(rg_column(m, c), t); }
-
-// Grid coordinate t of row coordinate v of column c (the inverse of rg_row_coord).
+// Grid coordinate t of row coordinate v of column c (the inverse of rg_row_coord_of).
 float rg_row_to_t_of(GridColumn col, float v) {
   return fract(col.phi0 / (2.0 * kRgPi) + v / float(max(col.rows, 1u)) * (1.0 - col.phi_gap / (2.0 * kRgPi)));
 }
@@ -196,21 +195,24 @@ bool rg_world_to_grid(ReconGrid m, vec3 p, bool is_direction, out vec2 uv) {
   return true;
 }
 
-// The four bilinear taps of (u, t): two columns (ρ clamped), and in each column the two
-// rows around its row coordinate of t (φ wraps on full rings, clamps on packed columns and
-// the raster). Cell indices row * padded_columns + column; weights sum to 1.
-void rg_taps(ReconGrid m, vec2 uv, out uvec4 idx, out vec4 w) {
+// The four bilinear taps of (u, t): two columns (ρ clamped; `cols`, taps 0–1 in cols.x and
+// 2–3 in cols.y), and in each column the two rows around its row coordinate of t (φ wraps on
+// full rings, clamps on packed columns and the raster); each column's table entry read
+// once. Cell indices row * padded_columns + column; weights sum to 1.
+void rg_taps(ReconGrid m, vec2 uv, out uvec4 idx, out vec4 w, out uvec2 cols) {
   float uc = uv.x - 0.5;
   float c0f = floor(uc);
   float fx = uc - c0f;
   for (int i = 0; i < 2; ++i) {
     uint c = uint(clamp(int(c0f) + i, 0, int(m.g.columns) - 1));
-    uint rows = max(rg_rows(m, c), 1u);
-    float vr = rg_row_coord(m, c, uv.y) - 0.5;
+    cols[i] = c;
+    GridColumn col = rg_column(m, c);
+    uint rows = max(col.rows, 1u);
+    float vr = rg_row_coord_of(col, uv.y) - 0.5;
     float r0f = floor(vr);
     float fy = vr - r0f;
     int r0 = int(r0f), r1 = r0 + 1;
-    if (rg_wraps(m, c)) {
+    if (rg_column_wraps(m, col)) {
       r0 = rg_wrap(r0, int(rows));
       r1 = rg_wrap(r1, int(rows));
     } else {
@@ -238,26 +240,38 @@ RgCell rg_cell(ReconGrid m, uint j) {
   return RgCell(col, rg_row_to_t(m, col, float(j / pcols) + 0.5));
 }
 
-// Cell k of mapping m next to cell c: dc columns over (false beyond the grid), then dr rows
-// from the row at c's φ in that column (φ wraps on full rings; false beyond the raster or the
-// ends of a column packed to its visible arc).
-bool rg_neighbour_of(ReconGrid m, RgCell c, int dc, int dr, out uint k) {
-  k = 0u;
+// A column next to a cell, as its neighbourhood reads it: the column, its rows, whether
+// they wrap, and its row at the cell's φ. Taken once per column (rg_column_next_to), its
+// neighbours of the cell follow from it with integer arithmetic (rg_row_next_to): each
+// column's table entry and row coordinate are computed once, not once per neighbour.
+struct RgColumnNear {
+  uint col;
+  int rows;
+  bool wraps;
+  int row;
+};
+
+// The column dc over from cell c of mapping m; false beyond the grid.
+bool rg_column_next_to(ReconGrid m, RgCell c, int dc, out RgColumnNear n) {
+  n = RgColumnNear(0u, 1, false, 0);
   int cc = int(c.col) + dc;
   if (cc < 0 || cc >= int(m.g.columns)) return false;
-  int rows = int(max(rg_rows(m, uint(cc)), 1u));
-  int rr = int(floor(rg_row_coord(m, uint(cc), c.t))) + dr;
-  if (rg_wraps(m, uint(cc))) rr = rg_wrap(rr, rows);
-  else if (rr < 0 || rr >= rows) return false;
-  k = uint(rr) * m.g.padded_columns + uint(cc);
+  GridColumn col = rg_column(m, uint(cc));
+  n = RgColumnNear(uint(cc), int(max(col.rows, 1u)), rg_column_wraps(m, col), int(floor(rg_row_coord_of(col, c.t))));
   return true;
 }
 
-// The same next to cell j.
-bool rg_neighbour(ReconGrid m, uint j, int dc, int dr, out uint k) {
-  bool found = rg_neighbour_of(m, rg_cell(m, j), dc, dr, k);
-  if (!found) k = j;
-  return found;
+// Cell k, dr rows from n's row in n's column (φ wraps on full rings; false beyond the raster
+// or the ends of a column packed to its visible arc).
+bool rg_row_next_to(ReconGrid m, RgColumnNear n, int dr, out uint k) {
+  k = 0u;
+  int rr = n.row + dr;
+  if (rr < 0 || rr >= n.rows) {
+    if (!n.wraps) return false;
+    rr = rg_wrap(rr, n.rows);
+  }
+  k = uint(rr) * m.g.padded_columns + n.col;
+  return true;
 }
 
 // Where the centre of the current frame's cell `col` lies in mapping m, given the grid
@@ -282,12 +296,12 @@ float rg_cell_size(ReconGrid m, uint c) {
   return sqrt(max((col.r1 - col.r0) * circumference * turns / float(max(col.rows, 1u)), 0.0));
 }
 
-// Weight of a tap whose cell (index `tap` of mapping m) is `ratio` = its size / the sample's
-// own cell size: 1 up to `keep`, falling linearly to 0 at `reject` (ReconSettings). A
-// coarser cell holds a blurred estimate (after a saccade the new fovea lands on old
+// Weight of the taps in column c of mapping m, whose cells are `ratio` = their size / the
+// sample's own cell size: 1 up to `keep`, falling linearly to 0 at `reject` (ReconSettings).
+// A coarser cell holds a blurred estimate (after a saccade the new fovea lands on old
 // periphery); reusing it would keep the fovea blurred for many frames.
-float rg_coarse_weight(ReconGrid m, uint tap, float own_size, float keep, float reject) {
-  float ratio = rg_cell_size(m, tap % m.g.padded_columns) / max(own_size, 1e-12);
+float rg_coarse_weight(ReconGrid m, uint c, float own_size, float keep, float reject) {
+  float ratio = rg_cell_size(m, c) / max(own_size, 1e-12);
   return clamp((reject - ratio) / max(reject - keep, 1e-6), 0.0, 1.0);
 }
 
