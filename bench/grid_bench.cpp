@@ -7,6 +7,8 @@
 //            the worst case for a solve that starts from the previous frame.
 // Each also with the reference σ0 solver (…/bisection: the 56-step bisection the secant
 // replaced), so one run gives the ratio; `evaluations` counts column marches per frame.
+// Then the radius -> column lookup table the reconstruction builds from each column table,
+// three per eye and frame (reconstruct::radius_lut; radius_lut/PRESET, gaze at the centre).
 //   fovea_bench_grid [--benchmark_filter=fove0]
 #include <benchmark/benchmark.h>
 
@@ -19,6 +21,7 @@
 #include "fovea/core/display.hpp"
 #include "fovea/core/distribution.hpp"
 #include "fovea/core/visual_polar_testing.hpp"
+#include "fovea/reconstruct/grid_map.hpp"
 
 namespace fc = fovea::core;
 
@@ -65,6 +68,14 @@ void grid_build(benchmark::State& state, const std::string& preset, bool saccade
   state.counters["evaluations"] = evaluations / double(state.iterations());
 }
 
+void radius_lut(benchmark::State& state, const std::string& preset) {
+  const fc::View view = fc::load_display(preset).view(fc::Eye::Left);
+  const auto dist = fc::make_distribution(view, fc::DistributionParams{});
+  dist->set_frame(view.centre_dir());
+  for (auto _ : state) benchmark::DoNotOptimize(fovea::reconstruct::radius_lut(dist->column_table()).entries.data());
+  state.counters["columns"] = dist->columns();
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -76,6 +87,8 @@ int main(int argc, char** argv) {
                                          .c_str(),
                                      grid_build, preset, saccades, bisection)
             ->Unit(benchmark::kMicrosecond);
+  for (const std::string& preset : fc::display_preset_names())
+    benchmark::RegisterBenchmark(("radius_lut/" + preset).c_str(), radius_lut, preset)->Unit(benchmark::kMicrosecond);
   benchmark::Initialize(&argc, argv);
   if (benchmark::ReportUnrecognizedArguments(argc, argv)) return 1;
   benchmark::RunSpecifiedBenchmarks();

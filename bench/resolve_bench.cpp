@@ -1,5 +1,5 @@
-// The resolve stage (grid-image copy, recon_mip.comp, recon_radius_lut.comp + recon_resolve.comp
-// with the display depth, recon_blur.comp): GPU time of each part, both eyes, for a display
+// The resolve stage (grid-image copy, recon_mip.comp, recon_resolve.comp with the display depth,
+// recon_blur.comp): GPU time of each part, both eyes, for a display
 // preset, a distribution and a gaze. One frame of the `default` scene is rendered first
 // (1 bounce, so the grid holds a real image); then each iteration resolves that frame's
 // grids again and times the parts with timestamps (the benchmark's time is their sum).

@@ -13,9 +13,9 @@
 # Environment: FOVEA (the binary) [build/release/tools/fovea]; FRAMES [3]; BUDGET: Visual-Polar's
 # --budget [its default]; TRACE: both renders' --trace [auto: ray queries where the device
 # has them]; REF_WINDOW [7]
-# (degrees; 0: the whole view, rendered first by `fovea reference`); REF_SPP [256 for a
-# window, 8 for the whole view]: the reference's samples per pixel at most (it stops earlier
-# at a per-pixel relative error of REF_ERROR [0.02]); REF_BATCH [2]: the whole view's batch;
+# (degrees; 0: the whole view, rendered first by `fovea reference`); REF_SPP [2048 for a
+# window, enough for REF_ERROR on fove0's; 8 for the whole view]: the reference's samples per
+# pixel at most (it stops earlier at a per-pixel relative error of REF_ERROR [0.02]); REF_BATCH [2]: the whole view's batch;
 # REF_DIR: use reference_{left,right}.exr from there instead (any written by `fovea
 # reference` for this scene and view, whole or a window). The reference goes through the
 # reference cache (--reference-cache, default $XDG_CACHE_HOME/fovea/references): a second
@@ -27,7 +27,7 @@ FOVEA=${FOVEA:-build/release/tools/fovea}
 FRAMES=${FRAMES:-3}
 PRESET=${PRESET:-fove0}  # another display preset, for trying the script quickly
 REF_WINDOW=${REF_WINDOW:-7}
-if [[ $REF_WINDOW == 0 ]]; then REF_SPP=${REF_SPP:-8}; else REF_SPP=${REF_SPP:-256}; fi
+if [[ $REF_WINDOW == 0 ]]; then REF_SPP=${REF_SPP:-8}; else REF_SPP=${REF_SPP:-2048}; fi
 REF_BATCH=${REF_BATCH:-2}
 REF_ERROR=${REF_ERROR:-0.02}
 vp_budget=()

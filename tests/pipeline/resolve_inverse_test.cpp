@@ -1,5 +1,5 @@
 // The resolve's display -> grid inverse on the GPU (float; column through the per-frame
-// radius lookup table, recon_radius_lut.comp) against the CPU's exact inverse
+// radius lookup table, reconstruct::radius_lut) against the CPU's exact inverse
 // (core PolarDistribution::screen_to_grid: double atan2, binary search of the double
 // radii) for every pixel of the `small` and `fove0` rasters, with the gaze at the centre,
 // 25° off it and near a corner. u (column coordinate) is continuous across column
