@@ -5,6 +5,7 @@
 #ifdef FOVEA_TRAVERSE_STATS
 #extension GL_KHR_shader_subgroup_arithmetic : require
 #endif
+#include "fovea/shaders/pt_order.h"
 #include "fovea/shaders/pt_scene.h"
 #include "fovea/shaders/pt_raycast.h"
 
@@ -19,7 +20,12 @@ layout(push_constant) uniform Params { PtRaycastParams pc; };
 #include "fovea/shaders/pt_rayquery.h"
 
 void main() {
-  const uint i = gl_GlobalInvocationID.x;
+  // Whole workgroups take their 64 rays in pt_order.h's strip order: llvmpipe gives each of
+  // its threads a contiguous part of the dispatch, which in the rays' own order (a raster's
+  // rows) is the top or the bottom of the image, rarely equal work; the strips give every
+  // part the same share of each region. Rays and hits keep their indices.
+  const uint blocks = pc.count / 64u, w = gl_WorkGroupID.x;
+  const uint i = w < blocks ? pt_tile_of_workgroup(w, blocks) * 64u + gl_LocalInvocationID.x : gl_GlobalInvocationID.x;
   if (i >= pc.count) return;
   const PtRay ray = rays[i];
   const vec3 org = vec3(ray.org_x, ray.org_y, ray.org_z), dir = vec3(ray.dir_x, ray.dir_y, ray.dir_z);

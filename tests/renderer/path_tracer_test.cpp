@@ -233,6 +233,30 @@ TEST(TraceOrder, TilesCoverEveryCellOnceWithVectorsDownOneColumn) {
   EXPECT_EQ(kPtTileColumns * kPtTileRows, 64u);  // pt_trace.comp's workgroup: one tile each
 }
 
+// The workgroup -> tile map (shifts and masks, no division) is a permutation of the tiles for
+// any count, takes s = the lowest set bit of the count (at most kPtTileStrips) strips, and
+// gives the first half of the dispatch half of every strip of two tiles or more (± 1).
+TEST(TraceOrder, WorkgroupsTakeEveryTileOnceFromEveryStrip) {
+  using fovea::shaders::kPtTileStrips;
+  using fovea::shaders::pt_tile_of_workgroup;
+  for (const std::uint32_t tiles : {1u, 2u, 3u, 7u, 64u, 1800u, 4096u, 3072u, 20000u, 3u << 12, (1u << 20) + 4u}) {
+    std::vector<int> hits(tiles, 0);
+    for (std::uint32_t w = 0; w < tiles; ++w) {
+      const std::uint32_t t = pt_tile_of_workgroup(w, tiles);
+      ASSERT_LT(t, tiles) << tiles << " tiles, workgroup " << w;
+      ++hits[t];
+    }
+    ASSERT_EQ(std::count(hits.begin(), hits.end(), 1), std::ptrdiff_t(tiles)) << tiles << " tiles";
+    std::uint32_t s = 1;
+    while (s < kPtTileStrips && tiles % (2 * s) == 0) s *= 2;
+    const std::uint32_t per = tiles / s;  // tiles per strip
+    if (per < 2) continue;
+    std::vector<double> first_half(s, 0);
+    for (std::uint32_t w = 0; w < tiles / 2; ++w) ++first_half[pt_tile_of_workgroup(w, tiles) / per];
+    for (std::uint32_t k = 0; k < s; ++k) EXPECT_LE(std::abs(first_half[k] - per / 2.0), 1.0) << tiles << " tiles, strip " << k;
+  }
+}
+
 // llvmpipe gives each of its k threads one contiguous 1/k of a dispatch's workgroups: each
 // such part must hold about the same number of traced cells, though a Visual-Polar grid's
 // padding (the rows above each inner column's last) sits in its high rows. Measured, least /

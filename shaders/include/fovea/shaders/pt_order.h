@@ -16,7 +16,11 @@
 #include "fovea/shaders/common.h"
 
 #ifdef __cplusplus
+#include <bit>
+#define PT_ORDER_LSB(x) FOVEA_UINT(std::countr_zero(x))
 namespace fovea::shaders {
+#else
+#define PT_ORDER_LSB(x) uint(findLSB(x))
 #endif
 
 FOVEA_CONST FOVEA_UINT kPtTileRows = 8u;     // one 8-lane vector down a column
@@ -29,13 +33,15 @@ FOVEA_CONST FOVEA_UINT kPtTileColumns = 8u;  // kPtTileRows × kPtTileColumns = 
 // traced on alone (elapsed / CPU time of the trace on 2 threads 0.61, against 0.52 for a
 // raster). Workgroup w takes tile (w % s) · (tiles / s) + w / s, s the largest power of two
 // up to kPtTileStrips dividing the tile count (64 on fove0 and small): a thread's part takes
-// the same share of each of s strips spread over the grid.
+// the same share of each of s strips spread over the grid. s is the lowest set bit of the
+// tile count (at most kPtTileStrips), so the map takes shifts and masks: lavapipe divides
+// integers lane by lane, which cost a primary ray a tenth of its time (fovea_bench_raytrace).
 FOVEA_CONST FOVEA_UINT kPtTileStrips = 1024u;
 
 FOVEA_FN FOVEA_UINT pt_tile_of_workgroup(FOVEA_UINT w, FOVEA_UINT tiles) {
-  FOVEA_UINT s = kPtTileStrips;
-  while (tiles % s != 0u) s /= 2u;
-  return (w % s) * (tiles / s) + w / s;
+  const FOVEA_UINT low = tiles & (0u - tiles);
+  const FOVEA_UINT s = low == 0u || low > kPtTileStrips ? kPtTileStrips : low, k = PT_ORDER_LSB(s);
+  return (w & (s - 1u)) * (tiles >> k) + (w >> k);
 }
 
 // Cell of invocation n in a grid of `columns` columns and `cells` cells (index = row *
