@@ -15,7 +15,11 @@
 //   σ = kCentreSigma cells; Karis 2014 weights current samples by a reconstruction filter of
 //   their distance to the pixel centre): the history converges to a centre-weighted mean of
 //   the cell instead of its box mean, which the resolve's tent between cells blurs further
-//   (docs/reconstruction.md, "Jitter and reprojection"; stereo-occluders 40–42°).
+//   (docs/reconstruction.md, "Jitter and reprojection"; stereo-occluders 40–42°). Not on a
+//   grid that is the display's own raster (full Cartesian, linear fall-off): the resolve
+//   reads its cells at the pixels' centres without a tent, so the box mean is what a pixel
+//   of the reference holds; there the weight only lengthened TAA's memory (its mean is
+//   ~0.36) and cost 0.2–4 dB along a moving gaze (docs/sweep.md).
 // - In the frames after Phase I rejected a cell's history as too coarse (a saccade's new
 //   fovea; kReconRestartFrames, never at a still gaze) the current input is first averaged
 //   with the grid neighbours that pass the history's validity test (same surface): 5×5 in
@@ -124,8 +128,9 @@ void main() {
   for (int k = 0; k < 4; ++k) h += w[k] * compress(texelFetch(prev_final, int(idx[k])).rgb);
   h = from_ycocg(clamp(to_ycocg(h), lo, hi));
   vec2 jitter = vec2(m.g.jitter_u, m.g.jitter_v);  // the sample's offset from the cell centre (cells)
-  float g = exp(-dot(jitter, jitter) / (2.0 * kCentreSigma * kCentreSigma));
-  float a = follow ? g / (kMeanCentre * (since - 1.0) + g)
+  bool weighted = !(m.g.family == kFamilyCartesian && float(m.g.columns) == m.g.width && float(m.g.rows) == m.g.height);
+  float g = weighted ? exp(-dot(jitter, jitter) / (2.0 * kCentreSigma * kCentreSigma)) : 1.0;
+  float a = follow ? g / ((weighted ? kMeanCentre : 1.0) * (since - 1.0) + g)
                    : max(1.0 / max(texelFetch(post, int(i)).w, 1.0), pc.taa_alpha) * g;
   final_color[i] = vec4(max(expand(mix(h, compress(c), a)), vec3(0.0)), 1.0);
 }
