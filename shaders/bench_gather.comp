@@ -1,4 +1,5 @@
 #version 460
+#extension GL_EXT_samplerless_texture_functions : require  // texelFetch on texture buffers
 // fovea_bench_gather (bench/gather_bench.cpp): each invocation sums `taps` vec4s of one
 // buffer, read as a storage buffer or as a texel buffer (kTexel), at its own index plus a
 // stride (coherent: neighbouring invocations read neighbouring elements) or at hashed
@@ -10,7 +11,7 @@ layout(local_size_x = 64) in;
 layout(constant_id = 0) const bool kTexel = false;
 
 layout(std430, binding = 0) readonly buffer Src { vec4 src[]; };
-layout(binding = 1) uniform samplerBuffer src_texels;  // the same buffer
+layout(binding = 1) uniform textureBuffer src_texels;  // the same buffer
 layout(std430, binding = 2) writeonly buffer Dst { vec4 dst[]; };
 layout(push_constant) uniform Push {
   uint count, mask, taps, random;  // mask: element count - 1 (a power of two)

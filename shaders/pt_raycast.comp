@@ -2,6 +2,7 @@
 // Traces a batch of rays against the scene BVH (or by brute force): BVH tests and the
 // ray-throughput benchmark.
 #extension GL_GOOGLE_include_directive : require
+#extension GL_EXT_samplerless_texture_functions : require  // texelFetch on texture buffers
 #ifdef FOVEA_TRAVERSE_STATS
 #extension GL_KHR_shader_subgroup_arithmetic : require
 #endif
@@ -10,8 +11,8 @@
 #include "fovea/shaders/pt_raycast.h"
 
 layout(local_size_x = 64) in;
-layout(set = 0, binding = 0) uniform usamplerBuffer nodes;  // PtBvhNode: pt_node()
-layout(set = 0, binding = 1) uniform usamplerBuffer tris;   // PtTriangle: pt_tri()
+layout(set = 0, binding = 0) uniform utextureBuffer nodes;  // PtBvhNode: pt_node()
+layout(set = 0, binding = 1) uniform utextureBuffer tris;   // PtTriangle: pt_tri()
 layout(std430, set = 0, binding = 2) readonly buffer Rays { PtRay rays[]; };
 layout(std430, set = 0, binding = 3) writeonly buffer Hits { PtHitRecord hits[]; };
 layout(push_constant) uniform Params { PtRaycastParams pc; };

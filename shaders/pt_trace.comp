@@ -4,6 +4,7 @@
 // one BSDF-sampled bounce, NEE again, MIS between light and BSDF sampling).
 // Output layout and conventions: fovea/shaders/pt_trace.h.
 #extension GL_GOOGLE_include_directive : require
+#extension GL_EXT_samplerless_texture_functions : require  // texelFetch on texture buffers
 #include "fovea/shaders/common.h"
 #include "fovea/shaders/grid.h"
 #include "fovea/shaders/pt_scene.h"
@@ -11,15 +12,15 @@
 #include "fovea/shaders/pt_order.h"
 
 layout(local_size_x = 64) in;  // one tile of the tile order (pt_order.h)
-layout(set = 0, binding = 0) uniform usamplerBuffer nodes;  // PtBvhNode: pt_node()
-layout(set = 0, binding = 1) uniform usamplerBuffer tris;   // PtTriangle: pt_tri()
+layout(set = 0, binding = 0) uniform utextureBuffer nodes;  // PtBvhNode: pt_node()
+layout(set = 0, binding = 1) uniform utextureBuffer tris;   // PtTriangle: pt_tri()
 // Scene data read per path vertex are texel buffers (pt_traverse.h says why): decoded by
 // pt_shading(), pt_material(), pt_light() below.
-layout(set = 0, binding = 2) uniform samplerBuffer shading;    // PtShading: 4 texels each
-layout(set = 0, binding = 3) uniform samplerBuffer materials;  // PtMaterial: 3 texels each
-layout(set = 0, binding = 4) uniform samplerBuffer lights;     // PtLight: 1 texel each
+layout(set = 0, binding = 2) uniform textureBuffer shading;    // PtShading: 4 texels each
+layout(set = 0, binding = 3) uniform textureBuffer materials;  // PtMaterial: 3 texels each
+layout(set = 0, binding = 4) uniform textureBuffer lights;     // PtLight: 1 texel each
 layout(std430, set = 0, binding = 5) readonly buffer TexTable { PtTextureInfo tex_table[]; };
-layout(set = 0, binding = 6) uniform usamplerBuffer texels;    // RGBA8 per texel
+layout(set = 0, binding = 6) uniform utextureBuffer texels;    // RGBA8 per texel
 layout(std430, set = 0, binding = 7) readonly buffer Grid { GridSample cells[]; };
 layout(std430, set = 0, binding = 8) buffer OutDirect { vec4 out_direct[]; };
 layout(std430, set = 0, binding = 9) buffer OutIndirect { vec4 out_indirect[]; };
@@ -27,7 +28,7 @@ layout(std430, set = 0, binding = 10) buffer OutAlbedo { vec4 out_albedo[]; };
 layout(std430, set = 0, binding = 11) buffer OutNormalDepth { vec4 out_normal_depth[]; };
 layout(std430, set = 0, binding = 12) buffer OutPosMat { vec4 out_position_material[]; };
 layout(std430, set = 0, binding = 13) buffer OutRadiance { vec4 out_radiance[]; };
-layout(set = 0, binding = 14) uniform samplerBuffer ggx_albedo;  // read by pt_sampling.h
+layout(set = 0, binding = 14) uniform textureBuffer ggx_albedo;  // read by pt_sampling.h
 layout(push_constant) uniform Params { PtFrameParams pc; };
 // What the scene uses (PathTracer sets them from GpuScene::features()); false removes the
 // code: base-colour textures, GGX lobes (all F0 = 0), emission and next-event estimation.

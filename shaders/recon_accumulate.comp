@@ -9,6 +9,7 @@
 // Direct+specular and indirect diffuse are accumulated separately (the indirect one is
 // shared between the eyes later); each carries its own 8-bit sample count in .w.
 #extension GL_GOOGLE_include_directive : require
+#extension GL_EXT_samplerless_texture_functions : require  // texelFetch on texture buffers
 
 layout(local_size_x = 64) in;
 
@@ -18,16 +19,16 @@ layout(local_size_x = 64) in;
 #include "fovea/shaders/recon_grid.h"
 
 layout(std430, binding = RECON_MAPS) readonly buffer Maps { ReconGrid maps[]; };
-layout(binding = RECON_TABLES) uniform samplerBuffer tables;  // GridColumn: rg_table()
+layout(binding = RECON_TABLES) uniform textureBuffer tables;  // GridColumn: rg_table()
 layout(std430, binding = RECON_ACC_SAMPLES) readonly buffer Samples { GridSample samples[]; };
-layout(binding = RECON_ACC_DIRECT) uniform samplerBuffer direct;
-layout(binding = RECON_ACC_INDIRECT) uniform samplerBuffer indirect;
-layout(binding = RECON_ACC_NORMAL_DEPTH) uniform samplerBuffer normal_depth;
-layout(binding = RECON_ACC_POSITION_MATERIAL) uniform samplerBuffer position_material;
-layout(binding = RECON_ACC_PREV_DIRECT) uniform samplerBuffer prev_direct;
-layout(binding = RECON_ACC_PREV_INDIRECT) uniform samplerBuffer prev_indirect;
-layout(binding = RECON_ACC_PREV_POS) uniform samplerBuffer prev_pos;
-layout(binding = RECON_ACC_PREV_NRM) uniform samplerBuffer prev_nrm;
+layout(binding = RECON_ACC_DIRECT) uniform textureBuffer direct;
+layout(binding = RECON_ACC_INDIRECT) uniform textureBuffer indirect;
+layout(binding = RECON_ACC_NORMAL_DEPTH) uniform textureBuffer normal_depth;
+layout(binding = RECON_ACC_POSITION_MATERIAL) uniform textureBuffer position_material;
+layout(binding = RECON_ACC_PREV_DIRECT) uniform textureBuffer prev_direct;
+layout(binding = RECON_ACC_PREV_INDIRECT) uniform textureBuffer prev_indirect;
+layout(binding = RECON_ACC_PREV_POS) uniform textureBuffer prev_pos;
+layout(binding = RECON_ACC_PREV_NRM) uniform textureBuffer prev_nrm;
 layout(std430, binding = RECON_ACC_OUT_DIRECT) writeonly buffer AccDirect { vec4 acc_direct[]; };
 layout(std430, binding = RECON_ACC_OUT_INDIRECT) writeonly buffer AccIndirect { vec4 acc_indirect[]; };
 layout(std430, binding = RECON_ACC_OUT_POS) writeonly buffer Pos { vec4 vpos[]; };
@@ -35,9 +36,9 @@ layout(std430, binding = RECON_ACC_OUT_NRM) writeonly buffer Nrm { vec4 vnrm[]; 
 layout(std430, binding = RECON_ACC_TAP_IDX) writeonly buffer TapIdx { uvec4 tap_idx[]; };
 layout(std430, binding = RECON_ACC_TAP_W) writeonly buffer TapW { vec4 tap_w[]; };
 layout(std430, binding = RECON_ACC_MATERIALS) readonly buffer Materials { PtMaterial materials[]; };
-layout(binding = RECON_ACC_PREV_RESTART) uniform samplerBuffer prev_restart;
+layout(binding = RECON_ACC_PREV_RESTART) uniform textureBuffer prev_restart;
 layout(std430, binding = RECON_ACC_OUT_RESTART) writeonly buffer Restart { float restart[]; };
-layout(binding = RECON_ACC_LUTS) uniform usamplerBuffer radius_luts;
+layout(binding = RECON_ACC_LUTS) uniform utextureBuffer radius_luts;
 
 #define RG_RADIUS_LUT
 #include "fovea/shaders/recon_map.h"

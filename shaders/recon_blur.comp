@@ -5,6 +5,7 @@
 // direction, so it carries across displays. Pixels whose σ is below min_sigma_px are copied.
 // Weights renormalise at the raster's border.
 #extension GL_GOOGLE_include_directive : require
+#extension GL_EXT_samplerless_texture_functions : require  // texelFetch on texture buffers
 
 layout(local_size_x = 8, local_size_y = 8) in;
 
@@ -13,8 +14,8 @@ layout(local_size_x = 8, local_size_y = 8) in;
 #include "fovea/shaders/recon_grid.h"
 
 layout(std430, binding = RECON_MAPS) readonly buffer Maps { ReconGrid maps[]; };
-layout(binding = RECON_TABLES) uniform samplerBuffer tables;  // GridColumn: rg_table()
-layout(binding = RECON_BLUR_SRC) uniform samplerBuffer src;
+layout(binding = RECON_TABLES) uniform textureBuffer tables;  // GridColumn: rg_table()
+layout(binding = RECON_BLUR_SRC) uniform textureBuffer src;
 layout(std430, binding = RECON_BLUR_DST) writeonly buffer Dst { vec4 dst[]; };
 
 #include "fovea/shaders/recon_map.h"

@@ -26,6 +26,7 @@
 // Workgroup: kGroup invocations (default 8: one 8-wide SIMD row on lavapipe) loop over
 // 1024/kGroup rows each; a row's grid cell and validity are kept in shared memory.
 #extension GL_GOOGLE_include_directive : require
+#extension GL_EXT_samplerless_texture_functions : require  // texelFetch on texture buffers
 #extension GL_EXT_control_flow_attributes : require
 
 layout(local_size_x_id = 0) in;
@@ -37,14 +38,14 @@ layout(constant_id = 1) const bool kFp16 = false;   // features rounded to fp16 
 #include "fovea/shaders/recon_grid.h"
 #include "fovea/shaders/pt_scene.h"
 
-layout(binding = RECON_BMFR_POS) uniform samplerBuffer vpos;
-layout(binding = RECON_BMFR_NRM) uniform samplerBuffer vnrm;
-layout(binding = RECON_BMFR_Z) uniform samplerBuffer z;
+layout(binding = RECON_BMFR_POS) uniform textureBuffer vpos;
+layout(binding = RECON_BMFR_NRM) uniform textureBuffer vnrm;
+layout(binding = RECON_BMFR_Z) uniform textureBuffer z;
 layout(std430, binding = RECON_BMFR_FITTED) writeonly buffer Fitted { vec4 fitted[]; };
 layout(std430, binding = RECON_BMFR_COLUMNS) readonly buffer Columns { GridColumn tables[]; };
 layout(std430, binding = RECON_BMFR_MATERIALS) readonly buffer Materials { PtMaterial materials[]; };
 layout(std430, binding = RECON_BMFR_EXCESS) writeonly buffer Excess { vec4 excess[]; };
-layout(binding = RECON_BMFR_EDGE) uniform usamplerBuffer edge;  // 1: on a surface edge
+layout(binding = RECON_BMFR_EDGE) uniform utextureBuffer edge;  // 1: on a surface edge
 
 layout(push_constant) uniform Push { ReconBmfrPush pc; };
 

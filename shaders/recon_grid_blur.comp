@@ -11,6 +11,7 @@
 // linearly between its two rows there; φ wraps on full rings, clamps at a packed column's
 // ends and at the grid's first/last column (weights renormalised).
 #extension GL_GOOGLE_include_directive : require
+#extension GL_EXT_samplerless_texture_functions : require  // texelFetch on texture buffers
 
 layout(local_size_x = 8, local_size_y = 8) in;
 
@@ -19,8 +20,8 @@ layout(local_size_x = 8, local_size_y = 8) in;
 #include "fovea/shaders/recon_grid.h"
 
 layout(std430, binding = RECON_MAPS) readonly buffer Maps { ReconGrid maps[]; };
-layout(binding = RECON_TABLES) uniform samplerBuffer tables;  // GridColumn: rg_table()
-layout(binding = RECON_BLUR_SRC) uniform samplerBuffer src;
+layout(binding = RECON_TABLES) uniform textureBuffer tables;  // GridColumn: rg_table()
+layout(binding = RECON_BLUR_SRC) uniform textureBuffer src;
 layout(std430, binding = RECON_BLUR_DST) writeonly buffer Dst { vec4 dst[]; };
 
 #include "fovea/shaders/recon_map.h"

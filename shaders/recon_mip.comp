@@ -5,6 +5,7 @@
 // l, per column; a column of R rows has ceil(R / 2^l) rows at level l. Colours are
 // premultiplied by coverage (.w), so cells without a sample never darken their neighbours.
 #extension GL_GOOGLE_include_directive : require
+#extension GL_EXT_samplerless_texture_functions : require  // texelFetch on texture buffers
 
 layout(local_size_x = 8, local_size_y = 8) in;
 
@@ -13,7 +14,7 @@ layout(local_size_x = 8, local_size_y = 8) in;
 #include "fovea/shaders/recon_grid.h"
 
 layout(std430, binding = RECON_MAPS) readonly buffer Maps { ReconGrid maps[]; };
-layout(binding = RECON_TABLES) uniform samplerBuffer tables;  // GridColumn: rg_table()
+layout(binding = RECON_TABLES) uniform textureBuffer tables;  // GridColumn: rg_table()
 layout(std430, binding = RECON_MIP_MIPS) buffer Mips { vec4 mips[]; };
 
 #include "fovea/shaders/recon_map.h"

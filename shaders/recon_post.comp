@@ -16,21 +16,22 @@
 //   again it would outlive the same firefly without BMFR several times over.
 // Without denoising the Phase I result (direct + indirect) passes through.
 #extension GL_GOOGLE_include_directive : require
+#extension GL_EXT_samplerless_texture_functions : require  // texelFetch on texture buffers
 
 layout(local_size_x = 64) in;
 
 #include "fovea/shaders/recon_bindings.h"
 #include "fovea/shaders/recon_grid.h"
 
-layout(binding = RECON_POST_POS) uniform samplerBuffer vpos;
-layout(binding = RECON_POST_TAP_IDX) uniform usamplerBuffer tap_idx;
-layout(binding = RECON_POST_TAP_W) uniform samplerBuffer tap_w;
-layout(binding = RECON_POST_SOURCE) uniform samplerBuffer source;  // fitted indirect, or z without BMFR
-layout(binding = RECON_POST_ACC_DIRECT) uniform samplerBuffer acc_direct;  // .w: Phase I count
-layout(binding = RECON_POST_PREV) uniform samplerBuffer prev_post;  // accumulated fit, .w weight
+layout(binding = RECON_POST_POS) uniform textureBuffer vpos;
+layout(binding = RECON_POST_TAP_IDX) uniform utextureBuffer tap_idx;
+layout(binding = RECON_POST_TAP_W) uniform textureBuffer tap_w;
+layout(binding = RECON_POST_SOURCE) uniform textureBuffer source;  // fitted indirect, or z without BMFR
+layout(binding = RECON_POST_ACC_DIRECT) uniform textureBuffer acc_direct;  // .w: Phase I count
+layout(binding = RECON_POST_PREV) uniform textureBuffer prev_post;  // accumulated fit, .w weight
 layout(std430, binding = RECON_POST_OUT) writeonly buffer Post { vec4 post[]; };
-layout(binding = RECON_POST_PREV_ACC_DIRECT) uniform samplerBuffer prev_acc_direct;
-layout(binding = RECON_POST_EXCESS) uniform samplerBuffer excess;  // unread without BMFR
+layout(binding = RECON_POST_PREV_ACC_DIRECT) uniform textureBuffer prev_acc_direct;
+layout(binding = RECON_POST_EXCESS) uniform textureBuffer excess;  // unread without BMFR
 layout(std430, binding = RECON_POST_SUM) writeonly buffer Sum { vec4 sum[]; };          // TAA's input
 
 layout(push_constant) uniform Push { ReconPostPush pc; };

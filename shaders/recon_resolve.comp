@@ -8,6 +8,7 @@
 // distance along -Z (no filtering: depths must not blend across silhouettes), 0 where that
 // cell saw the sky or holds no sample; for depth compositing, the image does not use it.
 #extension GL_GOOGLE_include_directive : require
+#extension GL_EXT_samplerless_texture_functions : require  // texelFetch on texture buffers
 
 layout(local_size_x = 8, local_size_y = 8) in;
 
@@ -16,13 +17,13 @@ layout(local_size_x = 8, local_size_y = 8) in;
 #include "fovea/shaders/recon_grid.h"
 
 layout(std430, binding = RECON_MAPS) readonly buffer Maps { ReconGrid maps[]; };
-layout(binding = RECON_TABLES) uniform samplerBuffer tables;  // GridColumn: rg_table()
-layout(binding = RECON_RESOLVE_MIPS) uniform samplerBuffer mips;
+layout(binding = RECON_TABLES) uniform textureBuffer tables;  // GridColumn: rg_table()
+layout(binding = RECON_RESOLVE_MIPS) uniform textureBuffer mips;
 layout(std430, binding = RECON_RESOLVE_OFFSETS) readonly buffer Offsets { uint level_offset[]; };
 layout(std430, binding = RECON_RESOLVE_SCREEN) writeonly buffer Screen { vec4 screen[]; };
-layout(binding = RECON_RESOLVE_POS) uniform samplerBuffer vpos;  // world position, .w material code
+layout(binding = RECON_RESOLVE_POS) uniform textureBuffer vpos;  // world position, .w material code
 layout(std430, binding = RECON_RESOLVE_DEPTH) writeonly buffer Depth { float depth[]; };
-layout(binding = RECON_RESOLVE_LUTS) uniform usamplerBuffer radius_luts;
+layout(binding = RECON_RESOLVE_LUTS) uniform utextureBuffer radius_luts;
 
 #define RG_RADIUS_LUT
 #include "fovea/shaders/recon_map.h"

@@ -9,6 +9,7 @@
 // (recon_bmfr_fit.comp): this pass is the first to hold every cell's validation data of the
 // frame, and the fit's workgroups would read each cell's neighbourhood in a per-block loop.
 #extension GL_GOOGLE_include_directive : require
+#extension GL_EXT_samplerless_texture_functions : require  // texelFetch on texture buffers
 
 layout(local_size_x = 64) in;
 
@@ -17,18 +18,18 @@ layout(local_size_x = 64) in;
 #include "fovea/shaders/recon_grid.h"
 
 layout(std430, binding = RECON_MAPS) readonly buffer Maps { ReconGrid maps[]; };
-layout(binding = RECON_TABLES) uniform samplerBuffer tables;  // GridColumn: rg_table()
-layout(binding = RECON_SHARE_POS) uniform samplerBuffer vpos;
-layout(binding = RECON_SHARE_NRM) uniform samplerBuffer vnrm;
-layout(binding = RECON_SHARE_ACC_DIRECT) uniform samplerBuffer acc_direct;
-layout(binding = RECON_SHARE_ACC_INDIRECT) uniform samplerBuffer acc_indirect;
-layout(binding = RECON_SHARE_OTHER_POS) uniform samplerBuffer other_pos;
-layout(binding = RECON_SHARE_OTHER_NRM) uniform samplerBuffer other_nrm;
-layout(binding = RECON_SHARE_OTHER_INDIRECT) uniform samplerBuffer other_indirect;
+layout(binding = RECON_TABLES) uniform textureBuffer tables;  // GridColumn: rg_table()
+layout(binding = RECON_SHARE_POS) uniform textureBuffer vpos;
+layout(binding = RECON_SHARE_NRM) uniform textureBuffer vnrm;
+layout(binding = RECON_SHARE_ACC_DIRECT) uniform textureBuffer acc_direct;
+layout(binding = RECON_SHARE_ACC_INDIRECT) uniform textureBuffer acc_indirect;
+layout(binding = RECON_SHARE_OTHER_POS) uniform textureBuffer other_pos;
+layout(binding = RECON_SHARE_OTHER_NRM) uniform textureBuffer other_nrm;
+layout(binding = RECON_SHARE_OTHER_INDIRECT) uniform textureBuffer other_indirect;
 layout(std430, binding = RECON_SHARE_SHARED) writeonly buffer Shared { vec4 shared_indirect[]; };
 layout(std430, binding = RECON_SHARE_Z) writeonly buffer Z { vec4 z[]; };
 layout(std430, binding = RECON_SHARE_EDGE) writeonly buffer Edge { uint edge[]; };  // 1: on a surface edge
-layout(binding = RECON_SHARE_LUTS) uniform usamplerBuffer radius_luts;
+layout(binding = RECON_SHARE_LUTS) uniform utextureBuffer radius_luts;
 
 #define RG_RADIUS_LUT
 #include "fovea/shaders/recon_map.h"

@@ -34,6 +34,7 @@
 //   history (docs/reconstruction.md, "Saccade recovery curve").
 // .w = 1 marks cells holding a sample (the resolve renormalises over them).
 #extension GL_GOOGLE_include_directive : require
+#extension GL_EXT_samplerless_texture_functions : require  // texelFetch on texture buffers
 
 layout(local_size_x = 64) in;
 
@@ -43,16 +44,16 @@ layout(local_size_x = 64) in;
 #include "fovea/shaders/recon_grid.h"
 
 layout(std430, binding = RECON_MAPS) readonly buffer Maps { ReconGrid maps[]; };
-layout(binding = RECON_TABLES) uniform samplerBuffer tables;  // GridColumn: rg_table()
-layout(binding = RECON_TAA_POS) uniform samplerBuffer vpos;
-layout(binding = RECON_TAA_TAP_IDX) uniform usamplerBuffer tap_idx;
-layout(binding = RECON_TAA_TAP_W) uniform samplerBuffer tap_w;
-layout(binding = RECON_TAA_POST) uniform samplerBuffer post;
-layout(binding = RECON_TAA_ALBEDO) uniform samplerBuffer albedo;
-layout(binding = RECON_TAA_PREV_FINAL) uniform samplerBuffer prev_final;
+layout(binding = RECON_TABLES) uniform textureBuffer tables;  // GridColumn: rg_table()
+layout(binding = RECON_TAA_POS) uniform textureBuffer vpos;
+layout(binding = RECON_TAA_TAP_IDX) uniform utextureBuffer tap_idx;
+layout(binding = RECON_TAA_TAP_W) uniform textureBuffer tap_w;
+layout(binding = RECON_TAA_POST) uniform textureBuffer post;
+layout(binding = RECON_TAA_ALBEDO) uniform textureBuffer albedo;
+layout(binding = RECON_TAA_PREV_FINAL) uniform textureBuffer prev_final;
 layout(std430, binding = RECON_TAA_FINAL) writeonly buffer Final { vec4 final_color[]; };
-layout(binding = RECON_TAA_NRM) uniform samplerBuffer vnrm;
-layout(binding = RECON_TAA_RESTART) uniform samplerBuffer restart;  // Phase I's window
+layout(binding = RECON_TAA_NRM) uniform textureBuffer vnrm;
+layout(binding = RECON_TAA_RESTART) uniform textureBuffer restart;  // Phase I's window
 
 #include "fovea/shaders/recon_map.h"
 

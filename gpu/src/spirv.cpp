@@ -18,7 +18,7 @@ constexpr std::uint32_t kOpConstant = 43, kOpConstantComposite = 44, kOpSpecCons
                         kOpSpecConstantComposite = 51;
 constexpr std::uint32_t kModeLocalSize = 17, kModeLocalSizeId = 38;
 constexpr std::uint32_t kDecorationSpecId = 1, kDecorationBuiltIn = 11, kBuiltInWorkgroupSize = 25;
-constexpr std::uint32_t kDimBuffer = 5;  // OpTypeImage's Dim operand for samplerBuffer
+constexpr std::uint32_t kDimBuffer = 5;  // OpTypeImage's Dim operand for textureBuffer / samplerBuffer
 constexpr std::uint32_t kOpTypeImage = 25, kOpTypeSampledImage = 27, kOpTypeArray = 28, kOpTypeRuntimeArray = 29,
                         kOpTypePointer = 32, kOpVariable = 59;
 constexpr std::uint32_t kOpTypeAccelerationStructureKHR = 5341;
@@ -134,7 +134,9 @@ std::vector<DeclaredBinding> descriptor_bindings(std::span<const std::uint32_t> 
     } else if (storage == kStorageUniform) {
       d.type = Binding::UniformBuffer;
     } else if (storage == kStorageUniformConstant && sampled_image.count(t)) {
-      d.type = sampled_image[t] ? Binding::TexelBuffer : Binding::SampledImage;
+      d.type = sampled_image[t] ? Binding::TexelBuffer : Binding::SampledImage;  // samplerBuffer / sampler2D
+    } else if (storage == kStorageUniformConstant && buffer_image.count(t) && image_sampled[t] == 1) {
+      d.type = Binding::TexelBuffer;  // textureBuffer (GL_EXT_samplerless_texture_functions)
     } else if (storage == kStorageUniformConstant && accel.count(t)) {
       d.type = Binding::AccelerationStructure;
     } else if (storage == kStorageUniformConstant && image_sampled.count(t) && image_sampled[t] == 2) {

@@ -17,7 +17,7 @@ inline gpu::Buffer storage(gpu::Context& ctx, VkDeviceSize bytes, const char* na
                            .memory = memory, .name = name});
 }
 
-// Per-cell data that later kernels read as texels (`samplerBuffer` / `usamplerBuffer`,
+// Per-cell data that later kernels read as texels (`textureBuffer` / `utextureBuffer`,
 // texelFetch) and their producer writes as a storage buffer: vec4 (RGBA32F) by default.
 inline gpu::Buffer cells(gpu::Context& ctx, std::uint32_t count, const char* name,
                          VkFormat format = VK_FORMAT_R32G32B32A32_SFLOAT) {

@@ -42,7 +42,7 @@ struct BufferDesc {
   BufferUsage usage = BufferUsage::Storage;
   Memory memory = Memory::DeviceLocal;
   std::string name;  // shown in validation messages
-  // Also readable as a texel buffer (`samplerBuffer` / `usamplerBuffer`, texelFetch) of this
+  // Also readable as a texel buffer (`textureBuffer` / `utextureBuffer`, texelFetch) of this
   // format (R32/R32G32/R32G32B32A32, UINT or SFLOAT): the buffer owns a view of itself that
   // DescriptorSet binds to Binding::TexelBuffer. lavapipe fetches a texel as one vector
   // gather, where a storage-buffer load whose address differs per invocation is a loop over

@@ -22,7 +22,7 @@ enum class Binding {
   StorageImage,   // image2D / uimage2D with a format qualifier
   SampledImage,   // sampler2D (combined image sampler)
   AccelerationStructure,  // accelerationStructureEXT (the top level of a TriangleAccel)
-  TexelBuffer,            // samplerBuffer / usamplerBuffer (a Buffer with a texel_format)
+  TexelBuffer,            // textureBuffer / utextureBuffer (a Buffer with a texel_format)
 };
 const char* binding_name(Binding b);  // "storage buffer", ... for messages
 

@@ -1,7 +1,7 @@
 // GLSL only: the counter-based random numbers and the BSDF (GGX with Smith masking and a
 // multiple-scattering lobe over an energy-compensated Lambert base, glTF
 // metallic-roughness) of the path tracer. The includer
-// declares `samplerBuffer ggx_albedo`, the table described with kPtGgxTableSize (pt_scene.h).
+// declares `textureBuffer ggx_albedo`, the table described with kPtGgxTableSize (pt_scene.h).
 #ifndef FOVEA_SHADERS_PT_SAMPLING_H
 #define FOVEA_SHADERS_PT_SAMPLING_H
 

@@ -1,6 +1,6 @@
 // GLSL only: BVH traversal and the watertight ray-triangle test. The including shader
-// declares the texel buffers `usamplerBuffer nodes` (PtBvhNode, 4 texels per node) and
-// `usamplerBuffer tris` (PtTriangle, 3 per triangle) first; pt_node() and pt_tri() decode them.
+// declares the texel buffers `utextureBuffer nodes` (PtBvhNode, 4 texels per node) and
+// `utextureBuffer tris` (PtTriangle, 3 per triangle) first; pt_node() and pt_tri() decode them.
 #ifndef FOVEA_SHADERS_PT_TRAVERSE_H
 #define FOVEA_SHADERS_PT_TRAVERSE_H
 

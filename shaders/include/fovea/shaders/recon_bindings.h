@@ -2,7 +2,7 @@
 // definition for the GLSL `layout(binding = ...)` and the C++ binding structs
 // (reconstruct/src/bindings.hpp). gpu::ComputePipeline checks the layout against the
 // SPIR-V at start-up, DescriptorSet::bind_all that every binding is given once. Per-cell
-// inputs are declared `samplerBuffer` / `usamplerBuffer` and read with texelFetch: on
+// inputs are declared `textureBuffer` / `utextureBuffer` and read with texelFetch: on
 // lavapipe a storage-buffer load whose address differs per invocation is a loop over the
 // SIMD lanes, a texel fetch one vector gather (docs/gpu.md, "Texel buffers").
 #ifndef FOVEA_SHADERS_RECON_BINDINGS_H

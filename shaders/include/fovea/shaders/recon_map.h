@@ -1,8 +1,8 @@
 // GLSL only: grid-space mapping helpers of the reconstruction (see recon_grid.h). Include
 // after declaring the mapping buffer and the column table's texel buffer:
-//   buffer ... { ReconGrid maps[]; }  and  uniform samplerBuffer tables;
+//   buffer ... { ReconGrid maps[]; }  and  uniform textureBuffer tables;
 // and, in kernels that define RG_RADIUS_LUT, the mappings' radius lookup tables:
-//   uniform usamplerBuffer radius_luts;
+//   uniform utextureBuffer radius_luts;
 #ifndef FOVEA_SHADERS_RECON_MAP_H
 #define FOVEA_SHADERS_RECON_MAP_H
 const float kRgPi = 3.14159265358979323846;
