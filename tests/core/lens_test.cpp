@@ -19,7 +19,7 @@ std::string preset_with_lens(const std::string& lens, int w = 100, int h = 110) 
          R"(,"fov_deg":{"left":-50,"right":50,"up":53,"down":-53},"lens":)" + lens + "}";
 }
 
-std::string error_of(const std::string& json) {
+std::string lens_error_of(const std::string& json) {
   try {
     const DisplayPreset d = parse_display(json, "test.json");
     (void)Lens::for_eye(d, Eye::Left);
@@ -151,36 +151,36 @@ TEST(Lens, NoLensSectionIsTheIdentity) {
 
 TEST(Lens, InvalidCoefficientsAreRefusedNamingTheField) {
   const std::string ok_k = R"("k":[0.75,-0.01,0.75,0,3.8],"aberration":[0.999,1.008,1.018],"centre":[0.5,0.5])";
-  EXPECT_NE(error_of(preset_with_lens(R"({"model":"panotools",)" + ok_k + R"(,"scale":0})")).find("lens.scale"),
+  EXPECT_NE(lens_error_of(preset_with_lens(R"({"model":"panotools",)" + ok_k + R"(,"scale":0})")).find("lens.scale"),
             std::string::npos);
-  EXPECT_NE(error_of(preset_with_lens(
+  EXPECT_NE(lens_error_of(preset_with_lens(
                 R"({"model":"panotools","k":[0.75,null,0.75,0,3.8],"aberration":[1,1,1],"centre":[0.5,0.5],"scale":1.2})"))
                 .find("lens.k[1]"),
             std::string::npos);
-  EXPECT_NE(error_of(preset_with_lens(
+  EXPECT_NE(lens_error_of(preset_with_lens(
                 R"({"model":"panotools","k":[0,1,0,0,0],"aberration":[1,1,1],"centre":[0.5,0.5],"scale":1.2})"))
                 .find("lens.k[0]"),
             std::string::npos);
-  EXPECT_NE(error_of(preset_with_lens(
+  EXPECT_NE(lens_error_of(preset_with_lens(
                 R"({"model":"panotools","k":[1,0,0,0,0],"aberration":[1,0,1],"centre":[0.5,0.5],"scale":1.2})"))
                 .find("lens.aberration[1]"),
             std::string::npos);
-  EXPECT_NE(error_of(preset_with_lens(R"({"model":"fisheye"})")).find("lens.model"), std::string::npos);
+  EXPECT_NE(lens_error_of(preset_with_lens(R"({"model":"fisheye"})")).find("lens.model"), std::string::npos);
   const std::string ch = R"({"centre":[0,0],"k":[0,0,0,0]})";
-  EXPECT_NE(error_of(preset_with_lens(R"({"model":"vive","aspect":0,"grow_for_undistort":0.5,"red":)" + ch +
+  EXPECT_NE(lens_error_of(preset_with_lens(R"({"model":"vive","aspect":0,"grow_for_undistort":0.5,"red":)" + ch +
                                       R"(,"green":)" + ch + R"(,"blue":)" + ch + "}"))
                 .find("lens.aspect"),
             std::string::npos);
-  EXPECT_NE(error_of(preset_with_lens(R"({"model":"vive","aspect":0.9,"grow_for_undistort":-1,"red":)" + ch +
+  EXPECT_NE(lens_error_of(preset_with_lens(R"({"model":"vive","aspect":0.9,"grow_for_undistort":-1,"red":)" + ch +
                                       R"(,"green":)" + ch + R"(,"blue":)" + ch + "}"))
                 .find("lens.grow_for_undistort"),
             std::string::npos);
-  EXPECT_NE(error_of(preset_with_lens(R"({"model":"vive","aspect":0.9,"grow_for_undistort":0.5,"red":)" + ch +
+  EXPECT_NE(lens_error_of(preset_with_lens(R"({"model":"vive","aspect":0.9,"grow_for_undistort":0.5,"red":)" + ch +
                                       R"(,"green":{"centre":[0,0],"k":[0,0,0,-1]},"blue":)" + ch + "}"))
                 .find("lens.green.k"),
             std::string::npos);
   // A radial map that turns back almost at once leaves nothing usable: refused.
-  EXPECT_NE(error_of(preset_with_lens(
+  EXPECT_NE(lens_error_of(preset_with_lens(
                 R"({"model":"panotools","k":[1,0,-1e6,0,0],"aberration":[1,1,1],"centre":[0.5,0.5],"scale":1.2})"))
                 .find("no usable lens area"),
             std::string::npos);

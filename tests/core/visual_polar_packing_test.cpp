@@ -12,12 +12,12 @@
 #include "fovea/core/density_report.hpp"
 #include "fovea/core/display.hpp"
 #include "fovea/core/distribution.hpp"
+#include "density_strided.hpp"
 
 using namespace fovea::core;
+using fovea::core::test::kDeg;
 
 namespace {
-
-constexpr double kDeg = std::numbers::pi / 180;
 
 // A gaze `deg` degrees from the view centre, towards the upper left (as the docs' 0.25,0.35).
 glm::dvec3 gaze_from_centre(const View& v, double deg) {
@@ -27,30 +27,26 @@ glm::dvec3 gaze_from_centre(const View& v, double deg) {
   return std::cos(deg * kDeg) * c + std::sin(deg * kDeg) * side;
 }
 
-DensityReport measure(const SampleDistribution& d) {
-  return measure_density(d, 2.0, std::max(1, d.view().width() / 320), std::max(1, d.rows() / 360));
-}
-
 double onscreen_fraction(const SampleDistribution& d) {
-  const DensityReport r = measure(d);
+  const DensityReport r = test::measure_strided(d);
   return double(r.traced) / double(r.grid_samples);
 }
 
-struct GazeCase {
+struct PackingGaze {
   const char* name;
   double deg;        // from the view centre; NaN: use `pixel` (normalised) or a NaN gaze
   glm::dvec2 pixel;  // normalised screen position
 };
 
-const GazeCase kCases[] = {{"centre", 0, {}},
-                           {"25deg", 25, {}},
-                           {"36deg", 36, {}},
-                           {"40deg", 40, {}},
-                           {"corner", std::numeric_limits<double>::quiet_NaN(), {0, 0}},
-                           {"outside", std::numeric_limits<double>::quiet_NaN(), {1.6, -0.4}},
-                           {"nan", std::numeric_limits<double>::quiet_NaN(), {std::nan(""), 0}}};
+const PackingGaze kCases[] = {{"centre", 0, {}},
+                              {"25deg", 25, {}},
+                              {"36deg", 36, {}},
+                              {"40deg", 40, {}},
+                              {"corner", std::numeric_limits<double>::quiet_NaN(), {0, 0}},
+                              {"outside", std::numeric_limits<double>::quiet_NaN(), {1.6, -0.4}},
+                              {"nan", std::numeric_limits<double>::quiet_NaN(), {std::nan(""), 0}}};
 
-glm::dvec3 gaze_of(const View& v, const GazeCase& g) {
+glm::dvec3 gaze_of(const View& v, const PackingGaze& g) {
   if (!std::isnan(g.deg)) return gaze_from_centre(v, g.deg);
   if (std::isnan(g.pixel.x)) return glm::dvec3(std::nan(""), 0, -1);
   return v.pixel_to_dir({g.pixel.x * v.width(), g.pixel.y * v.height()});
@@ -64,7 +60,7 @@ TEST_P(Packing, MostSamplesLandOnScreen) {
   const View v = load_display(GetParam()).view(Eye::Left);
   auto packed = make_distribution(v, DistributionParams{});
   auto full = make_distribution(v, DistributionParams{.pack = false});
-  for (const GazeCase& g : kCases) {
+  for (const PackingGaze& g : kCases) {
     packed->set_frame(gaze_of(v, g));
     full->set_frame(gaze_of(v, g));
     const double p = onscreen_fraction(*packed), f = onscreen_fraction(*full);
@@ -85,7 +81,7 @@ TEST_P(Packing, SameDensityMoreSamplesOnScreen) {
   for (double deg : {0.0, 25.0, 36.0}) {
     packed->set_frame(gaze_from_centre(v, deg));
     full->set_frame(gaze_from_centre(v, deg));
-    const DensityReport rp = measure(*packed), rf = measure(*full);
+    const DensityReport rp = test::measure_strided(*packed), rf = test::measure_strided(*full);
     EXPECT_GE(double(rp.traced), 0.99 * double(rf.traced)) << deg;
     int checked = 0;
     for (const auto& b : rp.bands) {
@@ -107,7 +103,7 @@ TEST_P(Packing, EveryPixelLandsInItsColumnsArc) {
   const View v = load_display(GetParam()).view(Eye::Left);
   auto d = make_distribution(v, DistributionParams{});
   const int step = std::max(1, v.width() / 160);
-  for (const GazeCase& g : kCases) {
+  for (const PackingGaze& g : kCases) {
     d->set_frame(gaze_of(v, g));
     const auto& table = d->column_table();
     double worst = 0;

@@ -16,14 +16,15 @@
 #include "fovea/core/distribution.hpp"
 #include "fovea/core/error.hpp"
 #include "fovea/core/visual_polar_testing.hpp"
+#include "density_strided.hpp"
 
 using namespace fovea::core;
+using fovea::core::test::kDeg;
 namespace sh = fovea::shaders;
 
 namespace {
 
 constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
-constexpr double kDeg = std::numbers::pi / 180;
 
 struct GazeCase {
   const char* name;
@@ -85,15 +86,8 @@ class VisualPolarProperties : public ::testing::TestWithParam<std::tuple<std::st
   double from_centre_ = 0;
 };
 
-// Strides keep the large presets quick; bands still hold thousands of samples.
-DensityReport measure(const SampleDistribution& d) {
-  const int ps = std::max(1, d.view().width() / 320);
-  const int rs = std::max(1, d.rows() / 360);
-  return measure_density(d, 2.0, ps, rs);
-}
-
 void VisualPolarProperties::P1_DensityMatchesTarget() {
-  const auto r = measure(*d_);
+  const auto r = test::measure_strided(*d_);
   const auto st = visual_polar_state(*d_);
   ASSERT_TRUE(st);
   const double tol = from_centre_ <= 25 ? 0.10 : 0.15;
@@ -122,7 +116,7 @@ void VisualPolarProperties::P2_ConstantBudget() {
   if (from_centre_ <= 25 && v.width() * v.height() >= 10000) {
     EXPECT_NEAR(cells / budget, 1.0, 0.05);
   }
-  const auto r = measure(*d_);
+  const auto r = test::measure_strided(*d_);
   RecordProperty("onscreen_fraction", std::to_string(double(r.traced) / r.grid_samples));
 }
 
@@ -206,7 +200,7 @@ void VisualPolarProperties::P6_ExtremesAreSafe() {
 
 void VisualPolarProperties::P7_FoveaGetsFullDensity() {
   if (from_centre_ > 25) return;  // property 7 covers gazes up to 25° from the view centre
-  const auto r = measure(*d_);
+  const auto r = test::measure_strided(*d_);
   EXPECT_GE(r.fovea_spp, d_->params().cap * 0.995) << "fovea samples per display pixel";
   RecordProperty("traced_fraction",
                  std::to_string(double(r.traced) / (double(d_->view().width()) * d_->view().height())));

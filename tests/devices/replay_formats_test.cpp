@@ -1,5 +1,4 @@
 #include <sys/resource.h>
-#include <zlib.h>
 
 #include <cmath>
 #include <cstdio>
@@ -14,26 +13,15 @@
 
 using namespace fovea::devices;
 using fovea::devices::test::scratch_dir;
+using fovea::devices::test::read_all;
+using fovea::devices::test::write_gz;
 using fovea::devices::test::write_text;
 
 namespace {
-std::vector<GazeSample> read_all(GazeReader& r) {
-  std::vector<GazeSample> v;
-  GazeSample s;
-  while (r.next(s)) v.push_back(s);
-  return v;
-}
 SourceOptions symmetric_screen(int w, int h, double hfov, double vfov) {
   SourceOptions o;
   o.screen = fovea::core::View(fovea::core::Fov::from_degrees(-hfov / 2, hfov / 2, vfov / 2, -vfov / 2), w, h);
   return o;
-}
-std::string write_gz(const std::string& name, const std::string& text) {
-  const std::string p = scratch_dir() + "/" + name;
-  gzFile g = gzopen(p.c_str(), "wb");
-  gzwrite(g, text.data(), static_cast<unsigned>(text.size()));
-  gzclose(g);
-  return p;
 }
 // Direction -> (x right, y up) angles in degrees for readable expectations.
 double az(glm::dvec3 d) { return std::atan2(d.x, -d.z) * 180 / M_PI; }

@@ -1,7 +1,6 @@
 // Replay as a researcher checks it: event statistics against known ground truth at every
 // sampling rate, vendor blink marks, 2-D geometry from files and URIs, data quality, kept
 // messages, and the fuzz findings on gaze files and HID captures kept as regressions.
-#include <zlib.h>
 
 #include <cmath>
 #include <filesystem>
@@ -27,6 +26,8 @@ using namespace fovea::devices;
 using fovea::core::InputError;
 using fovea::core::TimeNs;
 using fovea::devices::test::scratch_dir;
+using fovea::devices::test::read_all;
+using fovea::devices::test::write_gz;
 using fovea::devices::test::write_text;
 
 namespace {
@@ -107,22 +108,6 @@ GazeSummary summary_of(std::vector<GazeSample> v) {
   SummaryParams p;
   p.infer_blinks = false;
   return summarize(s, p);
-}
-
-std::string write_gz(const std::string& name, const std::string& text, std::size_t keep_bytes = SIZE_MAX) {
-  const std::string p = scratch_dir() + "/" + name;
-  gzFile g = gzopen(p.c_str(), "wb");
-  gzwrite(g, text.data(), static_cast<unsigned>(text.size()));
-  gzclose(g);
-  if (keep_bytes != SIZE_MAX) std::filesystem::resize_file(p, keep_bytes);
-  return p;
-}
-
-std::vector<GazeSample> read_all(SampleStream& r) {
-  std::vector<GazeSample> v;
-  GazeSample s;
-  while (r.next(s)) v.push_back(s);
-  return v;
 }
 
 }  // namespace

@@ -1,12 +1,17 @@
 #pragma once
 // Helpers for the devices tests: scratch files in a per-test temporary directory.
 #include <unistd.h>
+#include <zlib.h>
 
 #include <filesystem>
 #include <fstream>
+#include <cstdint>
 #include <string>
+#include <vector>
 
 #include <gtest/gtest.h>
+
+#include "fovea/devices/gaze.hpp"
 
 namespace fovea::devices::test {
 
@@ -22,6 +27,23 @@ inline std::string write_text(const std::string& name, const std::string& text) 
   const std::string p = scratch_dir() + "/" + name;
   std::ofstream(p, std::ios::binary) << text;
   return p;
+}
+
+// `text` gzip-compressed into a scratch file; `keep_bytes` truncates the file (a cut download).
+inline std::string write_gz(const std::string& name, const std::string& text, std::size_t keep_bytes = SIZE_MAX) {
+  const std::string p = scratch_dir() + "/" + name;
+  gzFile g = gzopen(p.c_str(), "wb");
+  gzwrite(g, text.data(), static_cast<unsigned>(text.size()));
+  gzclose(g);
+  if (keep_bytes != SIZE_MAX) std::filesystem::resize_file(p, keep_bytes);
+  return p;
+}
+
+inline std::vector<GazeSample> read_all(SampleStream& r) {
+  std::vector<GazeSample> v;
+  GazeSample s;
+  while (r.next(s)) v.push_back(s);
+  return v;
 }
 
 inline std::string source_dir() {

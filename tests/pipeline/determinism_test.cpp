@@ -20,7 +20,7 @@ using fovea::test::GpuTest;
 namespace {
 
 constexpr std::uint32_t kQuietNan = 0x7fc00001u;
-constexpr std::uint32_t kFrames = 4;
+constexpr std::uint32_t kRunFrames = 4;
 
 // Everything a frame leaves behind that a test or tool can read, per eye, as raw bytes.
 struct Snapshot {
@@ -43,7 +43,7 @@ std::array<glm::dvec3, 2> gaze_of(std::uint32_t f) {
 }
 
 Snapshot render_sequence(pipeline::FramePipeline& p, const std::array<core::Pose, 2>& poses) {
-  for (std::uint32_t f = 0; f < kFrames; ++f) p.render(poses, gaze_of(f), 10 + f);
+  for (std::uint32_t f = 0; f < kRunFrames; ++f) p.render(poses, gaze_of(f), 10 + f);
   Snapshot s;
   for (int e = 0; e < p.eyes(); ++e) {
     const core::Eye eye = core::Eye(e);

@@ -12,6 +12,7 @@
 
 #include "fovea/core/json.hpp"
 
+using fovea::test::read_text;
 using fovea::test::run_fovea;
 using fovea::test::temp_dir;
 
@@ -20,12 +21,6 @@ namespace {
 std::string write(const std::string& path, const std::string& text) {
   std::ofstream(path, std::ios::binary) << text;
   return path;
-}
-std::string slurp(const std::string& path) {
-  std::ifstream in(path);
-  std::stringstream ss;
-  ss << in.rdbuf();
-  return ss.str();
 }
 std::string shipped(const std::string& name) {
   const char* s = std::getenv("FOVEA_SOURCE_DIR");
@@ -68,10 +63,10 @@ TEST(GazeCli, ConvertKeepsTheTimeBaseAndTheMessages) {
                                 "MSG\t5004 target \"A\", onset\n5006\t961.0\t541.0\t1000.0\n");
   const auto r = run_fovea("gaze convert " + asc + " " + dir + "/out.csv --screen 1920x1080@531x299mm@700mm");
   ASSERT_EQ(r.status, 0) << r.err;
-  const auto side = fovea::core::parse_json(slurp(dir + "/out.csv.json"));
+  const auto side = fovea::core::parse_json(read_text(dir + "/out.csv.json"));
   EXPECT_EQ(side["time_base"]["t0_device_time_ns"], 5'002'000'000);
   EXPECT_NEAR(side["screen"]["hfov_deg"].get<double>(), 41.55, 0.01);
-  EXPECT_EQ(slurp(dir + "/out.csv.events.csv"),
+  EXPECT_EQ(read_text(dir + "/out.csv.events.csv"),
             "t_ns,device_time_ns,kind,text\n"
             "-2000000,5000000000,msg,\"DISPLAY_COORDS 0 0 1919 1079\"\n"
             "-1000000,5001000000,msg,\"TRIALID 7\"\n"
@@ -115,14 +110,14 @@ TEST(GazeCli, FuzzFindingsGiveExitTwoOrSaneOutput) {
   EXPECT_GE(ej["duration_s"].get<double>(), 0);
   EXPECT_EQ(ej["dropped"]["time_overflow"], 1);
   // (7) one timestamp byte of the shipped capture changed to 2^62 µs: no negative t_ns.
-  std::string cap = slurp(shipped("hid-ms.hidcap"));
+  std::string cap = read_text(shipped("hid-ms.hidcap"));
   const auto at = cap.find(" 10 ", cap.find("\ninput ", cap.find("\ninput ") + 1));
   cap.replace(at + 4, 23, "00 00 00 00 00 00 00 40");
   const std::string capf = write(dir + "/ts.hidcap", cap);
   const auto c = run_fovea("gaze convert " + capf + " " + dir + "/cap.csv");
   ASSERT_EQ(c.status, 0) << c.err;
   EXPECT_NE(c.err.find("time_overflow: 1"), std::string::npos) << c.err;
-  EXPECT_EQ(slurp(dir + "/cap.csv").find("\n-"), std::string::npos);
+  EXPECT_EQ(read_text(dir + "/cap.csv").find("\n-"), std::string::npos);
   // A bad geometry is named wherever it is given.
   const auto sc = run_fovea("render --display tiny --frames 1 --screen 12 --out " + dir + "/r");
   EXPECT_EQ(sc.status, 2);

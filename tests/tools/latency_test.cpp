@@ -14,7 +14,7 @@ namespace {
 // Clean synthetic saccades sampled at 1 kHz: the true eye.
 constexpr const char* kTruth = "synthetic:5?task=search&rate=1000&noise=0&dropouts=0";
 
-devices::SourceOptions options() {
+devices::SourceOptions source_options() {
   devices::SourceOptions o;
   o.horizon_ns = 0;
   return o;
@@ -52,7 +52,7 @@ Scenario panel(double hz, core::TimeNs seconds_ns) {
 // D + render + compositor budget + half the persistence.
 TEST(LatencySimulation, TrackerDelayExactAndGazeToPhotonFromItsTerms) {
   const core::TimeNs D = 20'000'000, R = 5'000'000;
-  auto tracker = open_tracker(kTruth, ideal(D, 1000), options());
+  auto tracker = open_tracker(kTruth, ideal(D, 1000), source_options());
   Scenario sc = panel(90, 1'000'000'000);
   sc.display.persistence_ns = 2'000'000;
   const Simulation sim = simulate(*tracker, sc, fixed(R));
@@ -85,7 +85,7 @@ TEST(LatencySimulation, TrackerDelayExactAndGazeToPhotonFromItsTerms) {
 // A frame finishing late is counted as missed and shown one period later; the previous
 // frame stays on the panel at the vsync it missed.
 TEST(LatencySimulation, LateFrameIsMissedAndShownOnePeriodLater) {
-  auto tracker = open_tracker(kTruth, ideal(0, 1000), options());
+  auto tracker = open_tracker(kTruth, ideal(0, 1000), source_options());
   const Scenario sc = panel(90, 200'000'000);
   const xrcommon::DisplayModel m(sc.display);
   const RenderFn slow_third = [&](std::int64_t f, const std::array<glm::dvec3, 2>&) {
@@ -124,7 +124,7 @@ TEST(LatencySimulation, LateFrameIsMissedAndShownOnePeriodLater) {
 // A rolling scan-out lights each region of each eye at its own time: the records carry the
 // start, middle and end rows' photon times.
 TEST(LatencySimulation, RollingScanOutPhotonTimesPerRegion) {
-  auto tracker = open_tracker(kTruth, ideal(0, 1000), options());
+  auto tracker = open_tracker(kTruth, ideal(0, 1000), source_options());
   Scenario sc = panel(72, 100'000'000);
   sc.display.scan_out = xrcommon::ScanOut::Rolling;
   sc.display.scan_ns = 12'000'000;
@@ -146,7 +146,7 @@ TEST(LatencySimulation, RollingScanOutPhotonTimesPerRegion) {
 TEST(LatencySimulation, FovealErrorGrowsWithInjectedLatency) {
   double last_mean = -1, last_above = -1;
   for (core::TimeNs inject : {0, 30'000'000, 60'000'000, 100'000'000}) {
-    auto tracker = open_tracker(kTruth, ideal(10'000'000, 250, inject), options());
+    auto tracker = open_tracker(kTruth, ideal(10'000'000, 250, inject), source_options());
     const Simulation sim = simulate(*tracker, panel(90, 3'000'000'000), fixed(6'000'000));
     double sum = 0;
     int n = 0, above = 0;
@@ -168,7 +168,7 @@ TEST(LatencySimulation, FovealErrorGrowsWithInjectedLatency) {
 TEST(LatencySimulation, RecoveryTimeFollowsTheDelay) {
   std::vector<double> medians;
   for (core::TimeNs delay : {0, 100'000'000}) {
-    auto tracker = open_tracker(kTruth, ideal(delay, 1000), options());
+    auto tracker = open_tracker(kTruth, ideal(delay, 1000), source_options());
     const Simulation sim = simulate(*tracker, panel(90, 3'000'000'000), fixed(4'000'000));
     const std::vector<double> r = recovery_ms(sim);
     ASSERT_FALSE(r.empty());
@@ -192,7 +192,7 @@ TEST(LatencySimulation, LandingPredictionShortensThePostSaccadeRecovery) {
     std::size_t post = 0, saccades = 0;
   };
   const auto run = [](devices::PredictMode mode) {
-    devices::SourceOptions o = options();
+    devices::SourceOptions o = source_options();
     o.predict = mode;
     o.horizon_ns = mode == devices::PredictMode::None ? 0 : devices::SourceOptions{}.horizon_ns;
     TrackerChoice c;
@@ -224,7 +224,7 @@ TEST(LatencySimulation, LandingPredictionShortensThePostSaccadeRecovery) {
 }
 
 TEST(LatencySimulation, TrackerKeysInTheUriAreRefused) {
-  EXPECT_THROW(open_tracker("synthetic:1?tracker=fove0", ideal(0, 1000), options()), core::InputError);
+  EXPECT_THROW(open_tracker("synthetic:1?tracker=fove0", ideal(0, 1000), source_options()), core::InputError);
 }
 
 TEST(LatencyAnalysis, NearestRankPercentiles) {

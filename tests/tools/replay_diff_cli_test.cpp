@@ -12,6 +12,7 @@
 
 #include "fovea/core/json.hpp"
 
+using fovea::test::read_text;
 using fovea::test::run_fovea;
 using fovea::test::temp_dir;
 namespace fs = std::filesystem;
@@ -36,14 +37,8 @@ TEST(ReplayDiffCli, TwoRunsAgreeAndChangesAreFound) {
   }
   EXPECT_EQ(frames, 2u);
   // Deterministic fields only: two identical runs write identical bytes; timings apart.
-  auto slurp = [](const std::string& p) {
-    std::ifstream f(p);
-    std::stringstream t;
-    t << f.rdbuf();
-    return t.str();
-  };
-  EXPECT_EQ(slurp(a + "/frames.jsonl"), slurp(b + "/frames.jsonl"));
-  const auto times = fovea::core::parse_json(slurp(a + "/frame_times.jsonl").substr(0, slurp(a + "/frame_times.jsonl").find('\n')));
+  EXPECT_EQ(read_text(a + "/frames.jsonl"), read_text(b + "/frames.jsonl"));
+  const auto times = fovea::core::parse_json(read_text(a + "/frame_times.jsonl").substr(0, read_text(a + "/frame_times.jsonl").find('\n')));
   EXPECT_EQ(times["frame"], 0);
   EXPECT_EQ(times["schema"], "fovea-timing");
   EXPECT_TRUE(times["gpu_ms"].contains("trace"));

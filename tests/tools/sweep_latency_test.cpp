@@ -21,7 +21,7 @@ namespace {
 namespace fs = std::filesystem;
 using nlohmann::json;
 
-CommandOptions options() {
+CommandOptions command_options() {
   return {{"render", {{"scene", true}, {"display", true}, {"distribution", true}, {"budget", true}, {"out", true}, {"quiet", false}}},
           {"latency", {{"scene", true}, {"display", true}, {"tracker-delay", true}, {"predict", true}, {"seconds", true},
                        {"inject-latency", true}, {"out", true}, {"quiet", false}}}};
@@ -35,7 +35,7 @@ json latency_part() {
 TEST(SweepLatency, PlanExpandsLatencyJobsWithStableIds) {
   const json file = json::array({fovea::core::parse_json(R"({"scenes": "default", "displays": "tiny", "distribution": ["a", "b"]})"),
                                  latency_part()});
-  const Plan p = expand_sweep(file, "s.json", options());
+  const Plan p = expand_sweep(file, "s.json", command_options());
   ASSERT_EQ(p.jobs.size(), 2u + 3u * 2u);
   EXPECT_TRUE(p.shared.empty());
   std::set<std::string> ids;
@@ -70,7 +70,7 @@ TEST(SweepLatency, PlanExpandsLatencyJobsWithStableIds) {
   json reordered = json::object();
   const json part = latency_part();
   for (auto it = part.rbegin(); it != part.rend(); ++it) reordered[it.key()] = *it;
-  const Plan q = expand_sweep(reordered, "other.json", options());
+  const Plan q = expand_sweep(reordered, "other.json", command_options());
   ASSERT_EQ(q.jobs.size(), 6u);
   for (std::size_t i = 0; i < q.jobs.size(); ++i) EXPECT_EQ(q.jobs[i].id, p.jobs[i + 2].id);
   // The id hashes the command: a render job with a latency job's settings differs.
@@ -80,7 +80,7 @@ TEST(SweepLatency, PlanExpandsLatencyJobsWithStableIds) {
   // An explicit --inject-latency is kept as given.
   json with_inject = latency_part();
   with_inject["inject-latency"] = "0,50";
-  const Plan w = expand_sweep(with_inject, "w.json", options());
+  const Plan w = expand_sweep(with_inject, "w.json", command_options());
   const auto& a = w.jobs[0].argv;
   EXPECT_EQ(std::count(a.begin(), a.end(), "--inject-latency"), 1);
   EXPECT_EQ(*(std::find(a.begin(), a.end(), "--inject-latency") + 1), "0,50");
@@ -89,7 +89,7 @@ TEST(SweepLatency, PlanExpandsLatencyJobsWithStableIds) {
 TEST(SweepLatency, PlanRefusesKeysTheCommandDoesNotHave) {
   auto error = [](const json& j) {
     try {
-      expand_sweep(j, "bad.json", options());
+      expand_sweep(j, "bad.json", command_options());
     } catch (const core::InputError& e) {
       return std::string(e.what());
     }
@@ -153,7 +153,7 @@ TEST(SweepLatency, ReportDrawsLatencyAgainstQualityAndSectionsPerScene) {
       {fovea::core::parse_json(R"({"scenes": ["cornell", "default"], "distribution": ["a", "b"], "budget": [0.2, 0.4],
                       "report": {"quality": ["fovea_psnr"], "section": "scene"}})"),
        latency_part()});
-  const Plan plan = expand_sweep(file, "synthetic.json", options());
+  const Plan plan = expand_sweep(file, "synthetic.json", command_options());
   ASSERT_EQ(plan.jobs.size(), 8u + 6u);
   std::map<std::string, json> settings_of;
   for (const Job& j : plan.jobs) {

@@ -16,7 +16,7 @@ namespace {
 
 using nlohmann::json;
 
-std::vector<RenderOption> options() {
+std::vector<RenderOption> render_options() {
   return {{"scene", true},  {"display", true},     {"gaze", true},      {"frames", true}, {"distribution", true},
           {"budget", true}, {"reference", true},   {"png-every", true}, {"out", true},    {"no-blur", false},
           {"quiet", false}};
@@ -37,7 +37,7 @@ TEST(SweepPlan, FnvMatchesPublishedVectors) {
 }
 
 TEST(SweepPlan, ExpandsEveryCombinationWithStableIds) {
-  const Plan p = expand_sweep(sweep_file(), "s.json", options());
+  const Plan p = expand_sweep(sweep_file(), "s.json", render_options());
   ASSERT_EQ(p.jobs.size(), 2u * 3u * 3u * 2u);
   std::set<std::string> ids;
   std::set<double> budgets;
@@ -64,13 +64,13 @@ TEST(SweepPlan, ExpandsEveryCombinationWithStableIds) {
   json reordered = json::object();
   const json f = sweep_file();
   for (auto it = f.rbegin(); it != f.rend(); ++it) reordered[it.key()] = *it;
-  const Plan q = expand_sweep(reordered, "other.json", options());
+  const Plan q = expand_sweep(reordered, "other.json", render_options());
   ASSERT_EQ(q.jobs.size(), p.jobs.size());
   for (std::size_t i = 0; i < p.jobs.size(); ++i) EXPECT_EQ(q.jobs[i].id, p.jobs[i].id);
 }
 
 TEST(SweepPlan, ReferencesAreSharedPerSceneAndDisplay) {
-  const Plan p = expand_sweep(sweep_file(), "s.json", options());
+  const Plan p = expand_sweep(sweep_file(), "s.json", render_options());
   ASSERT_EQ(p.shared.size(), 2u);  // cornell and default, one display, one spp
   std::map<std::string, int> users;
   for (const Job& j : p.jobs) {
@@ -95,7 +95,7 @@ TEST(SweepPlan, ReferencesAreSharedPerSceneAndDisplay) {
   // No reference, no shared input.
   json f = sweep_file();
   f.erase("reference");
-  EXPECT_TRUE(expand_sweep(f, "s.json", options()).shared.empty());
+  EXPECT_TRUE(expand_sweep(f, "s.json", render_options()).shared.empty());
 }
 
 // A list of sweeps is their union: cartesian without budgets next to budgeted distributions.
@@ -105,25 +105,25 @@ TEST(SweepPlan, AListOfSweepsIsTheirUnion) {
      "report": {"group": "distribution"}},
     {"scenes": "cornell", "distribution": "cartesian", "reference": 8},
     {"scenes": "cornell", "distribution": "log-polar", "budget": 0.3, "reference": 8}])");
-  const Plan p = expand_sweep(list, "list.json", options());
+  const Plan p = expand_sweep(list, "list.json", render_options());
   ASSERT_EQ(p.jobs.size(), 5u);  // 4 + 1, the third part's job is already planned
   EXPECT_EQ(p.jobs[4].settings, json({{"distribution", "cartesian"}, {"reference", 8}, {"scene", "cornell"}}));
   EXPECT_EQ(p.shared.size(), 1u);  // one reference for all of them
   EXPECT_EQ(p.header["report"]["group"], "distribution");
   EXPECT_EQ(p.header["jobs"], 5);
   try {
-    expand_sweep(fovea::core::parse_json(R"([{"scenes": "cornell"}, {"budgett": 1}])"), "list.json", options());
+    expand_sweep(fovea::core::parse_json(R"([{"scenes": "cornell"}, {"budgett": 1}])"), "list.json", render_options());
     ADD_FAILURE() << "unknown key accepted";
   } catch (const core::InputError& e) {
     EXPECT_NE(std::string(e.what()).find("list.json[1]"), std::string::npos) << e.what();
   }
-  EXPECT_THROW(expand_sweep(json::array(), "list.json", options()), core::InputError);
+  EXPECT_THROW(expand_sweep(json::array(), "list.json", render_options()), core::InputError);
 }
 
 TEST(SweepPlan, RejectsBadSweepFilesNamingKeyAndFile) {
   auto error = [](const std::string& text) {
     try {
-      expand_sweep(fovea::core::parse_json(text), "bad.json", options());
+      expand_sweep(fovea::core::parse_json(text), "bad.json", render_options());
     } catch (const core::InputError& e) {
       return std::string(e.what());
     }

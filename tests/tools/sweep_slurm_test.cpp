@@ -30,13 +30,6 @@ namespace {
 namespace fs = std::filesystem;
 using nlohmann::json;
 
-std::string slurp(const fs::path& p) {
-  std::ifstream in(p);
-  std::stringstream ss;
-  ss << in.rdbuf();
-  return ss.str();
-}
-
 TEST(SweepSlurm, ScriptsDescribeTheArrayAndTheMerge) {
   const std::string dir = test::temp_dir("sweep-slurm");
   SlurmOptions o;
@@ -52,7 +45,7 @@ TEST(SweepSlurm, ScriptsDescribeTheArrayAndTheMerge) {
   o.time = "01:00:00";
   o.mem = "4G";
   const SlurmScripts s = write_slurm_scripts(o);
-  const std::string array = slurp(s.array_script), merge = slurp(s.merge_script), submit = slurp(s.submit_script);
+  const std::string array = test::read_text(s.array_script), merge = test::read_text(s.merge_script), submit = test::read_text(s.submit_script);
   for (const char* line : {"#SBATCH --array=0-3\n", "#SBATCH --cpus-per-task=2\n", "#SBATCH --gpus=1\n",
                            "#SBATCH --partition=gpu\n", "#SBATCH --time=01:00:00\n", "#SBATCH --mem=4G\n", "array_%A_%a.out"})
     EXPECT_NE(array.find(line), std::string::npos) << line << "\n" << array;
@@ -73,7 +66,7 @@ TEST(SweepSlurm, ScriptsDescribeTheArrayAndTheMerge) {
 
 // Metrics and bands of every job in a report's results.json, timings removed.
 json numbers_without_timings(const fs::path& results) {
-  json j = fovea::core::parse_json(slurp(results));
+  json j = fovea::core::parse_json(test::read_text(results));
   json out = json::object();
   for (auto& row : j["jobs"]) {
     json m = json::object();
@@ -142,7 +135,7 @@ class OneNodeSlurm {
     }
     if (sh("/usr/sbin/munged --key-file=" + dir_ + "/munge.key --socket=" + dir_ + "/munge.sock --pid-file=" + dir_ +
            "/munged.pid --log-file=" + dir_ + "/munged.log --seed-file=" + dir_ + "/munge.seed --force") != 0)
-      return "munged did not start: " + slurp(dir_ + "/munged.log");
+      return "munged did not start: " + test::read_text(dir_ + "/munged.log");
     const std::string host = host_short();
     const int ctld_port = free_port(), d_port = free_port();
     std::ostringstream conf;
@@ -157,18 +150,18 @@ class OneNodeSlurm {
          << " Default=YES MaxTime=INFINITE State=UP\n";
     std::ofstream(dir_ + "/slurm.conf") << conf.str();
     ::setenv("SLURM_CONF", (dir_ + "/slurm.conf").c_str(), 1);
-    if (sh("/usr/sbin/slurmctld") != 0) return "slurmctld did not start: " + slurp(dir_ + "/slurmctld.log");
-    if (sh("/usr/sbin/slurmd") != 0) return "slurmd did not start: " + slurp(dir_ + "/slurmd.log");
+    if (sh("/usr/sbin/slurmctld") != 0) return "slurmctld did not start: " + test::read_text(dir_ + "/slurmctld.log");
+    if (sh("/usr/sbin/slurmd") != 0) return "slurmd did not start: " + test::read_text(dir_ + "/slurmd.log");
     for (int i = 0; i < 60; ++i) {  // ~5 s is usual
       if (sh_out("sinfo -h -o %t 2>/dev/null").find("idle") != std::string::npos) return "";
       std::this_thread::sleep_for(std::chrono::milliseconds(500));
     }
-    return "the node did not become idle within 30 s: " + slurp(dir_ + "/slurmctld.log");
+    return "the node did not become idle within 30 s: " + test::read_text(dir_ + "/slurmctld.log");
   }
 
   void stop() {
     for (const char* d : {"slurmd", "slurmctld", "munged"}) {
-      const std::string pid_text = slurp(dir_ + "/" + d + ".pid");
+      const std::string pid_text = test::read_text(dir_ + "/" + d + ".pid");
       const pid_t pid = pid_t(std::atol(pid_text.c_str()));
       if (pid <= 0) continue;
       ::kill(pid, SIGTERM);
@@ -223,8 +216,8 @@ TEST(SweepSlurm, EndToEndOnARealOneNodeSlurmMatchesALocalRun) {
       << state << "\narray: " << sh_out("scontrol -o show job " + array + " 2>&1") << "\nlogs: "
       << sh_out("cat " + dir + "/slurm-run/slurm/logs/* 2>&1");
   // Both array tasks ran a shard; the merge wrote the report.
-  const json a0 = fovea::core::parse_json(slurp(dir + "/slurm-run/slurm/logs/array_" + array + "_0.out"));
-  const json a1 = fovea::core::parse_json(slurp(dir + "/slurm-run/slurm/logs/array_" + array + "_1.out"));
+  const json a0 = fovea::core::parse_json(test::read_text(dir + "/slurm-run/slurm/logs/array_" + array + "_0.out"));
+  const json a1 = fovea::core::parse_json(test::read_text(dir + "/slurm-run/slurm/logs/array_" + array + "_1.out"));
   EXPECT_EQ(a0["shard"], "0/2");
   EXPECT_EQ(a1["shard"], "1/2");
   EXPECT_EQ(a0["ran"].get<int>() + a1["ran"].get<int>(), 2);
