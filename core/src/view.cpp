@@ -12,11 +12,11 @@
 namespace fovea::core {
 
 namespace {
-constexpr double kDeg = std::numbers::pi / 180.0;
+constexpr double kRadPerDeg = std::numbers::pi / 180.0;
 }
 
 Fov Fov::from_degrees(double left, double right, double up, double down) {
-  return {left * kDeg, right * kDeg, up * kDeg, down * kDeg};
+  return {left * kRadPerDeg, right * kRadPerDeg, up * kRadPerDeg, down * kRadPerDeg};
 }
 
 Fov Fov::mirrored() const { return {-angle_right, -angle_left, angle_up, angle_down}; }
@@ -59,7 +59,7 @@ double View::pixels_per_deg2(glm::dvec3 d) const {
   const double tx = d.x / -d.z, ty = d.y / -d.z;
   const double px_per_t2 = (width_ / (tr_ - tl_)) * (height_ / (tu_ - td_));
   const double q = 1.0 + tx * tx + ty * ty;
-  return px_per_t2 * q * std::sqrt(q) * kDeg * kDeg;
+  return px_per_t2 * q * std::sqrt(q) * kRadPerDeg * kRadPerDeg;
 }
 
 void View::corner_dirs(glm::dvec3 out[4]) const {
@@ -82,7 +82,7 @@ bool View::clamp_to_frustum(glm::dvec3& d) const {
 }
 
 double angle_deg(glm::dvec3 a, glm::dvec3 b) {
-  return std::atan2(glm::length(glm::cross(a, b)), glm::dot(a, b)) / kDeg;
+  return std::atan2(glm::length(glm::cross(a, b)), glm::dot(a, b)) / kRadPerDeg;
 }
 
 }  // namespace fovea::core
