@@ -1,11 +1,12 @@
 #pragma once
-// Helpers for the devices tests: scratch files in a per-test temporary directory.
+// Helpers for the devices tests: scratch files (plain or gzip) in a per-test temporary
+// directory, and a stream read whole.
 #include <unistd.h>
 #include <zlib.h>
 
+#include <cstdint>
 #include <filesystem>
 #include <fstream>
-#include <cstdint>
 #include <string>
 #include <vector>
 
