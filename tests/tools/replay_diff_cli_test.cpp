@@ -49,9 +49,7 @@ TEST(ReplayDiffCli, TwoRunsAgreeAndChangesAreFound) {
   EXPECT_EQ(fovea::core::parse_json(same.out)["images"].size(), 6u);
 
   // The gaze of frame 1 turned by ~0.06°: found; accepted with a looser tolerance.
-  std::ifstream fin(b + "/frames.jsonl");
-  std::stringstream ss;
-  ss << fin.rdbuf();
+  std::stringstream ss(read_text(b + "/frames.jsonl"));
   std::vector<std::string> lines;
   for (std::string l; std::getline(ss, l);) lines.push_back(l);
   auto j = fovea::core::parse_json(lines[1]);
