@@ -25,7 +25,7 @@ std::unique_ptr<SampleStream> open_device_stream(SourceUri& u, const SourceOptio
     p.seed = static_cast<std::uint64_t>(u.take_number("seed", 1, 0, 9e15));
     if (auto t = u.take("task"); !t.empty()) p.task = parse_synth_task(t);
     p.rate_hz = u.take_number("rate", p.rate_hz, 60, 1000);
-    p.seconds = u.take_number("seconds", 0, 0, 1e6);
+    p.seconds = u.take_seconds(0);
     p.ipd_m = opt.display.ipd_m;
     // Faults and pacing, so a layer or runtime can be tested against a live-timed device
     // that misbehaves (counts are in reports read by the host).

@@ -145,6 +145,17 @@ double SourceUri::take_number(const std::string& key, double fallback, double lo
   return d;
 }
 
+double SourceUri::take_seconds(double fallback) {
+  const std::string v = take("seconds");
+  if (v.empty()) return fallback;
+  double d = 0;
+  const auto r = std::from_chars(v.data(), v.data() + v.size(), d);
+  if (r.ec != std::errc() || r.ptr != v.data() + v.size() || !(d > 0 && d <= 1e6))
+    throw core::InputError("gaze source \"" + text + "\": seconds=" + v +
+                           " must be a length in (0, 1000000] s (leave seconds= out for endless gaze)");
+  return d;
+}
+
 std::string SourceUri::rebuilt() const {
   std::string out = scheme + ":" + body;
   char sep = '?';
@@ -246,7 +257,7 @@ std::unique_ptr<SampleStream> open_raw_stream(SourceUri& u, const SourceOptions&
     p.seed = seed;
     if (auto t = u.take("task"); !t.empty()) p.task = parse_synth_task(t);
     p.rate_hz = u.take_number("rate", p.rate_hz, 60, 1000);
-    p.seconds = u.take_number("seconds", 0, 0, 1e6);
+    p.seconds = u.take_seconds(0);
     p.noise_deg = u.take_number("noise", p.noise_deg, 0, 10);
     p.noise_color = u.take_number("color", p.noise_color, 0, 0.98);
     p.dropout_per_s = u.take_number("dropouts", p.dropout_per_s, 0, 10);

@@ -14,6 +14,9 @@ struct SourceUri {
   std::map<std::string, std::string> query;
   std::string take(const std::string& key);  // "" if absent; removes the key
   double take_number(const std::string& key, double fallback, double lo, double hi);
+  // seconds=S of the generated sources: a length in (0, 1e6] s, `fallback` when absent. An
+  // explicit 0 is refused: it read as "endless", and a tool walking every sample never ended.
+  double take_seconds(double fallback);
   void finish() const;  // throws for any key nobody took
   std::string rebuilt() const;  // "scheme:body?k=v&..." with the keys not yet taken
 };

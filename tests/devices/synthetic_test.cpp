@@ -207,3 +207,23 @@ TEST(Synthetic, RejectsBadParameters) {
   p.noise_color = 1;
   EXPECT_THROW(SyntheticStream{p}, fovea::core::InputError);
 }
+
+// seconds=0 used to mean "endless": `fovea gaze info/plot/convert` walked it forever (convert
+// wrote 700 MB in 15 s). A given length must be positive; leaving the key out stays endless.
+TEST(Synthetic, ZeroSecondsIsAnErrorAndAGivenLengthEnds) {
+  SourceOptions o;
+  for (const char* uri : {"synthetic:1?seconds=0", "synthetic:1?seconds=-1", "hid-emulated:ms?seconds=0"}) {
+    try {
+      (void)open_sample_stream(uri, o);
+      ADD_FAILURE() << uri << " was accepted";
+    } catch (const fovea::core::InputError& e) {
+      EXPECT_NE(std::string(e.what()).find("seconds="), std::string::npos) << e.what();
+      EXPECT_NE(std::string(e.what()).find(uri), std::string::npos) << e.what();
+    }
+  }
+  auto s = open_sample_stream("synthetic:1?seconds=0.5&rate=120", o);
+  GazeSample g;
+  int n = 0;
+  while (s->next(g) && n < 1000) ++n;
+  EXPECT_EQ(n, 60);
+}
