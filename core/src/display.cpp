@@ -1,12 +1,14 @@
 #include "fovea/core/display.hpp"
 
 #include <cmath>
+#include <cstdio>
 #include <filesystem>
 
 #include <nlohmann/json.hpp>
 
 #include "fovea/core/error.hpp"
 #include "fovea/core/input_limits.hpp"
+#include "fovea/core/lens.hpp"
 #include "json_input.hpp"
 
 namespace fovea::core {
@@ -22,6 +24,12 @@ using nlohmann::json;
 
 [[noreturn]] void fail(std::string_view origin, const std::string& what) {
   throw InputError(std::string(origin) + ": " + what);
+}
+
+std::string fmt(double v) {
+  char buf[32];
+  std::snprintf(buf, sizeof buf, "%g", v);
+  return buf;
 }
 
 double number(const json& j, const char* key, std::string_view origin, const std::string& path) {
@@ -52,12 +60,16 @@ DisplayPreset parse_display(std::string_view text, std::string_view origin) {
   if (!j.is_object()) fail(origin, "top level must be an object");
   DisplayPreset d;
   d.json = std::string(text);
+  d.origin = std::string(origin);
   d.name = string_member(j, "name", origin);
   if (d.name.empty()) fail(origin, "missing \"name\"");
   d.description = string_member(j, "description", origin);
   const double w = number(j, "width", origin, ""), h = number(j, "height", origin, "");
-  if (w < 1 || h < 1 || w > 65536 || h > 65536 || w != std::floor(w) || h != std::floor(h))
-    fail(origin, "\"width\"/\"height\" must be whole numbers in 1..65536");
+  const std::string max_px = std::to_string(kMaxEyePixels);
+  if (w < 1 || w > kMaxEyePixels || w != std::floor(w))
+    fail(origin, "\"width\" must be a whole number of pixels in 1.." + max_px + " (per eye)");
+  if (h < 1 || h > kMaxEyePixels || h != std::floor(h))
+    fail(origin, "\"height\" must be a whole number of pixels in 1.." + max_px + " (per eye)");
   d.width = static_cast<int>(w);
   d.height = static_cast<int>(h);
   if (!j.contains("fov_deg")) fail(origin, "missing \"fov_deg\"");
@@ -67,13 +79,19 @@ DisplayPreset parse_display(std::string_view text, std::string_view origin) {
   if (j.contains("refresh_hz")) d.refresh_hz = number(j, "refresh_hz", origin, "");
   if (j.contains("ipd_m")) d.ipd_m = number(j, "ipd_m", origin, "");
   d.lens = parse_lens_params(text, origin);
-  if (!(d.refresh_hz > 0 && d.refresh_hz <= 1000)) fail(origin, "\"refresh_hz\" must be in (0, 1000]");
+  if (!(d.refresh_hz >= kMinRefreshHz && d.refresh_hz <= kMaxRefreshHz))
+    fail(origin, "\"refresh_hz\" must be in [" + fmt(kMinRefreshHz) + ", " + fmt(kMaxRefreshHz) + "] Hz");
+  // A negative IPD swaps the eyes, a huge one puts them outside any scene.
+  if (!(d.ipd_m >= 0 && d.ipd_m <= kMaxIpdM))
+    fail(origin, "\"ipd_m\" must be in [0, " + fmt(kMaxIpdM) + "] m");
   try {  // validates the FOV and raster
     (void)d.view(Eye::Left);
     (void)d.view(Eye::Right);
   } catch (const InputError& e) {
     fail(origin, e.what());
   }
+  // The optics depend on the FOV only (uv space), so they are checked here, whatever uses them.
+  for (Eye e : {Eye::Left, Eye::Right}) (void)Lens::for_eye(d, e);
   return d;
 }
 

@@ -130,9 +130,33 @@ Lens::Lens(const LensParams& p, const View& view, Eye eye, const std::string& na
                        "% of the panel corner's radius); everything beyond is outside the lens");
     ch.r_edge = std::min(limit, cutoff);
   }
+  if (p.kind != LensModelKind::None) check_visible_area(name, eye);
 }
 
-Lens Lens::for_eye(const DisplayPreset& d, Eye eye) { return Lens(d.lens, d.view(eye), eye, d.name + " lens"); }
+// Coefficients far from any real lens (k = 1e30) keep the radial map increasing but send
+// every panel pixel's source outside the FOV: an all-black panel. Refused, on a coarse grid
+// of panel positions (the per-pixel mask is the hidden area's job, hidden_area.hpp).
+void Lens::check_visible_area(const std::string& name, Eye eye) const {
+  constexpr int kGrid = 64;
+  int shown = 0;
+  for (int j = 0; j < kGrid; ++j)
+    for (int i = 0; i < kGrid; ++i) {
+      const LensSample s = forward({(i + 0.5) / kGrid, (j + 0.5) / kGrid});
+      bool ok = s.within_lens;
+      for (const glm::dvec2& t : s.tangent)
+        ok = ok && t.x >= view_.tan_left() && t.x <= view_.tan_right() && t.y >= view_.tan_down() && t.y <= view_.tan_up();
+      shown += ok;
+    }
+  if (shown < kMinVisibleFraction * kGrid * kGrid)
+    throw InputError(name + " (" + eye_name(eye) + " eye): " + std::to_string(shown) + " of " +
+                     std::to_string(kGrid * kGrid) + " panel positions show the field of view, below the minimum of " +
+                     std::to_string(int(kMinVisibleFraction * 100)) +
+                     "%: the lens leaves no usable area (check lens.k, lens.scale and the FOV)");
+}
+
+Lens Lens::for_eye(const DisplayPreset& d, Eye eye) {
+  return Lens(d.lens, d.view(eye), eye, (d.origin.empty() ? d.name : d.origin) + ": lens");
+}
 
 glm::dvec2 Lens::uv_to_tangent(glm::dvec2 uv) const {
   return {view_.tan_left() + uv.x * (view_.tan_right() - view_.tan_left()),

@@ -69,3 +69,51 @@ TEST(DisplayInput, FilesAreReadBounded) {
   EXPECT_THROW((void)read_file_bounded(big, 1 << 20), InputError);
   std::filesystem::remove_all(dir);
 }
+
+namespace {
+std::string preset(const std::string& extra) {
+  return R"({"name":"t","width":64,"height":72,)" + kFov + extra + "}";
+}
+const std::string kLens =
+    R"("model":"panotools","aberration":[0.999,1.008,1.018],"centre":[0.5,0.5],"scale":1.2,"cutoff":0.45)";
+}  // namespace
+
+// A 1e-9 Hz display hung `fovea render` (its second frame lies 30 years into the gaze).
+TEST(DisplayInput, RefreshRateHasAPhysicalRange) {
+  for (const char* hz : {"1e-9", "0.5", "0", "-70", "1001"}) expect_error(preset(std::string(R"(,"refresh_hz":)") + hz), "\"refresh_hz\" must be in [1, 1000] Hz");
+  EXPECT_DOUBLE_EQ(parse_display(preset(R"(,"refresh_hz":1)"), "p").refresh_hz, 1.0);
+  EXPECT_DOUBLE_EQ(parse_display(preset(R"(,"refresh_hz":1000)"), "p").refresh_hz, 1000.0);
+}
+
+// 16384² and 65536² rasters hung `fovea density` and ran `lens`/`render` out of memory; an
+// 8k-per-eye display still loads.
+TEST(DisplayInput, RasterIsBoundedPerEyeAndEightKFits) {
+  const auto raster = [](const std::string& w, const std::string& h) {
+    return R"({"name":"t","width":)" + w + R"(,"height":)" + h + "," + kFov + "}";
+  };
+  expect_error(raster("16384", "16384"), "\"width\" must be a whole number of pixels in 1..8192");
+  expect_error(raster("65536", "64"), "\"width\"");
+  expect_error(raster("64", "8193"), "\"height\" must be a whole number of pixels in 1..8192");
+  expect_error(raster("64.5", "64"), "\"width\"");
+  const DisplayPreset d = parse_display(raster(std::to_string(kMaxEyePixels), std::to_string(kMaxEyePixels)), "p");
+  EXPECT_EQ(d.width, 8192);
+  EXPECT_EQ(d.height, 8192);
+}
+
+// A negative IPD swapped the eyes; 1e30 put them outside every scene (black frames).
+TEST(DisplayInput, IpdMustBeAnAdultsOrZero) {
+  for (const char* ipd : {"-0.063", "1e30", "0.2"}) expect_error(preset(std::string(R"(,"ipd_m":)") + ipd), "\"ipd_m\" must be in [0, 0.1] m");
+  EXPECT_DOUBLE_EQ(parse_display(preset(R"(,"ipd_m":0)"), "p").ipd_m, 0.0);
+  EXPECT_DOUBLE_EQ(parse_display(preset(R"(,"ipd_m":0.07)"), "p").ipd_m, 0.07);
+}
+
+// k = 1e30 kept the radial map increasing but hid every panel pixel (hidden fraction 1.0,
+// garbage frames): refused at load, naming the file and the lens.
+TEST(DisplayInput, LensWithoutVisibleAreaIsRefused) {
+  expect_error(preset(R"(,"lens":{"k":[1e30,0,0,0,0],)" + kLens + "}"), "lens (left eye)");
+  expect_error(preset(R"(,"lens":{"k":[1e30,0,0,0,0],)" + kLens + "}"), "no usable area");
+  // The shipped coefficients load, and their error names nothing.
+  const DisplayPreset d = parse_display(preset(R"(,"lens":{"k":[0.75,-0.01,0.75,0,3.8],)" + kLens + "}"), "p");
+  EXPECT_EQ(d.origin, "p");
+  for (const auto& name : display_preset_names()) EXPECT_NO_THROW((void)load_display(name)) << name;
+}

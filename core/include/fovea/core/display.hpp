@@ -13,8 +13,17 @@ namespace fovea::core {
 
 enum class Eye { Left = 0, Right = 1 };
 
+// What a preset may hold, checked when it is loaded (docs/file-formats.md). The raster bound
+// keeps 8k-per-eye headsets and refuses rasters no stage could allocate (a 16384² eye is
+// 4 GiB per RGBA32F image); the refresh and IPD bounds keep frame times and eye positions
+// physical (a 1e-9 Hz display put its second frame 30 years into the gaze recording).
+inline constexpr int kMaxEyePixels = 8192;          // width and height, each
+inline constexpr double kMinRefreshHz = 1, kMaxRefreshHz = 1000;
+inline constexpr double kMaxIpdM = 0.1;             // adults: 0.05..0.08 m
+
 struct DisplayPreset {
   std::string name;
+  std::string origin;  // where it was loaded from: the preset name or the file path, for messages
   std::string description;
   int width = 0, height = 0;  // per eye, pixels
   Fov fov_left;               // the left eye's FOV; the right eye's is given or mirrored
@@ -29,7 +38,7 @@ struct DisplayPreset {
 };
 
 // A name of an embedded preset, or a path to a JSON file. Throws InputError naming the
-// input and the offending field.
+// input and the offending field, also for a lens that leaves (almost) no visible area.
 DisplayPreset load_display(std::string_view name_or_path);
 DisplayPreset parse_display(std::string_view json_text, std::string_view origin);
 std::vector<std::string> display_preset_names();

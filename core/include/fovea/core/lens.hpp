@@ -39,8 +39,12 @@ class Lens {
     double r_edge = 0;                // radius beyond which the channel is outside the lens
   };
 
+  // A lens must show the FOV on at least this fraction of its panel, else it is refused.
+  static constexpr double kMinVisibleFraction = 0.01;
+
   Lens() = default;
-  // Throws InputError (naming `name`) if the lens leaves no usable region.
+  // Throws InputError (naming `name`) if the lens leaves no usable region: the radial map
+  // ends within 2% of the panel radius, or under kMinVisibleFraction of the panel shows the FOV.
   Lens(const LensParams& params, const View& view, Eye eye, const std::string& name = "lens");
   static Lens for_eye(const DisplayPreset& d, Eye eye);
 
@@ -68,6 +72,7 @@ class Lens {
   double radial_derivative(int c, double r) const;
 
  private:
+  void check_visible_area(const std::string& name, Eye eye) const;
   View view_;
   LensModelKind kind_ = LensModelKind::None;
   std::array<Channel, 3> ch_{};
