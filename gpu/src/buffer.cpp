@@ -46,7 +46,8 @@ Buffer::Buffer(Context& ctx, const BufferDesc& desc) : ctx_(&ctx), size_(desc.si
   if (texels) ci.usage |= VK_BUFFER_USAGE_UNIFORM_TEXEL_BUFFER_BIT;
   ci.sharingMode = VK_SHARING_MODE_EXCLUSIVE;
   VkBuffer buffer = VK_NULL_HANDLE;
-  check(vkCreateBuffer(dev, &ci, nullptr, &buffer), "vkCreateBuffer");
+  const std::string what = "gpu::Buffer '" + desc.name + "'";
+  check_fits(vkCreateBuffer(dev, &ci, nullptr, &buffer), "vkCreateBuffer", what, desc.size, 0);
   buffer_ = {dev, buffer};
 
   VkMemoryRequirements req;
@@ -65,7 +66,9 @@ Buffer::Buffer(Context& ctx, const BufferDesc& desc) : ctx_(&ctx), size_(desc.si
   flags.flags = VK_MEMORY_ALLOCATE_DEVICE_ADDRESS_BIT;
   if ((ci.usage & VK_BUFFER_USAGE_SHADER_DEVICE_ADDRESS_BIT) != 0) ai.pNext = &flags;
   VkDeviceMemory memory = VK_NULL_HANDLE;
-  check(vkAllocateMemory(dev, &ai, nullptr, &memory), "vkAllocateMemory");
+  const VkDeviceSize heap = ctx.memory_type_heap_size(type);
+  check_fits(req.size > heap ? VK_ERROR_OUT_OF_DEVICE_MEMORY : vkAllocateMemory(dev, &ai, nullptr, &memory),
+             "vkAllocateMemory", what, req.size, heap);
   memory_ = {dev, memory};
   check(vkBindBufferMemory(dev, buffer, memory, 0), "vkBindBufferMemory");
   if (host) {

@@ -362,6 +362,10 @@ std::uint32_t Context::memory_type(std::uint32_t type_bits, VkMemoryPropertyFlag
   return *fallback;
 }
 
+VkDeviceSize Context::memory_type_heap_size(std::uint32_t index) const {
+  return memory_.memoryHeaps[memory_.memoryTypes[index].heapIndex].size;
+}
+
 VkMemoryPropertyFlags Context::memory_type_flags(std::uint32_t index) const {
   return memory_.memoryTypes[index].propertyFlags;
 }

@@ -1,6 +1,25 @@
 #include "fovea/gpu/error.hpp"
 
+#include "fovea/core/error.hpp"
+
 namespace fovea::gpu {
+
+namespace {
+std::string mib(VkDeviceSize bytes) { return std::to_string((bytes + (1u << 20) - 1) >> 20) + " MiB"; }
+}  // namespace
+
+void check_fits(VkResult result, const char* call, const std::string& what, VkDeviceSize bytes,
+                VkDeviceSize heap_bytes) {
+  const std::string heap = heap_bytes ? "the device's memory heap holds " + mib(heap_bytes) : "";
+  const std::string hint = "; a smaller display raster, budget or scene fits";
+  if (heap_bytes && bytes > heap_bytes)
+    throw core::InputError(what + ": " + mib(bytes) + ", more than " + heap + hint);
+  if (result == VK_ERROR_OUT_OF_DEVICE_MEMORY || result == VK_ERROR_OUT_OF_HOST_MEMORY)
+    throw core::InputError(what + (bytes ? ": " + mib(bytes) : "") + ": " + call + " ran out of memory (" +
+                           result_name(result) +
+                           (heap.empty() ? "" : "; " + heap) + ")" + hint);
+  check(result, call);
+}
 
 VulkanError::VulkanError(VkResult result, const std::string& what)
     : std::runtime_error(what + " failed: " + result_name(result)), result_(result) {}

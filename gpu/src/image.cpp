@@ -74,7 +74,8 @@ Image2D::Image2D(Context& ctx, const ImageDesc& desc)
   ci.sharingMode = VK_SHARING_MODE_EXCLUSIVE;
   ci.initialLayout = VK_IMAGE_LAYOUT_UNDEFINED;
   VkImage image = VK_NULL_HANDLE;
-  check(vkCreateImage(dev, &ci, nullptr, &image), "vkCreateImage");
+  check_fits(vkCreateImage(dev, &ci, nullptr, &image), "vkCreateImage",
+             what + " (" + std::to_string(desc.width) + "x" + std::to_string(desc.height) + ")", 0, 0);
   image_ = {dev, image};
 
   VkMemoryRequirements req;
@@ -83,7 +84,9 @@ Image2D::Image2D(Context& ctx, const ImageDesc& desc)
   ai.allocationSize = req.size;
   ai.memoryTypeIndex = ctx.memory_type(req.memoryTypeBits, 0, VK_MEMORY_PROPERTY_DEVICE_LOCAL_BIT);
   VkDeviceMemory memory = VK_NULL_HANDLE;
-  check(vkAllocateMemory(dev, &ai, nullptr, &memory), "vkAllocateMemory");
+  const VkDeviceSize heap = ctx.memory_type_heap_size(ai.memoryTypeIndex);
+  check_fits(req.size > heap ? VK_ERROR_OUT_OF_DEVICE_MEMORY : vkAllocateMemory(dev, &ai, nullptr, &memory),
+             "vkAllocateMemory", what, req.size, heap);
   memory_ = {dev, memory};
   check(vkBindImageMemory(dev, image, memory, 0), "vkBindImageMemory");
 

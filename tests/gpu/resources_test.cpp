@@ -9,6 +9,7 @@
 #include "fovea/gpu/barriers.hpp"
 #include "fovea/gpu/buffer.hpp"
 #include "fovea/gpu/descriptors.hpp"
+#include "fovea/gpu/error.hpp"
 #include "fovea/gpu/image.hpp"
 #include "gpu_fixture.hpp"
 
@@ -141,4 +142,28 @@ TEST_F(Buffers, SubmissionsNest) {
     gpu::copy_buffer(cmd, a, b);
   });
   EXPECT_EQ(b.download<std::uint32_t>(), data);
+}
+
+// A size the device cannot hold is the input's size (a display's raster, a scene): an
+// InputError naming what, its size and the heap, not a VulkanError after the fact.
+TEST(AllocationLimits, OutOfMemoryAndOversizedRequestsAreInputErrorsStatingTheLimit) {
+  const VkDeviceSize mib = 1u << 20;
+  try {
+    gpu::check_fits(VK_SUCCESS, "vkAllocateMemory", "gpu::Buffer 'cells'", 3000 * mib, 2048 * mib);
+    ADD_FAILURE() << "a request above the heap passed";
+  } catch (const fovea::core::InputError& e) {
+    const std::string what = e.what();
+    EXPECT_NE(what.find("gpu::Buffer 'cells': 3000 MiB, more than the device's memory heap holds 2048 MiB"),
+              std::string::npos) << what;
+  }
+  try {
+    gpu::check_fits(VK_ERROR_OUT_OF_DEVICE_MEMORY, "vkCreateBuffer", "gpu::Buffer 'cells'", 5 * mib, 0);
+    ADD_FAILURE() << "an out-of-memory result passed";
+  } catch (const fovea::core::InputError& e) {
+    const std::string what = e.what();
+    EXPECT_NE(what.find("5 MiB: vkCreateBuffer ran out of memory (VK_ERROR_OUT_OF_DEVICE_MEMORY)"), std::string::npos)
+        << what;
+  }
+  EXPECT_THROW(gpu::check_fits(VK_ERROR_DEVICE_LOST, "vkAllocateMemory", "b", mib, 2 * mib), gpu::VulkanError);
+  EXPECT_NO_THROW(gpu::check_fits(VK_SUCCESS, "vkAllocateMemory", "b", mib, mib));
 }

@@ -13,6 +13,7 @@
 #include "fovea/core/display.hpp"
 #include "fovea/core/distribution.hpp"
 #include "fovea/core/error.hpp"
+#include "fovea/core/output_path.hpp"
 #include "fovea/core/image.hpp"
 #include "gaze_arg.hpp"
 
@@ -109,7 +110,10 @@ int run(std::vector<std::string> argv) {
   const core::DensityReport r = core::measure_density(*dist);
   const glm::dvec2 gp = view.dir_to_pixel(st.used).value_or(glm::dvec2(0));
 
-  if (auto out = a.opt("out")) core::write_png(*out, heat_map(*dist));
+  if (auto out = a.opt("out")) {
+    core::prepare_output_file(*out, "--out");
+    core::write_png(*out, heat_map(*dist));
+  }
   if (st.clamped) std::cerr << "fovea density: gaze outside the view, clamped to its border\n";
   if (st.fallback) std::cerr << "fovea density: gaze unusable (NaN, zero or backwards), using the view centre\n";
 

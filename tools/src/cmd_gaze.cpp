@@ -9,6 +9,7 @@
 #include "command.hpp"
 #include "plot_canvas.hpp"
 #include "fovea/core/error.hpp"
+#include "fovea/core/output_path.hpp"
 #include <chrono>
 #include <filesystem>
 #include <functional>
@@ -223,6 +224,7 @@ int cmd_convert(const std::vector<std::string>& argv) {
   const dv::SourceOptions opt = gaze_source_options(a);
   const std::string& in_path = a.positional()[0];
   const std::string& out_path = a.positional()[1];
+  core::prepare_output_file(out_path, "OUT");
   Input in = open_input(in_path, opt);
   MessageLog log(in.reader);
   nlohmann::json meta = {{"source", in_path}, {"source_format", in.format}, {"display", in.options.display.name}};
@@ -269,6 +271,7 @@ int cmd_convert(const std::vector<std::string>& argv) {
 int cmd_synth(const std::vector<std::string>& argv) {
   Args a(argv, {"task", "seconds", "seed", "rate", "noise", "color", "dropouts", "display"}, {}, 1);
   if (a.positional().size() != 1) throw core::InputError("gaze synth needs OUT (see --help)");
+  core::prepare_output_file(a.positional()[0], "OUT");
   dv::SynthParams p;
   p.task = dv::parse_synth_task(a.str("task", "search"));
   p.seconds = a.num("seconds", 5);
@@ -313,6 +316,7 @@ int cmd_synth(const std::vector<std::string>& argv) {
 int cmd_plot(const std::vector<std::string>& argv) {
   Args a(argv, {"format", "display", "screen", "min-confidence", "width", "from", "to"}, {}, 2);
   if (a.positional().size() != 2) throw core::InputError("gaze plot needs FILE and OUT.png (see --help)");
+  core::prepare_output_file(a.positional()[1], "OUT.png");
   const dv::SourceOptions opt = gaze_source_options(a);
   const double from_s = a.num("from", 0), to_s = a.num("to", 9.2e9);
   if (!(from_s >= 0 && to_s > from_s && to_s <= 9.2e9))
@@ -470,6 +474,7 @@ int cmd_plot(const std::vector<std::string>& argv) {
 int cmd_record(const std::vector<std::string>& argv) {
   Args a(argv, {"source", "seconds", "raw", "display", "screen", "timeout"}, {}, 1);
   if (a.positional().size() != 1 || !a.has("source")) throw core::InputError("gaze record needs --source URI and OUT (see --help)");
+  core::prepare_output_file(a.positional()[0], "OUT");
   dv::SourceOptions opt = gaze_source_options(a);
   opt.raw_capture = a.str("raw", "");
   const double seconds = a.num("seconds", 5);

@@ -16,6 +16,7 @@
 #include "fovea/core/display.hpp"
 #include "fovea/core/distribution.hpp"
 #include "fovea/core/error.hpp"
+#include "fovea/core/output_path.hpp"
 #include "fovea/core/eye_optics.hpp"
 #include "fovea/core/hidden_area.hpp"
 #include "fovea/core/image.hpp"
@@ -34,7 +35,7 @@ in dark red.
   --display NAME|FILE   display preset (fove0, vive, modern, small, tiny) or JSON file [fove0]
   --channel r|g|b       use one channel's optics for all colours (that channel's distortion)
   --grid                overlay the panel's own straight grid (every 1/16 of the panel)
-  --out PNG             picture to write [lens-<display>.png]
+  --out PNG             picture to write [out/lens/lens-<display>.png]
   --json                print {"display", "eyes": {"left": {"hidden_fraction",
                         "max_roundtrip_px", "samples_saved_fraction", "samples_hidden"},
                         "right": {...}}}
@@ -128,7 +129,9 @@ int run(std::vector<std::string> argv) {
     else if (*c == "b") select = compositor::ChannelSelect::Blue;
     else throw core::InputError("option --channel: expected r, g or b, got \"" + *c + "\"");
   }
-  const std::string out = args.str("out", "lens-" + d.name + ".png");
+  // Like every command's output, under out/ unless --out says otherwise.
+  const std::string out = args.str("out", "out/lens/lens-" + d.name + ".png");
+  core::prepare_output_file(out, "--out");
 
   nlohmann::ordered_json eyes;
   core::Image panel(2 * d.width, d.height);

@@ -11,6 +11,7 @@
 #include "fovea/core/display.hpp"
 #include "fovea/core/stereo_views.hpp"
 #include "fovea/core/error.hpp"
+#include "fovea/core/output_path.hpp"
 #include "fovea/core/image.hpp"
 #include "fovea/renderer/path_tracer.hpp"
 #include "fovea/gpu/context.hpp"
@@ -92,6 +93,7 @@ int run(std::vector<std::string> argv) {
   const std::filesystem::path out_path(*out);
   const std::string ext = out_path.extension().string();
   if (ext != ".exr" && ext != ".png") throw core::InputError("--out must end in .exr or .png, got \"" + *out + "\"");
+  core::prepare_output_file(*out, "--out");
   std::filesystem::path exr = out_path, png = out_path;
   exr.replace_extension(".exr");
   png.replace_extension(".png");

@@ -10,6 +10,7 @@
 
 #include "command.hpp"
 #include "fovea/core/error.hpp"
+#include "fovea/core/output_path.hpp"
 #include "fovea/core/image.hpp"
 #include "sweep/plan.hpp"
 #include "sweep/report.hpp"
@@ -100,7 +101,7 @@ int cmd_plan(const std::vector<std::string>& argv) {
   if (a.positional().size() != 1 || !a.has("out")) throw core::InputError("sweep plan needs FILE and --out PLAN (see --help)");
   const sweep::Plan plan = sweep::load_sweep_file(a.positional()[0], command_options());
   const std::string out = a.str("out", "");
-  if (fs::path(out).has_parent_path()) fs::create_directories(fs::path(out).parent_path());
+  core::prepare_output_file(out, "--out");
   core::write_file_atomic(out, sweep::plan_to_jsonl(plan));
   std::cout << json{{"plan", out}, {"jobs", plan.jobs.size()}, {"shared", plan.shared.size()}}.dump() << "\n";
   return 0;

@@ -7,6 +7,7 @@
 #include <cstdlib>
 #include <filesystem>
 #include <iostream>
+#include <new>
 #include <set>
 
 #include "command.hpp"
@@ -137,6 +138,12 @@ int main(int argc, char** argv) {
     return it->second.run(std::vector<std::string>(argv + 2, argv + argc));
   } catch (const fovea::core::InputError& e) {
     std::cerr << "fovea " << name << ": " << e.what() << "\n";
+    return 2;
+  } catch (const std::bad_alloc&) {
+    // Sizes come from the input (rasters, scenes, recordings) and are bounded where they are
+    // read; what still does not fit this machine is the input's size, not a fault.
+    std::cerr << "fovea " << name << ": out of host memory: the input needs more memory than this machine has "
+              << "(std::bad_alloc); a smaller display raster, scene or recording fits\n";
     return 2;
   } catch (const std::exception& e) {
     std::cerr << "fovea " << name << ": error: " << e.what() << "\n";

@@ -22,7 +22,8 @@ struct Image {
 
 enum class Encoding { Srgb, Linear };
 
-// RGB(A) PNG; values are clamped to [0,1], NaN written as 0. Throws std::runtime_error on I/O failure.
+// RGB(A) PNG; values are clamped to [0,1], NaN written as 0. Throws InputError when the path
+// cannot be opened for writing, std::runtime_error when writing fails.
 void write_png(const std::string& path, const Image& img, Encoding enc = Encoding::Srgb);
 // Reads an 8-bit PNG into linear floats (inverse of write_png). Throws InputError.
 Image read_png(const std::string& path, Encoding enc = Encoding::Srgb);

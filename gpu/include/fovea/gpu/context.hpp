@@ -120,6 +120,8 @@ class Context {
   std::uint32_t memory_type(std::uint32_t type_bits, VkMemoryPropertyFlags required,
                             VkMemoryPropertyFlags preferred = 0) const;
   VkMemoryPropertyFlags memory_type_flags(std::uint32_t index) const;
+  // Size of the heap that memory type `index` allocates from, bytes.
+  VkDeviceSize memory_type_heap_size(std::uint32_t index) const;
 
   // Names an object for validation messages (no-op without VK_EXT_debug_utils).
   void set_name(VkObjectType type, std::uint64_t handle, const std::string& name) const;
