@@ -148,7 +148,7 @@ FrameTimes FramePipeline::render(const std::array<core::Pose, 2>& eye_pose, cons
   for (auto& e : m.eyes) {
     const int i = int(e->eye);
     e->pose = eye_pose[i];
-    e->dist->set_frame(gaze[i], frame);
+    t.gaze[i] = e->dist->set_frame(gaze[i], frame);
     e->grid_pass->prepare(*e->dist, e->mask);
   }
   t.grid.cpu_ms = lap_ms(t0);

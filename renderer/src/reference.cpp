@@ -146,9 +146,8 @@ ReferenceResult render_reference(gpu::Context& ctx, const GpuScene& scene, const
   glm::dvec3 mean(0);
   for (std::size_t i : inside) mean += glm::dvec3(r.image.pixels[i]);
   r.mean_rgb = mean / double(inside.size());
-  // One batch: no spread to estimate from.
-  if (std::isnan(r.rel_error)) r.rel_error = 0;
-  if (std::isnan(r.pixel_rel_error)) r.pixel_rel_error = 0;
+  // One batch has no spread to estimate from: the errors stay NaN (unknown), never a 0 that
+  // reads as converged.
   return r;
 }
 

@@ -15,6 +15,7 @@
 #include "fovea/core/display.hpp"
 #include "fovea/core/duration.hpp"
 #include "fovea/core/error.hpp"
+#include "fovea/core/output_path.hpp"
 #include "fovea/core/image.hpp"
 #include "fovea/core/metrics.hpp"
 #include "fovea/renderer/scene_io.hpp"
@@ -214,7 +215,7 @@ int run(std::vector<std::string> argv) {
   if (args.has("records")) {
     for (const auto& o : sim_options)
       if (args.has(o)) throw core::InputError("--" + o + " configures a simulation; --records analyses a file");
-    fs::create_directories(out);
+    core::prepare_output_dir(out.string(), "--out");
     return run_records(args, out);
   }
 
@@ -278,7 +279,7 @@ int run(std::vector<std::string> argv) {
 
   const renderer::Scene scene = renderer::load_scene(args.str("scene", "default"));
   for (const auto& w : scene.warnings) std::cerr << "warning: " << w << "\n";
-  fs::create_directories(out);
+  core::prepare_output_dir(out.string(), "--out");
   // The defaults of `fovea render`: distribution, reconstruction, tracing, the hidden area culled.
   RenderSetup setup(scene, display, render_options);
   gpu::Context& ctx = setup.ctx;
@@ -400,14 +401,17 @@ int run(std::vector<std::string> argv) {
       latency::SweepPoint p;
       p.inject_ms = core::ns_to_ms(inj);
       p.error = latency::error_summary(latency::shown_errors(s));
-      p.gaze_to_photon_median_ms = latency::distribution(latency::latencies(s.records).gaze_to_photon_ms).median;
+      const latency::Distribution g2p = latency::distribution(latency::latencies(s.records).gaze_to_photon_ms);
       const std::vector<double> rec = latency::recovery_ms(s);
-      p.recovery_median_ms = latency::distribution(rec).median;
+      const latency::Distribution recovery = latency::distribution(rec);
+      p.gaze_to_photon_median_ms = g2p.median;
+      p.recovery_median_ms = recovery.median;
       p.recovered = rec.size();
+      // Medians of no values are null (to_json), as in every summary.
       nlohmann::json pj = {{"inject_ms", p.inject_ms},
-                           {"gaze_to_photon_median_ms", p.gaze_to_photon_median_ms},
+                           {"gaze_to_photon_median_ms", latency::to_json(g2p)["median"]},
                            {"foveal_error_deg", p.error},
-                           {"recovery_ms_median", p.recovery_median_ms},
+                           {"recovery_ms_median", latency::to_json(recovery)["median"]},
                            {"saccades_recovered", p.recovered}};
       if (reference && std::find(quality_at.begin(), quality_at.end(), inj) != quality_at.end()) {
         if (!quiet) std::fprintf(stderr, "quality at +%.0f ms...\n", p.inject_ms);

@@ -23,6 +23,7 @@
 #include "fovea/core/flip.hpp"
 #include "fovea/core/json.hpp"
 #include "fovea/core/metrics.hpp"
+#include "fovea/core/output_path.hpp"
 #include "fovea/devices/foveation_gaze.hpp"
 #include "fovea/devices/readers.hpp"
 #include "fovea/devices/screen.hpp"
@@ -64,8 +65,10 @@ nor reconstructed; samples_hidden counts them in the last frame.
 With --reference each eye's summary compares the last frame with a converged Cartesian
 reference (docs/metrics.md): tone-mapped PSNR and SSIM (ACES fit + sRGB), relMSE (linear),
 LDR- and HDR-FLIP, each over the whole image, the fovea (fovea_*, e <= 5.79 deg),
-acuity-weighted (foveated_*) and per 2 deg band ("bands"). Always: temporal_error and, over
-the trailing frames whose gaze did not move (up to 8), the flicker of the still image.
+acuity-weighted (foveated_*) and per 2 deg band ("bands"). Always: temporal_error, and the
+flicker of the still image over the trailing frames whose gaze did not move (up to 8); when
+the gaze moved between the last two frames there is nothing still to measure: flicker is
+null and flicker_note says so.
 With no options: a short demo on the shipped scene and gaze.
 
   --scene S             cornell | furnace | glossy-spheres | stereo-occluders | default,
@@ -329,6 +332,7 @@ int run(std::vector<std::string> argv) {
   settings.bmfr_precision = precision == "fp16" ? reconstruct::BmfrPrecision::Fp16 : reconstruct::BmfrPrecision::Fp32;
   settings.blur = !args.has("no-blur");
   const fs::path out_dir(args.str("out", "out/render"));
+  core::prepare_output_dir(out_dir.string(), "--out");
 
   std::string gaze_uri;
   if (auto g = args.opt("gaze")) {
@@ -349,7 +353,6 @@ int run(std::vector<std::string> argv) {
   const std::string scene_arg = args.str("scene", "default");
   const renderer::Scene scene = renderer::load_scene(scene_arg);
   for (const auto& w : scene.warnings) std::cerr << "warning: " << w << "\n";
-  fs::create_directories(out_dir);
 
   const bool cull = !args.has("no-cull");
   RenderSetup setup(scene, display, {dp, settings, tracing, cull});
@@ -387,6 +390,8 @@ int run(std::vector<std::string> argv) {
   std::array<std::deque<core::Image>, 2> still;
   std::array<glm::dvec3, 2> still_gaze{};
   std::array<glm::dvec3, 2> gaze{glm::dvec3(0, 0, -1), glm::dvec3(0, 0, -1)};
+  // Frames whose gaze the grid could not use as given (core::GazeStatus), per eye.
+  std::array<long, 2> gaze_fallback_frames{0, 0}, gaze_clamped_frames{0, 0};
   FrameLog frame_log((out_dir / "frames.jsonl").string(), (out_dir / "frame_times.jsonl").string());
   const auto start = std::chrono::steady_clock::now();
   for (long f = 0; f < frames; ++f) {
@@ -396,6 +401,10 @@ int run(std::vector<std::string> argv) {
     for (int e = 0; e < 2; ++e) gaze[e] = g.eye(core::Eye(e)).dir;
     cpu_ms["gaze"].push_back(core::ns_to_ms(core::now_ns() - t0));
     const pipeline::FrameTimes t = pipeline.render(poses, gaze, std::uint32_t(f));
+    for (int e = 0; e < 2; ++e) {
+      gaze_fallback_frames[e] += t.gaze[e].fallback;
+      gaze_clamped_frames[e] += t.gaze[e].clamped;
+    }
     for (const auto& [name, st] : {std::pair{"grid", t.grid}, {"trace", t.trace}, {"reconstruct", t.reconstruct},
                                    {"resolve", t.resolve}}) {
       gpu_ms[name].push_back(st.gpu_ms);
@@ -413,7 +422,7 @@ int run(std::vector<std::string> argv) {
     cpu_ms["readback"].push_back(core::ns_to_ms(core::now_ns() - t0));
     cpu_ms["total"].push_back(cpu_ms["gaze"].back() + t.cpu_ms() + cpu_ms["readback"].back());
     const auto& dist = pipeline.distribution(core::Eye::Left);
-    FrameRecord rec{f, t_ns, g, gaze, poses, dist.columns(), dist.rows(), {}, {}, gaze_source.live()};
+    FrameRecord rec{f, t_ns, g, {t.gaze[0].used, t.gaze[1].used}, poses, dist.columns(), dist.rows(), {}, {}, gaze_source.live()};
     for (const auto& [name, v] : gpu_ms) rec.gpu_ms.emplace_back(name, v.back());
     for (const auto& [name, v] : cpu_ms) rec.cpu_ms.emplace_back(name, v.back());
     frame_log.add(rec);
@@ -445,6 +454,17 @@ int run(std::vector<std::string> argv) {
                std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count());
   }
   if (bar) std::fprintf(stderr, "\n");
+  for (int e = 0; e < 2; ++e) {
+    const char* name = e == 0 ? "left" : "right";
+    if (gaze_fallback_frames[e] > 0)
+      std::cerr << "warning: --gaze " << gaze_uri << ": the " << name << " eye's gaze was unusable (behind the viewer, "
+                << "zero or not finite) in " << gaze_fallback_frames[e] << " of " << frames
+                << " frames; its last usable gaze, or the view centre, was rendered (frames.jsonl: used_gaze)\n";
+    if (gaze_clamped_frames[e] > 0)
+      std::cerr << "warning: --gaze " << gaze_uri << ": the " << name << " eye's gaze was outside the view in "
+                << gaze_clamped_frames[e] << " of " << frames
+                << " frames; it was clamped to the view's border (frames.jsonl: used_gaze)\n";
+  }
   frame_log.finish();
   renderer::write_exr((out_dir / "last_left.exr").string(), last[0]);
   renderer::write_exr((out_dir / "last_right.exr").string(), last[1]);
@@ -501,7 +521,13 @@ int run(std::vector<std::string> argv) {
     nlohmann::json s;
     s["gaze"] = {g.x, g.y, g.z};  // view space, as the grid used it
     s["temporal_error"] = frames > 1 ? te_sum[e] / double(frames - 1) : 0.0;
-    if (still[e].size() >= 2) add_flicker(s, still[e], ecc);
+    if (still[e].size() >= 2) {
+      add_flicker(s, still[e], ecc);
+    } else {
+      s["flicker"] = nullptr;
+      s["flicker_frames"] = still[e].size();
+      s["flicker_note"] = "the gaze moved between the last two frames: no still frames to measure flicker over";
+    }
     if (ref_spp > 0 || !ref_dir.empty()) {
       CachedReference ref;
       if (loaded[e]) {

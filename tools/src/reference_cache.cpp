@@ -1,9 +1,11 @@
 #include "reference_cache.hpp"
 
+#include <cmath>
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
 #include <iostream>
+#include <limits>
 #include <optional>
 #include <sstream>
 
@@ -118,8 +120,13 @@ CachedReference load(const std::string& exr, const json& meta, const std::string
     height = view.at("height").get<int>();
     r.identity = meta.at("identity").dump();
     r.result.spp = meta.at("spp").get<std::uint32_t>();
-    r.result.rel_error = meta.at("rel_error").get<double>();
-    r.result.pixel_rel_error = meta.at("pixel_rel_error").get<double>();
+    // null: a single batch, no estimate (NaN in ReferenceResult).
+    const auto error = [&](const char* key) {
+      const json& e = meta.at(key);
+      return e.is_null() ? std::numeric_limits<double>::quiet_NaN() : e.get<double>();
+    };
+    r.result.rel_error = error("rel_error");
+    r.result.pixel_rel_error = error("pixel_rel_error");
     r.result.seconds = meta.at("seconds").get<double>();
     const auto& m = meta.at("mean_rgb");
     r.result.mean_rgb = {m.at(0).get<double>(), m.at(1).get<double>(), m.at(2).get<double>()};
@@ -268,6 +275,10 @@ CachedReference cached_reference(gpu::Context& ctx, const renderer::GpuScene& sc
   o.window = req.window;
   CachedReference r;
   r.result = renderer::render_reference(ctx, scene, view, eye, o, progress);
+  if (std::isnan(r.result.pixel_rel_error))
+    std::cerr << "warning: reference: " << r.result.spp << " spp is a single batch of " << o.path.spp
+              << ": its error cannot be estimated (rel_error and pixel_rel_error are null); at least "
+              << 2 * o.path.spp << " spp (two batches) gives an estimate\n";
   r.key = key;
   r.identity = text;
   r.window = req.window;

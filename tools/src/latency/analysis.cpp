@@ -68,7 +68,9 @@ Distribution distribution(std::vector<double> v) {
 }
 
 nlohmann::json to_json(const Distribution& d) {
-  return {{"n", d.n}, {"median", d.median}, {"p95", d.p95}, {"p99", d.p99}, {"max", d.max}};
+  // No values: no statistic (null), never a 0 that reads as a measured zero latency.
+  const auto stat = [&](double v) { return d.n > 0 ? nlohmann::json(v) : nlohmann::json(nullptr); };
+  return {{"n", d.n}, {"median", stat(d.median)}, {"p95", stat(d.p95)}, {"p99", stat(d.p99)}, {"max", stat(d.max)}};
 }
 
 Latencies latencies(const std::vector<xrcommon::TimingRecord>& records) {
@@ -88,10 +90,11 @@ nlohmann::json error_summary(const std::vector<double>& error_deg) {
   nlohmann::json j = to_json(distribution(error_deg));
   double sum = 0;
   for (double e : error_deg) sum += e;
-  j["mean"] = error_deg.empty() ? 0.0 : sum / double(error_deg.size());
+  j["mean"] = error_deg.empty() ? nlohmann::json(nullptr) : nlohmann::json(sum / double(error_deg.size()));
   for (double th : {1.0, 2.0, 5.0}) {
     const auto above = std::count_if(error_deg.begin(), error_deg.end(), [&](double e) { return e > th; });
-    j["above_" + fmt(th, 0) + "deg"] = error_deg.empty() ? 0.0 : double(above) / double(error_deg.size());
+    j["above_" + fmt(th, 0) + "deg"] =
+        error_deg.empty() ? nlohmann::json(nullptr) : nlohmann::json(double(above) / double(error_deg.size()));
   }
   return j;
 }
@@ -208,8 +211,9 @@ std::vector<std::string> write_sweep_plots(const std::string& dir, const std::ve
   c.y_label = "foveal error at photon time (deg)";
   sweep::Series med{"median", sweep::palette(0), {}, true, true, {}}, p95{"p95", sweep::palette(1), {}, true, true, {}};
   for (const SweepPoint& p : points) {
-    med.points.push_back({p.inject_ms, p.error.value("median", 0.0)});
-    p95.points.push_back({p.inject_ms, p.error.value("p95", 0.0)});
+    if (p.error["median"].is_null()) continue;  // no shown frame had a true eye
+    med.points.push_back({p.inject_ms, p.error["median"].get<double>()});
+    p95.points.push_back({p.inject_ms, p.error["p95"].get<double>()});
   }
   c.series = {med, p95};
   save(dir, "sweep_error.png", c, written);

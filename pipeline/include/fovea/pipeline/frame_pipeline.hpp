@@ -37,6 +37,9 @@ struct FrameTimes {
   double mip_gpu_ms = 0, resample_gpu_ms = 0, blur_gpu_ms = 0;  // parts of resolve: its three kernels
   double submit_cpu_ms = 0;    // ending the command buffer and vkQueueSubmit (recording is in the stages)
   double wait_cpu_ms = 0;      // the fence wait until the GPU finished (on a CPU device: its work)
+  // What each eye's grid did with the gaze it was given (left, right): the direction it used
+  // (clamped into the view, or the last valid gaze / view centre for an unusable one).
+  std::array<core::GazeStatus, 2> gaze{};
   double gpu_ms() const { return grid.gpu_ms + trace.gpu_ms + reconstruct.gpu_ms + resolve.gpu_ms; }
   double cpu_ms() const {
     return grid.cpu_ms + trace.cpu_ms + reconstruct.cpu_ms + resolve.cpu_ms + submit_cpu_ms + wait_cpu_ms;

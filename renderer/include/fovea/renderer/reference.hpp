@@ -53,7 +53,8 @@ struct ReferenceResult {
   std::uint32_t spp = 0;
   glm::dvec3 mean_rgb{0};
   // Relative standard error of the image-mean luminance, from the spread of the
-  // per-batch image means (batch-means estimator).
+  // per-batch image means (batch-means estimator). Both errors are NaN (unknown, null in
+  // JSON) after a single batch.
   double rel_error = 0;
   // √(mean over pixels of se² / (Y² + 0.01)), se the standard error of the pixel's
   // luminance Y from its batch means: the reference's own expected relMSE (core/metrics'
