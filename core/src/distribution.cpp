@@ -321,16 +321,16 @@ std::unique_ptr<SampleDistribution> make_distribution(const View& view, const Di
   const double pixels = double(view.width()) * view.height();
   const double got = d->grid_samples() / pixels;
   if (std::abs(got - p.budget) * pixels <= std::max(0.05 * p.budget * pixels, 2.0)) return d;
-  const std::string name = distribution_name(p.kind);
+  const std::string name = (p.display.empty() ? "" : "display " + p.display + ": ") + "budget: " + distribution_name(p.kind);
   const std::string where = " on this " + std::to_string(view.width()) + "x" + std::to_string(view.height()) + " display";
   if (got < p.budget) {
     DistributionParams full = p;
     full.budget = 1.0;
     const double most = make_unchecked(view, full)->grid_samples() / pixels;
-    throw InputError("budget: " + name + " reaches at most " + fraction(std::max(most, got)) + " of the display's pixels" +
+    throw InputError(name + " reaches at most " + fraction(std::max(most, got)) + " of the display's pixels" +
                      where + " (requested " + fraction(p.budget) + ")");
   }
-  throw InputError("budget: " + name + " reaches no less than " + fraction(got) + " of the display's pixels" + where +
+  throw InputError(name + " reaches no less than " + fraction(got) + " of the display's pixels" + where +
                    " (requested " + fraction(p.budget) + ")");
 }
 

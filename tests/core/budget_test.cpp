@@ -74,6 +74,21 @@ TEST(Budget, RefusalsNameTheReachableLimit) {
     for (double b : {0.05, 1.0}) EXPECT_TRUE(try_budget(v, k, b).met) << distribution_name(k) << " " << b;
 }
 
+// A 170° display cannot reach the default budget with Visual-Polar (its pixels crowd at the
+// edges); the refusal used to name no display. It names the file the CLI passes on.
+TEST(Budget, RefusalNamesTheDisplayFile) {
+  const DisplayPreset d = parse_display(
+      R"({"name":"wide","width":320,"height":360,"fov_deg":{"left":-85,"right":85,"up":85,"down":-85}})", "wide.json");
+  DistributionParams p;
+  p.display = d.origin;
+  try {
+    (void)make_distribution(d.view(Eye::Left), p);
+    ADD_FAILURE() << "budget met";
+  } catch (const InputError& e) {
+    EXPECT_EQ(std::string(e.what()).rfind("display wide.json: budget: visual-polar reaches at most", 0), 0u) << e.what();
+  }
+}
+
 // Linear fall-off meets the budget at every gaze: fl and pl are solved per frame.
 TEST(Budget, LinearFalloffMeetsItAtOffCentreGazes) {
   const View v = left_view("small");

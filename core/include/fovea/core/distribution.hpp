@@ -51,6 +51,9 @@ struct DistributionParams {
   double logpolar_alpha = 4.0;  // Meng 2018; the buffer's σ is 1/√budget
   std::uint32_t seed = 0;    // random killing (linear fall-off)
   bool jitter = true;        // per-frame Halton (2, 3) sub-cell offset (anti-aliasing over frames)
+  // The display the view comes from (DisplayPreset::origin: preset name or file), named in
+  // make_distribution's budget refusals; a budget a wide-FOV file cannot meet is its problem.
+  std::string display;
 
   void validate() const;     // InputError naming the parameter
 };
