@@ -1,3 +1,4 @@
+#include <cctype>
 #include <cstdlib>
 #include <string>
 #include <vector>
@@ -88,8 +89,16 @@ TEST(ChooseDevice, NoMatchOrUnusableMatchListsDevices) {
   EXPECT_THROW(gpu::choose_device({}, ""), std::runtime_error);
 }
 
-// On this project's test machines the only device is lavapipe (a CPU device); with a
-// GPU present the default must be that GPU instead.
+// The Context tests below run on whatever Vulkan device the machine has (lavapipe on the
+// project's test machines, a GPU elsewhere): they name the device the default choice took.
+namespace {
+std::string default_device_name() {
+  ScopedEnv no_override("FOVEA_VK_DEVICE", "");
+  return gpu::Context({.validation = true}).info().name;
+}
+}  // namespace
+
+// A CPU device only when there is nothing else; with a GPU present the default must be that GPU.
 TEST(Context, DefaultChoiceIsBestDevice) {
   ScopedEnv no_override("FOVEA_VK_DEVICE", "");
   gpu::Context ctx({.validation = true});
@@ -104,7 +113,7 @@ TEST(Context, DefaultChoiceIsBestDevice) {
     all_cpu = all_cpu && p.deviceType == VK_PHYSICAL_DEVICE_TYPE_CPU;
   }
   if (all_cpu) {
-    EXPECT_NE(ctx.info().name.find("llvmpipe"), std::string::npos) << ctx.info().name;
+    EXPECT_EQ(ctx.info().type, VK_PHYSICAL_DEVICE_TYPE_CPU) << ctx.info().name;
   } else {
     EXPECT_NE(ctx.info().type, VK_PHYSICAL_DEVICE_TYPE_CPU) << ctx.info().name;
   }
@@ -113,13 +122,17 @@ TEST(Context, DefaultChoiceIsBestDevice) {
   EXPECT_EQ(ctx.validation_errors(), 0);
 }
 
-TEST(Context, EnvOverrideSelectsLlvmpipe) {
-  ScopedEnv env("FOVEA_VK_DEVICE", "LLVMpipe");
+TEST(Context, EnvOverrideSelectsByCaseInsensitiveName) {
+  const std::string name = default_device_name();
+  std::string shouted = name;
+  for (char& c : shouted) c = char(std::toupper(static_cast<unsigned char>(c)));
+  ScopedEnv env("FOVEA_VK_DEVICE", shouted.c_str());
   gpu::Context ctx({.validation = true});
-  EXPECT_NE(ctx.info().name.find("llvmpipe"), std::string::npos) << ctx.info().name;
+  EXPECT_EQ(ctx.info().name, name);
 }
 
 TEST(Context, NonsenseOverrideIsClearError) {
+  const std::string name = default_device_name();
   ScopedEnv env("FOVEA_VK_DEVICE", "no-such-gpu-xyz");
   std::exception_ptr error;
   try {
@@ -130,13 +143,14 @@ TEST(Context, NonsenseOverrideIsClearError) {
   ASSERT_TRUE(error) << "expected core::InputError";
   const std::string m = message_of(error);
   EXPECT_NE(m.find("FOVEA_VK_DEVICE 'no-such-gpu-xyz' matches no Vulkan device"), std::string::npos) << m;
-  EXPECT_NE(m.find("llvmpipe"), std::string::npos) << "the message lists the devices: " << m;
+  EXPECT_NE(m.find(name), std::string::npos) << "the message lists the devices: " << m;
 }
 
 TEST(Context, OptionOverridesEnvironment) {
+  const std::string name = default_device_name();
   ScopedEnv env("FOVEA_VK_DEVICE", "no-such-gpu-xyz");
-  gpu::Context ctx({.validation = true, .device = "llvmpipe"});
-  EXPECT_NE(ctx.info().name.find("llvmpipe"), std::string::npos);
+  gpu::Context ctx({.validation = true, .device = name});
+  EXPECT_EQ(ctx.info().name, name);
 }
 
 TEST(Context, ValidationEnvironmentIsParsed) {
