@@ -65,6 +65,37 @@ void check_exponents(std::string_view text, const std::string& origin) {
   }
 }
 
+// tinyobjloader reads "nan" and "inf" as 0 without a word, so a vertex of NaNs became the
+// origin and the scene's NaN check never saw it. Numeric statements holding such a token
+// are refused, naming the line; names (o, g, usemtl, ...) may spell anything.
+void check_non_finite(std::string_view text, const std::string& origin) {
+  static const std::set<std::string, std::less<>> numeric = {"v",  "vn", "vt", "vp", "Ka", "Kd", "Ks", "Ke",
+                                                             "Tf", "Ns", "Ni", "d",  "Tr", "Pr", "Pm"};
+  std::size_t line = 0;
+  for (std::size_t at = 0; at < text.size();) {
+    const std::size_t end = std::min(text.find('\n', at), text.size());
+    const std::string_view l(text.data() + at, end - at);
+    at = end + 1;
+    ++line;
+    std::size_t i = 0;
+    const auto word = [&] {
+      while (i < l.size() && std::isspace(static_cast<unsigned char>(l[i]))) ++i;
+      const std::size_t b = i;
+      while (i < l.size() && !std::isspace(static_cast<unsigned char>(l[i]))) ++i;
+      return l.substr(b, i - b);
+    };
+    if (!numeric.contains(word())) continue;
+    for (std::string_view w = word(); !w.empty(); w = word()) {
+      std::string_view v = w;
+      if (v[0] == '+' || v[0] == '-') v.remove_prefix(1);
+      std::string lower(v.substr(0, 3));
+      for (char& c : lower) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+      if (lower == "nan" || lower == "inf")
+        throw core::InputError(origin + ":" + std::to_string(line) + ": non-finite number \"" + std::string(w) + "\"");
+    }
+  }
+}
+
 // The material libraries named by `mtllib` lines, concatenated (tinyobjloader takes one
 // material stream for all of them), each read with what is left of the byte budget.
 std::string read_material_libraries(const std::string& obj, const std::string& dir, std::size_t& budget,
@@ -91,6 +122,7 @@ std::string read_material_libraries(const std::string& obj, const std::string& d
         const std::string text = core::read_file_bounded(path, budget);
         budget -= text.size();
         check_exponents(text, path);
+        check_non_finite(text, path);
         out += text;
       } catch (const core::InputError& e) {
         throw core::InputError(origin + ": mtllib " + e.what());
@@ -113,6 +145,7 @@ float ns_to_roughness(float ns) {
 Scene load_obj(const std::string& path, const SceneLimits& limits) {
   const std::string obj = core::read_file_bounded(path, limits.max_file_bytes);
   check_exponents(obj, path);
+  check_non_finite(obj, path);
   Scene s;
   const std::string dir = std::filesystem::path(path).parent_path().string();
   std::size_t budget = limits.max_file_bytes - obj.size();
