@@ -15,6 +15,8 @@ std::unique_ptr<SampleStream> open_device_stream(SourceUri& u, const SourceOptio
     throw core::InputError("gaze source \"" + u.text + "\": provided by the " +
                            (u.scheme == "mouse" ? "mirror window" : "OpenXR layer") + ", not by the devices module");
   if (u.scheme == "hid-capture") {
+    SourceOptions timeline = opt;
+    take_timeline_keys(u, timeline);  // checked; walking every sample does not use them
     u.finish();
     if (!opt.raw_capture.empty()) throw core::InputError("gaze source \"" + u.text + "\": a capture replay cannot be captured again");
     return std::make_unique<hid::HidCaptureStream>(u.body, opt);

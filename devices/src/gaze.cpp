@@ -187,6 +187,16 @@ void apply_common_options(SourceUri& u, SourceOptions& opt) {
   if (auto sc = u.take("screen"); !sc.empty()) opt.screen = parse_screen(sc, "gaze source \"" + u.text + "\": screen");
 }
 
+// speed= and loop=, the replay keys of the timeline (docs/gaze.md). Every entry point that
+// opens a recording takes and checks them; tools that walk every sample need not use them.
+void take_timeline_keys(SourceUri& u, SourceOptions& opt) {
+  opt.speed = u.take_number("speed", opt.speed, 1e-3, 1e3);
+  const std::string loop = u.take("loop");
+  if (!loop.empty() && loop != "0" && loop != "1")
+    throw core::InputError("gaze source \"" + u.text + "\": loop must be 0 or 1");
+  if (!loop.empty()) opt.loop = loop == "1";
+}
+
 namespace {
 std::unique_ptr<SampleStream> open_raw_stream(SourceUri& u, const SourceOptions& opt);
 
@@ -209,12 +219,15 @@ std::unique_ptr<SampleStream> open_sample_stream(std::string_view uri, const Sou
 
 Recording open_recording(std::string_view uri, const SourceOptions& base) {
   SourceUri u = parse_source_uri(uri);
-  if (u.scheme != "replay") throw core::InputError("\"" + u.text + "\": not a recording (replay:FILE or a file name)");
+  if (u.scheme != "replay" && u.scheme != "hid-capture")
+    throw core::InputError("\"" + u.text + "\": not a recording (replay:FILE, hid-capture:FILE or a file name)");
   if (u.body.empty()) throw core::InputError("gaze source \"" + u.text + "\": missing file name");
   Recording r;
   r.options = base;
   apply_common_options(u, r.options);
+  take_timeline_keys(u, r.options);
   if (auto f = u.take("format"); !f.empty()) r.options.format = f;
+  if (u.scheme == "hid-capture") r.options.format = format_name(Format::HidCapture);
   u.finish();
   auto reader = open_reader(u.body, r.options);
   r.reader = reader.get();
@@ -224,11 +237,8 @@ Recording open_recording(std::string_view uri, const SourceOptions& base) {
 
 std::vector<std::string> recording_notes(std::string_view uri, const SourceOptions& opt) {
   SourceUri u = parse_source_uri(uri);
-  if (u.scheme != "replay") return {};
-  // Only the keys a recording walk takes; timeline keys (speed, loop) do not change notes.
-  u.take("speed");
-  u.take("loop");
-  Recording r = open_recording(u.rebuilt(), opt);
+  if (u.scheme != "replay" && u.scheme != "hid-capture") return {};
+  Recording r = open_recording(uri, opt);
   GazeSample s;
   while (r.reader->next(s)) {
   }
@@ -243,8 +253,7 @@ std::unique_ptr<SampleStream> open_raw_stream(SourceUri& u, const SourceOptions&
   if (u.scheme == "replay") {
     if (u.body.empty()) throw core::InputError("gaze source \"" + u.text + "\": missing file name");
     if (auto f = u.take("format"); !f.empty()) opt.format = f;
-    u.take("speed");
-    u.take("loop");
+    take_timeline_keys(u, opt);
     u.finish();
     return open_reader(u.body, opt);
   }
@@ -273,13 +282,7 @@ std::unique_ptr<GazeSource> open_gaze_source(std::string_view uri, const SourceO
   SourceUri u = parse_source_uri(uri);
   SourceOptions opt = base;
   apply_common_options(u, opt);
-  if (u.scheme == "replay") {
-    opt.speed = u.take_number("speed", 1.0, 1e-3, 1e3);
-    const std::string loop = u.take("loop");
-    if (!loop.empty() && loop != "0" && loop != "1")
-      throw core::InputError("gaze source \"" + u.text + "\": loop must be 0 or 1");
-    opt.loop = loop == "1";
-  }
+  if (u.scheme == "replay" || u.scheme == "hid-capture") take_timeline_keys(u, opt);
   TrackerParams tracker;
   const bool modelled = take_tracker_options(u, tracker);
   if (modelled && !opt.filters.empty())

@@ -1,5 +1,7 @@
 #include "fovea/devices/hid_stream.hpp"
 
+#include "read_notes.hpp"
+
 #include <unistd.h>
 
 #include <chrono>
@@ -243,10 +245,12 @@ StreamStats HidGazeStream::stats() const {
 // ---- HidCaptureStream ----------------------------------------------------------------
 struct HidCaptureStream::Lines {
   detail::LineReader reader;
+  detail::OffViewCount off_view;
   explicit Lines(const std::string& p) : reader(p) {}
 };
 
-HidCaptureStream::HidCaptureStream(const std::string& path, const SourceOptions& opt) : path_(path), opt_(opt) {
+HidCaptureStream::HidCaptureStream(const std::string& path, const SourceOptions& opt)
+    : path_(path), opt_(opt) {
   if (!std::filesystem::is_regular_file(path)) throw core::InputError(path + ": no such file");
   lines_ = std::make_unique<Lines>(path);
   rewind();
@@ -256,7 +260,8 @@ HidCaptureStream::~HidCaptureStream() = default;
 void HidCaptureStream::rewind() {
   lines_->reader.rewind();
   stats_ = ReadStats{};
-  have_first_ = false;
+  lines_->off_view.reset();
+  have_first_ = ended_ = false;
   detail::Line l;
   // Header: magic, then everything up to and including the descriptor.
   bool magic = false;
@@ -333,9 +338,16 @@ bool HidCaptureStream::next(GazeSample& out) {
     out.host_time_ns = host;
     ++stats_.samples;
     if (out.tracked()) ++stats_.tracked;
+    lines_->off_view.add(opt_.screen_view(), out);
     return true;
   }
   stats_.peak_buffer_bytes = lines_->reader.peak_bytes();
+  if (!ended_) {  // the notes once per pass, as the other readers give them
+    ended_ = true;
+    if (lines_->reader.truncated()) detail::add_note(stats_, detail::truncated_note(path_));
+    const core::View v = opt_.screen_view();
+    lines_->off_view.note(stats_, path_, v.width(), v.height());
+  }
   return false;
 }
 

@@ -18,7 +18,9 @@
 #include "fovea/core/input_limits.hpp"
 #include "fovea/core/image.hpp"
 #include "fovea/core/json.hpp"
+#include "fovea/devices/hid_stream.hpp"
 #include "line_reader.hpp"
+#include "read_notes.hpp"
 #include "text.hpp"
 
 namespace fovea::devices {
@@ -39,6 +41,7 @@ const char* format_name(Format f) {
     case Format::Neon: return "neon";
     case Format::TobiiG3: return "tobii-g3";
     case Format::EyelinkAsc: return "eyelink-asc";
+    case Format::HidCapture: return "hid-capture";
   }
   return "?";
 }
@@ -50,15 +53,19 @@ const char* device_clock_name(Format f) {
     case Format::Neon: return "UTC (timestamp [ns] since 1970)";
     case Format::TobiiG3: return "s since the Glasses 3 recording start";
     case Format::EyelinkAsc: return "EyeLink tracker clock (ms)";
+    case Format::HidCapture: return "the tracker's sensor timestamp (unwrapped, docs/hid.md)";
   }
   return "?";
 }
 
+namespace {
+constexpr const char* kFormatList = "fovea, pupil-core, neon, tobii-g3, eyelink-asc, hid-capture";
+}
+
 Format parse_format(std::string_view n) {
-  for (Format f : {Format::Fovea, Format::PupilCore, Format::Neon, Format::TobiiG3, Format::EyelinkAsc})
+  for (Format f : {Format::Fovea, Format::PupilCore, Format::Neon, Format::TobiiG3, Format::EyelinkAsc, Format::HidCapture})
     if (n == format_name(f)) return f;
-  throw core::InputError("unknown gaze format \"" + std::string(n) +
-                         "\" (fovea, pupil-core, neon, tobii-g3, eyelink-asc)");
+  throw core::InputError("unknown gaze format \"" + std::string(n) + "\" (" + kFormatList + ")");
 }
 
 Format detect_format(const std::string& path) {
@@ -70,6 +77,8 @@ Format detect_format(const std::string& path) {
   head.resize(n > 0 ? static_cast<std::size_t>(n) : 0);
   if (head.rfind("\xEF\xBB\xBF", 0) == 0) head.erase(0, 3);
   const std::string first = head.substr(0, head.find('\n'));
+  // A raw HID capture (docs/hid.md), plain or gzip: its first line is the magic.
+  if (first.rfind("fovea-hid-capture", 0) == 0) return Format::HidCapture;
   std::size_t p = head.find_first_not_of(" \t\r\n");
   if (p != std::string::npos && head[p] == '{') {
     // Glasses 3 gazedata: one JSON object per line with "type" and "timestamp" (any other
@@ -88,8 +97,8 @@ Format detect_format(const std::string& path) {
   if (head.rfind("**", 0) == 0 || head.find("\nMSG") != std::string::npos ||
       head.find("\nSAMPLES") != std::string::npos || head.find("\nSTART") != std::string::npos)
     return Format::EyelinkAsc;
-  throw core::InputError(path + ": cannot detect the gaze format from its first line; pass the format "
-                         "(fovea, pupil-core, neon, tobii-g3, eyelink-asc)");
+  throw core::InputError(path + ": cannot detect the gaze format from its first line; pass the format (" +
+                         kFormatList + ")");
 }
 
 namespace {
@@ -99,8 +108,9 @@ constexpr double kDeg = std::numbers::pi / 180.0;
 // Shared machinery: line loop, drop accounting, time ordering and rebasing to t = 0.
 class ReaderBase : public GazeReader {
  public:
-  ReaderBase(const std::string& path, const SourceOptions& opt, Format f)
-      : lines_(path), opt_(opt), format_(f) {}
+  // `gaze_view`: the view the format's gaze refers to, where off-view samples are counted.
+  ReaderBase(const std::string& path, const SourceOptions& opt, Format f, const core::View& gaze_view)
+      : lines_(path), opt_(opt), format_(f), gaze_view_(gaze_view) {}
 
   bool next(GazeSample& out) override {
     detail::Line line;
@@ -120,9 +130,12 @@ class ReaderBase : public GazeReader {
         stats_.peak_buffer_bytes = lines_.peak_bytes();
         if (lines_.truncated() && !truncated_noted_) {
           truncated_noted_ = true;
-          note(lines_.path() + ": the gzip stream ends early (truncated file); the samples up to the cut were read");
+          note(detail::truncated_note(lines_.path()));
         }
-        if (!flush(out)) return false;
+        if (!flush(out)) {
+          off_view_.note(stats_, lines_.path(), raster().x, raster().y);
+          return false;
+        }
         have = true;
       }
       if (have && accept(out)) return true;
@@ -134,6 +147,7 @@ class ReaderBase : public GazeReader {
     stats_ = ReadStats{};
     have_last_ = false;
     truncated_noted_ = false;
+    off_view_.reset();
     reset();
   }
   std::string describe() const override { return std::string("replay:") + lines_.path() + " (" + format_name(format_) + ")"; }
@@ -154,9 +168,9 @@ class ReaderBase : public GazeReader {
   virtual void reset() {}
 
   void drop(const char* reason) { ++stats_.dropped[current_unterminated_ ? "truncated_last_line" : reason]; }
-  void note(const std::string& what) {
-    if (stats_.notes.size() < ReadStats::kMaxNotes) stats_.notes.push_back(what);
-  }
+  void note(const std::string& what) { detail::add_note(stats_, what); }
+  // The raster named in the off-view note: the gaze view's, or the file's own (EyeLink).
+  virtual glm::dvec2 raster() const { return {gaze_view_.width(), gaze_view_.height()}; }
   void message(core::TimeNs device_ns, const char* kind, std::string_view text) {
     if (sink_) sink_(RecordingMessage{device_ns, kind, std::string(text)});
   }
@@ -180,6 +194,7 @@ class ReaderBase : public GazeReader {
   detail::LineReader lines_;
   SourceOptions opt_;
   Format format_;
+  core::View gaze_view_;
   mutable ReadStats stats_;
   std::vector<std::string_view> fields_;
 
@@ -210,8 +225,10 @@ class ReaderBase : public GazeReader {
     s.host_time_ns = s.t_ns;
     ++stats_.samples;
     if (s.tracked()) ++stats_.tracked;
+    off_view_.add(gaze_view_, s);
     return true;
   }
+  detail::OffViewCount off_view_;
   bool current_unterminated_ = false, truncated_noted_ = false;
   bool have_last_ = false;
   core::TimeNs first_device_ = 0, last_device_ = 0;
@@ -227,7 +244,8 @@ bool unit_dir(double x, double y, double z, glm::dvec3& out) {
 // ---- The project's format ------------------------------------------------------------
 class FoveaReader final : public ReaderBase {
  public:
-  FoveaReader(const std::string& path, const SourceOptions& opt) : ReaderBase(path, opt, Format::Fovea) {
+  FoveaReader(const std::string& path, const SourceOptions& opt)
+      : ReaderBase(path, opt, Format::Fovea, opt.screen_view()) {
     const std::string side_path = path + ".json";
     if (std::filesystem::exists(side_path)) {
       // A sidecar holds a few fields: bound its size and nesting before parsing, so a hostile
@@ -334,7 +352,7 @@ class FoveaReader final : public ReaderBase {
 class PupilCoreReader final : public ReaderBase {
  public:
   PupilCoreReader(const std::string& path, const SourceOptions& opt)
-      : ReaderBase(path, opt, Format::PupilCore), view_(opt.screen_view()) {}
+      : ReaderBase(path, opt, Format::PupilCore, opt.screen_view()), view_(opt.screen_view()) {}
 
  protected:
   void reset() override { header_ = false; }
@@ -405,7 +423,8 @@ core::View neon_scene_camera() {  // Neon scene camera: 1600x1200, 103x77 deg (p
 class NeonReader final : public ReaderBase {
  public:
   NeonReader(const std::string& path, const SourceOptions& opt)
-      : ReaderBase(path, opt, Format::Neon), view_(opt.screen ? *opt.screen : neon_scene_camera()) {}
+      : ReaderBase(path, opt, Format::Neon, opt.screen ? *opt.screen : neon_scene_camera()),
+        view_(opt.screen ? *opt.screen : neon_scene_camera()) {}
   bool reports_blinks() const override { return true; }
 
  protected:
@@ -516,7 +535,8 @@ core::View g3_scene_camera() {  // Glasses 3 scene camera: 1920x1080, 95x63 deg 
 class TobiiG3Reader final : public ReaderBase {
  public:
   TobiiG3Reader(const std::string& path, const SourceOptions& opt)
-      : ReaderBase(path, opt, Format::TobiiG3), view_(opt.screen ? *opt.screen : g3_scene_camera()) {}
+      : ReaderBase(path, opt, Format::TobiiG3, opt.screen ? *opt.screen : g3_scene_camera()),
+        view_(opt.screen ? *opt.screen : g3_scene_camera()) {}
 
  protected:
   bool parse(const Line& l, GazeSample& out) override {
@@ -584,7 +604,7 @@ class TobiiG3Reader final : public ReaderBase {
 class EyelinkReader final : public ReaderBase {
  public:
   EyelinkReader(const std::string& path, const SourceOptions& opt)
-      : ReaderBase(path, opt, Format::EyelinkAsc), view_(opt.screen_view()) {}
+      : ReaderBase(path, opt, Format::EyelinkAsc, opt.screen_view()), view_(opt.screen_view()) {}
   bool reports_blinks() const override { return true; }
 
  protected:
@@ -595,7 +615,7 @@ class EyelinkReader final : public ReaderBase {
     coords_ = Coords::None;
     disp_w_ = view_.width();
     disp_h_ = view_.height();
-    outside_ = samples_ = 0;
+    samples_ = 0;
   }
   bool parse(const Line& l, GazeSample& out) override {
     detail::split_blank(l.text, fields_);
@@ -619,7 +639,6 @@ class EyelinkReader final : public ReaderBase {
     out = GazeSample{};
     out.device_time_ns = std::llround(tms * 1e6);
     const int eyes = binocular_ ? 2 : 1;
-    bool outside = false;
     for (int i = 0; i < eyes; ++i) {
       const int eye = binocular_ ? i : (mono_right_ ? 1 : 0);  // 0 = left, 1 = right
       const std::string_view xs = fields_[1 + 3 * i], ys = fields_[2 + 3 * i];
@@ -634,7 +653,6 @@ class EyelinkReader final : public ReaderBase {
           drop(detail::num_reason(n));
           return false;
         }
-        outside = outside || x < 0 || y < 0 || x > disp_w_ || y > disp_h_;
         // Display pixels (top-left, y down) scaled from DISPLAY_COORDS to the view raster.
         g = from_screen(view_, x * view_.width() / disp_w_, y * view_.height() / disp_h_, 1.0);
       }
@@ -645,20 +663,16 @@ class EyelinkReader final : public ReaderBase {
     out.combined = combine_eyes(out.left, out.right);
     if (!out.combined.tracked()) out.combined.flags = (out.left.flags | out.right.flags) & kBlink ? kBlink : kLost;
     ++samples_;
-    if (outside) ++outside_;
     return true;
   }
   bool flush(GazeSample&) override {
     if (coords_ == Coords::None && samples_ > 0)
       note(lines_.path() + ": no DISPLAY_COORDS or GAZE_COORDS message; gaze pixels were taken as the screen raster (" +
            std::to_string(view_.width()) + "x" + std::to_string(view_.height()) + ")");
-    if (outside_ > 0)
-      note(lines_.path() + ": " + std::to_string(outside_) + " of " + std::to_string(samples_) +
-           " samples lie outside the display (" + std::to_string(std::lround(disp_w_)) + "x" +
-           std::to_string(std::lround(disp_h_)) + " px); check the screen geometry");
-    samples_ = outside_ = 0;
+    samples_ = 0;
     return false;
   }
+  glm::dvec2 raster() const override { return {disp_w_, disp_h_}; }
 
  private:
   // Where the pixel raster of the gaze samples comes from, by priority.
@@ -705,7 +719,7 @@ class EyelinkReader final : public ReaderBase {
   bool binocular_ = false, mono_right_ = false, blink_[2] = {};
   Coords coords_ = Coords::None;
   double disp_w_ = view_.width(), disp_h_ = view_.height();
-  std::uint64_t outside_ = 0, samples_ = 0;
+  std::uint64_t samples_ = 0;
 };
 
 }  // namespace
@@ -719,6 +733,7 @@ std::unique_ptr<GazeReader> open_reader(const std::string& path, const SourceOpt
     case Format::Neon: return std::make_unique<NeonReader>(path, opt);
     case Format::TobiiG3: return std::make_unique<TobiiG3Reader>(path, opt);
     case Format::EyelinkAsc: return std::make_unique<EyelinkReader>(path, opt);
+    case Format::HidCapture: return std::make_unique<hid::HidCaptureStream>(path, opt);
   }
   throw core::InputError(path + ": unsupported format");
 }

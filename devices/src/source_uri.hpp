@@ -22,6 +22,8 @@ struct SourceUri {
 };
 
 SourceUri parse_source_uri(std::string_view uri);
+// speed=S (0.001..1000) and loop=0|1 of recordings, checked wherever one is opened.
+void take_timeline_keys(SourceUri& u, SourceOptions& opt);
 // hid:, usb:, hid-capture:, mouse, openxr (devices' own translation units).
 std::unique_ptr<SampleStream> open_device_stream(SourceUri& u, const SourceOptions& opt);
 // tracker=PRESET and the tracker_* keys (tracker_model.cpp); false when none is given.

@@ -454,3 +454,126 @@ TEST(FuzzRegression, HidWideFieldsSaturateAndStampsStayInInt64) {
   ASSERT_TRUE(m.map(report(2000), s, why)) << why;
   EXPECT_EQ(s.device_time_ns, 2'000'000);
 }
+
+// Gaze 50° and more off the display was replayed as tracked without a word by every reader
+// but EyeLink's. One policy for all: samples whose tracked gaze leaves the view are counted
+// and reported in the same words.
+TEST(OffDisplayGaze, EveryFormatWarnsTheSameWay) {
+  SourceOptions o;  // the `small` display: 100° wide
+  const auto expect_note = [](GazeReader& r, const std::string& what) {
+    read_all(r);
+    ASSERT_EQ(r.stats().notes.size(), 1u) << what;
+    EXPECT_NE(r.stats().notes[0].find("1 of 2 samples lie outside the display ("), std::string::npos) << what << ": "
+                                                                                                       << r.stats().notes[0];
+  };
+  // The project's format: a direction 60° to the right (the view ends at 50°).
+  auto fovea = open_reader(write_text("f.csv", "t_ns,eye,dir_x,dir_y,dir_z,confidence,flags\n0,C,0,0,-1,1,1\n"
+                                               "1000000,C,0.866,0,-0.5,1,1\n"), o);
+  expect_note(*fovea, "fovea");
+  // Pupil Core: normalised x = 3 (far right of the world image).
+  auto pupil = open_reader(write_text("gaze_positions.csv", "gaze_timestamp,confidence,norm_pos_x,norm_pos_y\n"
+                                                            "1.0,0.9,0.5,0.5\n1.01,0.9,3.0,0.5\n"), o);
+  expect_note(*pupil, "pupil-core");
+  // Neon: 5000 px right of a 1600-px scene camera.
+  auto neon = open_reader(write_text("gaze.csv", "timestamp [ns],gaze x [px],gaze y [px],worn\n"
+                                                 "1000,800,600,1\n2000,5000,600,1\n"), o);
+  expect_note(*neon, "neon");
+  // Tobii G3: gaze2d x = 4.
+  auto g3 = open_reader(write_text("gazedata", R"({"type":"gaze","timestamp":1.0,"data":{"gaze2d":[0.5,0.5]}})" "\n"
+                                               R"({"type":"gaze","timestamp":1.01,"data":{"gaze2d":[4,0.5]}})" "\n"), o);
+  expect_note(*g3, "tobii-g3");
+  // Behind the viewer counts as outside too; in-view gaze gives no note.
+  auto behind = open_reader(write_text("b.csv", "t_ns,eye,dir_x,dir_y,dir_z,confidence,flags\n0,C,0,0,-1,1,1\n"
+                                                "1000000,C,0,0,1,1,1\n"), o);
+  expect_note(*behind, "behind");
+  auto inside = open_reader(write_text("i.csv", "t_ns,eye,dir_x,dir_y,dir_z,confidence,flags\n0,C,0,0,-1,1,1\n"
+                                                "1000000,C,0.5,0,-1,1,1\n"), o);
+  read_all(*inside);
+  EXPECT_TRUE(inside->stats().notes.empty());
+}
+
+namespace {
+std::string shipped_capture() {
+  std::ifstream in(fovea::devices::test::source_dir() + "/data/gaze/hid-ms.hidcap");
+  std::stringstream ss;
+  ss << in.rdbuf();
+  return ss.str();
+}
+}  // namespace
+
+// HID captures, plain or gzip, are detected by their first line wherever a recording is
+// opened (a plain file name, replay:, `fovea render`); they are read like every reader
+// (truncated gzip noted) and the format list of a failed detection names them.
+TEST(HidCaptureReplay, DetectedPlainAndGzipAndTruncationIsNoted) {
+  const std::string text = shipped_capture();
+  ASSERT_FALSE(text.empty());
+  const std::string plain = write_text("c.hidcap", text), gz = write_gz("c.hidcap.gz", text);
+  EXPECT_EQ(detect_format(plain), Format::HidCapture);
+  EXPECT_EQ(detect_format(gz), Format::HidCapture);
+  auto r = open_reader(gz, SourceOptions{});
+  const auto all = read_all(*r);
+  EXPECT_GT(all.size(), 100u);
+  EXPECT_FALSE(r->reports_blinks());
+  auto src = open_gaze_source(plain, SourceOptions{});
+  EXPECT_TRUE(src->sample_at(100'000'000).tracked());
+  Recording rec = open_recording("hid-capture:" + gz + "?speed=2", SourceOptions{});
+  EXPECT_EQ(rec.reader->format(), Format::HidCapture);
+
+  std::string longer;
+  const std::string head = text.substr(0, text.find("\ninput ") + 1), body = text.substr(head.size());
+  longer = head;
+  for (int i = 0; i < 40; ++i) longer += body;  // repeated reports: later ones drop as out of order
+  const std::string cut = write_gz("cut.hidcap.gz", longer);
+  std::filesystem::resize_file(cut, std::filesystem::file_size(cut) * 2 / 3);
+  auto t = open_reader(cut, SourceOptions{});
+  read_all(*t);
+  bool noted = false;
+  for (const auto& n : t->stats().notes) noted = noted || n.find("truncated") != std::string::npos;
+  EXPECT_TRUE(noted);
+
+  try {
+    (void)detect_format(write_text("x.txt", "hello\n"));
+    ADD_FAILURE() << "detected";
+  } catch (const fovea::core::InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("hid-capture"), std::string::npos) << e.what();
+  }
+}
+
+// The page carries no blink usage: captures infer blinks from 80–500 ms untracked runs, as
+// every format without blink marks does (docs/gaze.md). A capture of synthetic gaze with
+// blinks through the emulated device finds them.
+TEST(HidCaptureReplay, BlinksAreInferredFromUntrackedRuns) {
+  const std::string cap = scratch_dir() + "/blinks.hidcap";
+  {
+    SourceOptions o;
+    o.raw_capture = cap;
+    auto s = open_sample_stream("hid-emulated:ms?seed=3&rate=120&seconds=20&task=search", o);
+    GazeSample g;
+    auto* hs = dynamic_cast<hid::HidGazeStream*>(s.get());
+    ASSERT_NE(hs, nullptr);
+    for (int waits = 0; waits < 30'000 && !hs->finished();)  // at most 30 s
+      if (!s->next(g)) {
+        std::this_thread::sleep_for(std::chrono::milliseconds(1));
+        ++waits;
+      }
+    hs->stop();
+  }
+  Recording rec = open_recording(cap, SourceOptions{});
+  ASSERT_FALSE(rec.reader->reports_blinks());
+  SummaryParams sp;
+  sp.infer_blinks = !rec.reader->reports_blinks();
+  const GazeSummary sum = summarize(*rec.stream, sp);
+  EXPECT_GT(sum.samples, 2000u);
+  EXPECT_GE(sum.blinks, 1u);
+}
+
+// docs/gaze.md lists speed= and loop= as replay keys: every entry point takes and checks them.
+TEST(ReplayKeys, SpeedAndLoopAreTakenEverywhereAndChecked) {
+  const std::string f = write_text("k.csv", "t_ns,eye,dir_x,dir_y,dir_z,confidence,flags\n0,C,0,0,-1,1,1\n"
+                                            "1000000,C,0,0,-1,1,1\n");
+  EXPECT_NO_THROW((void)open_recording(f + "?speed=2&loop=1", SourceOptions{}));
+  EXPECT_NO_THROW((void)open_sample_stream("replay:" + f + "?speed=0.5", SourceOptions{}));
+  EXPECT_NO_THROW((void)recording_notes(f + "?speed=2", SourceOptions{}));
+  EXPECT_THROW((void)open_recording(f + "?speed=0", SourceOptions{}), fovea::core::InputError);
+  EXPECT_THROW((void)open_recording(f + "?loop=2", SourceOptions{}), fovea::core::InputError);
+}

@@ -100,9 +100,12 @@ class HidGazeStream final : public SampleStream {
   std::thread thread_;
 };
 
-// hid-capture:FILE — replays a capture through the same codec and mapper. Timeline: device
-// time from the first sample; host_time_ns: the captured receive time.
-class HidCaptureStream final : public SampleStream {
+// hid-capture:FILE, or a capture file detected as such (plain or gzip) — replays a capture
+// through the same codec and mapper, as a reader like the other recorded formats: the same
+// notes (truncated gzip, gaze off the screen) and, the page having no blink usage, blinks
+// inferred from untracked runs. Timeline: device time from the first sample; host_time_ns:
+// the captured receive time.
+class HidCaptureStream final : public GazeReader {
  public:
   HidCaptureStream(const std::string& path, const SourceOptions& opt);
   ~HidCaptureStream() override;
@@ -110,19 +113,23 @@ class HidCaptureStream final : public SampleStream {
   bool rewindable() const override { return true; }
   void rewind() override;
   std::string describe() const override { return "hid-capture:" + path_; }
-  const ReadStats& stats() const { return stats_; }
+  const ReadStats& stats() const override { return stats_; }
+  Format format() const override { return Format::HidCapture; }
+  bool reports_blinks() const override { return false; }
+  std::string metadata_json() const override { return "{}"; }
+  core::TimeNs time_origin_ns() const override { return first_; }
   const EyeTrackerCodec& codec() const { return *codec_; }
   const DeviceConfig& config() const { return mapper_->config(); }
 
  private:
-  struct Lines;
+  struct Lines;  // the line reader and the readers' shared notes policy (src/read_notes.hpp)
   std::string path_;
   SourceOptions opt_;
   std::unique_ptr<Lines> lines_;
   std::unique_ptr<EyeTrackerCodec> codec_;
   std::unique_ptr<GazeMapper> mapper_;
   ReadStats stats_;
-  bool have_first_ = false;
+  bool have_first_ = false, ended_ = false;
   core::TimeNs first_ = 0;
   std::vector<std::uint8_t> buf_;
 };

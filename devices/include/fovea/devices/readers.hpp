@@ -14,10 +14,13 @@
 
 namespace fovea::devices {
 
-enum class Format { Fovea, PupilCore, Neon, TobiiG3, EyelinkAsc };
-const char* format_name(Format f);           // "fovea", "pupil-core", "neon", "tobii-g3", "eyelink-asc"
+// HidCapture: a raw HID capture (docs/hid.md), replayed through the device's decoder.
+enum class Format { Fovea, PupilCore, Neon, TobiiG3, EyelinkAsc, HidCapture };
+const char* format_name(Format f);  // "fovea", "pupil-core", "neon", "tobii-g3", "eyelink-asc", "hid-capture"
 Format parse_format(std::string_view name);  // throws core::InputError
-Format detect_format(const std::string& path);  // from the first bytes; throws core::InputError
+// From the first bytes (decompressed if gzip); throws core::InputError listing the formats.
+// The one detection every entry point uses (open_reader, hence replays, `fovea render`, `gaze`).
+Format detect_format(const std::string& path);
 // The clock a format's own time stamps count on (kept as device_time_ns), for sidecars.
 const char* device_clock_name(Format f);
 
