@@ -203,18 +203,24 @@ FrameTimes FramePipeline::render(const std::array<core::Pose, 2>& eye_pose, cons
     if (m.settings.blur) m.resolve->record_blur(cmd, m.settings);
     m.timer.stage(cmd, "blur");
     t.resolve.cpu_ms = lap_ms(r0);
+    if (m.temporal) {
+      m.resolve->record_temporal(cmd, m.temporal_frames > 0);
+      m.timer.stage(cmd, "temporal");
+    }
     recording_ms = core::ns_to_ms(r0 - start);
   }, &t.wait_cpu_ms);
   t.submit_cpu_ms = std::max(0.0, lap_ms(t0) - recording_ms - t.wait_cpu_ms);
   for (auto& e : m.eyes) e->mapping->advance(e->pose);
   m.parity = p;
   ++m.frames_done;
+  if (m.temporal) m.temporal_pairs += m.temporal_frames++ > 0;
   t.reconstruct.cpu_ms += lap_ms(t0);
 
   if (const auto stages = m.timer.read()) {
     for (const gpu::StageTime& s : *stages) {
       const double ms = double(s.duration_ns()) * 1e-6;
-      if (s.name == "grid") t.grid.gpu_ms += ms;
+      if (s.name == "temporal") t.temporal_gpu_ms = ms;
+      else if (s.name == "grid") t.grid.gpu_ms += ms;
       else if (s.name == "trace") t.trace.gpu_ms += ms;
       else if (s.name == "resolve" || s.name == "grid_blur" || s.name == "mip" || s.name == "resample" || s.name == "blur")
         t.resolve.gpu_ms += ms;
@@ -226,6 +232,16 @@ FrameTimes FramePipeline::render(const std::array<core::Pose, 2>& eye_pose, cons
     }
   }
   return t;
+}
+
+void FramePipeline::enable_temporal_error() { impl_->temporal = true; }
+
+double FramePipeline::temporal_error(core::Eye e) const {
+  const Impl& m = *impl_;
+  const int i = m.index(e, "temporal_error");
+  if (m.temporal_pairs == 0) return 0;
+  const core::View& v = m.eyes[std::size_t(i)]->base_view;
+  return m.resolve->temporal_abs_luma_sum(i) / (double(v.width()) * v.height() * m.temporal_pairs);
 }
 
 core::Image FramePipeline::image(core::Eye e) const {

@@ -39,6 +39,8 @@ struct FramePipeline::Impl {
   gpu::GpuTimer timer;
   std::uint32_t frames_done = 0;  // frames since the last reset
   int parity = 0;                 // history buffers written by the last frame
+  bool temporal = false;          // the temporal error is measured on the device
+  std::uint32_t temporal_frames = 0, temporal_pairs = 0;  // frames measured, consecutive pairs summed
   std::optional<renderer::TraceOrder> forced_order;  // testing::set_trace_order
 
   Impl(gpu::Context& c, const renderer::GpuScene& scene, const renderer::PathConfig& p,

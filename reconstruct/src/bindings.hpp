@@ -147,6 +147,14 @@ struct BlurBindings {
   }
 };
 
+struct TemporalBindings {
+  FOVEA_BINDING_COUNT(RECON_TEMPORAL_COUNT)
+  Buf screen, prev, sums;
+  Slots slots() const {
+    return {{{RECON_TEMPORAL_SCREEN, screen}, {RECON_TEMPORAL_PREV, prev}, {RECON_TEMPORAL_SUMS, sums}}};
+  }
+};
+
 #undef FOVEA_BINDING_COUNT
 
 // One pointer field per binding: a field added or dropped without the constant breaks here.
@@ -158,5 +166,6 @@ static_assert(sizeof(TaaBindings) == TaaBindings::kCount * sizeof(Buf));
 static_assert(sizeof(MipBindings) == MipBindings::kCount * sizeof(Buf));
 static_assert(sizeof(ResolveBindings) == ResolveBindings::kCount * sizeof(Buf));
 static_assert(sizeof(BlurBindings) == BlurBindings::kCount * sizeof(Buf));
+static_assert(sizeof(TemporalBindings) == TemporalBindings::kCount * sizeof(Buf));
 
 }  // namespace fovea::reconstruct

@@ -87,6 +87,10 @@ MipReach mip_reach(const shaders::ReconGrid& m, const gpu::Buffer& tables, std::
   }
   return reach;
 }
+// recon_temporal.comp's invocations (runs of kReconTemporalRun pixels per row), one running sum each.
+std::uint32_t temporal_runs(std::uint32_t width, std::uint32_t height) {
+  return (width + shaders::kReconTemporalRun - 1) / shaders::kReconTemporalRun * height;
+}
 }  // namespace
 
 Resolve::Resolve(gpu::Context& ctx, std::span<const EyeGrid> eyes, const Accumulation& acc)
@@ -94,6 +98,7 @@ Resolve::Resolve(gpu::Context& ctx, std::span<const EyeGrid> eyes, const Accumul
       resolve_(kernel<ResolveBindings, shaders::ReconResolvePush>(ctx, "recon_resolve.comp.spv")),
       blur_(kernel<BlurBindings, shaders::ReconBlurPush>(ctx, "recon_blur.comp.spv")),
       grid_blur_(kernel<BlurBindings, shaders::ReconGridBlurPush>(ctx, "recon_grid_blur.comp.spv")),
+      temporal_(kernel<TemporalBindings, shaders::ReconTemporalPush>(ctx, "recon_temporal.comp.spv")),
       eyes_(eyes.size()) {
   for (std::size_t i = 0; i < eyes.size(); ++i) {
     const EyeGrid& g = eyes[i];
@@ -126,6 +131,10 @@ Resolve::Resolve(gpu::Context& ctx, std::span<const EyeGrid> eyes, const Accumul
     for (int p = 0; p < 2; ++p)
       e.resolve_set[p] = make_set(ctx, resolve_, ResolveBindings{g.maps, g.tables, &e.mips, &e.offsets, &e.screen_a,
                                                                  &acc.position(int(i), p), &e.depth, g.luts});
+    e.prev_luma = storage(ctx, VkDeviceSize(pixels) * 4, "recon.temporal_prev_luma");
+    e.temporal_sums = storage(ctx, VkDeviceSize(temporal_runs(g.width, g.height)) * 4, "recon.temporal_sums");
+    e.temporal_sums.upload(std::vector<float>(temporal_runs(g.width, g.height), 0.0f));
+    e.temporal_set = make_set(ctx, temporal_, TemporalBindings{&e.screen_a, &e.prev_luma, &e.temporal_sums});
     e.blur_h = make_set(ctx, blur_, BlurBindings{g.maps, g.tables, &e.screen_a, &e.screen_b});
     e.blur_v = make_set(ctx, blur_, BlurBindings{g.maps, g.tables, &e.screen_b, &e.screen_a});
     if (g.polar) {  // grid-space blur: level 0 -> grid_tmp (across columns) -> level 0 (along φ)
@@ -218,6 +227,19 @@ void Resolve::record_blur(VkCommandBuffer cmd, const ReconSettings& s) const {
     }
     gpu::compute_to_compute(cmd);
   }
+}
+
+void Resolve::record_temporal(VkCommandBuffer cmd, bool accumulate) const {
+  for (const Eye& e : eyes_)
+    temporal_.run(cmd, {&e.temporal_set}, shaders::ReconTemporalPush{e.width, e.height, accumulate ? 1u : 0u, 0},
+                  temporal_runs(e.width, e.height));
+  gpu::compute_to_compute(cmd);
+}
+
+double Resolve::temporal_abs_luma_sum(int eye) const {
+  double sum = 0;
+  for (float s : eyes_.at(std::size_t(eye)).temporal_sums.download<float>()) sum += s;
+  return sum;
 }
 
 void Resolve::fill(VkCommandBuffer cmd, std::uint32_t word) const {

@@ -56,3 +56,38 @@ TEST_F(GpuTest, AccumulationKeepsAStaticSceneStableWhileTheGazeSweeps) {
   EXPECT_GT(count / double(n), 0.9 * frames);
   EXPECT_LT(te_with, 0.65 * te_without);  // measured 0.54: EMA noise floor plus resampling of the moving grid
 }
+
+// The temporal error measured on the device (FramePipeline::enable_temporal_error, what
+// `fovea render` reports without reading frames back) is core::temporal_error of the images
+// it displayed, averaged over consecutive pairs, for both eyes; reset() does not restart it.
+TEST_F(GpuTest, DeviceTemporalErrorIsTheHostOneOfTheDisplayedImages) {
+  const renderer::Scene scene = renderer::load_scene("cornell");
+  renderer::GpuScene gs(ctx(), scene);
+  // 70 pixels: rows end inside a 64-pixel run of recon_temporal.comp.
+  const core::DisplayPreset display = fovea::test::display_of_size(70, 48);
+  pipeline::FramePipeline p(ctx(), gs, core::stereo_views(display), {}, {});
+  p.enable_temporal_error();
+  const auto poses = core::eye_poses(scene.camera, display.ipd_m);
+  std::array<core::Image, 2> prev;
+  std::array<double, 2> host{0, 0};
+  const int frames = 5;
+  for (int f = 0; f < frames; ++f) {
+    const double a = (-10.0 + 5.0 * f) * M_PI / 180;
+    const glm::dvec3 g(std::sin(a), 0, -std::cos(a));
+    if (f == 3) p.reset();
+    p.render(poses, {g, g}, std::uint32_t(f));
+    for (int e = 0; e < 2; ++e) {
+      const core::Image img = p.image(core::Eye(e));
+      if (f > 0) host[e] += core::temporal_error(prev[e], img);
+      prev[e] = img;
+    }
+    if (f == 0) {
+      EXPECT_EQ(p.temporal_error(core::Eye::Left), 0.0);
+    }
+  }
+  for (int e = 0; e < 2; ++e) {
+    const double expected = host[e] / (frames - 1);
+    EXPECT_GT(expected, 0.0);
+    EXPECT_NEAR(p.temporal_error(core::Eye(e)), expected, 1e-5 * expected) << "eye " << e;
+  }
+}

@@ -43,8 +43,13 @@ TEST(RenderCli, ReportFramesAndExrOnTheTinyDisplay) {
   // The Vulkan device and driver the timings come from.
   EXPECT_FALSE(j["device"]["name"].get<std::string>().empty());
   EXPECT_FALSE(j["device"]["driver"].get<std::string>().empty());
-  for (const char* k : {"gaze", "grid", "trace", "reconstruct", "resolve", "submit", "wait", "readback", "total"})
+  for (const char* k : {"gaze", "grid", "trace", "reconstruct", "resolve", "submit", "wait", "total"})
     EXPECT_GE(j["cpu_ms"].value(k, -1.0), 0.0) << "cpu_ms." << k;
+  // Output apart from the frame: every frame is written (--png-every 1), so each is read back.
+  EXPECT_FALSE(j["cpu_ms"].contains("readback"));
+  EXPECT_EQ(j["output"]["frames_read_back"], 3);
+  EXPECT_EQ(j["output"]["host_bytes_read_back"].get<std::int64_t>(), 3 * 2 * 64 * 72 * 16);
+  EXPECT_GT(j["output"]["write_cpu_ms"].get<double>(), 0.0);
   EXPECT_GT(j["cpu_ms"]["total"].get<double>(), 0.0);
   // The tiny preset's lens hides the view's corners: those cells are not traced.
   for (const char* eye : {"left", "right"}) EXPECT_GT(j["samples_hidden"][eye].get<double>(), 0) << eye;
@@ -101,6 +106,36 @@ TEST(RenderCli, BadInputExitsWithTwo) {
   EXPECT_EQ(r.status, 2) << r.err;
   EXPECT_NE(r.err.find("FOVEA_VK_DRIVER"), std::string::npos) << r.err;
   std::filesystem::remove_all(dir);
+}
+
+}  // namespace
+
+namespace {
+
+// Frames neither written nor in the flicker window (the last 8) stay on the device: the
+// temporal error is measured there.
+TEST(RenderCli, FramesNotWrittenAreNotReadBack) {
+  namespace fs = std::filesystem;
+  const std::string dir = fovea::test::temp_dir("render-resident");
+  const auto r = run_fovea("render --display tiny --scene cornell --frames 12 --png-every 0 --quiet --out " + dir);
+  ASSERT_EQ(r.status, 0) << r.err;
+  std::ifstream in(dir + "/report.json");
+  const auto j = fovea::core::parse_json(in);
+  EXPECT_EQ(j["output"]["frames_read_back"], 8);
+  EXPECT_EQ(j["output"]["host_bytes_read_back"].get<std::int64_t>(), 8 * 2 * 64 * 72 * 16);
+  EXPECT_DOUBLE_EQ(j["output"]["host_bytes_per_frame"].get<double>(), 8.0 * 2 * 64 * 72 * 16 / 12);
+  for (const char* eye : {"left", "right"}) EXPECT_GT(j["summary"][eye]["temporal_error"].get<double>(), 0.0) << eye;
+  // Only the last frame is written; the frame records carry the output times of the frames
+  // that had output.
+  EXPECT_TRUE(fs::exists(dir + "/frame_0011_sbs.png"));
+  EXPECT_FALSE(fs::exists(dir + "/frame_0000_sbs.png"));
+  std::ifstream times(dir + "/frame_times.jsonl");
+  std::string line;
+  int with_readback = 0;
+  while (std::getline(times, line))
+    with_readback += fovea::core::parse_json(line)["cpu_ms"].contains("output_readback");
+  EXPECT_EQ(with_readback, 8);
+  fs::remove_all(dir);
 }
 
 }  // namespace

@@ -56,8 +56,12 @@ the peripheral blur. Writes to --out:
   report.json   {"frames", "samples_traced_per_eye", "samples_hidden": {"left", "right"},
                  "device": {name, driver}, "trace": "rayquery" or "compute",
                  "gpu_ms": {grid, trace, reconstruct, resolve, total, bmfr_fit, mip, resample, blur},
-                 "cpu_ms": {gaze, grid, trace, reconstruct, resolve, submit, wait, readback,
-                 total} (medians per frame; submit: vkQueueSubmit, wait: the fence),
+                 "cpu_ms": {gaze, grid, trace, reconstruct, resolve, submit, wait, total}
+                 (medians per frame; submit: vkQueueSubmit, wait: the fence; total: the
+                 frame alone, without output),
+                 "output": {frames_read_back, host_bytes_read_back, host_bytes_per_frame,
+                 readback_cpu_ms, write_cpu_ms}: images are read back only for the frames
+                 written (--png-every) and the flicker window (the last 8),
                  "metrics": {tone mapper, exposure, ppd, reference},
                  "summary": {"left": {...}, "right": {...}}}
 Cells that the preset's lens hides (its hidden area, seen from the view) are neither traced
@@ -383,8 +387,13 @@ int run(std::vector<std::string> argv) {
   const bool marker = !args.has("no-marker");
   // Per-frame times, milliseconds: GPU and CPU per stage (medians reported).
   std::map<std::string, std::vector<double>> gpu_ms, cpu_ms;
-  std::array<core::Image, 2> previous, last;
-  std::array<double, 2> te_sum{0, 0};
+  // Output work, apart from the frame: reading images back (only those written or in the
+  // flicker window) and encoding and writing them.
+  std::vector<double> readback_ms, write_ms, temporal_gpu_ms;
+  std::int64_t host_bytes = 0;
+  std::array<core::Image, 2> last;
+  // The temporal error is measured on the device: no frame is read back for it.
+  pipeline.enable_temporal_error();
   // The trailing frames whose gaze equals the last one's: with the head and scene still,
   // every change between them is an artefact (flicker).
   std::array<std::deque<core::Image>, 2> still;
@@ -417,26 +426,35 @@ int run(std::vector<std::string> argv) {
     gpu_ms["blur"].push_back(t.blur_gpu_ms);
     cpu_ms["submit"].push_back(t.submit_cpu_ms);
     cpu_ms["wait"].push_back(t.wait_cpu_ms);
-    t0 = core::now_ns();
-    for (int e = 0; e < 2; ++e) last[e] = pipeline.image(core::Eye(e));
-    cpu_ms["readback"].push_back(core::ns_to_ms(core::now_ns() - t0));
-    cpu_ms["total"].push_back(cpu_ms["gaze"].back() + t.cpu_ms() + cpu_ms["readback"].back());
+    // The frame's CPU time: the gaze read and the pipeline's recording, submit and wait.
+    cpu_ms["total"].push_back(cpu_ms["gaze"].back() + t.cpu_ms());
+    temporal_gpu_ms.push_back(t.temporal_gpu_ms);
+    const bool write = png_every > 0 ? f % png_every == 0 || f == frames - 1 : f == frames - 1;
+    // Flicker is measured over the trailing still frames, at most kFlickerFrames of them.
+    const bool flicker_window = f >= frames - long(kFlickerFrames);
     const auto& dist = pipeline.distribution(core::Eye::Left);
     FrameRecord rec{f, t_ns, g, {t.gaze[0].used, t.gaze[1].used}, poses, dist.columns(), dist.rows(), {}, {}, gaze_source.live()};
     for (const auto& [name, v] : gpu_ms) rec.gpu_ms.emplace_back(name, v.back());
     for (const auto& [name, v] : cpu_ms) rec.cpu_ms.emplace_back(name, v.back());
-    frame_log.add(rec);
-    std::array<core::Image, 2> ldr;
-    for (int e = 0; e < 2; ++e) {
-      if (f > 0) te_sum[e] += core::temporal_error(previous[e], last[e]);
-      previous[e] = last[e];
-      if (still[e].empty() || gaze[e] != still_gaze[e]) still[e].clear();
-      still_gaze[e] = gaze[e];
-      still[e].push_back(last[e]);
-      if (still[e].size() > kFlickerFrames) still[e].pop_front();
+    if (write || flicker_window) {
+      t0 = core::now_ns();
+      for (int e = 0; e < 2; ++e) {
+        last[e] = pipeline.image(core::Eye(e));
+        host_bytes += std::int64_t(last[e].pixels.size() * sizeof(last[e].pixels[0]));
+      }
+      readback_ms.push_back(core::ns_to_ms(core::now_ns() - t0));
+      rec.cpu_ms.emplace_back("output_readback", readback_ms.back());
     }
-    const bool write = png_every > 0 ? f % png_every == 0 || f == frames - 1 : f == frames - 1;
+    std::array<core::Image, 2> ldr;
+    if (flicker_window)
+      for (int e = 0; e < 2; ++e) {
+        if (still[e].empty() || gaze[e] != still_gaze[e]) still[e].clear();
+        still_gaze[e] = gaze[e];
+        still[e].push_back(last[e]);
+        if (still[e].size() > kFlickerFrames) still[e].pop_front();
+      }
     if (write) {
+      t0 = core::now_ns();
       char name[64];
       for (int e = 0; e < 2; ++e) {
         ldr[e] = renderer::tone_map(last[e]);
@@ -448,7 +466,10 @@ int run(std::vector<std::string> argv) {
       }
       std::snprintf(name, sizeof(name), "frame_%04ld_sbs.png", f);
       core::write_png((out_dir / name).string(), side_by_side(ldr[0], ldr[1]));
+      write_ms.push_back(core::ns_to_ms(core::now_ns() - t0));
+      rec.cpu_ms.emplace_back("output_write", write_ms.back());
     }
+    frame_log.add(rec);
     if (bar)
       progress(int(f + 1), int(frames),
                std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count());
@@ -489,6 +510,16 @@ int run(std::vector<std::string> argv) {
                  {"cull_hidden_area", cull}};
   for (const auto& [name, v] : gpu_ms) j["gpu_ms"][name] = median(v);
   for (const auto& [name, v] : cpu_ms) j["cpu_ms"][name] = median(v);
+  // Output apart from the frame: the host bytes read back (0 for a frame neither written nor
+  // in the flicker window) and the CPU time of reading and of encoding + writing PNGs.
+  const auto median_or_null = [](const std::vector<double>& v) { return v.empty() ? nlohmann::json() : nlohmann::json(median(v)); };
+  j["output"] = {{"frames_read_back", readback_ms.size()},
+                 {"host_bytes_read_back", host_bytes},
+                 {"host_bytes_per_frame", double(host_bytes) / double(frames)},
+                 {"readback_cpu_ms", median_or_null(readback_ms)},
+                 {"write_cpu_ms", median_or_null(write_ms)},
+                 {"temporal_error_gpu_ms", median(temporal_gpu_ms)},
+                 {"note", "medians over the frames that did each; the frame's own times are gpu_ms and cpu_ms"}};
   // Which Vulkan driver produced the timings (lavapipe 22.3 and 25 differ ~2x).
   j["device"] = {{"name", ctx.info().name}, {"driver", ctx.info().driver}};
   j["trace"] = renderer::tracing_name(gpu_scene.tracing());
@@ -520,7 +551,7 @@ int run(std::vector<std::string> argv) {
     const std::vector<float> ecc = core::eccentricity_map(v, g);
     nlohmann::json s;
     s["gaze"] = {g.x, g.y, g.z};  // view space, as the grid used it
-    s["temporal_error"] = frames > 1 ? te_sum[e] / double(frames - 1) : 0.0;
+    s["temporal_error"] = pipeline.temporal_error(eye);
     if (still[e].size() >= 2) {
       add_flicker(s, still[e], ecc);
     } else {

@@ -37,6 +37,7 @@ struct FrameTimes {
   double mip_gpu_ms = 0, resample_gpu_ms = 0, blur_gpu_ms = 0;  // parts of resolve: its three kernels
   double submit_cpu_ms = 0;    // ending the command buffer and vkQueueSubmit (recording is in the stages)
   double wait_cpu_ms = 0;      // the fence wait until the GPU finished (on a CPU device: its work)
+  double temporal_gpu_ms = 0;  // the temporal error's kernel (a measurement, not part of the frame's stages)
   // What each eye's grid did with the gaze it was given (left, right): the direction it used
   // (clamped into the view, or the last valid gaze / view centre for an unusable one).
   std::array<core::GazeStatus, 2> gaze{};
@@ -72,6 +73,12 @@ class FramePipeline {
                     std::uint32_t frame);
   // Forget the history (the next frame starts fresh).
   void reset();
+  // Measure the temporal error of the displayed images on the device from the next frame on
+  // (shaders/recon_temporal.comp), so that nothing is read back for it; reset() keeps it.
+  void enable_temporal_error();
+  // core::temporal_error averaged over the consecutive frame pairs since it was enabled (0
+  // before the second frame).
+  double temporal_error(core::Eye e) const;
 
   core::Image image(core::Eye e) const;  // the displayed image of the last frame
   // The last frame's display-space linear depth, row-major like image(): per pixel the

@@ -144,6 +144,12 @@ class Resolve {
   // grid_coords: each pixel's grid coordinate (u, t, LOD, 0) instead of its colour (tests).
   void record_resample(VkCommandBuffer cmd, int parity, bool grid_coords = false) const;
   void record_blur(VkCommandBuffer cmd, const ReconSettings& settings) const;
+  // The temporal error of the screen images on the device (shaders/recon_temporal.comp):
+  // keeps each eye's luminance for the next call and, with `accumulate` (a previous image
+  // exists), adds |Y - Y_previous| to running sums that temporal_abs_luma_sum() reads.
+  void record_temporal(VkCommandBuffer cmd, bool accumulate) const;
+  // Σ over pixels and accumulated frames of |Y - Y_previous| (a small download).
+  double temporal_abs_luma_sum(int eye) const;
   void fill(VkCommandBuffer cmd, std::uint32_t word) const;
 
   gpu::Buffer& level0(int eye) { return eyes_[eye].mips; }  // for a given grid image
@@ -158,11 +164,11 @@ class Resolve {
     double max_pixels_per_deg = 0;
     const gpu::Buffer *maps = nullptr, *tables = nullptr;  // host-visible (GridMapping)
     std::vector<std::uint32_t> level_rows, level_offset;
-    gpu::Buffer mips, offsets, screen_a, screen_b, depth, grid_tmp;
-    gpu::DescriptorSet mip_set, resolve_set[2], blur_h, blur_v, grid_blur_rho, grid_blur_phi;
+    gpu::Buffer mips, offsets, screen_a, screen_b, depth, grid_tmp, prev_luma, temporal_sums;
+    gpu::DescriptorSet mip_set, resolve_set[2], blur_h, blur_v, grid_blur_rho, grid_blur_phi, temporal_set;
   };
   std::uint32_t max_levels() const;
-  gpu::ComputePipeline mip_, resolve_, blur_, grid_blur_;
+  gpu::ComputePipeline mip_, resolve_, blur_, grid_blur_, temporal_;
   std::vector<Eye> eyes_;
 };
 

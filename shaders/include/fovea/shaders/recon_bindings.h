@@ -105,4 +105,10 @@
 #define RECON_BLUR_DST 3
 #define RECON_BLUR_COUNT 4
 
+// recon_temporal.comp (the temporal error of the display image, on the device)
+#define RECON_TEMPORAL_SCREEN 0
+#define RECON_TEMPORAL_PREV 1
+#define RECON_TEMPORAL_SUMS 2
+#define RECON_TEMPORAL_COUNT 3
+
 #endif

@@ -96,6 +96,14 @@ struct ReconBlurPush {
   float sigma_fovea_deg, min_sigma_px, max_sigma_px, cos_skip;  // σ(e) = σ_fovea / m(e) degrees; cos e > cos_skip: σ < min
 };
 
+// Temporal error of the display image (recon_temporal.comp): per run of kReconTemporalRun
+// pixels of a row the running sum over frames of |Y_t - Y_(t-1)|; accumulate = 0 on the
+// first frame (no previous image).
+FOVEA_CONST FOVEA_UINT kReconTemporalRun = 64u;
+struct ReconTemporalPush {
+  FOVEA_UINT width, height, accumulate, pad0;
+};
+
 // Grid-space peripheral blur of an angular polar grid (recon_grid_blur.comp): one pass over
 // columns [first_column, columns) of the current mapping, across columns (along ρ) or, with
 // phi_pass, along the rows of each column; σ in cells from the acuity model and the cells'
@@ -114,6 +122,7 @@ static_assert(sizeof(ReconPostPush) == 32);
 static_assert(sizeof(ReconMipPush) == 32);
 static_assert(sizeof(ReconResolvePush) == 32);
 static_assert(sizeof(ReconBlurPush) == 32);
+static_assert(sizeof(ReconTemporalPush) == 16);
 }  // namespace fovea::shaders
 #else
 bool rg_no_sample(float code) { return abs(code - kReconNoSample) < 0.5; }
