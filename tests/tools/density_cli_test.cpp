@@ -71,10 +71,14 @@ TEST(DensityCliOutput, WritesHeatMapAtomically) {
   int entries = 0;
   for ([[maybe_unused]] const auto& e : std::filesystem::directory_iterator(dir)) ++entries;
   EXPECT_EQ(entries, 1) << "no temporary files left behind";
-  // Unwritable destination: clear failure, no partial file.
-  const auto bad = run_fovea("density --display tiny --out " + dir + "/missing/heat.png");
-  EXPECT_NE(bad.status, 0);
-  EXPECT_FALSE(std::filesystem::exists(dir + "/missing"));
+  // Unwritable destination (a file where its directory should be): exit 2 naming it, no
+  // partial file. (A missing directory is created: HostileInputs.MissingOutputDirectoriesAreCreated.)
+  const auto bad = run_fovea("density --display tiny --out " + png + "/heat.png");
+  EXPECT_EQ(bad.status, 2) << bad.err;
+  EXPECT_NE(bad.err.find(png), std::string::npos) << bad.err;
+  entries = 0;
+  for ([[maybe_unused]] const auto& e : std::filesystem::directory_iterator(dir)) ++entries;
+  EXPECT_EQ(entries, 1) << "nothing written beside the heat map";
   std::filesystem::remove_all(dir);
 }
 

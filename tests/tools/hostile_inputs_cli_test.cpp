@@ -156,4 +156,29 @@ TEST(HostileInputs, AReferenceOfOneBatchHasNoErrorEstimate) {
   fs::remove_all(dir);
 }
 
+TEST(HostileInputs, BudgetRefusalsNameTheDisplayFile) {
+  const std::string dir = fovea::test::temp_dir("wide-display");
+  // The small preset widened to +-85 degrees: Visual-Polar cannot spend the default budget.
+  const std::string file = dir + "/wide.json";
+  std::ofstream(file) << R"({"name": "wide", "width": 320, "height": 360, "refresh_hz": 70, "ipd_m": 0.063,
+    "fov_deg": {"left": -85, "right": 85, "up": 53.28, "down": -53.28}})";
+  for (const std::string& cmd : {"render --frames 1 --quiet --out " + dir + "/r", std::string("density --json")}) {
+    const auto r = run_fovea(cmd + " --display " + file);
+    EXPECT_EQ(r.status, 2) << cmd << ": " << r.err;
+    EXPECT_NE(r.err.find("display " + file + ": budget: visual-polar reaches at most"), std::string::npos)
+        << cmd << ": " << r.err;
+  }
+  fs::remove_all(dir);
+}
+
+TEST(HostileInputs, GazeToolsOpenHidCapturesLikeEveryRecording) {
+  const char* source = std::getenv("FOVEA_SOURCE_DIR");
+  const std::string capture = std::string(source ? source : ".") + "/data/gaze/hid-ms.hidcap";
+  for (const std::string& uri : {capture, "hid-capture:" + capture + "?speed=2"}) {
+    const auto r = run_fovea("gaze info '" + uri + "'");
+    ASSERT_EQ(r.status, 0) << uri << ": " << r.err;
+    EXPECT_EQ(fovea::core::parse_json(r.out)["format"], "hid-capture") << uri;
+  }
+}
+
 }  // namespace hostile_inputs

@@ -103,6 +103,7 @@ int run(std::vector<std::string> argv) {
   p.cap = a.num("cap", p.cap);
   p.aniso = a.num("aniso", p.aniso);
   p.staircase = a.has("staircase");
+  p.display = preset.origin;
   const glm::dvec3 gaze = parse_gaze(a, view);
 
   auto dist = core::make_distribution(view, p);

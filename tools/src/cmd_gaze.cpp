@@ -76,36 +76,20 @@ struct Input {
 Input open_input(const std::string& arg, const dv::SourceOptions& opt) {
   Input in;
   in.options = opt;
-  std::string uri = arg;
-  if (uri.find(':') == std::string::npos) {
-    std::FILE* f = std::fopen(arg.c_str(), "rb");
-    char head[20] = {};
-    if (f) {
-      const std::size_t n = std::fread(head, 1, sizeof head - 1, f);
-      head[n] = 0;
-      std::fclose(f);
-    }
-    if (std::string(head).rfind("fovea-hid-capture", 0) == 0) uri = "hid-capture:" + arg;
-  }
-  if (uri.rfind("hid-capture:", 0) == 0) {
-    auto cap = std::make_unique<dv::hid::HidCaptureStream>(uri.substr(12), opt);
-    auto* raw = cap.get();
-    in.stats = [raw] { return &raw->stats(); };
-    in.format = "hid-capture";
-    in.stream = std::move(cap);
-    return in;
-  }
+  const std::string& uri = arg;
   if (uri.rfind("synthetic:", 0) == 0) {
     if (uri.find("seconds=") == std::string::npos) throw core::InputError(arg + ": give the synthetic gaze a length (seconds=S)");
     in.stream = dv::open_sample_stream(uri, opt);
     in.format = "synthetic";
     return in;
   }
+  // Every recording, raw HID captures included (detected by their first line, plain or gzip).
+  const bool capture = uri.rfind("hid-capture:", 0) == 0;
   const std::string file = uri.rfind("replay:", 0) == 0 ? uri.substr(7) : uri;
   const std::string path = file.substr(0, file.find('?'));
-  if (path.find(':') != std::string::npos && !std::filesystem::exists(path))
+  if (!capture && path.find(':') != std::string::npos && !std::filesystem::exists(path))
     throw core::InputError(arg + ": not a recording (live sources: use `fovea gaze record`)");
-  dv::Recording rec = dv::open_recording("replay:" + file, opt);
+  dv::Recording rec = dv::open_recording(capture ? uri : "replay:" + file, opt);
   auto* raw = rec.reader;
   in.stats = [raw] { return &raw->stats(); };
   in.reader = raw;

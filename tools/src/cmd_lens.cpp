@@ -98,8 +98,10 @@ struct SamplesHidden {
   std::int64_t count = 0;   // cells
 };
 
-SamplesHidden samples_hidden(const core::EyeOptics& optics) {
-  auto dist = core::make_distribution(optics.view(), core::DistributionParams{});
+SamplesHidden samples_hidden(const core::EyeOptics& optics, const std::string& display) {
+  core::DistributionParams params;
+  params.display = display;
+  auto dist = core::make_distribution(optics.view(), params);
   dist->set_frame({0, 0, -1});
   const core::ViewMask mask = optics.view_mask();
   dist->set_visibility([&mask](glm::dvec2 px) { return mask.visible_at(px); });
@@ -145,7 +147,7 @@ int run(std::vector<std::string> argv) {
     for (int y = 0; y < d.height; ++y)
       for (int x = 0; x < d.width; ++x) panel.at(x0 + x, y) = img.at(x, y);
     if (args.has("json")) {
-      const SamplesHidden saved = samples_hidden(optics);
+      const SamplesHidden saved = samples_hidden(optics, d.origin);
       eyes[core::eye_name(eye)] = {{"hidden_fraction", mask.hidden_fraction()},
                                    {"max_roundtrip_px", max_roundtrip_px(mask)},
                                    {"samples_saved_fraction", saved.fraction},

@@ -131,6 +131,7 @@ int run(std::vector<std::string> argv) {
   core::DistributionParams dp;
   dp.budget = args.num("budget", dp.budget);
   dp.jitter = core::parse_jitter(args.str("jitter", "on"));
+  dp.display = d.origin;
   dp.validate();
   const core::EyeOptics optics[2] = {core::EyeOptics(d, core::Eye::Left), core::EyeOptics(d, core::Eye::Right)};
 
