@@ -65,10 +65,10 @@ Buffer::Buffer(Context& ctx, const BufferDesc& desc) : ctx_(&ctx), size_(desc.si
   VkMemoryAllocateFlagsInfo flags{VK_STRUCTURE_TYPE_MEMORY_ALLOCATE_FLAGS_INFO};
   flags.flags = VK_MEMORY_ALLOCATE_DEVICE_ADDRESS_BIT;
   if ((ci.usage & VK_BUFFER_USAGE_SHADER_DEVICE_ADDRESS_BIT) != 0) ai.pNext = &flags;
+  charge_ = ctx.charge_memory(what, req.size, type);
   VkDeviceMemory memory = VK_NULL_HANDLE;
-  const VkDeviceSize heap = ctx.memory_type_heap_size(type);
-  check_fits(req.size > heap ? VK_ERROR_OUT_OF_DEVICE_MEMORY : vkAllocateMemory(dev, &ai, nullptr, &memory),
-             "vkAllocateMemory", what, req.size, heap);
+  check_fits(vkAllocateMemory(dev, &ai, nullptr, &memory), "vkAllocateMemory", what, req.size,
+             ctx.memory_type_heap_size(type));
   memory_ = {dev, memory};
   check(vkBindBufferMemory(dev, buffer, memory, 0), "vkBindBufferMemory");
   if (host) {
@@ -92,6 +92,7 @@ Buffer::Buffer(Buffer&& o) noexcept
     : ctx_(std::exchange(o.ctx_, nullptr)),
       size_(std::exchange(o.size_, 0)),
       mapped_(std::exchange(o.mapped_, nullptr)),
+      charge_(std::move(o.charge_)),
       memory_(std::move(o.memory_)),
       buffer_(std::move(o.buffer_)),
       view_(std::move(o.view_)) {}
@@ -101,6 +102,7 @@ Buffer& Buffer::operator=(Buffer&& o) noexcept {
     view_ = std::move(o.view_);      // the view goes before its buffer,
     buffer_ = std::move(o.buffer_);  // the buffer before the memory it is bound to
     memory_ = std::move(o.memory_);
+    charge_ = std::move(o.charge_);
     ctx_ = std::exchange(o.ctx_, nullptr);
     size_ = std::exchange(o.size_, 0);
     mapped_ = std::exchange(o.mapped_, nullptr);

@@ -1,8 +1,12 @@
 #include "fovea/gpu/context.hpp"
 
+#include <unistd.h>
+
+#include <algorithm>
 #include <cstdio>
 #include <cstdlib>
 #include <cstring>
+#include <fstream>
 
 #include "fovea/core/clock.hpp"
 #include "fovea/core/error.hpp"
@@ -10,7 +14,17 @@
 #include "fovea/gpu/error.hpp"
 
 namespace fovea::gpu {
+
 namespace {
+// MemAvailable of /proc/meminfo (bytes), else the free physical pages; 0 when unknown.
+std::uint64_t host_memory_available() {
+  std::ifstream in("/proc/meminfo");
+  unsigned long long kib = 0;
+  for (std::string line; std::getline(in, line);)
+    if (std::sscanf(line.c_str(), "MemAvailable: %llu kB", &kib) == 1) return std::uint64_t(kib) * 1024;
+  const long pages = ::sysconf(_SC_AVPHYS_PAGES), page = ::sysconf(_SC_PAGESIZE);
+  return pages > 0 && page > 0 ? std::uint64_t(pages) * std::uint64_t(page) : 0;
+}
 
 constexpr const char* kValidationLayer = "VK_LAYER_KHRONOS_validation";
 
@@ -213,6 +227,7 @@ void Context::create_device(bool ray_query) {
   vkGetPhysicalDeviceProperties2(physical_device_, &props);
   limits_ = props.properties.limits;
   vkGetPhysicalDeviceMemoryProperties(physical_device_, &memory_);
+  if (props.properties.deviceType == VK_PHYSICAL_DEVICE_TYPE_CPU) host_available_ = host_memory_available();
   info_.name = props.properties.deviceName;
   info_.driver = std::string(p12.driverName) + " " + p12.driverInfo;
   info_.type = props.properties.deviceType;
@@ -364,6 +379,30 @@ std::uint32_t Context::memory_type(std::uint32_t type_bits, VkMemoryPropertyFlag
 
 VkDeviceSize Context::memory_type_heap_size(std::uint32_t index) const {
   return memory_.memoryHeaps[memory_.memoryTypes[index].heapIndex].size;
+}
+
+VkDeviceSize Context::memory_limit(std::uint32_t memory_type) const {
+  const VkDeviceSize heap = memory_type_heap_size(memory_type);
+  return host_available_ > 0 ? std::min<VkDeviceSize>(heap, host_available_ / 4 * 3) : heap;
+}
+
+VkDeviceSize Context::memory_in_use(std::uint32_t memory_type) const {
+  return heap_in_use_[memory_.memoryTypes[memory_type].heapIndex].load();
+}
+
+MemoryCharge Context::charge_memory(const std::string& what, VkDeviceSize bytes, std::uint32_t memory_type) {
+  std::atomic<std::uint64_t>& account = heap_in_use_[memory_.memoryTypes[memory_type].heapIndex];
+  const std::uint64_t before = account.fetch_add(bytes);
+  const VkDeviceSize limit = memory_limit(memory_type);
+  if (before + bytes > limit) {
+    account.fetch_sub(bytes);
+    const auto mib = [](std::uint64_t b) { return std::to_string((b + (1u << 20) - 1) >> 20) + " MiB"; };
+    throw core::InputError(what + ": " + mib(bytes) + " more device memory, with " + mib(before) +
+                           " already held, is more than this device can give (" + mib(limit) +
+                           (host_available_ > 0 ? ": 3/4 of the host memory available to this CPU device" : ": its heap") +
+                           "); a smaller display raster, budget or scene fits");
+  }
+  return MemoryCharge(&account, bytes);
 }
 
 VkMemoryPropertyFlags Context::memory_type_flags(std::uint32_t index) const {

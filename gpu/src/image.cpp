@@ -83,10 +83,10 @@ Image2D::Image2D(Context& ctx, const ImageDesc& desc)
   VkMemoryAllocateInfo ai{VK_STRUCTURE_TYPE_MEMORY_ALLOCATE_INFO};
   ai.allocationSize = req.size;
   ai.memoryTypeIndex = ctx.memory_type(req.memoryTypeBits, 0, VK_MEMORY_PROPERTY_DEVICE_LOCAL_BIT);
+  charge_ = ctx.charge_memory(what, req.size, ai.memoryTypeIndex);
   VkDeviceMemory memory = VK_NULL_HANDLE;
-  const VkDeviceSize heap = ctx.memory_type_heap_size(ai.memoryTypeIndex);
-  check_fits(req.size > heap ? VK_ERROR_OUT_OF_DEVICE_MEMORY : vkAllocateMemory(dev, &ai, nullptr, &memory),
-             "vkAllocateMemory", what, req.size, heap);
+  check_fits(vkAllocateMemory(dev, &ai, nullptr, &memory), "vkAllocateMemory", what, req.size,
+             ctx.memory_type_heap_size(ai.memoryTypeIndex));
   memory_ = {dev, memory};
   check(vkBindImageMemory(dev, image, memory, 0), "vkBindImageMemory");
 

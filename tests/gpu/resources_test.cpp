@@ -167,3 +167,33 @@ TEST(AllocationLimits, OutOfMemoryAndOversizedRequestsAreInputErrorsStatingTheLi
   EXPECT_THROW(gpu::check_fits(VK_ERROR_DEVICE_LOST, "vkAllocateMemory", "b", mib, 2 * mib), gpu::VulkanError);
   EXPECT_NO_THROW(gpu::check_fits(VK_SUCCESS, "vkAllocateMemory", "b", mib, mib));
 }
+
+// Buffers charge their memory to the context while they live; a request past the limit the
+// device can give (on a CPU device: 3/4 of the host memory available) is refused before
+// anything is allocated, naming the sizes.
+TEST_F(Buffers, DeviceMemoryIsChargedAndTheLimitRefusedBeforeAllocating) {
+  gpu::Buffer probe(ctx(), {.size = 16, .name = "probe"});
+  VkMemoryRequirements req;
+  vkGetBufferMemoryRequirements(ctx().device(), probe.handle(), &req);
+  const std::uint32_t type = ctx().memory_type(req.memoryTypeBits, 0, VK_MEMORY_PROPERTY_DEVICE_LOCAL_BIT);
+  const VkDeviceSize before = ctx().memory_in_use(type);
+  {
+    gpu::Buffer big(ctx(), {.size = 1u << 20, .name = "big"});
+    EXPECT_GE(ctx().memory_in_use(type), before + (1u << 20));
+    gpu::Buffer moved = std::move(big);  // the charge moves with it, once
+    EXPECT_GE(ctx().memory_in_use(type), before + (1u << 20));
+    EXPECT_LT(ctx().memory_in_use(type), before + (2u << 20));
+  }
+  EXPECT_EQ(ctx().memory_in_use(type), before);
+  const VkDeviceSize limit = ctx().memory_limit(type);
+  EXPECT_LE(limit, ctx().memory_type_heap_size(type));
+  try {
+    [[maybe_unused]] gpu::MemoryCharge c = ctx().charge_memory("gpu::Buffer 'huge'", limit, type);
+    ADD_FAILURE() << "a charge past the limit passed";
+  } catch (const fovea::core::InputError& e) {
+    const std::string what = e.what();
+    EXPECT_NE(what.find("gpu::Buffer 'huge'"), std::string::npos) << what;
+    EXPECT_NE(what.find("more than this device can give"), std::string::npos) << what;
+  }
+  EXPECT_EQ(ctx().memory_in_use(type), before);
+}

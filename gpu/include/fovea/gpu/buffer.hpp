@@ -12,6 +12,7 @@
 #include <vector>
 
 #include "fovea/gpu/handle.hpp"
+#include "fovea/gpu/memory_charge.hpp"
 
 namespace fovea::gpu {
 
@@ -99,6 +100,7 @@ class Buffer {
   Context* ctx_ = nullptr;
   VkDeviceSize size_ = 0;
   std::byte* mapped_ = nullptr;
+  MemoryCharge charge_;                                 // returned after the memory is freed
   DeviceHandle<VkDeviceMemory, vkFreeMemory> memory_;  // declared first: destroyed after the buffer
   DeviceHandle<VkBuffer, vkDestroyBuffer> buffer_;
   DeviceHandle<VkBufferView, vkDestroyBufferView> view_;  // declared last: destroyed before the buffer

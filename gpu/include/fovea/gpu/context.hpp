@@ -10,6 +10,7 @@
 //
 // A Context is neither copyable nor movable: resources keep a pointer to it and must
 // be destroyed before it. It is meant to be used from one thread at a time.
+#include <array>
 #include <atomic>
 #include <cstdint>
 #include <functional>
@@ -21,6 +22,8 @@
 #include <vector>
 
 #include <vulkan/vulkan_core.h>
+
+#include "fovea/gpu/memory_charge.hpp"
 
 namespace fovea::gpu {
 
@@ -122,6 +125,16 @@ class Context {
   VkMemoryPropertyFlags memory_type_flags(std::uint32_t index) const;
   // Size of the heap that memory type `index` allocates from, bytes.
   VkDeviceSize memory_type_heap_size(std::uint32_t index) const;
+  // The most device memory this context's buffers and images may hold in that heap: the
+  // heap's size, and on a CPU device (whose device memory is the process's) at most 3/4 of
+  // the host memory available when the context was created, so that an input too large for
+  // the machine is refused before the system runs out (a render at 8192x8192 per eye on a
+  // 24 GB machine was killed by the kernel's out-of-memory killer instead).
+  VkDeviceSize memory_limit(std::uint32_t memory_type) const;
+  // Charges `bytes` of memory type `memory_type` for `what` before it is allocated; throws
+  // core::InputError naming what, the sizes and the limit when it would pass memory_limit.
+  MemoryCharge charge_memory(const std::string& what, VkDeviceSize bytes, std::uint32_t memory_type);
+  VkDeviceSize memory_in_use(std::uint32_t memory_type) const;
 
   // Names an object for validation messages (no-op without VK_EXT_debug_utils).
   void set_name(VkObjectType type, std::uint64_t handle, const std::string& name) const;
@@ -145,6 +158,8 @@ class Context {
   DeviceInfo info_;
   VkPhysicalDeviceLimits limits_{};
   VkPhysicalDeviceMemoryProperties memory_{};
+  std::array<std::atomic<std::uint64_t>, VK_MAX_MEMORY_HEAPS> heap_in_use_{};
+  std::uint64_t host_available_ = 0;  // bytes available to the process at creation (CPU devices)
   EnabledFeatures features_;
   PFN_vkSetDebugUtilsObjectNameEXT set_object_name_ = nullptr;
 };

@@ -11,6 +11,7 @@
 #include <vector>
 
 #include "fovea/gpu/handle.hpp"
+#include "fovea/gpu/memory_charge.hpp"
 
 namespace fovea::gpu {
 
@@ -65,6 +66,7 @@ class Image2D {
   Context* ctx_ = nullptr;
   std::uint32_t width_ = 0, height_ = 0;
   VkFormat format_ = VK_FORMAT_UNDEFINED;
+  MemoryCharge charge_;                                 // returned after the memory is freed
   DeviceHandle<VkDeviceMemory, vkFreeMemory> memory_;  // declared first: destroyed last
   DeviceHandle<VkImage, vkDestroyImage> image_;
   DeviceHandle<VkImageView, vkDestroyImageView> view_;
