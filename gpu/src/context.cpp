@@ -97,20 +97,85 @@ Context::Context(const ContextOptions& options) {
   }
 }
 
+std::vector<std::string> missing_for_pipeline(const GivenDevice& g) {
+  std::vector<std::string> missing;
+  const auto version = [](std::uint32_t v) {
+    return std::to_string(VK_API_VERSION_MAJOR(v)) + "." + std::to_string(VK_API_VERSION_MINOR(v));
+  };
+  if (g.instance == VK_NULL_HANDLE || g.physical_device == VK_NULL_HANDLE || g.device == VK_NULL_HANDLE) {
+    missing.push_back("an instance, a physical device and a device (a handle is null)");
+    return missing;
+  }
+  if (g.instance_api_version < VK_API_VERSION_1_2)
+    missing.push_back("Vulkan 1.2 on the instance (it was created for " + version(g.instance_api_version) + ")");
+  VkPhysicalDeviceProperties p;
+  vkGetPhysicalDeviceProperties(g.physical_device, &p);
+  if (p.apiVersion < VK_API_VERSION_1_2)
+    missing.push_back(std::string("Vulkan 1.2 on the device (") + p.deviceName + " offers " + version(p.apiVersion) + ")");
+  std::uint32_t nq = 0;
+  vkGetPhysicalDeviceQueueFamilyProperties(g.physical_device, &nq, nullptr);
+  std::vector<VkQueueFamilyProperties> families(nq);
+  vkGetPhysicalDeviceQueueFamilyProperties(g.physical_device, &nq, families.data());
+  if (g.queue_family >= nq)
+    missing.push_back("queue family " + std::to_string(g.queue_family) + " (the device has " + std::to_string(nq) + ")");
+  else if ((families[g.queue_family].queueFlags & VK_QUEUE_COMPUTE_BIT) == 0)
+    missing.push_back("compute on queue family " + std::to_string(g.queue_family));
+  else if (g.queue_index >= families[g.queue_family].queueCount)
+    missing.push_back("queue " + std::to_string(g.queue_index) + " of family " + std::to_string(g.queue_family) +
+                      " (it has " + std::to_string(families[g.queue_family].queueCount) + ")");
+  if (g.ray_query_features)
+    for (const char* e : {VK_KHR_ACCELERATION_STRUCTURE_EXTENSION_NAME, VK_KHR_RAY_QUERY_EXTENSION_NAME,
+                          VK_KHR_DEFERRED_HOST_OPERATIONS_EXTENSION_NAME})
+      if (std::find(g.device_extensions.begin(), g.device_extensions.end(), e) == g.device_extensions.end())
+        missing.push_back(std::string("ray queries: ") + e + " enabled on the device");
+  return missing;
+}
+
+Context::Context(const GivenDevice& given) : owns_device_(false) {
+  const std::vector<std::string> missing = missing_for_pipeline(given);
+  if (!missing.empty()) {
+    std::string m = "the given Vulkan device cannot run the pipeline; it lacks:";
+    for (const std::string& s : missing) m += "\n  " + s;
+    throw core::InputError(m);
+  }
+  instance_ = given.instance;
+  physical_device_ = given.physical_device;
+  device_ = given.device;
+  queue_family_ = given.queue_family;
+  describe_device();
+  vkGetDeviceQueue(device_, queue_family_, given.queue_index, &queue_);
+  if (given.ray_query_features) {
+    VkPhysicalDeviceAccelerationStructurePropertiesKHR as_props{
+        VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_ACCELERATION_STRUCTURE_PROPERTIES_KHR};
+    VkPhysicalDeviceProperties2 p2{VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_PROPERTIES_2, &as_props};
+    vkGetPhysicalDeviceProperties2(physical_device_, &p2);
+    features_.ray_query = true;
+    features_.as_scratch_alignment = as_props.minAccelerationStructureScratchOffsetAlignment;
+  }
+  try {
+    create_command_pool();
+  } catch (...) {
+    release();
+    throw;
+  }
+}
+
 Context::~Context() { release(); }
 
 void Context::release() {
   if (device_ != VK_NULL_HANDLE) {
-    vkDeviceWaitIdle(device_);
+    // A given device is its owner's: only what this context made on it goes.
+    if (owns_device_) vkDeviceWaitIdle(device_);
+    else if (queue_ != VK_NULL_HANDLE) vkQueueWaitIdle(queue_);
     if (command_pool_ != VK_NULL_HANDLE) vkDestroyCommandPool(device_, command_pool_, nullptr);
-    vkDestroyDevice(device_, nullptr);
+    if (owns_device_) vkDestroyDevice(device_, nullptr);
   }
   if (messenger_ != VK_NULL_HANDLE) {
     auto destroy = reinterpret_cast<PFN_vkDestroyDebugUtilsMessengerEXT>(
         vkGetInstanceProcAddr(instance_, "vkDestroyDebugUtilsMessengerEXT"));
     destroy(instance_, messenger_, nullptr);
   }
-  if (instance_ != VK_NULL_HANDLE) vkDestroyInstance(instance_, nullptr);
+  if (instance_ != VK_NULL_HANDLE && owns_device_) vkDestroyInstance(instance_, nullptr);
   command_pool_ = VK_NULL_HANDLE;
   device_ = VK_NULL_HANDLE;
   messenger_ = VK_NULL_HANDLE;
@@ -207,20 +272,11 @@ void Context::pick_device(const std::string& override) {
   physical_device_ = devices[choose_device(candidates, override)];
 }
 
-void Context::create_device(bool ray_query) {
-  // Queue: the first compute family that has timestamps, else the first compute family.
+void Context::describe_device() {
   std::uint32_t nq = 0;
   vkGetPhysicalDeviceQueueFamilyProperties(physical_device_, &nq, nullptr);
   std::vector<VkQueueFamilyProperties> families(nq);
   vkGetPhysicalDeviceQueueFamilyProperties(physical_device_, &nq, families.data());
-  std::optional<std::uint32_t> chosen;
-  for (std::uint32_t i = 0; i < nq; ++i) {
-    if ((families[i].queueFlags & VK_QUEUE_COMPUTE_BIT) == 0) continue;
-    if (!chosen || (families[*chosen].timestampValidBits == 0 && families[i].timestampValidBits > 0)) chosen = i;
-  }
-  queue_family_ = *chosen;  // choose_device guaranteed a compute family
-
-  // Properties.
   VkPhysicalDeviceVulkan12Properties p12{VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_VULKAN_1_2_PROPERTIES};
   VkPhysicalDeviceVulkan11Properties p11{VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_VULKAN_1_1_PROPERTIES, &p12};
   VkPhysicalDeviceProperties2 props{VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_PROPERTIES_2, &p11};
@@ -240,6 +296,28 @@ void Context::create_device(bool ray_query) {
   // timestampComputeAndGraphics == false means only some queues support timestamps: trust the family.
   info_.timestamp_valid_bits = families[queue_family_].timestampValidBits;
   info_.timestamp_period_ns = limits_.timestampPeriod;
+}
+
+void Context::create_command_pool() {
+  VkCommandPoolCreateInfo pci{VK_STRUCTURE_TYPE_COMMAND_POOL_CREATE_INFO};
+  pci.flags = VK_COMMAND_POOL_CREATE_TRANSIENT_BIT;
+  pci.queueFamilyIndex = queue_family_;
+  check(vkCreateCommandPool(device_, &pci, nullptr, &command_pool_), "vkCreateCommandPool");
+}
+
+void Context::create_device(bool ray_query) {
+  // Queue: the first compute family that has timestamps, else the first compute family.
+  std::uint32_t nq = 0;
+  vkGetPhysicalDeviceQueueFamilyProperties(physical_device_, &nq, nullptr);
+  std::vector<VkQueueFamilyProperties> families(nq);
+  vkGetPhysicalDeviceQueueFamilyProperties(physical_device_, &nq, families.data());
+  std::optional<std::uint32_t> chosen;
+  for (std::uint32_t i = 0; i < nq; ++i) {
+    if ((families[i].queueFlags & VK_QUEUE_COMPUTE_BIT) == 0) continue;
+    if (!chosen || (families[*chosen].timestampValidBits == 0 && families[i].timestampValidBits > 0)) chosen = i;
+  }
+  queue_family_ = *chosen;  // choose_device guaranteed a compute family
+  describe_device();
 
   // Features: enable only what is supported and useful to compute shaders.
   VkPhysicalDeviceVulkan12Features s12{VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_VULKAN_1_2_FEATURES};
@@ -313,11 +391,7 @@ void Context::create_device(bool ray_query) {
   dci.ppEnabledExtensionNames = device_exts.data();
   check(vkCreateDevice(physical_device_, &dci, nullptr, &device_), "vkCreateDevice");
   vkGetDeviceQueue(device_, queue_family_, 0, &queue_);
-
-  VkCommandPoolCreateInfo pci{VK_STRUCTURE_TYPE_COMMAND_POOL_CREATE_INFO};
-  pci.flags = VK_COMMAND_POOL_CREATE_TRANSIENT_BIT;
-  pci.queueFamilyIndex = queue_family_;
-  check(vkCreateCommandPool(device_, &pci, nullptr, &command_pool_), "vkCreateCommandPool");
+  create_command_pool();
 }
 
 void Context::submit_and_wait(const std::function<void(VkCommandBuffer)>& record, double* wait_ms) {

@@ -37,6 +37,27 @@ struct ContextOptions {
   bool ray_query = true;
 };
 
+// A Vulkan device made elsewhere in the process (an OpenXR application's, or another
+// Context's) for a Context to run on without owning it (as Monado's vk_init_from_given):
+// the handles, the queue to submit to — which nobody else may use while the Context does —
+// and what was enabled on them, which Vulkan cannot be asked afterwards.
+struct GivenDevice {
+  VkInstance instance = VK_NULL_HANDLE;
+  VkPhysicalDevice physical_device = VK_NULL_HANDLE;
+  VkDevice device = VK_NULL_HANDLE;
+  std::uint32_t queue_family = 0;
+  std::uint32_t queue_index = 0;
+  std::uint32_t instance_api_version = VK_API_VERSION_1_0;  // VkApplicationInfo::apiVersion of the instance
+  std::vector<std::string> device_extensions;                // enabled on `device`
+  // accelerationStructure, rayQuery and bufferDeviceAddress were enabled (with the three
+  // extensions): the path tracer may use ray queries.
+  bool ray_query_features = false;
+};
+
+// What the pipeline needs that `given` lacks, one line each (empty: it can run there):
+// Vulkan 1.2 on the instance and the device, a queue of a compute-capable family.
+std::vector<std::string> missing_for_pipeline(const GivenDevice& given);
+
 // Counters of validation messages, shared so they can be read after the context
 // (and its device) is gone: errors at vkDestroyDevice are counted too.
 struct ValidationCounters {
@@ -94,7 +115,12 @@ struct EnabledFeatures {
 class Context {
  public:
   explicit Context(const ContextOptions& options = {});
+  // Runs on a device made elsewhere, which the Context neither owns nor destroys (it makes
+  // and destroys its own command pool only). Throws core::InputError listing everything
+  // missing_for_pipeline() finds. Validation messages are the instance owner's to count.
+  explicit Context(const GivenDevice& given);
   ~Context();
+  bool owns_device() const { return owns_device_; }
   Context(const Context&) = delete;
   Context& operator=(const Context&) = delete;
 
@@ -143,11 +169,15 @@ class Context {
   void create_instance(bool validation);
   void pick_device(const std::string& override);
   void create_device(bool ray_query);
+  // Properties, limits, memory and queue of physical_device_ for queue_family_.
+  void describe_device();
+  void create_command_pool();
   void release();
 
   std::shared_ptr<ValidationCounters> counters_ = std::make_shared<ValidationCounters>();
   bool validation_ = false;
   bool debug_utils_ = false;
+  bool owns_device_ = true;  // false: a GivenDevice's instance and device
   VkInstance instance_ = VK_NULL_HANDLE;
   VkDebugUtilsMessengerEXT messenger_ = VK_NULL_HANDLE;
   VkPhysicalDevice physical_device_ = VK_NULL_HANDLE;
