@@ -302,18 +302,9 @@ XrResult api::xrAttachSessionActionSets(XrSession session, const XrSessionAction
       }
     }
     s->actions_attached = true;
-    if (gaze && s->instance->has(XR_EXT_EYE_GAZE_INTERACTION_EXTENSION_NAME)) {
-      s->gaze_profile_active = true;
-      QueuedEvent e;
-      auto* ev = reinterpret_cast<XrEventDataInteractionProfileChanged*>(&e.data);
-      ev->type = XR_TYPE_EVENT_DATA_INTERACTION_PROFILE_CHANGED;
-      ev->next = nullptr;
-      ev->session = session;
-      e.session = s->id;
-      s->instance->events.push_back(e);
-    }
+    s->gaze_profile_bound = gaze && s->instance->has(XR_EXT_EYE_GAZE_INTERACTION_EXTENSION_NAME);
     FOVEA_LOG_INFO("action sets attached: %u, eye gaze %s", info->countActionSets,
-                   s->gaze_profile_active ? "bound" : "not bound");
+                   s->gaze_profile_bound ? "bound" : "not bound");
     return XR_SUCCESS;
   });
 }
@@ -417,6 +408,16 @@ XrResult api::xrSyncActions(XrSession session, const XrActionsSyncInfo* info) {
         if (!is_top_level_user_path(*p, s->instance->has(XR_EXT_EYE_GAZE_INTERACTION_EXTENSION_NAME)))
           return XR_ERROR_PATH_UNSUPPORTED;
       }
+    }
+    if (s->running && s->gaze_profile_bound && !s->gaze_profile_active) {
+      s->gaze_profile_active = true;
+      QueuedEvent e;
+      auto* ev = reinterpret_cast<XrEventDataInteractionProfileChanged*>(&e.data);
+      ev->type = XR_TYPE_EVENT_DATA_INTERACTION_PROFILE_CHANGED;
+      ev->next = nullptr;
+      ev->session = session;
+      e.session = s->id;
+      s->instance->events.push_back(e);
     }
     return s->state == XR_SESSION_STATE_FOCUSED ? XR_SUCCESS : XR_SESSION_NOT_FOCUSED;
   });

@@ -109,6 +109,10 @@ struct Session final : Object {
   // Actions.
   bool actions_attached = false;
   std::vector<std::uint64_t> attached_sets;
+  // The eye-gaze profile becomes current (and its change event is queued) at the first
+  // xrSyncActions of a running session after an attach with an eye-gaze binding: the core
+  // specification allows interaction-profile changes only during xrSyncActions.
+  bool gaze_profile_bound = false;
   bool gaze_profile_active = false;
   std::unique_ptr<OneShotQueue> gpu;  // created at xrCreateSession
   std::unique_ptr<Compositor> compositor;

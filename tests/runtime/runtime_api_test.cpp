@@ -587,6 +587,11 @@ XrAction attach_gaze_action(XrInstance instance, XrSession session, XrActionSet*
 XrSpace make_gaze_space(XrInstance instance, XrSession session) {
   XrActionSet set = XR_NULL_HANDLE;
   const XrAction gaze = attach_gaze_action(instance, session, &set);
+  XrActiveActionSet active{set, XR_NULL_PATH};
+  XrActionsSyncInfo sync{XR_TYPE_ACTIONS_SYNC_INFO};
+  sync.countActiveActionSets = 1;
+  sync.activeActionSets = &active;
+  EXPECT_EQ(xrSyncActions(session, &sync), XR_SUCCESS);
   XrEventDataBuffer ev{XR_TYPE_EVENT_DATA_BUFFER};
   EXPECT_EQ(xrPollEvent(instance, &ev), XR_SUCCESS);
   EXPECT_EQ(ev.type, XR_TYPE_EVENT_DATA_INTERACTION_PROFILE_CHANGED);
@@ -597,11 +602,6 @@ XrSpace make_gaze_space(XrInstance instance, XrSession session) {
   XrPath profile = XR_NULL_PATH;
   EXPECT_EQ(xrStringToPath(instance, "/interaction_profiles/ext/eye_gaze_interaction", &profile), XR_SUCCESS);
   EXPECT_EQ(ips.interactionProfile, profile);
-  XrActiveActionSet active{set, XR_NULL_PATH};
-  XrActionsSyncInfo sync{XR_TYPE_ACTIONS_SYNC_INFO};
-  sync.countActiveActionSets = 1;
-  sync.activeActionSets = &active;
-  EXPECT_EQ(xrSyncActions(session, &sync), XR_SUCCESS);
   XrActionStateGetInfo gi{XR_TYPE_ACTION_STATE_GET_INFO};
   gi.action = gaze;
   XrActionStatePose st{XR_TYPE_ACTION_STATE_POSE};
@@ -1029,6 +1029,55 @@ TEST_F(XrTest, CtsUnsupportedEnums) {
 
 // Actions are inactive while the session is not focused: the eye gaze action reports
 // inactive and its space untracked before FOCUSED and again after focus is lost.
+// CTS 1.1.41 `multithreading`: "Event with type XR_TYPE_EVENT_DATA_INTERACTION_PROFILE_CHANGED
+// must only be queued during xrSyncActions". The runtime used to queue it inside
+// xrAttachSessionActionSets, session not even running. Now the eye-gaze profile becomes
+// current, and its event is queued, at the first xrSyncActions of a running session.
+TEST_F(XrTest, CtsInteractionProfileChangedOnlyDuringSyncActions) {
+  create_instance({XR_EXT_EYE_GAZE_INTERACTION_EXTENSION_NAME});
+  create_session();
+  XrActionSet set = XR_NULL_HANDLE;
+  attach_gaze_action(instance_, session_, &set);
+  const XrPath eyes = path("/user/eyes_ext"), profile = path("/interaction_profiles/ext/eye_gaze_interaction");
+  // The event types polled now, and the eye-gaze profile current now.
+  const auto events = [&] {
+    std::vector<XrStructureType> types;
+    for (XrEventDataBuffer ev{XR_TYPE_EVENT_DATA_BUFFER}; xrPollEvent(instance_, &ev) == XR_SUCCESS;
+         ev = {XR_TYPE_EVENT_DATA_BUFFER}) {
+      types.push_back(ev.type);
+      if (ev.type == XR_TYPE_EVENT_DATA_INTERACTION_PROFILE_CHANGED) {
+        EXPECT_EQ(reinterpret_cast<XrEventDataInteractionProfileChanged*>(&ev)->session, session_);
+      }
+    }
+    return std::count(types.begin(), types.end(), XR_TYPE_EVENT_DATA_INTERACTION_PROFILE_CHANGED);
+  };
+  const auto current = [&] {
+    XrInteractionProfileState ips{XR_TYPE_INTERACTION_PROFILE_STATE};
+    EXPECT_EQ(xrGetCurrentInteractionProfile(session_, eyes, &ips), XR_SUCCESS);
+    return ips.interactionProfile;
+  };
+  EXPECT_EQ(events(), 0) << "after the attach (IDLE, READY)";
+  EXPECT_EQ(current(), XrPath(XR_NULL_PATH));
+  XrActiveActionSet active{set, XR_NULL_PATH};
+  XrActionsSyncInfo sync{XR_TYPE_ACTIONS_SYNC_INFO};
+  sync.countActiveActionSets = 1;
+  sync.activeActionSets = &active;
+  EXPECT_EQ(xrSyncActions(session_, &sync), XR_SESSION_NOT_FOCUSED);
+  EXPECT_EQ(events(), 0) << "after a sync before xrBeginSession";
+  EXPECT_EQ(current(), XrPath(XR_NULL_PATH));
+  XrSessionBeginInfo bi{XR_TYPE_SESSION_BEGIN_INFO};
+  bi.primaryViewConfigurationType = XR_VIEW_CONFIGURATION_TYPE_PRIMARY_STEREO;
+  ASSERT_EQ(xrBeginSession(session_, &bi), XR_SUCCESS);
+  ASSERT_EQ(frame(), XR_SUCCESS);
+  EXPECT_EQ(events(), 0) << "running, before a sync (SYNCHRONIZED, VISIBLE, FOCUSED)";
+  EXPECT_EQ(current(), XrPath(XR_NULL_PATH));
+  EXPECT_EQ(xrSyncActions(session_, &sync), XR_SUCCESS);
+  EXPECT_EQ(events(), 1) << "after the first sync of the running session";
+  EXPECT_EQ(current(), profile);
+  EXPECT_EQ(xrSyncActions(session_, &sync), XR_SUCCESS);
+  EXPECT_EQ(events(), 0) << "the profile did not change again";
+}
+
 TEST_F(XrTest, CtsEyeGazeInactiveWhenNotFocused) {
   create_instance({XR_EXT_EYE_GAZE_INTERACTION_EXTENSION_NAME});
   create_session();
