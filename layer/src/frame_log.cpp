@@ -10,6 +10,7 @@
 #include <cmath>
 #include <cstring>
 
+#include "fovea/xrcommon/output_dir.hpp"
 #include "log.hpp"
 
 namespace fovea::layer {
@@ -36,10 +37,11 @@ FrameLog::~FrameLog() {
 void FrameLog::open(const std::string& dir) {
   if (dir.empty()) return;
   try {
+    xrcommon::create_output_dir(dir, "FOVEA_LAYER_OUT");  // as the runtime creates FOVEA_RUNTIME_OUT
     writer_.open(dir + "/layer_timing.jsonl");
   } catch (const std::exception& e) {
     // Reported, not fatal: the session works, its frames are just not logged.
-    FOVEA_LAYER_WARN("%s (FOVEA_LAYER_OUT); frames are not logged", e.what());
+    FOVEA_LAYER_WARN("%s; frames are not logged", e.what());
     return;
   }
   pending_.reserve(kBufferedRecords);

@@ -1,28 +1,17 @@
 // Instance lifetime, extensions, events, paths, string conversions and time conversion.
 #include <cstdio>
 #include <cstring>
-#include <filesystem>
 #include <string>
 
 #include <openxr/openxr_reflection.h>
 
 #include "api.hpp"
 #include "fovea/core/error.hpp"
+#include "fovea/xrcommon/output_dir.hpp"
 #include "state.hpp"
 
 namespace fovea::runtime {
 namespace {
-
-// FOVEA_RUNTIME_OUT is created with its parents, so a first frame never fails on a missing
-// directory; one that cannot be created is a configuration error naming the variable.
-void create_out_dir(const std::string& dir) {
-  if (dir.empty()) return;
-  std::error_code ec;
-  std::filesystem::create_directories(dir, ec);
-  if (ec || !std::filesystem::is_directory(dir))
-    throw core::InputError("FOVEA_RUNTIME_OUT=" + dir + ": cannot create the directory: " +
-                           (ec ? ec.message() : "a file of that name exists"));
-}
 
 const XrExtensionProperties kExtensions[] = {
     {XR_TYPE_EXTENSION_PROPERTIES, nullptr, XR_KHR_VULKAN_ENABLE_EXTENSION_NAME, XR_KHR_vulkan_enable_SPEC_VERSION},
@@ -113,7 +102,7 @@ XrResult api::xrCreateInstance(const XrInstanceCreateInfo* info, XrInstance* ins
     }
     try {
       inst->config = read_config();
-      create_out_dir(inst->config.out_dir);
+      xrcommon::create_output_dir(inst->config.out_dir, "FOVEA_RUNTIME_OUT");
       inst->display = core::load_display(inst->config.display);
       inst->head = HeadMotion::from_spec(inst->config.head);
       inst->gaze = std::make_unique<GazeTracker>(inst->config.gaze, inst->display);

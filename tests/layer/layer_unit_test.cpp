@@ -1,7 +1,11 @@
 // The layer's host-side parts without an OpenXR session: configuration, compositing, gaze.
+#include <unistd.h>
+
 #include <algorithm>
 #include <cmath>
 #include <cstdlib>
+#include <filesystem>
+#include <fstream>
 #include <limits>
 #include <thread>
 #include <vector>
@@ -13,6 +17,7 @@
 #include "fovea/core/error.hpp"
 #include "fovea/core/clock.hpp"
 #include "fovea/devices/hid_stream.hpp"
+#include "frame_log.hpp"
 #include "frame_queue.hpp"
 #include "gaze_input.hpp"
 #include "next_chain.hpp"
@@ -495,6 +500,27 @@ TEST(LayerNextChain, AnUnknownStructureBeforeTheDepthIsCounted) {
   ASSERT_NE(head, nullptr);
   EXPECT_EQ(head->type, XR_TYPE_COMPOSITION_LAYER_COLOR_SCALE_BIAS_KHR);
   EXPECT_EQ(head->next, nullptr);
+}
+
+// FOVEA_LAYER_OUT is created when missing, as the runtime creates FOVEA_RUNTIME_OUT (one
+// helper, xrcommon::create_output_dir): the frames are logged, not just warned about.
+TEST(LayerFrameLog, MissingOutputDirectoryIsCreated) {
+  namespace fs = std::filesystem;
+  const fs::path root = fs::temp_directory_path() / ("fovea_layer_out_" + std::to_string(::getpid()));
+  fs::remove_all(root);
+  const fs::path out = root / "not" / "yet";
+  {
+    FrameLog log;
+    log.open(out.string());
+    FrameTimes t;
+    t.frame = 3;
+    log.write(t);
+  }  // the destructor writes what is left
+  std::ifstream in(out / "layer_timing.jsonl");
+  std::string line;
+  ASSERT_TRUE(std::getline(in, line)) << "no record in " << out;
+  EXPECT_NE(line.find("\"frame\":3"), std::string::npos) << line;
+  fs::remove_all(root);
 }
 
 }  // namespace
