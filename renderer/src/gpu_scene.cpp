@@ -1,10 +1,10 @@
 #include "fovea/renderer/gpu_scene.hpp"
 
-#include <chrono>
 #include <cstring>
 
 #include <glm/geometric.hpp>
 
+#include "fovea/core/clock.hpp"
 #include "fovea/core/error.hpp"
 #include "fovea/gpu/accel.hpp"
 #include "ggx_albedo.hpp"
@@ -59,14 +59,14 @@ GpuScene::GpuScene(gpu::Context& ctx, const Scene& s, const BvhOptions& bvh_opti
     throw core::InputError("--trace rayquery: the Vulkan device '" + ctx.info().name + "' (" + ctx.info().driver +
                            ") does not offer ray queries (VK_KHR_acceleration_structure + VK_KHR_ray_query); "
                            "use --trace compute or auto");
-  const auto t0 = std::chrono::steady_clock::now();
+  const core::TimeNs t0 = core::now_ns();
   // The compute traversal gets the tree built for the rays from the scene camera; with ray
   // queries the nodes go unused (and the triangle order stays the SAH tree's).
   const bool ray_queries = tracing != Tracing::Compute && ctx.features().ray_query;
   BvhOptions options = bvh_options;
   if (!options.eye && !ray_queries) options.eye = glm::vec3(s.camera.position);
   const Bvh bvh = build_bvh(s.positions, options);
-  stats_.build_ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
+  stats_.build_ms = core::ns_to_ms(core::now_ns() - t0);
   const std::size_t n = bvh.order.size();
 
   // Lights: emissive triangles, chosen with probability proportional to their power.
@@ -154,9 +154,9 @@ GpuScene::GpuScene(gpu::Context& ctx, const Scene& s, const BvhOptions& bvh_opti
     vertices.reserve(9 * n);
     for (const PtTriangle& t : tris)
       vertices.insert(vertices.end(), {t.v0_x, t.v0_y, t.v0_z, t.v1_x, t.v1_y, t.v1_z, t.v2_x, t.v2_y, t.v2_z});
-    const auto t1 = std::chrono::steady_clock::now();
+    const core::TimeNs t1 = core::now_ns();
     accel_ = std::make_unique<gpu::TriangleAccel>(ctx, vertices);
-    stats_.accel_build_ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t1).count();
+    stats_.accel_build_ms = core::ns_to_ms(core::now_ns() - t1);
     stats_.accel_bytes = accel_->bytes();
     accel_layout_ = gpu::DescriptorSetLayout(ctx, {gpu::Binding::AccelerationStructure});
     accel_set_ = gpu::DescriptorSet(ctx, accel_layout_);

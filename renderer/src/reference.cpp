@@ -2,7 +2,6 @@
 
 #include <unistd.h>
 
-#include <chrono>
 #include <cstdio>
 #include <cstdlib>
 #include <cmath>
@@ -12,6 +11,7 @@
 
 #include <tinyexr.h>
 
+#include "fovea/core/clock.hpp"
 #include "fovea/core/error.hpp"
 #include "fovea/core/tonemap.hpp"
 
@@ -68,7 +68,7 @@ ReferenceResult render_reference(gpu::Context& ctx, const GpuScene& scene, const
   std::vector<std::size_t> inside;
   for (std::size_t i = 0; i < covered.size(); ++i)
     if (covered[i]) inside.push_back(i);
-  const auto t0 = std::chrono::steady_clock::now();
+  const core::TimeNs t0 = core::now_ns();
   auto grid = cartesian_grid(view);
   for (std::size_t i = 0; i < grid.size(); ++i)
     if (!covered[i]) grid[i].flags = shaders::kCellOffscreen;
@@ -137,7 +137,7 @@ ReferenceResult render_reference(gpu::Context& ctx, const GpuScene& scene, const
       }
       r.pixel_rel_error = std::sqrt(rel2 / double(std::max<std::size_t>(pix_sum.size(), 1)));
     }
-    r.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+    r.seconds = double(core::now_ns() - t0) * 1e-9;
     if (progress) progress({r.spp, r.rel_error, r.pixel_rel_error, r.seconds});
     if (B >= 4 && ((o.until_rel_error > 0 && r.rel_error <= o.until_rel_error) ||
                    (o.until_pixel_rel_error > 0 && r.pixel_rel_error <= o.until_pixel_rel_error)))

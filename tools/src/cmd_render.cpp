@@ -2,7 +2,6 @@
 // PNGs, an EXR of the last frame and report.json with timings and quality.
 #include <algorithm>
 #include <array>
-#include <chrono>
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
@@ -402,7 +401,7 @@ int run(std::vector<std::string> argv) {
   // Frames whose gaze the grid could not use as given (core::GazeStatus), per eye.
   std::array<long, 2> gaze_fallback_frames{0, 0}, gaze_clamped_frames{0, 0};
   FrameLog frame_log((out_dir / "frames.jsonl").string(), (out_dir / "frame_times.jsonl").string());
-  const auto start = std::chrono::steady_clock::now();
+  const core::TimeNs start = core::now_ns();
   for (long f = 0; f < frames; ++f) {
     core::TimeNs t0 = core::now_ns();
     const auto t_ns = core::TimeNs(std::llround(double(f) / display.refresh_hz * 1e9));
@@ -472,7 +471,7 @@ int run(std::vector<std::string> argv) {
     frame_log.add(rec);
     if (bar)
       progress(int(f + 1), int(frames),
-               std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count());
+               double(core::now_ns() - start) * 1e-9);
   }
   if (bar) std::fprintf(stderr, "\n");
   for (int e = 0; e < 2; ++e) {
