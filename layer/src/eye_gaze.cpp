@@ -1,6 +1,8 @@
 #include "eye_gaze.hpp"
 
+#include <cstdio>
 #include <cstring>
+#include <random>
 #include <stdexcept>
 #include <string>
 #include <vector>
@@ -20,9 +22,15 @@ void check(XrResult r, const char* what) {
 
 EyeGazeActions create_eye_gaze_actions(const Dispatch& next, XrInstance instance) {
   EyeGazeActions a;
+  // Action set names and localized names are unique per instance, so a fixed name could
+  // collide with the application's (XR_ERROR_NAME_DUPLICATED, or
+  // XR_ERROR_LOCALIZED_NAME_DUPLICATED for its localized name): both carry 64 random bits
+  // drawn per instance, which no application can guess.
+  std::random_device entropy;
+  const unsigned long long tag = (static_cast<unsigned long long>(entropy()) << 32) ^ entropy();
   XrActionSetCreateInfo si{XR_TYPE_ACTION_SET_CREATE_INFO};
-  std::strcpy(si.actionSetName, "xr_apilayer_fovea_gaze");
-  std::strcpy(si.localizedActionSetName, "Fovea layer eye gaze");
+  std::snprintf(si.actionSetName, sizeof si.actionSetName, "xr_apilayer_fovea_gaze_%016llx", tag);
+  std::snprintf(si.localizedActionSetName, sizeof si.localizedActionSetName, "Fovea layer eye gaze %016llx", tag);
   check(next.xrCreateActionSet(instance, &si, &a.set), "xrCreateActionSet");
   // A later step's failure must not leave the set (and its action) behind in the runtime.
   struct SetGuard {

@@ -5,6 +5,7 @@
 #include <fstream>
 #include <functional>
 #include <ostream>
+#include <set>
 
 #include <gtest/gtest.h>
 #include <nlohmann/json.hpp>
@@ -178,6 +179,70 @@ TEST_F(LayerApiTest, OwnExtensionIsStrippedBeforeTheRuntime) {
   ASSERT_EQ(frame(), XR_SUCCESS);
 }
 
+// What an application can observe of the layer's presence in the extension list: the
+// layer's own XR_FOVEA_path_tracing (its manifest's, answered by the loader) and nothing else;
+// the extensions the layer enables below itself are listed exactly when the runtime lists them.
+TEST_F(LayerApiTest, ExtensionListGainsOnlyTheLayersOwnExtension) {
+  setenv("FOVEA_LAYER_SCENE", "cornell", 1);
+  const auto names = [] {
+    uint32_t n = 0;
+    EXPECT_EQ(xrEnumerateInstanceExtensionProperties(nullptr, 0, &n, nullptr), XR_SUCCESS);
+    std::vector<XrExtensionProperties> props(n, {XR_TYPE_EXTENSION_PROPERTIES});
+    EXPECT_EQ(xrEnumerateInstanceExtensionProperties(nullptr, n, &n, props.data()), XR_SUCCESS);
+    std::set<std::string> v;
+    for (uint32_t i = 0; i < n; ++i) v.insert(props[i].extensionName);
+    return v;
+  };
+  const std::set<std::string> layered = names();
+  unsetenv("XR_ENABLE_API_LAYERS");
+  std::set<std::string> expected = names();
+  EXPECT_EQ(expected.count("XR_FOVEA_path_tracing"), 0u);
+  EXPECT_EQ(expected.count("XR_EXT_eye_gaze_interaction"), 1u);
+  expected.insert("XR_FOVEA_path_tracing");
+  EXPECT_EQ(layered, expected);
+}
+
+// The layer's eye-gaze action set has a name and a localized name with a random tag per
+// instance: an application's action sets named like the layer's former fixed name
+// (`xr_apilayer_fovea_gaze`) or with its former localized name ("Fovea layer eye gaze") are
+// created (they were XR_ERROR_NAME_DUPLICATED and XR_ERROR_LOCALIZED_NAME_DUPLICATED), with
+// and without the application enabling the extension.
+TEST_F(LayerApiTest, ApplicationActionSetNamesNeverCollideWithTheLayers) {
+  setenv("FOVEA_LAYER_SCENE", "cornell", 1);
+  setenv("FOVEA_RUNTIME_OUT", log_->path().c_str(), 1);
+  for (const bool enable : {false, true}) {
+    SCOPED_TRACE(enable ? "extension enabled" : "extension not enabled");
+    std::vector<const char*> ext;
+    if (enable) ext.push_back("XR_EXT_eye_gaze_interaction");
+    ASSERT_NO_FATAL_FAILURE(create_instance(ext));
+    XrActionSetCreateInfo named{XR_TYPE_ACTION_SET_CREATE_INFO};
+    std::strcpy(named.actionSetName, "xr_apilayer_fovea_gaze");
+    std::strcpy(named.localizedActionSetName, "App gaze");
+    XrActionSetCreateInfo localized{XR_TYPE_ACTION_SET_CREATE_INFO};
+    std::strcpy(localized.actionSetName, "app_gaze");
+    std::strcpy(localized.localizedActionSetName, "Fovea layer eye gaze");
+    XrActionSet sets[2] = {XR_NULL_HANDLE, XR_NULL_HANDLE};
+    EXPECT_EQ(xrCreateActionSet(instance_, &named, &sets[0]), XR_SUCCESS);
+    EXPECT_EQ(xrCreateActionSet(instance_, &localized, &sets[1]), XR_SUCCESS);
+    ASSERT_NO_FATAL_FAILURE(create_session());
+    XrSessionActionSetsAttachInfo attach{XR_TYPE_SESSION_ACTION_SETS_ATTACH_INFO};
+    attach.countActionSets = 2;
+    attach.actionSets = sets;
+    EXPECT_EQ(xrAttachSessionActionSets(session_, &attach), XR_SUCCESS);
+    // Not vacuous: the layer's own set with its eye-gaze binding rode along (the runtime's log).
+    const std::string log = read_text(log_->path() + "/runtime.log");
+    EXPECT_NE(log.find("action sets attached: 3, eye gaze bound"), std::string::npos) << log;
+    XrTest::TearDown();
+    instance_ = XR_NULL_HANDLE;
+    session_ = XR_NULL_HANDLE;
+    vk_instance_ = VK_NULL_HANDLE;
+    vk_physical_ = VK_NULL_HANDLE;
+    vk_device_ = VK_NULL_HANDLE;
+    messenger_ = VK_NULL_HANDLE;
+  }
+  unsetenv("FOVEA_RUNTIME_OUT");
+}
+
 // With a scene the layer enables XR_KHR_visibility_mask below itself for culling, unseen by
 // the application: the command stays unsupported unless the application enables the
 // extension itself, in which case it reaches the runtime and answers.
@@ -207,6 +272,7 @@ struct Observed {
   XrResult attach_none = XR_SUCCESS, profile_before = XR_SUCCESS, attach = XR_SUCCESS;
   XrResult eyes = XR_SUCCESS, hand = XR_SUCCESS;
   XrResult sync_eyes = XR_SUCCESS, sync_hand = XR_SUCCESS;  // xrSyncActions with that subaction path
+  XrResult begin = XR_SUCCESS, sync_running = XR_SUCCESS;   // then xrBeginSession and a sync of all
   std::vector<XrStructureType> events;
   std::string eyes_profile_name, hand_profile_name;  // paths differ between instances: compared as strings
 };
@@ -215,7 +281,7 @@ bool operator==(const Observed& a, const Observed& b) {
   return a.supports_eye_gaze == b.supports_eye_gaze && a.eyes_action == b.eyes_action && a.suggest_gaze == b.suggest_gaze &&
          a.suggest_hand == b.suggest_hand && a.attach_none == b.attach_none && a.profile_before == b.profile_before &&
          a.attach == b.attach && a.eyes == b.eyes && a.hand == b.hand && a.sync_eyes == b.sync_eyes &&
-         a.sync_hand == b.sync_hand && a.events == b.events &&
+         a.sync_hand == b.sync_hand && a.begin == b.begin && a.sync_running == b.sync_running && a.events == b.events &&
          a.eyes_profile_name == b.eyes_profile_name && a.hand_profile_name == b.hand_profile_name;
 }
 
@@ -223,14 +289,16 @@ std::ostream& operator<<(std::ostream& os, const Observed& o) {
   os << "{supports " << o.supports_eye_gaze << ", action on /user/eyes_ext " << o.eyes_action << ", suggest gaze " << o.suggest_gaze << " hand " << o.suggest_hand
      << ", attach none " << o.attach_none << ", profile before attach " << o.profile_before << ", attach " << o.attach
      << ", eyes " << o.eyes << " '" << o.eyes_profile_name << "', hand " << o.hand << " '" << o.hand_profile_name
-     << "', sync /user/eyes_ext " << o.sync_eyes << " /user/hand/left " << o.sync_hand << ", events";
+     << "', sync /user/eyes_ext " << o.sync_eyes << " /user/hand/left " << o.sync_hand << ", begin " << o.begin
+     << ", sync running " << o.sync_running << ", events";
   for (XrStructureType t : o.events) os << " " << int(t);
   return os << "}";
 }
 
 // The application's eye-gaze and action calls through whatever layers are enabled: a pose
 // action suggested for the eye-gaze profile (when `suggest_gaze`) and the simple controller,
-// attach with no set, then with its set, the profiles and the events that follow.
+// attach with no set, then with its set, syncs before the session runs and one after xrBeginSession,
+// the profiles and the events that follow.
 Observed observe(XrInstance instance, const XrSession& session, bool suggest_gaze,
                  const std::function<void()>& create_session, const std::function<XrPath(const char*)>& path) {
   Observed o;
@@ -283,6 +351,29 @@ Observed observe(XrInstance instance, const XrSession& session, bool suggest_gaz
   attach.countActionSets = 1;
   attach.actionSets = &set;
   o.attach = xrAttachSessionActionSets(session, &attach);
+  // Before the session runs: no profile becomes current, no event (the runtime changes
+  // profiles only in xrSyncActions of a running session).
+  const auto sync = [&](const char* subaction) {
+    const XrActiveActionSet active{set, subaction ? path(subaction) : XrPath(XR_NULL_PATH)};
+    XrActionsSyncInfo sync_info{XR_TYPE_ACTIONS_SYNC_INFO};
+    sync_info.countActiveActionSets = 1;
+    sync_info.activeActionSets = &active;
+    return xrSyncActions(session, &sync_info);
+  };
+  o.sync_eyes = sync("/user/eyes_ext");
+  o.sync_hand = sync("/user/hand/left");
+  const auto poll = [&] {
+    for (;;) {
+      XrEventDataBuffer e{XR_TYPE_EVENT_DATA_BUFFER};
+      if (xrPollEvent(instance, &e) != XR_SUCCESS) break;
+      o.events.push_back(e.type);
+    }
+  };
+  poll();  // IDLE, READY
+  XrSessionBeginInfo bi{XR_TYPE_SESSION_BEGIN_INFO};
+  bi.primaryViewConfigurationType = XR_VIEW_CONFIGURATION_TYPE_PRIMARY_STEREO;
+  o.begin = xrBeginSession(session, &bi);
+  o.sync_running = sync(nullptr);
   const auto name = [&](XrPath p) {
     if (p == XR_NULL_PATH) return std::string("null");
     char buf[XR_MAX_PATH_LENGTH];
@@ -295,20 +386,7 @@ Observed observe(XrInstance instance, const XrSession& session, bool suggest_gaz
   ps = {XR_TYPE_INTERACTION_PROFILE_STATE};
   o.hand = xrGetCurrentInteractionProfile(session, path("/user/hand/left"), &ps);
   o.hand_profile_name = o.hand == XR_SUCCESS ? name(ps.interactionProfile) : "";
-  const auto sync = [&](const char* subaction) {
-    const XrActiveActionSet active{set, path(subaction)};
-    XrActionsSyncInfo sync_info{XR_TYPE_ACTIONS_SYNC_INFO};
-    sync_info.countActiveActionSets = 1;
-    sync_info.activeActionSets = &active;
-    return xrSyncActions(session, &sync_info);
-  };
-  o.sync_eyes = sync("/user/eyes_ext");
-  o.sync_hand = sync("/user/hand/left");
-  for (;;) {
-    XrEventDataBuffer e{XR_TYPE_EVENT_DATA_BUFFER};
-    if (xrPollEvent(instance, &e) != XR_SUCCESS) break;
-    o.events.push_back(e.type);
-  }
+  poll();  // the profile change of the running session's sync, if the application sees one
   return o;
 }
 
@@ -350,6 +428,10 @@ TEST_F(LayerApiTest, EyeGazeStaysTheApplicationsChoice) {
     EXPECT_EQ(seen[0].sync_eyes, c.enable ? XR_SESSION_NOT_FOCUSED : XR_ERROR_PATH_UNSUPPORTED);
     EXPECT_EQ(seen[0].sync_hand, XR_SESSION_NOT_FOCUSED);
     EXPECT_EQ(seen[0].eyes_profile_name == "/interaction_profiles/ext/eye_gaze_interaction", c.enable && c.suggest);
+    EXPECT_EQ(seen[0].begin, XR_SUCCESS);
+    EXPECT_EQ(seen[0].sync_running, XR_SESSION_NOT_FOCUSED);
+    EXPECT_EQ(std::count(seen[0].events.begin(), seen[0].events.end(), XR_TYPE_EVENT_DATA_INTERACTION_PROFILE_CHANGED),
+              c.enable && c.suggest ? 1 : 0);
   }
 }
 
