@@ -16,6 +16,7 @@
 #include "fovea/renderer/path_tracer.hpp"
 #include "fovea/gpu/context.hpp"
 #include "fovea/renderer/reference.hpp"
+#include "fovea/renderer/trace_choice.hpp"
 #include "fovea/renderer/scene_io.hpp"
 #include "reference_cache.hpp"
 
@@ -30,7 +31,7 @@ standard error falls to its target. Writes the linear image as OpenEXR (32-bit f
 its description F.json (key, settings, statistics; what `fovea render --reference DIR`
 checks) and a tone-mapped PNG (same name, other extension), and prints JSON:
 {"spp", "mean_rgb", "rel_error", "pixel_rel_error", "seconds", "key", "cached", "window",
-"pixels"}.
+"pixels", "trace", "trace_why"}.
 With --window only the pixels of the window are traced (the stop rules and statistics are
 over them); the EXR's alpha is 1 on them and 0 elsewhere (RGB 0, not traced), the JSON
 records the window, and `fovea render --reference DIR` scores only what they cover.
@@ -44,7 +45,8 @@ so either command reuses the other's references.
                         or a .gltf/.glb/.obj file [default]
   --trace auto|rayquery|compute
                         ray queries through the device's acceleration structure, or the
-                        compute BVH traversal; auto: ray queries when the device has them [auto]
+                        compute BVH traversal; auto: the faster of the two on this device,
+                        measured once per device and driver and cached [auto]
   --display NAME|FILE   display preset (fove0, vive, modern, small, tiny) or JSON [small]
   --eye left|right      which eye; it sits ipd/2 beside the scene's camera [left]
   --spp N               samples per pixel to stop at [256]
@@ -127,7 +129,8 @@ int run(std::vector<std::string> argv) {
   if (auto w = args.opt("window")) window = parse_window(*w, view, "--window");
 
   gpu::Context ctx;
-  renderer::GpuScene gs(ctx, scene, {}, tracing);
+  const renderer::TraceChoice choice = renderer::choose_tracing(ctx, tracing, renderer::default_trace_choice_cache());
+  renderer::GpuScene gs(ctx, scene, {}, choice.tracing);
   ReferenceRequest req;
   req.scene = args.str("scene", "default");
   req.settings = defaults;
@@ -158,6 +161,8 @@ int run(std::vector<std::string> argv) {
   j["seconds"] = r.seconds;
   j["key"] = c.key;
   j["cached"] = c.from_cache;
+  j["trace"] = renderer::tracing_name(gs.tracing());
+  j["trace_why"] = choice.why;
   // What the image holds: a whole-view entry may have served a window request.
   j["window"] = window_json(c.window);
   j["pixels"] = c.valid.empty() ? r.image.pixels.size() : std::size_t(std::count(c.valid.begin(), c.valid.end(), true));

@@ -78,7 +78,9 @@ With no options: a short demo on the shipped scene and gaze.
                         or a .gltf/.glb/.obj file [default]
   --trace auto|rayquery|compute
                         ray queries through the device's acceleration structure, or the
-                        compute BVH traversal; auto: ray queries when the device has them [auto]
+                        compute BVH traversal; auto: the faster of the two on this device,
+                        measured once per device and driver and cached
+                        (report.json: trace, trace_choice) [auto]
   --display NAME|FILE   display preset (fove0, vive, modern, small, tiny) or JSON [small]
   --gaze URI            recording, or synthetic:<seed>[?...] (docs/gaze.md)
                         [the shipped recording data/gaze/default.csv]
@@ -522,6 +524,12 @@ int run(std::vector<std::string> argv) {
   // Which Vulkan driver produced the timings (lavapipe 22.3 and 25 differ ~2x).
   j["device"] = {{"name", ctx.info().name}, {"driver", ctx.info().driver}};
   j["trace"] = renderer::tracing_name(gpu_scene.tracing());
+  const renderer::TraceChoice& choice = setup.trace_choice;
+  j["trace_choice"] = {{"requested", args.str("trace", "auto")},
+                       {"why", choice.why},
+                       {"compute_ms", choice.compute_ms ? nlohmann::json(*choice.compute_ms) : nlohmann::json()},
+                       {"rayquery_ms", choice.rayquery_ms ? nlohmann::json(*choice.rayquery_ms) : nlohmann::json()},
+                       {"cached", choice.cached}};
   // Effective indirect-diffuse samples per cell after sharing vs the eye's own.
   double own = 0, shared = 0;
   for (int e = 0; e < 2; ++e) {

@@ -23,6 +23,7 @@
 #include "fovea/gpu/context.hpp"
 #include "fovea/pipeline/frame_pipeline.hpp"
 #include "fovea/renderer/gpu_scene.hpp"
+#include "fovea/renderer/trace_choice.hpp"
 #include "fovea/renderer/reference.hpp"
 #include "fovea/renderer/scene_io.hpp"
 #include "gaze_arg.hpp"
@@ -44,7 +45,8 @@ of view directions (lines every 5 degrees), a picture of the optics.
                         .gltf/.glb/.obj file: path trace it (otherwise the direction grid)
   --trace auto|rayquery|compute
                         ray queries through the device's acceleration structure, or the
-                        compute BVH traversal; auto: ray queries when the device has them [auto]
+                        compute BVH traversal; auto: the faster of the two on this device,
+                        measured once per device and driver and cached [auto]
   --gaze G              mouse: the cursor over a panel is the gaze (looked at through that
                         eye's lens; kept when the cursor leaves the panels);
                         X,Y: fixed gaze in normalised view coordinates;
@@ -173,7 +175,9 @@ int run(std::vector<std::string> argv) {
   std::optional<SceneRenderer> sr;
   if (scene) {
     sr.emplace();
-    sr->gpu_scene = std::make_unique<renderer::GpuScene>(ctx, *scene, renderer::BvhOptions{}, tracing);
+    const renderer::TraceChoice choice = renderer::choose_tracing(ctx, tracing, renderer::default_trace_choice_cache());
+    std::cerr << "fovea view: tracing " << renderer::tracing_name(choice.tracing) << ": " << choice.why << "\n";
+    sr->gpu_scene = std::make_unique<renderer::GpuScene>(ctx, *scene, renderer::BvhOptions{}, choice.tracing);
     const core::StereoViews views = core::stereo_views(d, scene->camera);
     sr->poses = views.poses();
     sr->pipeline = std::make_unique<pipeline::FramePipeline>(ctx, *sr->gpu_scene, views, dp, reconstruct::ReconSettings{});

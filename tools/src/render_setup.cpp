@@ -14,7 +14,8 @@ core::DistributionParams named(core::DistributionParams p, const core::DisplayPr
 
 RenderSetup::RenderSetup(const renderer::Scene& scene, const core::DisplayPreset& display,
                          const RenderSetupOptions& options)
-    : gpu_scene(ctx, scene, {}, options.tracing),
+    : trace_choice(renderer::choose_tracing(ctx, options.tracing, renderer::default_trace_choice_cache())),
+      gpu_scene(ctx, scene, {}, trace_choice.tracing),
       views(core::stereo_views(display, scene.camera)),
       poses(views.poses()),
       pipeline(ctx, gpu_scene, views, named(options.distribution, display), options.settings) {

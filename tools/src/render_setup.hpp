@@ -10,6 +10,7 @@
 #include "fovea/pipeline/frame_pipeline.hpp"
 #include "fovea/renderer/gpu_scene.hpp"
 #include "fovea/renderer/scene.hpp"
+#include "fovea/renderer/trace_choice.hpp"
 
 namespace fovea::tools {
 
@@ -27,6 +28,7 @@ struct RenderSetup {
   RenderSetup& operator=(const RenderSetup&) = delete;
 
   gpu::Context ctx;
+  renderer::TraceChoice trace_choice;  // --trace auto resolved for this device (renderer/trace_choice.hpp)
   renderer::GpuScene gpu_scene;
   core::StereoViews views;
   std::array<core::Pose, 2> poses;  // the static head's eyes
