@@ -60,17 +60,26 @@ INSTANTIATE_TEST_SUITE_P(Kinds, DensityCli,
                            return n;
                          });
 
-TEST(DensityCliOutput, WritesHeatMapAtomically) {
+TEST(DensityCliOutput, WritesFigureAndDataAtomically) {
   const std::string dir = test::temp_dir("density");
   const std::string png = dir + "/heat.png";
   const auto r = run_fovea("density --display tiny --gaze 0,0 --out " + png);
   ASSERT_EQ(r.status, 0) << r.err;
-  const core::Image img = core::read_png(png);
-  EXPECT_EQ(img.width, 64);
-  EXPECT_GT(img.height, 72);  // the colour bar below the display
+  // The figure (matplotlib, PNG and SVG) and its data: the per-pixel map and what to mark.
+  EXPECT_GT(core::read_png(png).width, 64);
+  const std::string svg = test::read_text(dir + "/heat.svg");
+  EXPECT_NE(svg.find("<svg"), std::string::npos);
+  EXPECT_NE(svg.find("samples per display pixel (log scale)"), std::string::npos) << "the colour bar has a title";
+  const auto j = fovea::core::parse_json(test::read_text(dir + "/heat.json"));
+  EXPECT_EQ(j["figure"], "density");
+  EXPECT_EQ(j["array"], "heat.npy");
+  const std::string npy = test::read_text(dir + "/heat.npy");
+  ASSERT_GT(npy.size(), 128u);
+  EXPECT_EQ(npy.substr(0, 6), "\x93NUMPY");
+  EXPECT_NE(npy.find("'shape': (2, 72, 64)"), std::string::npos) << npy.substr(0, 128);
   int entries = 0;
   for ([[maybe_unused]] const auto& e : std::filesystem::directory_iterator(dir)) ++entries;
-  EXPECT_EQ(entries, 1) << "no temporary files left behind";
+  EXPECT_EQ(entries, 4) << "PNG, SVG, JSON and NPY; no temporary files left behind";
   // Unwritable destination (a file where its directory should be): exit 2 naming it, no
   // partial file. (A missing directory is created: HostileInputs.MissingOutputDirectoriesAreCreated.)
   const auto bad = run_fovea("density --display tiny --out " + png + "/heat.png");
@@ -78,7 +87,7 @@ TEST(DensityCliOutput, WritesHeatMapAtomically) {
   EXPECT_NE(bad.err.find(png), std::string::npos) << bad.err;
   entries = 0;
   for ([[maybe_unused]] const auto& e : std::filesystem::directory_iterator(dir)) ++entries;
-  EXPECT_EQ(entries, 1) << "nothing written beside the heat map";
+  EXPECT_EQ(entries, 4) << "nothing written beside the figure";
   std::filesystem::remove_all(dir);
 }
 

@@ -2,6 +2,7 @@
 // (samples per display pixel, log scale) and as JSON bands against the target.
 #include <cmath>
 #include <cstdio>
+#include <filesystem>
 #include <iostream>
 #include <sstream>
 
@@ -15,6 +16,7 @@
 #include "fovea/core/error.hpp"
 #include "fovea/core/output_path.hpp"
 #include "fovea/core/image.hpp"
+#include "figures.hpp"
 #include "gaze_arg.hpp"
 
 namespace fovea::tools {
@@ -36,51 +38,62 @@ Shows how a sample distribution spreads its samples over one eye's display.
   --cap K               at most K samples per display pixel [1]
   --aniso A             bound on the cells' phi/rho spacing ratio [2]
   --staircase           P5's rows-constant-per-32-columns layout (visual-polar)
-  --out PNG             heat map of samples per display pixel (log scale 1e-3..10,
-                        colour bar below; gaze cross and fovea circle marked)
+  --out PNG             heat map of samples per display pixel (log scale 1e-3..10, numbered
+                        colour bar; gaze cross and fovea edge marked), drawn by matplotlib
+                        as PNG and SVG from the data written beside them (same stem, .json
+                        and .npy; docs/figures.md)
   --json                print the measurement as JSON on stdout
   --help                this text
 
 Exit status: 0 on success, 2 on invalid arguments.
 )";
 
-void mark(core::Image& img, int x, int y, glm::vec4 c) {
-  if (x >= 0 && y >= 0 && x < img.width && y < img.height) img.at(x, y) = c;
+// The figure's data: OUT's stem + .npy, float32 [2, height, width]: log10 of the samples per
+// display pixel (clamped to kLogRange) and each pixel's eccentricity from the gaze (deg);
+// and OUT's stem + .json: what tools/plots/density.py needs besides (gaze, fovea radius).
+// The figure: the heat map with a numbered colour bar, gaze and fovea marked (PNG and SVG).
+constexpr double kLogRange[2] = {-3, 1};
+
+void write_npy(const std::string& path, const std::vector<float>& values, int layers, int height, int width) {
+  std::string header = "{'descr': '<f4', 'fortran_order': False, 'shape': (" + std::to_string(layers) + ", " +
+                       std::to_string(height) + ", " + std::to_string(width) + "), }";
+  header.append(63 - (10 + header.size()) % 64, ' ');  // NPY 1.0: magic, version, length, header, '\n' to 64 bytes
+  header += '\n';
+  std::string bytes("\x93NUMPY\x01\x00", 8);
+  bytes += char(header.size() & 0xff);
+  bytes += char(header.size() >> 8);
+  bytes += header;
+  // Little-endian float32, as on every host the project builds for (x86-64, arm64).
+  bytes.append(reinterpret_cast<const char*>(values.data()), values.size() * sizeof(float));
+  core::write_file_atomic(path, bytes);
 }
 
-core::Image heat_map(const core::SampleDistribution& d) {
+void write_figure(const std::string& out_png, const core::SampleDistribution& d, const std::string& title) {
   const core::View& v = d.view();
-  const int bar = std::max(6, v.height() / 40);
-  core::Image img(v.width(), v.height() + bar);
-  const double lo = -3, hi = 1;  // log10 spp
-  const double fovea = core::acuity::kFoveaDeg + d.params().margin_deg;
-  const glm::dvec2 gp = v.dir_to_pixel(d.gaze()).value_or(glm::dvec2(-100));
-  for (int y = 0; y < v.height(); ++y)
-    for (int x = 0; x < v.width(); ++x) {
+  const int w = v.width(), h = v.height();
+  std::vector<float> values(2 * std::size_t(w) * std::size_t(h));
+  for (int y = 0; y < h; ++y)
+    for (int x = 0; x < w; ++x) {
       const glm::dvec2 px{x + 0.5, y + 0.5};
       const double spp = d.samples_per_pixel(px);
-      const double t = spp > 0 ? (std::log10(spp) - lo) / (hi - lo) : 0;
-      img.at(x, y) = core::colormap_inferno(float(t));
-      // The fovea circle: pixels whose eccentricity crosses the radius.
-      const glm::dvec3 dir = v.pixel_to_dir(px);
-      const double e = core::angle_deg(dir, d.gaze());
-      const double step = 1.0 / std::sqrt(v.pixels_per_deg2(dir));  // degrees per pixel
-      if (std::abs(e - fovea) < 0.5 * step) img.at(x, y) = {1, 1, 1, 1};
+      const std::size_t i = std::size_t(y) * std::size_t(w) + std::size_t(x);
+      values[i] = float(spp > 0 ? std::clamp(std::log10(spp), kLogRange[0], kLogRange[1]) : kLogRange[0]);
+      values[std::size_t(w) * std::size_t(h) + i] = float(core::angle_deg(v.pixel_to_dir(px), d.gaze()));
     }
-  const int arm = std::max(3, v.width() / 60);
-  for (int k = -arm; k <= arm; ++k)
-    for (int w = -1; w <= 1; ++w) {
-      mark(img, int(gp.x) + k, int(gp.y) + w, {0.2f, 1, 0.3f, 1});
-      mark(img, int(gp.x) + w, int(gp.y) + k, {0.2f, 1, 0.3f, 1});
-    }
-  for (int x = 0; x < v.width(); ++x) {
-    const float t = (x + 0.5f) / v.width();
-    const double decade = t * (hi - lo);
-    const bool tick = std::abs(decade - std::round(decade)) * v.width() / (hi - lo) < 1.0;
-    for (int y = v.height(); y < v.height() + bar; ++y)
-      img.at(x, y) = (tick && y < v.height() + bar / 2) ? glm::vec4(1) : core::colormap_inferno(t);
-  }
-  return img;
+  const std::filesystem::path stem = std::filesystem::path(out_png).replace_extension();
+  write_npy(stem.string() + ".npy", values, 2, h, w);
+  const glm::dvec2 gp = v.dir_to_pixel(d.gaze()).value_or(glm::dvec2(w / 2.0, h / 2.0));
+  nlohmann::ordered_json j;
+  j["figure"] = "density";
+  j["file"] = stem.filename().string();
+  j["array"] = stem.filename().string() + ".npy";
+  j["title"] = title;
+  j["gaze_px"] = {gp.x, gp.y};
+  j["fovea_deg"] = core::acuity::kFoveaDeg + d.params().margin_deg;
+  j["range_log10"] = kLogRange;
+  const std::string data = stem.string() + ".json";
+  core::write_file_atomic(data, j.dump(2) + "\n");
+  draw_figures("density", data, std::cerr);
 }
 
 int run(std::vector<std::string> argv) {
@@ -113,7 +126,10 @@ int run(std::vector<std::string> argv) {
 
   if (auto out = a.opt("out")) {
     core::prepare_output_file(*out, "--out");
-    core::write_png(*out, heat_map(*dist));
+    char title[200];
+    std::snprintf(title, sizeof title, "%s, %s eye %dx%d px, budget %.2f: samples per display pixel",
+                  core::distribution_name(p.kind), core::eye_name(eye), view.width(), view.height(), p.budget);
+    write_figure(*out, *dist, title);
   }
   if (st.clamped) std::cerr << "fovea density: gaze outside the view, clamped to its border\n";
   if (st.fallback) std::cerr << "fovea density: gaze unusable (NaN, zero or backwards), using the view centre\n";

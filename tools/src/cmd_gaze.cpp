@@ -7,7 +7,7 @@
 #include <nlohmann/json.hpp>
 
 #include "command.hpp"
-#include "plot_canvas.hpp"
+#include "figures.hpp"
 #include "fovea/core/error.hpp"
 #include "fovea/core/output_path.hpp"
 #include <chrono>
@@ -39,8 +39,9 @@ const char* kHelp =
     "  synth --task T --seconds S OUT  synthetic gaze (--seed N --rate HZ --noise DEG --color C\n"
     "                                  --dropouts PER_S); tasks: reading search pursuit fixation-grid\n"
     "  plot FILE OUT.png [--from S --to S --width PX]\n"
-    "                                  gaze angles against time (numbered axes, legend) and the\n"
-    "                                  scanpath on the screen; --from/--to: a time window (s)\n"
+    "                                  gaze angles against time and the scanpath on the screen,\n"
+    "                                  drawn by matplotlib as OUT.png and OUT.svg from OUT.json\n"
+    "                                  (the data; docs/figures.md); --from/--to: a time window (s)\n"
     "  record --source URI --seconds S OUT [--raw CAPTURE] [--timeout S]\n"
     "                                  record any source (hid:, usb:, hid-emulated:LAYOUT, synthetic:,\n"
     "                                  replay); --raw writes the raw HID traffic (docs/hid.md)\n"
@@ -292,165 +293,115 @@ int cmd_synth(const std::vector<std::string>& argv) {
 }
 
 // ---- plot ------------------------------------------------------------------------------
-// Three panels, each with numbered axes in their units: horizontal and vertical gaze angle
-// (degrees; + right, + up) against time (s), with I-VT saccades shaded red and untracked
-// time grey; below, the scanpath on the screen raster (px): fixation samples dark, saccade
-// paths red. A legend names every colour. Two streaming passes, bounded memory; the number
-// of grid lines is bounded whatever the time span.
+// The figure's data, OUT's stem + .json: per sample (every stride-th in the window, at most
+// kMaxPlotSamples) the time, the horizontal and vertical gaze angle (deg; + right, + up;
+// null when untracked), the point on the screen raster (px; null when off it) and whether it
+// is in a saccade; the I-VT saccades and the untracked stretches as time intervals. Drawn by
+// tools/plots/gaze.py as OUT.png and OUT.svg: angles against time with saccades shaded and
+// lines broken where the eye was untracked or the recording has a gap, and the scanpath.
+constexpr std::uint64_t kMaxPlotSamples = 200000;
+
 int cmd_plot(const std::vector<std::string>& argv) {
   Args a(argv, {"format", "display", "screen", "min-confidence", "width", "from", "to"}, {}, 2);
   if (a.positional().size() != 2) throw core::InputError("gaze plot needs FILE and OUT.png (see --help)");
-  core::prepare_output_file(a.positional()[1], "OUT.png");
+  const std::string out_png = a.positional()[1];
+  core::prepare_output_file(out_png, "OUT.png");
   const dv::SourceOptions opt = gaze_source_options(a);
   const double from_s = a.num("from", 0), to_s = a.num("to", 9.2e9);
   if (!(from_s >= 0 && to_s > from_s && to_s <= 9.2e9))
     throw core::InputError("--from/--to: need 0 <= FROM < TO (seconds from the first sample)");
+  const long width = std::clamp(a.integer("width", 1200), 400L, 4000L);
   const auto from_ns = static_cast<core::TimeNs>(from_s * 1e9), to_ns = static_cast<core::TimeNs>(to_s * 1e9);
   Input in = open_input(a.positional()[0], opt);
   dv::SampleStream* reader = in.stream.get();
   dv::GazeSample s;
-  core::TimeNs t_lo = -1, t_hi = 0;
-  double max_angle = 10;
-  std::uint64_t tracked = 0;
+  std::uint64_t tracked = 0, in_range = 0;
+  std::vector<double> steps;  // the first sample intervals: the recording's sample period
+  core::TimeNs last = -1;
   auto angles = [](const glm::dvec3& d) {
     return glm::dvec2(std::atan2(d.x, -d.z), std::atan2(d.y, std::hypot(d.x, d.z))) * (180.0 / M_PI);
   };
   auto in_window = [&](core::TimeNs t) { return t >= from_ns && t <= to_ns; };
   while (reader->next(s)) {
     if (!in_window(s.t_ns)) continue;
-    if (t_lo < 0) t_lo = s.t_ns;
-    t_hi = s.t_ns;
-    if (s.tracked()) {
-      ++tracked;
-      const glm::dvec2 g = angles(s.combined.dir);
-      max_angle = std::max({max_angle, std::abs(g.x), std::abs(g.y)});
-    }
+    ++in_range;
+    tracked += s.tracked();
+    if (last >= 0 && s.t_ns > last && steps.size() < 10000) steps.push_back(double(s.t_ns - last) * 1e-9);
+    last = s.t_ns;
   }
   print_notes(in);
   if (tracked == 0) throw core::InputError(a.positional()[0] + ": no usable sample to plot" + (a.has("from") || a.has("to") ? " in --from/--to" : ""));
-  max_angle = std::min(90.0, std::ceil(max_angle / 10) * 10);
-  const int W = static_cast<int>(std::clamp(a.integer("width", 1200), 400L, 4000L));
-  const int fs = W >= 1000 ? 2 : 1;  // font scale
-  const int th = Canvas::text_height(fs), gap = th;
-  const int ml = Canvas::text_width("-90", fs) + 3 * gap, mr = 2 * gap;
-  const int pw = W - ml - mr, ph = W * 2 / 10;
+  std::sort(steps.begin(), steps.end());
+  const std::uint64_t stride = std::max<std::uint64_t>(1, (in_range + kMaxPlotSamples - 1) / kMaxPlotSamples);
   const core::View view = in.options.screen_view();
-  const int disp_h = std::min(W * 5 / 10, static_cast<int>(double(pw) * view.height() / view.width()));
-  const int disp_w = static_cast<int>(double(disp_h) * view.width() / view.height());
-  // Rows: legend, panel title, panel, tick labels, panel title, panel, tick labels + axis
-  // title, scanpath title, scanpath, tick labels.
-  const int legend_y = gap, p1 = legend_y + 2 * th + 2 * gap, p2 = p1 + ph + 3 * th + gap;
-  const int sp_y = p2 + ph + 6 * th + 2 * gap;
-  Canvas c(W, sp_y + disp_h + 3 * th + gap);
-  const glm::vec4 ink{0, 0, 0, 1}, grid{0, 0, 0, 0.12f}, blue{0.1f, 0.3f, 0.9f, 0.9f}, green{0.1f, 0.6f, 0.2f, 0.9f},
-      red{0.9f, 0.1f, 0.1f, 0.25f}, grey{0.5f, 0.5f, 0.5f, 0.3f};
-  // Legend.
-  int lx = ml;
-  auto legend = [&](const char* label, glm::vec4 col) {
-    c.rect(lx, legend_y, lx + 3 * th, legend_y + th, glm::vec4(glm::vec3(col), std::max(col.w, 0.5f)));
-    c.text(lx + 3 * th + th / 2, legend_y, label, fs, ink);
-    lx += 3 * th + th + Canvas::text_width(label, fs) + 2 * th;
-  };
-  legend("horizontal", blue);
-  legend("vertical", green);
-  legend("saccade (i-vt)", red);
-  legend("untracked", grey);
-  legend("fixation sample", glm::vec4(0.1f, 0.1f, 0.4f, 0.6f));
-  // Time axis: seconds from the first sample; a bounded number of labelled ticks.
-  const double t0_s = static_cast<double>(t_lo) * 1e-9, t1_s = std::max(static_cast<double>(t_hi) * 1e-9, t0_s + 1e-3);
-  auto tx = [&](core::TimeNs t) { return ml + (pw - 1) * (static_cast<double>(t) * 1e-9 - t0_s) / (t1_s - t0_s); };
-  const int max_time_ticks = std::max(2, pw / Canvas::text_width("0000000000", fs));
-  const auto tt = nice_ticks(t0_s, t1_s, max_time_ticks);
-  const double t_step = tt.size() > 1 ? tt[1] - tt[0] : t1_s - t0_s;
-  const auto at = nice_ticks(-max_angle, max_angle, std::max(3, ph / (3 * th)));
-  const double a_step = at.size() > 1 ? at[1] - at[0] : max_angle;
-  for (const auto& [y0, title] : {std::pair{p1, "horizontal gaze angle (deg, + right)"},
-                                  std::pair{p2, "vertical gaze angle (deg, + up)"}}) {
-    c.text(ml, y0 - th - gap / 2, title, fs, ink);
-    for (double t : tt) {
-      c.line(tx(core::TimeNs(t * 1e9)), y0, tx(core::TimeNs(t * 1e9)), y0 + ph - 1, grid);
-      const std::string l = tick_label(t, t_step);
-      c.text(static_cast<int>(tx(core::TimeNs(t * 1e9))) - Canvas::text_width(l, fs) / 2, y0 + ph + gap / 2, l, fs, ink);
-    }
-    for (double d : at) {
-      const double y = y0 + (ph - 1) * (0.5 - 0.5 * d / max_angle);
-      c.line(ml, y, ml + pw - 1, y, {0, 0, 0, d == 0 ? 0.4f : 0.12f});
-      const std::string l = tick_label(d, a_step);
-      c.text(ml - gap / 2 - Canvas::text_width(l, fs), static_cast<int>(y) - th / 2, l, fs, ink);
-    }
-    c.frame(ml, y0, ml + pw, y0 + ph, ink);
-  }
-  const std::string t_title = "time (s)";
-  c.text(ml + pw / 2 - Canvas::text_width(t_title, fs) / 2, p2 + ph + 2 * th, t_title, fs, ink);
-  auto ay = [&](int y0, double deg) { return y0 + (ph - 1) * (0.5 - 0.5 * deg / max_angle); };
-  // Scanpath panel with pixel axes.
-  const int dx0 = ml + (pw - disp_w) / 2, dy0 = sp_y;
-  char sp_title[160];
-  std::snprintf(sp_title, sizeof sp_title, "scanpath on the screen (px), %dx%d, %.1fx%.1f deg", view.width(), view.height(),
-                (view.fov().angle_right - view.fov().angle_left) * 180 / M_PI, (view.fov().angle_up - view.fov().angle_down) * 180 / M_PI);
-  c.text(ml, dy0 - 2 * th - gap / 2, sp_title, fs, ink);
-  c.rect(dx0, dy0, dx0 + disp_w, dy0 + disp_h, {0.95f, 0.95f, 0.95f, 1});
-  const auto xt = nice_ticks(0, view.width(), std::max(2, disp_w / Canvas::text_width("00000", fs)));
-  const auto yt = nice_ticks(0, view.height(), std::max(2, disp_h / (3 * th)));
-  for (double x : xt) {
-    const double px = dx0 + x / view.width() * (disp_w - 1);
-    c.line(px, dy0, px, dy0 + disp_h - 1, grid);
-    const std::string l = tick_label(x, 1);
-    c.text(static_cast<int>(px) - Canvas::text_width(l, fs) / 2, dy0 + disp_h + gap / 2, l, fs, ink);
-  }
-  for (double y : yt) {
-    const double py = dy0 + y / view.height() * (disp_h - 1);
-    c.line(dx0, py, dx0 + disp_w - 1, py, grid);
-    const std::string l = tick_label(y, 1);
-    c.text(dx0 - gap / 2 - Canvas::text_width(l, fs), static_cast<int>(py) - th / 2, l, fs, ink);
-  }
-  c.frame(dx0, dy0, dx0 + disp_w, dy0 + disp_h, ink);
-  // Pass 2: events (shading) and traces.
+
+  // Pass 2: the samples, the saccades and the untracked stretches.
   reader->rewind();
   dv::SummaryParams sp;
   sp.infer_blinks = !in.reports_blinks;
+  nlohmann::json saccades = nlohmann::json::array(), untracked = nlohmann::json::array();
   dv::EventSegmenter seg(sp, [&](const dv::GazeEvent& e) {
-    if (e.kind == dv::GazeEvent::Kind::Saccade)
-      for (int y0 : {p1, p2}) c.rect(static_cast<int>(tx(e.start_ns)), y0 + 1, static_cast<int>(std::ceil(tx(e.end_ns))) + 1, y0 + ph - 1, red);
+    if (e.kind == dv::GazeEvent::Kind::Saccade) saccades.push_back({e.start_ns * 1e-9, e.end_ns * 1e-9});
   });
+  nlohmann::json t = nlohmann::json::array(), h = t, v = t, x = t, y = t, sacc_flag = t;
+  core::TimeNs lost_since = -1;  // start of the untracked stretch (times in the window are >= 0)
   bool have_prev = false;
   dv::GazeSample prev;
-  glm::dvec2 prev_px{};
-  bool prev_on = false;
-  int last_grey = -1;  // one grey column per pixel, however many samples fall on it
+  std::uint64_t index = 0;
   while (reader->next(s)) {
     if (!in_window(s.t_ns)) continue;
     seg.add(s);
+    const bool keep = index++ % stride == 0;
     if (!s.tracked()) {
-      const int x = static_cast<int>(tx(s.t_ns));
-      if (x != last_grey)
-        for (int y0 : {p1, p2}) c.rect(x, y0 + 1, x + 1, y0 + ph - 1, grey);
-      last_grey = x;
+      if (lost_since < 0) lost_since = s.t_ns;
       have_prev = false;
+      if (keep) {
+        t.push_back(round_to(s.t_ns * 1e-9, 6));
+        for (auto* col : {&h, &v, &x, &y}) col->push_back(nullptr);
+        sacc_flag.push_back(0);
+      }
       continue;
     }
-    const glm::dvec2 g = angles(s.combined.dir);
-    if (have_prev) {
-      const glm::dvec2 p = angles(prev.combined.dir);
-      c.line(tx(prev.t_ns), ay(p1, p.x), tx(s.t_ns), ay(p1, g.x), blue);
-      c.line(tx(prev.t_ns), ay(p2, p.y), tx(s.t_ns), ay(p2, g.y), green);
-    }
-    const auto pix = view.dir_to_pixel(s.combined.dir);
-    const bool on = pix.has_value();
-    glm::dvec2 q{};
-    if (on) q = glm::dvec2(dx0 + pix->x / view.width() * disp_w, dy0 + pix->y / view.height() * disp_h);
+    if (lost_since >= 0) untracked.push_back({lost_since * 1e-9, s.t_ns * 1e-9});
+    lost_since = -1;
     const bool sacc = s.motion == dv::Motion::Saccade || (have_prev && core::angle_deg(prev.combined.dir, s.combined.dir) /
                                                                             std::max(1e-9, (s.t_ns - prev.t_ns) * 1e-9) >= sp.ivt.threshold_deg_s);
-    if (on && prev_on && have_prev) c.line(prev_px.x, prev_px.y, q.x, q.y, sacc ? glm::vec4(0.9f, 0.1f, 0.1f, 0.6f) : glm::vec4(0.1f, 0.1f, 0.3f, 0.15f));
-    if (on && !sacc) c.rect(int(q.x) - 1, int(q.y) - 1, int(q.x) + 2, int(q.y) + 2, {0.1f, 0.1f, 0.4f, 0.25f});
     prev = s;
-    prev_px = q;
-    prev_on = on;
     have_prev = true;
+    if (!keep) continue;
+    const glm::dvec2 g = angles(s.combined.dir);
+    const auto pix = view.dir_to_pixel(s.combined.dir);
+    t.push_back(round_to(s.t_ns * 1e-9, 6));
+    h.push_back(round_to(g.x, 4));
+    v.push_back(round_to(g.y, 4));
+    x.push_back(pix ? nlohmann::json(round_to(pix->x, 2)) : nlohmann::json(nullptr));
+    y.push_back(pix ? nlohmann::json(round_to(pix->y, 2)) : nlohmann::json(nullptr));
+    sacc_flag.push_back(sacc ? 1 : 0);
   }
+  if (lost_since >= 0) untracked.push_back({lost_since * 1e-9, last * 1e-9});
   seg.finish();
-  core::write_png(a.positional()[1], c.img);
-  std::cerr << "wrote " << a.positional()[1] << " (" << c.img.width << "x" << c.img.height << ")\n";
+
+  const std::filesystem::path stem = std::filesystem::path(out_png).replace_extension();
+  const std::string data_path = stem.string() + ".json";
+  nlohmann::ordered_json j;
+  j["figure"] = "gaze";
+  j["file"] = stem.filename().string();
+  j["source"] = std::filesystem::path(a.positional()[0]).filename().string();
+  j["width_px"] = width;
+  j["screen"] = {{"width", view.width()},
+                 {"height", view.height()},
+                 {"fov_x_deg", (view.fov().angle_right - view.fov().angle_left) * 180 / M_PI},
+                 {"fov_y_deg", (view.fov().angle_up - view.fov().angle_down) * 180 / M_PI}};
+  j["sample_period_s"] = steps.empty() ? 0.0 : steps[steps.size() / 2];
+  j["stride"] = stride;
+  j["saccades"] = saccades;
+  j["untracked"] = untracked;
+  j["t"] = t, j["h"] = h, j["v"] = v, j["x"] = x, j["y"] = y, j["saccade"] = sacc_flag;
+  core::write_file_atomic(data_path, j.dump() + "\n");
+  if (draw_figures("gaze", data_path, std::cerr))
+    std::cerr << "wrote " << stem.string() << ".png and .svg (data: " << data_path << ")\n";
+  else
+    std::cerr << "wrote " << data_path << "\n";
   return 0;
 }
 

@@ -49,13 +49,15 @@ foveal error and fovea quality. With --records: the same analysis of an OpenXR s
 Prints the summary JSON on stdout; writes into --out:
   records.jsonl        the simulation's timing records (virtual clock, from 0)
   summary.json         the summary
-  latency.png          CDFs of tracker delay, gaze-to-photon, motion-to-photon
-  stages.png           CDFs of each stage's CPU and GPU time
-  foveal_error.png     foveal error at photon time over time, saccade onsets marked
-  sweep_error.png      injected latency vs foveal error (median, p95)
-  sweep_quality.png    injected latency vs tone-mapped PSNR where the user looks after
-                       saccades (--quality-frames > 0)
-  sweep_flip.png       the same with HDR-FLIP
+  figures.json         the data of the figures below, drawn by matplotlib as .png and
+                       .svg (docs/figures.md; redraw: fovea plot DIR/figures.json)
+  latency              CDFs of tracker delay, gaze-to-photon, motion-to-photon
+  stages               CDFs of each stage's CPU and GPU time
+  foveal_error         foveal error at photon time over time, saccade onsets marked
+  sweep_error          injected latency vs foveal error (median, p95, n per point)
+  sweep_quality        injected latency vs tone-mapped PSNR where the user looks after
+                       saccades (--quality-frames > 0; frames and saccades per point)
+  sweep_flip           the same with HDR-FLIP
 
   --scene S             cornell | furnace | glossy-spheres | stereo-occluders | default,
                         or a .gltf/.glb/.obj file [default]
@@ -139,7 +141,8 @@ int run_records(const Args& args, const fs::path& out) {
   j["records"] = path;
   j["source"] = records.front().source;
   j["clock"] = xrcommon::time_base_name(records.front().clock);
-  finish(out, j, latency::write_plots(out.string(), records, nullptr, "records: " + fs::path(path).filename().string()));
+  finish(out, j, sweep::write_charts(out.string(), "figures.json",
+                                     latency::plots(records, nullptr, "records: " + fs::path(path).filename().string())));
   return 0;
 }
 
@@ -352,7 +355,7 @@ int run(std::vector<std::string> argv) {
   std::snprintf(notebuf, sizeof notebuf, "%s %.0f Hz, budget %.2f, tracker %s %.0f Hz delay %.1f ms jitter %.1f ms, render %s",
                 display.name.c_str(), display.refresh_hz, render_options.distribution.budget, tp.name.c_str(), tp.rate_hz,
                 core::ns_to_ms(tp.delay_ns), core::ns_to_ms(tp.jitter_ns), fixed_cost ? "fixed" : "measured");
-  std::vector<std::string> plots = latency::write_plots(out.string(), sim.records, &sim, notebuf);
+  std::vector<sweep::Chart> charts = latency::plots(sim.records, &sim, notebuf);
 
   // The comparisons replay the main run's costs frame by frame, so every run has the same
   // frames at the same times and differs only by the gaze the frames were foveated for.
@@ -420,6 +423,8 @@ int run(std::vector<std::string> argv) {
           p.fovea_psnr_db = q.psnr;
           p.fovea_hdr_flip = q.hdr_flip;
           p.quality_radius_deg = radius;
+          p.quality_frames = std::size_t(q.frames);
+          p.quality_saccades = std::size_t(q.saccades);
           pj["fovea_quality"] = {{"psnr_db", q.psnr},      {"hdr_flip", q.hdr_flip}, {"ldr_flip", q.ldr_flip},
                                  {"radius_deg", radius}, {"frames", q.frames},     {"saccades", q.saccades}};
         }
@@ -428,9 +433,9 @@ int run(std::vector<std::string> argv) {
       sweep.push_back(pj);
     }
     j["sweep"] = sweep;
-    for (const auto& f : latency::write_sweep_plots(out.string(), points, notebuf)) plots.push_back(f);
+    for (auto& c : latency::sweep_plots(points, notebuf)) charts.push_back(std::move(c));
   }
-  finish(out, j, plots);
+  finish(out, j, sweep::write_charts(out.string(), "figures.json", charts));
   return 0;
 }
 

@@ -2,11 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
-#include <filesystem>
 #include <map>
-
-#include "fovea/core/image.hpp"
-#include "sweep/plot.hpp"
 
 namespace fovea::latency {
 
@@ -23,26 +19,20 @@ std::string fmt(double v, int decimals = 1) {
   return b;
 }
 
-// The empirical CDF of v as a step line.
+// The empirical CDF of v as a step line; the legend carries n and the statistics.
 sweep::Series cdf(const std::string& name, std::vector<double> v, std::size_t colour) {
   std::sort(v.begin(), v.end());
   const Distribution d = distribution(v);
   sweep::Series s;
-  s.label = name + ": med " + fmt(d.median) + " p95 " + fmt(d.p95) + " p99 " + fmt(d.p99) + " max " + fmt(d.max);
-  s.color = sweep::palette(colour);
+  s.label = name + " (n=" + std::to_string(d.n) + "): median " + fmt(d.median) + ", p95 " + fmt(d.p95) + ", p99 " +
+            fmt(d.p99) + ", max " + fmt(d.max) + " ms";
+  s.color = colour;
   s.line = true;
   s.markers = false;
-  for (std::size_t i = 0; i < v.size(); ++i) {
-    s.points.push_back({v[i], double(i) / double(v.size())});
-    s.points.push_back({v[i], double(i + 1) / double(v.size())});
-  }
+  s.step = true;
+  s.points.push_back({v.front(), 0.0});
+  for (std::size_t i = 0; i < v.size(); ++i) s.points.push_back({v[i], double(i + 1) / double(v.size())});
   return s;
-}
-
-void save(const std::string& dir, const std::string& name, const sweep::Chart& c, std::vector<std::string>& written) {
-  // Wide: the legend carries each distribution's median, p95, p99 and max.
-  core::write_png((std::filesystem::path(dir) / name).string(), sweep::draw_chart(c, 1600, 700));
-  written.push_back(name);
 }
 
 }  // namespace
@@ -145,11 +135,12 @@ nlohmann::json summarize(const std::vector<xrcommon::TimingRecord>& records, con
   return j;
 }
 
-std::vector<std::string> write_plots(const std::string& dir, const std::vector<xrcommon::TimingRecord>& records,
-                                     const Simulation* sim, const std::string& note) {
-  std::vector<std::string> written;
+std::vector<sweep::Chart> plots(const std::vector<xrcommon::TimingRecord>& records, const Simulation* sim,
+                                const std::string& note) {
+  std::vector<sweep::Chart> charts;
   const Latencies l = latencies(records);
   sweep::Chart c;
+  c.file = "latency";
   c.title = "Latency distributions (CDF)";
   c.note = note;
   c.x_label = "latency (ms)";
@@ -158,7 +149,7 @@ std::vector<std::string> write_plots(const std::string& dir, const std::vector<x
   for (auto [name, v] : {std::pair{"tracker delay", &l.tracker_delay_ms}, {"gaze-to-photon", &l.gaze_to_photon_ms},
                          {"motion-to-photon", &l.motion_to_photon_ms}})
     if (!v->empty()) c.series.push_back(cdf(name, *v, colour++));
-  if (!c.series.empty()) save(dir, "latency.png", c, written);
+  if (!c.series.empty()) charts.push_back(c);
 
   std::map<std::string, std::vector<double>> stages;
   for (const auto& r : records) {
@@ -166,78 +157,83 @@ std::vector<std::string> write_plots(const std::string& dir, const std::vector<x
     for (const auto& [k, v] : r.gpu_ms) stages["GPU " + k].push_back(v);
   }
   sweep::Chart st;
+  st.file = "stages";
   st.title = "Per-stage time (CDF)";
   st.note = note;
   st.x_label = "time per frame (ms)";
   st.y_label = "fraction of frames";
   colour = 0;
   for (const auto& [k, v] : stages) st.series.push_back(cdf(k, v, colour++));
-  if (!st.series.empty()) save(dir, "stages.png", st, written);
+  if (!st.series.empty()) charts.push_back(st);
 
   if (sim && !sim->shown.empty()) {
     sweep::Chart e;
+    e.file = "foveal_error";
     e.title = "Foveal error at photon time";
     e.note = note;
     e.x_label = "time (s)";
     e.y_label = "angle true gaze to fovea (deg)";
-    sweep::Series err{"foveal error (panel, every vsync)", sweep::palette(0), {}, true, false, {}};
-    double top = 5;
+    // Vsyncs without a true eye are missing values: the line breaks there, and at gaps in time.
+    sweep::Series err{"foveal error (panel, every vsync with a true eye)", 0, {}, true, false};
+    err.gaps = true;
     for (const Shown& s : sim->shown)
-      if (s.error_deg) {
-        err.points.push_back({double(s.photon_ns) * 1e-9, *s.error_deg});
-        top = std::max(top, *s.error_deg);
-      }
+      err.points.push_back({double(s.photon_ns) * 1e-9, s.error_deg ? *s.error_deg : std::nan("")});
     e.series.push_back(err);
-    sweep::Series onsets{"saccade onset (I-VT on the true eye)", sweep::palette(3), {}, true, false, {}};
-    for (const Saccade& s : sim->saccades) {
-      const double t = double(s.onset_ns) * 1e-9;
-      onsets.points.insert(onsets.points.end(), {{t, 0}, {t, top}, {t, 0}});
-    }
-    if (!onsets.points.empty()) e.series.push_back(onsets);
-    const double t0 = double(sim->shown.front().photon_ns) * 1e-9, t1 = double(sim->shown.back().photon_ns) * 1e-9;
-    e.series.push_back({"2 deg (recovered below)", sweep::palette(2), {{t0, 2.0}, {t1, 2.0}}, true, false, {}});
-    save(dir, "foveal_error.png", e, written);
+    sweep::Series onsets{"saccade onset (I-VT on the true eye)", 3, {}, false, false};
+    for (const Saccade& s : sim->saccades) onsets.vlines.push_back(double(s.onset_ns) * 1e-9);
+    if (!onsets.vlines.empty()) e.series.push_back(onsets);
+    sweep::Series two{"2 deg (recovered below)", 2, {}, false, false};
+    two.hline = 2.0;
+    e.series.push_back(two);
+    charts.push_back(e);
   }
-  return written;
+  return charts;
 }
 
-std::vector<std::string> write_sweep_plots(const std::string& dir, const std::vector<SweepPoint>& points,
-                                           const std::string& note) {
-  std::vector<std::string> written;
+std::vector<sweep::Chart> sweep_plots(const std::vector<SweepPoint>& points, const std::string& note) {
+  std::vector<sweep::Chart> charts;
   sweep::Chart c;
+  c.file = "sweep_error";
   c.title = "Injected latency vs foveal error";
-  c.note = note;
+  c.note = note + "; n: vsyncs with a true eye";
   c.x_label = "injected latency (ms)";
   c.y_label = "foveal error at photon time (deg)";
-  sweep::Series med{"median", sweep::palette(0), {}, true, true, {}}, p95{"p95", sweep::palette(1), {}, true, true, {}};
+  sweep::Series med{"median", 0, {}, true, true}, p95{"p95", 1, {}, true, true};
   for (const SweepPoint& p : points) {
     if (p.error["median"].is_null()) continue;  // no shown frame had a true eye
     med.points.push_back({p.inject_ms, p.error["median"].get<double>()});
+    med.point_labels.push_back("n=" + std::to_string(p.error["n"].get<std::size_t>()));
     p95.points.push_back({p.inject_ms, p.error["p95"].get<double>()});
   }
   c.series = {med, p95};
-  save(dir, "sweep_error.png", c, written);
-  sweep::Chart q;
-  q.title = "Injected latency vs quality where the user looks, after saccades";
-  q.note = note;
-  q.x_label = "injected latency (ms)";
-  q.y_label = "fovea PSNR, tone-mapped (dB)";
-  sweep::Series ps{"", sweep::palette(0), {}, true, true, {}}, fl{"", sweep::palette(1), {}, true, true, {}};
+  charts.push_back(c);
+  // Quality is a mean over few frames after few saccades: each point carries its n.
+  sweep::Series ps{"", 0, {}, true, true}, fl{"", 1, {}, true, true};
   for (const SweepPoint& p : points) {
     if (!p.fovea_psnr_db) continue;
+    const std::string n = std::to_string(p.quality_frames) + " frames, " + std::to_string(p.quality_saccades) + " sacc.";
     ps.points.push_back({p.inject_ms, *p.fovea_psnr_db});
     fl.points.push_back({p.inject_ms, *p.fovea_hdr_flip});
+    ps.point_labels.push_back(n);
+    fl.point_labels.push_back(n);
     ps.label = "PSNR, " + fmt(p.quality_radius_deg) + " deg around the true gaze";
     fl.label = "HDR-FLIP, " + fmt(p.quality_radius_deg) + " deg around the true gaze";
   }
   if (!ps.points.empty()) {
+    sweep::Chart q;
+    q.title = "Injected latency vs quality where the user looks, after saccades";
+    q.note = note;
+    q.x_label = "injected latency (ms)";
+    q.file = "sweep_quality";
+    q.y_label = "fovea PSNR, tone-mapped (dB)";
     q.series = {ps};
-    save(dir, "sweep_quality.png", q, written);
+    charts.push_back(q);
+    q.file = "sweep_flip";
     q.y_label = "fovea HDR-FLIP (lower is better)";
     q.series = {fl};
-    save(dir, "sweep_flip.png", q, written);
+    charts.push_back(q);
   }
-  return written;
+  return charts;
 }
 
 }  // namespace fovea::latency

@@ -2,13 +2,14 @@
 // What `fovea latency` reports from timing records (a simulation's or an OpenXR session's):
 // distributions of tracker delay, gaze-to-photon, motion-to-photon and each stage, missed
 // frames, and — where the records carry the truth — the foveal error at photon time; plus
-// the plots of them (PNG). docs/latency.md.
+// the charts of them (drawn by matplotlib, docs/figures.md). docs/latency.md.
 #include <string>
 #include <vector>
 
 #include <nlohmann/json.hpp>
 
 #include "latency/simulate.hpp"
+#include "sweep/plot.hpp"
 
 namespace fovea::latency {
 
@@ -38,10 +39,10 @@ nlohmann::json error_summary(const std::vector<double>& error_deg);
 // recovery times.
 nlohmann::json summarize(const std::vector<xrcommon::TimingRecord>& records, const Simulation* sim);
 
-// The plots into `dir`: latency.png (distributions), stages.png, and with the truth
-// foveal_error.png (over time, saccade onsets marked). Returns the file names written.
-std::vector<std::string> write_plots(const std::string& dir, const std::vector<xrcommon::TimingRecord>& records,
-                                     const Simulation* sim, const std::string& note);
+// The charts: latency (distributions), stages, and with the truth foveal_error (over
+// time, saccade onsets marked, broken where no true eye was shown).
+std::vector<sweep::Chart> plots(const std::vector<xrcommon::TimingRecord>& records, const Simulation* sim,
+                                const std::string& note);
 
 struct SweepPoint {
   double inject_ms = 0;
@@ -52,10 +53,10 @@ struct SweepPoint {
   // Quality against the converged reference within quality_radius_deg of the true gaze.
   std::optional<double> fovea_psnr_db, fovea_hdr_flip;
   double quality_radius_deg = 0;
+  std::size_t quality_frames = 0, quality_saccades = 0;  // what the quality is a mean over
 };
-// sweep_error.png (foveal error vs injected latency) and, with quality, sweep_quality.png
-// (tone-mapped PSNR) and sweep_flip.png (HDR-FLIP).
-std::vector<std::string> write_sweep_plots(const std::string& dir, const std::vector<SweepPoint>& points,
-                                           const std::string& note);
+// sweep_error (foveal error vs injected latency, n per point) and, with quality,
+// sweep_quality (tone-mapped PSNR) and sweep_flip (HDR-FLIP), frames and saccades per point.
+std::vector<sweep::Chart> sweep_plots(const std::vector<SweepPoint>& points, const std::string& note);
 
 }  // namespace fovea::latency

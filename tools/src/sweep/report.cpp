@@ -52,14 +52,33 @@ std::string file_stem(const std::string& metric) {
   return s;
 }
 
-// Axis label with the unit the metric's name implies.
+// A metric's key in words, e.g. "fovea_hdr_flip" -> "fovea HDR-FLIP", "cpu_ms.total" ->
+// "CPU time: total".
+std::string human_name(const std::string& m) {
+  static const std::pair<const char*, const char*> kWords[] = {
+      {"gaze_to_photon_ms", "gaze-to-photon latency"}, {"foveal_error_deg", "foveal error"},
+      {"fovea_quality", "fovea quality after saccades"}, {"hdr_flip", "HDR-FLIP"}, {"ldr_flip", "LDR-FLIP"},
+      {"psnr_db", "PSNR"}, {"psnr", "PSNR"}, {"ssim", "SSIM"}, {"rel_mse", "relative MSE"}, {"cpu_ms", "CPU time"},
+      {"gpu_ms", "GPU time"}, {"wall_seconds", "wall time"}, {"above_", "share above "}};
+  std::string s = m;
+  for (const auto& [key, words] : kWords)
+    for (auto at = s.find(key); at != std::string::npos; at = s.find(key, at + std::string_view(words).size()))
+      s.replace(at, std::string_view(key).size(), words);
+  std::string out;
+  for (char c : s) out += c == '_' ? std::string(" ") : c == '.' ? std::string(": ") : std::string(1, c);
+  return out;
+}
+
+// Axis label: the metric in words with the unit its key implies.
 std::string axis_label(const std::string& m) {
-  if (m.find("psnr") != std::string::npos) return m + " (dB)";
-  if (m.find(".above_") != std::string::npos) return m + " (fraction of vsyncs)";
-  if (m.find("_deg") != std::string::npos) return m + " (deg)";
-  if (m.find("_ms") != std::string::npos || m.rfind("ms", m.size() - 2) == m.size() - 2) return m + " (ms)";
-  if (m.find("seconds") != std::string::npos) return m + " (s)";
-  return m;
+  const std::string h = human_name(m);
+  if (m.find("psnr") != std::string::npos) return h + " (dB)";
+  if (m.find(".above_") != std::string::npos) return h + " (fraction of vsyncs)";
+  if (m.find("_deg") != std::string::npos) return h + " (deg)";
+  if (m.find("_ms") != std::string::npos || m.rfind("ms", m.size() - 2) == m.size() - 2) return h + " (ms)";
+  if (m.find("seconds") != std::string::npos) return h + " (s)";
+  if (m.find("flip") != std::string::npos) return h + " (lower is better)";
+  return h;
 }
 
 // fovea latency's summary: the share of vsyncs whose foveal error exceeds 2°, and the
@@ -601,10 +620,11 @@ ReportSummary write_report(const Plan& plan, const ReportOptions& o) {
   const bool sectioned = sections.size() > 1;
   fs::create_directories(out);
   std::map<std::string, std::vector<std::string>> section_files;  // section -> PNGs; latency plots under kLatencySection
-  auto save = [&](const core::Image& img, const std::string& name, const std::string& section) {
-    core::write_png((out / name).string(), img);
-    sum.files.push_back(name);
-    section_files[section].push_back(name);
+  std::vector<Chart> charts;  // drawn together at the end (figures.json)
+  auto save = [&](Chart c, const std::string& stem, const std::string& section) {
+    c.file = stem;
+    charts.push_back(std::move(c));
+    section_files[section].push_back(stem + ".png");
   };
 
   std::map<std::string, std::map<std::string, bool>> on_front;  // quality -> id -> flag
@@ -621,23 +641,27 @@ ReportSummary write_report(const Plan& plan, const ReportOptions& o) {
     // Pareto fronts of quality against time, per group.
     for (const auto& q : cfg.quality) {
       Chart ch;
-      ch.title = q + " against time per frame" + where;
-      ch.note = "ringed: Pareto front per " + cfg.group + " (" + (cfg.lower_better(q) ? "lower" : "higher") + " " + q +
-                " is better, less time is better)";
+      ch.title = human_name(q) + " against time per frame" + where;
+      ch.note = "ringed: Pareto front per " + cfg.group + " (" + (cfg.lower_better(q) ? "lower" : "higher") + " " +
+                human_name(q) + " is better, less time is better); labels: " + cfg.budget;
       ch.x_label = axis_label(cfg.time) + " per stereo frame";
       ch.y_label = axis_label(q);
       for (std::size_t g = 0; g < groups.size(); ++g) {
         std::vector<const Row*> members;
         std::vector<glm::dvec2> pts;
+        std::vector<std::string> budgets_of;
         for (const Row* r : members_of_section)
           if (group_of(*r) == groups[g] && r->metrics.count(cfg.time) && r->metrics.count(q)) {
             members.push_back(r);
             pts.push_back({r->metrics.at(cfg.time), r->metrics.at(q)});
+            budgets_of.push_back(r->settings.contains(cfg.budget) ? setting_text(r->settings[cfg.budget]) : "");
           }
         if (pts.empty()) continue;
         const std::vector<bool> f = pareto_front(pts, !cfg.lower_better(q));
-        Series s{groups[g], palette(g), pts, false, true, f};
-        Series line{"", palette(g), {}, true, false, {}};
+        Series s{groups[g], g, pts, false, true};
+        s.emphasised = f;
+        s.point_labels = budgets_of;
+        Series line{"", g, {}, true, false};
         json ids = json::array();
         std::vector<std::pair<glm::dvec2, std::string>> fp;
         for (std::size_t i = 0; i < pts.size(); ++i) {
@@ -650,7 +674,7 @@ ReportSummary write_report(const Plan& plan, const ReportOptions& o) {
         ch.series.push_back(line);
         ch.series.push_back(s);
       }
-      if (!ch.series.empty()) save(draw_chart(ch), "quality_vs_time_" + file_stem(q) + suffix + ".png", section);
+      if (!ch.series.empty()) save(ch, "quality_vs_time_" + file_stem(q) + suffix, section);
 
       // Quality against budget: the best job at each budget, per group.
       std::set<std::string> budgets;
@@ -658,7 +682,7 @@ ReportSummary write_report(const Plan& plan, const ReportOptions& o) {
         if (r->settings.contains(cfg.budget)) budgets.insert(r->settings[cfg.budget].dump());
       if (budgets.size() > 1) {
         Chart cb;
-        cb.title = q + " against " + cfg.budget + where;
+        cb.title = human_name(q) + " against " + cfg.budget + where;
         cb.note = "best job at each " + cfg.budget + " over the other settings, per " + cfg.group;
         cb.x_label = cfg.budget == "budget" ? "budget (grid samples / display pixels)" : cfg.budget;
         cb.y_label = axis_label(q);
@@ -671,11 +695,11 @@ ReportSummary write_report(const Plan& plan, const ReportOptions& o) {
               auto it = best.find(b);
               if (it == best.end() || (cfg.lower_better(q) ? v < it->second : v > it->second)) best[b] = v;
             }
-          Series s{groups[g], palette(g), {}, true, true, {}};
+          Series s{groups[g], g, {}, true, true};
           for (const auto& [b, v] : best) s.points.push_back({b, v});
           if (!s.points.empty()) cb.series.push_back(s);
         }
-        if (!cb.series.empty()) save(draw_chart(cb), "quality_vs_budget_" + file_stem(q) + suffix + ".png", section);
+        if (!cb.series.empty()) save(cb, "quality_vs_budget_" + file_stem(q) + suffix, section);
       }
     }
 
@@ -686,7 +710,7 @@ ReportSummary write_report(const Plan& plan, const ReportOptions& o) {
         if (cfg.bands.empty() || std::find(cfg.bands.begin(), cfg.bands.end(), k) != cfg.bands.end()) band_names.insert(k);
     for (const auto& bname : band_names) {
       Chart cb;
-      cb.title = bname + " per eccentricity band" + where;
+      cb.title = human_name(bname) + " per eccentricity band" + where;
       cb.note = cfg.quality.empty() ? "" : "jobs on the " + cfg.quality[0] + " Pareto fronts";
       cb.x_label = "eccentricity, band centre (deg)";
       cb.y_label = axis_label(bname);
@@ -694,11 +718,11 @@ ReportSummary write_report(const Plan& plan, const ReportOptions& o) {
       for (const Row* r : members_of_section) {
         if (!r->bands.count(bname) || n >= 8) continue;
         if (!cfg.quality.empty() && !on_front[cfg.quality[0]][r->id]) continue;
-        Series s{group_of(*r) + " " + label_of(*r), palette(n++), {}, true, true, {}};
+        Series s{group_of(*r) + " " + label_of(*r), n++, {}, true, true};
         for (const BandValue& b : r->bands.at(bname)) s.points.push_back({0.5 * (b.e_min + b.e_max), b.value});
         cb.series.push_back(s);
       }
-      if (!cb.series.empty()) save(draw_chart(cb), "bands_" + file_stem(bname) + suffix + ".png", section);
+      if (!cb.series.empty()) save(cb, "bands_" + file_stem(bname) + suffix, section);
     }
   }
 
@@ -715,22 +739,23 @@ ReportSummary write_report(const Plan& plan, const ReportOptions& o) {
         lgroups.push_back(lgroup_of(r));
     for (const auto& q : cfg.latency_quality) {
       Chart cl;
-      cl.title = q + " against " + cfg.latency;
+      cl.title = human_name(q) + " against " + human_name(cfg.latency);
       cl.note = "one point per job; legend: " + cfg.latency_group + " (" + (cfg.lower_better(q) ? "lower" : "higher") +
                 " is better)";
       cl.x_label = axis_label(cfg.latency);
       cl.y_label = axis_label(q);
       for (std::size_t g = 0; g < lgroups.size(); ++g) {
-        Series s{cfg.latency_group + " " + lgroups[g], palette(g), {}, true, true, {}};
+        Series s{cfg.latency_group + " " + lgroups[g], g, {}, true, true};
         for (const auto& r : rows)
           if (r.status == "done" && lgroup_of(r) == lgroups[g] && r.metrics.count(q) && r.metrics.count(cfg.latency))
             s.points.push_back({r.metrics.at(cfg.latency), r.metrics.at(q)});
         std::sort(s.points.begin(), s.points.end(), [](const glm::dvec2& a, const glm::dvec2& b) { return a.x < b.x; });
         if (!s.points.empty()) cl.series.push_back(s);
       }
-      if (!cl.series.empty()) save(draw_chart(cl), "latency_vs_" + file_stem(q) + ".png", kLatencySection);
+      if (!cl.series.empty()) save(cl, "latency_vs_" + file_stem(q), kLatencySection);
     }
   }
+  sum.files = write_charts(out.string(), "figures.json", charts);
   // results.csv: one row per job; settings, metrics and bands as columns.
   std::set<std::string> setting_cols, metric_cols, band_cols;
   for (const auto& r : rows) {
