@@ -1,6 +1,7 @@
 // Loader negotiation, xrCreateApiLayerInstance and xrGetInstanceProcAddr (api_layer.adoc:
 // negotiation, create-instance process, intercept requirements).
 #include <algorithm>
+#include <cstdlib>
 #include <cstring>
 
 #include "fovea/runtime/loader_interface.hpp"
@@ -44,13 +45,14 @@ XrResult XRAPI_CALL get_instance_proc_addr(XrInstance instance, const char* name
     return XR_SUCCESS;
   }
   PFN_xrGetInstanceProcAddr next = nullptr;
-  bool mask_hidden = false;
+  bool mask_hidden = false, timespec_hidden = false;
   {
     std::lock_guard lock(layer().mutex);
     auto it = layer().instances.find(instance);
     if (it != layer().instances.end()) {
       next = it->second.next.xrGetInstanceProcAddr;
       mask_hidden = it->second.visibility_mask_hidden;
+      timespec_hidden = it->second.timespec_hidden;
     }
   }
   if (!next) {
@@ -58,7 +60,9 @@ XrResult XRAPI_CALL get_instance_proc_addr(XrInstance instance, const char* name
     return XR_ERROR_HANDLE_INVALID;  // not an instance created through this layer
   }
   // What the application did not enable stays unsupported for it, as without the layer.
-  if (mask_hidden && !std::strcmp(name, "xrGetVisibilityMaskKHR")) {
+  if ((mask_hidden && !std::strcmp(name, "xrGetVisibilityMaskKHR")) ||
+      (timespec_hidden &&
+       (!std::strcmp(name, "xrConvertTimeToTimespecTimeKHR") || !std::strcmp(name, "xrConvertTimespecTimeToTimeKHR")))) {
     *function = nullptr;
     return XR_ERROR_FUNCTION_UNSUPPORTED;
   }
@@ -100,10 +104,13 @@ XrResult XRAPI_CALL create_api_layer_instance(const XrInstanceCreateInfo* info, 
                                 strnlen(info->applicationInfo.applicationName, XR_MAX_APPLICATION_NAME_SIZE));
   // With a scene configured, the runtime's hidden area lets the layer skip tracing it.
   bool want_gaze = false, want_mask = false;
+  const char* out = std::getenv("FOVEA_LAYER_OUT");
+  const XrApiLayerNextInfo* last = next;
+  while (last->next) last = last->next;
+  // The timing log's XrTime values go on the layer's clock where the runtime can convert them.
+  const bool want_timespec = out && *out && runtime_has_extension(last->nextGetInstanceProcAddr, kConvertTimespecExtension);
   try {
     if (!load_config(application).scene.empty()) {
-      const XrApiLayerNextInfo* last = next;
-      while (last->next) last = last->next;
       want_gaze = runtime_has_extension(last->nextGetInstanceProcAddr, kEyeGazeExtension);
       want_mask = runtime_has_extension(last->nextGetInstanceProcAddr, kVisibilityMaskExtension);
     }
@@ -118,6 +125,8 @@ XrResult XRAPI_CALL create_api_layer_instance(const XrInstanceCreateInfo* info, 
   const bool app_mask = enabled(kVisibilityMaskExtension);
   const bool mask_hidden = want_mask && !app_mask;
   if (mask_hidden) extensions.push_back(kVisibilityMaskExtension);
+  const bool timespec_hidden = want_timespec && !enabled(kConvertTimespecExtension);
+  if (timespec_hidden) extensions.push_back(kConvertTimespecExtension);
   XrInstanceCreateInfo down = *info;
   down.enabledExtensionCount = uint32_t(extensions.size());
   down.enabledExtensionNames = extensions.data();
@@ -153,6 +162,15 @@ XrResult XRAPI_CALL create_api_layer_instance(const XrInstanceCreateInfo* info, 
     state.get_visibility_mask = nullptr;
   }
   state.visibility_mask_hidden = mask_hidden;
+  state.timespec_hidden = timespec_hidden;
+  if ((want_timespec || enabled(kConvertTimespecExtension)) &&
+      (XR_FAILED(next->nextGetInstanceProcAddr(*instance, "xrConvertTimeToTimespecTimeKHR",
+                                               reinterpret_cast<PFN_xrVoidFunction*>(&state.to_timespec))) ||
+       !state.to_timespec)) {
+    FOVEA_LAYER_WARN("%s enabled but xrConvertTimeToTimespecTimeKHR missing below: layer_timing.jsonl keeps the "
+                     "runtime's XrTime values", kConvertTimespecExtension);
+    state.to_timespec = nullptr;
+  }
   state.gaze_hidden = gaze_hidden;
   if (want_gaze) try {
       state.gaze = create_eye_gaze_actions(state.next, *instance);

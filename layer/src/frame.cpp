@@ -23,6 +23,8 @@ struct SessionRefs {
   EyeGazeSession gaze;
   PFN_xrGetVisibilityMaskKHR get_visibility_mask = nullptr;
   std::uint64_t visibility_mask_generation = 0;
+  XrInstance instance = XR_NULL_HANDLE;
+  ConvertTimeToTimespec to_timespec = nullptr;  // null: the runtime cannot convert its XrTime
 };
 
 SessionRefs refs(XrSession session) {
@@ -37,7 +39,31 @@ SessionRefs refs(XrSession session) {
   r.gaze = s.gaze;
   r.get_visibility_mask = s.get_visibility_mask;
   r.visibility_mask_generation = s.visibility_mask_generation;
+  r.instance = s.instance;
+  if (auto i = layer().instances.find(s.instance); i != layer().instances.end()) r.to_timespec = i->second.to_timespec;
   return r;
+}
+
+// The record's XrTime values on CLOCK_MONOTONIC, the clock of the layer's own stamps, with the
+// runtime's XR_KHR_convert_timespec_time. Without it, or when a conversion fails, they stay
+// the runtime's XrTime and the record says so (xr_time_converted false): an XrTime need not be
+// CLOCK_MONOTONIC.
+void convert_xr_times(const SessionRefs& s, FrameTimes& t) {
+  if (!s.to_timespec) return;
+  const auto convert = [&](std::int64_t& ns) {
+    if (ns <= 0) return true;  // none: nothing to convert
+    timespec ts{};
+    if (XR_FAILED(s.to_timespec(s.instance, ns, &ts))) return false;
+    ns = std::int64_t(ts.tv_sec) * 1'000'000'000 + ts.tv_nsec;
+    return true;
+  };
+  FrameTimes c = t;
+  bool ok = convert(c.display_time_ns) && convert(c.shown.traced_for_ns);
+  if (!c.shown.times.gaze_on_host_clock)
+    ok = ok && convert(c.shown.times.gaze_sample_ns) && convert(c.shown.times.gaze_receive_ns);
+  if (!ok) return;
+  t = c;
+  t.xr_time_converted = true;
 }
 
 // An internal failure: the session passes through from now on. Its renderer is released by
@@ -144,6 +170,7 @@ XrResult intercept::xrEndFrame(XrSession session, const XrFrameEndInfo* info) {
   if (s.renderer && record && info->displayTime > 0) {
     FrameInput in;
     in.display_time = info->displayTime;
+    in.app_frame_index = record->frame;
     in.app_frame = info;
     {
       // The first stereo projection layer is the one replaced.
@@ -186,6 +213,7 @@ XrResult intercept::xrEndFrame(XrSession session, const XrFrameEndInfo* info) {
         t.projection_views += reinterpret_cast<const XrCompositionLayerProjection*>(info->layers[i])->viewCount;
     t.replaced = submit != info;
     if (t.replaced) t.shown = shown;
+    convert_xr_times(s, t);
     s.frames->log.write(t);
   }
   return r;

@@ -91,11 +91,14 @@ void FrameLog::write_now(const FrameTimes& t) {
               {"wait", rt.wait_cpu},
               {"readback", rt.readback_cpu}};
   r.gpu_ms = {{"trace", rt.trace}, {"reconstruct", rt.reconstruct}, {"resolve", rt.resolve}};
-  r.extra = {{"layers", std::int64_t(t.layers)},     {"projection_views", std::int64_t(t.projection_views)},
+  r.extra = {// Which clock the runtime's XrTime values are on (FrameTimes::xr_time_converted).
+             {"xr_time_converted", t.xr_time_converted},
+             {"layers", std::int64_t(t.layers)},     {"projection_views", std::int64_t(t.projection_views)},
              {"replaced", t.replaced},                {"render_ms", rt.total},
              {"transfer_ms", rt.transfer},            {"samples_hidden", rt.samples_hidden},
              // Which path-traced frame this displayed frame shows (asynchronous rendering).
              {"traced_frame", t.shown.frame},         {"traced_for_ns", t.shown.traced_for_ns},
+             {"traced_for_frame", t.shown.traced_for_frame},
              {"traced_done_ns", t.shown.done_ns},
              {"traced_age_ns", t.shown.frame >= 0 ? t.display_time_ns - t.shown.traced_for_ns : std::int64_t(0)},
              {"reprojected_deg", std::isfinite(t.shown.reprojected_deg) ? t.shown.reprojected_deg : 0.0},

@@ -1,7 +1,8 @@
 #pragma once
 // The layer's per-frame timing log (pass-through measurement): one timing record
 // (fovea/xrcommon/timing_record.hpp) per line in <FOVEA_LAYER_OUT>/layer_timing.jsonl.
-// Times are int64 ns of CLOCK_MONOTONIC.
+// Times are int64 ns of CLOCK_MONOTONIC; the runtime's XrTime values are converted to it where
+// the runtime can (FrameTimes::xr_time_converted says whether they were).
 #include <chrono>
 #include <condition_variable>
 #include <cstdint>
@@ -26,6 +27,10 @@ struct FrameTimes {
   std::int64_t end_down_ns = 0;  // the call down the chain began (the layer's own work before it)
   std::uint32_t layers = 0, projection_views = 0;
   bool replaced = false;  // a frame renderer replaced the application's layers
+  // The runtime's XrTime values (display_time_ns, shown.traced_for_ns, and the gaze sample's
+  // times unless shown.times.gaze_on_host_clock) were converted to CLOCK_MONOTONIC with
+  // XR_KHR_convert_timespec_time; false: they are the runtime's XrTime as it gave them.
+  bool xr_time_converted = false;
   // What the frame renderer showed (Shown's defaults when not replaced: no traced frame, -1):
   // the path-traced frame, where it was composited, its render's split and this frame's.
   Shown shown;

@@ -111,6 +111,7 @@ core::StereoViews submitted_views(const std::vector<AppView>& v) {
 struct TraceRequest {
   std::int64_t id = 0;
   XrTime display_time = 0;
+  std::int64_t app_frame_index = 0;
   std::array<XrPosef, 2> poses{};
   bool gaze_from_action = false;
   ActionGaze action_gaze;
@@ -124,6 +125,7 @@ struct TraceRequest {
 struct TracedFrame {
   std::int64_t id = 0;
   XrTime traced_for = 0;
+  std::int64_t traced_for_frame = 0;
   std::int64_t done_ns = 0;
   std::array<glm::dquat, 2> orientation{};  // the views' orientations it was traced for (the application's space)
   std::array<Pixels8, 2> colour;
@@ -178,6 +180,7 @@ class PathTracer {
       times.gaze_receive_ns = fg.receive_ns;
     }
     times.gaze_read_ns = fg.read_ns;
+    times.gaze_on_host_clock = !in.gaze_from_action && gaze_->live();
     for (int e = 0; e < 2; ++e) {
       const auto ei = std::size_t(e);
       const core::Pose p = to_pose(in.poses[ei]);
@@ -221,6 +224,7 @@ class PathTracer {
     times.total = ms_since(t0);
     f->id = in.id;
     f->traced_for = in.display_time;
+    f->traced_for_frame = in.app_frame_index;
     f->done_ns = monotonic_ns();
     return f;
   }
@@ -318,6 +322,7 @@ class PathTraceRenderer final : public FrameRenderer {
 
     TraceRequest req;
     req.display_time = in.display_time;
+    req.app_frame_index = in.app_frame_index;
     for (std::size_t e = 0; e < 2; ++e) req.poses[e] = in.app_views[e].pose;
     req.gaze_from_action = in.gaze_from_action;
     req.action_gaze = in.action_gaze;
@@ -413,6 +418,7 @@ class PathTraceRenderer final : public FrameRenderer {
   const XrFrameEndInfo* compose(const FrameInput& in, const TracedFrame& f, Shown& shown) {
     shown.frame = f.id;
     shown.traced_for_ns = f.traced_for;
+    shown.traced_for_frame = f.traced_for_frame;
     shown.done_ns = f.done_ns;
     shown.times = f.times;
     const bool scene_only = config_.composite == Composite::SceneOnly;

@@ -57,6 +57,7 @@ struct AppView {
 
 struct FrameInput {
   XrTime display_time = 0;
+  std::int64_t app_frame_index = 0;  // the application's frame index (its xrWaitFrame count in the session)
   std::vector<AppView> app_views;  // the first stereo projection layer's views
   std::uint32_t projection_layer = 0;  // its index in app_frame->layers
   const XrFrameEndInfo* app_frame = nullptr;
@@ -83,13 +84,18 @@ struct RenderTimes {
   // The gaze sample the frame was foveated for (CLOCK_MONOTONIC ns; 0: none measured yet):
   // when it was measured, when the host received it, when the renderer read it.
   std::int64_t gaze_sample_ns = 0, gaze_receive_ns = 0, gaze_read_ns = 0;
+  // gaze_sample_ns and gaze_receive_ns are on the host's CLOCK_MONOTONIC (a live devices/
+  // source), else on the runtime's XrTime (the eye-gaze action's XrEyeGazeSampleTimeEXT, or
+  // a recorded or synthetic source counted from the first frame's display time).
+  bool gaze_on_host_clock = false;
   std::int64_t samples_hidden = 0;  // grid cells under the runtime's hidden area, both eyes: not traced
 };
 
 // The path-traced frame an xrEndFrame showed.
 struct Shown {
-  std::int64_t frame = -1;          // its number (-1: none)
+  std::int64_t frame = -1;          // its render request's number (-1: none)
   std::int64_t traced_for_ns = 0;   // the display time of the views it was traced for
+  std::int64_t traced_for_frame = -1;  // the application's frame index whose views it was traced for
   std::int64_t done_ns = 0;         // when it finished (CLOCK_MONOTONIC)
   double reprojected_deg = 0;       // head rotation since, the larger of the two eyes
   RenderTimes times;                // its render's split; `transfer` is this xrEndFrame's composition

@@ -30,6 +30,7 @@ class LayerGaze {
   // the action when given, else from the source (recordings start at the first frame).
   devices::FoveaGaze frame(std::int64_t display_time_ns, const ActionGaze* action);
   std::string describe() const { return gaze_.describe(); }
+  bool live() const { return gaze_.live(); }  // the source's times are the host's clock
 
  private:
   devices::FoveationGaze gaze_;

@@ -13,6 +13,8 @@
 #include <type_traits>
 #include <vector>
 
+#include <time.h>
+
 #include <vulkan/vulkan.h>
 
 #define XR_USE_GRAPHICS_API_VULKAN
@@ -34,6 +36,13 @@ constexpr std::uint32_t kLayerExtensionVersion = 1;
 // Enabled below the layer, when the runtime offers it and a scene is configured, for the
 // runtime's hidden area (the view pixels the layer does not trace).
 constexpr const char* kVisibilityMaskExtension = "XR_KHR_visibility_mask";
+// Enabled below the layer, when the runtime offers it and FOVEA_LAYER_OUT is set, so the
+// runtime's XrTime values in layer_timing.jsonl are converted to CLOCK_MONOTONIC, the clock of
+// the layer's own stamps (an XrTime need not be CLOCK_MONOTONIC: Monado's is not).
+constexpr const char* kConvertTimespecExtension = "XR_KHR_convert_timespec_time";
+// PFN_xrConvertTimeToTimespecTimeKHR, declared here: openxr_platform.h declares it only when
+// XR_USE_TIMESPEC was defined before its first inclusion, wherever that was.
+using ConvertTimeToTimespec = XrResult(XRAPI_PTR*)(XrInstance instance, XrTime time, struct timespec* timespecTime);
 
 // The next layer's (or the runtime's) commands the layer calls.
 #define FOVEA_LAYER_NEXT(X) \
@@ -122,6 +131,10 @@ struct InstanceState {
   // The layer enabled kVisibilityMaskExtension for itself: the application must not see it
   // (its command stays unsupported, its events are not delivered).
   bool visibility_mask_hidden = false;
+  // The runtime's xrConvertTimeToTimespecTimeKHR (null: the extension is not enabled below);
+  // hidden from an application that did not enable the extension itself.
+  ConvertTimeToTimespec to_timespec = nullptr;
+  bool timespec_hidden = false;
 };
 
 struct Layer {

@@ -288,7 +288,11 @@ TEST_P(AsyncLayer, PipelinedFramesOnTwoThreadsNeverWaitForTheRenderThread) {
   EXPECT_GT(recs.size(), 4 * traced.size()) << recs.size() << " frames, " << traced.size() << " traced";
   std::int64_t last_traced = -1, last_display = 0;
   int replaced = 0;
+  std::map<std::int64_t, std::int64_t> display_of;  // the application's frame index -> its display time
+  for (const auto& r : recs) display_of[r["frame"].get<std::int64_t>()] = r["predicted_display_ns"].get<std::int64_t>();
   for (const auto& r : recs) {
+    // One clock: the runtime's XrTime values converted with XR_KHR_convert_timespec_time.
+    EXPECT_TRUE(r["xr_time_converted"].get<bool>()) << r.dump();
     const std::int64_t tf = r["traced_frame"].get<std::int64_t>();
     const std::int64_t display = r["predicted_display_ns"].get<std::int64_t>();
     EXPECT_GT(display, last_display) << r.dump();  // the queue matched each end to its own wait
@@ -304,6 +308,14 @@ TEST_P(AsyncLayer, PipelinedFramesOnTwoThreadsNeverWaitForTheRenderThread) {
     last_traced = tf;
     // Traced for views submitted earlier (or these): its age is never negative, its gaze sample named.
     EXPECT_LE(r["traced_for_ns"].get<std::int64_t>(), display) << r.dump();
+    // The application's frame whose views it was traced for (traced_frame counts render
+    // requests, which skip the frames the render thread never picked up): an earlier frame
+    // of the log, or this one, with that display time.
+    const std::int64_t for_frame = r["traced_for_frame"].get<std::int64_t>();
+    EXPECT_LE(for_frame, r["frame"].get<std::int64_t>()) << r.dump();
+    if (display_of.count(for_frame)) {
+      EXPECT_EQ(display_of[for_frame], r["traced_for_ns"].get<std::int64_t>()) << r.dump();
+    }
     EXPECT_GE(r["traced_age_ns"].get<std::int64_t>(), 0) << r.dump();
     EXPECT_GT(r["traced_done_ns"].get<std::int64_t>(), 0) << r.dump();
     EXPECT_GT(r["gaze_read_ns"].get<std::int64_t>(), 0) << r.dump();

@@ -243,6 +243,57 @@ TEST_F(LayerApiTest, ApplicationActionSetNamesNeverCollideWithTheLayers) {
   unsetenv("FOVEA_RUNTIME_OUT");
 }
 
+// The timing log's XrTime values (the predicted display time, here) are converted to
+// CLOCK_MONOTONIC, the clock of the layer's own stamps, with XR_KHR_convert_timespec_time,
+// which the layer enables below itself while the application, which did not enable it, still
+// finds its commands unsupported; `frame` is the application's frame index. (The project's
+// runtime's XrTime is CLOCK_MONOTONIC: converted, the values stay the ones it predicted.)
+TEST_F(LayerApiTest, TimingRecordsAreOnOneClock) {
+  for (const bool app_enables : {false, true}) {
+    SCOPED_TRACE(app_enables ? "the application enabled XR_KHR_convert_timespec_time" : "not enabled by the application");
+    std::vector<const char*> ext;
+    if (app_enables) ext.push_back("XR_KHR_convert_timespec_time");
+    ASSERT_NO_FATAL_FAILURE(create_instance(ext));
+    for (const char* fn : {"xrConvertTimeToTimespecTimeKHR", "xrConvertTimespecTimeToTimeKHR"}) {
+      PFN_xrVoidFunction f = nullptr;
+      EXPECT_EQ(xrGetInstanceProcAddr(instance_, fn, &f), app_enables ? XR_SUCCESS : XR_ERROR_FUNCTION_UNSUPPORTED) << fn;
+      EXPECT_EQ(f != nullptr, app_enables) << fn;
+    }
+    ASSERT_NO_FATAL_FAILURE(run_to_focused());
+    std::vector<XrTime> predicted;
+    for (int f = 0; f < 3; ++f) {
+      XrFrameState fs{XR_TYPE_FRAME_STATE};
+      ASSERT_EQ(frame({}, &fs), XR_SUCCESS);
+      predicted.push_back(fs.predictedDisplayTime);
+    }
+    XrTest::TearDown();  // the session's records are complete once it is destroyed
+    instance_ = XR_NULL_HANDLE;
+    session_ = XR_NULL_HANDLE;
+    vk_instance_ = VK_NULL_HANDLE;
+    vk_physical_ = VK_NULL_HANDLE;
+    vk_device_ = VK_NULL_HANDLE;
+    messenger_ = VK_NULL_HANDLE;
+    std::vector<nlohmann::json> recs;
+    std::ifstream in(log_->path() + "/layer_timing.jsonl");
+    for (std::string line; std::getline(in, line);) recs.push_back(core::parse_json(line));
+    // This instance's session: run_to_focused's frame and the three above, last in the file.
+    ASSERT_GE(recs.size(), 4u);
+    const std::vector<nlohmann::json> mine(recs.end() - 4, recs.end());
+    for (std::size_t i = 0; i < mine.size(); ++i) {
+      const nlohmann::json& r = mine[i];
+      EXPECT_EQ(r["clock"], "monotonic") << r.dump();
+      EXPECT_TRUE(r["xr_time_converted"].get<bool>()) << r.dump();
+      EXPECT_EQ(r["frame"].get<std::int64_t>(), std::int64_t(i)) << r.dump();
+      EXPECT_EQ(r["traced_frame"].get<std::int64_t>(), -1) << r.dump();  // no scene: nothing traced
+      EXPECT_EQ(r["traced_for_frame"].get<std::int64_t>(), -1) << r.dump();
+      if (i > 0) {
+        EXPECT_EQ(r["predicted_display_ns"].get<std::int64_t>(), predicted[i - 1]) << r.dump();
+      }
+      EXPECT_TRUE(r["vsync_ns"].is_null()) << "OpenXR gives the application no vsync: " << r.dump();
+    }
+  }
+}
+
 // With a scene the layer enables XR_KHR_visibility_mask below itself for culling, unseen by
 // the application: the command stays unsupported unless the application enables the
 // extension itself, in which case it reaches the runtime and answers.
