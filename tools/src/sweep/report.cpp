@@ -711,7 +711,7 @@ ReportSummary write_report(const Plan& plan, const ReportOptions& o) {
     for (const auto& bname : band_names) {
       Chart cb;
       cb.title = human_name(bname) + " per eccentricity band" + where;
-      cb.note = cfg.quality.empty() ? "" : "jobs on the " + cfg.quality[0] + " Pareto fronts";
+      cb.note = cfg.quality.empty() ? "" : "jobs on the " + human_name(cfg.quality[0]) + " Pareto fronts";
       cb.x_label = "eccentricity, band centre (deg)";
       cb.y_label = axis_label(bname);
       std::size_t n = 0;
