@@ -20,7 +20,8 @@ namespace {
 
 // Set before the layer first logs (its log file is opened once per process).
 const bool kLogFileSet = [] {
-  setenv("FOVEA_LAYER_LOG_FILE", "/nonexistent-fovea-dir/layer.log", 1);
+  // Under a file, so that no directory can be created there (not even by root).
+  setenv("FOVEA_LAYER_LOG_FILE", "/dev/null/fovea/layer.log", 1);
   setenv("FOVEA_LAYER_LOG_LEVEL", "info", 1);
   return true;
 }();
@@ -211,7 +212,7 @@ class LayerChain : public ::testing::Test {
 // First: the log file is opened at the process's first log line. An unwritable log file or output directory is reported and the layer keeps working.
 TEST_F(LayerChain, OutputFailuresAreReportedNotFatal) {
   unsetenv("FOVEA_SCENE");
-  setenv("FOVEA_LAYER_OUT", "/nonexistent-fovea-dir/out", 1);
+  setenv("FOVEA_LAYER_OUT", "/dev/null/fovea/out", 1);  // missing directories are created, not under a file
   testing::internal::CaptureStderr();
   const XrInstance instance = layer_.create_instance();
   XrSessionCreateInfo si{XR_TYPE_SESSION_CREATE_INFO};
@@ -223,8 +224,8 @@ TEST_F(LayerChain, OutputFailuresAreReportedNotFatal) {
   EXPECT_EQ(r, XR_SUCCESS);
   EXPECT_EQ(e, XR_SUCCESS);
   EXPECT_EQ(find("xrEndFrame"), g.calls.size() - 1);  // the frame went down
-  EXPECT_NE(err.find("FOVEA_LAYER_LOG_FILE \"/nonexistent-fovea-dir/layer.log\""), std::string::npos) << err;
-  EXPECT_NE(err.find("/nonexistent-fovea-dir/out/layer_timing.jsonl"), std::string::npos) << err;
+  EXPECT_NE(err.find("FOVEA_LAYER_LOG_FILE \"/dev/null/fovea/layer.log\""), std::string::npos) << err;
+  EXPECT_NE(err.find("FOVEA_LAYER_OUT=/dev/null/fovea/out: cannot create the directory"), std::string::npos) << err;
   ASSERT_EQ(layer_.get<PFN_xrDestroyInstance>(instance, "xrDestroyInstance")(instance), XR_SUCCESS);
 }
 
