@@ -270,11 +270,12 @@ Sample trace_path(vec3 org, vec3 dir, vec3 forward, inout PtRng rng) {
 }
 
 void main() {
-  if (gl_GlobalInvocationID.x >= pc.cell_count) return;
+  const uint invocation = FOVEA_LINEAR_INVOCATION;
+  if (invocation >= pc.cell_count) return;
   // The cell, not the invocation, keys the random numbers and the outputs: both orders give
   // the same buffers.
-  const uint idx = (pc.flags & kPtTileOrder) != 0u ? pt_tile_cell(gl_GlobalInvocationID.x, pc.columns, pc.cell_count)
-                                                   : gl_GlobalInvocationID.x;
+  const uint idx = (pc.flags & kPtTileOrder) != 0u ? pt_tile_cell(invocation, pc.columns, pc.cell_count)
+                                                   : invocation;
   const GridSample g = cells[idx];
   const bool accumulate = (pc.flags & kPtAccumulate) != 0u && pc.accumulated_samples > 0u;
   if (g.flags != 0u) {

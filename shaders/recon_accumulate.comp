@@ -68,7 +68,7 @@ bool seen_near(ReconGrid m, uint j, vec4 here, vec3 n, float depth) {
 }
 
 void main() {
-  uint i = gl_GlobalInvocationID.x;
+  uint i = FOVEA_LINEAR_INVOCATION;
   if (i >= pc.cells) return;
   GridSample s = samples[i];
   if (s.flags != 0u) {

@@ -37,7 +37,7 @@ layout(std430, binding = RECON_POST_SUM) writeonly buffer Sum { vec4 sum[]; };  
 layout(push_constant) uniform Push { ReconPostPush pc; };
 
 void main() {
-  uint i = gl_GlobalInvocationID.x;
+  uint i = FOVEA_LINEAR_INVOCATION;
   if (i >= pc.cells) return;
   if (rg_no_sample(texelFetch(vpos, int(i)).w) || pc.denoise == 0u) {
     post[i] = vec4(0.0);

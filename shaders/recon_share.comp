@@ -61,7 +61,7 @@ bool straddles(ReconGrid m, uint i, vec4 here, vec4 nd) {
 }
 
 void main() {
-  uint i = gl_GlobalInvocationID.x;
+  uint i = FOVEA_LINEAR_INVOCATION;
   if (i >= pc.cells) return;
   vec4 here = texelFetch(vpos, int(i));
   vec4 own = texelFetch(acc_indirect, int(i));

@@ -80,7 +80,7 @@ vec3 remodulated(uint i) {
 }
 
 void main() {
-  uint i = gl_GlobalInvocationID.x;
+  uint i = FOVEA_LINEAR_INVOCATION;
   if (i >= pc.cells) return;
   if (rg_no_sample(texelFetch(vpos, int(i)).w)) {
     final_color[i] = vec4(0.0);

@@ -161,4 +161,16 @@ void ComputePipeline::dispatch(VkCommandBuffer cmd, std::uint32_t x, std::uint32
   vkCmdDispatch(cmd, groups[0], groups[1], groups[2]);
 }
 
+void ComputePipeline::dispatch_linear(VkCommandBuffer cmd, std::uint32_t count) const {
+  const std::uint64_t groups = (std::uint64_t(count) + local_size_[0] - 1) / local_size_[0];
+  // Rows of at most max_x groups, as even as the rounding allows.
+  const std::uint64_t rows = std::max<std::uint64_t>(1, (groups + max_groups_[0] - 1) / max_groups_[0]);
+  const std::uint64_t per_row = (groups + rows - 1) / rows;
+  if (rows > max_groups_[1])
+    throw core::InputError("gpu::ComputePipeline '" + shader_ + "': " + std::to_string(count) +
+                           " invocations need " + std::to_string(rows) + " rows of workgroups, more than the device's " +
+                           std::to_string(max_groups_[1]));
+  vkCmdDispatch(cmd, std::uint32_t(per_row), std::uint32_t(rows), 1);
+}
+
 }  // namespace fovea::gpu

@@ -38,7 +38,7 @@ void Accumulation::record(VkCommandBuffer cmd, int parity, bool history, std::sp
                           const ReconSettings& s) const {
   for (std::size_t i = 0; i < eyes_.size(); ++i) {
     const Eye& e = eyes_[i];
-    kernel_.run(cmd, {&e.set[parity]},
+    kernel_.run_linear(cmd, {&e.set[parity]},
                 shaders::ReconAccumulatePush{e.cells, history ? 1u : 0u, fresh[i] ? 1u : 0u, 0, s.alpha_min,
                                              s.coarse_keep, s.coarse_reject, 0},
                 e.cells);
@@ -76,7 +76,7 @@ StereoGather::StereoGather(gpu::Context& ctx, std::span<const EyeGrid> eyes, con
 
 void StereoGather::record(VkCommandBuffer cmd, int parity, bool share, const ReconSettings& s) const {
   for (const Eye& e : eyes_)
-    kernel_.run(cmd, {&e.set[parity]},
+    kernel_.run_linear(cmd, {&e.set[parity]},
                 shaders::ReconSharePush{e.cells, share ? 1u : 0u, s.coarse_keep, s.coarse_reject,
                                         s.denoiser == Denoiser::Bmfr ? 1u : 0u, 0, 0, 0},
                 e.cells);

@@ -53,7 +53,7 @@ void PostTaa::record_post(VkCommandBuffer cmd, int parity, bool history, const R
   shaders::ReconPostPush push = post_push(history, s);
   for (const Eye& e : eyes_) {
     push.cells = e.cells;
-    post_.run(cmd, {&e.post_set[parity]}, push, e.cells);
+    post_.run_linear(cmd, {&e.post_set[parity]}, push, e.cells);
   }
   gpu::compute_to_compute(cmd);
 }
@@ -62,7 +62,7 @@ void PostTaa::record_taa(VkCommandBuffer cmd, int parity, bool history, const Re
   shaders::ReconPostPush push = post_push(history, s);
   for (const Eye& e : eyes_) {
     push.cells = e.cells;
-    taa_.run(cmd, {&e.taa_set[parity]}, push, e.cells);
+    taa_.run_linear(cmd, {&e.taa_set[parity]}, push, e.cells);
   }
   gpu::compute_to_transfer(cmd);
 }

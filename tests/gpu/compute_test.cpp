@@ -51,6 +51,28 @@ TEST_F(Compute, DispatchWithPushAndSpecializationConstants) {
     ASSERT_EQ(got[i], i < n ? i * 3 + 5 + 100000 : 0xffffffffu) << "index " << i;
 }
 
+// More workgroups than the device allows in x (65535 on lavapipe): dispatch refuses them,
+// dispatch_linear folds them into rows and every invocation index is covered once.
+TEST_F(Compute, LinearDispatchFoldsMoreGroupsThanTheDeviceAllowsInX) {
+  gpu::ComputePipeline pipe(ctx(), fill_desc({gpu::SpecConstant::u32(1, 1)}));  // groups of 1
+  const std::uint32_t limit = ctx().limits().maxComputeWorkGroupCount[0];
+  const std::uint32_t n = limit + 4321, capacity = n + 64;
+  gpu::Buffer out(ctx(), {.size = std::uint64_t(capacity) * 4, .name = "fill out"});
+  gpu::Buffer params(ctx(), {.size = 4, .usage = gpu::BufferUsage::Uniform, .memory = gpu::Memory::HostVisible});
+  params.upload(std::vector<std::uint32_t>{7});
+  gpu::DescriptorSet set(ctx(), pipe.set_layout(0));
+  set.bind(0, out).bind(1, params);
+  ctx().submit_and_wait([&](VkCommandBuffer cmd) {
+    EXPECT_THROW(pipe.run(cmd, {&set}, FillPush{n, 0}, n), fovea::core::InputError);
+    gpu::fill_buffer(cmd, out, 0xffffffffu);
+    gpu::transfer_to_compute(cmd);
+    pipe.run_linear(cmd, {&set}, FillPush{n, 0}, n);
+  });
+  const auto got = out.download<std::uint32_t>();
+  for (std::uint32_t i = 0; i < capacity; ++i)
+    ASSERT_EQ(got[i], i < n ? i + 7 : 0xffffffffu) << "index " << i;
+}
+
 TEST_F(Compute, DefaultWorkgroupSizeAndChainedDispatches) {
   gpu::ComputePipeline pipe(ctx(), fill_desc({}));
   EXPECT_EQ(pipe.workgroup_size(), (std::array<std::uint32_t, 3>{64, 1, 1}));

@@ -62,6 +62,20 @@ class ComputePipeline {
   // shaders must bounds-check). Throws core::InputError beyond the device's group limits.
   void dispatch(VkCommandBuffer cmd, std::uint32_t x, std::uint32_t y = 1, std::uint32_t z = 1) const;
 
+  // Records a 1-D dispatch of `count` invocations for a shader that indexes them with
+  // FOVEA_LINEAR_INVOCATION (shaders/include/fovea/shaders/common.h): more workgroups than the
+  // device allows in x (maxComputeWorkGroupCount[0]: 65535 on lavapipe, so 4 M invocations
+  // of 64) are folded into rows of groups, so a full-resolution grid of any preset dispatches
+  // on any device. Rounded up like dispatch(); the shader bounds-checks.
+  void dispatch_linear(VkCommandBuffer cmd, std::uint32_t count) const;
+  template <class T>
+  void run_linear(VkCommandBuffer cmd, std::initializer_list<const DescriptorSet*> sets, const T& constants,
+                  std::uint32_t count) const {
+    bind(cmd, sets);
+    push(cmd, constants);
+    dispatch_linear(cmd, count);
+  }
+
   // Bind, push and dispatch in one go.
   template <class T>
   void run(VkCommandBuffer cmd, std::initializer_list<const DescriptorSet*> sets, const T& constants,

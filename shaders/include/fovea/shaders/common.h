@@ -13,5 +13,11 @@
 #define FOVEA_INT int
 #define FOVEA_CONST const
 #define FOVEA_FN
+// The index of this invocation in a 1-D dispatch of gpu::ComputePipeline::dispatch_linear,
+// which folds more workgroups than the device allows in x into rows of groups; without a
+// fold it equals gl_GlobalInvocationID.x. A macro: gl_WorkGroupSize is known only after the
+// shader's local_size declaration.
+#define FOVEA_LINEAR_INVOCATION \
+  ((gl_WorkGroupID.y * gl_NumWorkGroups.x + gl_WorkGroupID.x) * gl_WorkGroupSize.x + gl_LocalInvocationID.x)
 #endif
 #endif
