@@ -3,7 +3,6 @@
 #include <unistd.h>
 
 #include <algorithm>
-#include <array>
 #include <cerrno>
 #include <cmath>
 #include <cstdio>
@@ -82,26 +81,6 @@ Image read_png(const std::string& path, Encoding enc) {
     }
   stbi_image_free(data);
   return img;
-}
-
-glm::vec4 colormap_inferno(float t) {
-  // Piecewise-linear through samples of matplotlib's "inferno" (sRGB-encoded values).
-  static constexpr std::array<std::array<float, 3>, 9> k = {{{0.001f, 0.000f, 0.014f},
-                                                             {0.088f, 0.042f, 0.227f},
-                                                             {0.258f, 0.039f, 0.406f},
-                                                             {0.416f, 0.090f, 0.433f},
-                                                             {0.578f, 0.148f, 0.404f},
-                                                             {0.735f, 0.216f, 0.330f},
-                                                             {0.865f, 0.317f, 0.226f},
-                                                             {0.955f, 0.475f, 0.094f},
-                                                             {0.988f, 0.998f, 0.645f}}};
-  if (!std::isfinite(t)) t = 0;
-  t = std::clamp(t, 0.0f, 1.0f) * (k.size() - 1);
-  const int i = std::min(static_cast<int>(t), static_cast<int>(k.size()) - 2);
-  const float f = t - i;
-  glm::vec4 c{0, 0, 0, 1};
-  for (int j = 0; j < 3; ++j) c[j] = srgb_decode(k[i][j] + f * (k[i + 1][j] - k[i][j]));
-  return c;
 }
 
 }  // namespace fovea::core

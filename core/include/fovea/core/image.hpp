@@ -35,7 +35,4 @@ void write_file_atomic(const std::string& path, const std::string& text);
 float srgb_encode(float linear);
 float srgb_decode(float encoded);
 
-// Perceptual colour map (0 -> dark, 1 -> bright yellow) for heat maps.
-glm::vec4 colormap_inferno(float t);
-
 }  // namespace fovea::core
