@@ -2,6 +2,7 @@
 // metric flattening and per-band averaging, CSV/JSON and the plots.
 #include <gtest/gtest.h>
 
+#include <cstdlib>
 #include <filesystem>
 #include <fstream>
 
@@ -141,6 +142,44 @@ TEST(SweepReport, SyntheticSweepGivesKnownFrontsTablesAndPlots) {
         }
     }
   EXPECT_TRUE(pareto);
+  fs::remove_all(dir);
+}
+
+TEST(SweepReport, WithoutPythonWritesTheDataAndSaysHowToDrawTheFigures) {
+  const std::string dir = test::temp_dir("sweep-report-nopython");
+  const std::vector<RenderOption> opts = {{"distribution", true}, {"budget", true}, {"out", true}, {"quiet", false}};
+  const Plan plan = expand_sweep(fovea::core::parse_json(R"({"distribution": ["a"], "budget": [0.1, 0.2]})"),
+                                 "synthetic.json", opts);
+  for (const Job& j : plan.jobs) {
+    const double budget = j.settings["budget"].get<double>();
+    fs::create_directories(dir + "/" + j.out);
+    core::write_file_atomic(dir + "/" + j.out + "/report.json",
+                            render_report(100 * budget, 30 + 10 * budget, 0.3 - budget, 40).dump());
+  }
+  const std::string plan_path = dir + "/plan.jsonl";
+  core::write_file_atomic(plan_path, plan_to_jsonl(plan));
+  const std::string report = dir + "/report";
+  setenv("FOVEA_PYTHON", "/nonexistent/python3", 1);
+  const auto r = test::run_fovea("sweep report " + plan_path + " --out " + report);
+  unsetenv("FOVEA_PYTHON");
+  ASSERT_EQ(r.status, 0) << r.err;
+  // The data is all there; no figure was drawn, and the summary lists only what was written.
+  EXPECT_TRUE(fs::exists(report + "/results.json"));
+  const json fig = core::parse_json(test::read_text(report + "/figures.json"));
+  EXPECT_EQ(fig["figure"], "charts");
+  EXPECT_FALSE(fig["charts"].empty());
+  for (const auto& e : fs::directory_iterator(report))
+    EXPECT_TRUE(e.path().extension() != ".png" && e.path().extension() != ".svg") << e.path();
+  EXPECT_EQ(core::parse_json(r.out)["files"], json({"results.csv", "results.json", "figures.json"}));
+  // The warning names the script and the interpreter; the note gives the exact command.
+  EXPECT_NE(r.err.find("warning: figures not drawn by tools/plots/charts.py"), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find("/nonexistent/python3"), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find("fovea plot " + report + "/figures.json"), std::string::npos) << r.err;
+  // That command draws them once the interpreter is there.
+  const auto p = test::run_fovea("plot " + report + "/figures.json");
+  ASSERT_EQ(p.status, 0) << p.err;
+  EXPECT_EQ(test::read_text(report + "/quality_vs_time_fovea_psnr.png").rfind("\x89PNG\r\n\x1a\n", 0), 0u);
+  EXPECT_NE(test::read_text(report + "/quality_vs_time_fovea_psnr.svg").find("<svg"), std::string::npos);
   fs::remove_all(dir);
 }
 
