@@ -2,17 +2,23 @@
 // the layer makes down the chain and can fail the Nth call of a command: teardown order,
 // cleanup after partial failure, and reported (not fatal) output failures.
 #include <dlfcn.h>
+#include <time.h>
+#include <unistd.h>
 
 #include <algorithm>
 #include <cstdlib>
 #include <cstring>
+#include <filesystem>
+#include <fstream>
 #include <map>
 #include <string>
 #include <vector>
 
 #include <gtest/gtest.h>
 
+#define XR_USE_TIMESPEC  // xrConvertTimeToTimespecTimeKHR
 #include <openxr/openxr.h>
+#include <openxr/openxr_platform.h>
 
 #include "fovea/runtime/loader_interface.hpp"
 
@@ -27,6 +33,7 @@ const bool kLogFileSet = [] {
 }();
 
 constexpr const char* kLayerName = "XR_APILAYER_FOVEA_path_tracing";
+constexpr XrTime kXrTimeAhead = 1'000'000'000;
 
 // The fake next layer's state: the calls in order ("command handle"), failures to inject.
 struct Fake {
@@ -36,6 +43,7 @@ struct Fake {
   std::uint64_t next_handle = 0x1000;
   bool eye_gaze = true;
   bool visibility_mask = false;         // the fake offers XR_KHR_visibility_mask
+  bool convert_timespec = false;        // the fake offers XR_KHR_convert_timespec_time
   std::vector<std::string> enabled;     // the extensions enabled on the call down
   int mask_events = 0;                  // visibility-mask change events queued for xrPollEvent
 } g;
@@ -65,6 +73,7 @@ XrResult XRAPI_CALL fake_enumerate_extensions(const char*, uint32_t capacity, ui
   std::vector<const char*> names;
   if (g.eye_gaze) names.push_back("XR_EXT_eye_gaze_interaction");
   if (g.visibility_mask) names.push_back("XR_KHR_visibility_mask");
+  if (g.convert_timespec) names.push_back("XR_KHR_convert_timespec_time");
   *count = uint32_t(names.size());
   if (capacity < names.size()) return capacity ? XR_ERROR_SIZE_INSUFFICIENT : XR_SUCCESS;
   for (std::size_t i = 0; i < names.size(); ++i) std::strcpy(p[i].extensionName, names[i]);
@@ -132,6 +141,14 @@ XrResult XRAPI_CALL fake_gipa(XrInstance, const char* n, PFN_xrVoidFunction* fn)
   FAKE_PLAIN(xrGetCurrentInteractionProfile)
   FAKE(xrPollEvent, &fake_poll_event)
   if (g.visibility_mask) FAKE_PLAIN(xrGetVisibilityMaskKHR)
+  // The fake's XrTime runs kXrTimeAhead ahead of CLOCK_MONOTONIC (as another runtime's may).
+  if (g.convert_timespec)
+    FAKE(xrConvertTimeToTimespecTimeKHR, [](XrInstance h, XrTime t, timespec* ts) -> XrResult {
+      record("xrConvertTimeToTimespecTimeKHR", id(h));
+      const XrTime m = t - kXrTimeAhead;
+      *ts = {time_t(m / 1'000'000'000), long(m % 1'000'000'000)};
+      return XR_SUCCESS;
+    })
   *fn = nullptr;
   return XR_ERROR_FUNCTION_UNSUPPORTED;
 }
@@ -303,6 +320,48 @@ TEST_F(LayerChain, VisibilityMaskEnabledBelowStaysHidden) {
     }
     ASSERT_EQ(layer_.get<PFN_xrDestroyInstance>(instance, "xrDestroyInstance")(instance), XR_SUCCESS);
   }
+}
+
+// layer_timing.jsonl says which clock the runtime's XrTime values are on: converted to
+// CLOCK_MONOTONIC with XR_KHR_convert_timespec_time when the runtime below offers it (the layer
+// enables it for itself, the application still finds its commands unsupported), else kept as
+// the runtime's XrTime and labelled so.
+TEST_F(LayerChain, TimingRecordsSayWhichClockTheirXrTimesAreOn) {
+  unsetenv("FOVEA_SCENE");
+  for (const bool offered : {true, false}) {
+    SCOPED_TRACE(offered ? "the runtime offers XR_KHR_convert_timespec_time" : "it does not");
+    g = Fake{};
+    g.convert_timespec = offered;
+    const std::string out = "/tmp/fovea_layer_chain_clock_" + std::to_string(getpid()) + (offered ? "_on" : "_off");
+    setenv("FOVEA_LAYER_OUT", out.c_str(), 1);
+    const XrInstance instance = layer_.create_instance();
+    EXPECT_EQ(std::count(g.enabled.begin(), g.enabled.end(), "XR_KHR_convert_timespec_time"), offered ? 1 : 0);
+    PFN_xrVoidFunction f = nullptr;
+    EXPECT_EQ(layer_.request.getInstanceProcAddr(instance, "xrConvertTimeToTimespecTimeKHR", &f),
+              XR_ERROR_FUNCTION_UNSUPPORTED);
+    XrSessionCreateInfo si{XR_TYPE_SESSION_CREATE_INFO};
+    XrSession session = XR_NULL_HANDLE;
+    ASSERT_EQ(layer_.get<PFN_xrCreateSession>(instance, "xrCreateSession")(instance, &si, &session), XR_SUCCESS);
+    constexpr XrTime kDisplay = 5'000'000'000;
+    XrFrameState fs{XR_TYPE_FRAME_STATE};
+    fs.predictedDisplayTime = kDisplay;  // the fake's xrWaitFrame leaves it
+    ASSERT_EQ(layer_.get<PFN_xrWaitFrame>(instance, "xrWaitFrame")(session, nullptr, &fs), XR_SUCCESS);
+    ASSERT_EQ(layer_.get<PFN_xrBeginFrame>(instance, "xrBeginFrame")(session, nullptr), XR_SUCCESS);
+    XrFrameEndInfo end{XR_TYPE_FRAME_END_INFO};
+    end.displayTime = kDisplay;
+    ASSERT_EQ(layer_.get<PFN_xrEndFrame>(instance, "xrEndFrame")(session, &end), XR_SUCCESS);
+    ASSERT_EQ(layer_.get<PFN_xrDestroySession>(instance, "xrDestroySession")(session), XR_SUCCESS);  // records written
+    ASSERT_EQ(layer_.get<PFN_xrDestroyInstance>(instance, "xrDestroyInstance")(instance), XR_SUCCESS);
+    std::ifstream in(out + "/layer_timing.jsonl");
+    std::string record;
+    ASSERT_TRUE(std::getline(in, record)) << out;
+    const XrTime expected = offered ? kDisplay - kXrTimeAhead : kDisplay;
+    EXPECT_NE(record.find("\"predicted_display_ns\":" + std::to_string(expected) + ","), std::string::npos) << record;
+    EXPECT_NE(record.find(std::string("\"xr_time_converted\":") + (offered ? "true" : "false")), std::string::npos)
+        << record;
+    std::filesystem::remove_all(out);
+  }
+  unsetenv("FOVEA_LAYER_OUT");
 }
 
 }  // namespace
