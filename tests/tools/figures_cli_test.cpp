@@ -62,6 +62,30 @@ TEST(Figures, GazePlotWritesPngSvgAndData) {
   fs::remove_all(dir);
 }
 
+TEST(Figures, GazePlotBreaksLinesAtGaps) {
+  // 0.8 s at 250 Hz, a 2-hour gap, 0.8 s more: two line pieces, not one line across the gap.
+  const std::string dir = temp_dir("fig-gap");
+  std::string csv = "t_ns,eye,dir_x,dir_y,dir_z,confidence,flags\n";
+  for (long long part : {0LL, 7200000000000LL})
+    for (int i = 0; i < 200; ++i)
+      csv += std::to_string(part + i * 4000000LL) + ",C," + std::to_string(0.1 * std::sin(i / 20.0)) + ",0,-1,1,1\n";
+  FILE* f = std::fopen((dir + "/gap.csv").c_str(), "w");
+  std::fputs(csv.c_str(), f);
+  std::fclose(f);
+  const auto r = run_fovea("gaze plot " + dir + "/gap.csv " + dir + "/g.png");
+  ASSERT_EQ(r.status, 0) << r.err;
+  const auto j = fovea::core::parse_json(read_text(dir + "/g.json"));
+  EXPECT_NEAR(j["sample_period_s"].get<double>(), 0.004, 1e-9);
+  const std::string svg = read_text(dir + "/g.svg");
+  const auto at = svg.find("id=\"gaze-h\"");
+  ASSERT_NE(at, std::string::npos);
+  const auto d = svg.find(" d=\"", at);
+  ASSERT_NE(d, std::string::npos);
+  const std::string path = svg.substr(d + 4, svg.find('"', d + 4) - d - 4);
+  EXPECT_EQ(std::count(path.begin(), path.end(), 'M'), 2) << path;  // one move per piece
+  fs::remove_all(dir);
+}
+
 TEST(Figures, LatencyChartsComeFromFiguresJson) {
   const std::string dir = temp_dir("fig-latency");
   const auto r = run_fovea(kLatency + dir);

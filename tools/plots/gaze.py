@@ -40,7 +40,7 @@ def draw(d, data_path):
         for i, (a, b) in enumerate(d["untracked"]):
             ax.axvspan(a, b, color="0.5", alpha=0.3, linewidth=0, label="untracked" if i == 0 else None)
         xs, ys = broken(t, d[key], period)
-        ax.plot(xs, ys, color=colour, linewidth=0.9, label=name)
+        ax.plot(xs, ys, color=colour, linewidth=0.9, label=name, gid=f"gaze-{key}")
         ax.axhline(0, color="black", linewidth=0.6, alpha=0.5)
         ax.set_ylabel(f"{name.split()[0]} ({unit})")
         fp.legend(ax, 3)
