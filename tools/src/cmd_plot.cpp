@@ -20,8 +20,9 @@ Draws the figures described by DATA.json as PNG and SVG next to it, with matplot
 data files `fovea latency` and `fovea sweep report` write (figures.json), and those `fovea
 gaze plot` and `fovea density --out` write beside their figure (same stem, .json).
 
-The interpreter is $FOVEA_PYTHON, else python3; it needs matplotlib (Debian:
-python3-matplotlib). The scripts are tools/plots/*.py, built into this program.
+The interpreter is $FOVEA_PYTHON, else /usr/bin/python3 when present, else python3 on
+PATH; it needs matplotlib (Debian: python3-matplotlib). The scripts are tools/plots/*.py,
+built into this program.
 
 Exit status: 0 when drawn, 2 on an invalid data file, 1 when the figures could not be drawn.
 )";

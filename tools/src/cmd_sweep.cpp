@@ -44,10 +44,12 @@ slurm   writes DIR/sweep-array.sbatch (one array task per shard), DIR/sweep-merg
         (`fovea sweep report` into DIR/report) and DIR/submit.sh; --submit submits both, the
         merge with --dependency=afterok on the array, and prints the job ids. [DIR: slurm/
         next to the plan]
-report  merges the results into DIR/results.csv and results.json and draws PNG plots:
-        quality against time per frame with the Pareto front per distribution, quality
-        against budget, per-band curves (per scene when the scene varies), latency against
-        quality (latency jobs: gaze-to-photon against foveal error and fovea quality).
+report  merges the results into DIR/results.csv and results.json and writes the figures'
+        data to DIR/figures.json, drawn by matplotlib as PNG and SVG (docs/figures.md;
+        redraw: fovea plot DIR/figures.json): quality against time per frame with the
+        Pareto front per distribution and each point's budget, quality against budget,
+        per-band curves (per scene when the scene varies), latency against quality
+        (latency jobs: gaze-to-photon against foveal error and fovea quality).
         --markdown PAGE also writes a Markdown page: every job at equal samples, the
         best quality at equal time, per-band PSNR, the plots (linked relative to PAGE) and
         the front's cost against the cartesian job for a 90 Hz frame; --command is the
