@@ -113,11 +113,11 @@ TEST(Figures, ChartsMissingValuesAreNullNeverNaN) {
   fovea::sweep::Chart c;
   c.file = "x";
   fovea::sweep::Series s{"error", 0, {{0, 1}, {1, std::nan("")}, {2, 3}}, true, false};
-  s.yerr = {{0.1, INFINITY}, {0, 0}, {0, 0}};
+  s.vlines = {0.5};
   c.series.push_back(s);
   const nlohmann::json j = fovea::sweep::to_json(c);
   EXPECT_TRUE(j["series"][0]["points"][1][1].is_null());
-  EXPECT_TRUE(j["series"][0]["yerr"][0][1].is_null());
+  EXPECT_EQ(j["series"][0]["vlines"], nlohmann::json({0.5}));
   EXPECT_EQ(j.dump().find("NaN"), std::string::npos);
 }
 

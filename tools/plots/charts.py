@@ -1,12 +1,11 @@
 """Line and scatter charts (latency distributions and sweeps, the sweep report's Pareto,
 budget, band and latency plots) from a data file with {"figure": "charts", "charts": [...]}.
 
-A chart: file (stem), title, note, x_label, y_label, x_log, series. A series: label, points
+A chart: file (stem), title, note, x_label, y_label, series. A series: label, points
 [[x, y], ...] (y null: no value, the line breaks), line, markers, step (a CDF), gaps (break
 the line where x jumps), emphasised (per point: ringed, e.g. a Pareto front), point_labels
-(text next to each point, e.g. the budget or n), yerr ([[below, above], ...]), vlines (x
-positions of vertical marks), hline (a constant y), color (index; shared by series that
-belong together)."""
+(text next to each point, e.g. the budget or n), vlines (x positions of vertical marks),
+hline (a constant y), color (index; shared by series that belong together)."""
 import fovea_plot as fp
 from fovea_plot import plt
 
@@ -30,10 +29,6 @@ def draw_series(ax, s, colour):
         label = None
     elif s.get("markers"):
         ax.scatter(xs, ys, color=colour, s=18, alpha=0.8, label=label, zorder=3)
-    if s.get("yerr"):
-        lo = [fp.num(e[0]) for e in s["yerr"]]
-        hi = [fp.num(e[1]) for e in s["yerr"]]
-        ax.errorbar(xs, ys, yerr=[lo, hi], fmt="none", ecolor=colour, capsize=3, linewidth=1)
     emph = s.get("emphasised") or []
     ex = [x for x, e in zip(xs, emph) if e]
     ey = [y for y, e in zip(ys, emph) if e]
@@ -56,8 +51,6 @@ def draw_chart(c, data_path):
     ax.set_title(title, fontsize=10)
     ax.set_xlabel(c.get("x_label", ""))
     ax.set_ylabel(c.get("y_label", ""))
-    if c.get("x_log"):
-        ax.set_xscale("log")
     fp.legend(ax, entries)
     fp.save(fig, fp.out_stem(data_path, c["file"]))
 

@@ -26,11 +26,6 @@ nlohmann::json to_json(const Chart& c) {
     if (s.gaps) j["gaps"] = true;
     if (!s.emphasised.empty()) j["emphasised"] = s.emphasised;
     if (!s.point_labels.empty()) j["point_labels"] = s.point_labels;
-    if (!s.yerr.empty()) {
-      nlohmann::json e = nlohmann::json::array();
-      for (const auto& b : s.yerr) e.push_back({number(b.x), number(b.y)});
-      j["yerr"] = e;
-    }
     if (!s.vlines.empty()) j["vlines"] = s.vlines;
     if (s.hline) j["hline"] = number(*s.hline);
     series.push_back(j);

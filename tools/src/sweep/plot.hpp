@@ -21,7 +21,6 @@ struct Series {
   bool gaps = false;               // break the line where x jumps far beyond its usual step
   std::vector<bool> emphasised;    // per point: ringed (e.g. a Pareto front)
   std::vector<std::string> point_labels;  // per point: text next to it (a budget, n)
-  std::vector<glm::dvec2> yerr;    // per point: error bar below and above
   std::vector<double> vlines;      // vertical marks at these x (points unused)
   std::optional<double> hline;     // a horizontal reference line at this y
 };
