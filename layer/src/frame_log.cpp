@@ -9,6 +9,8 @@
 #include <cerrno>
 #include <cmath>
 #include <cstring>
+#include <filesystem>
+#include <set>
 
 #include "fovea/xrcommon/output_dir.hpp"
 #include "log.hpp"
@@ -34,11 +36,34 @@ FrameLog::~FrameLog() {
   thread_.join();
 }
 
+namespace {
+
+// What the process's logs share: the session numbers and the files already started (a later
+// session appends to them instead of truncating the earlier sessions' records).
+struct ProcessLogs {
+  std::mutex mutex;
+  std::int64_t sessions = 0;
+  std::set<std::string> started;
+};
+
+ProcessLogs& process_logs() {
+  static ProcessLogs p;
+  return p;
+}
+
+}  // namespace
+
 void FrameLog::open(const std::string& dir) {
   if (dir.empty()) return;
+  ProcessLogs& p = process_logs();
+  std::lock_guard process_lock(p.mutex);
+  session_ = p.sessions++;
   try {
     xrcommon::create_output_dir(dir, "FOVEA_LAYER_OUT");  // as the runtime creates FOVEA_RUNTIME_OUT
-    writer_.open(dir + "/layer_timing.jsonl");
+    const std::string file = std::filesystem::absolute(dir + "/layer_timing.jsonl").lexically_normal().string();
+    const bool started = p.started.count(file) > 0;
+    writer_.open(file, started ? xrcommon::TimingWriter::Mode::Append : xrcommon::TimingWriter::Mode::Stream);
+    p.started.insert(file);
   } catch (const std::exception& e) {
     // Reported, not fatal: the session works, its frames are just not logged.
     FOVEA_LAYER_WARN("%s; frames are not logged", e.what());
@@ -78,6 +103,7 @@ void FrameLog::write_now(const FrameTimes& t) {
   xrcommon::TimingRecord r;
   r.source = "layer";
   r.frame = t.frame;
+  r.session = session_;
   r.gaze_valid = rt.gaze_sample_ns != 0;  // 0: no tracker sample measured yet (or no renderer)
   r.set_gaze_times(rt.gaze_sample_ns, rt.gaze_receive_ns, rt.gaze_read_ns);
   r.predicted_display_ns = t.display_time_ns;

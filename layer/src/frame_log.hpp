@@ -1,6 +1,7 @@
 #pragma once
 // The layer's per-frame timing log (pass-through measurement): one timing record
-// (fovea/xrcommon/timing_record.hpp) per line in <FOVEA_LAYER_OUT>/layer_timing.jsonl.
+// (fovea/xrcommon/timing_record.hpp) per line in <FOVEA_LAYER_OUT>/layer_timing.jsonl, the
+// records of all the process's sessions.
 // Times are int64 ns of CLOCK_MONOTONIC; the runtime's XrTime values are converted to it where
 // the runtime can (FrameTimes::xr_time_converted says whether they were).
 #include <chrono>
@@ -52,7 +53,12 @@ class FrameLog {
   FrameLog(const FrameLog&) = delete;
   FrameLog& operator=(const FrameLog&) = delete;
 
-  void open(const std::string& dir);  // empty: no log; call once, before write()
+  // Numbers the session (from 0, in the order sessions open their logs in the process) and
+  // starts logging to <dir>/layer_timing.jsonl: the process's first log there truncates the
+  // file, later ones append, so the file holds every session of the process, each record
+  // naming its session. Empty `dir`: no log. Call once, before write().
+  void open(const std::string& dir);
+  std::int64_t session() const { return session_; }
   // Any thread. No allocation while the writer keeps up (the buffers keep their capacity).
   void write(const FrameTimes& t);
 
@@ -61,6 +67,7 @@ class FrameLog {
   void write_now(const FrameTimes& t);
 
   xrcommon::TimingWriter writer_;  // the writer thread's once it runs
+  std::int64_t session_ = -1;
   std::mutex mutex_;
   std::condition_variable stop_cv_;
   bool stop_ = false;

@@ -1,6 +1,7 @@
 // Timing records: the JSON line, its round trip, and the writer's failure reporting.
 #include <unistd.h>
 
+#include <algorithm>
 #include <cmath>
 #include <filesystem>
 #include <fstream>
@@ -77,6 +78,13 @@ TEST(TimingRecord, JsonLineRoundTripsAndHasNoNonFiniteNumbers) {
   EXPECT_EQ(back.gpu_ms[0].second, 2.25);
   EXPECT_FALSE(back.end_call_ns.has_value());
   EXPECT_NEAR(*back.foveal_error_deg(), 3.0, 1e-9);
+  // The session: null when absent, kept when present; a line without it still reads.
+  EXPECT_TRUE(j["session"].is_null());
+  EXPECT_FALSE(back.session.has_value());
+  TimingRecord in_session = r;
+  in_session.session = 2;
+  EXPECT_EQ(parse_timing_record(to_json_line(in_session), "t.jsonl:2").session, std::optional<std::int64_t>(2));
+  EXPECT_FALSE(parse_timing_record(old.dump(), "old.jsonl:1").session.has_value());
 }
 
 TEST(TimingRecord, BadLinesNameTheirPlace) {
@@ -131,6 +139,29 @@ TEST(TimingWriter, StreamLinesAreReadableAtOnce) {
   EXPECT_EQ(std::count_if(text.begin(), text.end(), [](char c) { return c == '\n'; }), 2);
   const std::string after = slurp(dir.path / "timing.jsonl");
   EXPECT_EQ(std::count(after.begin(), after.end(), '\n'), 3);
+}
+
+// Append keeps what the file holds (a second session of the process after the first);
+// Stream starts it again.
+TEST(TimingWriter, AppendKeepsEarlierRecords) {
+  TempDir dir;
+  const std::string path = (dir.path / "layer_timing.jsonl").string();
+  TimingRecord r = sample_record();
+  for (const TimingWriter::Mode mode : {TimingWriter::Mode::Stream, TimingWriter::Mode::Append}) {
+    TimingWriter w;
+    w.open(path, mode);
+    ASSERT_TRUE(w.write(r));
+    ++r.frame;
+  }
+  std::string text = slurp(path);
+  ASSERT_EQ(std::count(text.begin(), text.end(), '\n'), 2);
+  EXPECT_EQ(parse_timing_record(text.substr(0, text.find('\n')), "x").frame, 7);
+  EXPECT_EQ(parse_timing_record(text.substr(text.find('\n') + 1), "x").frame, 8);
+  TimingWriter w;
+  w.open(path);
+  ASSERT_TRUE(w.write(r));
+  text = slurp(path);
+  EXPECT_EQ(std::count(text.begin(), text.end(), '\n'), 1);
 }
 
 TEST(TimingWriter, AtomicFileAppearsOnlyWhenComplete) {

@@ -82,6 +82,7 @@ std::string to_json_line(const TimingRecord& r) {
   j["source"] = r.source;
   j["clock"] = time_base_name(r.clock);
   j["frame"] = r.frame;
+  j["session"] = r.session ? json(*r.session) : json(nullptr);
   j["gaze_valid"] = r.gaze_valid;
   for (const auto& [key, field] : kTimes) j[key] = time_or_null(r.*field);
   j["missed_vsyncs"] = r.missed_vsyncs;
@@ -124,6 +125,7 @@ TimingRecord parse_timing_record(std::string_view line, const std::string& where
     if (clock != "monotonic" && clock != "virtual") throw core::InputError(where + ": clock \"" + clock + "\": expected monotonic or virtual");
     r.clock = clock == "monotonic" ? TimeBase::Monotonic : TimeBase::Virtual;
     r.frame = j.at("frame").get<std::int64_t>();
+    if (j.contains("session") && !j["session"].is_null()) r.session = j["session"].get<std::int64_t>();
     r.gaze_valid = j.value("gaze_valid", false);
     for (const auto& [key, field] : kTimes)
       if (j.contains(key) && !j[key].is_null()) r.*field = j[key].get<core::TimeNs>();

@@ -48,7 +48,7 @@ void TimingWriter::open(const std::string& path, Mode mode) {
   mode_ = mode;
   error_.clear();
   const std::string name = file_name(path, mode);
-  fd_ = ::open(name.c_str(), O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC, 0644);
+  fd_ = ::open(name.c_str(), O_WRONLY | O_CREAT | O_CLOEXEC | (mode == Mode::Append ? O_APPEND : O_TRUNC), 0644);
   if (fd_ < 0) {
     error_ = "timing records \"" + name + "\": cannot create: " + std::strerror(errno);
     throw std::runtime_error(error_);

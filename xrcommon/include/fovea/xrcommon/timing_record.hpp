@@ -30,6 +30,10 @@ struct TimingRecord {
   std::string source;                  // "runtime", "layer", "render", "latency"
   TimeBase clock = TimeBase::Monotonic;
   std::int64_t frame = 0;
+  // The OpenXR session the frame belongs to, numbered in the producer's process from 0 in
+  // creation order (absent: not an OpenXR session's record). Several sessions of one process
+  // share one file.
+  std::optional<std::int64_t> session;
   // The gaze sample the frame used: when it was measured, its stamp on the tracker's clock,
   // when the host received it, and when the renderer read it. Absent: not known / none.
   bool gaze_valid = false;

@@ -9,9 +9,11 @@ namespace fovea::xrcommon {
 class TimingWriter {
  public:
   // Stream: lines appear in the file as they are written (a live session's log, readable
-  // while it runs and after a crash). Atomic: written under PATH.tmp and renamed onto PATH by
-  // close(), so PATH is either absent or complete (a tool's output).
-  enum class Mode { Stream, Atomic };
+  // while it runs and after a crash). Append: as Stream, after what the file already holds
+  // (O_APPEND: each line lands whole at the end, also with other writers of the file).
+  // Atomic: written under PATH.tmp and renamed onto PATH by close(), so PATH is either absent
+  // or complete (a tool's output).
+  enum class Mode { Stream, Append, Atomic };
 
   TimingWriter() = default;
   ~TimingWriter();  // closes; an Atomic file not closed is removed (incomplete)
@@ -20,7 +22,7 @@ class TimingWriter {
   TimingWriter(TimingWriter&& o) noexcept;
   TimingWriter& operator=(TimingWriter&& o) noexcept;
 
-  // Creates (truncates) the file. Throws std::runtime_error naming the path and the reason
+  // Creates the file (truncating it, except in Append mode). Throws std::runtime_error naming the path and the reason
   // when it cannot.
   void open(const std::string& path, Mode mode = Mode::Stream);
   bool is_open() const { return fd_ >= 0; }
