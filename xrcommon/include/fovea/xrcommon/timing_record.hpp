@@ -3,8 +3,10 @@
 // layer (layer_timing.jsonl), `fovea render` (frame_times.jsonl), `fovea latency`
 // (records.jsonl) — and `fovea latency --records` reads: one JSON object per line, schema
 // "fovea-timing", version kTimingVersion. Every time is int64 ns on the clock the record
-// names ("monotonic": CLOCK_MONOTONIC, the XrTime base; "virtual": a simulation's timeline
-// from 0), except gaze_device_ns, on the eye tracker's own clock. Fields and their events:
+// names ("monotonic": CLOCK_MONOTONIC, which the project's runtime uses for XrTime, another
+// runtime need not: the layer converts the runtime's XrTime values where it can and says so in
+// its xr_time_converted field; "virtual": a simulation's timeline from 0), except
+// gaze_device_ns, on the eye tracker's own clock. Fields and their events:
 // docs/openxr.md ("Timing records").
 #include <array>
 #include <cstdint>
