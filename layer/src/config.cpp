@@ -1,5 +1,7 @@
 #include "config.hpp"
 
+#include <algorithm>
+#include <cctype>
 #include <cstdint>
 #include <cstdlib>
 #include <filesystem>
@@ -77,9 +79,23 @@ void apply_section(const nlohmann::json& s, const std::string& where, LayerConfi
         rgb[i] = static_cast<int>(v[i].get<std::int64_t>());
       }
       c.app_background = rgb;
+    } else if (const auto& names = pipeline::frame_option_names(); std::find(names.begin(), names.end(), key) != names.end()) {
+      pipeline::apply_frame_option(c.frame, key, v.is_string() ? v.get<std::string>() : v.dump(), field);
+      c.budget_given |= key == "budget";
     } else {
-      throw core::InputError(field + ": unknown key (scene, composite, app_background, gaze, render, compositor, render_priority)");
+      throw core::InputError(field + ": unknown key (scene, composite, app_background, gaze, render, compositor, "
+                                     "render_priority, budget, distribution, jitter, denoiser, bmfr-precision, "
+                                     "stereo-share, trace)");
     }
+  }
+}
+
+// The frame options' joint checks (Cartesian's budget, the budget's range), naming `origin`.
+void finish_frame(LayerConfig& c, const std::string& origin) {
+  try {
+    pipeline::finish(c.frame, c.budget_given);
+  } catch (const core::InputError& e) {
+    throw core::InputError(origin + ": " + e.what());
   }
 }
 
@@ -98,7 +114,10 @@ const char* composite_name(Composite c) {
   return "?";
 }
 
-LayerConfig parse_config(const std::string& text, const std::string& origin, const std::string& application) {
+namespace {
+// The file's sections over the defaults, the frame options not yet finished (the environment
+// may still change them).
+LayerConfig parse_sections(const std::string& text, const std::string& origin, const std::string& application) {
   nlohmann::json j;
   try {
     j = core::parse_json(text);
@@ -118,6 +137,13 @@ LayerConfig parse_config(const std::string& text, const std::string& origin, con
   }
   return c;
 }
+}  // namespace
+
+LayerConfig parse_config(const std::string& text, const std::string& origin, const std::string& application) {
+  LayerConfig c = parse_sections(text, origin, application);
+  finish_frame(c, origin);
+  return c;
+}
 
 LayerConfig load_config(const std::string& application) {
   namespace fs = std::filesystem;
@@ -127,7 +153,7 @@ LayerConfig load_config(const std::string& application) {
   const fs::path file = dir / "fovea" / "layer.json";
   std::error_code ec;
   if (!dir.empty() && fs::is_regular_file(file, ec)) {
-    c = parse_config(core::read_file_bounded(file.string(), 1 << 20), file.string(), application);
+    c = parse_sections(core::read_file_bounded(file.string(), 1 << 20), file.string(), application);
   }
   for (const char* name : {"FOVEA_LAYER_SCENE", "FOVEA_SCENE"})
     if (!env(name).empty()) {
@@ -140,6 +166,14 @@ LayerConfig load_config(const std::string& application) {
     c.gpu_compositor = parse_compositor(env("FOVEA_LAYER_COMPOSITOR"), "FOVEA_LAYER_COMPOSITOR");
   if (!env("FOVEA_LAYER_RENDER_PRIORITY").empty())
     c.render_priority = parse_render_priority(env("FOVEA_LAYER_RENDER_PRIORITY"), "FOVEA_LAYER_RENDER_PRIORITY");
+  for (const std::string& name : pipeline::frame_option_names()) {
+    std::string var = "FOVEA_LAYER_" + name;
+    for (char& ch : var) ch = ch == '-' ? '_' : char(std::toupper(static_cast<unsigned char>(ch)));
+    if (env(var.c_str()).empty()) continue;
+    pipeline::apply_frame_option(c.frame, name, env(var.c_str()), var);
+    c.budget_given |= name == "budget";
+  }
+  finish_frame(c, "the layer's configuration");
   return c;
 }
 

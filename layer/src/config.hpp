@@ -3,13 +3,18 @@
 //   $XDG_CONFIG_HOME/fovea/layer.json (else ~/.config/fovea/layer.json):
 //     {"default": {...}, "applications": {"<XrApplicationInfo::applicationName>": {...}}}
 //     with keys "scene", "composite", "app_background", "gaze", "render", "compositor",
-//     "render_priority" (an application's section over "default");
+//     "render_priority" and the frame options of `fovea render` by their names ("budget",
+//     "distribution", "jitter", "denoiser", "bmfr-precision", "stereo-share", "trace":
+//     pipeline/frame_config.hpp) (an application's section over "default");
 //   env FOVEA_LAYER_SCENE, then FOVEA_SCENE (the scene); FOVEA_GAZE (the gaze source);
 //   FOVEA_LAYER_RENDER (the render mode); FOVEA_LAYER_COMPOSITOR (where compositing runs);
-//   FOVEA_LAYER_RENDER_PRIORITY (the render thread's CPU priority).
+//   FOVEA_LAYER_RENDER_PRIORITY (the render thread's CPU priority); FOVEA_LAYER_<OPTION> for
+//   each frame option (FOVEA_LAYER_BUDGET, FOVEA_LAYER_STEREO_SHARE, ...).
 #include <array>
 #include <optional>
 #include <string>
+
+#include "fovea/pipeline/frame_config.hpp"
 
 namespace fovea::layer {
 
@@ -48,6 +53,9 @@ struct LayerConfig {
   // thread and the threads of the device it creates (Linux threads inherit both), so that on a
   // CPU device the path tracer runs below the application's threads.
   RenderPriority render_priority;
+  // The frame: the defaults and option names of `fovea render` (finished: validated).
+  pipeline::FrameConfig frame;
+  bool budget_given = false;  // for finish(): Cartesian refuses a budget other than 1
 };
 
 // Throws core::InputError naming the file and field for a malformed configuration file.

@@ -40,6 +40,7 @@
 #include "fovea/gpu/context.hpp"
 #include "fovea/pipeline/frame_pipeline.hpp"
 #include "fovea/renderer/gpu_scene.hpp"
+#include "fovea/renderer/trace_choice.hpp"
 #include "fovea/renderer/scene_io.hpp"
 #include "layer.hpp"
 #include "log.hpp"
@@ -149,15 +150,18 @@ class PathTracer {
              const core::DisplayPreset& display, VkFormat format, XrSession session, const AppDevice* slots)
       : config_(config), scene_(scene), views_(views), format_(format), session_(session), slots_(slots),
         gaze_(std::make_unique<LayerGaze>(config.gaze, display)), ctx_(std::make_unique<gpu::Context>()),
-        gpu_scene_(std::make_unique<renderer::GpuScene>(*ctx_, scene_)) {
-    reconstruct::ReconSettings settings;
-    settings.share = reconstruct::StereoShare::Gather;
-    pipeline_ = std::make_unique<pipeline::FramePipeline>(*ctx_, *gpu_scene_, views_, core::DistributionParams{}, settings);
+        trace_choice_(renderer::choose_tracing(*ctx_, config.frame.tracing, renderer::default_trace_choice_cache())),
+        gpu_scene_(std::make_unique<renderer::GpuScene>(*ctx_, scene_, renderer::BvhOptions{}, trace_choice_.tracing)) {
+    // The frame of `fovea render`: its defaults and options (pipeline/frame_config.hpp).
+    pipeline_ = std::make_unique<pipeline::FramePipeline>(*ctx_, *gpu_scene_, views_, config_.frame.distribution,
+                                                          config_.frame.recon);
     FOVEA_LAYER_INFO("rendering scene \"%s\" (from %s) at %dx%d per eye on %s, composite %s, gaze %s, render %s, "
-                     "render thread %s",
+                     "render thread %s, frame %s, tracing %s (%s)",
                      config_.scene.c_str(), config_.origin.c_str(), display.width, display.height,
                      ctx_->info().name.c_str(), composite_name(config_.composite), gaze_->describe().c_str(),
-                     config_.lockstep ? "lockstep" : "async", render_priority_name(config_.render_priority).c_str());
+                     config_.lockstep ? "lockstep" : "async", render_priority_name(config_.render_priority).c_str(),
+                     pipeline::to_json(config_.frame).dump().c_str(), renderer::tracing_name(trace_choice_.tracing),
+                     trace_choice_.why.c_str());
   }
 
   // Null when stopped while waiting for a free slot.
@@ -261,6 +265,7 @@ class PathTracer {
   std::optional<std::uint64_t> mask_generation_;  // of the mask fetched last (none yet)
   bool mask_set_ = false;                         // the pipeline culls with a runtime mask
   std::unique_ptr<gpu::Context> ctx_;
+  renderer::TraceChoice trace_choice_;
   std::unique_ptr<renderer::GpuScene> gpu_scene_;
   std::unique_ptr<pipeline::FramePipeline> pipeline_;
 };

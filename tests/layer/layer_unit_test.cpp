@@ -523,5 +523,53 @@ TEST(LayerFrameLog, MissingOutputDirectoryIsCreated) {
   fs::remove_all(root);
 }
 
+// The layer's frame is `fovea render`'s: the same defaults (FrameDefaults.* checks the CLI's
+// entry points against them) and the same option names, in the file and the environment.
+TEST(FrameConfigLayer, DefaultsAndOptionNamesAreFoveaRendersOwn) {
+  const nlohmann::json defaults = pipeline::to_json(pipeline::FrameConfig{});
+  EXPECT_EQ(pipeline::to_json(parse_config("{}", "cfg.json", "App").frame), defaults);
+  const LayerConfig c = parse_config(
+      R"({"default": {"budget": 0.2, "distribution": "log-polar", "jitter": "off", "denoiser": "none",
+                      "bmfr-precision": "fp16", "stereo-share": "alternate", "trace": "compute"},
+          "applications": {"App": {"budget": 0.25}}})",
+      "cfg.json", "App");
+  const nlohmann::json j = pipeline::to_json(c.frame);
+  EXPECT_EQ(j["budget"], 0.25);
+  EXPECT_EQ(j["distribution"], "log-polar");
+  EXPECT_EQ(j["jitter"], "off");
+  EXPECT_EQ(j["denoiser"], "none");
+  EXPECT_EQ(j["bmfr-precision"], "fp16");
+  EXPECT_EQ(j["stereo-share"], "alternate");
+  EXPECT_EQ(j["trace"], "compute");
+  // Cartesian traces every pixel; a fraction is refused naming the file, as on the command line.
+  EXPECT_EQ(parse_config(R"({"default": {"distribution": "cartesian"}})", "cfg.json", "App").frame.distribution.budget, 1.0);
+  for (const char* bad : {R"({"default": {"distribution": "cartesian", "budget": 0.5}})",
+                          R"({"default": {"budget": 7}})", R"({"default": {"stereo-share": "both"}})"}) {
+    try {
+      parse_config(bad, "cfg.json", "App");
+      ADD_FAILURE() << "accepted " << bad;
+    } catch (const core::InputError& e) {
+      EXPECT_EQ(std::string(e.what()).rfind("cfg.json", 0), 0u) << e.what();
+    }
+  }
+}
+
+TEST(FrameConfigLayer, EnvironmentTakesTheSameOptions) {
+  setenv("XDG_CONFIG_HOME", "/nonexistent-fovea-config", 1);  // no configuration file
+  setenv("FOVEA_LAYER_BUDGET", "0.2", 1);
+  setenv("FOVEA_LAYER_STEREO_SHARE", "off", 1);
+  const nlohmann::json j = pipeline::to_json(load_config("App").frame);
+  EXPECT_EQ(j["budget"], 0.2);
+  EXPECT_EQ(j["stereo-share"], "off");
+  setenv("FOVEA_LAYER_DENOISER", "neural", 1);
+  try {
+    load_config("App");
+    ADD_FAILURE() << "FOVEA_LAYER_DENOISER=neural accepted";
+  } catch (const core::InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("FOVEA_LAYER_DENOISER: unknown \"neural\""), std::string::npos) << e.what();
+  }
+  for (const char* v : {"FOVEA_LAYER_BUDGET", "FOVEA_LAYER_STEREO_SHARE", "FOVEA_LAYER_DENOISER"}) unsetenv(v);
+}
+
 }  // namespace
 }  // namespace fovea::layer

@@ -65,7 +65,11 @@ Prints the summary JSON on stdout; writes into --out:
   --gaze SRC            the true eye: recording or synthetic:<seed>[?...] (docs/gaze.md)
                         [synthetic:1?task=search&rate=1000&noise=0&dropouts=0]
   --budget B            grid samples as a fraction of display pixels: the foveation's
-                        strength (visual-polar; docs/visual-polar.md) [0.39]
+                        strength (docs/visual-polar.md) [0.39]
+  --distribution D, --denoiser D, --bmfr-precision P, --stereo-share M, --trace T
+                        the frame's options, as `fovea render` takes them and with its
+                        defaults (visual-polar, bmfr, fp32, gather, auto); the sub-cell
+                        jitter is on (--jitter here is the tracker's)
   --tracker PRESET      eye-tracker model preset: fove0 | ideal [fove0]
   --tracker-delay T     delay from measurement to delivery [preset's]
   --jitter T            extra delivery delay, uniform in [0, T] [preset's]
@@ -210,7 +214,8 @@ int run(std::vector<std::string> argv) {
   const std::vector<std::string> sim_options{"scene", "display", "gaze", "tracker", "tracker-delay", "jitter", "rate",
                                              "predict", "seconds", "render-time", "scan-out", "persistence",
                                              "inject-latency", "quality-frames", "reference-spp", "budget",
-                                             "quality-at", "quality-radius", "reference-error", "reference-cache"};
+                                             "quality-at", "quality-radius", "reference-error", "reference-cache",
+                                             "distribution", "denoiser", "bmfr-precision", "stereo-share", "trace"};
   std::vector<std::string> valued = sim_options;
   valued.insert(valued.end(), {"records", "out"});
   const Args args(argv, valued, {"quiet", "no-main-render"});
@@ -266,13 +271,9 @@ int run(std::vector<std::string> argv) {
       if (std::find(injected.begin(), injected.end(), t) == injected.end())
         throw core::InputError("--quality-at: " + std::to_string(core::ns_to_ms(t)) + " ms is not in --inject-latency");
   }
-  RenderSetupOptions render_options;
-  render_options.distribution.budget = args.num("budget", render_options.distribution.budget);
-  try {
-    render_options.distribution.validate();
-  } catch (const core::InputError& e) {
-    throw core::InputError(std::string("--") + e.what());  // "--budget: must be in ..."
-  }
+  // The frame of `fovea render`: the same defaults and option names (pipeline/frame_config.hpp).
+  const pipeline::FrameConfig frame = frame_config_of(args, {"jitter"});
+  RenderSetupOptions render_options{frame.distribution, frame.recon, frame.tracing, true};
   const std::string gaze_uri = args.str("gaze", kDefaultGaze);
   devices::SourceOptions so;
   so.display = display;
@@ -349,6 +350,7 @@ int run(std::vector<std::string> argv) {
                               {"dropout", tp.dropout}}},
                  {"predict", predict},
                  {"budget", render_options.distribution.budget},
+                 {"frame_options", to_json(frame)},
                  {"seconds", seconds},
                  {"device", {{"name", ctx.info().name}, {"driver", ctx.info().driver}}}};
   char notebuf[256];

@@ -316,25 +316,9 @@ int run(std::vector<std::string> argv) {
   const long png_every = args.integer("png-every", 1);
   if (png_every < 0) throw core::InputError("--png-every must be >= 0");
   const core::DisplayPreset display = core::load_display(args.str("display", "small"));
-  core::DistributionParams dp;
-  dp.kind = core::parse_distribution(args.str("distribution", "visual-polar"));
-  dp.budget = args.num("budget", dp.budget);
-  dp.jitter = core::parse_jitter(args.str("jitter", "on"));
-  // Cartesian traces every pixel: a smaller budget is cartesian-uniform's job.
-  if (dp.kind == core::DistributionKind::Cartesian) {
-    if (args.has("budget") && dp.budget != 1.0)
-      throw core::InputError("--budget: cartesian traces every pixel (budget 1); use cartesian-uniform for " +
-                             args.str("budget", "") + " of the pixels");
-    dp.budget = 1.0;
-  }
-  dp.validate();
-  reconstruct::ReconSettings settings;
-  settings.denoiser = reconstruct::parse_denoiser(args.str("denoiser", "bmfr"));
-  settings.share = reconstruct::parse_stereo_share(args.str("stereo-share", "gather"));
-  const std::string precision = args.str("bmfr-precision", "fp32");
-  if (precision != "fp32" && precision != "fp16")
-    throw core::InputError("--bmfr-precision: expected fp32 or fp16, got \"" + precision + "\"");
-  settings.bmfr_precision = precision == "fp16" ? reconstruct::BmfrPrecision::Fp16 : reconstruct::BmfrPrecision::Fp32;
+  pipeline::FrameConfig frame_config = frame_config_of(args);
+  core::DistributionParams& dp = frame_config.distribution;
+  reconstruct::ReconSettings& settings = frame_config.recon;
   settings.blur = !args.has("no-blur");
   const fs::path out_dir(args.str("out", "out/render"));
   core::prepare_output_dir(out_dir.string(), "--out");
@@ -354,13 +338,12 @@ int run(std::vector<std::string> argv) {
   devices::FoveationGaze gaze_source(gaze_uri, so);
   for (const auto& n : devices::recording_notes(gaze_uri, so)) std::cerr << "warning: " << n << "\n";
 
-  const renderer::Tracing tracing = renderer::parse_tracing(args.str("trace", "auto"));
   const std::string scene_arg = args.str("scene", "default");
   const renderer::Scene scene = renderer::load_scene(scene_arg);
   for (const auto& w : scene.warnings) std::cerr << "warning: " << w << "\n";
 
   const bool cull = !args.has("no-cull");
-  RenderSetup setup(scene, display, {dp, settings, tracing, cull});
+  RenderSetup setup(scene, display, {dp, settings, frame_config.tracing, cull});
   gpu::Context& ctx = setup.ctx;
   renderer::GpuScene& gpu_scene = setup.gpu_scene;
   const std::array<core::Pose, 2>& poses = setup.poses;
@@ -505,10 +488,11 @@ int run(std::vector<std::string> argv) {
                  {"budget", dp.budget},
                  {"grid", {pipeline.distribution(core::Eye::Left).columns(), pipeline.distribution(core::Eye::Left).rows()}},
                  {"denoiser", reconstruct::denoiser_name(settings.denoiser)},
-                 {"bmfr_precision", precision},
+                 {"bmfr_precision", to_json(frame_config)["bmfr-precision"]},
                  {"stereo_share", reconstruct::stereo_share_name(settings.share)},
                  {"blur", settings.blur},
-                 {"cull_hidden_area", cull}};
+                 {"cull_hidden_area", cull},
+                 {"frame_options", to_json(frame_config)}};
   for (const auto& [name, v] : gpu_ms) j["gpu_ms"][name] = median(v);
   for (const auto& [name, v] : cpu_ms) j["cpu_ms"][name] = median(v);
   // Output apart from the frame: the host bytes read back (0 for a frame neither written nor

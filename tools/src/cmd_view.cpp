@@ -12,6 +12,7 @@
 #include <thread>
 
 #include "command.hpp"
+#include "render_setup.hpp"
 #include "fovea/compositor/distortion.hpp"
 #include "fovea/compositor/mirror_window.hpp"
 #include "fovea/core/display.hpp"
@@ -55,6 +56,9 @@ of view directions (lines every 5 degrees), a picture of the optics.
   --gaze-dir x,y,z      fixed gaze as a view-space direction (OpenXR: -Z forward, +Y up)
   --budget B            grid samples as a fraction of display pixels [0.39]
   --jitter on|off       per-frame sub-cell jitter (Halton 2, 3) of every grid [on]
+  --distribution D, --denoiser D, --bmfr-precision P, --stereo-share M
+                        the frame's options, as `fovea render` takes them and with its
+                        defaults (visual-polar, bmfr, fp32, gather)
   --optics direct|lut   distortion pass: evaluate the optics per pixel, or read them from
                         the 128x128 LUT cache [direct]
   --window WxH          window size [fits both panels in 1280x720]
@@ -124,17 +128,17 @@ int run(std::vector<std::string> argv) {
     }
   const Args args(argv,
                   {"display", "scene", "trace", "gaze", "gaze-dir", "budget", "jitter", "optics", "window", "frames",
+                   "distribution", "denoiser", "bmfr-precision", "stereo-share",
                    "screenshot", "panels"},
                   {});
   const core::DisplayPreset d = core::load_display(args.str("display", "small"));
   const long frames = args.integer("frames", 0);
   if (frames < 0) throw core::InputError("option --frames: must be 0 or more");
   const compositor::OpticsEval eval = parse_optics(args.str("optics", "direct"));
-  core::DistributionParams dp;
-  dp.budget = args.num("budget", dp.budget);
-  dp.jitter = core::parse_jitter(args.str("jitter", "on"));
+  // The frame of `fovea render`: the same defaults and option names (pipeline/frame_config.hpp).
+  const pipeline::FrameConfig frame = frame_config_of(args);
+  core::DistributionParams dp = frame.distribution;
   dp.display = d.origin;
-  dp.validate();
   const core::EyeOptics optics[2] = {core::EyeOptics(d, core::Eye::Left), core::EyeOptics(d, core::Eye::Right)};
 
   // The gaze: the mouse, a fixed direction, or a gaze source (recording, synthetic).
@@ -154,7 +158,6 @@ int run(std::vector<std::string> argv) {
 
   // Inputs are checked (the scene loaded) before the window opens, the window before the
   // GPU work: without an X display there is no point building the renderer.
-  const renderer::Tracing tracing = renderer::parse_tracing(args.str("trace", "auto"));
   std::optional<renderer::Scene> scene;
   if (auto name = args.opt("scene")) {
     scene = renderer::load_scene(*name);
@@ -175,12 +178,13 @@ int run(std::vector<std::string> argv) {
   std::optional<SceneRenderer> sr;
   if (scene) {
     sr.emplace();
-    const renderer::TraceChoice choice = renderer::choose_tracing(ctx, tracing, renderer::default_trace_choice_cache());
+    const renderer::TraceChoice choice = renderer::choose_tracing(ctx, frame.tracing, renderer::default_trace_choice_cache());
+    std::cerr << "fovea view: frame " << to_json(frame).dump() << "\n";
     std::cerr << "fovea view: tracing " << renderer::tracing_name(choice.tracing) << ": " << choice.why << "\n";
     sr->gpu_scene = std::make_unique<renderer::GpuScene>(ctx, *scene, renderer::BvhOptions{}, choice.tracing);
     const core::StereoViews views = core::stereo_views(d, scene->camera);
     sr->poses = views.poses();
-    sr->pipeline = std::make_unique<pipeline::FramePipeline>(ctx, *sr->gpu_scene, views, dp, reconstruct::ReconSettings{});
+    sr->pipeline = std::make_unique<pipeline::FramePipeline>(ctx, *sr->gpu_scene, views, dp, frame.recon);
     for (int e = 0; e < 2; ++e) sr->pipeline->set_visibility(core::Eye(e), optics[e].view_mask());
   } else {
     // The direction grid is static: distort it once.

@@ -1,5 +1,7 @@
 #include "render_setup.hpp"
 
+#include <algorithm>
+
 #include "fovea/core/eye_optics.hpp"
 
 namespace fovea::tools {
@@ -11,6 +13,19 @@ core::DistributionParams named(core::DistributionParams p, const core::DisplayPr
   return p;
 }
 }  // namespace
+
+pipeline::FrameConfig frame_config_of(const Args& args, const std::vector<std::string>& not_frame) {
+  pipeline::FrameConfig c;
+  for (const std::string& name : pipeline::frame_option_names())
+    if (std::find(not_frame.begin(), not_frame.end(), name) == not_frame.end())
+      if (auto v = args.opt(name)) pipeline::apply_frame_option(c, name, *v, "--" + name);
+  try {
+    pipeline::finish(c, args.has("budget"));
+  } catch (const core::InputError& e) {
+    throw core::InputError(std::string("--") + e.what());  // "--budget: must be in ..."
+  }
+  return c;
+}
 
 RenderSetup::RenderSetup(const renderer::Scene& scene, const core::DisplayPreset& display,
                          const RenderSetupOptions& options)

@@ -7,12 +7,20 @@
 #include "fovea/core/display.hpp"
 #include "fovea/core/stereo_views.hpp"
 #include "fovea/gpu/context.hpp"
+#include "command.hpp"
+#include "fovea/pipeline/frame_config.hpp"
 #include "fovea/pipeline/frame_pipeline.hpp"
 #include "fovea/renderer/gpu_scene.hpp"
 #include "fovea/renderer/scene.hpp"
 #include "fovea/renderer/trace_choice.hpp"
 
 namespace fovea::tools {
+
+// The frame options given on the command line (--budget, --distribution, --jitter, --denoiser,
+// --bmfr-precision, --stereo-share, --trace: pipeline::frame_option_names) over
+// pipeline::FrameConfig's defaults, finished (Cartesian's budget, validated). `not_frame`:
+// names a command uses for something else (fovea latency's --jitter is the tracker's).
+pipeline::FrameConfig frame_config_of(const Args& args, const std::vector<std::string>& not_frame = {});
 
 struct RenderSetupOptions {
   core::DistributionParams distribution;

@@ -1,0 +1,45 @@
+#pragma once
+// What every entry point of the pipeline — `fovea render`, `view`, `latency` and the OpenXR
+// layer — configures about a foveated frame, with every default defined here once: the
+// sample distribution and its budget, jitter, the denoiser and its precision, stereo
+// sharing, the traversal. Each entry point starts from FrameConfig{} and applies its options
+// by the same names (`--budget 0.2` on the command line, "budget": 0.2 in the layer's file).
+#include <string>
+#include <string_view>
+#include <vector>
+
+#include <nlohmann/json.hpp>
+
+#include "fovea/core/distribution.hpp"
+#include "fovea/reconstruct/settings.hpp"
+#include "fovea/renderer/gpu_scene.hpp"
+
+namespace fovea::pipeline {
+
+struct FrameConfig {
+  core::DistributionParams distribution;  // visual-polar, budget 0.39, jitter on (core's defaults)
+  reconstruct::ReconSettings recon = default_recon();
+  renderer::Tracing tracing = renderer::Tracing::Auto;
+
+  // BMFR at fp32, the peripheral blur, and stereo sharing by gather: the reconstruction a
+  // render shows (ReconSettings{} itself leaves sharing off, for the stage tests).
+  static reconstruct::ReconSettings default_recon();
+};
+
+// The option names, shared by the command line (--NAME VALUE) and the layer's configuration
+// ("NAME": VALUE): budget, distribution, jitter, denoiser, bmfr-precision, stereo-share, trace.
+const std::vector<std::string>& frame_option_names();
+
+// Sets option `name` from its text `value`; core::InputError naming `where` (e.g. "--budget",
+// "layer.json: default.budget") and the accepted values. The distribution's own constraints
+// (the budget's range, Cartesian's budget of 1) are checked by finish().
+void apply_frame_option(FrameConfig& c, std::string_view name, std::string_view value, const std::string& where);
+
+// After the options: Cartesian traces every pixel (budget 1; a smaller one explicitly given is
+// refused, cartesian-uniform's job), then DistributionParams::validate().
+void finish(FrameConfig& c, bool budget_given);
+
+// The configuration by the option names, for reports (report.json's config, the layer's log).
+nlohmann::json to_json(const FrameConfig& c);
+
+}  // namespace fovea::pipeline

@@ -1,0 +1,79 @@
+#include "fovea/pipeline/frame_config.hpp"
+
+#include <cerrno>
+#include <cmath>
+#include <cstdlib>
+
+#include "fovea/core/error.hpp"
+
+namespace fovea::pipeline {
+
+reconstruct::ReconSettings FrameConfig::default_recon() {
+  reconstruct::ReconSettings s;
+  s.share = reconstruct::StereoShare::Gather;
+  return s;
+}
+
+const std::vector<std::string>& frame_option_names() {
+  static const std::vector<std::string> names = {"budget",         "distribution", "jitter", "denoiser",
+                                                 "bmfr-precision", "stereo-share", "trace"};
+  return names;
+}
+
+void apply_frame_option(FrameConfig& c, std::string_view name, std::string_view value, const std::string& where) {
+  try {
+    if (name == "budget") {
+      const std::string v(value);
+      char* end = nullptr;
+      errno = 0;
+      const double b = std::strtod(v.c_str(), &end);
+      if (v.empty() || *end != '\0' || errno == ERANGE || !std::isfinite(b))
+        throw core::InputError("expected a finite number, got \"" + v + "\"");
+      c.distribution.budget = b;
+    } else if (name == "distribution") {
+      c.distribution.kind = core::parse_distribution(value);
+    } else if (name == "jitter") {
+      c.distribution.jitter = core::parse_jitter(value);
+    } else if (name == "denoiser") {
+      c.recon.denoiser = reconstruct::parse_denoiser(value);
+    } else if (name == "bmfr-precision") {
+      if (value != "fp32" && value != "fp16")
+        throw core::InputError("expected fp32 or fp16, got \"" + std::string(value) + "\"");
+      c.recon.bmfr_precision = value == "fp16" ? reconstruct::BmfrPrecision::Fp16 : reconstruct::BmfrPrecision::Fp32;
+    } else if (name == "stereo-share") {
+      c.recon.share = reconstruct::parse_stereo_share(value);
+    } else if (name == "trace") {
+      c.tracing = renderer::parse_tracing(value, "--trace");
+    } else {
+      throw core::InputError("not a frame option");
+    }
+  } catch (const core::InputError& e) {
+    // The parsers name the command-line option ("--jitter: ..."): the caller's `where` replaces it.
+    std::string what = e.what();
+    const std::string option = "--" + std::string(name) + ": ";
+    if (what.rfind(option, 0) == 0) what = what.substr(option.size());
+    throw core::InputError(where + ": " + what);
+  }
+}
+
+void finish(FrameConfig& c, bool budget_given) {
+  if (c.distribution.kind == core::DistributionKind::Cartesian) {
+    if (budget_given && c.distribution.budget != 1.0)
+      throw core::InputError("budget: cartesian traces every pixel (budget 1); use cartesian-uniform for a fraction of "
+                             "the pixels");
+    c.distribution.budget = 1.0;
+  }
+  c.distribution.validate();
+}
+
+nlohmann::json to_json(const FrameConfig& c) {
+  return {{"distribution", core::distribution_name(c.distribution.kind)},
+          {"budget", c.distribution.budget},
+          {"jitter", c.distribution.jitter ? "on" : "off"},
+          {"denoiser", reconstruct::denoiser_name(c.recon.denoiser)},
+          {"bmfr-precision", c.recon.bmfr_precision == reconstruct::BmfrPrecision::Fp16 ? "fp16" : "fp32"},
+          {"stereo-share", reconstruct::stereo_share_name(c.recon.share)},
+          {"trace", renderer::tracing_name(c.tracing)}};
+}
+
+}  // namespace fovea::pipeline
