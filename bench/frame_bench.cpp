@@ -25,26 +25,16 @@
 #include "fovea/pipeline/frame_pipeline.hpp"
 #include "fovea/renderer/gpu_scene.hpp"
 #include "fovea/renderer/scene_io.hpp"
+#include "default_scene.hpp"
 
 namespace fp = fovea::pipeline;
 namespace fc = fovea::core;
 
 namespace {
 
-fovea::gpu::Context& context() {
-  static fovea::gpu::Context ctx;
-  return ctx;
-}
-
-const fovea::renderer::Scene& scene() {
-  static const fovea::renderer::Scene s = fovea::renderer::load_scene("default");
-  return s;
-}
-
-const fovea::renderer::GpuScene& gpu_scene() {
-  static const fovea::renderer::GpuScene gs(context(), scene());
-  return gs;
-}
+using fovea::bench::context;
+using fovea::bench::gpu_scene;
+using fovea::bench::scene;
 
 void frame(benchmark::State& state, const std::string& display, fc::DistributionKind kind) {
   const fc::DisplayPreset d = fc::load_display(display);

@@ -19,26 +19,16 @@
 #include "fovea/pipeline/testing.hpp"
 #include "fovea/renderer/gpu_scene.hpp"
 #include "fovea/renderer/scene_io.hpp"
+#include "default_scene.hpp"
 
 namespace fp = fovea::pipeline;
 namespace fc = fovea::core;
 
 namespace {
 
-fovea::gpu::Context& context() {
-  static fovea::gpu::Context ctx;
-  return ctx;
-}
-
-const fovea::renderer::Scene& scene() {
-  static const fovea::renderer::Scene s = fovea::renderer::load_scene("default");
-  return s;
-}
-
-const fovea::renderer::GpuScene& gpu_scene() {
-  static const fovea::renderer::GpuScene gs(context(), scene());
-  return gs;
-}
+using fovea::bench::context;
+using fovea::bench::gpu_scene;
+using fovea::bench::scene;
 
 // Gaze `deg` degrees off the view axis, towards the upper right (a corner: the largest
 // eccentricities on the opposite side).

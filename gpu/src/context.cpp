@@ -144,14 +144,7 @@ Context::Context(const GivenDevice& given) : owns_device_(false) {
   queue_family_ = given.queue_family;
   describe_device();
   vkGetDeviceQueue(device_, queue_family_, given.queue_index, &queue_);
-  if (given.ray_query_features) {
-    VkPhysicalDeviceAccelerationStructurePropertiesKHR as_props{
-        VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_ACCELERATION_STRUCTURE_PROPERTIES_KHR};
-    VkPhysicalDeviceProperties2 p2{VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_PROPERTIES_2, &as_props};
-    vkGetPhysicalDeviceProperties2(physical_device_, &p2);
-    features_.ray_query = true;
-    features_.as_scratch_alignment = as_props.minAccelerationStructureScratchOffsetAlignment;
-  }
+  if (given.ray_query_features) note_ray_queries();
   try {
     create_command_pool();
   } catch (...) {
@@ -298,6 +291,15 @@ void Context::describe_device() {
   info_.timestamp_period_ns = limits_.timestampPeriod;
 }
 
+void Context::note_ray_queries() {
+  VkPhysicalDeviceAccelerationStructurePropertiesKHR as_props{
+      VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_ACCELERATION_STRUCTURE_PROPERTIES_KHR};
+  VkPhysicalDeviceProperties2 p2{VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_PROPERTIES_2, &as_props};
+  vkGetPhysicalDeviceProperties2(physical_device_, &p2);
+  features_.ray_query = true;
+  features_.as_scratch_alignment = as_props.minAccelerationStructureScratchOffsetAlignment;
+}
+
 void Context::create_command_pool() {
   VkCommandPoolCreateInfo pci{VK_STRUCTURE_TYPE_COMMAND_POOL_CREATE_INFO};
   pci.flags = VK_COMMAND_POOL_CREATE_TRANSIENT_BIT;
@@ -363,12 +365,7 @@ void Context::create_device(bool ray_query) {
     VkPhysicalDeviceFeatures2 f2{VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_FEATURES_2, &s_rq};
     vkGetPhysicalDeviceFeatures2(physical_device_, &f2);
     if (s_as.accelerationStructure && s_rq.rayQuery) {
-      VkPhysicalDeviceAccelerationStructurePropertiesKHR as_props{
-          VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_ACCELERATION_STRUCTURE_PROPERTIES_KHR};
-      VkPhysicalDeviceProperties2 p2{VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_PROPERTIES_2, &as_props};
-      vkGetPhysicalDeviceProperties2(physical_device_, &p2);
-      features_.ray_query = true;
-      features_.as_scratch_alignment = as_props.minAccelerationStructureScratchOffsetAlignment;
+      note_ray_queries();
       e_as.accelerationStructure = VK_TRUE;
       e_rq.rayQuery = VK_TRUE;
       e12.bufferDeviceAddress = VK_TRUE;

@@ -172,6 +172,8 @@ class Context {
   // Properties, limits, memory and queue of physical_device_ for queue_family_.
   void describe_device();
   void create_command_pool();
+  // Ray queries are enabled on the device: features_.ray_query and the scratch alignment.
+  void note_ray_queries();
   void release();
 
   std::shared_ptr<ValidationCounters> counters_ = std::make_shared<ValidationCounters>();
