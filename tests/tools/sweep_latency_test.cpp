@@ -96,8 +96,8 @@ TEST(SweepLatency, PlanRefusesKeysTheCommandDoesNotHave) {
     return std::string("no error");
   };
   json render_only = latency_part();
-  render_only["distribution"] = "cartesian-uniform";  // a render option, not a latency one
-  EXPECT_NE(error(render_only).find("bad.json: key \"distribution\": unknown key"), std::string::npos) << error(render_only);
+  render_only["png-every"] = 0;  // a render option, not a latency one
+  EXPECT_NE(error(render_only).find("bad.json: key \"png-every\": unknown key"), std::string::npos) << error(render_only);
   EXPECT_NE(error(render_only).find("`fovea latency` option"), std::string::npos);
   EXPECT_NE(error(fovea::core::parse_json(R"({"command": "replay"})")).find("key \"command\""), std::string::npos);
   EXPECT_NE(error(fovea::core::parse_json(R"({"command": ["latency", "render"]})")).find("one command name"), std::string::npos);
@@ -110,7 +110,7 @@ TEST(SweepLatency, PlanRefusesKeysTheCommandDoesNotHave) {
   core::write_file_atomic(dir + "/bad.json", render_only.dump());
   const auto bad = test::run_fovea("sweep plan " + dir + "/bad.json --out " + dir + "/plan.jsonl");
   EXPECT_EQ(bad.status, 2);
-  EXPECT_NE(bad.err.find("\"distribution\""), std::string::npos) << bad.err;
+  EXPECT_NE(bad.err.find("\"png-every\""), std::string::npos) << bad.err;
   fs::remove_all(dir);
 }
 

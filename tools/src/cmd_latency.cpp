@@ -66,10 +66,14 @@ Prints the summary JSON on stdout; writes into --out:
                         [synthetic:1?task=search&rate=1000&noise=0&dropouts=0]
   --budget B            grid samples as a fraction of display pixels: the foveation's
                         strength (docs/visual-polar.md) [0.39]
-  --distribution D, --denoiser D, --bmfr-precision P, --stereo-share M, --trace T
-                        the frame's options, as `fovea render` takes them and with its
-                        defaults (visual-polar, bmfr, fp32, gather, auto); the sub-cell
-                        jitter is on (--jitter here is the tracker's)
+  --distribution D      as `fovea render` (the frame's options and defaults are the same):
+                        visual-polar | paper-visual-polar | cartesian | cartesian-uniform |
+                        linear-falloff | log-polar [visual-polar]
+  --denoiser D          bmfr | none [bmfr]
+  --bmfr-precision P    fp32 | fp16 [fp32]
+  --stereo-share M      off | gather | alternate [gather]
+  --trace T             auto | rayquery | compute [auto]; the grid's sub-cell jitter is on
+                        (--jitter here is the tracker's)
   --tracker PRESET      eye-tracker model preset: fove0 | ideal [fove0]
   --tracker-delay T     delay from measurement to delivery [preset's]
   --jitter T            extra delivery delay, uniform in [0, T] [preset's]

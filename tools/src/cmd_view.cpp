@@ -56,9 +56,12 @@ of view directions (lines every 5 degrees), a picture of the optics.
   --gaze-dir x,y,z      fixed gaze as a view-space direction (OpenXR: -Z forward, +Y up)
   --budget B            grid samples as a fraction of display pixels [0.39]
   --jitter on|off       per-frame sub-cell jitter (Halton 2, 3) of every grid [on]
-  --distribution D, --denoiser D, --bmfr-precision P, --stereo-share M
-                        the frame's options, as `fovea render` takes them and with its
-                        defaults (visual-polar, bmfr, fp32, gather)
+  --distribution D      as `fovea render` (the frame's options and defaults are the same):
+                        visual-polar | paper-visual-polar | cartesian | cartesian-uniform |
+                        linear-falloff | log-polar [visual-polar]
+  --denoiser D          bmfr | none [bmfr]
+  --bmfr-precision P    fp32 | fp16 [fp32]
+  --stereo-share M      off | gather | alternate [gather]
   --optics direct|lut   distortion pass: evaluate the optics per pixel, or read them from
                         the 128x128 LUT cache [direct]
   --window WxH          window size [fits both panels in 1280x720]
