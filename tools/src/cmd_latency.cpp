@@ -277,7 +277,7 @@ int run(std::vector<std::string> argv) {
   }
   // The frame of `fovea render`: the same defaults and option names (pipeline/frame_config.hpp).
   const pipeline::FrameConfig frame = frame_config_of(args, {"jitter"});
-  RenderSetupOptions render_options{frame.distribution, frame.recon, frame.tracing, true};
+  const RenderSetupOptions render_options{frame, true};
   const std::string gaze_uri = args.str("gaze", kDefaultGaze);
   devices::SourceOptions so;
   so.display = display;
@@ -353,13 +353,13 @@ int run(std::vector<std::string> argv) {
                               {"jitter_ms", core::ns_to_ms(tp.jitter_ns)}, {"noise_deg", tp.noise_deg},
                               {"dropout", tp.dropout}}},
                  {"predict", predict},
-                 {"budget", render_options.distribution.budget},
+                 {"budget", frame.distribution.budget},
                  {"frame_options", to_json(frame)},
                  {"seconds", seconds},
                  {"device", {{"name", ctx.info().name}, {"driver", ctx.info().driver}}}};
   char notebuf[256];
   std::snprintf(notebuf, sizeof notebuf, "%s %.0f Hz, budget %.2f, tracker %s %.0f Hz delay %.1f ms jitter %.1f ms, render %s",
-                display.name.c_str(), display.refresh_hz, render_options.distribution.budget, tp.name.c_str(), tp.rate_hz,
+                display.name.c_str(), display.refresh_hz, frame.distribution.budget, tp.name.c_str(), tp.rate_hz,
                 core::ns_to_ms(tp.delay_ns), core::ns_to_ms(tp.jitter_ns), fixed_cost ? "fixed" : "measured");
   std::vector<sweep::Chart> charts = latency::plots(sim.records, &sim, notebuf);
 

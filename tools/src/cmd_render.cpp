@@ -343,7 +343,7 @@ int run(std::vector<std::string> argv) {
   for (const auto& w : scene.warnings) std::cerr << "warning: " << w << "\n";
 
   const bool cull = !args.has("no-cull");
-  RenderSetup setup(scene, display, {dp, settings, frame_config.tracing, cull});
+  RenderSetup setup(scene, display, {frame_config, cull});
   gpu::Context& ctx = setup.ctx;
   renderer::GpuScene& gpu_scene = setup.gpu_scene;
   const std::array<core::Pose, 2>& poses = setup.poses;

@@ -29,11 +29,11 @@ pipeline::FrameConfig frame_config_of(const Args& args, const std::vector<std::s
 
 RenderSetup::RenderSetup(const renderer::Scene& scene, const core::DisplayPreset& display,
                          const RenderSetupOptions& options)
-    : trace_choice(renderer::choose_tracing(ctx, options.tracing, renderer::default_trace_choice_cache())),
+    : trace_choice(renderer::choose_tracing(ctx, options.frame.tracing, renderer::default_trace_choice_cache())),
       gpu_scene(ctx, scene, {}, trace_choice.tracing),
       views(core::stereo_views(display, scene.camera)),
       poses(views.poses()),
-      pipeline(ctx, gpu_scene, views, named(options.distribution, display), options.settings) {
+      pipeline(ctx, gpu_scene, views, named(options.frame.distribution, display), options.frame.recon) {
   if (options.cull)
     for (core::Eye e : {core::Eye::Left, core::Eye::Right})
       pipeline.set_visibility(e, core::EyeOptics(display, e).view_mask());

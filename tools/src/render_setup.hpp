@@ -22,11 +22,10 @@ namespace fovea::tools {
 // names a command uses for something else (fovea latency's --jitter is the tracker's).
 pipeline::FrameConfig frame_config_of(const Args& args, const std::vector<std::string>& not_frame = {});
 
+// A frame (FrameConfig) and whether the lens' hidden area is skipped.
 struct RenderSetupOptions {
-  core::DistributionParams distribution;
-  reconstruct::ReconSettings settings;
-  renderer::Tracing tracing = renderer::Tracing::Auto;
-  bool cull = true;  // skip the lens' hidden area
+  pipeline::FrameConfig frame;
+  bool cull = true;
 };
 
 // Members in construction order; they refer to each other, so the setup stays in place.
