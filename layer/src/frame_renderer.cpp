@@ -150,7 +150,9 @@ class PathTracer {
              const core::DisplayPreset& display, VkFormat format, XrSession session, const AppDevice* slots)
       : config_(config), scene_(scene), views_(views), format_(format), session_(session), slots_(slots),
         gaze_(std::make_unique<LayerGaze>(config.gaze, display)), ctx_(std::make_unique<gpu::Context>()),
-        trace_choice_(renderer::choose_tracing(*ctx_, config.frame.tracing, renderer::default_trace_choice_cache())),
+        // A measurement would delay the first traced frame by seconds: the cached one, or none.
+        trace_choice_(renderer::choose_tracing(*ctx_, config.frame.tracing, renderer::default_trace_choice_cache(),
+                                               false)),
         gpu_scene_(std::make_unique<renderer::GpuScene>(*ctx_, scene_, renderer::BvhOptions{}, trace_choice_.tracing)) {
     // The frame of `fovea render`: its defaults and options (pipeline/frame_config.hpp).
     pipeline_ = std::make_unique<pipeline::FramePipeline>(*ctx_, *gpu_scene_, views_, config_.frame.distribution,

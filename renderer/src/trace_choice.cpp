@@ -85,7 +85,7 @@ std::string default_trace_choice_cache() {
   return "";
 }
 
-TraceChoice choose_tracing(gpu::Context& ctx, Tracing requested, const std::string& cache_file) {
+TraceChoice choose_tracing(gpu::Context& ctx, Tracing requested, const std::string& cache_file, bool measure) {
   if (requested != Tracing::Auto) return {requested, "asked for (--trace)", {}, {}, false};
   if (!ctx.features().ray_query) return {Tracing::Compute, "the device has no ray queries", {}, {}, false};
   const std::string key = device_key(ctx);
@@ -108,6 +108,9 @@ TraceChoice choose_tracing(gpu::Context& ctx, Tracing requested, const std::stri
       cache = nlohmann::json::object();
     }
   }
+  if (!measure)
+    return {Tracing::RayQuery, "no measurement for this device in " + (cache_file.empty() ? "(no cache)" : cache_file) +
+                                   stale + " and none taken here: ray queries, which the device offers", {}, {}, false};
   const Scene probe = load_scene("default");
   const double compute = probe_ms(ctx, probe, Tracing::Compute);
   const double rayquery = probe_ms(ctx, probe, Tracing::RayQuery);

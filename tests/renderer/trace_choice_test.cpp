@@ -37,6 +37,11 @@ TEST_F(TraceChoice, AutoMeasuresOnceAndTheCacheDecidesAfterwards) {
   const fs::path dir = fs::temp_directory_path() / ("fovea-trace-choice-" + std::to_string(::getpid()));
   fs::remove_all(dir);
   const std::string cache = (dir / "sub" / "trace-choice.json").string();
+  // Without measuring (the OpenXR layer) and nothing cached: ray queries, nothing written.
+  const fr::TraceChoice unmeasured = fr::choose_tracing(ctx(), fr::Tracing::Auto, cache, false);
+  EXPECT_EQ(unmeasured.tracing, fr::Tracing::RayQuery);
+  EXPECT_FALSE(unmeasured.compute_ms.has_value());
+  EXPECT_FALSE(fs::exists(cache));
   const fr::TraceChoice first = fr::choose_tracing(ctx(), fr::Tracing::Auto, cache);
   ASSERT_TRUE(first.compute_ms && first.rayquery_ms);
   EXPECT_GT(*first.compute_ms, 0.0);
@@ -47,6 +52,8 @@ TEST_F(TraceChoice, AutoMeasuresOnceAndTheCacheDecidesAfterwards) {
 
   const fr::TraceChoice second = fr::choose_tracing(ctx(), fr::Tracing::Auto, cache);
   EXPECT_TRUE(second.cached);
+  EXPECT_EQ(fr::choose_tracing(ctx(), fr::Tracing::Auto, cache, false).tracing, first.tracing)
+      << "without measuring, the cached measurement decides";
   EXPECT_EQ(second.tracing, first.tracing);
   EXPECT_EQ(*second.compute_ms, *first.compute_ms);
 

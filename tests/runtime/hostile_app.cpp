@@ -145,10 +145,20 @@ void HostileApp::check_layer_after() {
   const std::string log = read_text(out_->path() + "/layer.log");
   EXPECT_EQ(log.find("internal failure"), std::string::npos) << log;
   EXPECT_EQ(log.find("passes this session through"), std::string::npos) << log;
-  std::ifstream in(out_->path() + "/layer_timing.jsonl");
-  std::string line, last;
-  while (std::getline(in, line)) last = line;
+  const auto last_record = [&] {
+    std::ifstream in(out_->path() + "/layer_timing.jsonl");
+    std::string line, last;
+    while (std::getline(in, line)) last = line;
+    return last;
+  };
   const bool rendering = !GetParam().scene.empty();
+  // The render thread's first traced frame comes when it is done (async): on a loaded machine
+  // later than the hostile calls' frames end. Normal frames for it, up to about 10 s.
+  std::string last = last_record();
+  for (int i = 0; rendering && last.find("\"replaced\":true") == std::string::npos && i < 700; ++i) {
+    normal_frames(1);
+    last = last_record();
+  }
   EXPECT_NE(last.find(rendering ? "\"replaced\":true" : "\"replaced\":false"), std::string::npos) << last;
 }
 

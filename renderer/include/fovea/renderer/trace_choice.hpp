@@ -23,7 +23,9 @@ struct TraceChoice {
 // for this device in `cache_file` ("" : none, measured every time), or a measurement that
 // is then written there (to a temporary name, renamed). An unreadable or foreign cache file
 // is measured over, with the reason in `why`.
-TraceChoice choose_tracing(gpu::Context& ctx, Tracing requested, const std::string& cache_file);
+// `measure` false: without a cached entry, no measurement (the OpenXR layer does not delay its
+// first frame for one): ray queries where the device offers them, as before auto measured.
+TraceChoice choose_tracing(gpu::Context& ctx, Tracing requested, const std::string& cache_file, bool measure = true);
 
 // FOVEA_TRACE_CHOICE_CACHE (a file, or "off": ""), else $XDG_CACHE_HOME/fovea/trace-choice.json,
 // else ~/.cache/fovea/trace-choice.json, else "".
