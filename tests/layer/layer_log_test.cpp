@@ -31,16 +31,6 @@ class LayerLogTest : public XrTest {
     XrTest::TearDown();
     for (const char* v : {"XR_API_LAYER_PATH", "XR_ENABLE_API_LAYERS", "FOVEA_LAYER_OUT"}) unsetenv(v);
   }
-  // The instance and its session gone (their records written), ready for another.
-  void end_instance() {
-    XrTest::TearDown();
-    instance_ = XR_NULL_HANDLE;
-    session_ = XR_NULL_HANDLE;
-    vk_instance_ = VK_NULL_HANDLE;
-    vk_physical_ = VK_NULL_HANDLE;
-    vk_device_ = VK_NULL_HANDLE;
-    messenger_ = VK_NULL_HANDLE;
-  }
   std::vector<nlohmann::json> records() const {
     std::vector<nlohmann::json> v;
     std::ifstream in(out_->path() + "/layer_timing.jsonl");

@@ -232,13 +232,7 @@ TEST_F(LayerApiTest, ApplicationActionSetNamesNeverCollideWithTheLayers) {
     // Not vacuous: the layer's own set with its eye-gaze binding rode along (the runtime's log).
     const std::string log = read_text(log_->path() + "/runtime.log");
     EXPECT_NE(log.find("action sets attached: 3, eye gaze bound"), std::string::npos) << log;
-    XrTest::TearDown();
-    instance_ = XR_NULL_HANDLE;
-    session_ = XR_NULL_HANDLE;
-    vk_instance_ = VK_NULL_HANDLE;
-    vk_physical_ = VK_NULL_HANDLE;
-    vk_device_ = VK_NULL_HANDLE;
-    messenger_ = VK_NULL_HANDLE;
+    end_instance();
   }
   unsetenv("FOVEA_RUNTIME_OUT");
 }
@@ -266,13 +260,7 @@ TEST_F(LayerApiTest, TimingRecordsAreOnOneClock) {
       ASSERT_EQ(frame({}, &fs), XR_SUCCESS);
       predicted.push_back(fs.predictedDisplayTime);
     }
-    XrTest::TearDown();  // the session's records are complete once it is destroyed
-    instance_ = XR_NULL_HANDLE;
-    session_ = XR_NULL_HANDLE;
-    vk_instance_ = VK_NULL_HANDLE;
-    vk_physical_ = VK_NULL_HANDLE;
-    vk_device_ = VK_NULL_HANDLE;
-    messenger_ = VK_NULL_HANDLE;
+    end_instance();  // the session's records are complete once it is destroyed
     std::vector<nlohmann::json> recs;
     std::ifstream in(log_->path() + "/layer_timing.jsonl");
     for (std::string line; std::getline(in, line);) recs.push_back(core::parse_json(line));
@@ -460,13 +448,7 @@ TEST_F(LayerApiTest, EyeGazeStaysTheApplicationsChoice) {
       ASSERT_NO_FATAL_FAILURE(create_instance(ext));
       seen[layered] = observe(instance_, session_, c.suggest, [&] { create_session(); },
                               [&](const char* s) { return path(s); });
-      XrTest::TearDown();
-      instance_ = XR_NULL_HANDLE;
-      session_ = XR_NULL_HANDLE;
-      vk_instance_ = VK_NULL_HANDLE;
-      vk_physical_ = VK_NULL_HANDLE;
-      vk_device_ = VK_NULL_HANDLE;
-      messenger_ = VK_NULL_HANDLE;
+      end_instance();
       setenv("XR_ENABLE_API_LAYERS", kLayer, 1);
     }
     EXPECT_EQ(seen[1], seen[0]) << "through the layer: " << seen[1] << "\nwithout it: " << seen[0];

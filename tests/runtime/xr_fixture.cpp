@@ -42,7 +42,9 @@ bool validation_requested() {
 
 }  // namespace
 
-void XrTest::TearDown() {
+void XrTest::TearDown() { end_instance(); }
+
+void XrTest::end_instance() {
   if (session_) {
     EXPECT_EQ(xrDestroySession(session_), XR_SUCCESS);
   }
@@ -57,6 +59,12 @@ void XrTest::TearDown() {
   if (instance_) {
     EXPECT_EQ(xrDestroyInstance(instance_), XR_SUCCESS);
   }
+  instance_ = XR_NULL_HANDLE;
+  session_ = XR_NULL_HANDLE;
+  vk_instance_ = VK_NULL_HANDLE;
+  vk_physical_ = VK_NULL_HANDLE;
+  vk_device_ = VK_NULL_HANDLE;
+  messenger_ = VK_NULL_HANDLE;
 }
 
 void XrTest::create_instance(std::vector<const char*> extensions) {

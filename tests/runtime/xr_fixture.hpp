@@ -21,6 +21,9 @@ class XrTest : public ::testing::Test {
  protected:
   void SetUp() override;
   void TearDown() override;
+  // Destroys the session, the Vulkan objects and the instance (their records written) and
+  // forgets them, ready for another instance in the same test; TearDown does the same.
+  void end_instance();
 
   // Creates instance_ with the given extensions (vulkan_enable2 always) and gets system_.
   void create_instance(std::vector<const char*> extensions = {});
