@@ -219,6 +219,11 @@ std::vector<float> ldr_flip(const Image& test, const Image& reference, double pp
   return out;
 }
 
+double flip_neighbour_weight(double ppd) {
+  const double pi = std::numbers::pi, x = 1.0 / ppd;
+  return std::exp(-pi * pi * x * x / kCsfMaxB);
+}
+
 int flip_support_px(double ppd) { return std::max(csf_radius(ppd), feature_radius(ppd)); }
 
 HdrFlip hdr_flip_exposures(const Image& reference, const std::vector<bool>& valid) {

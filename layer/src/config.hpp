@@ -4,7 +4,7 @@
 //     {"default": {...}, "applications": {"<XrApplicationInfo::applicationName>": {...}}}
 //     with keys "scene", "composite", "app_background", "gaze", "render", "compositor",
 //     "render_priority" and the frame options of `fovea render` by their names ("budget",
-//     "distribution", "jitter", "denoiser", "bmfr-precision", "stereo-share", "trace":
+//     "distribution", "jitter", "denoiser", "bmfr-precision", "stereo-share", "trace", "bounces":
 //     pipeline/frame_config.hpp) (an application's section over "default");
 //   env FOVEA_LAYER_SCENE, then FOVEA_SCENE (the scene); FOVEA_GAZE (the gaze source);
 //   FOVEA_LAYER_RENDER (the render mode); FOVEA_LAYER_COMPOSITOR (where compositing runs);

@@ -156,7 +156,8 @@ class PathTracer {
         gpu_scene_(std::make_unique<renderer::GpuScene>(*ctx_, scene_, renderer::BvhOptions{}, trace_choice_.tracing)) {
     // The frame of `fovea render`: its defaults and options (pipeline/frame_config.hpp).
     pipeline_ = std::make_unique<pipeline::FramePipeline>(*ctx_, *gpu_scene_, views_, config_.frame.distribution,
-                                                          config_.frame.recon);
+                                                          config_.frame.recon,
+                                                          pipeline::path_config(config_.frame.bounces, scene_));
     FOVEA_LAYER_INFO("rendering scene \"%s\" (from %s) at %dx%d per eye on %s, composite %s, gaze %s, render %s, "
                      "render thread %s, frame %s, tracing %s (%s)",
                      config_.scene.c_str(), config_.origin.c_str(), display.width, display.height,

@@ -16,7 +16,7 @@ reconstruct::ReconSettings FrameConfig::default_recon() {
 
 const std::vector<std::string>& frame_option_names() {
   static const std::vector<std::string> names = {"budget",         "distribution", "jitter", "denoiser",
-                                                 "bmfr-precision", "stereo-share", "trace"};
+                                                 "bmfr-precision", "stereo-share", "trace", "bounces"};
   return names;
 }
 
@@ -44,6 +44,19 @@ void apply_frame_option(FrameConfig& c, std::string_view name, std::string_view 
       c.recon.share = reconstruct::parse_stereo_share(value);
     } else if (name == "trace") {
       c.tracing = renderer::parse_tracing(value, "--trace");
+    } else if (name == "bounces") {
+      const std::string v(value);
+      if (v == "auto") {
+        c.bounces.from_albedo = true;
+      } else {
+        char* end = nullptr;
+        errno = 0;
+        const long n = std::strtol(v.c_str(), &end, 10);
+        if (v.empty() || *end != '\0' || errno == ERANGE || n < 0 || n > Bounces::kMaxBounces)
+          throw core::InputError("expected auto or a whole number in 0.." + std::to_string(Bounces::kMaxBounces) +
+                                 ", got \"" + v + "\"");
+        c.bounces = {false, int(n)};
+      }
     } else {
       throw core::InputError("not a frame option");
     }
@@ -73,7 +86,22 @@ nlohmann::json to_json(const FrameConfig& c) {
           {"denoiser", reconstruct::denoiser_name(c.recon.denoiser)},
           {"bmfr-precision", c.recon.bmfr_precision == reconstruct::BmfrPrecision::Fp16 ? "fp16" : "fp32"},
           {"stereo-share", reconstruct::stereo_share_name(c.recon.share)},
-          {"trace", renderer::tracing_name(c.tracing)}};
+          {"trace", renderer::tracing_name(c.tracing)},
+          {"bounces", c.bounces.from_albedo ? nlohmann::json("auto") : nlohmann::json(c.bounces.count)}};
+}
+
+renderer::PathConfig path_config(const Bounces& bounces, const renderer::Scene& scene) {
+  if (bounces.from_albedo) return renderer::albedo_path_config(renderer::albedo_stats(scene));
+  renderer::PathConfig p;
+  p.max_bounces = bounces.count;
+  return p;
+}
+
+nlohmann::json transport_json(const renderer::PathConfig& path, const std::string& rule) {
+  const bool roulette = path.rr_start <= std::uint32_t(Bounces::kMaxBounces);
+  return {{"bounces", path.max_bounces < 0 ? nlohmann::json("unlimited") : nlohmann::json(path.max_bounces)},
+          {"rr_start", roulette ? nlohmann::json(path.rr_start) : nlohmann::json()},
+          {"rule", rule}};
 }
 
 }  // namespace fovea::pipeline

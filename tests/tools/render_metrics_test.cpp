@@ -157,7 +157,8 @@ TEST(ReferenceCache, SecondRunReadsTheCacheAndASceneByteChangesTheKey) {
 }
 
 // `fovea reference` and `fovea render --reference SPP` share defaults, keys and cache
-// entries, in both directions; the render's reference error is part of the key.
+// entries, in both directions (the render with --bounces auto traces the reference's full
+// global illumination); the render's reference error is part of the key.
 TEST(ReferenceCache, RenderAndReferenceCommandsReuseEachOthersEntries) {
   const std::string dir = fovea::test::temp_dir("refshare");
   const std::string cache = " --reference-cache " + dir + "/cache";
@@ -169,7 +170,7 @@ TEST(ReferenceCache, RenderAndReferenceCommandsReuseEachOthersEntries) {
   };
   const json left = reference("left", "");
   EXPECT_FALSE(left["cached"].get<bool>());
-  const json a = render("--frames 1 --gaze synthetic:3 --reference 8" + cache, dir + "/a");
+  const json a = render("--frames 1 --gaze synthetic:3 --bounces auto --reference 8" + cache, dir + "/a");
   const json& ref = a["metrics"]["reference"];
   EXPECT_TRUE(ref["left"]["cached"].get<bool>()) << "render did not reuse the reference command's entry";
   EXPECT_EQ(ref["left"]["key"], left["key"]);
@@ -183,10 +184,56 @@ TEST(ReferenceCache, RenderAndReferenceCommandsReuseEachOthersEntries) {
   EXPECT_TRUE(right["cached"].get<bool>());
   EXPECT_EQ(right["key"], ref["right"]["key"]);
   // Another error target is another reference.
-  const json b = render("--frames 1 --gaze synthetic:3 --reference 8 --reference-error 0.05" + cache, dir + "/b");
+  const json b = render("--frames 1 --gaze synthetic:3 --bounces auto --reference 8 --reference-error 0.05" + cache,
+                        dir + "/b");
   EXPECT_FALSE(b["metrics"]["reference"]["left"]["cached"].get<bool>());
   EXPECT_NE(b["metrics"]["reference"]["left"]["key"], left["key"]);
   EXPECT_EQ(b["metrics"]["reference"]["left"]["settings"]["until_pixel_rel_error"].get<double>(), 0.05);
+  fs::remove_all(dir);
+}
+
+// The scores compare the same light transport: the default render (one bounce) against a
+// one-bounce reference (the entry `fovea reference --bounces 1 --rr-start 1000` makes), full
+// GI as its own labelled score, a DIR reference of another transport scored with a warning;
+// lens-hidden pixels are counted and not scored; FLIP's filters said to be off at tiny.
+TEST(RenderTransport, ScoresCompareTheSameLightTransport) {
+  const std::string dir = fovea::test::temp_dir("transport");
+  const std::string cache = " --reference-cache " + dir + "/cache";
+  const auto r = run_fovea("reference --display tiny --scene cornell --eye left --spp 8 --bounces 1 --rr-start 1000 "
+                           "--until-pixel-rel-error 0.02 --quiet" + cache + " --out " + dir + "/one.exr");
+  ASSERT_EQ(r.status, 0) << r.err;
+  const json one = fovea::core::parse_json(r.out);
+  const json a = render("--frames 2 --gaze synthetic:3 --reference 8 --full-gi-score" + cache, dir + "/a");
+  const json& t = a["transport"];
+  EXPECT_EQ(t["render"]["bounces"], 1);
+  EXPECT_TRUE(t["render"]["rr_start"].is_null());
+  EXPECT_EQ(t["reference"]["bounces"], 1);
+  EXPECT_TRUE(t["matched"].get<bool>());
+  EXPECT_GT(t["full_gi"]["bounces"].get<int>(), 1);  // the albedo rule's
+  const json& ref = a["metrics"]["reference"]["left"];
+  EXPECT_TRUE(ref["cached"].get<bool>()) << "the one-bounce entry of `fovea reference` was not reused";
+  EXPECT_EQ(ref["key"], one["key"]);
+  EXPECT_NE(ref["full_gi"]["key"], ref["key"]);
+  const json& s = a["summary"]["left"];
+  ASSERT_TRUE(s.contains("full_gi"));
+  EXPECT_TRUE(s["full_gi"]["hdr_flip"].is_number());
+  EXPECT_NE(s["full_gi"]["hdr_flip"], s["hdr_flip"]);
+  EXPECT_TRUE(fs::exists(dir + "/a/reference_left_full_gi.exr"));
+  EXPECT_GT(a["metrics"]["hidden_pixels"]["left"].get<long>(), 0);
+  EXPECT_FALSE(a["metrics"]["flip_filters"]["active"].get<bool>());
+  // With --bounces auto the full-GI score is the matched one.
+  const json b = render("--frames 2 --gaze synthetic:3 --bounces auto --reference 8 --full-gi-score" + cache, dir + "/b");
+  EXPECT_EQ(b["summary"]["left"]["full_gi"]["hdr_flip"], b["summary"]["left"]["hdr_flip"]);
+  // A directory of full-GI references scored by a one-bounce render: said, not hidden.
+  const auto c = run_fovea("render --display tiny --scene cornell --quiet --png-every 0 --frames 2 --gaze synthetic:3 "
+                           "--reference " + dir + "/b --out " + dir + "/c");
+  ASSERT_EQ(c.status, 0) << c.err;
+  EXPECT_NE(c.err.find("compare different light transport"), std::string::npos) << c.err;
+  EXPECT_FALSE(read_json(dir + "/c/report.json")["transport"]["matched"].get<bool>());
+  // Bad values name the option.
+  const auto bad = run_fovea("render --display tiny --scene cornell --quiet --frames 1 --bounces 300 --out " + dir + "/d");
+  EXPECT_EQ(bad.status, 2);
+  EXPECT_NE(bad.err.find("--bounces"), std::string::npos) << bad.err;
   fs::remove_all(dir);
 }
 

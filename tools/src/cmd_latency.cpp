@@ -72,6 +72,7 @@ Prints the summary JSON on stdout; writes into --out:
   --denoiser D          bmfr | none [bmfr]
   --bmfr-precision P    fp32 | fp16 [fp32]
   --stereo-share M      off | gather | alternate [gather]
+  --bounces N|auto      BSDF-sampled bounces after the primary hit [1]
   --trace T             auto | rayquery | compute [auto]; the grid's sub-cell jitter is on
                         (--jitter here is the tracker's)
   --tracker PRESET      eye-tracker model preset: fove0 | ideal [fove0]
@@ -219,7 +220,8 @@ int run(std::vector<std::string> argv) {
                                              "predict", "seconds", "render-time", "scan-out", "persistence",
                                              "inject-latency", "quality-frames", "reference-spp", "budget",
                                              "quality-at", "quality-radius", "reference-error", "reference-cache",
-                                             "distribution", "denoiser", "bmfr-precision", "stereo-share", "trace"};
+                                             "distribution", "denoiser", "bmfr-precision", "stereo-share", "trace",
+                                             "bounces"};
   std::vector<std::string> valued = sim_options;
   valued.insert(valued.end(), {"records", "out"});
   const Args args(argv, valued, {"quiet", "no-main-render"});

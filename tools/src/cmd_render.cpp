@@ -8,6 +8,7 @@
 #include <deque>
 #include <filesystem>
 #include <iostream>
+#include <limits>
 #include <map>
 #include <optional>
 
@@ -17,6 +18,7 @@
 #include "fovea/core/acuity.hpp"
 #include "fovea/core/clock.hpp"
 #include "fovea/core/display.hpp"
+#include "fovea/core/eye_optics.hpp"
 #include "fovea/core/error.hpp"
 #include "fovea/core/image.hpp"
 #include "fovea/core/flip.hpp"
@@ -96,15 +98,24 @@ With no options: a short demo on the shipped scene and gaze.
   --denoiser D          bmfr | none (accumulation only) [bmfr]
   --bmfr-precision P    fp32 | fp16: storage of BMFR's regression matrix [fp32]
   --stereo-share M      off | gather | alternate [gather]
+  --bounces N|auto      BSDF-sampled bounces after the primary hit, no Russian roulette (1:
+                        the BMFR/P5 configuration); auto: the bounce limit and Russian
+                        roulette from the scene's albedo, i.e. full global illumination as
+                        `fovea reference` traces it [1]
   --no-blur             skip the peripheral blur
   --no-cull             trace the lens' hidden area too
-  --reference SPP|DIR   SPP: converged reference of the last frame (full global illumination,
-                        at most SPP samples per pixel, see --reference-error), from the
-                        cache or rendered into it: the reference of `fovea reference --spp
-                        SPP --until-pixel-rel-error X` with its other defaults (bounces and
-                        Russian roulette from the scene's albedo), the same cache entry;
-                        DIR: load reference_left.exr and reference_right.exr written by
-                        `fovea reference` (checked to show this scene and view)
+  --reference SPP|DIR   SPP: converged reference of the last frame with the render's own light
+                        transport (--bounces; at most SPP samples per pixel, see
+                        --reference-error), from the cache or rendered into it: the
+                        reference of `fovea reference --spp SPP --until-pixel-rel-error X
+                        --bounces N --rr-start 1000` (auto: its defaults), the same cache
+                        entry; DIR: load reference_left.exr and reference_right.exr written
+                        by `fovea reference` (checked to show this scene and view; a
+                        different transport is scored, with a warning and
+                        transport.matched false). Lens-hidden pixels are never scored
+  --full-gi-score       with --reference SPP: also score against full global illumination
+                        (bounces and Russian roulette from the scene's albedo), as
+                        summary.*.full_gi (the same object when --bounces auto)
   --reference-error X   stop the reference once its per-pixel relative standard error
                         (RMS over the pixels, over the mean luminance) is <= X; 0: off [0.02]
   --reference-window DEG  with --reference SPP: each eye's reference traces only the pixels
@@ -183,6 +194,16 @@ nlohmann::json scores_json(const core::Scores& sc, const std::string& prefix) {
           {prefix + "hdr_flip", sc.hdr_flip}};
 }
 
+// The eccentricity of a lens-hidden pixel: no weight anywhere (fovea, acuity, bands, whole).
+constexpr float kHidden = std::numeric_limits<float>::quiet_NaN();
+
+// 1 for the pixels that are scored (finite eccentricity), 0 for the hidden ones.
+std::vector<float> visible_weights(const std::vector<float>& ecc) {
+  std::vector<float> w(ecc.size());
+  for (std::size_t i = 0; i < ecc.size(); ++i) w[i] = std::isfinite(ecc[i]) ? 1.0f : 0.0f;
+  return w;
+}
+
 std::vector<float> fovea_weights(const std::vector<float>& ecc) {
   std::vector<float> w(ecc.size());
   for (std::size_t i = 0; i < ecc.size(); ++i) w[i] = ecc[i] <= core::acuity::kFoveaDeg ? 1.0f : 0.0f;
@@ -201,8 +222,14 @@ nlohmann::json missing_scores(const std::string& prefix) {
 // and error_map_support_px around it), so those scores are the ones a whole reference with
 // the same pixels gives; the other regions are null, never scored against the untraced
 // zeros, with a note in quality_notes.
-void add_quality(nlohmann::json& s, const core::Image& img, const core::Image& ref, const std::vector<bool>& valid,
+void add_quality(nlohmann::json& s, const core::Image& rendered, const core::Image& ref, const std::vector<bool>& valid,
                  const std::vector<float>& ecc, double ppd) {
+  // Lens-hidden pixels (kHidden eccentricity) take the reference's values: they score 0 and
+  // their neighbours' SSIM and FLIP windows do not see the black lens edge.
+  core::Image img = rendered;
+  for (std::size_t i = 0; i < ecc.size(); ++i)
+    if (std::isnan(ecc[i])) img.pixels[i] = ref.pixels[i];
+  const std::vector<float> visible = visible_weights(ecc);
   const core::ErrorMaps maps = core::error_maps(img, ref, ppd, kExposure, valid);
   // What a missing pixel takes away: the whole image and the acuity weights (nowhere 0)
   // always, the fovea and the bands where it falls.
@@ -227,9 +254,11 @@ void add_quality(nlohmann::json& s, const core::Image& img, const core::Image& r
                 double(std::max<std::size_t>(valid.size(), 1)));
   const std::string margin = " or within " + std::to_string(support) + " px of them (the SSIM and FLIP neighbourhoods)";
   if (whole) {
-    s.update(scores_json(core::pool(maps), ""));
+    s.update(scores_json(core::pool(maps, visible), ""));
     s.update(scores_json(core::pool(maps, core::foveation_weights(ecc)), "foveated_"));
-    s["linear_psnr"] = core::psnr(img, ref);  // linear HDR, peak 1: dominated by emitters
+    std::vector<bool> seen(visible.size());
+    for (std::size_t i = 0; i < seen.size(); ++i) seen[i] = visible[i] > 0;
+    s["linear_psnr"] = core::psnr_masked(img, ref, seen);  // linear HDR, peak 1: dominated by emitters
   } else {
     s.update(missing_scores(""));
     s.update(missing_scores("foveated_"));
@@ -266,7 +295,7 @@ void add_quality(nlohmann::json& s, const core::Image& img, const core::Image& r
 void add_flicker(nlohmann::json& s, const std::deque<core::Image>& frames, const std::vector<float>& ecc) {
   const std::vector<float> map = core::flicker_map({frames.begin(), frames.end()}, kExposure);
   s["flicker_frames"] = frames.size();
-  s["flicker"] = core::weighted_mean(map);
+  s["flicker"] = core::weighted_mean(map, visible_weights(ecc));
   s["fovea_flicker"] = core::weighted_mean(map, fovea_weights(ecc));
   s["foveated_flicker"] = core::weighted_mean(map, core::foveation_weights(ecc));
   float e_max = 0;
@@ -292,9 +321,9 @@ int run(std::vector<std::string> argv) {
     }
   const Args args(argv,
                   {"scene", "display", "gaze", "frames", "distribution", "budget", "jitter", "denoiser", "bmfr-precision",
-                   "stereo-share", "reference", "reference-error", "reference-cache", "reference-window", "png-every",
+                   "stereo-share", "bounces", "reference", "reference-error", "reference-cache", "reference-window", "png-every",
                    "out", "screen", "trace"},
-                  {"no-blur", "no-cull", "no-marker", "quiet"});
+                  {"no-blur", "no-cull", "no-marker", "quiet", "full-gi-score"});
   const long frames = args.integer("frames", 24);
   if (frames < 1 || frames > 100000) throw core::InputError("--frames must be in 1..100000");
   // --reference: a sample count renders (or finds in the cache), anything else is a directory.
@@ -350,12 +379,22 @@ int run(std::vector<std::string> argv) {
   pipeline::FramePipeline& pipeline = setup.pipeline;
 
   // The same settings as `fovea reference --spp SPP --until-pixel-rel-error X`: one cache.
-  ReferenceRequest ref_request;
-  ref_request.scene = scene_arg;
-  ref_request.settings = reference_defaults(scene);
-  ref_request.settings.max_spp = std::uint32_t(ref_spp);
-  ref_request.settings.until_pixel_rel_error = ref_error;
-  ref_request.cache_dir = ref_cache;
+  // The scores compare against the render's own transport; full GI (the albedo rule) is a
+  // score of its own (--full-gi-score).
+  ReferenceRequest full_gi_request;
+  full_gi_request.scene = scene_arg;
+  full_gi_request.settings = reference_defaults(scene);
+  full_gi_request.settings.max_spp = std::uint32_t(ref_spp);
+  full_gi_request.settings.until_pixel_rel_error = ref_error;
+  full_gi_request.cache_dir = ref_cache;
+  const renderer::PathConfig transport = pipeline::path_config(frame_config.bounces, scene);
+  ReferenceRequest ref_request = full_gi_request;
+  ref_request.settings.bounces = transport.max_bounces;
+  ref_request.settings.rr_start = transport.rr_start;
+  const bool full_gi_is_matched = ref_request.settings.bounces == full_gi_request.settings.bounces &&
+                                  ref_request.settings.rr_start == full_gi_request.settings.rr_start;
+  const bool full_gi_score = args.has("full-gi-score");
+  if (full_gi_score && ref_spp == 0) throw core::InputError("--full-gi-score: only with --reference SPP");
   // A loaded reference and the window's radius are checked before the frames are paid for
   // (the gaze is inside the view: a disc at its centre stands for it).
   if (ref_window)
@@ -533,13 +572,31 @@ int run(std::vector<std::string> argv) {
                   {"fovea_deg", core::acuity::kFoveaDeg},
                   {"band_deg", kBandDeg},
                   {"foveated_weights", "normalised acuity m(e), Koskela et al. 2018 P4 Eq. 1"}};
-  nlohmann::json ref_info;
+  const double neighbour = core::flip_neighbour_weight(ppd);
+  j["metrics"]["flip_filters"] = {
+      {"active", neighbour >= core::kFlipFiltersActiveWeight},
+      {"neighbour_weight", neighbour},
+      {"note", neighbour >= core::kFlipFiltersActiveWeight
+                   ? "FLIP's spatial filters act at this display's pixels per degree"
+                   : "FLIP's spatial filters are inactive at this display's pixels per degree (a pixel's neighbour "
+                     "weighs below 1e-3 in the widest CSF filter): FLIP compares pixel by pixel here; use a preset of "
+                     "6 ppd or more (fove0: 9.4) for scores that model the eye's contrast sensitivity"}};
+  nlohmann::json ref_info, hidden_scored;
+  bool transport_matched = true;
   for (int e = 0; e < 2; ++e) {
     const core::Eye eye = core::Eye(e);
     const char* name = e == 0 ? "left" : "right";
     const core::View v = pipeline.view(eye);
     const glm::dvec3 g = pipeline.distribution(eye).gaze();
-    const std::vector<float> ecc = core::eccentricity_map(v, g);
+    // The lens-hidden pixels (the display's lens, whether or not they were traced): nobody
+    // sees them, so no score counts them (not-a-number eccentricity, see add_quality).
+    std::vector<float> ecc = core::eccentricity_map(v, g);
+    const core::ViewMask lens = core::EyeOptics(display, eye).view_mask();
+    long hidden_pixels = 0;
+    for (int y = 0; y < v.height(); ++y)
+      for (int x = 0; x < v.width(); ++x)
+        if (lens.hidden(x, y)) ecc[std::size_t(y) * std::size_t(v.width()) + std::size_t(x)] = kHidden, ++hidden_pixels;
+    hidden_scored[name] = hidden_pixels;
     nlohmann::json s;
     s["gaze"] = {g.x, g.y, g.z};  // view space, as the grid used it
     s["temporal_error"] = pipeline.temporal_error(eye);
@@ -551,34 +608,82 @@ int run(std::vector<std::string> argv) {
       s["flicker_note"] = "the gaze moved between the last two frames: no still frames to measure flicker over";
     }
     if (ref_spp > 0 || !ref_dir.empty()) {
-      CachedReference ref;
-      if (loaded[e]) {
-        ref = std::move(*loaded[e]);
-      } else {
-        if (bar) std::fprintf(stderr, "reference %s eye, up to %ld spp...\n", name, ref_spp);
-        ReferenceRequest req = ref_request;
+      // Renders (or finds) this eye's reference of `request`, written next to the frames as
+      // reference_<eye><suffix>.exr; describes it in ref_info.
+      const auto reference = [&](const ReferenceRequest& request, const std::string& suffix) {
+        if (bar) std::fprintf(stderr, "reference%s %s eye, up to %ld spp...\n", suffix.c_str(), name, ref_spp);
+        ReferenceRequest req = request;
         if (ref_window) req.window.discs = {{g, ref_window_deg}};
-        ref = cached_reference(ctx, gpu_scene, v, eye, req);
-        write_reference((out_dir / (std::string("reference_") + name + ".exr")).string(), ref);
+        CachedReference r = cached_reference(ctx, gpu_scene, v, eye, req);
+        write_reference((out_dir / (std::string("reference_") + name + suffix + ".exr")).string(), r);
+        return r;
+      };
+      const auto describe = [&](const CachedReference& r) {
+        const nlohmann::json settings = core::parse_json(r.identity).value("settings", nlohmann::json());
+        nlohmann::json d = {{"spp", r.result.spp},
+                            {"pixel_rel_error", r.result.pixel_rel_error},
+                            {"rel_error", r.result.rel_error},
+                            {"key", r.key},
+                            {"cached", r.from_cache},
+                            {"seconds", r.result.seconds},
+                            {"settings", settings},
+                            {"window", window_json(r.window)}};
+        const core::HdrFlip range = core::hdr_flip_exposures(r.result.image, r.valid);
+        d["hdr_flip_exposures"] = {{"start", range.start_exposure},
+                                   {"stop", range.stop_exposure},
+                                   {"count", range.exposures},
+                                   {"from", r.valid.empty() ? "whole image" : "window"}};
+        return d;
+      };
+      CachedReference ref = loaded[e] ? std::move(*loaded[e]) : reference(ref_request, "");
+      ref_info[name] = describe(ref);
+      const nlohmann::json settings = ref_info[name]["settings"];
+      renderer::PathConfig ref_transport;
+      ref_transport.max_bounces = settings.value("bounces", -1);
+      ref_transport.rr_start = settings.value("rr_start", 0u);
+      const bool matched = ref_transport.max_bounces == transport.max_bounces && ref_transport.rr_start == transport.rr_start;
+      ref_info[name]["transport"] = pipeline::transport_json(ref_transport, matched ? "the render's" : "another");
+      if (!matched) {
+        transport_matched = false;
+        std::cerr << "warning: --reference " << ref_dir << ": the " << name << " reference traces "
+                  << ref_info[name]["transport"].dump() << ", the render " << pipeline::transport_json(transport, "").dump()
+                  << ": its scores compare different light transport (report.json: transport.matched false)\n";
       }
-      ref_info[name] = {{"spp", ref.result.spp},
-                        {"pixel_rel_error", ref.result.pixel_rel_error},
-                        {"rel_error", ref.result.rel_error},
-                        {"key", ref.key},
-                        {"cached", ref.from_cache},
-                        {"seconds", ref.result.seconds},
-                        {"settings", core::parse_json(ref.identity).value("settings", nlohmann::json())},
-                        {"window", window_json(ref.window)}};
-      const core::HdrFlip range = core::hdr_flip_exposures(ref.result.image, ref.valid);
-      ref_info[name]["hdr_flip_exposures"] = {{"start", range.start_exposure},
-                                              {"stop", range.stop_exposure},
-                                              {"count", range.exposures},
-                                              {"from", ref.valid.empty() ? "whole image" : "window"}};
       add_quality(s, last[e], ref.result.image, ref.valid, ecc, ppd);
+      if (full_gi_score) {
+        nlohmann::json full;
+        if (full_gi_is_matched) {
+          full = s;
+        } else {
+          const CachedReference fr = reference(full_gi_request, "_full_gi");
+          ref_info[name]["full_gi"] = describe(fr);
+          add_quality(full, last[e], fr.result.image, fr.valid, ecc, ppd);
+        }
+        for (const char* k : {"gaze", "temporal_error", "flicker", "flicker_frames", "flicker_note", "fovea_flicker",
+                              "foveated_flicker", "flicker_bands"})
+          full.erase(k);
+        s["full_gi"] = full;
+      }
     }
     j["summary"][name] = s;
   }
   if (!ref_info.is_null()) j["metrics"]["reference"] = ref_info;
+  j["metrics"]["hidden_pixels"] = {{"left", hidden_scored["left"]},
+                                   {"right", hidden_scored["right"]},
+                                   {"note", "the display lens' hidden area: never scored; the rendered image takes the "
+                                            "reference's pixels there, so that no SSIM or FLIP neighbourhood sees the "
+                                            "lens edge"}};
+  j["transport"] = {{"render", pipeline::transport_json(transport, frame_config.bounces.from_albedo
+                                                                      ? "auto: from the scene's albedo"
+                                                                      : "--bounces")}};
+  if (!ref_info.is_null()) {
+    j["transport"]["reference"] = ref_info["left"]["transport"];
+    j["transport"]["matched"] = transport_matched;
+    if (full_gi_score)
+      j["transport"]["full_gi"] = pipeline::transport_json(
+          {.max_bounces = full_gi_request.settings.bounces, .rr_start = full_gi_request.settings.rr_start},
+          "the scene's albedo (summary.*.full_gi)");
+  }
   core::write_file_atomic((out_dir / "report.json").string(), j.dump(2) + "\n");
   std::cout << nlohmann::json{{"gpu_ms", j["gpu_ms"]}, {"cpu_ms", j["cpu_ms"]}}.dump() << "\n";
   return 0;

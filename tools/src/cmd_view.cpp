@@ -62,6 +62,7 @@ of view directions (lines every 5 degrees), a picture of the optics.
   --denoiser D          bmfr | none [bmfr]
   --bmfr-precision P    fp32 | fp16 [fp32]
   --stereo-share M      off | gather | alternate [gather]
+  --bounces N|auto      BSDF-sampled bounces after the primary hit [1]
   --optics direct|lut   distortion pass: evaluate the optics per pixel, or read them from
                         the 128x128 LUT cache [direct]
   --window WxH          window size [fits both panels in 1280x720]
@@ -131,7 +132,7 @@ int run(std::vector<std::string> argv) {
     }
   const Args args(argv,
                   {"display", "scene", "trace", "gaze", "gaze-dir", "budget", "jitter", "optics", "window", "frames",
-                   "distribution", "denoiser", "bmfr-precision", "stereo-share",
+                   "distribution", "denoiser", "bmfr-precision", "stereo-share", "bounces",
                    "screenshot", "panels"},
                   {});
   const core::DisplayPreset d = core::load_display(args.str("display", "small"));
@@ -187,7 +188,8 @@ int run(std::vector<std::string> argv) {
     sr->gpu_scene = std::make_unique<renderer::GpuScene>(ctx, *scene, renderer::BvhOptions{}, choice.tracing);
     const core::StereoViews views = core::stereo_views(d, scene->camera);
     sr->poses = views.poses();
-    sr->pipeline = std::make_unique<pipeline::FramePipeline>(ctx, *sr->gpu_scene, views, dp, frame.recon);
+    sr->pipeline = std::make_unique<pipeline::FramePipeline>(ctx, *sr->gpu_scene, views, dp, frame.recon,
+                                                             pipeline::path_config(frame.bounces, *scene));
     for (int e = 0; e < 2; ++e) sr->pipeline->set_visibility(core::Eye(e), optics[e].view_mask());
   } else {
     // The direction grid is static: distort it once.

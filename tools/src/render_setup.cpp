@@ -33,7 +33,8 @@ RenderSetup::RenderSetup(const renderer::Scene& scene, const core::DisplayPreset
       gpu_scene(ctx, scene, {}, trace_choice.tracing),
       views(core::stereo_views(display, scene.camera)),
       poses(views.poses()),
-      pipeline(ctx, gpu_scene, views, named(options.frame.distribution, display), options.frame.recon) {
+      pipeline(ctx, gpu_scene, views, named(options.frame.distribution, display), options.frame.recon,
+               pipeline::path_config(options.frame.bounces, scene)) {
   if (options.cull)
     for (core::Eye e : {core::Eye::Left, core::Eye::Right})
       pipeline.set_visibility(e, core::EyeOptics(display, e).view_mask());

@@ -17,7 +17,7 @@
 namespace fovea::tools {
 
 // The frame options given on the command line (--budget, --distribution, --jitter, --denoiser,
-// --bmfr-precision, --stereo-share, --trace: pipeline::frame_option_names) over
+// --bmfr-precision, --stereo-share, --trace, --bounces: pipeline::frame_option_names) over
 // pipeline::FrameConfig's defaults, finished (Cartesian's budget, validated). `not_frame`:
 // names a command uses for something else (fovea latency's --jitter is the tracker's).
 pipeline::FrameConfig frame_config_of(const Args& args, const std::vector<std::string>& not_frame = {});

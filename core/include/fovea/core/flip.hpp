@@ -26,6 +26,13 @@ std::vector<float> ldr_flip(const Image& test, const Image& reference, double pp
 // widest of the CSF filters and the feature detector at `ppd`.
 int flip_support_px(double ppd);
 
+// The weight a pixel's direct neighbour gets relative to the pixel itself in FLIP's widest
+// spatial filter (the CSF's b = 0.04 Gaussian, exp(−π²·(1/ppd)²/b)). Below
+// kFlipFiltersActiveWeight the filters leave every pixel as it is: FLIP then compares pixel
+// by pixel, as it would at a far lower resolution than the display's (below ≈ 6 ppd).
+double flip_neighbour_weight(double ppd);
+constexpr double kFlipFiltersActiveWeight = 1e-3;
+
 struct HdrFlip {
   std::vector<float> error;  // per pixel, the maximum LDR-FLIP over the exposures
   double start_exposure = 0, stop_exposure = 0;
