@@ -145,12 +145,20 @@ FrameTimes FramePipeline::render(const std::array<core::Pose, 2>& eye_pose, cons
   core::TimeNs t0 = core::now_ns();
   const int p = m.frames_done == 0 ? 0 : 1 - m.parity;
   const bool history = m.frames_done > 0;
+  double motion = 0;  // the largest change of an eye's view since the last frame (degrees)
   for (auto& e : m.eyes) {
     const int i = int(e->eye);
+    const core::Pose pose_before = e->pose;
+    const glm::dvec3 gaze_before = e->gaze_used;
     e->pose = eye_pose[i];
     t.gaze[i] = e->dist->set_frame(gaze[i], frame);
+    e->gaze_used = t.gaze[i].used;
+    motion = std::max(motion, reconstruct::view_motion_deg(gaze_before, e->gaze_used, pose_before, e->pose));
     e->grid_pass->prepare(*e->dist, e->mask);
   }
+  // A still view converges (history weights 1/n); a moving one keeps the EMA floors.
+  const reconstruct::ReconSettings settings = reconstruct::with_history_floors(m.settings, motion);
+  t.history_floor = float(settings.alpha_min / std::max(m.settings.alpha_min, 1e-9f));
   t.grid.cpu_ms = lap_ms(t0);
   m.write_mappings();
   t.reconstruct.cpu_ms = lap_ms(t0);
@@ -180,14 +188,14 @@ FrameTimes FramePipeline::render(const std::array<core::Pose, 2>& eye_pose, cons
     gpu::compute_to_compute(cmd);
     m.timer.stage(cmd, "trace");
     t.trace.cpu_ms = lap_ms(r0);
-    m.accumulation->record(cmd, p, history, std::span(fresh, m.eyes.size()), m.settings);
-    m.gather->record(cmd, p, stereo && m.settings.share != reconstruct::StereoShare::Off, m.settings);
+    m.accumulation->record(cmd, p, history, std::span(fresh, m.eyes.size()), settings);
+    m.gather->record(cmd, p, stereo && m.settings.share != reconstruct::StereoShare::Off, settings);
     m.timer.stage(cmd, "accumulate");
     if (m.bmfr)
       m.bmfr->record(cmd, p, frame, m.settings.block_offsets ? reconstruct::bmfr_block_offset(frame) : glm::ivec2(0),
                      m.settings.noise);
     m.timer.stage(cmd, "bmfr_fit");
-    m.post->record(cmd, p, history, m.settings);
+    m.post->record(cmd, p, history, settings);
     m.timer.stage(cmd, "post");
     t.reconstruct.cpu_ms += lap_ms(r0);
     std::vector<const gpu::Buffer*> finals;

@@ -17,6 +17,7 @@ struct EyeState {
   std::unique_ptr<core::SampleDistribution> dist;
   core::View base_view;
   core::Pose pose;
+  glm::dvec3 gaze_used{0, 0, -1};  // the gaze the grid used in the last frame
   std::unique_ptr<gpu::GridPass> grid_pass;
   gpu::Buffer grid;
   renderer::TraceOutputs trace;

@@ -1,6 +1,9 @@
 #include "fovea/reconstruct/settings.hpp"
 
+#include <algorithm>
 #include <cmath>
+
+#include <glm/gtc/quaternion.hpp>
 #include <numbers>
 #include <string>
 
@@ -24,6 +27,25 @@ StereoShare parse_stereo_share(std::string_view s) {
 
 double blur_sigma_deg(double e_deg, double mar_fovea_deg) {
   return std::sqrt(std::numbers::ln2 / 2) / std::numbers::pi * mar_fovea_deg / core::acuity::m(e_deg);
+}
+
+double view_motion_deg(glm::dvec3 gaze_before, glm::dvec3 gaze_now, const core::Pose& before, const core::Pose& now) {
+  // The relative rotation's angle: 2·acos|w| of q_now · q_before⁻¹ (|w| folds q and −q).
+  const double w = std::min(1.0, std::abs((now.orientation * glm::inverse(before.orientation)).w));
+  const double rotation = 2.0 * std::acos(w) * 180.0 / std::numbers::pi;
+  const double parallax = std::atan2(glm::length(now.position - before.position), kMotionParallaxM) * 180.0 / std::numbers::pi;
+  const double m = core::angle_deg(gaze_before, gaze_now) + rotation + parallax;
+  return std::isfinite(m) ? m : kFullFloorMotionDeg;  // an unknown change counts as a full one
+}
+
+ReconSettings with_history_floors(const ReconSettings& s, double motion_deg) {
+  const float k = float(std::clamp(motion_deg / kFullFloorMotionDeg, 0.0, 1.0));
+  ReconSettings r = s;
+  r.alpha_min *= k;
+  r.post_alpha_min *= k;
+  r.taa_alpha *= k;
+  r.fit_handover = 1.0f - k;
+  return r;
 }
 
 const char* denoiser_name(Denoiser d) { return d == Denoiser::Bmfr ? "bmfr" : "none"; }

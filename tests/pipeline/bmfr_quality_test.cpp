@@ -5,8 +5,10 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <limits>
 #include <string>
 
+#include "fovea/core/eye_optics.hpp"
 #include "fovea/core/flip.hpp"
 #include "fovea/core/metrics.hpp"
 #include "fovea/renderer/reference.hpp"
@@ -57,7 +59,12 @@ void expect_bmfr_not_worse(fovea::gpu::Context& ctx, const char* scene_name) {
   const core::Image ref = renderer::render_reference(ctx, gs, view, core::Eye::Left, o).image;
 
   const double ppd = core::flip_ppd(view);
-  const std::vector<float> ecc = core::eccentricity_map(view, kGaze[0]);
+  // The lens-hidden pixels are never seen, so never scored (docs/metrics.md).
+  std::vector<float> ecc = core::eccentricity_map(view, kGaze[0]);
+  const core::ViewMask lens = core::EyeOptics(fovea::test::display_of_size(kWidth, kHeight), core::Eye::Left).view_mask();
+  for (int y = 0; y < kHeight; ++y)
+    for (int x = 0; x < kWidth; ++x)
+      if (lens.hidden(x, y)) ecc[std::size_t(y) * kWidth + std::size_t(x)] = std::numeric_limits<float>::quiet_NaN();
   const core::ErrorMaps mb = core::error_maps(bmfr, ref, ppd), mn = core::error_maps(none, ref, ppd);
   const auto b = core::band_scores(mb, ecc), n = core::band_scores(mn, ecc);
   ASSERT_EQ(b.size(), n.size());
@@ -69,8 +76,11 @@ void expect_bmfr_not_worse(fovea::gpu::Context& ctx, const char* scene_name) {
   }
   // Per band, the paired per-pixel differences (BMFR − none) of the tone-mapped squared
   // error (the MSE behind the PSNR) and of HDR-FLIP: BMFR is worse only where the mean
-  // difference exceeds twice its standard error (the reference and both renders are noisy;
-  // a band of a few pixels cannot show a difference of 0.01 dB).
+  // difference exceeds 3.4 standard errors (the reference and both renders are noisy; a band
+  // of a few pixels cannot show a difference of 0.01 dB). 3.4σ: ~30 bands × 2 metrics per
+  // scene, four scenes, a family-wise 5% false alarm (Bonferroni). A still view hands BMFR
+  // over to the accumulated input (recon_post.comp), so both converge to the same image and
+  // at 2σ some of the ~240 comparisons of two near-equal images fail by chance.
   for (std::size_t k = 0; k < b.size(); ++k) {
     for (int metric = 0; metric < 2; ++metric) {
       const std::vector<float>& x = metric == 0 ? mb.squared_error : mb.hdr_flip;
@@ -79,7 +89,7 @@ void expect_bmfr_not_worse(fovea::gpu::Context& ctx, const char* scene_name) {
       for (std::size_t i = 0; i < ecc.size(); ++i)
         if (ecc[i] >= b[k].e_min && ecc[i] < b[k].e_max) d.push_back(double(x[i]) - double(y[i]));
       const fovea::test::MeanSe m = fovea::test::mean_se(d);
-      EXPECT_LE(m.mean, 2.0 * m.se) << scene_name << " band " << b[k].e_min << "-" << b[k].e_max << ": BMFR worse in "
+      EXPECT_LE(m.mean, 3.4 * m.se) << scene_name << " band " << b[k].e_min << "-" << b[k].e_max << ": BMFR worse in "
                                     << (metric == 0 ? "tone-mapped MSE" : "HDR-FLIP") << " by " << m.mean << " ± "
                                     << m.se;
     }

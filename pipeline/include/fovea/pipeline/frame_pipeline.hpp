@@ -41,6 +41,9 @@ struct FrameTimes {
   // What each eye's grid did with the gaze it was given (left, right): the direction it used
   // (clamped into the view, or the last valid gaze / view centre for an unusable one).
   std::array<core::GazeStatus, 2> gaze{};
+  // The share of the EMA floors this frame kept (reconstruct::with_history_floors): 0 for a
+  // still view (history weights 1/n: it converges), 1 once it moved kFullFloorMotionDeg.
+  float history_floor = 1;
   double gpu_ms() const { return grid.gpu_ms + trace.gpu_ms + reconstruct.gpu_ms + resolve.gpu_ms; }
   double cpu_ms() const {
     return grid.cpu_ms + trace.cpu_ms + reconstruct.cpu_ms + resolve.cpu_ms + submit_cpu_ms + wait_cpu_ms;

@@ -2,6 +2,10 @@
 // Reconstruction in grid space (docs/reconstruction.md): the settings every stage reads.
 #include <string_view>
 
+#include <glm/vec3.hpp>
+
+#include "fovea/core/view.hpp"
+
 #include "fovea/reconstruct/bmfr.hpp"
 
 namespace fovea::reconstruct {
@@ -25,6 +29,21 @@ const char* stereo_share_name(StereoShare s);
 constexpr double kMarFoveaDeg = 1.0 / 60.0;
 double blur_sigma_deg(double e_deg, double mar_fovea_deg = kMarFoveaDeg);
 
+struct ReconSettings;
+
+// Convergence (docs/reconstruction.md, "History weights"): the EMA floors (alpha_min,
+// post_alpha_min, taa_alpha) keep a moving view's history short, so that what changed shows
+// within a few frames. A still view (the same eye poses and gaze; scenes are static) has
+// nothing to forget: its history weights become 1/n, a cumulative mean that converges to the
+// reference. In between the floors scale with the view's motion per frame, in full from
+// kFullFloorMotionDeg on: the cap on n is 1/floor, set by how much the view changed.
+constexpr double kFullFloorMotionDeg = 1.0;
+// The view's change between two frames in degrees: the gaze's angle, the eye's rotation and
+// its translation seen from kMotionParallaxM away (the parallax of a surface at that distance).
+constexpr double kMotionParallaxM = 1.0;
+double view_motion_deg(glm::dvec3 gaze_before, glm::dvec3 gaze_now, const core::Pose& before, const core::Pose& now);
+ReconSettings with_history_floors(const ReconSettings& s, double motion_deg);
+
 struct ReconSettings {
   Denoiser denoiser = Denoiser::Bmfr;
   BmfrPrecision bmfr_precision = BmfrPrecision::Fp32;  // storage of BMFR's regression matrix
@@ -38,6 +57,10 @@ struct ReconSettings {
   // saccade by far more. Huge values switch the test off (for measuring what it does).
   float coarse_keep = 1.25f, coarse_reject = 2.0f;
   float noise = 0.01f;           // stochastic regularisation ε (BMFR Eq. 7)
+  // Set per frame by with_history_floors: 1 − the floors' share (1: a still view). The
+  // regression's bias does not average out, the accumulated input's noise does: a still
+  // view hands the fit over to its input as samples accumulate (recon_post.comp).
+  float fit_handover = 0;
   bool block_offsets = true;     // 16 static block-grid displacements
   bool blur = true;              // peripheral blur
   double blur_mar_fovea_deg = kMarFoveaDeg;  // MAR₀ of blur_sigma_deg
