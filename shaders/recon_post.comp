@@ -14,11 +14,6 @@
 //   Phase I kept of its own (cell-size test, rounding of the counts).
 // - The outlier excess (recon_bmfr_fit.comp) is already Phase I's temporal mean: accumulated
 //   again it would outlive the same firefly without BMFR several times over.
-// - A still view (pc.handover 1, the EMA floors off: reconstruct/settings.hpp) converges to
-//   the reference: the fit's bias would not average out, the input's noise does. The output
-//   hands over from Phase III to the fit's input (Phase I's cumulative mean) as the input's
-//   samples n accumulate, β = handover · n / (n + kFitSamples): the fit counts as
-//   kFitSamples samples.
 // Without denoising the Phase I result (direct + indirect) passes through.
 #extension GL_GOOGLE_include_directive : require
 #extension GL_EXT_samplerless_texture_functions : require  // texelFetch on texture buffers
@@ -38,9 +33,6 @@ layout(std430, binding = RECON_POST_OUT) writeonly buffer Post { vec4 post[]; };
 layout(binding = RECON_POST_PREV_ACC_DIRECT) uniform textureBuffer prev_acc_direct;
 layout(binding = RECON_POST_EXCESS) uniform textureBuffer excess;  // unread without BMFR
 layout(std430, binding = RECON_POST_SUM) writeonly buffer Sum { vec4 sum[]; };          // TAA's input
-layout(binding = RECON_POST_Z) uniform textureBuffer shared_indirect;  // the fit's input; .w its samples
-
-const float kFitSamples = 8.0;
 
 layout(push_constant) uniform Push { ReconPostPush pc; };
 
@@ -72,10 +64,5 @@ void main() {
   }
   post[i] = acc;
   vec4 direct = texelFetch(acc_direct, int(i));
-  vec3 indirect = acc.rgb + texelFetch(excess, int(i)).rgb;
-  if (pc.handover > 0.0) {  // after Phase III, which keeps accumulating fits: its mean of means is not the input's mean
-    vec4 input_ = texelFetch(shared_indirect, int(i));
-    indirect = mix(indirect, input_.rgb, pc.handover * input_.w / (input_.w + kFitSamples));
-  }
-  sum[i] = vec4(indirect + direct.rgb, direct.w);  // .w: TAA's CMA start
+  sum[i] = vec4(acc.rgb + texelFetch(excess, int(i)).rgb + direct.rgb, direct.w);  // .w: TAA's CMA start
 }

@@ -85,7 +85,7 @@ struct BmfrBindings {
 
 struct PostBindings {
   FOVEA_BINDING_COUNT(RECON_POST_COUNT)
-  Buf pos, tap_idx, tap_w, source, acc_direct, prev, out, prev_acc_direct, excess, sum, z;
+  Buf pos, tap_idx, tap_w, source, acc_direct, prev, out, prev_acc_direct, excess, sum;
   Slots slots() const {
     return {{{RECON_POST_POS, pos},
              {RECON_POST_TAP_IDX, tap_idx},
@@ -96,8 +96,7 @@ struct PostBindings {
              {RECON_POST_OUT, out},
              {RECON_POST_PREV_ACC_DIRECT, prev_acc_direct},
              {RECON_POST_EXCESS, excess},
-             {RECON_POST_SUM, sum},
-             {RECON_POST_Z, z}}};
+             {RECON_POST_SUM, sum}}};
   }
 };
 

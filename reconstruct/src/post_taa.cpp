@@ -29,7 +29,7 @@ PostTaa::PostTaa(gpu::Context& ctx, std::span<const EyeGrid> eyes, const Accumul
       e.post_set[p] = make_set(ctx, post_,
                                PostBindings{&acc.position(me, p), &acc.tap_index(me), &acc.tap_weight(me), source,
                                             &acc.direct(me, p), &e.post[q], &e.post[p], &acc.direct(me, q), excess,
-                                            &e.sum, &gather.shared(me)});
+                                            &e.sum});
       e.taa_set[p] = make_set(ctx, taa_,
                               TaaBindings{g.maps, g.tables, &acc.position(me, p), &acc.tap_index(me),
                                           &acc.tap_weight(me), &e.sum, g.albedo, &e.final_[q], &e.final_[p],
@@ -40,7 +40,7 @@ PostTaa::PostTaa(gpu::Context& ctx, std::span<const EyeGrid> eyes, const Accumul
 
 namespace {
 shaders::ReconPostPush post_push(bool history, const ReconSettings& s) {
-  return {0, history ? 1u : 0u, s.denoiser == Denoiser::Bmfr ? 1u : 0u, 0, s.post_alpha_min, s.taa_alpha, s.fit_handover, 0};
+  return {0, history ? 1u : 0u, s.denoiser == Denoiser::Bmfr ? 1u : 0u, 0, s.post_alpha_min, s.taa_alpha, s.still, 0};
 }
 }  // namespace
 

@@ -44,7 +44,7 @@ ReconSettings with_history_floors(const ReconSettings& s, double motion_deg) {
   r.alpha_min *= k;
   r.post_alpha_min *= k;
   r.taa_alpha *= k;
-  r.fit_handover = 1.0f - k;
+  r.still = 1.0f - k;
   return r;
 }
 

@@ -57,10 +57,9 @@ struct ReconSettings {
   // saccade by far more. Huge values switch the test off (for measuring what it does).
   float coarse_keep = 1.25f, coarse_reject = 2.0f;
   float noise = 0.01f;           // stochastic regularisation ε (BMFR Eq. 7)
-  // Set per frame by with_history_floors: 1 − the floors' share (1: a still view). The
-  // regression's bias does not average out, the accumulated input's noise does: a still
-  // view hands the fit over to its input as samples accumulate (recon_post.comp).
-  float fit_handover = 0;
+  // Set per frame by with_history_floors: 1 − the floors' share (1: a still view, which
+  // needs no TAA: recon_taa.comp).
+  float still = 0;
   bool block_offsets = true;     // 16 static block-grid displacements
   bool blur = true;              // peripheral blur
   double blur_mar_fovea_deg = kMarFoveaDeg;  // MAR₀ of blur_sigma_deg

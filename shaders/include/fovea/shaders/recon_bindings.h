@@ -73,8 +73,7 @@
 #define RECON_POST_PREV_ACC_DIRECT 7
 #define RECON_POST_EXCESS 8
 #define RECON_POST_SUM 9
-#define RECON_POST_Z 10
-#define RECON_POST_COUNT 11
+#define RECON_POST_COUNT 10
 
 // recon_taa.comp
 #define RECON_TAA_POS 2

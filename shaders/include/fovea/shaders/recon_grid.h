@@ -72,7 +72,7 @@ struct ReconBmfrPush {
 struct ReconPostPush {
   FOVEA_UINT cells, has_history, denoise, pad;  // denoise = 0: remodulated accumulation only
   float alpha_min, taa_alpha;  // BMFR Phase III: 0.1, TAA: 0.2
-  float handover;             // 0..1: how still the view is (1 − the EMA floors' share); recon_post.comp
+  float still;                // 0..1: how still the view is (1 − the EMA floors' share); recon_taa.comp
   float pad1;
 };
 
