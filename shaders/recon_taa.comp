@@ -133,10 +133,11 @@ void main() {
   float g = weighted ? exp(-dot(jitter, jitter) / (2.0 * kCentreSigma * kCentreSigma)) : 1.0;
   float a = follow ? g / ((weighted ? kMeanCentre : 1.0) * (since - 1.0) + g)
                    : max(1.0 / max(texelFetch(post, int(i)).w, 1.0), pc.taa_alpha) * g;
-  // A still view (pc.still 1) needs no TAA: Phase I's cumulative mean of the jittered samples
-  // is each cell's box-filtered mean already, and TAA's blend kept a bias that never averages
-  // out (measured, docs/reconstruction.md "History weights": with the clamp; without it in
-  // the compressed space; in linear space as a weighted cumulative mean).
-  a = mix(a, 1.0, pc.still);
+  // A still view (pc.still 1) needs no TAA outside a restart window: Phase I's cumulative
+  // mean of the jittered samples is each cell's box-filtered mean already, and TAA's blend
+  // kept a bias that never averages out (measured, docs/reconstruction.md "History weights":
+  // with the clamp; without it in the compressed space; in linear space as a weighted
+  // cumulative mean). A restart window keeps its running mean: its history is young.
+  if (!follow) a = mix(a, 1.0, pc.still);
   final_color[i] = vec4(max(expand(mix(h, compress(c), a)), vec3(0.0)), 1.0);
 }
