@@ -13,6 +13,7 @@
 
 #include "command.hpp"
 #include "fovea/core/display.hpp"
+#include "fovea/core/eye_optics.hpp"
 #include "fovea/core/duration.hpp"
 #include "fovea/core/error.hpp"
 #include "fovea/core/output_path.hpp"
@@ -168,7 +169,7 @@ struct Quality {
 };
 Quality fovea_quality(pipeline::FramePipeline& pipe, const std::array<core::Pose, 2>& poses,
                       const latency::Simulation& sim, std::size_t count, std::size_t warm, double radius_deg,
-                      const core::Image& reference) {
+                      const core::Image& reference, const core::ViewMask& lens) {
   Quality q;
   const core::View view = pipe.view(core::Eye::Left);
   const auto first_shown_from = [&](core::TimeNs t) {
@@ -188,7 +189,10 @@ Quality fovea_quality(pipeline::FramePipeline& pipe, const std::array<core::Pose
       if (f < landed || !truth) continue;
       const std::vector<float> ecc = core::eccentricity_map(view, *truth);
       std::vector<float> w(ecc.size());
-      for (std::size_t i = 0; i < ecc.size(); ++i) w[i] = ecc[i] <= radius_deg ? 1.0f : 0.0f;
+      for (std::size_t i = 0; i < ecc.size(); ++i)  // lens-hidden pixels are never scored
+        w[i] = ecc[i] <= radius_deg && !lens.hidden(int(i % std::size_t(view.width())), int(i / std::size_t(view.width())))
+                   ? 1.0f
+                   : 0.0f;
       const double ppd = std::sqrt(view.pixels_per_deg2(*truth));
       const core::Scores sc = core::pool(core::error_maps(pipe.image(core::Eye::Left), reference, ppd), w);
       if (sc.weight <= 0) continue;  // the true gaze is off the view
@@ -390,13 +394,16 @@ int run(std::vector<std::string> argv) {
     if (quality_frames > 0 && !quality_at.empty()) {
       ReferenceRequest req;
       req.scene = args.str("scene", "default");
-      req.settings = reference_defaults(scene);  // the settings of `fovea render`/`reference`: one cache
+      // The render's own light transport, as `fovea render --reference` (one cache).
+      req.settings = reference_settings(scene, pipeline::path_config(frame.bounces, scene));
       req.settings.max_spp = std::uint32_t(ref_spp);
       req.settings.until_pixel_rel_error = ref_error;
       req.cache_dir = ref_cache;
       if (!quiet) std::fprintf(stderr, "reference, up to %ld spp...\n", ref_spp);
       CachedReference ref = cached_reference(ctx, setup.gpu_scene, pipe.view(core::Eye::Left), core::Eye::Left, req);
-      j["quality_reference"] = {{"spp", ref.result.spp},
+      j["quality_reference"] = {{"transport", pipeline::transport_json(pipeline::path_config(frame.bounces, scene),
+                                                                        "the render's")},
+                                {"spp", ref.result.spp},
                                 {"pixel_rel_error", ref.result.pixel_rel_error},
                                 {"key", ref.key},
                                 {"from_cache", ref.from_cache}};
@@ -426,7 +433,8 @@ int run(std::vector<std::string> argv) {
                            {"saccades_recovered", p.recovered}};
       if (reference && std::find(quality_at.begin(), quality_at.end(), inj) != quality_at.end()) {
         if (!quiet) std::fprintf(stderr, "quality at +%.0f ms...\n", p.inject_ms);
-        const Quality q = fovea_quality(pipe, poses, s, std::size_t(quality_frames), warm, radius, *reference);
+        const Quality q = fovea_quality(pipe, poses, s, std::size_t(quality_frames), warm, radius, *reference,
+                                        core::EyeOptics(display, core::Eye::Left).view_mask());
         if (q.frames) {
           p.fovea_psnr_db = q.psnr;
           p.fovea_hdr_flip = q.hdr_flip;

@@ -389,8 +389,9 @@ int run(std::vector<std::string> argv) {
   full_gi_request.cache_dir = ref_cache;
   const renderer::PathConfig transport = pipeline::path_config(frame_config.bounces, scene);
   ReferenceRequest ref_request = full_gi_request;
-  ref_request.settings.bounces = transport.max_bounces;
-  ref_request.settings.rr_start = transport.rr_start;
+  ref_request.settings = reference_settings(scene, transport);
+  ref_request.settings.max_spp = std::uint32_t(ref_spp);
+  ref_request.settings.until_pixel_rel_error = ref_error;
   const bool full_gi_is_matched = ref_request.settings.bounces == full_gi_request.settings.bounces &&
                                   ref_request.settings.rr_start == full_gi_request.settings.rr_start;
   const bool full_gi_score = args.has("full-gi-score");

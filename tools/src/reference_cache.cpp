@@ -236,6 +236,13 @@ ReferenceSettings reference_defaults(const renderer::Scene& scene) {
   return s;
 }
 
+ReferenceSettings reference_settings(const renderer::Scene& scene, const renderer::PathConfig& transport) {
+  ReferenceSettings s = reference_defaults(scene);
+  s.bounces = transport.max_bounces;
+  s.rr_start = transport.rr_start;
+  return s;
+}
+
 std::string default_reference_cache() {
   if (const char* x = std::getenv("XDG_CACHE_HOME"); x && *x) return (fs::path(x) / "fovea" / "references").string();
   if (const char* h = std::getenv("HOME"); h && *h) return (fs::path(h) / ".cache" / "fovea" / "references").string();

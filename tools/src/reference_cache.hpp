@@ -34,6 +34,9 @@ struct ReferenceSettings {
 // error is <= 0.02.
 inline constexpr double kDefaultPixelRelError = 0.02;
 ReferenceSettings reference_defaults(const renderer::Scene& scene);
+// The defaults with a render's light transport (bounces, Russian roulette): the reference
+// its scores compare against (docs/metrics.md, "What is compared with what").
+ReferenceSettings reference_settings(const renderer::Scene& scene, const renderer::PathConfig& transport);
 
 // `dir` empty: no cache. `scene` is the --scene argument (a file's bytes are hashed). A
 // window (part of the key) renders only its pixels; an entry of the whole view with the
