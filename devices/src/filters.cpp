@@ -226,7 +226,9 @@ GazeSample GazePredictor::predict(const std::deque<GazeSample>& h, std::size_t c
       peak = std::max(peak, v);
       onset_angles = pa;
     } else {
-      if (last.t_ns - a.t_ns > p_.velocity_window_ns) break;
+      // The pursuit window ends where a saccade does: a jump measured into it (a step between
+      // two samples of a slow recording) would be extrapolated as motion, 6° past a 32° step.
+      if (last.t_ns - a.t_ns > p_.velocity_window_ns || v >= p_.saccade_deg_s) break;
       window_start = pa;
       window_t = a.t_ns;
     }

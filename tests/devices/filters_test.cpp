@@ -153,6 +153,23 @@ TEST(Prediction, ConstantVelocityInPursuitAndHorizonThroughTheTimeline) {
   EXPECT_EQ(pred.predict(lost, lost.back().t_ns + 10'000'000, 20'000'000).combined.flags, kLost);
 }
 
+// A gaze step (the eye landed between two samples, as at low rates or in a recording that
+// jumps): once the newest interval is still, the prediction stays within 1° of the landing
+// point, whatever the step and the rate (before: the pursuit window spanned the jump and
+// extrapolated it, 6° past a 32° step).
+TEST(Prediction, AStepIsNotExtrapolatedPastItsLanding) {
+  GazePredictor pred;
+  for (const double step : {5.0, 32.0})
+    for (const TimeNs dt : {TimeNs(4'000'000), TimeNs(8'333'333), TimeNs(16'666'667)}) {
+      std::deque<GazeSample> h;
+      for (int i = 0; i < 20; ++i) h.push_back(sample(i * dt, dir_deg(i < 15 ? -step / 2 : step / 2, 0)));
+      for (const TimeNs ahead : {TimeNs(0), TimeNs(10'000'000), TimeNs(20'000'000)}) {
+        const GazeSample p = pred.predict(h, h.back().t_ns + ahead, 20'000'000);
+        EXPECT_LE(angle_deg(p.combined.dir, dir_deg(step / 2, 0)), 1.0) << step << " deg, dt " << dt << ", ahead " << ahead;
+      }
+    }
+}
+
 TEST(Filters, ComposeOnAnySourceByUri) {
   SourceOptions o;
   auto src = open_gaze_source("synthetic:3?rate=250&filters=ivt,oneeuro", o);
