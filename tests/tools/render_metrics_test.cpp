@@ -237,6 +237,45 @@ TEST(RenderTransport, ScoresCompareTheSameLightTransport) {
   fs::remove_all(dir);
 }
 
+// The saccade recovery curve: a 32° gaze step (250 Hz samples, read without prediction)
+// gives one landing of the asked frames, at the frame the grid reached the new gaze, with
+// finite scores; still frames give none; it needs a whole-view reference.
+TEST(RenderRecovery, AGazeStepGivesOneLandingCurve) {
+  const std::string dir = fovea::test::temp_dir("recovery");
+  const std::string step = dir + "/step.csv";
+  {
+    std::ofstream out(step);
+    out << "t_ns,eye,dir_x,dir_y,dir_z,confidence,flags\n";
+    const double s = std::sin(16 * M_PI / 180), c = std::cos(16 * M_PI / 180);
+    for (int i = 0; i < 250; ++i) {
+      const long long t = i * 4'000'000LL;
+      out << t << ",combined," << (t < 100'000'000 ? -s : s) << ",0," << -c << ",1,1\n";
+    }
+  }
+  const json a = render("--frames 12 --gaze " + step + "?predict=none --reference 8 --recovery-frames 4"
+                        " --reference-cache " + dir + "/cache", dir + "/a");
+  const json& r = a["recovery"];
+  ASSERT_EQ(r["landings"].size(), 1u) << r.dump();
+  const json& l = r["landings"][0];
+  EXPECT_EQ(l["frame"], 7);  // 100 ms at 70 Hz: frame 7 (100.0 ms) is the first after the step
+  EXPECT_NEAR(l["amplitude_deg"].get<double>(), 32.0, 0.5);
+  ASSERT_EQ(l["fovea_hdr_flip"].size(), 4u);
+  for (const json& v : l["fovea_hdr_flip"]) EXPECT_TRUE(v.is_number() && v.get<double>() > 0 && v.get<double>() < 1);
+  EXPECT_EQ(r["incomplete"], 0);
+  EXPECT_EQ(r["mean_fovea_hdr_flip"].size(), 4u);
+  // A still gaze: no landing.
+  const json b = render("--frames 4 --gaze " + fixed_gaze(dir) + " --reference 8 --reference-cache " + dir + "/cache",
+                        dir + "/b");
+  EXPECT_EQ(b["recovery"]["landings"].size(), 0u);
+  EXPECT_TRUE(b["recovery"]["mean_fovea_hdr_flip"].is_null());
+  // Needs a whole-view reference.
+  const auto bad = run_fovea("render --display tiny --scene cornell --quiet --frames 2 --recovery-frames 4 --out " + dir +
+                             "/c");
+  EXPECT_EQ(bad.status, 2);
+  EXPECT_NE(bad.err.find("--recovery-frames"), std::string::npos) << bad.err;
+  fs::remove_all(dir);
+}
+
 // A damaged entry (truncated image, unreadable or foreign description) is reported on
 // stderr, rendered again and replaced; the run succeeds.
 TEST(ReferenceCache, DamagedEntriesAreReportedAndRenderedAgain) {
