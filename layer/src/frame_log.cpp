@@ -135,7 +135,9 @@ void FrameLog::write_now(const FrameTimes& t) {
              {"acquire_waits", t.shown.acquire_waits},
              {"acquire_ms", t.shown.acquire_ms}, {"compose_ms", t.shown.compose_ms},
              {"release_ms", t.shown.release_ms}, {"submit_ms", t.shown.submit_ms},
-             {"submit_preemptions", t.shown.submit_preemptions}};
+             {"submit_preemptions", t.shown.submit_preemptions},
+             // How the shown traced frame reached the application's device (RenderTimes::handover).
+             {"handover", std::string(rt.handover)}, {"host_bytes", rt.host_bytes}};
   if (!writer_.write(r)) FOVEA_LAYER_WARN("%s", writer_.error().c_str());
 }
 

@@ -208,9 +208,16 @@ class PathTracer {
     if (mask_set_) times.samples_hidden = pipeline_->hidden_cells(core::Eye::Left) + pipeline_->hidden_cells(core::Eye::Right);
     const auto r0 = std::chrono::steady_clock::now();
     for (int e = 0; e < 2; ++e) {
-      f->colour[std::size_t(e)] = encode_scene(pipeline_->image(core::Eye(e)), pixel_format(format_));
-      if (config_.composite != Composite::SceneOnly) f->depth[std::size_t(e)] = pipeline_->depth(core::Eye(e));
+      const core::Image linear = pipeline_->image(core::Eye(e));
+      times.host_bytes += std::int64_t(linear.pixels.size() * sizeof(linear.pixels[0]));
+      f->colour[std::size_t(e)] = encode_scene(linear, pixel_format(format_));
+      times.host_bytes += std::int64_t(f->colour[std::size_t(e)].data.size());  // written into the app's memory
+      if (config_.composite != Composite::SceneOnly) {
+        f->depth[std::size_t(e)] = pipeline_->depth(core::Eye(e));
+        times.host_bytes += 2 * std::int64_t(f->depth[std::size_t(e)].size() * sizeof(float));  // read, written
+      }
     }
+    times.handover = slots_ ? "host-slot" : "host";
     if (slots_) {
       // Into the application's device memory here, so that xrEndFrame copies no frame. The
       // slot is free: no pass reads it until the frame is published.

@@ -89,6 +89,12 @@ struct RenderTimes {
   // a recorded or synthetic source counted from the first frame's display time).
   bool gaze_on_host_clock = false;
   std::int64_t samples_hidden = 0;  // grid cells under the runtime's hidden area, both eyes: not traced
+  // How the traced frame reached the application's device, and the bytes that crossed the
+  // host on the way: "host-slot" (read back, encoded and written by the host into the GPU
+  // composition's slot in the application's device memory) or "host" (read back and encoded
+  // for the host composition, which uploads its result: those bytes are counted too).
+  const char* handover = "";
+  std::int64_t host_bytes = 0;
 };
 
 // The path-traced frame an xrEndFrame showed.

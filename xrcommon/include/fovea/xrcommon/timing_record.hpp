@@ -56,7 +56,7 @@ struct TimingRecord {
   // row), both the combined gaze in view space; foveal_error_deg is the angle between them.
   std::optional<glm::dvec3> fovea_dir, true_gaze_dir;
   // Producer-specific fields, written at the top level after the schema's.
-  std::vector<std::pair<std::string, std::variant<std::int64_t, double, bool>>> extra;
+  std::vector<std::pair<std::string, std::variant<std::int64_t, double, bool, std::string>>> extra;
 
   std::optional<double> foveal_error_deg() const;
   // The gaze sample's host times where 0 means "none measured" (the OpenXR paths' convention).
