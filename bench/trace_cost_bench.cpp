@@ -1,5 +1,5 @@
 // Where a foveated frame's trace and reconstruction time goes, per sample distribution
-// (docs/reconstruction.md, "Whole frame on fove0"): the `default` scene on a display preset
+// (docs/reconstruction-history.md, "Whole frame on fove0"): the `default` scene on a display preset
 // with the lens' hidden area skipped, gaze at the centre, both eyes, the default
 // reconstruction with stereo gather. Per configuration and trace order (grid: cell n in
 // invocation n; tiles: pt_order.h) it prints the grid's cells and traced cells, and how the

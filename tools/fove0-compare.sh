@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# Whole frame on fove0 (docs/reconstruction.md): Visual-Polar (default settings) against
+# Whole frame on fove0 (docs/reconstruction-history.md): Visual-Polar (default settings) against
 # full-resolution Cartesian, the same reconstruction, back to back, both scored against one
 # converged reference of the default scene; prints the table of times, gains and fovea quality.
 #

@@ -59,7 +59,7 @@ struct FramePipeline::Impl {
     }
   }
   // Tile order for polar grids, whose grid-order vectors span radii far apart on the display
-  // (docs/reconstruction.md, "Coherent Visual-Polar vectors"); grid order for Cartesian ones.
+  // (docs/reconstruction-history.md, "Coherent Visual-Polar vectors"); grid order for Cartesian ones.
   renderer::TraceOrder trace_order(const EyeState& e) const {
     if (forced_order) return *forced_order;
     return e.dist->gpu_params().family != shaders::kFamilyCartesian ? renderer::TraceOrder::Tiles
