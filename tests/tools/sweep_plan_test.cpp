@@ -98,6 +98,34 @@ TEST(SweepPlan, ReferencesAreSharedPerSceneAndDisplay) {
   EXPECT_TRUE(expand_sweep(f, "s.json", render_options()).shared.empty());
 }
 
+// The shared reference traces the render's light transport: the frame's one bounce without
+// Russian roulette by default, a swept --bounces per value (auto: the reference's defaults).
+TEST(SweepPlan, SharedReferencesTraceTheRendersTransport) {
+  const auto has = [](const std::vector<std::string>& a, const std::string& k, const std::string& v) {
+    const auto it = std::find(a.begin(), a.end(), k);
+    return it != a.end() && it + 1 != a.end() && *(it + 1) == v;
+  };
+  const Plan p = expand_sweep(sweep_file(), "s.json", render_options());
+  for (const auto& s : p.shared) {
+    EXPECT_TRUE(has(s.commands[0], "--bounces", "1")) << s.settings.dump();
+    EXPECT_TRUE(has(s.commands[0], "--rr-start", "1000"));
+  }
+  std::vector<RenderOption> options = render_options();
+  options.push_back({"bounces", true});
+  json f = sweep_file();
+  f["scenes"] = "cornell";
+  f["bounces"] = json::array({2, "auto"});
+  const Plan q = expand_sweep(f, "s.json", options);
+  ASSERT_EQ(q.shared.size(), 2u);  // one per transport
+  for (const auto& s : q.shared) {
+    if (s.settings["bounces"] == "auto") {
+      EXPECT_EQ(std::find(s.commands[0].begin(), s.commands[0].end(), "--bounces"), s.commands[0].end());
+    } else {
+      EXPECT_TRUE(has(s.commands[0], "--bounces", "2"));
+    }
+  }
+}
+
 // A list of sweeps is their union: cartesian without budgets next to budgeted distributions.
 TEST(SweepPlan, AListOfSweepsIsTheirUnion) {
   const json list = fovea::core::parse_json(R"([

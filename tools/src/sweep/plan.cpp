@@ -10,6 +10,7 @@
 #include <sstream>
 
 #include "fovea/core/error.hpp"
+#include "fovea/pipeline/frame_config.hpp"
 #include "fovea/core/json.hpp"
 
 namespace fovea::sweep {
@@ -89,6 +90,10 @@ SharedInput reference_input(const json& settings) {
   s.settings = {{"kind", "reference"}, {"spp", settings["reference"]}};
   for (const char* k : {"scene", "display", "reference-error"})
     if (settings.contains(k)) s.settings[k] = settings[k];
+  // The render's light transport (docs/metrics.md, "What is compared with what"): its
+  // --bounces, else the frame's default; auto is the reference's own default.
+  const json bounces = settings.contains("bounces") ? settings["bounces"] : json(pipeline::Bounces{}.count);
+  s.settings["bounces"] = bounces;
   s.id = settings_id(s.settings);
   s.out = "shared/" + s.id;
   const long spp = settings["reference"].get<long>();
@@ -100,6 +105,7 @@ SharedInput reference_input(const json& settings) {
     // computes (and shares its cache entries).
     const std::string error = settings.contains("reference-error") ? arg_text(settings["reference-error"]) : "0.02";
     a.insert(a.end(), {"--eye", eye, "--spp", std::to_string(spp), "--until-pixel-rel-error", error});
+    if (arg_text(bounces) != "auto") a.insert(a.end(), {"--bounces", arg_text(bounces), "--rr-start", "1000"});
     // Where it is cached does not change the image: not part of the id.
     if (settings.contains("reference-cache")) a.insert(a.end(), {"--reference-cache", arg_text(settings["reference-cache"])});
     a.insert(a.end(), {"--out", s.out + "/reference_" + eye + ".exr", "--quiet"});
