@@ -241,7 +241,11 @@ TEST(SweepLatency, ReportDrawsLatencyAgainstQualityAndSectionsPerScene) {
   const std::string page((std::istreambuf_iterator<char>(page_in)), std::istreambuf_iterator<char>());
   for (const char* text : {"## scene cornell", "## scene default", "### Equal samples", "### Equal time",
                            "## Latency against quality", "report/latency_vs_foveal_error_deg_above_2deg.png",
-                           "fovea latency --display tiny", "--inject-latency 0"})
+                           "fovea latency --display tiny", "--inject-latency 0", "### Which to pick",
+                           // Equal quality at equal budget, a cheaper: a is never better, and
+                           // a at 0.4 is the fastest within 5% of the best.
+                           "- a against b in fovea_psnr at equal budget: better at 0 of 2.",
+                           "- The fastest within 5% of it: a at budget 0.4 (34.00, 40 ms)."})
     EXPECT_NE(page.find(text), std::string::npos) << text;
   // Latency rows do not enter the render tables.
   const std::size_t latency_at = page.find("## Latency against quality");

@@ -406,10 +406,52 @@ void markdown_section(std::ostringstream& md, const MarkdownInput& in, const std
     md << " | " << (f != in.on_front.end() && f->second.count(r->id) && f->second.at(r->id) ? "yes" : "") << " |\n";
   }
 
-  // Equal time: each group's best quality within the time of each job of the first group.
   std::vector<std::string> groups;
   for (const Row* r : done)
     if (std::find(groups.begin(), groups.end(), setting(*r, cfg.group)) == groups.end()) groups.push_back(setting(*r, cfg.group));
+
+  // Which to pick: the best first quality, and the fastest job within 5% of it; then the
+  // first group against each other group at equal budget.
+  if (!q0.empty() && !groups.empty()) {
+    const auto better = [&](double a, double b) { return lower(q0) ? a < b : a > b; };
+    const Row* best = nullptr;
+    for (const Row* r : done)
+      if (r->metrics.count(q0) && (!best || better(r->metrics.at(q0), best->metrics.at(q0)))) best = r;
+    if (best) {
+      const double b = best->metrics.at(q0), slack = 0.05 * std::abs(b);
+      const Row* pick = nullptr;
+      for (const Row* r : done)
+        if (r->metrics.count(q0) && r->metrics.count(cfg.time) && !better(b + (lower(q0) ? slack : -slack), r->metrics.at(q0)) &&
+            (!pick || r->metrics.at(cfg.time) < pick->metrics.at(cfg.time)))
+          pick = r;
+      const auto name = [&](const Row& r) {
+        return setting(r, cfg.group) + (r.settings.contains(cfg.budget) ? " at " + cfg.budget + " " + setting(r, cfg.budget) : "");
+      };
+      md << "\n" << h << "Which to pick\n\n- Best " << q0 << ": " << name(*best) << " (" << md_value(*best, q0) << ", "
+         << md_value(*best, cfg.time) << " ms).\n";
+      if (pick)
+        md << "- The fastest within 5% of it: " << name(*pick) << " (" << md_value(*pick, q0) << ", "
+           << md_value(*pick, cfg.time) << " ms).\n";
+      const std::string anchor = groups[0];
+      for (const std::string& g : groups) {
+        if (g == anchor) continue;
+        int both = 0, wins = 0;
+        for (const Row* a : done)
+          for (const Row* o : done)
+            if (setting(*a, cfg.group) == anchor && setting(*o, cfg.group) == g && a->settings.contains(cfg.budget) &&
+                o->settings.contains(cfg.budget) && a->settings[cfg.budget] == o->settings[cfg.budget] &&
+                a->metrics.count(q0) && o->metrics.count(q0)) {
+              ++both;
+              wins += better(a->metrics.at(q0), o->metrics.at(q0));
+            }
+        if (both)
+          md << "- " << anchor << " against " << g << " in " << q0 << " at equal " << cfg.budget << ": better at " << wins
+             << " of " << both << ".\n";
+      }
+    }
+  }
+
+  // Equal time: each group's best quality within the time of each job of the first group.
   if (!q0.empty() && !groups.empty()) {
     const std::string anchor = groups[0];
     std::vector<double> limits;
