@@ -158,7 +158,7 @@ FrameTimes FramePipeline::render(const std::array<core::Pose, 2>& eye_pose, cons
   }
   // A still view converges (history weights 1/n); a moving one keeps the EMA floors.
   const reconstruct::ReconSettings settings = reconstruct::with_history_floors(m.settings, motion);
-  t.history_floor = float(settings.alpha_min / std::max(m.settings.alpha_min, 1e-9f));
+  t.history_floor = 1.0f - settings.still;
   t.grid.cpu_ms = lap_ms(t0);
   m.write_mappings();
   t.reconstruct.cpu_ms = lap_ms(t0);

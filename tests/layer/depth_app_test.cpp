@@ -12,7 +12,9 @@
 #include <cstdlib>
 #include <cstring>
 #include <filesystem>
+#include <chrono>
 #include <fstream>
+#include <thread>
 #include <ostream>
 #include <string>
 
@@ -298,9 +300,16 @@ TEST_P(DepthApp, NearHalfShowsTheAppFarHalfShowsTheScene) {
   const std::string log = read_text(log_path());
   EXPECT_EQ(count(log, "compositing by depth"), depth_sessions + 1) << log;
   EXPECT_EQ(log.find("internal failure"), std::string::npos) << log;
-  std::ifstream timing(out_->path() + "/layer_timing.jsonl");
-  std::string line, last;
-  while (std::getline(timing, line)) last = line;
+  // The log thread writes its records in batches (FrameLog::kFlushPeriod): wait for the last
+  // frame's record rather than reading whatever was written so far.
+  std::string last;
+  const std::string last_frame = "\"frame\":" + std::to_string(kFrames - 1) + ",";
+  for (int tries = 0; tries < 250 && last.find(last_frame) == std::string::npos; ++tries) {
+    if (tries) std::this_thread::sleep_for(std::chrono::milliseconds(20));
+    std::ifstream timing(out_->path() + "/layer_timing.jsonl");
+    for (std::string line; std::getline(timing, line);) last = line;
+  }
+  ASSERT_NE(last.find(last_frame), std::string::npos) << "the last frame's record was not written within 5 s: " << last;
   EXPECT_NE(last.find("\"replaced\":true"), std::string::npos) << last;
   // By depth on the application's device (the default compositor): no image reaches the host.
   EXPECT_NE(last.find("\"composited_on_gpu\":true,\"host_readbacks\":0"), std::string::npos) << last;
