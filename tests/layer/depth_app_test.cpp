@@ -301,9 +301,10 @@ TEST_P(DepthApp, NearHalfShowsTheAppFarHalfShowsTheScene) {
   EXPECT_EQ(count(log, "compositing by depth"), depth_sessions + 1) << log;
   EXPECT_EQ(log.find("internal failure"), std::string::npos) << log;
   // The log thread writes its records in batches (FrameLog::kFlushPeriod): wait for the last
-  // frame's record rather than reading whatever was written so far.
+  // frame's record rather than reading whatever was written so far. Records count the
+  // session's xrEndFrame calls: run_to_focused's one (frame 0), then the kFrames above.
   std::string last;
-  const std::string last_frame = "\"frame\":" + std::to_string(kFrames - 1) + ",";
+  const std::string last_frame = "\"frame\":" + std::to_string(kFrames) + ",";
   for (int tries = 0; tries < 250 && last.find(last_frame) == std::string::npos; ++tries) {
     if (tries) std::this_thread::sleep_for(std::chrono::milliseconds(20));
     std::ifstream timing(out_->path() + "/layer_timing.jsonl");
