@@ -31,11 +31,8 @@ constexpr int kWidth = 128, kHeight = 144;  // the tiny preset's optics at this 
 const std::array<glm::dvec3, 2> kGaze{glm::dvec3(0, 0, -1), glm::dvec3(0, 0, -1)};
 
 double fovea_hdr_flip(const core::Image& img, const core::Image& ref, const core::View& view) {
-  const core::ErrorMaps maps = core::error_maps(img, ref, core::flip_ppd(view));
-  const std::vector<float> ecc = core::eccentricity_map(view, kGaze[0]);
-  std::vector<float> w(ecc.size());
-  for (std::size_t i = 0; i < ecc.size(); ++i) w[i] = ecc[i] <= core::acuity::kFoveaDeg ? 1.0f : 0.0f;
-  return core::pool(maps, w).hdr_flip;
+  return core::pool(core::error_maps(img, ref, core::flip_ppd(view)), fovea::test::fovea_pixel_weights(view, kGaze[0]))
+      .hdr_flip;
 }
 
 TEST_F(GpuTest, StillViewConvergesForEveryDistribution) {

@@ -9,6 +9,8 @@
 
 #include "fovea/pipeline/frame_pipeline.hpp"
 #include "fovea/pipeline/testing.hpp"
+#include "fovea/core/acuity.hpp"
+#include "fovea/core/metrics.hpp"
 #include "fovea/core/stereo_views.hpp"
 #include "fovea/core/display.hpp"
 #include "fovea/core/image.hpp"
@@ -44,6 +46,15 @@ inline core::Image cells_image(const std::vector<glm::vec4>& v, Keep keep) {
   core::Image img(int(px.size()), 1);
   img.pixels = px;
   return img;
+}
+
+// Weight 1 for the pixels of `view` within the fovea (e <= 5.79°) around `gaze`, else 0:
+// the pooling weights of the fovea scores.
+inline std::vector<float> fovea_pixel_weights(const core::View& view, glm::dvec3 gaze) {
+  const std::vector<float> ecc = core::eccentricity_map(view, gaze);
+  std::vector<float> w(ecc.size());
+  for (std::size_t i = 0; i < ecc.size(); ++i) w[i] = ecc[i] <= core::acuity::kFoveaDeg ? 1.0f : 0.0f;
+  return w;
 }
 
 inline bool all_finite(const std::vector<glm::vec4>& v) {

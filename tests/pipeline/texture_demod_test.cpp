@@ -85,11 +85,9 @@ Fovea fovea_ssim(fovea::gpu::Context& ctx, const renderer::Scene& scene) {
   o.until_pixel_rel_error = 0.01;  // the indirectly lit wall needs ~4096, the lit one far fewer
   const core::Image ref = renderer::render_reference(ctx, gs, view, core::Eye::Left, o).image;
   const core::ErrorMaps maps = core::error_maps(p.image(core::Eye::Left), ref, core::flip_ppd(view));
-  const std::vector<float> ecc = core::eccentricity_map(view, kGaze[0]);
-  std::vector<float> w(ecc.size());
+  const std::vector<float> w = fovea::test::fovea_pixel_weights(view, kGaze[0]);
   double lum = 0, n = 0;
-  for (std::size_t i = 0; i < ecc.size(); ++i) {
-    w[i] = ecc[i] <= core::acuity::kFoveaDeg ? 1.0f : 0.0f;
+  for (std::size_t i = 0; i < w.size(); ++i) {
     const glm::vec4 c = ref.pixels[i];
     lum += w[i] * (0.2126 * c.x + 0.7152 * c.y + 0.0722 * c.z);
     n += w[i];
