@@ -475,21 +475,21 @@ int run(std::vector<std::string> argv) {
   renderer::GpuScene& gpu_scene = setup.gpu_scene;
   const std::array<core::Pose, 2>& poses = setup.poses;
   pipeline::FramePipeline& pipeline = setup.pipeline;
+  // Each eye's lens mask: the pixels no score counts (built once, used per scored frame).
+  const std::array<core::ViewMask, 2> lens{core::EyeOptics(display, core::Eye::Left).view_mask(),
+                                           core::EyeOptics(display, core::Eye::Right).view_mask()};
 
   // The same settings as `fovea reference --spp SPP --until-pixel-rel-error X`: one cache.
   // The scores compare against the render's own transport; full GI (the albedo rule) is a
   // score of its own (--full-gi-score).
-  ReferenceRequest full_gi_request;
-  full_gi_request.scene = scene_arg;
-  full_gi_request.settings = reference_defaults(scene);
-  full_gi_request.settings.max_spp = std::uint32_t(ref_spp);
-  full_gi_request.settings.until_pixel_rel_error = ref_error;
-  full_gi_request.cache_dir = ref_cache;
+  const auto request_for = [&](ReferenceSettings s) {
+    s.max_spp = std::uint32_t(ref_spp);
+    s.until_pixel_rel_error = ref_error;
+    return ReferenceRequest{scene_arg, s, {}, ref_cache};
+  };
   const renderer::PathConfig transport = pipeline::path_config(frame_config.bounces, scene);
-  ReferenceRequest ref_request = full_gi_request;
-  ref_request.settings = reference_settings(scene, transport);
-  ref_request.settings.max_spp = std::uint32_t(ref_spp);
-  ref_request.settings.until_pixel_rel_error = ref_error;
+  const ReferenceRequest full_gi_request = request_for(reference_defaults(scene));
+  const ReferenceRequest ref_request = request_for(reference_settings(scene, transport));
   const bool full_gi_is_matched = ref_request.settings.bounces == full_gi_request.settings.bounces &&
                                   ref_request.settings.rr_start == full_gi_request.settings.rr_start;
   const bool full_gi_score = args.has("full-gi-score");
@@ -588,7 +588,7 @@ int run(std::vector<std::string> argv) {
         host_bytes += std::int64_t(last[0].pixels.size() * sizeof(last[0].pixels[0]));
       }
       const core::View v = pipeline.view(core::Eye::Left);
-      const std::vector<float> ecc = scored_eccentricity(v, t.gaze[0].used, core::EyeOptics(display, core::Eye::Left).view_mask());
+      const std::vector<float> ecc = scored_eccentricity(v, t.gaze[0].used, lens[0]);
       const core::Scores sc = core::pool(scored_maps(last[0], loaded[0]->result.image, ecc, core::flip_ppd(v)), fovea_weights(ecc));
       recovery.add(f, sc.hdr_flip, sc.psnr);
       rec.cpu_ms.emplace_back("output_recovery", core::ns_to_ms(core::now_ns() - r0));
@@ -714,7 +714,7 @@ int run(std::vector<std::string> argv) {
     const core::View v = pipeline.view(eye);
     const glm::dvec3 g = pipeline.distribution(eye).gaze();
     // The lens-hidden pixels (the display's lens, whether or not they were traced) are never scored.
-    const std::vector<float> ecc = scored_eccentricity(v, g, core::EyeOptics(display, eye).view_mask());
+    const std::vector<float> ecc = scored_eccentricity(v, g, lens[std::size_t(e)]);
     hidden_scored[name] = std::count_if(ecc.begin(), ecc.end(), [](float e) { return std::isnan(e); });
     nlohmann::json s;
     s["gaze"] = {g.x, g.y, g.z};  // view space, as the grid used it
