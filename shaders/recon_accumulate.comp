@@ -7,7 +7,10 @@
 // when the sample's surface was seen in the tap's cell or next to it (seen_near); taps from
 // cells coarser than the sample's own are down-weighted or rejected (rg_coarse_weight).
 // Direct+specular and indirect diffuse are accumulated separately (the indirect one is
-// shared between the eyes later); each carries its own 8-bit sample count in .w.
+// shared between the eyes later); each carries its own 8-bit sample count in .w. The first
+// hit's albedo is accumulated with the direct light's weights, so textures are re-modulated
+// from the mean of the cell's jittered samples, not from one sample per frame (which aliased
+// fine textures into moiré, docs/reconstruction.md "Textures under sparse cells").
 #extension GL_GOOGLE_include_directive : require
 #extension GL_EXT_samplerless_texture_functions : require  // texelFetch on texture buffers
 
@@ -39,6 +42,9 @@ layout(std430, binding = RECON_ACC_MATERIALS) readonly buffer Materials { PtMate
 layout(binding = RECON_ACC_PREV_RESTART) uniform textureBuffer prev_restart;
 layout(std430, binding = RECON_ACC_OUT_RESTART) writeonly buffer Restart { float restart[]; };
 layout(binding = RECON_ACC_LUTS) uniform utextureBuffer radius_luts;
+layout(binding = RECON_ACC_ALBEDO) uniform textureBuffer albedo;  // the tracer's, this frame
+layout(binding = RECON_ACC_PREV_ALBEDO) uniform textureBuffer prev_albedo;
+layout(std430, binding = RECON_ACC_OUT_ALBEDO) writeonly buffer AccAlbedo { vec4 acc_albedo[]; };
 
 #define RG_RADIUS_LUT
 #include "fovea/shaders/recon_map.h"
@@ -74,6 +80,7 @@ void main() {
   if (s.flags != 0u) {
     acc_direct[i] = vec4(0.0);
     acc_indirect[i] = vec4(0.0);
+    acc_albedo[i] = vec4(0.0);
     vpos[i] = vec4(0.0, 0.0, 0.0, kReconNoSample);
     vnrm[i] = vec4(0.0);
     tap_idx[i] = uvec4(0u);
@@ -97,7 +104,7 @@ void main() {
   vpos[i] = here;
   vnrm[i] = vec4(n, depth);
 
-  vec4 hd = vec4(0.0), hi = vec4(0.0);
+  vec4 hd = vec4(0.0), hi = vec4(0.0), ha = vec4(0.0);
   uvec4 idx = uvec4(0u);
   vec4 w = vec4(0.0);
   float confidence = 0.0;  // the history's share: valid taps, less for coarser cells
@@ -124,6 +131,7 @@ void main() {
         for (int k = 0; k < 4; ++k) {
           hd += w[k] * texelFetch(prev_direct, int(idx[k]));
           hi += w[k] * texelFetch(prev_indirect, int(idx[k]));
+          ha += w[k] * texelFetch(prev_albedo, int(idx[k]));
           if (w[k] > 0.0) since = max(since, texelFetch(prev_restart, int(idx[k])).x);
         }
       } else {
@@ -145,6 +153,14 @@ void main() {
   float nd = min(round(hd.w) + 1.0, 255.0);
   float ad = max(1.0 / nd, pc.alpha_min);
   acc_direct[i] = vec4(mix(hd.rgb, texelFetch(direct, int(i)).rgb, ad), nd);
+  // The albedo with the direct light's weights where the history sits on the cell (a still
+  // grid): the jittered first hits average to the texture's box filter over the cell. Where
+  // the grid moved, every frame's bilinear resampling would blur it further (measured: a
+  // fine texture under a drifting gaze lost most of its contrast), so the history fades out
+  // as the nearest tap's weight falls from 0.99 to 0.9 (≈ 0.05 cells off) and the cell takes
+  // this frame's sample, which the tracer prefilters at the cell's size (kPtTextureLod).
+  float aligned = clamp((max(max(w.x, w.y), max(w.z, w.w)) - 0.9) / 0.09, 0.0, 1.0);
+  acc_albedo[i] = vec4(mix(ha.rgb, texelFetch(albedo, int(i)).rgb, mix(1.0, ad, aligned)), 1.0);
   if (pc.indirect_fresh != 0u) {
     float ni = min(round(hi.w) + 1.0, 255.0);
     float ai = max(1.0 / ni, pc.alpha_min);

@@ -32,6 +32,19 @@
 //   an even mean measured worse, the input already being Phase I's mean of the window.)
 //   The new fovea starts over with a few samples per cell against a fixed gaze's long
 //   history (docs/reconstruction.md, "Saccade recovery curve").
+// - The history is read with Catmull–Rom over 4 columns × 4 rows (each column at its own row
+//   coordinate; Karis 2014 reads it bicubic too) where Phase I kept all four bilinear taps
+//   (one surface, no coarser cells) and every tap holds a sample; else with Phase I's taps.
+//   The bilinear taps' blur, repeated on every frame the gaze moved the grid, smeared fine
+//   texture along the motion (streaks across the bricks of a grazing face at 16 ppd); the
+//   neighbourhood clamp takes Catmull–Rom's overshoot (docs/reconstruction.md, "History
+//   resampling").
+// - Fireflies are capped before the resolve spreads a cell over its pixels (a peripheral cell
+//   at a low budget covers tens of them): a surface cell's output luminance is at most
+//   kFireflyRatio times the brightest of its 3×3 grid neighbours' inputs. Only an isolated
+//   maximum is touched (a highlight or an edge has a bright neighbour), emitters and the sky
+//   never; the cap acts on the output only, so Phase I's history keeps the sample and the
+//   still image still converges (docs/reconstruction.md, "Fireflies").
 // .w = 1 marks cells holding a sample (the resolve renormalises over them).
 #extension GL_GOOGLE_include_directive : require
 #extension GL_EXT_samplerless_texture_functions : require  // texelFetch on texture buffers
@@ -62,6 +75,7 @@ layout(push_constant) uniform Push { ReconPostPush pc; };
 const float kCentreSigma = 0.25;
 // ḡ: the mean of exp(−|j|²/(2σ²)) over a uniform jitter j in the cell, (σ√(2π) erf(1/(2√2 σ)))².
 const float kMeanCentre = 0.358;
+const float kFireflyRatio = 4.0;   // a surface cell's luminance over its brightest neighbour's, at most
 const float kRestartFollow = 4.0;  // restart frames with the 5×5 average and TAA's running mean
 const int kRestartReach = 2;       // the 5×5 average's reach (cells)
 
@@ -79,6 +93,75 @@ vec3 remodulated(uint i) {
   return texelFetch(post, int(i)).rgb * max(texelFetch(albedo, int(i)).rgb, vec3(kPtMinDemodAlbedo));
 }
 
+// The firefly cap of cell i: kFireflyRatio times the largest luminance of its 3×3 grid
+// neighbours' inputs; no cap (3e38) for emitters, the sky and a cell without neighbours.
+float firefly_cap(ReconGrid m, uint i) {
+  if (texelFetch(vpos, int(i)).w < 0.0) return 3.0e38;
+  RgCell cell = rg_cell(m, i);
+  float brightest = -1.0;
+  for (int dc = -1; dc <= 1; ++dc) {
+    RgColumnNear near;
+    if (!rg_column_next_to(m, cell, dc, near)) continue;
+    for (int dr = -1; dr <= 1; ++dr) {
+      uint j;
+      if ((dc == 0 && dr == 0) || !rg_row_next_to(m, near, dr, j) || j == i || rg_no_sample(texelFetch(vpos, int(j)).w)) continue;
+      brightest = max(brightest, luma(remodulated(j)));
+    }
+  }
+  return brightest < 0.0 ? 3.0e38 : kFireflyRatio * brightest;
+}
+
+// The history at grid coordinate uv of the previous mapping by Catmull–Rom, in the compressed
+// space; false when a tap holds no sample (the caller then keeps Phase I's taps).
+bool history_catmull_rom(ReconGrid prev, vec2 uv, out vec3 h) {
+  h = vec3(0.0);
+  float uc = uv.x - 0.5, c0f = floor(uc);
+  vec4 wx = rg_catmull_rom(uc - c0f);
+  for (int a = 0; a < 4; ++a) {
+    uint c = uint(clamp(int(c0f) - 1 + a, 0, int(prev.g.columns) - 1));
+    GridColumn col = rg_column(prev, c);
+    int rows = int(max(col.rows, 1u));
+    bool wraps = rg_column_wraps(prev, col);
+    float vr = rg_row_coord_of(col, uv.y) - 0.5, r0f = floor(vr);
+    vec4 wy = rg_catmull_rom(vr - r0f);
+    for (int b = 0; b < 4; ++b) {
+      int r = int(r0f) - 1 + b;
+      r = wraps ? rg_wrap(r, rows) : clamp(r, 0, rows - 1);
+      vec4 v = texelFetch(prev_final, int(uint(r) * prev.g.padded_columns + c));
+      if (v.w <= 0.0) return false;
+      h += wx[a] * wy[b] * compress(v.rgb);
+    }
+  }
+  return true;
+}
+
+// Phase I kept all four bilinear taps of uv in the previous mapping at their bilinear
+// weights (no tap rejected as another surface or reweighted as coarser).
+bool taps_all_kept(ReconGrid prev, vec2 uv, vec4 kept) {
+  uvec4 idx;
+  vec4 w;
+  uvec2 cols;
+  rg_taps(prev, uv, idx, w, cols);
+  vec4 d = abs(w - kept);
+  return max(max(d.x, d.y), max(d.z, d.w)) < 1e-4;
+}
+
+// The history of a cell of column `col` whose sample is `here` (position, code) by
+// Catmull–Rom, where Phase I kept all its bilinear taps `kept` and every tap holds a sample.
+bool sharp_history(ReconGrid cur, uint col, vec4 here, vec4 kept, out vec3 h) {
+  h = vec3(0.0);
+  ReconGrid prev = maps[kReconPrevious];
+  vec2 uv;
+  if (!rg_world_to_grid(prev, here.xyz, abs(here.w - kReconSky) < 0.5, uv)) return false;
+  uv = rg_unjitter(cur, col, prev, uv);
+  return taps_all_kept(prev, uv, kept) && history_catmull_rom(prev, uv, h);
+}
+
+vec3 capped(vec3 c, float cap) {
+  float l = luma(c);
+  return l > cap ? c * (cap / l) : c;
+}
+
 void main() {
   uint i = FOVEA_LINEAR_INVOCATION;
   if (i >= pc.cells) return;
@@ -86,14 +169,15 @@ void main() {
     final_color[i] = vec4(0.0);
     return;
   }
+  ReconGrid m = maps[kReconCurrent];
+  float cap = firefly_cap(m, i);
   if (pc.denoise == 0u) {
-    final_color[i] = vec4(remodulated(i), 1.0);
+    final_color[i] = vec4(capped(remodulated(i), cap), 1.0);
     return;
   }
   vec4 w = texelFetch(tap_w, int(i));
   bool history = pc.has_history != 0u && w.x + w.y + w.z + w.w > 0.0;
   float since = texelFetch(restart, int(i)).x;  // frames since Phase I restarted the cell's history (0: none recent)
-  ReconGrid m = maps[kReconCurrent];
   vec3 lo = vec3(3.0e38), hi = vec3(-3.0e38);
   vec4 here = texelFetch(vpos, int(i)), nd = texelFetch(vnrm, int(i));
   vec3 avg = texelFetch(post, int(i)).rgb;
@@ -121,12 +205,15 @@ void main() {
   }
   vec3 c = avg / avg_w * max(texelFetch(albedo, int(i)).rgb, vec3(kPtMinDemodAlbedo));
   if (!history || since == 1.0) {  // nothing to blend, or the history is the coarse periphery's
-    final_color[i] = vec4(c, 1.0);
+    final_color[i] = vec4(capped(c, cap), 1.0);
     return;
   }
-  uvec4 idx = texelFetch(tap_idx, int(i));
-  vec3 h = vec3(0.0);
-  for (int k = 0; k < 4; ++k) h += w[k] * compress(texelFetch(prev_final, int(idx[k])).rgb);
+  vec3 h;
+  if (!sharp_history(m, cell.col, here, w, h)) {
+    uvec4 idx = texelFetch(tap_idx, int(i));
+    h = vec3(0.0);
+    for (int k = 0; k < 4; ++k) h += w[k] * compress(texelFetch(prev_final, int(idx[k])).rgb);
+  }
   h = from_ycocg(clamp(to_ycocg(h), lo, hi));
   vec2 jitter = vec2(m.g.jitter_u, m.g.jitter_v);  // the sample's offset from the cell centre (cells)
   bool weighted = !(m.g.family == kFamilyCartesian && float(m.g.columns) == m.g.width && float(m.g.rows) == m.g.height);
@@ -139,5 +226,5 @@ void main() {
   // with the clamp; without it in the compressed space; in linear space as a weighted
   // cumulative mean). A restart window keeps its running mean: its history is young.
   if (!follow) a = mix(a, 1.0, pc.still);
-  final_color[i] = vec4(max(expand(mix(h, compress(c), a)), vec3(0.0)), 1.0);
+  final_color[i] = vec4(capped(max(expand(mix(h, compress(c), a)), vec3(0.0)), cap), 1.0);
 }

@@ -182,6 +182,7 @@ FrameTimes FramePipeline::render(const std::array<core::Pose, 2>& eye_pose, cons
       renderer::PathConfig cfg = m.path;
       if (!fresh[i]) cfg.max_bounces = 0;
       cfg.order = m.trace_order(e);
+      cfg.texture_lod = true;  // one sample per cell and frame: textures prefiltered at the cell's size
       m.tracer.record(cmd, e.trace, core::View(e.base_view.fov(), e.base_view.width(), e.base_view.height(), e.pose),
                       e.eye, frame, cfg);
     }

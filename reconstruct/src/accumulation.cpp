@@ -20,6 +20,7 @@ Accumulation::Accumulation(gpu::Context& ctx, std::span<const EyeGrid> eyes, con
       e.pos[p] = cells(ctx, g.cells, "recon.vpos");
       e.nrm[p] = cells(ctx, g.cells, "recon.vnrm");
       e.restart[p] = cells(ctx, g.cells, "recon.restart", VK_FORMAT_R32_SFLOAT);
+      e.albedo[p] = cells(ctx, g.cells, "recon.acc_albedo");
     }
     e.tap_idx = cells(ctx, g.cells, "recon.tap_idx", VK_FORMAT_R32G32B32A32_UINT);
     e.tap_w = cells(ctx, g.cells, "recon.tap_w");
@@ -29,7 +30,8 @@ Accumulation::Accumulation(gpu::Context& ctx, std::span<const EyeGrid> eyes, con
                           AccumulateBindings{g.maps, g.tables, g.samples, g.direct, g.indirect, g.normal_depth,
                                              g.position_material, &e.direct[q], &e.indirect[q], &e.pos[q], &e.nrm[q],
                                              &e.direct[p], &e.indirect[p], &e.pos[p], &e.nrm[p], &e.tap_idx, &e.tap_w,
-                                             &materials, &e.restart[q], &e.restart[p], g.luts});
+                                             &materials, &e.restart[q], &e.restart[p], g.luts, g.albedo, &e.albedo[q],
+                                             &e.albedo[p]});
     }
   }
 }
@@ -49,7 +51,7 @@ void Accumulation::record(VkCommandBuffer cmd, int parity, bool history, std::sp
 void Accumulation::fill(VkCommandBuffer cmd, std::uint32_t word) const {
   for (const Eye& e : eyes_) {
     for (int p = 0; p < 2; ++p)
-      for (const gpu::Buffer* b : {&e.direct[p], &e.indirect[p], &e.pos[p], &e.nrm[p], &e.restart[p]})
+      for (const gpu::Buffer* b : {&e.direct[p], &e.indirect[p], &e.pos[p], &e.nrm[p], &e.restart[p], &e.albedo[p]})
         gpu::fill_buffer(cmd, *b, word);
     gpu::fill_buffer(cmd, e.tap_idx, word);
     gpu::fill_buffer(cmd, e.tap_w, word);

@@ -22,7 +22,8 @@ using Buf = const gpu::Buffer*;
 struct AccumulateBindings {
   FOVEA_BINDING_COUNT(RECON_ACC_COUNT)
   Buf maps, tables, samples, direct, indirect, normal_depth, position_material, prev_direct, prev_indirect, prev_pos,
-      prev_nrm, out_direct, out_indirect, out_pos, out_nrm, tap_idx, tap_w, materials, prev_restart, out_restart, luts;
+      prev_nrm, out_direct, out_indirect, out_pos, out_nrm, tap_idx, tap_w, materials, prev_restart, out_restart, luts,
+      albedo, prev_albedo, out_albedo;
   Slots slots() const {
     return {{{RECON_MAPS, maps},
              {RECON_TABLES, tables},
@@ -44,7 +45,10 @@ struct AccumulateBindings {
              {RECON_ACC_MATERIALS, materials},
              {RECON_ACC_PREV_RESTART, prev_restart},
              {RECON_ACC_OUT_RESTART, out_restart},
-             {RECON_ACC_LUTS, luts}}};
+             {RECON_ACC_LUTS, luts},
+             {RECON_ACC_ALBEDO, albedo},
+             {RECON_ACC_PREV_ALBEDO, prev_albedo},
+             {RECON_ACC_OUT_ALBEDO, out_albedo}}};
   }
 };
 

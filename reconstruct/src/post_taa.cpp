@@ -32,7 +32,7 @@ PostTaa::PostTaa(gpu::Context& ctx, std::span<const EyeGrid> eyes, const Accumul
                                             &e.sum});
       e.taa_set[p] = make_set(ctx, taa_,
                               TaaBindings{g.maps, g.tables, &acc.position(me, p), &acc.tap_index(me),
-                                          &acc.tap_weight(me), &e.sum, g.albedo, &e.final_[q], &e.final_[p],
+                                          &acc.tap_weight(me), &e.sum, &acc.albedo(me, p), &e.final_[q], &e.final_[p],
                                           &acc.normal(me, p), &acc.restart(me, p)});
     }
   }

@@ -1,11 +1,14 @@
 #include "fovea/renderer/gpu_scene.hpp"
 
+#include <algorithm>
+#include <cmath>
 #include <cstring>
 
 #include <glm/geometric.hpp>
 
 #include "fovea/core/clock.hpp"
 #include "fovea/core/error.hpp"
+#include "fovea/core/image.hpp"
 #include "fovea/gpu/accel.hpp"
 #include "ggx_albedo.hpp"
 #include "tracer_pipeline.hpp"
@@ -20,6 +23,39 @@ gpu::Buffer upload(gpu::Context& ctx, const std::vector<T>& data, const char* na
   gpu::Buffer b(ctx, {data.size() * sizeof(T), gpu::BufferUsage::Storage, gpu::Memory::DeviceLocal, name, texel_format});
   b.upload(data);
   return b;
+}
+
+// Appends texture t and its box-filtered mip chain to `texels` (level l of max(w >> l, 1) ×
+// max(h >> l, 1) texels right after level l − 1; a texel of level l + 1 averages the 2×2
+// texels below it, in linear light for the colour); returns the number of levels. The
+// tracer picks a level from the primary ray's cone (pt_trace.comp, cone_lod).
+std::uint32_t append_mip_chain(const Texture& t, std::vector<std::uint32_t>& texels) {
+  std::vector<glm::vec4> level(std::size_t(t.width) * t.height);
+  for (std::size_t i = 0; i < level.size(); ++i)
+    level[i] = {core::srgb_decode(t.rgba[4 * i] / 255.0f), core::srgb_decode(t.rgba[4 * i + 1] / 255.0f),
+                core::srgb_decode(t.rgba[4 * i + 2] / 255.0f), t.rgba[4 * i + 3] / 255.0f};
+  auto byte = [](float v) { return std::uint32_t(std::lround(std::clamp(v, 0.0f, 1.0f) * 255.0f)); };
+  int w = t.width, h = t.height;
+  std::uint32_t levels = 0;
+  for (;;) {
+    for (const glm::vec4& c : level)
+      texels.push_back(byte(core::srgb_encode(c.x)) | byte(core::srgb_encode(c.y)) << 8 |
+                       byte(core::srgb_encode(c.z)) << 16 | byte(c.w) << 24);
+    ++levels;
+    if (w == 1 && h == 1) return levels;
+    const int nw = std::max(w / 2, 1), nh = std::max(h / 2, 1);
+    std::vector<glm::vec4> next(std::size_t(nw) * nh);
+    for (int y = 0; y < nh; ++y)
+      for (int x = 0; x < nw; ++x) {
+        const int x0 = std::min(2 * x, w - 1), x1 = std::min(2 * x + 1, w - 1);
+        const int y0 = std::min(2 * y, h - 1), y1 = std::min(2 * y + 1, h - 1);
+        next[std::size_t(y) * nw + x] = 0.25f * (level[std::size_t(y0) * w + x0] + level[std::size_t(y0) * w + x1] +
+                                                 level[std::size_t(y1) * w + x0] + level[std::size_t(y1) * w + x1]);
+      }
+    level = std::move(next);
+    w = nw;
+    h = nh;
+  }
 }
 
 }  // namespace
@@ -119,13 +155,11 @@ GpuScene::GpuScene(gpu::Context& ctx, const Scene& s, const BvhOptions& bvh_opti
   std::vector<PtTextureInfo> table;
   std::vector<std::uint32_t> texels;
   for (const Texture& t : s.textures) {
-    table.push_back({std::uint32_t(texels.size()), std::uint32_t(t.width), std::uint32_t(t.height), 0});
-    const std::size_t first = texels.size();
-    texels.resize(first + std::size_t(t.width) * t.height);
-    std::memcpy(texels.data() + first, t.rgba.data(), t.rgba.size());  // RGBA8 -> unpackUnorm4x8 order
+    const std::uint32_t offset = std::uint32_t(texels.size());
+    table.push_back({offset, std::uint32_t(t.width), std::uint32_t(t.height), append_mip_chain(t, texels)});
   }
   stats_.textures = std::uint32_t(table.size());
-  if (table.empty()) table.push_back({0, 1, 1, 0});
+  if (table.empty()) table.push_back({0, 1, 1, 1});
   if (texels.empty()) texels.push_back(0xFFFFFFFFu);
 
   // Also texel buffers, the tracers' reads (pt_traverse.h says why).

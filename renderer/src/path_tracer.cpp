@@ -110,7 +110,7 @@ void PathTracer::record(VkCommandBuffer cmd, TraceOutputs& out, const core::View
     p.sample_offset = first;
     p.accumulated_samples = std::uint32_t(std::min<std::uint64_t>(done, 0xFFFFFFFFu));
     p.flags = (c.jitter ? shaders::kPtJitter : 0u) | (done > 0 ? shaders::kPtAccumulate : 0u) |
-              (tiles ? shaders::kPtTileOrder : 0u);
+              (tiles ? shaders::kPtTileOrder : 0u) | (c.texture_lod ? shaders::kPtTextureLod : 0u);
     if (scene_.tracing() == Tracing::RayQuery) pipeline_.run_linear(cmd, {&out.set_, &scene_.ray_query_set()}, p, out.cells_);
     else pipeline_.run_linear(cmd, {&out.set_}, p, out.cells_);
     done += p.spp;

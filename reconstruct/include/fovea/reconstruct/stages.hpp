@@ -50,11 +50,14 @@ class Accumulation {
   const gpu::Buffer& tap_weight(int eye) const { return eyes_[eye].tap_w; }
   // Frames since the history was rejected for coarse cells (float per cell; 0: none recent).
   const gpu::Buffer& restart(int eye, int parity) const { return eyes_[eye].restart[parity]; }
+  // The first hits' albedo, accumulated with the direct light's history weights: its
+  // jittered samples' mean is the texture's box filter over the cell (re-modulation, TAA).
+  const gpu::Buffer& albedo(int eye, int parity) const { return eyes_[eye].albedo[parity]; }
 
  private:
   struct Eye {
     std::uint32_t cells = 0;
-    gpu::Buffer direct[2], indirect[2], pos[2], nrm[2], restart[2], tap_idx, tap_w;
+    gpu::Buffer direct[2], indirect[2], pos[2], nrm[2], restart[2], albedo[2], tap_idx, tap_w;
     gpu::DescriptorSet set[2];
   };
   gpu::ComputePipeline kernel_;

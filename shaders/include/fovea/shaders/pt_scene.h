@@ -68,9 +68,10 @@ struct PtMaterial {
   float pad;
 };
 
-// A texture in the shared texel buffer (RGBA8 sRGB words).
+// A texture in the shared texel buffer (RGBA8 sRGB words): `levels` mip levels from
+// `offset`, level l of max(width >> l, 1) × max(height >> l, 1) texels after level l − 1.
 struct PtTextureInfo {
-  FOVEA_UINT offset, width, height, pad;
+  FOVEA_UINT offset, width, height, levels;
 };
 
 // Emissive triangle for next-event estimation, chosen by power with a CDF.

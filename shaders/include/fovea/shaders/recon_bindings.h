@@ -35,7 +35,10 @@
 #define RECON_ACC_PREV_RESTART 18
 #define RECON_ACC_OUT_RESTART 19
 #define RECON_ACC_LUTS 20
-#define RECON_ACC_COUNT 21
+#define RECON_ACC_ALBEDO 21
+#define RECON_ACC_PREV_ALBEDO 22
+#define RECON_ACC_OUT_ALBEDO 23
+#define RECON_ACC_COUNT 24
 
 // recon_share.comp (stereo gather of indirect diffuse)
 #define RECON_SHARE_POS 2

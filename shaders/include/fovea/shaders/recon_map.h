@@ -227,6 +227,13 @@ void rg_taps(ReconGrid m, vec2 uv, out uvec4 idx, out vec4 w, out uvec2 cols) {
   }
 }
 
+// Catmull–Rom weights (Mitchell–Netravali B = 0, C = ½) of the taps at −1, 0, 1, 2 around
+// f in [0, 1) past tap 0: they sum to 1 and give tap 0 alone at f = 0.
+vec4 rg_catmull_rom(float f) {
+  float f2 = f * f, f3 = f2 * f;
+  return vec4(-0.5 * f3 + f2 - 0.5 * f, 1.5 * f3 - 2.5 * f2 + 1.0, -1.5 * f3 + 2.0 * f2 + 0.5 * f, 0.5 * f3 - 0.5 * f2);
+}
+
 // A cell of mapping m as its neighbourhood needs it: its column and the grid coordinate t
 // of its centre (computed once for the 3×3 neighbours: the index division and the φ of the
 // row were most of a neighbourhood's cost on lavapipe).
