@@ -27,6 +27,7 @@ std::vector<glm::vec4> grid_buffer(const FramePipeline& pipeline, core::Eye eye,
       break;
     case GridBuffer::Final: b = &m.post->final_color(i, p); break;
     case GridBuffer::Albedo: b = &e.trace.albedo(); break;
+    case GridBuffer::AccAlbedo: b = &m.accumulation->albedo(i, p); break;
     case GridBuffer::Position: b = &m.accumulation->position(i, p); break;
   }
   std::vector<glm::vec4> v = b->download<glm::vec4>();

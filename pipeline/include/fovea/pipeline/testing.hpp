@@ -18,7 +18,8 @@ enum class GridBuffer {
   SharedIndirect,  // after stereo sharing (.w effective count)
   Fitted,          // BMFR weighted sum (demodulated); only with the BMFR denoiser
   Final,           // remodulated output in grid space (.w = 1 where a sample exists)
-  Albedo,
+  Albedo,          // the path tracer's first-hit albedo, this frame
+  AccAlbedo,       // Phase I's accumulated albedo (what TAA re-modulates with)
   Position,        // validation data: world position (sky: direction), .w material (-2: no sample)
 };
 
