@@ -1,5 +1,6 @@
 // Fireflies are capped in grid space before the resolve spreads a cell over its pixels
-// (recon_taa.comp, docs/reconstruction.md "Fireflies"): at budget 0.01 a cell of the scaled
+// (recon_taa.comp, docs/reconstruction.md "Textures under sparse
+// cells, fireflies, history resampling"): at budget 0.01 a cell of the scaled
 // raster covers ~100 display pixels, and one 1-spp outlier became a blob. No surface cell
 // leaves TAA brighter than kFireflyRatio (4) times its brightest grid neighbour, on frames
 // whose traced radiance holds such outliers; emitters and the sky are never capped.
