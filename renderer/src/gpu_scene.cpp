@@ -37,10 +37,15 @@ std::uint32_t append_mip_chain(const Texture& t, std::vector<std::uint32_t>& tex
   auto byte = [](float v) { return std::uint32_t(std::lround(std::clamp(v, 0.0f, 1.0f) * 255.0f)); };
   int w = t.width, h = t.height;
   std::uint32_t levels = 0;
+  // Level 0 as loaded (RGBA8 bytes in unpackUnorm4x8 order); the others encoded from linear.
+  const std::size_t first = texels.size();
+  texels.resize(first + level.size());
+  std::memcpy(texels.data() + first, t.rgba.data(), t.rgba.size());
   for (;;) {
-    for (const glm::vec4& c : level)
-      texels.push_back(byte(core::srgb_encode(c.x)) | byte(core::srgb_encode(c.y)) << 8 |
-                       byte(core::srgb_encode(c.z)) << 16 | byte(c.w) << 24);
+    if (levels > 0)
+      for (const glm::vec4& c : level)
+        texels.push_back(byte(core::srgb_encode(c.x)) | byte(core::srgb_encode(c.y)) << 8 |
+                         byte(core::srgb_encode(c.z)) << 16 | byte(c.w) << 24);
     ++levels;
     if (w == 1 && h == 1) return levels;
     const int nw = std::max(w / 2, 1), nh = std::max(h / 2, 1);
