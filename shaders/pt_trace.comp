@@ -331,7 +331,8 @@ void main() {
   vec3 dv = vec3(g.dir_x, g.dir_y, g.dir_z);
   vec3 sum_d = vec3(0.0), sum_i = vec3(0.0), sum_a = vec3(0.0), sum_l = vec3(0.0);
   Sample first;
-  const uint spp = max(pc.spp, 1u);
+  // A new fovea's first frames (PathConfig::boost_spp): more samples near the gaze.
+  const uint spp = pc.boost_spp > pc.spp && g.ecc_deg <= pc.boost_deg ? pc.boost_spp : max(pc.spp, 1u);
   // With kPtTextureLod the primary ray's cone is the cell's angular size: its sample spacing
   // on the z = -1 tangent plane times cos^1.5 of the angle off the axis (a tangent-plane step
   // dt spans dt·cos² radially and dt·cos across; their geometric mean).
@@ -365,8 +366,9 @@ void main() {
     alb_mean = mix(out_albedo[idx].rgb, alb_mean, w);
     rad_mean = mix(out_radiance[idx].rgb, rad_mean, w);
   }
-  out_direct[idx] = vec4(finite_or_zero(dir_mean), 1.0);
-  out_indirect[idx] = vec4(finite_or_zero(ind_mean), 1.0);
+  const float held = accumulate ? 1.0 : float(spp);  // samples in this mean (Phase I's count)
+  out_direct[idx] = vec4(finite_or_zero(dir_mean), held);
+  out_indirect[idx] = vec4(finite_or_zero(ind_mean), held);
   out_albedo[idx] = vec4(finite_or_zero(alb_mean), 1.0);
   out_radiance[idx] = vec4(finite_or_zero(rad_mean), 1.0);
   if (!accumulate) {

@@ -150,9 +150,13 @@ void main() {
   // history counts for its share only, which raises α.
   hd.w *= confidence;
   hi.w *= confidence;
-  float nd = min(round(hd.w) + 1.0, 255.0);
-  float ad = max(1.0 / nd, pc.alpha_min);
-  acc_direct[i] = vec4(mix(hd.rgb, texelFetch(direct, int(i)).rgb, ad), nd);
+  // This frame's mean holds `held` samples (the tracer's .a: more in a new fovea's first
+  // frames), so it counts for that many.
+  vec4 now_d = texelFetch(direct, int(i));
+  float held = max(now_d.w, 1.0);
+  float nd = min(round(hd.w) + held, 255.0);
+  float ad = max(held / nd, pc.alpha_min);
+  acc_direct[i] = vec4(mix(hd.rgb, now_d.rgb, ad), nd);
   // The albedo with the direct light's weights where the history sits on the cell (a still
   // grid): the jittered first hits average to the texture's box filter over the cell. Where
   // the grid moved, every frame's bilinear resampling would blur it further (measured: a
@@ -162,9 +166,10 @@ void main() {
   float aligned = clamp((max(max(w.x, w.y), max(w.z, w.w)) - 0.9) / 0.09, 0.0, 1.0);
   acc_albedo[i] = vec4(mix(ha.rgb, texelFetch(albedo, int(i)).rgb, mix(1.0, ad, aligned)), 1.0);
   if (pc.indirect_fresh != 0u) {
-    float ni = min(round(hi.w) + 1.0, 255.0);
-    float ai = max(1.0 / ni, pc.alpha_min);
-    acc_indirect[i] = vec4(mix(hi.rgb, texelFetch(indirect, int(i)).rgb, ai), ni);
+    vec4 now_i = texelFetch(indirect, int(i));
+    float ni = min(round(hi.w) + max(now_i.w, 1.0), 255.0);
+    float ai = max(max(now_i.w, 1.0) / ni, pc.alpha_min);
+    acc_indirect[i] = vec4(mix(hi.rgb, now_i.rgb, ai), ni);
   } else {
     acc_indirect[i] = vec4(hi.rgb, round(hi.w));  // not traced this frame: history only
   }

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <string>
 
+#include "fovea/core/acuity.hpp"
 #include "fovea/core/clock.hpp"
 #include "fovea/core/error.hpp"
 #include "fovea/gpu/barriers.hpp"
@@ -126,6 +127,7 @@ FramePipeline::~FramePipeline() = default;
 
 void FramePipeline::reset() {
   impl_->frames_done = 0;
+  impl_->landing_left = 0;
   for (auto& e : impl_->eyes) e->dist->restart();  // no σ0 warm start from the frames before
 }
 
@@ -146,6 +148,7 @@ FrameTimes FramePipeline::render(const std::array<core::Pose, 2>& eye_pose, cons
   const int p = m.frames_done == 0 ? 0 : 1 - m.parity;
   const bool history = m.frames_done > 0;
   double motion = 0;  // the largest change of an eye's view since the last frame (degrees)
+  double jump = 0;    // the largest change of an eye's gaze (degrees)
   for (auto& e : m.eyes) {
     const int i = int(e->eye);
     const core::Pose pose_before = e->pose;
@@ -154,11 +157,15 @@ FrameTimes FramePipeline::render(const std::array<core::Pose, 2>& eye_pose, cons
     t.gaze[i] = e->dist->set_frame(gaze[i], frame);
     e->gaze_used = t.gaze[i].used;
     motion = std::max(motion, reconstruct::view_motion_deg(gaze_before, e->gaze_used, pose_before, e->pose));
+    if (history) jump = std::max(jump, core::angle_deg(gaze_before, e->gaze_used));
     e->grid_pass->prepare(*e->dist, e->mask);
   }
   // A still view converges (history weights 1/n); a moving one keeps the EMA floors.
   const reconstruct::ReconSettings settings = reconstruct::with_history_floors(m.settings, motion);
   t.history_floor = 1.0f - settings.still;
+  if (jump >= reconstruct::kLandingJumpDeg) m.landing_left = reconstruct::kLandingFrames;
+  const bool landing = m.landing_left > 0;
+  if (landing) --m.landing_left;
   t.grid.cpu_ms = lap_ms(t0);
   m.write_mappings();
   t.reconstruct.cpu_ms = lap_ms(t0);
@@ -183,6 +190,10 @@ FrameTimes FramePipeline::render(const std::array<core::Pose, 2>& eye_pose, cons
       if (!fresh[i]) cfg.max_bounces = 0;
       cfg.order = m.trace_order(e);
       cfg.texture_lod = true;  // one sample per cell and frame: textures prefiltered at the cell's size
+      if (landing) {
+        cfg.boost_spp = m.settings.landing_spp;
+        cfg.boost_deg = core::acuity::kFoveaDeg + e.dist->params().margin_deg;
+      }
       m.tracer.record(cmd, e.trace, core::View(e.base_view.fov(), e.base_view.width(), e.base_view.height(), e.pose),
                       e.eye, frame, cfg);
     }

@@ -39,6 +39,7 @@ struct FramePipeline::Impl {
   std::unique_ptr<reconstruct::Resolve> resolve;
   gpu::GpuTimer timer;
   std::uint32_t frames_done = 0;  // frames since the last reset
+  std::uint32_t landing_left = 0;  // frames still tracing the new fovea's extra samples
   int parity = 0;                 // history buffers written by the last frame
   bool temporal = false;          // the temporal error is measured on the device
   std::uint32_t temporal_frames = 0, temporal_pairs = 0;  // frames measured, consecutive pairs summed

@@ -109,6 +109,9 @@ void PathTracer::record(VkCommandBuffer cmd, TraceOutputs& out, const core::View
     p.spp = std::min(spp - first, shaders::kPtMaxSppPerDispatch);
     p.sample_offset = first;
     p.accumulated_samples = std::uint32_t(std::min<std::uint64_t>(done, 0xFFFFFFFFu));
+    const bool boost = first == 0 && done == 0 && spp == 1 && c.boost_spp > 1;
+    p.boost_spp = boost ? std::min(c.boost_spp, shaders::kPtMaxSppPerDispatch) : 0u;
+    p.boost_deg = float(c.boost_deg);
     p.flags = (c.jitter ? shaders::kPtJitter : 0u) | (done > 0 ? shaders::kPtAccumulate : 0u) |
               (tiles ? shaders::kPtTileOrder : 0u) | (c.texture_lod ? shaders::kPtTextureLod : 0u);
     if (scene_.tracing() == Tracing::RayQuery) pipeline_.run_linear(cmd, {&out.set_, &scene_.ray_query_set()}, p, out.cells_);

@@ -41,6 +41,10 @@ constexpr double kFullFloorMotionDeg = 1.0;
 // The view's change between two frames in degrees: the gaze's angle, the eye's rotation and
 // its translation seen from kMotionParallaxM away (the parallax of a surface at that distance).
 constexpr double kMotionParallaxM = 1.0;
+// A gaze jump that puts the fovea where there was periphery, and the frames from it that
+// trace ReconSettings::landing_spp samples per fovea cell.
+constexpr double kLandingJumpDeg = 5.0;
+constexpr std::uint32_t kLandingFrames = 4;
 double view_motion_deg(glm::dvec3 gaze_before, glm::dvec3 gaze_now, const core::Pose& before, const core::Pose& now);
 ReconSettings with_history_floors(const ReconSettings& s, double motion_deg);
 
@@ -57,6 +61,11 @@ struct ReconSettings {
   // saccade by far more. Huge values switch the test off (for measuring what it does).
   float coarse_keep = 1.25f, coarse_reject = 2.0f;
   float noise = 0.01f;           // stochastic regularisation ε (BMFR Eq. 7)
+  // A new fovea's first frames (docs/reconstruction.md, "A 32° gaze step"): for
+  // kLandingFrames frames from one where the gaze jumped by kLandingJumpDeg or more, the
+  // cells within the fovea (plus the distribution's margin) trace this many samples (at most
+  // 8; 1: off), so that the landed fovea's history fills faster than one sample a frame.
+  std::uint32_t landing_spp = 4;
   // Set per frame by with_history_floors: 1 − the floors' share (1: a still view, which
   // needs no TAA: recon_taa.comp).
   float still = 0;

@@ -41,6 +41,11 @@ struct PathConfig {
   // resolution aliases into rings and per-frame noise. Off for references: their many
   // jittered samples per pixel are the pixel's box filter of the full-resolution texture.
   bool texture_lod = false;
+  // Cells within boost_deg of the gaze trace boost_spp samples (at most kPtMaxSppPerDispatch)
+  // instead of spp: the frame pipeline's first frames at a new fovea. Only with spp = 1 and
+  // no accumulation over dispatches (the tracer's direct/indirect .a then says the count).
+  std::uint32_t boost_spp = 0;
+  double boost_deg = 0;
   TraceOrder order = TraceOrder::Grid;
 };
 

@@ -2,8 +2,9 @@
 //
 // Outputs, one entry per grid cell (index = row * columns + column, like the GridSample
 // input), all vec4 of fp32, never NaN/Inf:
-//   direct    rgb: demodulated (a) emission + direct lighting + specular-lobe indirect, a = 1
-//   indirect  rgb: demodulated (b) diffuse-lobe indirect lighting, a = 1
+//   direct    rgb: demodulated (a) emission + direct lighting + specular-lobe indirect, a: the
+//             samples this cell's mean holds this dispatch (spp, or boost_spp in the boosted fovea)
+//   indirect  rgb: demodulated (b) diffuse-lobe indirect lighting, a as direct's
 //   albedo    rgb: first-hit base colour (textured); 1 for rays that leave the scene; a = 1
 //   normal_depth    xyz: world shading normal facing the viewer, w: linear view depth (0 on a miss)
 //   position_material xyz: world position, w: material index (-1 on a miss or a skipped cell)
@@ -55,10 +56,12 @@ struct PtFrameParams {
   float pixel_tx, pixel_ty;         // tangent-plane size of one display pixel (jitter scale)
   FOVEA_UINT sample_offset;         // index of this dispatch's first sample in the frame (RNG key)
   FOVEA_UINT columns;               // the grid's padded column count (kPtTileOrder)
+  FOVEA_UINT boost_spp;             // cells within boost_deg of the gaze trace this many samples (0: none)
+  float boost_deg;
 };
 
 #ifdef __cplusplus
-static_assert(sizeof(PtFrameParams) == 112);
+static_assert(sizeof(PtFrameParams) == 120);
 }  // namespace fovea::shaders
 #endif
 #endif
