@@ -175,17 +175,18 @@ TEST_F(GpuTest, FoveaIsSharpWithinThreeFramesAfterA40DegreeSaccade) {
     for (int f = 0; f < after; ++f) {
       jump.render(poses, {target, target}, std::uint32_t(settle + f));
       const double r = fovea_sharpness(jump.image(core::Eye::Left), jump.view(core::Eye::Left), target) / sharp;
-      std::printf("%s, frame %d after the saccade: fovea sharpness %.3f of the fixed gaze's, history %.2f frames\n",
+      std::printf("%s, frame %d after the saccade: fovea sharpness %.3f of the fixed gaze's, history %.2f samples\n",
                   reconstruct::denoiser_name(denoiser), f + 1, r, fovea_history(jump));
       // The mechanism itself: the fovea's history from 40° out is rejected at the jump (its
-      // samples start over; measured 5.8 frames of history without the cell-size test) and
-      // accepted again from the next frame on (same-size cells).
-      const double count = fovea_history(jump);
+      // samples start over with the frame's own landing_spp; measured 5.8 frames of history
+      // without the cell-size test) and accepted again from the next frame on (same-size
+      // cells), each landing frame adding landing_spp samples.
+      const double count = fovea_history(jump), per_frame = s.landing_spp;
       if (f == 0) {
-        EXPECT_LT(count, 1.05);
+        EXPECT_LT(count, per_frame + 0.05);
       }
       if (f == 1) {
-        EXPECT_GT(count, 1.9);
+        EXPECT_GT(count, 2 * per_frame - 0.1);
       }
       if (f >= 2) {  // from the third frame after the jump on
         EXPECT_NEAR(r, 1.0, 0.1) << f + 1;
@@ -261,11 +262,11 @@ TEST_F(GpuTest, SaccadeRecoveryCurveOnTheDefaultScene) {
           EXPECT_GE(q.psnr, qc.psnr - 0.5) << "frame " << f + 1;
           EXPECT_LE(q.hdr_flip, qc.hdr_flip + 0.003) << "frame " << f + 1;
         }
-        if (f == 0) {
+        if (f == 0) {  // Phase I counts samples: the frame's own c.path.spp after a restart
           if (check) {
-            EXPECT_LT(count, 1.05);
+            EXPECT_LT(count, c.path.spp + 0.05);
           } else {
-            EXPECT_GT(count, 2.0);
+            EXPECT_GT(count, 2.0 * c.path.spp);
           }
         }
       }
