@@ -93,24 +93,6 @@ vec3 remodulated(uint i) {
   return texelFetch(post, int(i)).rgb * max(texelFetch(albedo, int(i)).rgb, vec3(kPtMinDemodAlbedo));
 }
 
-// The firefly cap of cell i: kFireflyRatio times the largest luminance of its 3×3 grid
-// neighbours' inputs; no cap (3e38) for emitters, the sky and a cell without neighbours.
-float firefly_cap(ReconGrid m, uint i) {
-  if (texelFetch(vpos, int(i)).w < 0.0) return 3.0e38;
-  RgCell cell = rg_cell(m, i);
-  float brightest = -1.0;
-  for (int dc = -1; dc <= 1; ++dc) {
-    RgColumnNear near;
-    if (!rg_column_next_to(m, cell, dc, near)) continue;
-    for (int dr = -1; dr <= 1; ++dr) {
-      uint j;
-      if ((dc == 0 && dr == 0) || !rg_row_next_to(m, near, dr, j) || j == i || rg_no_sample(texelFetch(vpos, int(j)).w)) continue;
-      brightest = max(brightest, luma(remodulated(j)));
-    }
-  }
-  return brightest < 0.0 ? 3.0e38 : kFireflyRatio * brightest;
-}
-
 // The history at grid coordinate uv of the previous mapping by Catmull–Rom, in the compressed
 // space; false when a tap holds no sample (the caller then keeps Phase I's taps).
 bool history_catmull_rom(ReconGrid prev, vec2 uv, out vec3 h) {
@@ -170,15 +152,14 @@ void main() {
     return;
   }
   ReconGrid m = maps[kReconCurrent];
-  float cap = firefly_cap(m, i);
-  if (pc.denoise == 0u) {
-    final_color[i] = vec4(capped(remodulated(i), cap), 1.0);
-    return;
-  }
+  bool denoise = pc.denoise != 0u;
   vec4 w = texelFetch(tap_w, int(i));
   bool history = pc.has_history != 0u && w.x + w.y + w.z + w.w > 0.0;
-  float since = texelFetch(restart, int(i)).x;  // frames since Phase I restarted the cell's history (0: none recent)
+  // Frames since Phase I restarted the cell's history (0: none recent); its window's
+  // neighbour average and running mean belong to the denoised path.
+  float since = denoise ? texelFetch(restart, int(i)).x : 0.0;
   vec3 lo = vec3(3.0e38), hi = vec3(-3.0e38);
+  float brightest = -1.0;  // the largest luminance of the 3×3 neighbours' inputs (the firefly cap)
   vec4 here = texelFetch(vpos, int(i)), nd = texelFetch(vnrm, int(i));
   vec3 avg = texelFetch(post, int(i)).rgb;
   float avg_w = 1.0;
@@ -191,10 +172,12 @@ void main() {
     for (int dr = -reach; dr <= reach; ++dr) {
       uint j;
       if (!rg_row_next_to(m, near, dr, j) || rg_no_sample(texelFetch(vpos, int(j)).w)) continue;
-      if (abs(dc) <= 1 && abs(dr) <= 1) {  // the clamp's 3×3 neighbourhood
-        vec3 y = to_ycocg(compress(remodulated(j)));
+      if (abs(dc) <= 1 && abs(dr) <= 1) {  // the clamp's and the cap's 3×3 neighbourhood
+        vec3 r = remodulated(j);
+        vec3 y = to_ycocg(compress(r));
         lo = min(lo, y);
         hi = max(hi, y);
+        if ((dc != 0 || dr != 0) && j != i) brightest = max(brightest, luma(r));
       }
       if (since > 0.0 && (dc != 0 || dr != 0) &&
           rg_tap_valid(here, nd.xyz, nd.w, texelFetch(vpos, int(j)), texelFetch(vnrm, int(j)).xyz)) {
@@ -203,8 +186,11 @@ void main() {
       }
     }
   }
+  // No cap for emitters, the sky and a cell without neighbours.
+  float cap = here.w < 0.0 || brightest < 0.0 ? 3.0e38 : kFireflyRatio * brightest;
   vec3 c = avg / avg_w * max(texelFetch(albedo, int(i)).rgb, vec3(kPtMinDemodAlbedo));
-  if (!history || since == 1.0) {  // nothing to blend, or the history is the coarse periphery's
+  // Accumulation only, nothing to blend, or a history that is the coarse periphery's.
+  if (!denoise || !history || since == 1.0) {  // nothing to blend, or the history is the coarse periphery's
     final_color[i] = vec4(capped(c, cap), 1.0);
     return;
   }
