@@ -5,7 +5,6 @@
 // against the same frames with landing_spp 1.
 #include <algorithm>
 #include <cmath>
-#include <numbers>
 #include <vector>
 
 #include "fovea/core/acuity.hpp"
@@ -20,11 +19,6 @@ namespace reconstruct = fovea::reconstruct;
 namespace core = fovea::core;
 namespace renderer = fovea::renderer;
 using fovea::test::GpuTest;
-
-glm::dvec3 gaze_at(double deg) {
-  const double r = deg * std::numbers::pi / 180;
-  return {std::sin(r), 0, -std::cos(r)};
-}
 
 double median(std::vector<double> v) {
   if (v.empty()) return NAN;
@@ -48,7 +42,7 @@ std::vector<Counts> counts_after_landing(fovea::gpu::Context& ctx, std::uint32_t
   const auto poses = core::eye_poses(scene.camera, display.ipd_m);
   std::vector<Counts> out;
   for (std::uint32_t f = 0; f < 3 + reconstruct::kLandingFrames + 2; ++f) {
-    const glm::dvec3 g = gaze_at(f < 3 ? -16 : 16);
+    const glm::dvec3 g = fovea::test::horizontal_gaze(f < 3 ? -16 : 16);
     p.render(poses, {g, g}, f);
     if (f < 3) continue;
     const auto acc = pipeline::testing::grid_buffer(p, core::Eye::Left, pipeline::testing::GridBuffer::AccDirect);

@@ -29,6 +29,12 @@ inline core::DisplayPreset display_of_size(int w, int h) {
   return d;
 }
 
+// The view-space gaze `deg` degrees to the right of straight ahead (left for negative).
+inline glm::dvec3 horizontal_gaze(double deg) {
+  const double r = deg * (M_PI / 180);
+  return {std::sin(r), 0, -std::cos(r)};
+}
+
 // Mean of `frames` frames of 1 spp traced on `grid` (the pipeline's current grid): a
 // grid-space reference of the plain radiance and of the demodulated indirect diffuse.
 inline Traced trace_reference(gpu::Context& ctx, const renderer::GpuScene& scene,

@@ -24,8 +24,6 @@ namespace {
 constexpr double kDeg = M_PI / 180;
 constexpr double kTarget = 20;  // the gaze jumps from -20° to +20° horizontally
 
-glm::dvec3 gaze_at(double deg) { return {std::sin(deg * kDeg), 0, -std::cos(deg * kDeg)}; }
-
 // A dark wall 1.5 in front of the eye under a constant white sky, with a checkerboard of
 // bright 1.5° squares within 9° of the saccade's target: a Lambert plane that sees the whole
 // sky has no noise under cosine sampling, so only reconstruction changes the image.
@@ -138,7 +136,7 @@ struct CurveSetting {
   renderer::Scene scene;
   core::DisplayPreset display = fovea::test::display_of_size(256, 288);
   std::array<core::Pose, 2> poses;
-  glm::dvec3 target = gaze_at(kTarget), before = gaze_at(-kTarget);
+  glm::dvec3 target = fovea::test::horizontal_gaze(kTarget), before = fovea::test::horizontal_gaze(-kTarget);
   renderer::PathConfig path;
 
   explicit CurveSetting(const char* name) : scene(renderer::load_scene(name)) {
@@ -158,7 +156,7 @@ TEST_F(GpuTest, FoveaIsSharpWithinThreeFramesAfterA40DegreeSaccade) {
   core::DisplayPreset display = fovea::test::display_of_size(256, 288);
   display.fov_left = display.fov_right = core::Fov::from_degrees(-30, 30, 33, -33);
   const auto poses = core::eye_poses(core::Pose{}, display.ipd_m);
-  const glm::dvec3 target = gaze_at(kTarget), before = gaze_at(-kTarget);
+  const glm::dvec3 target = fovea::test::horizontal_gaze(kTarget), before = fovea::test::horizontal_gaze(-kTarget);
   const int settle = 10, after = 8;
   // Without a denoiser the display shows Phase I's history directly; with BMFR (the
   // default) the TAA's neighbourhood clamp also limits what a blurred history can do.
