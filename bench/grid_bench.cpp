@@ -7,6 +7,8 @@
 //            the worst case for a solve that starts from the previous frame.
 // Each also with the reference σ0 solver (…/bisection: the 56-step bisection the secant
 // replaced), so one run gives the ratio; `evaluations` counts column marches per frame.
+// Each pursuit also under the lens' hidden area (…/secant/lens), as `fovea render` culls: the
+// budget's per-column estimate then probes the mask.
 // Then the radius -> column lookup table the reconstruction builds from each column table,
 // three per eye and frame (reconstruct::radius_lut; radius_lut/PRESET, gaze at the centre).
 //   fovea_bench_grid [--benchmark_filter=fove0]
@@ -20,6 +22,7 @@
 
 #include "fovea/core/display.hpp"
 #include "fovea/core/distribution.hpp"
+#include "fovea/core/eye_optics.hpp"
 #include "fovea/core/visual_polar_testing.hpp"
 #include "fovea/reconstruct/grid_map.hpp"
 
@@ -50,10 +53,12 @@ std::vector<glm::dvec3> saccade_path(const fc::View& v) {
   return path;
 }
 
-void grid_build(benchmark::State& state, const std::string& preset, bool saccades, bool bisection) {
-  const fc::View view = fc::load_display(preset).view(fc::Eye::Left);
+void grid_build(benchmark::State& state, const std::string& preset, bool saccades, bool bisection, bool lens) {
+  const fc::DisplayPreset display = fc::load_display(preset);
+  const fc::View view = display.view(fc::Eye::Left);
   const auto dist = fc::make_distribution(view, fc::DistributionParams{});
   fc::set_reference_sigma0_solve(*dist, bisection);
+  if (lens) dist->set_visibility(fc::EyeOptics(display, fc::Eye::Left).view_mask());
   const auto path = saccades ? saccade_path(view) : pursuit_path(view);
   std::size_t i = 0;
   double evaluations = 0;
@@ -85,8 +90,12 @@ int main(int argc, char** argv) {
         benchmark::RegisterBenchmark(("grid_build/" + preset + (saccades ? "/saccade" : "/pursuit") +
                                       (bisection ? "/bisection" : "/secant"))
                                          .c_str(),
-                                     grid_build, preset, saccades, bisection)
+                                     grid_build, preset, saccades, bisection, false)
             ->Unit(benchmark::kMicrosecond);
+  for (const std::string& preset : fc::display_preset_names())
+    benchmark::RegisterBenchmark(("grid_build/" + preset + "/pursuit/secant/lens").c_str(), grid_build, preset, false,
+                                 false, true)
+        ->Unit(benchmark::kMicrosecond);
   for (const std::string& preset : fc::display_preset_names())
     benchmark::RegisterBenchmark(("radius_lut/" + preset).c_str(), radius_lut, preset)->Unit(benchmark::kMicrosecond);
   benchmark::Initialize(&argc, argv);

@@ -13,6 +13,7 @@
 
 #include "distribution_impl.hpp"
 #include "fovea/core/error.hpp"
+#include "fovea/core/eye_optics.hpp"
 #include "fovea/shaders/hash.h"
 
 namespace fovea::core {
@@ -128,7 +129,7 @@ shaders::GridSample SampleDistribution::sample_at(int column, int row, glm::dvec
   if (!view_.contains_pixel(px)) flags |= shaders::kCellOffscreen;
   // Only cells that would be traced are tested against the mask (as the GPU does): a
   // packed column's clipped rows map beyond its arc, often into the hidden area.
-  else if (flags == 0 && visible_ && !visible_(px)) flags |= shaders::kCellHidden;
+  else if (flags == 0 && mask_ && !mask_->visible_at(px)) flags |= shaders::kCellHidden;
   s.dir_x = float(dir.x);
   s.dir_y = float(dir.y);
   s.dir_z = float(dir.z);
@@ -143,6 +144,44 @@ shaders::GridSample SampleDistribution::sample_at(int column, int row, glm::dvec
 }
 
 std::uint32_t SampleDistribution::cell_flags(int, int, glm::dvec3) const { return 0; }
+
+void SampleDistribution::set_visibility(const ViewMask& mask) {
+  if (mask.width() != view_.width() || mask.height() != view_.height())
+    throw InputError("visibility mask: " + std::to_string(mask.width()) + "x" + std::to_string(mask.height()) +
+                     " differs from the view's raster " + std::to_string(view_.width()) + "x" +
+                     std::to_string(view_.height()));
+  mask_ = std::make_shared<const ViewMask>(mask);
+  visible_fraction_ = 1.0 - mask.hidden_fraction();
+  const glm::dvec3 centre = view_.centre_dir();
+  const glm::dvec2 centre_px = view_.dir_to_pixel(centre).value_or(glm::dvec2(0.5 * view_.width(), 0.5 * view_.height()));
+  mask_free_deg_ = mask_free_px_ = INFINITY;
+  for (int y = 0; y < mask.height(); ++y)
+    for (int x = 0; x < mask.width(); ++x) {
+      if (!mask.hidden(x, y)) continue;
+      // The pixel's nearest point to the centre, so the disk holds no part of it.
+      const glm::dvec2 near{std::clamp(centre_px.x, double(x), x + 1.0), std::clamp(centre_px.y, double(y), y + 1.0)};
+      mask_free_px_ = std::min(mask_free_px_, glm::length(near - centre_px));
+      mask_free_deg_ = std::min(mask_free_deg_, angle_deg(view_.pixel_to_dir(near), centre));
+    }
+  // Two pixels of margin for the pixel-to-angle rounding above.
+  mask_free_px_ -= 2;
+  mask_free_deg_ -= 2 / std::sqrt(view_.pixels_per_deg2(centre));
+  if (centre_traced_ > 0) {  // the polar kinds' reference: the centred gaze under the mask
+    const glm::dvec3 gaze = gaze_;
+    centre_traced_ = 0;
+    gaze_ = centre;
+    on_frame();
+    gaze_ = gaze;
+  }
+  on_frame();
+}
+
+double SampleDistribution::budget_samples() const {
+  if (centre_traced_ > 0) return centre_traced_;
+  return std::max(1.0, params_.budget * view_.width() * view_.height() * visible_fraction_);
+}
+
+double SampleDistribution::traced_samples() const { return grid_samples() * visible_fraction_; }
 
 double SampleDistribution::samples_per_pixel(glm::dvec2 px) const {
   // One sample per cell: the inverse of the cell's area on the display where px falls.
@@ -229,6 +268,9 @@ class RasterDistribution final : public SampleDistribution {
   double grid_samples() const override {
     return params_.kind == DistributionKind::LinearFalloff ? expected_kept_ : SampleDistribution::grid_samples();
   }
+  double traced_samples() const override {
+    return params_.kind == DistributionKind::LinearFalloff ? expected_traced_ : SampleDistribution::traced_samples();
+  }
 
   double target_density(glm::dvec3 dir) const override {
     const double per_pixel = double(columns_) * rows_ / (double(view_.width()) * view_.height());
@@ -253,27 +295,33 @@ class RasterDistribution final : public SampleDistribution {
   }
   // Linear fall-off: the factor on (fl, pl) whose expected kept pixels are the budget, by
   // bisection over the eccentricities of a subsampled raster (the mean keep probability
-  // grows with the factor, from Pp at 0 to 1 once fl passes the farthest pixel).
+  // grows with the factor, from Pp at 0 to 1 once fl passes the farthest pixel). Pixels the
+  // lens hides are never traced: the mean is over the visible ones.
   void on_frame() override {
     if (params_.kind != DistributionKind::LinearFalloff) return;
     const int step = std::max(1, int(std::sqrt(double(view_.width()) * view_.height() / 40000.0)));
-    std::vector<double> ecc;
+    std::vector<double> ecc, hidden;
     for (int y = step / 2; y < view_.height(); y += step)
-      for (int x = step / 2; x < view_.width(); x += step)
-        ecc.push_back(angle_deg(view_.pixel_to_dir({x + 0.5, y + 0.5}), gaze_));
-    const auto mean_keep = [&](double scale) {
+      for (int x = step / 2; x < view_.width(); x += step) {
+        const glm::dvec2 px{x + 0.5, y + 0.5};
+        (mask_ && !mask_->visible_at(px) ? hidden : ecc).push_back(angle_deg(view_.pixel_to_dir(px), gaze_));
+      }
+    if (ecc.empty()) ecc.swap(hidden);  // everything hidden: keep the budget's shape
+    const auto mean_keep = [&](const std::vector<double>& es, double scale) {
       double sum = 0;
-      for (double e : ecc) sum += keep_probability(e, scale);
-      return sum / double(ecc.size());
+      for (double e : es) sum += keep_probability(e, scale);
+      return es.empty() ? 0.0 : sum / double(es.size());
     };
     const double e_max = *std::max_element(ecc.begin(), ecc.end());
     double lo = 0, hi = std::max(1.0, e_max / std::max(params_.falloff_fovea_deg, 1e-3) + 1);
     for (int i = 0; i < 60; ++i) {
       const double mid = 0.5 * (lo + hi);
-      (mean_keep(mid) < params_.budget ? lo : hi) = mid;
+      (mean_keep(ecc, mid) < params_.budget ? lo : hi) = mid;
     }
     scale_ = 0.5 * (lo + hi);
-    expected_kept_ = mean_keep(scale_) * view_.width() * view_.height();
+    const double pixels = double(view_.width()) * view_.height(), n = double(ecc.size() + hidden.size());
+    expected_traced_ = mean_keep(ecc, scale_) * pixels * visible_fraction_;
+    expected_kept_ = expected_traced_ + mean_keep(hidden, scale_) * pixels * double(hidden.size()) / n;
   }
   std::uint32_t cell_flags(int column, int row, glm::dvec3 dir) const override {
     if (params_.kind != DistributionKind::LinearFalloff) return 0;
@@ -290,7 +338,7 @@ class RasterDistribution final : public SampleDistribution {
   }
 
  private:
-  double scale_ = 1, expected_kept_ = 0;
+  double scale_ = 1, expected_kept_ = 0, expected_traced_ = 0;
 };
 
 std::unique_ptr<SampleDistribution> make_unchecked(const View& view, const DistributionParams& p) {
@@ -319,14 +367,14 @@ std::unique_ptr<SampleDistribution> make_distribution(const View& view, const Di
   // The budget is met at the centred gaze the distribution starts with, or refused; two
   // samples of slack let displays of a few pixels keep their minimal grids.
   const double pixels = double(view.width()) * view.height();
-  const double got = d->grid_samples() / pixels;
+  const double got = d->budgeted_samples() / pixels;
   if (std::abs(got - p.budget) * pixels <= std::max(0.05 * p.budget * pixels, 2.0)) return d;
   const std::string name = (p.display.empty() ? "" : "display " + p.display + ": ") + "budget: " + distribution_name(p.kind);
   const std::string where = " on this " + std::to_string(view.width()) + "x" + std::to_string(view.height()) + " display";
   if (got < p.budget) {
     DistributionParams full = p;
     full.budget = 1.0;
-    const double most = make_unchecked(view, full)->grid_samples() / pixels;
+    const double most = make_unchecked(view, full)->budgeted_samples() / pixels;
     throw InputError(name + " reaches at most " + fraction(std::max(most, got)) + " of the display's pixels" +
                      where + " (requested " + fraction(p.budget) + ")");
   }

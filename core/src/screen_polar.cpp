@@ -25,6 +25,7 @@ constexpr double kPaperFoveaS = 2 * kPaperClip;  // a right-triangle clip over s
 class ScreenPolar final : public PolarDistribution {
  public:
   ScreenPolar(const View& v, const DistributionParams& p) : PolarDistribution(v, p) {
+    pack_arcs_ = p.pack;
     if (p.kind == DistributionKind::PaperVisualPolar) {
       // Per-axis scale k with k²·(1 − 12%) = budget (P5: 2/3 per axis at 39%).
       const double k = std::sqrt(p.budget / (1.0 - kPaperClip));
@@ -44,12 +45,13 @@ class ScreenPolar final : public PolarDistribution {
     const auto g = screen_to_grid(*px);
     if (!g) return 0;
     const int i = std::clamp(int(g->x), 0, columns_ - 1);
-    const double area = std::numbers::pi * (r_[i + 1] * r_[i + 1] - r_[i] * r_[i]);
+    const double area = std::numbers::pi * (r_[i + 1] * r_[i + 1] - r_[i] * r_[i]) * arc_fraction(i);
     return area > 0 ? h_[i] / area * view_.pixels_per_deg2(dir) : 0;
   }
 
   double pixels_per_cell(int column, glm::dvec3) const override {
-    return std::numbers::pi * (r_[column + 1] * r_[column + 1] - r_[column] * r_[column]) / h_[column];
+    return std::numbers::pi * (r_[column + 1] * r_[column + 1] - r_[column] * r_[column]) * arc_fraction(column) /
+           h_[column];
   }
 
  protected:
@@ -65,6 +67,28 @@ class ScreenPolar final : public PolarDistribution {
     return true;
   }
   void fill_gpu(shaders::GridParams& g) const override { g.family = shaders::kFamilyScreenPolar; }
+
+  // The display's edges seen from the gaze pixel: a ring of radius r crosses the edge at
+  // distance d where cos(φ − its direction) > d / r.
+  double mask_free_radius() const override {
+    const auto centre = view_.dir_to_pixel(view_.centre_dir());
+    return centre ? mask_free_px_ - glm::length(gaze_px_ - *centre) : -INFINITY;
+  }
+
+  // The published grid's samples (the budget), less the lens' hidden share: packed rings
+  // take up what the published layout leaves beyond the display's edges.
+  double centre_reference(double) const override { return budgeted_samples() * visible_fraction_; }
+  double budgeted_samples() const override {
+    double rows = 0;
+    for (double h : full_) rows += h;
+    return rows;
+  }
+
+  RingSides view_sides(double r) const override {
+    const double w = view_.width(), h = view_.height(), pi = std::numbers::pi;
+    const auto t = [r](double d) { return r > 0 ? d / r : INFINITY; };
+    return {{{t(gaze_px_.x), pi}, {t(w - gaze_px_.x), 0}, {t(gaze_px_.y), -0.5 * pi}, {t(h - gaze_px_.y), 0.5 * pi}}};
+  }
 
   void on_frame() override {
     gaze_px_ = view_.dir_to_pixel(gaze_).value_or(glm::dvec2(view_.width() * 0.5, view_.height() * 0.5));
@@ -97,6 +121,13 @@ class ScreenPolar final : public PolarDistribution {
                   ? std::clamp(int(std::lround(rows_ * s_mid / kPaperFoveaS)), 1, rows_)
                   : rows_;
     }
+    // The papers' layouts, each ring packed to its arc on the display with its rows scaled
+    // so the published grid's samples are traced at every gaze (pack = false: as published).
+    full_.assign(h_.begin(), h_.end());
+    if (pack_arcs_)
+      fit_budget();
+    else  // full rings: the layout as published at every gaze
+      pack(1.0);
     publish_table();
   }
 

@@ -107,14 +107,10 @@ double solve_increasing(G&& g, double x0, double& slope, double tol, double piec
   return has_hi ? hi : x;
 }
 
-// The arc of φ of the ring at eccentricity e (degrees) around g (basis b1, b2) that the
-// view frustum does not hide, as {φ0, gap}: the ring is [φ0, φ0 + 2π − gap), the circle
-// minus its longest hidden run. Each frustum side n·d >= 0 (n inward; n·g >= 0 as the gaze
-// is inside) hides on d = cos e·g + sin e·(cos φ·b1 + sin φ·b2) the φ with
-// cos(φ − α) < −t, t = cos e·(n·g) / (sin e·|(n·b1, n·b2)|), α = atan2(n·b2, n·b1): an arc
-// centred at α + π of half-width acos t. The frustum is convex and holds g, so what is
-// hidden at e stays hidden further out: the arc at a column's inner radius covers the column.
-// One frustum side seen from the gaze: n·g, |(n·b1, n·b2)| and α + π (per frame).
+// The frustum's sides seen from the gaze g (basis b1, b2): each side n·d >= 0 (n inward;
+// n·g >= 0 as the gaze is inside) hides on d = cos e·g + sin e·(cos φ·b1 + sin φ·b2) the φ
+// with cos(φ − α) < −t, t = cos e·(n·g) / (sin e·|(n·b1, n·b2)|), α = atan2(n·b2, n·b1):
+// an arc centred at α + π of half-width acos t. Per side: n·g, |(n·b1, n·b2)| and α + π.
 struct FrustumSide {
   double along, across, hidden_centre;
 };
@@ -129,37 +125,6 @@ std::array<FrustumSide, 4> frustum_sides(const View& v, glm::dvec3 g, glm::dvec3
   return sides;
 }
 
-std::pair<double, double> visible_arc(const std::array<FrustumSide, 4>& sides, double e_deg) {
-  const double se = std::sin(e_deg * kDeg), ce = std::cos(e_deg * kDeg), two_pi = 2 * kPi;
-  std::pair<double, double> runs[8];  // hidden [start, end), start in [0, 2π); then shifted by 2π
-  int n = 0;
-  for (const FrustumSide& side : sides) {
-    const double c = ce * side.along, across = se * side.across;
-    if (across <= c) continue;  // the whole ring is inside this side
-    const double t = c / across;
-    if (t <= -1) return {0.0, 0.0};  // the whole ring hidden (not a column of the view): keep it full
-    const double half = std::acos(t);
-    double start = std::fmod(side.hidden_centre - half, two_pi);
-    if (start < 0) start += two_pi;
-    runs[n++] = {start, start + 2 * half};
-  }
-  if (n == 0) return {0.0, 0.0};
-  for (int k = 1; k < n; ++k)  // sort the (at most four) runs by start
-    for (int j = k; j > 0 && runs[j].first < runs[j - 1].first; --j) std::swap(runs[j], runs[j - 1]);
-  for (int k = 0; k < n; ++k) runs[n + k] = {runs[k].first + two_pi, runs[k].second + two_pi};
-  double best_start = 0, best_len = 0, start = runs[0].first, end = runs[0].second;
-  for (int k = 1; k <= 2 * n; ++k) {
-    if (k < 2 * n && runs[k].first <= end) {
-      end = std::max(end, runs[k].second);
-      continue;
-    }
-    if (end - start > best_len) best_start = start, best_len = end - start;
-    if (k < 2 * n) start = runs[k].first, end = runs[k].second;
-  }
-  if (best_len >= two_pi) return {0.0, 0.0};
-  return {std::fmod(best_start + best_len, two_pi), best_len};
-}
-
 class VisualPolar final : public PolarDistribution {
  public:
   VisualPolar(const View& v, const DistributionParams& p) : PolarDistribution(v, p) {
@@ -170,12 +135,19 @@ class VisualPolar final : public PolarDistribution {
       a_[k] = acuity_term(e);
       circ_[k] = circumference_deg(e);
     }
+    pack_arcs_ = packing();
     setup_session();
     session_ = {sigma0_, slope_, e_max_, r_};
     set_frame(view_.centre_dir());
   }
 
-  double target_density(glm::dvec3 dir) const override { return sigma(angle_deg(dir, gaze_), sigma0_); }
+  // σ at the budget's scale, less where the grid's N_φ rows cannot hold a ring's share.
+  double target_density(glm::dvec3 dir) const override {
+    const double e = angle_deg(dir, gaze_);
+    const auto it = std::upper_bound(r_.begin(), r_.end(), e);
+    const size_t i = size_t(std::clamp(int(it - r_.begin()) - 1, 0, columns_ - 1));
+    return sigma(e, row_scale_ * sigma0_) * (i < rows_kept_.size() ? rows_kept_[i] : 1.0);
+  }
 
   double pixels_per_cell(int column, glm::dvec3 dir) const override {
     // Ring solid angle 2π(cos e_i − cos e_i+1) = 4π sin(mid)·sin(half-width) sr (no
@@ -185,7 +157,7 @@ class VisualPolar final : public PolarDistribution {
     return sr * arc_fraction(column) / (kDeg * kDeg) / h_[column] * view_.pixels_per_deg2(dir);
   }
 
-  VisualPolarState state() const { return {sigma0_, sigma_disp_, e_max_, evaluations_}; }
+  VisualPolarState state() const { return {sigma0_, row_scale_, sigma_disp_, e_max_, evaluations_}; }
   void set_reference_solve(bool on) {
     reference_solve_ = on;
     on_frame();
@@ -208,6 +180,30 @@ class VisualPolar final : public PolarDistribution {
 
   void fill_gpu(shaders::GridParams& g) const override { g.family = shaders::kFamilyAngularPolar; }
 
+  double mask_free_radius() const override { return mask_free_deg_ - angle_deg(gaze_, view_.centre_dir()); }
+
+  RingSides view_sides(double e) const override {
+    const double se = std::sin(e * kDeg), ce = std::cos(e * kDeg);
+    RingSides sides;
+    for (size_t k = 0; k < 4; ++k) {
+      const double across = se * sides_[k].across;
+      sides[k] = {across > 0 ? ce * sides_[k].along / across : INFINITY, sides_[k].hidden_centre};
+    }
+    return sides;
+  }
+
+  // Density c·σ0·a(e) with the columns held: the rows follow the density's change at the
+  // column's middle, so the capped fovea keeps its rows (κ samples per pixel at most).
+  // Never fewer rows than the anisotropy bound A asks of the column.
+  double scaled_rows(int i, double c) const override {
+    if (c == 1.0) return full_[size_t(i)];
+    const size_t k = size_t(i);
+    const double a = column_acuity_[k], cap = params_.cap * sigma_disp_;
+    const double rows = full_[k] * std::min(cap, c * sigma0_ * a) / std::max(std::min(cap, sigma0_ * a), 1e-300);
+    const double least = circumference_deg(0.5 * (r_[k] + r_[k + 1])) / (params_.aniso * (r_[k + 1] - r_[k]));
+    return std::max(rows, std::min(least, full_[k]));
+  }
+
   // The per-frame solve starts from the previous frame's root; its several close roots
   // (docs/visual-polar.md) make the grid depend on that history in the last bits.
   void forget_frames() override {
@@ -219,6 +215,7 @@ class VisualPolar final : public PolarDistribution {
 
   void on_frame() override {
     orthonormal_basis(gaze_, b1_, b2_);
+    sides_ = frustum_sides(view_, gaze_, b1_, b2_);
     const double previous_e_max = e_max_;
     const double e_max = e_max_ = farthest_view_angle(gaze_);
     sigma_disp_ = fovea_pixel_density(gaze_);
@@ -231,8 +228,14 @@ class VisualPolar final : public PolarDistribution {
     sigma0_ = std::exp(solve_columns(e_max, x0));
     // The solve leaves the last boundary within 10⁻⁹ of a column of e_max: cover it exactly.
     r_.back() = std::max(r_.back(), e_max);
+    // The budget at this gaze: rows scaled so the traced samples meet it (P5's staircase
+    // keeps its layout, as the option of the layout study it is).
     if (params_.staircase) apply_staircase();
-    pack_arcs(gaze_);
+    full_.assign(h_.begin(), h_.end());
+    column_acuity_.resize(h_.size());
+    for (size_t i = 0; i < h_.size(); ++i) column_acuity_[i] = acuity_term(0.5 * (r_[i] + r_[i + 1]));
+    row_scale_ = params_.staircase ? 1.0 : fit_budget();
+    if (params_.staircase) pack(1.0);
     publish_table();
   }
 
@@ -417,33 +420,6 @@ class VisualPolar final : public PolarDistribution {
 
   bool packing() const { return params_.pack && !params_.staircase; }
 
-  // Packs each column the frustum cuts to its visible arc (at its inner radius, so the arc
-  // covers the whole column): ceil(rows · arc / 2π) rows at exactly the full ring's spacing
-  // along φ, the arc widened to them around its centre (so σ and the anisotropy stay the
-  // full ring's even for arcs of a few rows). Arcs are rounded to float, the GPU table's
-  // precision, so CPU and GPU map cells identically.
-  void pack_arcs(glm::dvec3 g) {
-    phi0_.clear();
-    gap_.clear();
-    if (!packing()) return;
-    glm::dvec3 b1, b2;
-    orthonormal_basis(g, b1, b2);
-    const auto sides = frustum_sides(view_, g, b1, b2);
-    const int n = int(h_.size());
-    phi0_.assign(size_t(n), 0.0);
-    gap_.assign(size_t(n), 0.0);
-    for (int i = 0; i < n; ++i) {
-      const auto [phi0, gap] = visible_arc(sides, r_[i]);
-      const double visible = 2 * kPi - gap;
-      const int rows = int(std::clamp(std::ceil(h_[i] * visible / (2 * kPi) - 1e-9), 1.0, double(h_[i])));
-      if (rows == h_[i]) continue;  // a complete ring: stays full and wraps
-      const double arc = 2 * kPi * rows / h_[i];
-      h_[i] = rows;
-      phi0_[i] = float(phi0 - 0.5 * (arc - visible));
-      gap_[i] = float(2 * kPi - arc);
-    }
-  }
-
   void apply_staircase() {
     for (int b = 0; b < columns_; b += 32) {
       const int end = std::min(b + 32, columns_);
@@ -456,17 +432,16 @@ class VisualPolar final : public PolarDistribution {
   // so the disk of radius E holds B samples; N_φ bounds the anisotropy by A at the gazes
   // the grid must serve (centre, edges, corners), N_ρ is the columns that budget needs.
   void setup_session() {
-    const double budget = std::max(1.0, params_.budget * view_.width() * view_.height());
-    const glm::dvec3 centre = view_.centre_dir();
+    const double budget = budget_samples();
+    const glm::dvec3 centre = gaze_ = view_.centre_dir();
+    orthonormal_basis(centre, b1_, b2_);
+    sides_ = frustum_sides(view_, centre, b1_, b2_);
     // Packed rings hold only their visible arc: the budget integrand carries the visible
     // fraction of the ring at each node (centred gaze).
     std::vector<double> visible;
     if (packing()) {
-      glm::dvec3 b1, b2;
-      orthonormal_basis(centre, b1, b2);
-      const auto sides = frustum_sides(view_, centre, b1, b2);
       visible.resize(size_t(kNodes) + 1);
-      for (int k = 0; k <= kNodes; ++k) visible[size_t(k)] = 1 - visible_arc(sides, k * kStep).second / (2 * kPi);
+      for (int k = 0; k <= kNodes; ++k) visible[size_t(k)] = 1 - visible_arc(view_sides(k * kStep)).second / (2 * kPi);
     }
     double dlog = 1;  // d log(samples) / d log σ0 at the budget's root
     auto solve_budget = [&](glm::dvec3 g, double& e_max) {
@@ -483,11 +458,13 @@ class VisualPolar final : public PolarDistribution {
           0.0, slope, 1e-12));
     };
     // The packed columns take their arcs at their inner radius and round their rows: a few
-    // Newton steps on the rows they actually hold bring those to the budget.
+    // Newton steps on the rows they actually hold bring those to the budget. (What leaves
+    // the view at the columns' outer edges the frames' rows make up: fit_budget.)
     auto fit_packed = [&](double s0, double e_max) {
       for (int it = 0; it < 4 && packing(); ++it) {
         march(s0, e_max, 1 << 24, 0, &r_, &h_);
-        pack_arcs(centre);
+        full_.assign(h_.begin(), h_.end());
+        pack(1.0);
         double held = 0;
         for (int h : h_) held += h;
         const double g = std::log(std::max(held, 1.0) / budget);
@@ -535,7 +512,10 @@ class VisualPolar final : public PolarDistribution {
   std::vector<double> a_, circ_;        // per node: a(e), circ(e)
   mutable std::vector<double> f_, s_;   // per node for the current σ0: σ·circ and prefix
   glm::dvec3 b1_{1, 0, 0}, b2_{0, 1, 0};
+  std::array<FrustumSide, 4> sides_{};  // the frustum seen from the gaze (per frame)
   double sigma0_ = 1, sigma_disp_ = 1, e_max_ = 0;
+  double row_scale_ = 1;      // the budget's factor on σ0 for the rows (fit_budget)
+  std::vector<double> column_acuity_;  // a(e) at each column's middle (this frame)
   // d log(columns)/d log σ0 for the warm start: ~1/2 (columns ∝ √σ0 where σ is not
   // capped), then the previous solve's first secant.
   double slope_ = 0.5;

@@ -138,6 +138,7 @@ void FramePipeline::set_visibility(core::Eye eye, const core::ViewMask& mask) {
                            " differs from the eye's raster " + std::to_string(e.base_view.width()) + "x" +
                            std::to_string(e.base_view.height()));
   e.mask.assign(mask.words().begin(), mask.words().end());
+  e.dist->set_visibility(mask);  // the budget counts the pixels the mask leaves
 }
 
 FrameTimes FramePipeline::render(const std::array<core::Pose, 2>& eye_pose, const std::array<glm::dvec3, 2>& gaze,

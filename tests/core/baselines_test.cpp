@@ -138,8 +138,11 @@ INSTANTIATE_TEST_SUITE_P(Kinds, ScreenPolarRoundTrip,
 
 TEST(PaperVisualPolar, ReproducesThePaperGrid) {
   // P5: 1280×1440 -> 853×960 at 2/3 per axis; the fovea clip removes 12%; ~39% of the
-  // display's pixels are grid samples.
-  auto d = make(DistributionKind::PaperVisualPolar, "fove0", 0.39);
+  // display's pixels are grid samples (full rings: as published, without visible arcs).
+  DistributionParams p;
+  p.kind = DistributionKind::PaperVisualPolar;
+  p.pack = false;
+  auto d = make_distribution(load_display("fove0").view(Eye::Left), p);
   EXPECT_NEAR(d->columns(), 853, 3);
   EXPECT_NEAR(d->rows(), 960, 3);
   std::int64_t cells = 0;

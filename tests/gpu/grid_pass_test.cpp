@@ -87,7 +87,7 @@ TEST_F(GpuTest, GridPassMaskMatchesCpuReference) {
     const core::EyeOptics optics(display, core::Eye::Right);
     const core::ViewMask mask = optics.view_mask();
     auto d = core::make_distribution(optics.view(), core::DistributionParams{});
-    d->set_visibility([&mask](glm::dvec2 px) { return mask.visible_at(px); });
+    d->set_visibility(mask);
     gpu::GridPass pass(ctx());
     gpu::Buffer out(ctx(), {.size = gpu::GridPass::samples_bytes(*d), .memory = gpu::Memory::HostVisible});
     for (std::uint32_t f = 0; f < 2; ++f) {

@@ -14,6 +14,7 @@
 #include "fovea/core/display.hpp"
 #include "fovea/core/distribution.hpp"
 #include "fovea/core/error.hpp"
+#include "fovea/core/eye_optics.hpp"
 #include "fovea/core/output_path.hpp"
 #include "fovea/core/image.hpp"
 #include "figures.hpp"
@@ -26,7 +27,7 @@ constexpr const char* kHelp = R"(usage: fovea density [options]
 
 Shows how a sample distribution spreads its samples over one eye's display.
 
-  --display NAME|FILE   display preset (fove0, vive, modern, small, tiny) or JSON file [small]
+  --display NAME|FILE   display preset (fove0, vive, modern, wide, small, tiny) or JSON file [small]
   --eye left|right      which eye's view [left]
   --gaze X,Y            gaze in normalised screen coordinates, origin top-left [0.5,0.5]
   --gaze-dir x,y,z      gaze as a view-space direction (OpenXR: -Z forward, +Y up)
@@ -38,6 +39,8 @@ Shows how a sample distribution spreads its samples over one eye's display.
   --cap K               at most K samples per display pixel [1]
   --aniso A             bound on the cells' phi/rho spacing ratio [2]
   --staircase           P5's rows-constant-per-32-columns layout (visual-polar)
+  --hidden-area         cull with the lens' hidden area as `fovea render` does: its cells
+                        are not traced and the budget counts the pixels it leaves visible
   --out PNG             heat map of samples per display pixel (log scale 1e-3..10, numbered
                         colour bar; gaze cross and fovea edge marked), drawn by matplotlib
                         as PNG and SVG from the data written beside them (same stem, .json
@@ -103,7 +106,7 @@ int run(std::vector<std::string> argv) {
   }
   const Args a(argv,
                {"display", "eye", "gaze", "gaze-dir", "distribution", "budget", "margin", "gamma", "cap", "aniso", "out"},
-               {"json", "staircase"});
+               {"json", "staircase", "hidden-area"});
   const core::DisplayPreset preset = core::load_display(a.str("display", "small"));
   const core::Eye eye = core::parse_eye(a.str("eye", "left"));
   const core::View view = preset.view(eye);
@@ -120,6 +123,7 @@ int run(std::vector<std::string> argv) {
   const glm::dvec3 gaze = parse_gaze(a, view);
 
   auto dist = core::make_distribution(view, p);
+  if (a.has("hidden-area")) dist->set_visibility(core::EyeOptics(preset, eye).view_mask());
   const core::GazeStatus st = dist->set_frame(gaze);
   const core::DensityReport r = core::measure_density(*dist);
   const glm::dvec2 gp = view.dir_to_pixel(st.used).value_or(glm::dvec2(0));
@@ -149,8 +153,13 @@ int run(std::vector<std::string> argv) {
     j["samples_grid"] = r.grid_samples;
     j["samples_traced"] = r.traced;
     j["samples_offscreen"] = r.offscreen;
+    j["samples_hidden"] = r.hidden;
     j["budget_fraction"] = p.budget;
+    j["budget_samples"] = dist->budget_samples();
     j["traced_fraction"] = double(r.traced) / (double(view.width()) * view.height());
+    j["traced_of_budget"] = double(r.traced) / dist->budget_samples();
+    if (const auto vp = core::visual_polar_state(*dist))
+      j["visual_polar"] = {{"sigma0", vp->sigma0}, {"row_scale", vp->row_scale}, {"sigma_disp", vp->sigma_disp}};
     j["fovea_spp"] = r.fovea_spp;
     auto& bands = j["bands"] = nlohmann::ordered_json::array();
     for (const auto& b : r.bands)

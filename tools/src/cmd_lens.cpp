@@ -32,7 +32,7 @@ grid of view directions (lines every 5 degrees) warped through the optics, each 
 through its own channel's optics (chromatic aberration shows as fringes), the hidden area
 in dark red.
 
-  --display NAME|FILE   display preset (fove0, vive, modern, small, tiny) or JSON file [fove0]
+  --display NAME|FILE   display preset (fove0, vive, modern, wide, small, tiny) or JSON file [fove0]
   --channel r|g|b       use one channel's optics for all colours (that channel's distortion)
   --grid                overlay the panel's own straight grid (every 1/16 of the panel)
   --out PNG             picture to write [out/lens/lens-<display>.png]
@@ -104,7 +104,7 @@ SamplesHidden samples_hidden(const core::EyeOptics& optics, const std::string& d
   auto dist = core::make_distribution(optics.view(), params);
   dist->set_frame({0, 0, -1});
   const core::ViewMask mask = optics.view_mask();
-  dist->set_visibility([&mask](glm::dvec2 px) { return mask.visible_at(px); });
+  dist->set_visibility(mask);
   std::size_t traced = 0, hidden = 0;
   for (int row = 0; row < dist->rows(); ++row)
     for (int col = 0; col < dist->columns(); ++col) {

@@ -12,8 +12,8 @@
 //   cartesian-uniform   a uniformly scaled raster with the same budget
 //   linear-falloff      Weier et al. 2016: full raster, pixels kept with probability p(e)
 //   log-polar           Meng et al. 2018 kernel log-polar buffer (σ = 1.8, α = 4)
+#include <cmath>
 #include <cstdint>
-#include <functional>
 #include <memory>
 #include <optional>
 #include <string>
@@ -45,7 +45,7 @@ struct DistributionParams {
   double cap = 1.0;          // κ: at most this many samples per display pixel
   double aniso = 2.0;        // A: bound on φ-spacing / ρ-spacing
   bool staircase = false;    // P5's rows-constant-per-32-columns layout (VP option)
-  bool pack = true;          // visual-polar: each ring's rows only on its visible arc (not with staircase)
+  bool pack = true;          // polar kinds: each ring's rows only on its visible arc (VP: not with staircase)
   // Weier 2016; fl and pl are scaled together per frame so the kept pixels meet the budget.
   double falloff_fovea_deg = 10, falloff_periphery_deg = 20, falloff_min_p = 0.2;
   double logpolar_alpha = 4.0;  // Meng 2018; the buffer's σ is 1/√budget
@@ -64,6 +64,8 @@ struct GazeStatus {
   bool clamped = false;   // was outside the frustum, clamped to its border
   bool fallback = false;  // unusable (NaN, zero, backwards): last valid gaze or view centre used
 };
+
+class ViewMask;
 
 class SampleDistribution {
  public:
@@ -93,8 +95,9 @@ class SampleDistribution {
   void set_jitter(bool on) { jitter_ = on; }
   glm::dvec2 jitter() const;  // this frame's cell offset in [-0.5, 0.5)²
 
-  // Cells the lens hides (continuous display position -> visible?). Optional.
-  void set_visibility(std::function<bool(glm::dvec2)> visible) { visible_ = std::move(visible); }
+  // The view pixels the lens hides (optional): cells there are flagged hidden, and the
+  // budget counts only the pixels it leaves visible. Rebuilds the current frame.
+  void set_visibility(const ViewMask& mask);
 
   // The sample of cell (column, row), 0 <= column < padded_columns, 0 <= row < padded_rows.
   shaders::GridSample sample(int column, int row) const { return sample_at(column, row, jitter()); }
@@ -112,6 +115,17 @@ class SampleDistribution {
   // Samples of the current frame's grid: cells neither clipped, padding nor killed
   // (linear fall-off: the expected count); offscreen and hidden cells included.
   virtual double grid_samples() const;
+  // The samples the budget sets, which make_distribution checks at the centred gaze: the
+  // grid samples; the screen-polar kinds' published grid (packed, its rows are rescaled).
+  virtual double budgeted_samples() const { return grid_samples(); }
+  // The samples this frame traces: grid samples on the view and not hidden (estimated per
+  // column for polar grids, expected for linear fall-off). Every kind but cartesian keeps
+  // it at budget_samples() at any gaze, as far as its grid allows.
+  virtual double traced_samples() const;
+  // The samples every frame traces: raster kinds the budget fraction of the view pixels
+  // the mask leaves visible; polar kinds what their grid traces at the centred gaze (their
+  // layout there, P5's and Meng's as published: some of it beyond the view's edges).
+  double budget_samples() const;
 
   // GPU description of the current frame (uniforms + column table; see grid_params.h).
   shaders::GridParams gpu_params() const;
@@ -136,7 +150,12 @@ class SampleDistribution {
   bool has_valid_gaze_ = false;
   std::uint32_t frame_ = 0;
   bool jitter_ = true;
-  std::function<bool(glm::dvec2)> visible_;
+  std::shared_ptr<const ViewMask> mask_;
+  double visible_fraction_ = 1;  // of the view's pixels, by the mask
+  // The largest disk around the view centre the mask hides nothing of: its radius in
+  // degrees (around the centre direction) and in pixels (around the centre pixel).
+  double mask_free_deg_ = INFINITY, mask_free_px_ = INFINITY;
+  double centre_traced_ = 0;  // polar kinds: traced at the centred gaze (0: not yet known)
   std::vector<shaders::GridColumn> table_;  // polar kinds: per column radius range and rows
 };
 
@@ -144,7 +163,10 @@ std::unique_ptr<SampleDistribution> make_distribution(const View& view, const Di
 
 // The angular Visual-Polar construction's per-frame state (nullopt for other kinds).
 struct VisualPolarState {
-  double sigma0 = 0;       // acuity scale solved for this frame (samples/deg² at m = 1)
+  double sigma0 = 0;       // acuity scale solved for this frame's columns (samples/deg² at m = 1)
+  // The factor on σ0 the rows take so the traced samples meet the budget (the columns stay
+  // σ0's; 1 at a centred gaze, more where the view cuts the rings).
+  double row_scale = 1;
   double sigma_disp = 0;   // display pixel density that κ caps against (pixels/deg²)
   double e_max = 0;        // farthest view direction from the gaze, degrees
   int evaluations = 0;     // column marches the σ0 solve of this frame used
