@@ -146,7 +146,7 @@ void chain(benchmark::State& state, const char* scene_name) {
   fp::FramePipeline p(context(), gpu_scene, fovea::core::stereo_views(d), dp, fc::ReconSettings{});
   const glm::dvec3 ahead(0, 0, -1);
   std::uint32_t frame = 0;
-  for (; frame < 3; ++frame) p.render(fovea::core::eye_poses(scene.camera, d.ipd_m), {ahead, ahead}, frame);
+  for (; frame < 3; ++frame) p.render(fovea::core::eye_poses(scene.camera, d), {ahead, ahead}, frame);
   fp::testing::time_reconstruct(p, frame);  // compiles the kernels not yet run with history
   fp::testing::ReconKernelTimes sum;
   const auto add = [](fp::testing::KernelTime& a, const fp::testing::KernelTime& b) {

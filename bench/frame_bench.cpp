@@ -43,7 +43,7 @@ void frame(benchmark::State& state, const std::string& display, fc::Distribution
   if (kind == fc::DistributionKind::Cartesian) dp.budget = 1.0;
   dp.display = d.origin;
   fp::FramePipeline p(context(), gpu_scene(), fc::stereo_views(d), dp, {});
-  const auto poses = fc::eye_poses(scene().camera, d.ipd_m);
+  const auto poses = fc::eye_poses(scene().camera, d);
   double gpu = 0, trace = 0, recon = 0, fit = 0, resolve = 0, cpu = 0, readback = 0, bytes = 0;
   std::uint32_t f = 0;
   for (auto _ : state) {

@@ -44,7 +44,7 @@ void resolve(benchmark::State& state, std::string display, fc::DistributionKind 
   fovea::reconstruct::ReconSettings s;
   fp::FramePipeline p(context(), gpu_scene(), fc::stereo_views(d), dp, s);
   const glm::dvec3 g = gaze_at(gaze_deg);
-  p.render(fc::eye_poses(scene().camera, d.ipd_m), {g, g}, 0);
+  p.render(fc::eye_poses(scene().camera, d), {g, g}, 0);
   fp::testing::ResolveKernelTimes sum;
   const auto add = [](fp::testing::KernelTime& a, const fp::testing::KernelTime& b) {
     a.gpu_ms += b.gpu_ms, a.cpu_ms += b.cpu_ms;

@@ -114,7 +114,7 @@ int run(int argc, char** argv) {
   fovea::gpu::Context ctx;
   const fr::Scene scene = fr::load_scene("default");
   const fr::GpuScene gs(ctx, scene);
-  const auto poses = fc::eye_poses(scene.camera, display.ipd_m);
+  const auto poses = fc::eye_poses(scene.camera, display);
   const glm::dvec3 gaze(0, 0, -1);
   // Visual-Polar at its default budget and two lower ones; a uniform raster with as many
   // samples as the default Visual-Polar grid (the same count, spread evenly and coherently);

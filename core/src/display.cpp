@@ -78,12 +78,15 @@ DisplayPreset parse_display(std::string_view text, std::string_view origin) {
                                             : d.fov_left.mirrored();
   if (j.contains("refresh_hz")) d.refresh_hz = number(j, "refresh_hz", origin, "");
   if (j.contains("ipd_m")) d.ipd_m = number(j, "ipd_m", origin, "");
+  if (j.contains("cant_deg")) d.cant_deg = number(j, "cant_deg", origin, "");
   d.lens = parse_lens_params(text, origin);
   if (!(d.refresh_hz >= kMinRefreshHz && d.refresh_hz <= kMaxRefreshHz))
     fail(origin, "\"refresh_hz\" must be in [" + fmt(kMinRefreshHz) + ", " + fmt(kMaxRefreshHz) + "] Hz");
   // A negative IPD swaps the eyes, a huge one puts them outside any scene.
   if (!(d.ipd_m >= 0 && d.ipd_m <= kMaxIpdM))
     fail(origin, "\"ipd_m\" must be in [0, " + fmt(kMaxIpdM) + "] m");
+  if (!(d.cant_deg >= 0 && d.cant_deg <= kMaxCantDeg))
+    fail(origin, "\"cant_deg\" must be in [0, " + fmt(kMaxCantDeg) + "] degrees");
   try {  // validates the FOV and raster
     (void)d.view(Eye::Left);
     (void)d.view(Eye::Right);

@@ -1,6 +1,7 @@
 // Reference spaces (VIEW, LOCAL, STAGE), action spaces (eye gaze; controllers are never
 // tracked), xrLocateSpace and xrLocateViews. World coordinates are LOCAL space: its origin is
 // the head's position at the display epoch, the floor (STAGE origin) 1.6 m below it.
+#include <array>
 #include <cmath>
 #include <optional>
 #include <vector>
@@ -10,6 +11,7 @@
 #include <algorithm>
 
 #include "api.hpp"
+#include "fovea/core/stereo_views.hpp"
 #include "state.hpp"
 
 namespace fovea::runtime {
@@ -236,9 +238,10 @@ XrResult api::xrLocateViews(XrSession session, const XrViewLocateInfo* info, XrV
       f->head_pose_target_ns = info->displayTime;
     }
     const core::DisplayPreset& d = s->instance->display;
+    const std::array<core::Pose, 2> eyes_in_head = core::eye_poses(core::Pose{}, d);  // IPD and cant
     for (uint32_t i = 0; i < 2; ++i) {
       const core::Eye eye = i == 0 ? core::Eye::Left : core::Eye::Right;
-      const core::Pose eye_in_head{{1, 0, 0, 0}, {(i == 0 ? -0.5 : 0.5) * d.ipd_m, 0, 0}};
+      const core::Pose& eye_in_head = eyes_in_head[i];
       views[i].pose = b ? to_xr(compose(inverse(*b), compose(head, eye_in_head))) : XrPosef{{0, 0, 0, 1}, {0, 0, 0}};
       const core::Fov& f = d.fov(eye);
       views[i].fov = {float(f.angle_left), float(f.angle_right), float(f.angle_up), float(f.angle_down)};

@@ -1,13 +1,18 @@
 // Budgets are honoured or refused: every distribution but cartesian traces the requested
 // fraction of the display's pixels within ±5% (at the centred gaze it starts with), or
-// make_distribution throws InputError naming what it reaches.
+// make_distribution throws InputError naming what it reaches; and it keeps tracing that
+// many at every gaze, the lens' hidden area counted out.
 #include <gtest/gtest.h>
 
+#include <span>
 #include <string>
 
+#include "density_strided.hpp"
+#include "fovea/core/density_report.hpp"
 #include "fovea/core/display.hpp"
 #include "fovea/core/distribution.hpp"
 #include "fovea/core/error.hpp"
+#include "fovea/core/eye_optics.hpp"
 
 namespace fovea::core {
 namespace {
@@ -29,7 +34,7 @@ Outcome try_budget(const View& v, DistributionKind k, double budget) {
   Outcome o;
   try {
     const auto d = make_distribution(v, p);
-    o.fraction = d->grid_samples() / (double(v.width()) * v.height());
+    o.fraction = d->budgeted_samples() / (double(v.width()) * v.height());
     o.met = true;
   } catch (const InputError& e) {
     o.error = e.what();
@@ -106,6 +111,73 @@ TEST(Budget, LinearFalloffMeetsItAtOffCentreGazes) {
     EXPECT_NEAR(double(kept) / d->grid_samples(), 1.0, 0.03);
   }
 }
+
+// A gaze `deg` degrees from the view centre towards the upper left, or the display's
+// top-left corner (deg < 0).
+glm::dvec3 gaze_at(const View& v, double deg) {
+  if (deg < 0) return v.pixel_to_dir({0, 0});
+  const glm::dvec3 c = v.centre_dir();
+  const glm::dvec3 towards = glm::normalize(v.pixel_to_dir({0.25 * v.width(), 0.35 * v.height()}) - c);
+  const glm::dvec3 side = glm::normalize(towards - glm::dot(towards, c) * c);
+  const double rad = deg * 3.14159265358979323846 / 180;
+  return std::cos(rad) * c + std::sin(rad) * side;
+}
+
+// Gazes 0°, 15°, 35° and the display's corner. Samples the view's edges or the lens would
+// lose go back into the visible field: the cells traced (measured cell by cell) stay within
+// 5% of budget_samples() for every distribution, and the distribution's own estimate (what
+// it solved for) agrees with them. budget_samples() is the budget of the visible pixels for
+// the raster kinds; the polar kinds' is what their layout traces at the centred gaze, within
+// 15% of it (P5's paper grid leaves 10% beyond the display's edges there; under a lens
+// log-polar's rings, dense at the centre, lose less than the pixels). With the gaze in the
+// lens' hidden corner, Visual-Polar's rows reach their grid's N_φ: within 10%.
+constexpr DistributionKind kAllButCartesian[] = {DistributionKind::VisualPolar, DistributionKind::PaperVisualPolar,
+                                                  DistributionKind::CartesianUniform, DistributionKind::LinearFalloff,
+                                                  DistributionKind::LogPolar};
+
+void expect_budget_everywhere(const std::string& preset, bool lens,
+                              std::span<const DistributionKind> kinds = kAllButCartesian) {
+  const DisplayPreset display = load_display(preset);
+  const View v = display.view(Eye::Left);
+  const ViewMask mask = EyeOptics(display, Eye::Left).view_mask();
+  for (DistributionKind k : kinds) {
+    DistributionParams p;
+    p.kind = k;
+    auto d = make_distribution(v, p);
+    if (lens) d->set_visibility(mask);
+    const double requested = 0.39 * v.width() * v.height() * (lens ? 1 - mask.hidden_fraction() : 1.0);
+    const double budget = d->budget_samples();
+    EXPECT_NEAR(budget / requested, 1.0, 0.15) << preset << " " << distribution_name(k);
+    for (double deg : {0.0, 15.0, 35.0, -1.0}) {
+      // A gaze the lens hides (the display's corner; nobody looks there): the screen-polar
+      // kinds cannot move their rings' radii away from it (docs/visual-polar.md).
+      const auto gaze_px = v.dir_to_pixel(gaze_at(v, deg));
+      const bool hidden_corner = lens && gaze_px && !mask.visible_at(*gaze_px);
+      if (hidden_corner && (k == DistributionKind::PaperVisualPolar || k == DistributionKind::LogPolar)) continue;
+      d->set_frame(gaze_at(v, deg), 3);
+      const DensityReport r = test::measure_strided(*d);
+      const std::string what = preset + (lens ? " lens " : " ") + distribution_name(k) + " " + std::to_string(deg);
+      EXPECT_NEAR(double(r.traced) / budget, 1.0, hidden_corner ? 0.10 : 0.05) << what;
+      EXPECT_NEAR(d->traced_samples() / double(r.traced), 1.0, 0.03) << what;
+    }
+  }
+}
+
+TEST(Budget, KeptAtEveryGaze) { expect_budget_everywhere("small", false); }
+TEST(Budget, KeptAtEveryGazeUnderTheLens) { expect_budget_everywhere("small", true); }
+#ifndef FOVEA_SANITIZED_BUILD
+TEST(Budget, KeptAtEveryGazeFove0) { expect_budget_everywhere("fove0", false); }
+TEST(Budget, KeptAtEveryGazeFove0UnderTheLens) { expect_budget_everywhere("fove0", true); }
+// The wide preset: the baselines keep their budget. Visual-Polar does not yet: its cap of κ
+// samples per pixel of the fovea's display density leaves it 0.60 of its budget with the
+// gaze straight ahead, where this asymmetric raster's pixels are sparsest
+// (docs/visual-polar.md, "Wide fields of view").
+TEST(Budget, KeptAtEveryGazeWideUnderTheLensByTheBaselines) {
+  const DistributionKind baselines[] = {DistributionKind::PaperVisualPolar, DistributionKind::CartesianUniform,
+                                        DistributionKind::LinearFalloff, DistributionKind::LogPolar};
+  expect_budget_everywhere("wide", true, baselines);
+}
+#endif
 
 }  // namespace
 }  // namespace fovea::core

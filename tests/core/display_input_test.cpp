@@ -3,8 +3,10 @@
 // number beyond the range of double used to escape as raw JSON-library errors).
 #include <gtest/gtest.h>
 
+#include <cmath>
 #include <filesystem>
 #include <fstream>
+#include <numbers>
 #include <string>
 
 #include <unistd.h>
@@ -13,6 +15,7 @@
 #include "fovea/core/error.hpp"
 #include "fovea/core/input_limits.hpp"
 #include "fovea/core/lens_params.hpp"
+#include "fovea/core/stereo_views.hpp"
 
 using namespace fovea::core;
 
@@ -116,4 +119,31 @@ TEST(DisplayInput, LensWithoutVisibleAreaIsRefused) {
   const DisplayPreset d = parse_display(preset(R"(,"lens":{"k":[0.75,-0.01,0.75,0,3.8],)" + kLens + "}"), "p");
   EXPECT_EQ(d.origin, "p");
   for (const auto& name : display_preset_names()) EXPECT_NO_THROW((void)load_display(name)) << name;
+}
+
+// Canted panels: each eye turned outwards about the head's up axis, within [0, 45]°.
+TEST(DisplayInput, CantMustBeBetweenZeroAndFortyFiveDegrees) {
+  for (const char* cant : {"-5", "60", "1e30"})
+    expect_error(preset(std::string(R"(,"cant_deg":)") + cant), "\"cant_deg\" must be in [0, 45] degrees");
+  EXPECT_DOUBLE_EQ(parse_display(preset(R"(,"cant_deg":12.5)"), "p").cant_deg, 12.5);
+  EXPECT_DOUBLE_EQ(parse_display(preset(""), "p").cant_deg, 0.0);
+}
+
+// The wide preset: 125° per eye, panels canted 20° outwards, so the two eyes together see
+// 190° horizontally (75° + 20° towards each temple) and 60° with both eyes.
+TEST(WidePreset, CantedPanelsSee190DegreesBinocular) {
+  const DisplayPreset d = load_display("wide");
+  const StereoViews v = stereo_views(d);
+  const auto yaw_deg = [](const View& view, glm::dvec2 px) {
+    const glm::dvec3 w = view.pose().orientation * view.pixel_to_dir(px);  // head frame
+    return std::atan2(w.x, -w.z) * 180 / std::numbers::pi;
+  };
+  const double h = 0.5 * d.height;
+  EXPECT_NEAR(yaw_deg(v[Eye::Left], {0, h}), -95, 1e-6);            // left eye's temple edge
+  EXPECT_NEAR(yaw_deg(v[Eye::Left], {double(d.width), h}), 30, 1e-6);  // its nasal edge
+  EXPECT_NEAR(yaw_deg(v[Eye::Right], {double(d.width), h}), 95, 1e-6);
+  EXPECT_NEAR(yaw_deg(v[Eye::Right], {0, h}), -30, 1e-6);
+  // The eyes still sit ipd/2 beside the head, on its x axis.
+  EXPECT_NEAR(v[Eye::Left].pose().position.x, -0.5 * d.ipd_m, 1e-12);
+  EXPECT_NEAR(v[Eye::Right].pose().position.x, 0.5 * d.ipd_m, 1e-12);
 }

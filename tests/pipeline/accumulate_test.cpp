@@ -29,7 +29,7 @@ TEST_F(GpuTest, AccumulationKeepsAStaticSceneStableWhileTheGazeSweeps) {
   dp.jitter = false;
   pipeline::FramePipeline with(ctx(), gs, core::stereo_views(display), dp, s, {}, true);
   pipeline::FramePipeline without(ctx(), gs, core::stereo_views(display), dp, s, {}, true);
-  const auto poses = core::eye_poses(scene.camera, display.ipd_m);
+  const auto poses = core::eye_poses(scene.camera, display);
   const int frames = 12;
   double te_with = 0, te_without = 0;
   core::Image prev_with, prev_without;
@@ -67,7 +67,7 @@ TEST_F(GpuTest, DeviceTemporalErrorIsTheHostOneOfTheDisplayedImages) {
   const core::DisplayPreset display = fovea::test::display_of_size(70, 48);
   pipeline::FramePipeline p(ctx(), gs, core::stereo_views(display), {}, {});
   p.enable_temporal_error();
-  const auto poses = core::eye_poses(scene.camera, display.ipd_m);
+  const auto poses = core::eye_poses(scene.camera, display);
   std::array<core::Image, 2> prev;
   std::array<double, 2> host{0, 0};
   const int frames = 5;

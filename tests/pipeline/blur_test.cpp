@@ -47,7 +47,7 @@ struct BlurRig {
     settings.blur_mar_fovea_deg = mar_deg;
     p = std::make_unique<pipeline::FramePipeline>(ctx, gs, core::stereo_views(display), dp, settings,
                                                   renderer::PathConfig{}, true);
-    p->render(core::eye_poses(scene.camera, display.ipd_m), {glm::dvec3(0, 0, -1), glm::dvec3(0, 0, -1)}, 0);
+    p->render(core::eye_poses(scene.camera, display), {glm::dvec3(0, 0, -1), glm::dvec3(0, 0, -1)}, 0);
   }
   renderer::Scene scene;
   renderer::GpuScene gs;

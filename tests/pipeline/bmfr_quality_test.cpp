@@ -41,7 +41,7 @@ Rendered render(fovea::gpu::Context& ctx, const renderer::GpuScene& gs, const re
   reconstruct::ReconSettings s;
   s.denoiser = denoiser;
   pipeline::FramePipeline p(ctx, gs, core::stereo_views(display), {}, s, {}, /*mono=*/true);
-  const auto poses = core::eye_poses(scene.camera, display.ipd_m);
+  const auto poses = core::eye_poses(scene.camera, display);
   for (std::uint32_t f = 0; f < kFrames; ++f) p.render(poses, kGaze, f);
   return {p.image(core::Eye::Left), p.view(core::Eye::Left)};
 }
@@ -116,7 +116,7 @@ TEST_F(GpuTest, BmfrHasNoSeamAtPhiZero) {
   renderer::GpuScene gs(ctx(), scene);
   const core::DisplayPreset display = fovea::test::display_of_size(kWidth, kHeight);
   pipeline::FramePipeline p(ctx(), gs, core::stereo_views(display), {}, {}, {}, /*mono=*/true);
-  const auto poses = core::eye_poses(scene.camera, display.ipd_m);
+  const auto poses = core::eye_poses(scene.camera, display);
   const core::SampleDistribution& d = p.distribution(core::Eye::Left);
   std::vector<double> sum;
   std::vector<int> count;

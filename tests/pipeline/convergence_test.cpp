@@ -39,7 +39,7 @@ TEST_F(GpuTest, StillViewConvergesForEveryDistribution) {
   const renderer::Scene scene = renderer::load_scene("cornell");
   renderer::GpuScene gs(ctx(), scene);
   const core::DisplayPreset display = fovea::test::display_of_size(kWidth, kHeight);
-  const auto poses = core::eye_poses(scene.camera, display.ipd_m);
+  const auto poses = core::eye_poses(scene.camera, display);
   const core::StereoViews views = core::stereo_views(display);
   // The render's transport (one bounce, PathConfig{}), converged.
   renderer::ReferenceOptions o;

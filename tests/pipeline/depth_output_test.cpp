@@ -19,7 +19,7 @@ TEST_F(GpuTest, FramePipelineDepthIsTheNearestSamplesViewZ) {
   reconstruct::ReconSettings s;
   s.blur = false;
   pipeline::FramePipeline p(ctx(), gs, core::stereo_views(display), {}, s);
-  const auto poses = core::eye_poses(scene.camera, display.ipd_m);
+  const auto poses = core::eye_poses(scene.camera, display);
   p.render(poses, {glm::dvec3(0.05, 0, -1), glm::dvec3(0.05, 0, -1)}, 3);
   for (core::Eye eye : {core::Eye::Left, core::Eye::Right}) {
     const std::vector<float> depth = p.depth(eye);

@@ -83,7 +83,7 @@ void check_determinism(fovea::gpu::Context& ctx, const char* scene_name, const r
   const renderer::Scene scene = renderer::load_scene(scene_name);
   renderer::GpuScene gs(ctx, scene);
   const core::DisplayPreset display = fovea::test::display_of_size(40, 44);
-  const auto poses = core::eye_poses(scene.camera, display.ipd_m);
+  const auto poses = core::eye_poses(scene.camera, display);
   Snapshot first;
   {
     pipeline::FramePipeline p(ctx, gs, core::stereo_views(display), {}, settings);
@@ -126,7 +126,7 @@ TEST_F(GpuTest, FramePipelineTraceOrderChangesNoBufferOrImage) {
   const renderer::Scene scene = renderer::load_scene("default");
   renderer::GpuScene gs(ctx(), scene);
   const core::DisplayPreset display = fovea::test::display_of_size(40, 44);
-  const auto poses = core::eye_poses(scene.camera, display.ipd_m);
+  const auto poses = core::eye_poses(scene.camera, display);
   reconstruct::ReconSettings settings;
   settings.share = reconstruct::StereoShare::Gather;
   for (const auto& [kind, picked] : {std::pair{core::DistributionKind::VisualPolar, renderer::TraceOrder::Tiles},

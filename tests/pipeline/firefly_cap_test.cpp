@@ -57,7 +57,7 @@ TEST_F(GpuTest, FirefliesAreCappedBeforeTheResolve) {
     s.denoiser = den;
     pipeline::FramePipeline p(ctx(), gs, core::stereo_views(display), d, s, {}, /*mono=*/true);
     const auto& dist = p.distribution(core::Eye::Left);
-    const auto poses = core::eye_poses(scene.camera, display.ipd_m);
+    const auto poses = core::eye_poses(scene.camera, display);
     double input_worst = 0, output_worst = 0;
     for (std::uint32_t f = 0; f < 8; ++f) {
       p.render(poses, {dist.view().centre_dir(), dist.view().centre_dir()}, f);

@@ -18,7 +18,7 @@ TEST_F(GpuTest, FrameTimesReportTheFenceWaitApartFromTheSubmission) {
   renderer::GpuScene gs(ctx(), scene);
   const core::DisplayPreset display = fovea::test::display_of_size(48, 54);
   pipeline::FramePipeline p(ctx(), gs, core::stereo_views(display), {}, {});
-  const auto poses = core::eye_poses(scene.camera, display.ipd_m);
+  const auto poses = core::eye_poses(scene.camera, display);
   for (std::uint32_t f = 0; f < 3; ++f) {
     const core::TimeNs start = core::now_ns();
     const pipeline::FrameTimes t = p.render(poses, {glm::dvec3(0, 0, -1), glm::dvec3(0, 0, -1)}, f);

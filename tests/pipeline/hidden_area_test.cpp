@@ -28,7 +28,7 @@ TEST_F(GpuTest, FramePipelineNeverTracesHiddenCells) {
   culled.set_visibility(core::Eye::Left, mask);
   // A NaN pattern everywhere first: whatever a hidden cell reads back was written this frame.
   pipeline::testing::fill_buffers(culled, 0x7fc00001u);
-  const auto poses = core::eye_poses(scene.camera, display.ipd_m);
+  const auto poses = core::eye_poses(scene.camera, display);
   const std::array<glm::dvec3, 2> gaze{glm::normalize(glm::dvec3(0.1, 0.05, -1)), glm::dvec3(0, 0, -1)};
   for (std::uint32_t f = 0; f < 2; ++f) {
     culled.render(poses, gaze, f);

@@ -39,7 +39,7 @@ std::vector<Counts> counts_after_landing(fovea::gpu::Context& ctx, std::uint32_t
   s.landing_spp = landing_spp;
   pipeline::FramePipeline p(ctx, gs, core::stereo_views(display), {}, s, {}, /*mono=*/true);
   const auto& d = p.distribution(core::Eye::Left);
-  const auto poses = core::eye_poses(scene.camera, display.ipd_m);
+  const auto poses = core::eye_poses(scene.camera, display);
   std::vector<Counts> out;
   for (std::uint32_t f = 0; f < 3 + reconstruct::kLandingFrames + 2; ++f) {
     const glm::dvec3 g = fovea::test::horizontal_gaze(f < 3 ? -16 : 16);

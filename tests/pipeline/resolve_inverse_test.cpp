@@ -79,7 +79,7 @@ TEST_P(ResolveInverse, MatchesTheExactInverseOnEveryPixel) {
                               glm::normalize(glm::dvec3(-0.71, -0.71, -1))};
   std::uint32_t frame = 0;
   for (const glm::dvec3& g : gazes) {
-    p.render(core::eye_poses(scene.camera, display.ipd_m), {g, g}, frame++);
+    p.render(core::eye_poses(scene.camera, display), {g, g}, frame++);
     const core::SampleDistribution& d = p.distribution(core::Eye::Left);
     const InverseError e =
         compare(d, pipeline::testing::resolve_grid_coords(p, core::Eye::Left), display.width, display.height);

@@ -141,7 +141,7 @@ struct CurveSetting {
 
   explicit CurveSetting(const char* name) : scene(renderer::load_scene(name)) {
     display.fov_left = display.fov_right = core::Fov::from_degrees(-30, 30, 33, -33);
-    poses = core::eye_poses(scene.camera, display.ipd_m);
+    poses = core::eye_poses(scene.camera, display);
     path.spp = 4;
   }
 };
@@ -155,7 +155,7 @@ TEST_F(GpuTest, FoveaIsSharpWithinThreeFramesAfterA40DegreeSaccade) {
   // are several pixels wide while the fovea's are about one.
   core::DisplayPreset display = fovea::test::display_of_size(256, 288);
   display.fov_left = display.fov_right = core::Fov::from_degrees(-30, 30, 33, -33);
-  const auto poses = core::eye_poses(core::Pose{}, display.ipd_m);
+  const auto poses = core::eye_poses(core::Pose{}, display);
   const glm::dvec3 target = fovea::test::horizontal_gaze(kTarget), before = fovea::test::horizontal_gaze(-kTarget);
   const int settle = 10, after = 8;
   // Without a denoiser the display shows Phase I's history directly; with BMFR (the

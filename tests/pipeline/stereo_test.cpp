@@ -36,7 +36,7 @@ TEST_F(GpuTest, StereoGatherRaisesIndirectPsnrAndRespectsDisocclusions) {
   off.blur = gather.blur = false;
   gather.share = reconstruct::StereoShare::Gather;
   pipeline::FramePipeline a(ctx(), gs, core::stereo_views(display), {}, off), b(ctx(), gs, core::stereo_views(display), {}, gather);
-  const auto poses = core::eye_poses(scene.camera, display.ipd_m);
+  const auto poses = core::eye_poses(scene.camera, display);
   const std::array<glm::dvec3, 2> gaze{glm::dvec3(0, 0, -1), glm::dvec3(0, 0, -1)};
   for (std::uint32_t f = 0; f < 3; ++f) {
     a.render(poses, gaze, f);
@@ -98,7 +98,7 @@ TEST_F(GpuTest, StereoAlternateFillsTheUntracedEyeFromTheOther) {
   reconstruct::ReconSettings s;
   s.share = reconstruct::StereoShare::Alternate;
   pipeline::FramePipeline p(ctx(), gs, core::stereo_views(display), {}, s);
-  const auto poses = core::eye_poses(scene.camera, display.ipd_m);
+  const auto poses = core::eye_poses(scene.camera, display);
   for (std::uint32_t f = 0; f < 4; ++f) p.render(poses, {glm::dvec3(0, 0, -1), glm::dvec3(0, 0, -1)}, f);
   for (core::Eye e : {core::Eye::Left, core::Eye::Right}) {
     const auto own = pipeline::testing::grid_buffer(p, e, pipeline::testing::GridBuffer::AccIndirect);

@@ -76,7 +76,7 @@ Fovea fovea_ssim(fovea::gpu::Context& ctx, const renderer::Scene& scene) {
   renderer::GpuScene gs(ctx, scene);
   const core::DisplayPreset display = fovea::test::display_of_size(kWidth, kHeight);
   pipeline::FramePipeline p(ctx, gs, core::stereo_views(display), {}, reconstruct::ReconSettings{}, {}, /*mono=*/true);
-  const auto poses = core::eye_poses(scene.camera, display.ipd_m);
+  const auto poses = core::eye_poses(scene.camera, display);
   for (std::uint32_t f = 0; f < 16; ++f) p.render(poses, kGaze, f);
   const core::View view = p.view(core::Eye::Left);
   renderer::ReferenceOptions o;  // the pipeline's transport: PathConfig{}

@@ -185,7 +185,7 @@ TEST_F(Bmfr, CornellAfter32FramesBeatsInputAndAccumulation) {
   without.denoiser = reconstruct::Denoiser::None;
   pipeline::FramePipeline bmfr(ctx(), gs, core::stereo_views(display), dp, with, {}, true);
   pipeline::FramePipeline accum(ctx(), gs, core::stereo_views(display), dp, without, {}, true);
-  const auto poses = core::eye_poses(scene.camera, display.ipd_m);
+  const auto poses = core::eye_poses(scene.camera, display);
   const std::array<glm::dvec3, 2> gaze{glm::dvec3(0, 0, -1), glm::dvec3(0, 0, -1)};
   for (std::uint32_t f = 0; f < frames; ++f) {
     bmfr.render(poses, gaze, f);

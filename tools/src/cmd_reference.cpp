@@ -47,7 +47,7 @@ so either command reuses the other's references.
                         ray queries through the device's acceleration structure, or the
                         compute BVH traversal; auto: the faster of the two on this device,
                         measured once per device and driver and cached [auto]
-  --display NAME|FILE   display preset (fove0, vive, modern, small, tiny) or JSON [small]
+  --display NAME|FILE   display preset (fove0, vive, modern, wide, small, tiny) or JSON [small]
   --eye left|right      which eye; it sits ipd/2 beside the scene's camera [left]
   --spp N               samples per pixel to stop at [256]
   --until-rel-error X   stop once the image mean's relative standard error is <= X; 0: off [0]

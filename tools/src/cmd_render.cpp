@@ -85,7 +85,7 @@ With no options: a short demo on the shipped scene and gaze.
                         compute BVH traversal; auto: the faster of the two on this device,
                         measured once per device and driver and cached
                         (report.json: trace, trace_choice) [auto]
-  --display NAME|FILE   display preset (fove0, vive, modern, small, tiny) or JSON [small]
+  --display NAME|FILE   display preset (fove0, vive, modern, wide, small, tiny) or JSON [small]
   --gaze URI            recording, or synthetic:<seed>[?...] (docs/gaze.md)
                         [the shipped recording data/gaze/default.csv]
   --screen GEOMETRY     what 2-D gaze coordinates refer to: WxH@HFOVxVFOV or

@@ -41,7 +41,7 @@ path tracing, reconstruction, resolve; as fovea render, skipping the lens' hidde
 tone-mapped (ACES fit) and distorted for the panels. Without --scene each eye shows a grid
 of view directions (lines every 5 degrees), a picture of the optics.
 
-  --display NAME|FILE   display preset (fove0, vive, modern, small, tiny) or JSON file [small]
+  --display NAME|FILE   display preset (fove0, vive, modern, wide, small, tiny) or JSON file [small]
   --scene S             cornell | furnace | glossy-spheres | stereo-occluders | default, or a
                         .gltf/.glb/.obj file: path trace it (otherwise the direction grid)
   --trace auto|rayquery|compute

@@ -20,6 +20,7 @@ enum class Eye { Left = 0, Right = 1 };
 inline constexpr int kMaxEyePixels = 8192;          // width and height, each
 inline constexpr double kMinRefreshHz = 1, kMaxRefreshHz = 1000;
 inline constexpr double kMaxIpdM = 0.1;             // adults: 0.05..0.08 m
+inline constexpr double kMaxCantDeg = 45;           // canted panels: 10–20° on wide headsets
 
 struct DisplayPreset {
   std::string name;
@@ -30,6 +31,9 @@ struct DisplayPreset {
   Fov fov_right;
   double refresh_hz = 90;
   double ipd_m = 0.063;
+  // Each eye's view turned outwards about the head's up axis (canted panels, as on wide
+  // headsets): binocular field = both eyes' temple half-fields + 2·cant.
+  double cant_deg = 0;
   LensParams lens;   // the "lens" section (left eye; the right eye mirrors it), lens.hpp
   std::string json;  // the preset's source text, for modules that read their own sections
 

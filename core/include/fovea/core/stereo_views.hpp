@@ -17,9 +17,11 @@ struct StereoViews {
   std::array<Pose, 2> poses() const { return {eye[0].pose(), eye[1].pose()}; }
 };
 
-// The eye poses of a head: each eye ipd/2 beside `head` along the head's x axis.
-std::array<Pose, 2> eye_poses(const Pose& head, double ipd_m);
-// The preset's per-eye FOV and raster with the eyes of `head` (eye_poses, the preset's IPD).
+// The eye poses of a head: each eye ipd/2 beside `head` along the head's x axis, turned
+// outwards by `cant_deg` about its y axis (DisplayPreset::cant_deg).
+std::array<Pose, 2> eye_poses(const Pose& head, double ipd_m, double cant_deg);
+std::array<Pose, 2> eye_poses(const Pose& head, const DisplayPreset& d);
+// The preset's per-eye FOV and raster with the eyes of `head` (eye_poses, the preset's IPD and cant).
 StereoViews stereo_views(const DisplayPreset& d, const Pose& head = {});
 
 }  // namespace fovea::core
