@@ -15,7 +15,6 @@
 #include <map>
 #include <memory>
 #include <string>
-#include <thread>
 #include <vector>
 
 #include <glm/geometric.hpp>
@@ -30,7 +29,7 @@
 #include "fovea/renderer/scene_io.hpp"
 
 #ifdef FOVEA_HAVE_EMBREE
-#include <embree3/rtcore.h>
+#include "embree_rays.hpp"
 #endif
 
 namespace fr = fovea::renderer;
@@ -183,52 +182,11 @@ void BM_Paths(benchmark::State& state, const char* scene, fr::Tracing tracing, b
 #ifdef FOVEA_HAVE_EMBREE
 void BM_EmbreePrimaryRays(benchmark::State& state, const char* scene) {
   const Fixture& f = fixture(scene);
-  RTCDevice dev = rtcNewDevice(nullptr);
-  RTCScene sc = rtcNewScene(dev);
-  RTCGeometry geom = rtcNewGeometry(dev, RTC_GEOMETRY_TYPE_TRIANGLE);
-  const std::size_t n = f.scene.triangle_count();
-  auto* v = static_cast<float*>(rtcSetNewGeometryBuffer(geom, RTC_BUFFER_TYPE_VERTEX, 0, RTC_FORMAT_FLOAT3,
-                                                        3 * sizeof(float), 3 * n));
-  auto* idx = static_cast<unsigned*>(rtcSetNewGeometryBuffer(geom, RTC_BUFFER_TYPE_INDEX, 0, RTC_FORMAT_UINT3,
-                                                             3 * sizeof(unsigned), n));
-  for (std::size_t i = 0; i < 3 * n; ++i) {
-    v[3 * i] = f.scene.positions[i].x;
-    v[3 * i + 1] = f.scene.positions[i].y;
-    v[3 * i + 2] = f.scene.positions[i].z;
-    idx[i] = unsigned(i);
-  }
-  rtcCommitGeometry(geom);
-  rtcAttachGeometry(sc, geom);
-  rtcReleaseGeometry(geom);
-  rtcCommitScene(sc);
-  const unsigned threads = std::max(1u, std::thread::hardware_concurrency());
-  auto trace_all = [&] {
-    std::vector<std::thread> pool;
-    for (unsigned t = 0; t < threads; ++t)
-      pool.emplace_back([&, t] {
-        RTCIntersectContext ictx;
-        rtcInitIntersectContext(&ictx);
-        for (std::size_t i = t; i < f.rays.size(); i += threads) {
-          const auto& r = f.rays[i];
-          RTCRayHit rh{};
-          rh.ray.org_x = r.org_x; rh.ray.org_y = r.org_y; rh.ray.org_z = r.org_z;
-          rh.ray.dir_x = r.dir_x; rh.ray.dir_y = r.dir_y; rh.ray.dir_z = r.dir_z;
-          rh.ray.tnear = r.tmin;
-          rh.ray.tfar = r.tmax;
-          rh.ray.mask = ~0u;
-          rh.hit.geomID = RTC_INVALID_GEOMETRY_ID;
-          rtcIntersect1(sc, &ictx, &rh);
-          benchmark::DoNotOptimize(rh.hit.primID);
-        }
-      });
-    for (auto& th : pool) th.join();
-  };
-  trace_all();
+  const fovea::bench::EmbreeScene embree(f.scene);
+  embree.trace(f.rays, false);
   time_rays(state, 4.0 * double(f.rays.size()), "embree/" + std::string(scene), [&] {
-    for (int k = 0; k < 4; ++k) trace_all();
+    for (int k = 0; k < 4; ++k) embree.trace(f.rays, false);
   });
-  rtcReleaseScene(sc);
-  rtcReleaseDevice(dev);
 }
 #endif
 
