@@ -7,6 +7,8 @@
 // and, with Embree 3 installed, Embree on every CPU thread, on the same rays; ratios from this
 // one run. Rays and their order are fixed (hash of the index), so every run traces the same.
 //   fovea_bench_traversal [--scenes a,b,...] [--rays N]       (defaults: every built-in, 1M)
+// (Google Benchmark's --benchmark_* options, which `./x bench` passes to every benchmark,
+// are ignored.)
 #include <algorithm>
 #include <chrono>
 #include <cmath>
@@ -176,6 +178,8 @@ int main(int argc, char** argv) {
       scenes = split(argv[++i]);
     } else if (a == "--rays" && i + 1 < argc) {
       count = std::size_t(std::max(1024.0, std::atof(argv[++i])));
+    } else if (a.rfind("--benchmark_", 0) == 0) {
+      continue;  // `./x bench` passes Google Benchmark's options to every benchmark
     } else {
       std::fprintf(stderr, "usage: fovea_bench_traversal [--scenes a,b,...] [--rays N]\n");
       return 2;
