@@ -153,7 +153,8 @@ void SampleDistribution::set_visibility(const ViewMask& mask) {
   mask_ = std::make_shared<const ViewMask>(mask);
   visible_fraction_ = 1.0 - mask.hidden_fraction();
   const glm::dvec3 centre = view_.centre_dir();
-  const glm::dvec2 centre_px = view_.dir_to_pixel(centre).value_or(glm::dvec2(0.5 * view_.width(), 0.5 * view_.height()));
+  const glm::dvec2 centre_px =
+      view_.dir_to_pixel(centre).value_or(glm::dvec2(0.5 * view_.width(), 0.5 * view_.height()));
   mask_free_deg_ = mask_free_px_ = INFINITY;
   for (int y = 0; y < mask.height(); ++y)
     for (int x = 0; x < mask.width(); ++x) {

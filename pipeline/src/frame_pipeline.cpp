@@ -133,12 +133,8 @@ void FramePipeline::reset() {
 
 void FramePipeline::set_visibility(core::Eye eye, const core::ViewMask& mask) {
   EyeState& e = *impl_->eyes[std::size_t(impl_->index(eye, "set_visibility"))];
-  if (mask.width() != e.base_view.width() || mask.height() != e.base_view.height())
-    throw core::InputError("visibility mask: " + std::to_string(mask.width()) + "x" + std::to_string(mask.height()) +
-                           " differs from the eye's raster " + std::to_string(e.base_view.width()) + "x" +
-                           std::to_string(e.base_view.height()));
+  e.dist->set_visibility(mask);  // refuses another raster; the budget counts the pixels the mask leaves
   e.mask.assign(mask.words().begin(), mask.words().end());
-  e.dist->set_visibility(mask);  // the budget counts the pixels the mask leaves
 }
 
 FrameTimes FramePipeline::render(const std::array<core::Pose, 2>& eye_pose, const std::array<glm::dvec3, 2>& gaze,
