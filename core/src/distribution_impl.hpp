@@ -55,8 +55,8 @@ class PolarDistribution : public SampleDistribution {
   // column to the arc of its ring the view's edges leave (at its inner radius) and scales
   // the rows (scaled_rows) by the c whose traced samples — on the view, not hidden,
   // estimated per column — equal those of the centred gaze (the first frame: its layout's,
-  // or centre_reference); rows stay within the grid's. Returns c. Samples the view or the lens
-  // would lose go back into the visible field in proportion to the density there.
+  // or centre_reference); rows stay within the grid's. Returns c. Samples the view or the
+  // lens would lose go back into the visible field in proportion to the density there.
   double fit_budget();
   // Packs with a given c (1: the full rings' spacing) and returns the traced estimate.
   double pack(double c);
@@ -75,15 +75,15 @@ class PolarDistribution : public SampleDistribution {
   std::vector<int> h_;     // columns_ rows, each in [1, rows_]
   // Per column the arc [φ0, φ0 + 2π − gap) its rows cover (radians); empty: full rings.
   std::vector<double> phi0_, gap_;
-  std::vector<double> full_;  // per column the full ring's rows at c = 1 (fit_budget's h_)
+  std::vector<double> full_;  // per column the full ring's rows at c = 1 (set before fit_budget/pack)
   double traced_ = 0;         // the traced estimate of the current table
   // Per column the share of its scaled rows the grid's rows hold (1 unless capped).
   std::vector<double> rows_kept_;
-  bool pack_arcs_ = true;     // false: every column a full ring (rows scaled all the same)
+  bool pack_arcs_ = true;     // false: every column a full ring
 
  private:
   // Per column, for the current r_ and gaze: the view arc at the inner radius and the
-  // fraction of that arc's sector on the view and not hidden (sampled).
+  // fraction of that arc's sector on the view (closed form) and not hidden (probed).
   void measure_columns();
   double traced_for(double c) const;
   double pack_measured(double c);
