@@ -3,10 +3,14 @@
 #include <algorithm>
 #include <cstring>
 #include <stdexcept>
+#include <string>
 #include <vector>
 
 #include "fovea/core/distribution.hpp"
+#include "fovea/gpu/barriers.hpp"
 #include "fovea/gpu/context.hpp"
+#include "fovea/shaders/live_cells.h"
+#include "fovea/shaders/pt_order.h"
 
 namespace fovea::gpu {
 
@@ -16,17 +20,38 @@ Buffer host_buffer(Context& ctx, VkDeviceSize bytes, BufferUsage usage, const ch
 }
 }  // namespace
 
-GridPass::GridPass(Context& ctx)
+GridPass::GridPass(Context& ctx, std::uint32_t cells, bool ballot)
     : ctx_(&ctx),
-      pipeline_(ctx, {.shader = "grid_generate.comp.spv",
+      pipeline_(ctx, {.shader = ballot && ctx.info().subgroup_ballot ? "grid_generate.comp.spv"
+                                                                     : "grid_generate.noballot.comp.spv",
                       .sets = {{Binding::UniformBuffer, Binding::StorageBuffer, Binding::StorageBuffer,
-                                Binding::StorageBuffer, Binding::StorageBuffer}}}),
+                                Binding::StorageBuffer, Binding::StorageBuffer, Binding::StorageBuffer,
+                                Binding::StorageBuffer}}}),
+      args_pipeline_(ctx, {.shader = "grid_live_args.comp.spv",
+                           .sets = {{Binding::StorageBuffer, Binding::StorageBuffer}},
+                           .push_constant_bytes = sizeof(std::uint32_t)}),
       params_(host_buffer(ctx, sizeof(shaders::GridParams), BufferUsage::Uniform, "grid params")),
       columns_(host_buffer(ctx, 16, BufferUsage::Storage, "grid columns")),
       mask_(host_buffer(ctx, 16, BufferUsage::Storage, "hidden mask")),
-      counts_(host_buffer(ctx, 2 * sizeof(std::uint32_t), BufferUsage::Storage, "grid counts")),
-      set_(ctx, pipeline_.set_layout(0)) {
+      counts_(host_buffer(ctx, sizeof(shaders::GridCounts), BufferUsage::Storage, "grid counts")),
+      set_(ctx, pipeline_.set_layout(0)),
+      args_set_(ctx, args_pipeline_.set_layout(0)) {
   set_.bind(0, params_).bind(1, columns_).bind(2, mask_).bind(4, counts_);
+  args_set_.bind(0, counts_);
+  reserve(std::max<std::uint32_t>(cells, 1));
+}
+
+void GridPass::reserve(std::uint32_t cells) {
+  if (cells <= capacity_) return;
+  capacity_ = cells;
+  list_ = Buffer(*ctx_, {.size = (VkDeviceSize(shaders::kLiveHeaderWords) + cells) * sizeof(std::uint32_t),
+                         .usage = BufferUsage::Storage | BufferUsage::Indirect,
+                         .name = "grid live cells",
+                         .texel_format = VK_FORMAT_R32_UINT});
+  history_ = Buffer(*ctx_, {.size = VkDeviceSize(cells) * sizeof(std::uint32_t), .name = "grid live history"});
+  set_.bind(5, list_).bind(6, history_);
+  args_set_.bind(1, list_);
+  history_fresh_ = true;
 }
 
 VkDeviceSize GridPass::samples_bytes(const core::SampleDistribution& d) {
@@ -35,6 +60,10 @@ VkDeviceSize GridPass::samples_bytes(const core::SampleDistribution& d) {
 
 void GridPass::prepare(const core::SampleDistribution& d, std::span<const std::uint32_t> hidden_mask) {
   shaders::GridParams p = d.gpu_params();
+  if (p.padded_columns % shaders::kPtTileColumns != 0 || p.padded_rows % shaders::kPtTileRows != 0)
+    throw std::invalid_argument("grid pass: padded grid of " + std::to_string(p.padded_columns) + "x" +
+                                std::to_string(p.padded_rows) + " cells is not whole tiles");
+  reserve(p.padded_columns * p.padded_rows);
   const auto& table = d.column_table();
   const VkDeviceSize table_bytes = table.size() * sizeof(shaders::GridColumn);
   if (table_bytes > columns_.size()) {
@@ -54,8 +83,8 @@ void GridPass::prepare(const core::SampleDistribution& d, std::span<const std::u
   }
   params_.upload(std::span(&p, 1));
   // Host writes to coherent memory are visible to the next submission.
-  const std::uint32_t zero[2] = {0, 0};
-  counts_.upload(std::span(zero));
+  const shaders::GridCounts zero{};
+  counts_.upload(std::span(&zero, 1));
   padded_columns_ = p.padded_columns;
   padded_rows_ = p.padded_rows;
 }
@@ -67,14 +96,23 @@ void GridPass::record(VkCommandBuffer cmd, const Buffer& samples) {
     set_.bind(3, samples);
     bound_samples_ = samples.handle();
   }
+  if (history_fresh_) {
+    fill_buffer(cmd, history_, shaders::kLiveAllBefore);
+    transfer_to_compute(cmd);
+    history_fresh_ = false;
+  }
   pipeline_.bind(cmd, {&set_});
-  pipeline_.dispatch(cmd, padded_columns_, padded_rows_);
+  // A workgroup per tile: 2-D group counts stay within the device's limits for 8k rasters.
+  pipeline_.dispatch(cmd, padded_columns_ / shaders::kPtTileColumns * pipeline_.workgroup_size()[0],
+                     padded_rows_ / shaders::kPtTileRows);
+  compute_to_compute(cmd);
+  args_pipeline_.run(cmd, {&args_set_}, ctx_->limits().maxComputeWorkGroupCount[0], 1);
 }
 
 GridPass::Counts GridPass::counts() const {
-  std::uint32_t c[2];
-  std::memcpy(c, counts_.mapped().data(), sizeof(c));
-  return {c[0], c[1]};
+  shaders::GridCounts c;
+  std::memcpy(&c, counts_.mapped().data(), sizeof(c));
+  return {c.live, c.hidden, c.reset};
 }
 
 void GridPass::generate(const core::SampleDistribution& d, const Buffer& samples,

@@ -1,6 +1,7 @@
 #include "fovea/gpu/pipeline.hpp"
 
 #include <cstring>
+#include <stdexcept>
 #include <string>
 
 #include "fovea/core/error.hpp"
@@ -159,6 +160,13 @@ void ComputePipeline::dispatch(VkCommandBuffer cmd, std::uint32_t x, std::uint32
                              std::to_string(max_groups_[i]));
   }
   vkCmdDispatch(cmd, groups[0], groups[1], groups[2]);
+}
+
+void ComputePipeline::dispatch_indirect(VkCommandBuffer cmd, const Buffer& args, VkDeviceSize offset) const {
+  if (offset % 4 != 0 || offset + sizeof(VkDispatchIndirectCommand) > args.size())
+    throw std::out_of_range("gpu::ComputePipeline '" + shader_ + "': indirect arguments at byte " +
+                            std::to_string(offset) + " of a buffer of " + std::to_string(args.size()));
+  vkCmdDispatchIndirect(cmd, args.handle(), offset);
 }
 
 void ComputePipeline::dispatch_linear(VkCommandBuffer cmd, std::uint32_t count) const {

@@ -1,6 +1,10 @@
 // GPU grid generation (shaders/grid_generate.comp) = the CPU double-precision reference
 // (core::SampleDistribution::sample) for every distribution, on lavapipe.
+#include <algorithm>
+#include <array>
 #include <cmath>
+#include <string>
+#include <utility>
 #include <numeric>
 #include <vector>
 
@@ -9,6 +13,8 @@
 #include "fovea/core/eye_optics.hpp"
 #include "fovea/gpu/buffer.hpp"
 #include "fovea/gpu/grid_pass.hpp"
+#include "fovea/shaders/live_cells.h"
+#include "fovea/shaders/pt_order.h"
 #include "gpu_fixture.hpp"
 
 using namespace fovea;
@@ -122,6 +128,81 @@ TEST_F(GpuTest, GridPassMaskMatchesCpuReference) {
     // A mask smaller than the raster is refused before the GPU sees it.
     EXPECT_THROW(pass.prepare(*d, mask.words().first(mask.words().size() / 2)), std::invalid_argument);
   }
+}
+
+// The live-cell list (live_cells.h): exactly the cells with a sample, each once, runs of
+// one tile column in row order (with ballots); the reset cells exactly those without a sample
+// that had one in either of the two frames before (all of them in the first two frames); the
+// indirect dispatches cover each list with fewer than one row of idle workgroups. Under a
+// moving gaze and the lens mask, for both ways of appending.
+TEST_F(GpuTest, GridPassListsLiveAndResetCells) {
+  const core::DisplayPreset display = core::load_display("tiny");
+  const core::EyeOptics optics(display, core::Eye::Left);
+  const core::ViewMask mask = optics.view_mask();
+  const std::uint32_t max_x = ctx().limits().maxComputeWorkGroupCount[0];
+  for (const auto kind : {core::DistributionKind::VisualPolar, core::DistributionKind::Cartesian,
+                          core::DistributionKind::LinearFalloff})
+    for (const bool ballot : {true, false}) {
+      const std::string what = std::string(core::distribution_name(kind)) + (ballot ? " ballot" : " atomic");
+      core::DistributionParams p;
+      p.kind = kind;
+      auto d = core::make_distribution(optics.view(), p);
+      d->set_visibility(mask);
+      const std::size_t cells = std::size_t(d->padded_columns()) * d->padded_rows();
+      gpu::GridPass pass(ctx(), 0, ballot);
+      gpu::Buffer out(ctx(), {.size = gpu::GridPass::samples_bytes(*d), .memory = gpu::Memory::HostVisible});
+      std::vector<std::uint32_t> history(cells, shaders::kLiveAllBefore);
+      const glm::dvec3 gazes[] = {{0, 0, -1}, {0, 0, -1}, {0, 0, -1}, {0.3, -0.2, -1}, {-0.4, 0.1, -1}, {-0.4, 0.1, -1}};
+      for (std::uint32_t f = 0; f < std::size(gazes); ++f) {
+        d->set_frame(glm::normalize(gazes[f]), 7);  // one frame index: the moves alone change the cells
+        pass.generate(*d, out, mask.words());
+        const auto grid = out.download<shaders::GridSample>();
+        const auto list = pass.live_cells().download<std::uint32_t>();
+        const std::uint32_t* header = list.data();
+        const std::uint32_t* entries = list.data() + shaders::kLiveHeaderWords;
+        std::vector<std::uint32_t> live, reset;
+        for (std::uint32_t i = 0; i < cells; ++i) {
+          const bool now = grid[i].flags == 0;
+          (now ? live : reset).push_back(i);
+          if (!now && history[i] == 0) reset.pop_back();
+          history[i] = ((history[i] << 1) | (now ? 1u : 0u)) & shaders::kLiveAllBefore;
+        }
+        EXPECT_EQ(f < 2, reset.size() == cells - live.size()) << what << " frame " << f;
+        ASSERT_EQ(header[shaders::kLiveCount], live.size()) << what << " frame " << f;
+        ASSERT_EQ(header[shaders::kLiveResetCount], reset.size()) << what << " frame " << f;
+        EXPECT_EQ(pass.counts().traced, std::int64_t(live.size()));
+        EXPECT_EQ(pass.counts().reset, std::int64_t(reset.size()));
+        std::vector<std::uint32_t> got_live(entries, entries + live.size());
+        std::vector<std::uint32_t> got_reset(entries + cells - reset.size(), entries + cells);
+        if (ballot) {  // neighbours in the list from one tile follow its columns down their rows
+          const auto lane = [&](std::uint32_t i) {
+            const std::uint32_t col = i % d->padded_columns(), row = i / d->padded_columns();
+            return std::array{col / shaders::kPtTileColumns, row / shaders::kPtTileRows,
+                              col % shaders::kPtTileColumns * shaders::kPtTileRows + row % shaders::kPtTileRows};
+          };
+          int out_of_order = 0;
+          for (std::size_t k = 1; k < got_live.size(); ++k) {
+            const auto a = lane(got_live[k - 1]), b = lane(got_live[k]);
+            out_of_order += a[0] == b[0] && a[1] == b[1] && b[2] <= a[2] ? 1 : 0;
+          }
+          EXPECT_EQ(out_of_order, 0) << what << " frame " << f;
+        }
+        std::sort(got_live.begin(), got_live.end());
+        std::sort(got_reset.begin(), got_reset.end());
+        EXPECT_EQ(got_live, live) << what << " frame " << f;
+        EXPECT_EQ(got_reset, reset) << what << " frame " << f;
+        for (const auto& [at, n] : {std::pair{shaders::kLiveArgsLive, live.size()},
+                                   std::pair{shaders::kLiveArgsChanged, live.size() + reset.size()}}) {
+          const std::uint64_t groups = (n + shaders::kLiveGroupSize - 1) / shaders::kLiveGroupSize;
+          const std::uint64_t x = header[at], y = header[at + 1];
+          EXPECT_EQ(header[at + 2], 1u);
+          EXPECT_LE(x, max_x);
+          EXPECT_GE(x * y, groups) << what;
+          EXPECT_LT(x * y, groups + std::max<std::uint64_t>(y, 1)) << what << ": a row of groups or more idle";
+        }
+      }
+      EXPECT_GT(pass.counts().hidden, 0) << what;
+    }
 }
 
 const Case kCases[] = {

@@ -18,6 +18,7 @@ inline constexpr Access compute_read{VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT, VK_AC
 inline constexpr Access compute_write{VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT, VK_ACCESS_SHADER_WRITE_BIT};
 inline constexpr Access transfer_read{VK_PIPELINE_STAGE_TRANSFER_BIT, VK_ACCESS_TRANSFER_READ_BIT};
 inline constexpr Access transfer_write{VK_PIPELINE_STAGE_TRANSFER_BIT, VK_ACCESS_TRANSFER_WRITE_BIT};
+inline constexpr Access indirect_read{VK_PIPELINE_STAGE_DRAW_INDIRECT_BIT, VK_ACCESS_INDIRECT_COMMAND_READ_BIT};
 inline constexpr Access host_read{VK_PIPELINE_STAGE_HOST_BIT, VK_ACCESS_HOST_READ_BIT};
 inline constexpr Access host_write{VK_PIPELINE_STAGE_HOST_BIT, VK_ACCESS_HOST_WRITE_BIT};
 inline constexpr Access all_write{VK_PIPELINE_STAGE_ALL_COMMANDS_BIT, VK_ACCESS_MEMORY_WRITE_BIT};
@@ -30,6 +31,10 @@ void barrier(VkCommandBuffer cmd, Access src, Access dst);
 // The usual ones, spelled out.
 inline void compute_to_compute(VkCommandBuffer cmd) {
   barrier(cmd, access::compute_write, access::compute_read | access::compute_write);
+}
+// Also for the arguments of indirect dispatches the earlier shaders wrote.
+inline void compute_to_indirect(VkCommandBuffer cmd) {
+  barrier(cmd, access::compute_write, access::compute_read | access::compute_write | access::indirect_read);
 }
 inline void transfer_to_compute(VkCommandBuffer cmd) {
   barrier(cmd, access::transfer_write, access::compute_read | access::compute_write);

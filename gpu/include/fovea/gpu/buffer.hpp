@@ -28,6 +28,7 @@ enum class BufferUsage : std::uint32_t {
   DeviceAddress = VK_BUFFER_USAGE_SHADER_DEVICE_ADDRESS_BIT,
   AccelerationStructure = VK_BUFFER_USAGE_ACCELERATION_STRUCTURE_STORAGE_BIT_KHR,
   BuildInput = VK_BUFFER_USAGE_ACCELERATION_STRUCTURE_BUILD_INPUT_READ_ONLY_BIT_KHR,
+  Indirect = VK_BUFFER_USAGE_INDIRECT_BUFFER_BIT,  // vkCmdDispatchIndirect's arguments
 };
 constexpr BufferUsage operator|(BufferUsage a, BufferUsage b) {
   return static_cast<BufferUsage>(static_cast<std::uint32_t>(a) | static_cast<std::uint32_t>(b));

@@ -68,6 +68,10 @@ class ComputePipeline {
   // of 64) are folded into rows of groups, so a full-resolution grid of any preset dispatches
   // on any device. Rounded up like dispatch(); the shader bounds-checks.
   void dispatch_linear(VkCommandBuffer cmd, std::uint32_t count) const;
+  // Records vkCmdDispatchIndirect with the arguments at `offset` in `args` (a buffer with
+  // BufferUsage::Indirect, written by an earlier shader: order it with compute_to_indirect).
+  // For counts a shader found, folded like dispatch_linear (live_cells.h).
+  void dispatch_indirect(VkCommandBuffer cmd, const Buffer& args, VkDeviceSize offset) const;
   template <class T>
   void run_linear(VkCommandBuffer cmd, std::initializer_list<const DescriptorSet*> sets, const T& constants,
                   std::uint32_t count) const {
