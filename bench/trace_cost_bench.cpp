@@ -2,17 +2,20 @@
 // (docs/reconstruction-history.md, "Whole frame on fove0"): the `default` scene on a display preset
 // with the lens' hidden area skipped, gaze at the centre, both eyes, the default
 // reconstruction with stereo gather. Per configuration and trace order (grid: cell n in
-// invocation n; tiles: pt_order.h) it prints the grid's cells and traced cells, and how the
+// invocation n; tiles: pt_order.h; live: the live-cell list) it prints the grid's cells and traced cells, and how the
 // path tracer's invocations fall into SIMD vectors of LANES lanes: vectors with a traced cell
 // ("busy"), those among them that also hold skipped cells ("mixed": a SIMD device such as
 // lavapipe pays a vector's slowest lane for all its lanes), and the mean diagonal of the
 // display box a busy vector's samples span (how far apart the rays it traces in lockstep
 // start). Then per round and configuration the second frame's GPU ms: trace, the trace
-// again alone in the order the pipeline picks and in the other one (testing::time_trace,
+// again alone in the order the pipeline picks (live: the grid pass's live cells, docs/renderer.md
+// "Live cells") and in the other one (every cell; testing::time_trace,
 // GPU and process CPU ms), the reconstruction kernels (timed again one submission each,
 // testing::time_reconstruct) with each one's process CPU / GPU time (how many of lavapipe's
 // threads were busy on average: 2 for a dispatch split evenly), resolve and frame, and the
-// trace ms per 1000 traced samples.
+// trace ms per 1000 traced samples; last, the same frames in a pipeline that dispatches every
+// cell (the other order; the reconstruction's per-cell kernels over all cells): its trace,
+// reconstruction and frame GPU ms.
 // Rounds interleave the configurations, so load on a shared machine spreads over all of
 // them; compare configurations within a round.
 //   fovea_bench_trace_cost [DISPLAY [ROUNDS [LANES]]]     defaults: fove0 1 8
@@ -57,17 +60,20 @@ struct Vectors {
   double extent_px = 0;  // mean over the busy vectors
 };
 
-// `columns`: the grid's padded column count, for the tile order.
+// `columns`: the grid's padded column count, for the tile order; `live`: the live order's list.
 Vectors vectors(const std::vector<fovea::shaders::GridSample>& grid, std::size_t lanes, fr::TraceOrder order,
-                std::uint32_t columns) {
+                std::uint32_t columns, const std::vector<std::uint32_t>& live) {
   Vectors v;
   double extent = 0;
   const std::uint32_t cells = std::uint32_t(grid.size());
-  for (std::size_t start = 0; start < grid.size(); start += lanes) {
+  const std::size_t invocations = order == fr::TraceOrder::Live ? live.size() : grid.size();
+  for (std::size_t start = 0; start < invocations; start += lanes) {
     glm::vec2 lo(1e30f), hi(-1e30f);
     int traced = 0, n = 0;
-    for (std::size_t i = start; i < std::min(grid.size(), start + lanes); ++i, ++n) {
-      const auto cell = order == fr::TraceOrder::Tiles ? fovea::shaders::pt_tile_cell(std::uint32_t(i), columns, cells) : i;
+    for (std::size_t i = start; i < std::min(invocations, start + lanes); ++i, ++n) {
+      const auto cell = order == fr::TraceOrder::Live    ? live[i]
+                        : order == fr::TraceOrder::Tiles ? fovea::shaders::pt_tile_cell(std::uint32_t(i), columns, cells)
+                                                         : i;
       const auto& g = grid[cell];
       if (g.flags != 0) continue;
       ++traced;
@@ -84,7 +90,9 @@ Vectors vectors(const std::vector<fovea::shaders::GridSample>& grid, std::size_t
 }
 
 // The 1-minute load average (Linux), 0 where it cannot be read: printed next to each time.
-const char* order_name(fr::TraceOrder o) { return o == fr::TraceOrder::Tiles ? "tiles" : "grid"; }
+const char* order_name(fr::TraceOrder o) {
+  return o == fr::TraceOrder::Live ? "live" : o == fr::TraceOrder::Tiles ? "tiles" : "grid";
+}
 
 // Process CPU time over elapsed GPU time: how many of lavapipe's threads were busy on
 // average (2 when both work to the end of the dispatch).
@@ -146,8 +154,9 @@ int run(int argc, char** argv) {
       p.render(poses, {gaze, gaze}, 0);
       const fp::FrameTimes t = p.render(poses, {gaze, gaze}, 1);
       const fr::TraceOrder picked = fp::testing::trace_order(p, fc::Eye::Left);
-      const fr::TraceOrder orders[2] = {picked, picked == fr::TraceOrder::Tiles ? fr::TraceOrder::Grid
-                                                                               : fr::TraceOrder::Tiles};
+      // The other: every cell dispatched, in tile order on polar grids, grid order on rasters.
+      const bool polar = p.distribution(fc::Eye::Left).gpu_params().family != fovea::shaders::kFamilyCartesian;
+      const fr::TraceOrder orders[2] = {picked, polar ? fr::TraceOrder::Tiles : fr::TraceOrder::Grid};
       fp::testing::KernelTime trace[2];  // sums over the two repetitions
       const double load0 = load_average();
       for (int k = 0; k < 4; ++k) {
@@ -158,11 +167,19 @@ int run(int argc, char** argv) {
       }
       const double load1 = load_average();
       const fp::testing::ReconKernelTimes r = fp::testing::time_reconstruct(p, 1);
+      // The same frames with every cell dispatched (the other order, and the reconstruction's
+      // per-cell kernels over all cells): what the live-cell list saves in the whole frame.
+      fp::FramePipeline q(ctx, gs, fc::stereo_views(display), dp, settings);
+      for (fc::Eye e : {fc::Eye::Left, fc::Eye::Right}) q.set_visibility(e, fc::EyeOptics(display, e).view_mask());
+      fp::testing::set_trace_order(q, orders[1]);
+      q.render(poses, {gaze, gaze}, 0);
+      const fp::FrameTimes all = q.render(poses, {gaze, gaze}, 1);
       const long long traced = p.traced_cells(fc::Eye::Left) + p.traced_cells(fc::Eye::Right);
       if (round == 0) {
         const auto grid = p.grid_samples(fc::Eye::Left);
         for (const fr::TraceOrder o : orders) {
-          const Vectors v = vectors(grid, std::size_t(lanes), o, std::uint32_t(p.distribution(fc::Eye::Left).padded_columns()));
+          const Vectors v = vectors(grid, std::size_t(lanes), o, std::uint32_t(p.distribution(fc::Eye::Left).padded_columns()),
+                                    fp::testing::live_cells(p, fc::Eye::Left));
           std::printf("| %s | %s | %zu | %lld | %ld | %ld | %.1f |\n", c.name().c_str(), order_name(o), grid.size(),
                       static_cast<long long>(p.traced_cells(fc::Eye::Left)), v.busy, v.mixed, v.extent_px);
         }
@@ -170,13 +187,15 @@ int run(int argc, char** argv) {
       char row[640];
       std::snprintf(row, sizeof row,
                     "| %ld | %s | %.2f → %.2f | %.0f | %s | %.0f / %.0f | %s | %.0f / %.0f | %.3f / %.3f | %.0f | %.0f |"
-                    " %.0f | %.0f | %.0f | %.2f / %.2f / %.2f / %.2f / %.2f | %.0f | %.0f | %.0f | %.2f |",
+                    " %.0f | %.0f | %.0f | %.2f / %.2f / %.2f / %.2f / %.2f | %.0f | %.0f | %.0f | %.2f |"
+                    " %.0f / %.0f / %.0f |",
                     round + 1, c.name().c_str(), load0, load1, t.trace.gpu_ms, order_name(orders[0]), trace[0].gpu_ms,
                     trace[0].cpu_ms, order_name(orders[1]), trace[1].gpu_ms, trace[1].cpu_ms,
                     trace[1].gpu_ms / trace[0].gpu_ms, trace[1].cpu_ms / trace[0].cpu_ms, r.accumulate.gpu_ms,
                     r.share.gpu_ms, r.fit.gpu_ms, r.post.gpu_ms, r.taa.gpu_ms, threads_busy(r.accumulate), threads_busy(r.share), threads_busy(r.fit),
                     threads_busy(r.post), threads_busy(r.taa), t.reconstruct.gpu_ms, t.resolve.gpu_ms,
-                    t.gpu_ms(), 1000.0 * t.trace.gpu_ms / double(traced));
+                    t.gpu_ms(), 1000.0 * t.trace.gpu_ms / double(traced), all.trace.gpu_ms, all.reconstruct.gpu_ms,
+                    all.gpu_ms());
       rows.emplace_back(row);
       std::fprintf(stderr, "%s\n", row);  // progress: a round of fove0 takes minutes under load
       std::fflush(stdout);
@@ -186,8 +205,9 @@ int run(int argc, char** argv) {
   std::printf("| round | configuration | load | trace (frame) | order picked | trace GPU / CPU | other order |"
               " trace GPU / CPU | other / picked, GPU / CPU | accumulate | share | BMFR fit | post | TAA |"
               " CPU / GPU ms, accumulate / share / fit / post / TAA |"
-              " reconstruct (frame) | resolve | frame | trace ms per 1000 samples |\n"
-              "|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|\n");
+              " reconstruct (frame) | resolve | frame | trace ms per 1000 samples |"
+              " every cell dispatched: trace / reconstruct / frame |\n"
+              "|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|\n");
   for (const auto& row : rows) std::printf("%s\n", row.c_str());
   return 0;
 }

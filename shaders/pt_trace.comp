@@ -29,6 +29,8 @@ layout(std430, set = 0, binding = 11) buffer OutNormalDepth { vec4 out_normal_de
 layout(std430, set = 0, binding = 12) buffer OutPosMat { vec4 out_position_material[]; };
 layout(std430, set = 0, binding = 13) buffer OutRadiance { vec4 out_radiance[]; };
 layout(set = 0, binding = 14) uniform textureBuffer ggx_albedo;  // read by pt_sampling.h
+#define LIVE_CELLS_LAYOUT layout(set = 0, binding = 15)
+#include "fovea/shaders/live_cells.h"
 layout(push_constant) uniform Params { PtFrameParams pc; };
 // What the scene uses (PathTracer sets them from GpuScene::features()); false removes the
 // code: base-colour textures, GGX lobes (all F0 = 0), emission and next-event estimation.
@@ -308,11 +310,16 @@ Sample trace_path(vec3 org, vec3 dir, vec3 forward, float spread, inout PtRng rn
 
 void main() {
   const uint invocation = FOVEA_LINEAR_INVOCATION;
-  if (invocation >= pc.cell_count) return;
-  // The cell, not the invocation, keys the random numbers and the outputs: both orders give
-  // the same buffers.
-  const uint idx = (pc.flags & kPtTileOrder) != 0u ? pt_tile_cell(invocation, pc.columns, pc.cell_count)
-                                                   : invocation;
+  // The cell, not the invocation, keys the random numbers and the outputs: every order gives
+  // the same buffers (the live list's leaves the cells without a sample as they were).
+  uint idx;
+  if ((pc.flags & kPtLiveList) != 0u) {
+    idx = live_cell(invocation, pc.cell_count, false);
+    if (idx == kNoLiveCell) return;
+  } else {
+    if (invocation >= pc.cell_count) return;
+    idx = (pc.flags & kPtTileOrder) != 0u ? pt_tile_cell(invocation, pc.columns, pc.cell_count) : invocation;
+  }
   const GridSample g = cells[idx];
   const bool accumulate = (pc.flags & kPtAccumulate) != 0u && pc.accumulated_samples > 0u;
   if (g.flags != 0u) {

@@ -50,6 +50,8 @@ layout(std430, binding = RECON_ACC_OUT_ALBEDO) writeonly buffer AccAlbedo { vec4
 #include "fovea/shaders/recon_map.h"
 
 layout(push_constant) uniform Push { ReconAccumulatePush pc; };
+#define LIVE_CELLS_LAYOUT layout(binding = RECON_ACC_LIVE)
+#include "fovea/shaders/live_cells.h"
 
 // Whether the previous frame saw the sample's surface (rg_tap_valid) in cell j of mapping m
 // or next to it. With sub-cell jitter a cell on an edge sees one side or the other from
@@ -74,8 +76,8 @@ bool seen_near(ReconGrid m, uint j, vec4 here, vec3 n, float depth) {
 }
 
 void main() {
-  uint i = FOVEA_LINEAR_INVOCATION;
-  if (i >= pc.cells) return;
+  const uint i = cell_of_invocation(pc.cells, pc.listed != 0u);
+  if (i == kNoLiveCell) return;
   GridSample s = samples[i];
   if (s.flags != 0u) {
     acc_direct[i] = vec4(0.0);

@@ -35,10 +35,12 @@ layout(binding = RECON_POST_EXCESS) uniform textureBuffer excess;  // unread wit
 layout(std430, binding = RECON_POST_SUM) writeonly buffer Sum { vec4 sum[]; };          // TAA's input
 
 layout(push_constant) uniform Push { ReconPostPush pc; };
+#define LIVE_CELLS_LAYOUT layout(binding = RECON_POST_LIVE)
+#include "fovea/shaders/live_cells.h"
 
 void main() {
-  uint i = FOVEA_LINEAR_INVOCATION;
-  if (i >= pc.cells) return;
+  const uint i = cell_of_invocation(pc.cells, pc.listed != 0u);
+  if (i == kNoLiveCell) return;
   if (rg_no_sample(texelFetch(vpos, int(i)).w) || pc.denoise == 0u) {
     post[i] = vec4(0.0);
     sum[i] = rg_no_sample(texelFetch(vpos, int(i)).w) ? vec4(0.0) : vec4(texelFetch(source, int(i)).rgb, 1.0);

@@ -35,6 +35,8 @@ layout(binding = RECON_SHARE_LUTS) uniform utextureBuffer radius_luts;
 #include "fovea/shaders/recon_map.h"
 
 layout(push_constant) uniform Push { ReconSharePush pc; };
+#define LIVE_CELLS_LAYOUT layout(binding = RECON_SHARE_LIVE)
+#include "fovea/shaders/live_cells.h"
 
 // Whether cell i's area straddles a surface edge: a 3×3 grid neighbour (this frame's samples)
 // holds a surface the history test (rg_tap_valid) would not take for i's own. With sub-cell
@@ -61,8 +63,8 @@ bool straddles(ReconGrid m, uint i, vec4 here, vec4 nd) {
 }
 
 void main() {
-  uint i = FOVEA_LINEAR_INVOCATION;
-  if (i >= pc.cells) return;
+  const uint i = cell_of_invocation(pc.cells, pc.listed != 0u);
+  if (i == kNoLiveCell) return;
   vec4 here = texelFetch(vpos, int(i));
   vec4 own = texelFetch(acc_indirect, int(i));
   if (rg_no_sample(here.w)) {

@@ -71,6 +71,8 @@ layout(binding = RECON_TAA_RESTART) uniform textureBuffer restart;  // Phase I's
 #include "fovea/shaders/recon_map.h"
 
 layout(push_constant) uniform Push { ReconPostPush pc; };
+#define LIVE_CELLS_LAYOUT layout(binding = RECON_TAA_LIVE)
+#include "fovea/shaders/live_cells.h"
 
 const float kCentreSigma = 0.25;
 // ḡ: the mean of exp(−|j|²/(2σ²)) over a uniform jitter j in the cell, (σ√(2π) erf(1/(2√2 σ)))².
@@ -145,8 +147,8 @@ vec3 capped(vec3 c, float cap) {
 }
 
 void main() {
-  uint i = FOVEA_LINEAR_INVOCATION;
-  if (i >= pc.cells) return;
+  const uint i = cell_of_invocation(pc.cells, pc.listed != 0u);
+  if (i == kNoLiveCell) return;
   if (rg_no_sample(texelFetch(vpos, int(i)).w)) {
     final_color[i] = vec4(0.0);
     return;

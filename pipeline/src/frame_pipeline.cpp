@@ -47,11 +47,13 @@ std::unique_ptr<EyeState> make_eye(gpu::Context& ctx, renderer::PathTracer& trac
   if (!e->dist->invertible())
     throw core::InputError(std::string("--distribution: ") + core::distribution_name(dp.kind) +
                            " has no screen-to-grid mapping; the reconstruction needs one");
-  e->grid_pass = std::make_unique<gpu::GridPass>(ctx);
   e->cells = std::uint32_t(e->dist->padded_columns() * e->dist->padded_rows());
+  e->grid_pass = std::make_unique<gpu::GridPass>(ctx, e->cells);  // the list's capacity: no regrowth
   e->grid = storage(ctx, gpu::GridPass::samples_bytes(*e->dist), "recon.grid");
-  e->trace = tracer.bind(e->grid, renderer::GridExtent{std::uint32_t(e->dist->padded_columns()),
-                                                      std::uint32_t(e->dist->padded_rows())});
+  e->trace = tracer.bind(e->grid,
+                         renderer::GridExtent{std::uint32_t(e->dist->padded_columns()),
+                                              std::uint32_t(e->dist->padded_rows())},
+                         &e->grid_pass->live_cells());
   return e;
 }
 
@@ -79,6 +81,8 @@ void FramePipeline::Impl::fill(std::uint32_t word) {
     post->fill(cmd, word);
     resolve->fill(cmd, word);
   });
+  // The cells without a sample now hold `word` too: list them for the next two frames.
+  for (auto& e : eyes) e->grid_pass->reset_history();
 }
 
 FramePipeline::FramePipeline(gpu::Context& ctx, const renderer::GpuScene& scene, const core::StereoViews& views,
@@ -111,7 +115,8 @@ FramePipeline::FramePipeline(gpu::Context& ctx, const renderer::GpuScene& scene,
                      .indirect = &t.indirect(),
                      .normal_depth = &t.normal_depth(),
                      .position_material = &t.position_material(),
-                     .albedo = &t.albedo()});
+                     .albedo = &t.albedo(),
+                     .live = &e->grid_pass->live_cells()});
   }
   m.accumulation = std::make_unique<reconstruct::Accumulation>(ctx, grids, m.tracer.scene().materials());
   m.gather = std::make_unique<reconstruct::StereoGather>(ctx, grids, *m.accumulation);
@@ -128,7 +133,12 @@ FramePipeline::~FramePipeline() = default;
 void FramePipeline::reset() {
   impl_->frames_done = 0;
   impl_->landing_left = 0;
-  for (auto& e : impl_->eyes) e->dist->restart();  // no σ0 warm start from the frames before
+  for (auto& e : impl_->eyes) {
+    e->dist->restart();  // no σ0 warm start from the frames before
+    // The next frame writes parity 0 whichever the last one wrote, so a double-buffered cell
+    // may skip a frame: list every cell without a sample as reset for two frames.
+    e->grid_pass->reset_history();
+  }
 }
 
 void FramePipeline::set_visibility(core::Eye eye, const core::ViewMask& mask) {
@@ -178,14 +188,14 @@ FrameTimes FramePipeline::render(const std::array<core::Pose, 2>& eye_pose, cons
     core::TimeNs r0 = start;
     m.timer.begin(cmd);
     for (auto& e : m.eyes) e->grid_pass->record(cmd, e->grid);
-    gpu::compute_to_compute(cmd);
+    gpu::compute_to_indirect(cmd);
     m.timer.stage(cmd, "grid");
     t.grid.cpu_ms += lap_ms(r0);
     for (std::size_t i = 0; i < m.eyes.size(); ++i) {
       EyeState& e = *m.eyes[i];
       renderer::PathConfig cfg = m.path;
       if (!fresh[i]) cfg.max_bounces = 0;
-      cfg.order = m.trace_order(e);
+      cfg.order = m.trace_order();
       cfg.texture_lod = true;  // one sample per cell and frame: textures prefiltered at the cell's size
       if (landing) {
         cfg.boost_spp = m.settings.landing_spp;

@@ -43,11 +43,13 @@ struct FramePipeline::Impl {
   int parity = 0;                 // history buffers written by the last frame
   bool temporal = false;          // the temporal error is measured on the device
   std::uint32_t temporal_frames = 0, temporal_pairs = 0;  // frames measured, consecutive pairs summed
-  std::optional<renderer::TraceOrder> forced_order;  // testing::set_trace_order
+  std::optional<renderer::TraceOrder> forced_order;  // testing::set_trace_order (also sets settings.live_cells)
 
   Impl(gpu::Context& c, const renderer::GpuScene& scene, const renderer::PathConfig& p,
        const reconstruct::ReconSettings& s)
-      : ctx(c), settings(s), path(p), tracer(c, scene), timer(c) {}
+      : ctx(c), settings(s), path(p), tracer(c, scene), timer(c) {
+    settings.live_cells = true;  // follows trace_order()
+  }
 
   const EyeState* other(const EyeState& e) const {
     if (eyes.size() < 2) return nullptr;
@@ -59,13 +61,12 @@ struct FramePipeline::Impl {
       e->mapping->write(e->pose, o ? &o->pose : nullptr);
     }
   }
-  // Tile order for polar grids, whose grid-order vectors span radii far apart on the display
-  // (docs/reconstruction-history.md, "Coherent Visual-Polar vectors"); grid order for Cartesian ones.
-  renderer::TraceOrder trace_order(const EyeState& e) const {
-    if (forced_order) return *forced_order;
-    return e.dist->gpu_params().family != shaders::kFamilyCartesian ? renderer::TraceOrder::Tiles
-                                                                    : renderer::TraceOrder::Grid;
-  }
+  // The grid pass's live cells, in tile order (docs/renderer.md, "Live cells"): no thread for
+  // a cell without a sample, and vectors of neighbours in φ on polar grids (whose grid-order
+  // vectors span radii far apart on the display: docs/reconstruction-history.md, "Coherent
+  // Visual-Polar vectors"). Tests force the full dispatches (tile or grid order) to compare;
+  // the per-cell reconstruction kernels follow (ReconSettings::live_cells).
+  renderer::TraceOrder trace_order() const { return forced_order.value_or(renderer::TraceOrder::Live); }
   void fill(std::uint32_t word);
   int index(core::Eye e, const char* what) const;  // throws InputError when `e` is not rendered
 };

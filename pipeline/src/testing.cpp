@@ -2,6 +2,7 @@
 
 #include "fovea/core/clock.hpp"
 #include "fovea/core/error.hpp"
+#include "fovea/shaders/live_cells.h"
 #include "frame_pipeline_impl.hpp"
 
 namespace fovea::pipeline::testing {
@@ -43,11 +44,21 @@ void fill_buffers(FramePipeline& pipeline, std::uint32_t word) {
 
 renderer::TraceOrder trace_order(const FramePipeline& pipeline, core::Eye e) {
   const auto& m = Access::impl(pipeline);
-  return m.trace_order(*m.eyes[std::size_t(m.index(e, "trace_order"))]);
+  m.index(e, "trace_order");  // throws for an eye not rendered
+  return m.trace_order();
+}
+
+std::vector<std::uint32_t> live_cells(const FramePipeline& pipeline, core::Eye e) {
+  const auto& m = Access::impl(pipeline);
+  const auto list = m.eyes[std::size_t(m.index(e, "live_cells"))]->grid_pass->live_cells().download<std::uint32_t>();
+  const auto first = list.begin() + shaders::kLiveHeaderWords;
+  return {first, first + list[shaders::kLiveCount]};
 }
 
 void set_trace_order(FramePipeline& pipeline, renderer::TraceOrder order) {
-  Access::impl(pipeline).forced_order = order;
+  auto& m = Access::impl(pipeline);
+  m.forced_order = order;
+  m.settings.live_cells = order == renderer::TraceOrder::Live;
 }
 
 namespace {

@@ -14,6 +14,7 @@ Accumulation::Accumulation(gpu::Context& ctx, std::span<const EyeGrid> eyes, con
     const EyeGrid& g = eyes[i];
     Eye& e = eyes_[i];
     e.cells = g.cells;
+    e.live = &live_list(g.live);
     for (int p = 0; p < 2; ++p) {
       e.direct[p] = cells(ctx, g.cells, "recon.acc_direct");
       e.indirect[p] = cells(ctx, g.cells, "recon.acc_indirect");
@@ -31,7 +32,7 @@ Accumulation::Accumulation(gpu::Context& ctx, std::span<const EyeGrid> eyes, con
                                              g.position_material, &e.direct[q], &e.indirect[q], &e.pos[q], &e.nrm[q],
                                              &e.direct[p], &e.indirect[p], &e.pos[p], &e.nrm[p], &e.tap_idx, &e.tap_w,
                                              &materials, &e.restart[q], &e.restart[p], g.luts, g.albedo, &e.albedo[q],
-                                             &e.albedo[p]});
+                                             &e.albedo[p], e.live});
     }
   }
 }
@@ -40,10 +41,10 @@ void Accumulation::record(VkCommandBuffer cmd, int parity, bool history, std::sp
                           const ReconSettings& s) const {
   for (std::size_t i = 0; i < eyes_.size(); ++i) {
     const Eye& e = eyes_[i];
-    kernel_.run_linear(cmd, {&e.set[parity]},
-                shaders::ReconAccumulatePush{e.cells, history ? 1u : 0u, fresh[i] ? 1u : 0u, 0, s.alpha_min,
-                                             s.coarse_keep, s.coarse_reject, 0},
-                e.cells);
+    run_cells(cmd, kernel_, e.set[parity],
+              shaders::ReconAccumulatePush{e.cells, history ? 1u : 0u, fresh[i] ? 1u : 0u, s.live_cells ? 1u : 0u,
+                                           s.alpha_min, s.coarse_keep, s.coarse_reject, 0},
+              e.cells, e.live);
   }
   gpu::compute_to_compute(cmd);
 }
@@ -64,6 +65,7 @@ StereoGather::StereoGather(gpu::Context& ctx, std::span<const EyeGrid> eyes, con
     const EyeGrid& g = eyes[i];
     Eye& e = eyes_[i];
     e.cells = g.cells;
+    e.live = &live_list(g.live);
     e.shared = cells(ctx, g.cells, "recon.shared_indirect");
     e.z = cells(ctx, g.cells, "recon.z");
     e.edge = cells(ctx, g.cells, "recon.edge", VK_FORMAT_R32_UINT);
@@ -72,16 +74,16 @@ StereoGather::StereoGather(gpu::Context& ctx, std::span<const EyeGrid> eyes, con
       e.set[p] = make_set(ctx, kernel_,
                           ShareBindings{g.maps, g.tables, &acc.position(me, p), &acc.normal(me, p), &acc.direct(me, p),
                                         &acc.indirect(me, p), &acc.position(other, p), &acc.normal(other, p),
-                                        &acc.indirect(other, p), &e.shared, &e.z, &e.edge, g.luts});
+                                        &acc.indirect(other, p), &e.shared, &e.z, &e.edge, g.luts, e.live});
   }
 }
 
 void StereoGather::record(VkCommandBuffer cmd, int parity, bool share, const ReconSettings& s) const {
   for (const Eye& e : eyes_)
-    kernel_.run_linear(cmd, {&e.set[parity]},
-                shaders::ReconSharePush{e.cells, share ? 1u : 0u, s.coarse_keep, s.coarse_reject,
-                                        s.denoiser == Denoiser::Bmfr ? 1u : 0u, 0, 0, 0},
-                e.cells);
+    run_cells(cmd, kernel_, e.set[parity],
+              shaders::ReconSharePush{e.cells, share ? 1u : 0u, s.coarse_keep, s.coarse_reject,
+                                      s.denoiser == Denoiser::Bmfr ? 1u : 0u, s.live_cells ? 1u : 0u, 0, 0},
+              e.cells, e.live);
   gpu::compute_to_compute(cmd);
 }
 

@@ -23,7 +23,7 @@ struct AccumulateBindings {
   FOVEA_BINDING_COUNT(RECON_ACC_COUNT)
   Buf maps, tables, samples, direct, indirect, normal_depth, position_material, prev_direct, prev_indirect, prev_pos,
       prev_nrm, out_direct, out_indirect, out_pos, out_nrm, tap_idx, tap_w, materials, prev_restart, out_restart, luts,
-      albedo, prev_albedo, out_albedo;
+      albedo, prev_albedo, out_albedo, live;
   Slots slots() const {
     return {{{RECON_MAPS, maps},
              {RECON_TABLES, tables},
@@ -48,13 +48,15 @@ struct AccumulateBindings {
              {RECON_ACC_LUTS, luts},
              {RECON_ACC_ALBEDO, albedo},
              {RECON_ACC_PREV_ALBEDO, prev_albedo},
-             {RECON_ACC_OUT_ALBEDO, out_albedo}}};
+             {RECON_ACC_OUT_ALBEDO, out_albedo},
+             {RECON_ACC_LIVE, live}}};
   }
 };
 
 struct ShareBindings {
   FOVEA_BINDING_COUNT(RECON_SHARE_COUNT)
-  Buf maps, tables, pos, nrm, acc_direct, acc_indirect, other_pos, other_nrm, other_indirect, shared, z, edge, luts;
+  Buf maps, tables, pos, nrm, acc_direct, acc_indirect, other_pos, other_nrm, other_indirect, shared, z, edge, luts,
+      live;
   Slots slots() const {
     return {{{RECON_MAPS, maps},
              {RECON_TABLES, tables},
@@ -68,7 +70,8 @@ struct ShareBindings {
              {RECON_SHARE_SHARED, shared},
              {RECON_SHARE_Z, z},
              {RECON_SHARE_EDGE, edge},
-             {RECON_SHARE_LUTS, luts}}};
+             {RECON_SHARE_LUTS, luts},
+             {RECON_SHARE_LIVE, live}}};
   }
 };
 
@@ -89,7 +92,7 @@ struct BmfrBindings {
 
 struct PostBindings {
   FOVEA_BINDING_COUNT(RECON_POST_COUNT)
-  Buf pos, tap_idx, tap_w, source, acc_direct, prev, out, prev_acc_direct, excess, sum;
+  Buf pos, tap_idx, tap_w, source, acc_direct, prev, out, prev_acc_direct, excess, sum, live;
   Slots slots() const {
     return {{{RECON_POST_POS, pos},
              {RECON_POST_TAP_IDX, tap_idx},
@@ -100,13 +103,14 @@ struct PostBindings {
              {RECON_POST_OUT, out},
              {RECON_POST_PREV_ACC_DIRECT, prev_acc_direct},
              {RECON_POST_EXCESS, excess},
-             {RECON_POST_SUM, sum}}};
+             {RECON_POST_SUM, sum},
+             {RECON_POST_LIVE, live}}};
   }
 };
 
 struct TaaBindings {
   FOVEA_BINDING_COUNT(RECON_TAA_COUNT)
-  Buf maps, tables, pos, tap_idx, tap_w, post, albedo, prev_final, final_color, nrm, restart;
+  Buf maps, tables, pos, tap_idx, tap_w, post, albedo, prev_final, final_color, nrm, restart, live;
   Slots slots() const {
     return {{{RECON_MAPS, maps},
              {RECON_TABLES, tables},
@@ -118,7 +122,8 @@ struct TaaBindings {
              {RECON_TAA_PREV_FINAL, prev_final},
              {RECON_TAA_FINAL, final_color},
              {RECON_TAA_NRM, nrm},
-             {RECON_TAA_RESTART, restart}}};
+             {RECON_TAA_RESTART, restart},
+             {RECON_TAA_LIVE, live}}};
   }
 };
 

@@ -8,6 +8,7 @@
 #include "fovea/gpu/buffer.hpp"
 #include "fovea/gpu/descriptors.hpp"
 #include "fovea/gpu/pipeline.hpp"
+#include "fovea/shaders/live_cells.h"
 
 namespace fovea::reconstruct {
 
@@ -36,6 +37,23 @@ gpu::ComputePipeline kernel(gpu::Context& ctx, const char* shader, std::vector<g
                            std::to_string(Bindings::kCount));
   return gpu::ComputePipeline(ctx, {.shader = shader, .sets = {std::move(set)}, .push_constant_bytes = sizeof(Push),
                                     .specialization = std::move(spec)});
+}
+
+// The grid pass's live-cell list of an eye (EyeGrid::live), which every per-cell kernel binds.
+inline const gpu::Buffer& live_list(const gpu::Buffer* live) {
+  if (!live) throw core::InputError("reconstruction: the eye's grid has no live-cell list (EyeGrid::live)");
+  return *live;
+}
+
+// Records a per-cell kernel (bound with `set`, its push's `listed` set) over an eye's cells:
+// the live-cell list's live and reset cells, an indirect dispatch, or all `cells`.
+template <class Push>
+void run_cells(VkCommandBuffer cmd, const gpu::ComputePipeline& k, const gpu::DescriptorSet& set, const Push& push,
+               std::uint32_t cells, const gpu::Buffer* live) {
+  k.bind(cmd, {&set});
+  k.push(cmd, push);
+  if (push.listed) k.dispatch_indirect(cmd, live_list(live), shaders::kLiveArgsChanged * sizeof(std::uint32_t));
+  else k.dispatch_linear(cmd, cells);
 }
 
 // A descriptor set of `p` with every binding of a typed binding struct.

@@ -17,6 +17,7 @@ PostTaa::PostTaa(gpu::Context& ctx, std::span<const EyeGrid> eyes, const Accumul
     Eye& e = eyes_[i];
     const int me = int(i);
     e.cells = g.cells;
+    e.live = &live_list(g.live);
     for (int p = 0; p < 2; ++p) {
       e.post[p] = cells(ctx, g.cells, "recon.post");
       e.final_[p] = cells(ctx, g.cells, "recon.final");
@@ -29,18 +30,19 @@ PostTaa::PostTaa(gpu::Context& ctx, std::span<const EyeGrid> eyes, const Accumul
       e.post_set[p] = make_set(ctx, post_,
                                PostBindings{&acc.position(me, p), &acc.tap_index(me), &acc.tap_weight(me), source,
                                             &acc.direct(me, p), &e.post[q], &e.post[p], &acc.direct(me, q), excess,
-                                            &e.sum});
+                                            &e.sum, e.live});
       e.taa_set[p] = make_set(ctx, taa_,
                               TaaBindings{g.maps, g.tables, &acc.position(me, p), &acc.tap_index(me),
                                           &acc.tap_weight(me), &e.sum, &acc.albedo(me, p), &e.final_[q], &e.final_[p],
-                                          &acc.normal(me, p), &acc.restart(me, p)});
+                                          &acc.normal(me, p), &acc.restart(me, p), e.live});
     }
   }
 }
 
 namespace {
 shaders::ReconPostPush post_push(bool history, const ReconSettings& s) {
-  return {0, history ? 1u : 0u, s.denoiser == Denoiser::Bmfr ? 1u : 0u, 0, s.post_alpha_min, s.taa_alpha, s.still, 0};
+  return {0, history ? 1u : 0u, s.denoiser == Denoiser::Bmfr ? 1u : 0u, s.live_cells ? 1u : 0u, s.post_alpha_min,
+          s.taa_alpha, s.still, 0};
 }
 }  // namespace
 
@@ -53,7 +55,7 @@ void PostTaa::record_post(VkCommandBuffer cmd, int parity, bool history, const R
   shaders::ReconPostPush push = post_push(history, s);
   for (const Eye& e : eyes_) {
     push.cells = e.cells;
-    post_.run_linear(cmd, {&e.post_set[parity]}, push, e.cells);
+    run_cells(cmd, post_, e.post_set[parity], push, e.cells, e.live);
   }
   gpu::compute_to_compute(cmd);
 }
@@ -62,7 +64,7 @@ void PostTaa::record_taa(VkCommandBuffer cmd, int parity, bool history, const Re
   shaders::ReconPostPush push = post_push(history, s);
   for (const Eye& e : eyes_) {
     push.cells = e.cells;
-    taa_.run_linear(cmd, {&e.taa_set[parity]}, push, e.cells);
+    run_cells(cmd, taa_, e.taa_set[parity], push, e.cells, e.live);
   }
   gpu::compute_to_transfer(cmd);
 }

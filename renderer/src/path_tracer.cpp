@@ -8,6 +8,7 @@
 
 #include "fovea/core/error.hpp"
 #include "fovea/gpu/barriers.hpp"
+#include "fovea/shaders/live_cells.h"
 #include "fovea/shaders/pt_order.h"
 #include "tracer_pipeline.hpp"
 
@@ -15,13 +16,13 @@ namespace fovea::renderer {
 
 namespace {
 constexpr int kOutputs = 6;
-constexpr int kBindings = 8 + kOutputs + 1;  // scene, grid, outputs, GGX albedo table
+constexpr int kBindings = 8 + kOutputs + 2;  // scene, grid, outputs, GGX albedo table, live-cell list
 
 // The scene data read per ray or path vertex are texel buffers (nodes, triangles, shading,
 // materials, lights, texture texels, GGX albedo), the rest storage buffers.
 std::vector<gpu::Binding> set0_bindings() {
   std::vector<gpu::Binding> b(kBindings, gpu::Binding::StorageBuffer);
-  for (const int i : {0, 1, 2, 3, 4, 6, kBindings - 1}) b[std::size_t(i)] = gpu::Binding::TexelBuffer;
+  for (const int i : {0, 1, 2, 3, 4, 6, kBindings - 2, kBindings - 1}) b[std::size_t(i)] = gpu::Binding::TexelBuffer;
   return b;
 }
 }  // namespace
@@ -38,14 +39,22 @@ PathTracer::PathTracer(gpu::Context& ctx, const GpuScene& scene, const SceneFeat
                            {SpecConstant::boolean(shaders::kPtSpecTextures, f.textures),
                             SpecConstant::boolean(shaders::kPtSpecGlossy, f.glossy),
                             SpecConstant::boolean(shaders::kPtSpecEmitters, f.emitters)}));
+  no_list_ = gpu::Buffer(ctx, {.size = shaders::kLiveHeaderWords * sizeof(std::uint32_t), .name = "pt.no_live_list",
+                               .texel_format = VK_FORMAT_R32_UINT});
 }
 
-TraceOutputs PathTracer::bind(const gpu::Buffer& grid, GridExtent extent) const {
+TraceOutputs PathTracer::bind(const gpu::Buffer& grid, GridExtent extent, const gpu::Buffer* live) const {
   if (extent.columns == 0 || extent.rows == 0 || std::uint64_t(extent.columns) * extent.rows > 0xFFFFFFFFu)
     throw core::InputError("path tracer: grid extent " + std::to_string(extent.columns) + "x" +
                            std::to_string(extent.rows) + " out of range");
+  if (live && live->size() < (VkDeviceSize(shaders::kLiveHeaderWords) + extent.columns * extent.rows) * 4)
+    throw core::InputError("path tracer: the live-cell list holds fewer entries than the grid's cells");
   TraceOutputs o = bind(grid, extent.columns * extent.rows);
   o.extent_ = extent;
+  if (live) {
+    o.live_ = live;
+    o.set_.bind(15, *live);
+  }
   return o;
 }
 
@@ -70,7 +79,7 @@ TraceOutputs PathTracer::bind(const gpu::Buffer& grid, std::uint32_t cells) cons
   o.set_.bind(0, scene_.nodes()).bind(1, scene_.triangles()).bind(2, scene_.shading()).bind(3, scene_.materials());
   o.set_.bind(4, scene_.lights()).bind(5, scene_.texture_table()).bind(6, scene_.texels()).bind(7, grid);
   o.set_.bind(8, o.direct_).bind(9, o.indirect_).bind(10, o.albedo_).bind(11, o.normal_depth_);
-  o.set_.bind(12, o.position_material_).bind(13, o.radiance_).bind(14, scene_.ggx_albedo());
+  o.set_.bind(12, o.position_material_).bind(13, o.radiance_).bind(14, scene_.ggx_albedo()).bind(15, no_list_);
   return o;
 }
 
@@ -96,7 +105,8 @@ void PathTracer::record(VkCommandBuffer cmd, TraceOutputs& out, const core::View
   p.pixel_tx = float((view.tan_right() - view.tan_left()) / view.width());
   p.pixel_ty = float((view.tan_up() - view.tan_down()) / view.height());
   p.columns = out.extent_.columns;
-  const bool tiles = c.order == TraceOrder::Tiles;
+  const bool tiles = c.order == TraceOrder::Tiles, listed = c.order == TraceOrder::Live;
+  if (listed && !out.live_) throw core::InputError("path tracer: live order needs the grid pass's live-cell list bound");
   if (tiles && (out.extent_.columns == 0 || out.extent_.columns % shaders::kPtTileColumns != 0 ||
                 out.extent_.rows % shaders::kPtTileRows != 0))
     throw core::InputError("path tracer: tile order needs a grid of whole " + std::to_string(shaders::kPtTileColumns) +
@@ -113,9 +123,13 @@ void PathTracer::record(VkCommandBuffer cmd, TraceOutputs& out, const core::View
     p.boost_spp = boost ? std::min(c.boost_spp, shaders::kPtMaxSppPerDispatch) : 0u;
     p.boost_deg = float(c.boost_deg);
     p.flags = (c.jitter ? shaders::kPtJitter : 0u) | (done > 0 ? shaders::kPtAccumulate : 0u) |
-              (tiles ? shaders::kPtTileOrder : 0u) | (c.texture_lod ? shaders::kPtTextureLod : 0u);
-    if (scene_.tracing() == Tracing::RayQuery) pipeline_.run_linear(cmd, {&out.set_, &scene_.ray_query_set()}, p, out.cells_);
-    else pipeline_.run_linear(cmd, {&out.set_}, p, out.cells_);
+              (tiles ? shaders::kPtTileOrder : 0u) | (c.texture_lod ? shaders::kPtTextureLod : 0u) |
+              (listed ? shaders::kPtLiveList : 0u);
+    if (scene_.tracing() == Tracing::RayQuery) pipeline_.bind(cmd, {&out.set_, &scene_.ray_query_set()});
+    else pipeline_.bind(cmd, {&out.set_});
+    pipeline_.push(cmd, p);
+    if (listed) pipeline_.dispatch_indirect(cmd, *out.live_, shaders::kLiveArgsLive * sizeof(std::uint32_t));
+    else pipeline_.dispatch_linear(cmd, out.cells_);
     done += p.spp;
   }
 }

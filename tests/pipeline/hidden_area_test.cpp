@@ -1,6 +1,7 @@
 // Hidden-area culling: with the lens' view mask set, the cells it hides are neither traced
 // nor reconstructed, and the cells it leaves visible render as without the mask.
 #include <cmath>
+#include <cstring>
 
 #include "fovea/core/error.hpp"
 #include "fovea/core/eye_optics.hpp"
@@ -49,8 +50,11 @@ TEST_F(GpuTest, FramePipelineNeverTracesHiddenCells) {
     ++hidden;
     ASSERT_EQ(unmasked[i].flags, 0u) << "cell " << i << " is traced without the mask";
     EXPECT_FALSE(mask.visible_at({samples[i].screen_x, samples[i].screen_y})) << "cell " << i;
-    // Not traced: the tracer's skip values; not reconstructed: Phase I's "no sample", black.
-    EXPECT_EQ(radiance[i], glm::vec4(0.0f)) << "cell " << i;
+    // Not traced: no thread wrote the tracer's outputs (they keep the fill pattern); not
+    // reconstructed: Phase I's "no sample", black.
+    std::uint32_t words[4];
+    std::memcpy(words, &radiance[i], sizeof(words));
+    for (const std::uint32_t w : words) EXPECT_EQ(w, 0x7fc00001u) << "cell " << i;
     EXPECT_EQ(position[i].w, -2.0f) << "cell " << i;
     EXPECT_NE(full_position[i].w, -2.0f) << "cell " << i << " has a sample without the mask";
     EXPECT_EQ(final_color[i], glm::vec4(0.0f)) << "cell " << i;

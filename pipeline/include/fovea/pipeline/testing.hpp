@@ -36,6 +36,8 @@ void fill_buffers(FramePipeline& p, std::uint32_t word);
 // grid's cells in `order` from the next frame on; for tests and benchmarks of the order.
 renderer::TraceOrder trace_order(const FramePipeline& p, core::Eye e);
 void set_trace_order(FramePipeline& p, renderer::TraceOrder order);
+// The live cells the last frame's grid pass listed for eye `e`, in the list's order.
+std::vector<std::uint32_t> live_cells(const FramePipeline& p, core::Eye e);
 
 // Resolves a grid image given in the padded grid layout (premultiplied rgb, .w coverage)
 // with eye `e`'s current mapping, optionally blurred; for round-trip tests.

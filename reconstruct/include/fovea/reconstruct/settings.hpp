@@ -69,6 +69,10 @@ struct ReconSettings {
   // Set per frame by with_history_floors: 1 − the floors' share (1: a still view, which
   // needs no TAA: recon_taa.comp).
   float still = 0;
+  // Set by the frame pipeline: the per-cell kernels (accumulation, sharing, post,
+  // TAA) run over the grid pass's live and reset cells (EyeGrid::live, an indirect dispatch)
+  // instead of every cell of the padded grid.
+  bool live_cells = false;
   bool block_offsets = true;     // 16 static block-grid displacements
   bool blur = true;              // peripheral blur
   double blur_mar_fovea_deg = kMarFoveaDeg;  // MAR₀ of blur_sigma_deg

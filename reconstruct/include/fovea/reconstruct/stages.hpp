@@ -32,6 +32,9 @@ struct EyeGrid {
   // The path tracer's per-cell outputs (renderer::TraceOutputs) and the grid itself.
   const gpu::Buffer *samples = nullptr, *direct = nullptr, *indirect = nullptr, *normal_depth = nullptr,
                     *position_material = nullptr, *albedo = nullptr;
+  // The grid pass's live-cell list (gpu::GridPass::live_cells()): with
+  // ReconSettings::live_cells the per-cell kernels run over its live and reset cells alone.
+  const gpu::Buffer* live = nullptr;
 };
 
 class Accumulation {
@@ -57,6 +60,7 @@ class Accumulation {
  private:
   struct Eye {
     std::uint32_t cells = 0;
+    const gpu::Buffer* live = nullptr;  // EyeGrid::live
     gpu::Buffer direct[2], indirect[2], pos[2], nrm[2], restart[2], albedo[2], tap_idx, tap_w;
     gpu::DescriptorSet set[2];
   };
@@ -79,6 +83,7 @@ class StereoGather {
  private:
   struct Eye {
     std::uint32_t cells = 0;
+    const gpu::Buffer* live = nullptr;  // EyeGrid::live
     gpu::Buffer shared, z, edge;
     gpu::DescriptorSet set[2];
   };
@@ -124,6 +129,7 @@ class PostTaa {
  private:
   struct Eye {
     std::uint32_t cells = 0;
+    const gpu::Buffer* live = nullptr;  // EyeGrid::live
     gpu::Buffer post[2], sum, final_[2];  // post: accumulated fit (history); sum: + excess + direct
     gpu::DescriptorSet post_set[2], taa_set[2];
   };

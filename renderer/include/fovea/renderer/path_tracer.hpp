@@ -1,7 +1,8 @@
 #pragma once
 // The grid path tracer: traces one eye's per-sample rays of any sample grid (a storage
 // buffer of shaders::GridSample, index = row * columns + column, cells with flags != 0
-// skipped) and writes per-cell fp32 outputs in the same layout (pt_trace.h):
+// skipped, or only the live cells listed by the grid pass) and writes per-cell fp32 outputs
+// in the same layout (pt_trace.h):
 // demodulated radiance split into direct+specular and indirect diffuse, albedo, shading
 // normal + linear depth, world position + material id, and plain radiance.
 #include <cstdint>
@@ -27,6 +28,10 @@ namespace fovea::renderer {
 enum class TraceOrder {
   Grid,   // invocation n traces cell n: a SIMD vector runs along a row of the grid
   Tiles,  // tiles of the grid, each SIMD vector down one column (pt_order.h); needs the grid's extents
+  // The grid pass's live cells (gpu::GridPass::live_cells(), bound with the outputs), an
+  // indirect dispatch: no thread starts for a cell without a sample, whose outputs then stay
+  // as they were (the frame pipeline reads none of them).
+  Live,
 };
 
 // Default: the BMFR/P5 configuration (1 sample per cell, primary hit + NEE, one BSDF
@@ -82,7 +87,8 @@ class TraceOutputs {
  private:
   friend class PathTracer;
   std::uint32_t cells_ = 0;
-  GridExtent extent_;  // zero when bound by cell count: grid order only
+  GridExtent extent_;                   // zero when bound by cell count: grid order only
+  const gpu::Buffer* live_ = nullptr;   // the grid pass's live-cell list (live order), or none
   gpu::Buffer direct_, indirect_, albedo_, normal_depth_, position_material_, radiance_;
   gpu::DescriptorSet set_;
 };
@@ -98,7 +104,8 @@ class PathTracer {
   // only), or of `extent.columns * extent.rows` cells laid out row by row (either order;
   // tile order needs extents that are whole tiles: core::SampleDistribution's padded ones).
   TraceOutputs bind(const gpu::Buffer& grid, std::uint32_t cells) const;
-  TraceOutputs bind(const gpu::Buffer& grid, GridExtent extent) const;
+  // `live`: the grid pass's live-cell list of this grid (live order); it must outlive the outputs.
+  TraceOutputs bind(const gpu::Buffer& grid, GridExtent extent, const gpu::Buffer* live = nullptr) const;
 
   // Records one frame (split into dispatches of at most kPtMaxSppPerDispatch samples).
   // `view` gives the eye pose (world) and the display raster used for jitter; `frame`
@@ -116,6 +123,7 @@ class PathTracer {
   gpu::Context& ctx_;
   const GpuScene& scene_;
   gpu::ComputePipeline pipeline_;
+  gpu::Buffer no_list_;  // bound in place of a live-cell list (never read then)
 };
 
 // Cartesian grid of a view's raster, built on the CPU: one cell per pixel centre.

@@ -30,6 +30,7 @@ FOVEA_CONST FOVEA_UINT kPtJitter = 1;      // jitter directions over the cell's 
 FOVEA_CONST FOVEA_UINT kPtAccumulate = 2;  // running mean with `accumulated_samples` earlier samples
 FOVEA_CONST FOVEA_UINT kPtTileOrder = 4;   // invocations take cells in tile order (pt_order.h)
 FOVEA_CONST FOVEA_UINT kPtTextureLod = 8;  // first hits read the texture mip level of the cell's size
+FOVEA_CONST FOVEA_UINT kPtLiveList = 16;   // invocations take the grid pass's live cells (live_cells.h)
 
 // Scene features, specialization constants of pt_trace.comp (constant_id): a variant
 // without texture fetches, GGX lobes or light sampling for scenes that do not need them.

@@ -38,7 +38,8 @@
 #define RECON_ACC_ALBEDO 21
 #define RECON_ACC_PREV_ALBEDO 22
 #define RECON_ACC_OUT_ALBEDO 23
-#define RECON_ACC_COUNT 24
+#define RECON_ACC_LIVE 24
+#define RECON_ACC_COUNT 25
 
 // recon_share.comp (stereo gather of indirect diffuse)
 #define RECON_SHARE_POS 2
@@ -52,7 +53,8 @@
 #define RECON_SHARE_Z 10
 #define RECON_SHARE_EDGE 11
 #define RECON_SHARE_LUTS 12
-#define RECON_SHARE_COUNT 13
+#define RECON_SHARE_LIVE 13
+#define RECON_SHARE_COUNT 14
 
 // recon_bmfr_fit.comp (BMFR Phase II)
 #define RECON_BMFR_POS 0
@@ -76,7 +78,8 @@
 #define RECON_POST_PREV_ACC_DIRECT 7
 #define RECON_POST_EXCESS 8
 #define RECON_POST_SUM 9
-#define RECON_POST_COUNT 10
+#define RECON_POST_LIVE 10
+#define RECON_POST_COUNT 11
 
 // recon_taa.comp
 #define RECON_TAA_POS 2
@@ -88,7 +91,8 @@
 #define RECON_TAA_FINAL 8
 #define RECON_TAA_NRM 9
 #define RECON_TAA_RESTART 10
-#define RECON_TAA_COUNT 11
+#define RECON_TAA_LIVE 11
+#define RECON_TAA_COUNT 12
 
 // recon_mip.comp
 #define RECON_MIP_MIPS 2

@@ -51,7 +51,8 @@ FOVEA_CONST float kReconEmitterBase = -3.0f;
 FOVEA_CONST float kReconRestartFrames = 8.0f;
 
 struct ReconAccumulatePush {
-  FOVEA_UINT cells, has_history, indirect_fresh, pad;  // indirect_fresh = 0: reuse history only
+  FOVEA_UINT cells, has_history, indirect_fresh;  // indirect_fresh = 0: reuse history only
+  FOVEA_UINT listed;  // 1: the cells of the live-cell list (live_cells.h), an indirect dispatch
   float alpha_min;                                     // EMA floor (BMFR Phase I: 0.2)
   float coarse_keep, coarse_reject, pad1;              // cell-size test (ReconSettings, rg_coarse_weight)
 };
@@ -59,7 +60,8 @@ struct ReconAccumulatePush {
 struct ReconSharePush {
   FOVEA_UINT cells, enabled;
   float coarse_keep, coarse_reject;  // as ReconAccumulatePush
-  FOVEA_UINT edges, pad0, pad1, pad2;  // edges = 1: flag the cells on a surface edge (BMFR's fit reads them)
+  FOVEA_UINT edges;  // 1: flag the cells on a surface edge (BMFR's fit reads them)
+  FOVEA_UINT listed, pad1, pad2;  // listed: as ReconAccumulatePush
 };
 
 struct ReconBmfrPush {
@@ -70,7 +72,8 @@ struct ReconBmfrPush {
 };
 
 struct ReconPostPush {
-  FOVEA_UINT cells, has_history, denoise, pad;  // denoise = 0: remodulated accumulation only
+  FOVEA_UINT cells, has_history, denoise;  // denoise = 0: remodulated accumulation only
+  FOVEA_UINT listed;  // as ReconAccumulatePush
   float alpha_min, taa_alpha;  // BMFR Phase III: 0.1, TAA: 0.2
   float still;                // 0..1: how still the view is (1 − the EMA floors' share); recon_taa.comp
   float pad1;
