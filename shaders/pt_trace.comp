@@ -311,11 +311,12 @@ Sample trace_path(vec3 org, vec3 dir, vec3 forward, float spread, inout PtRng rn
 void main() {
   const uint invocation = FOVEA_LINEAR_INVOCATION;
   // The cell, not the invocation, keys the random numbers and the outputs: every order gives
-  // the same buffers (the live list's leaves the cells without a sample as they were).
+  // the same buffers (the live tiles' leaves the cells without a sample as they were).
   uint idx;
-  if ((pc.flags & kPtLiveList) != 0u) {
-    idx = live_cell(invocation, pc.cell_count, false);
-    if (idx == kNoLiveCell) return;
+  const bool listed = (pc.flags & kPtLiveList) != 0u;
+  if (listed) {
+    idx = live_cell(false, false);
+    if (idx == kNoLiveCell || cells[idx].flags != 0u) return;
   } else {
     if (invocation >= pc.cell_count) return;
     idx = (pc.flags & kPtTileOrder) != 0u ? pt_tile_cell(invocation, pc.columns, pc.cell_count) : invocation;

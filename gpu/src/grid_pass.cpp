@@ -27,30 +27,32 @@ GridPass::GridPass(Context& ctx, std::uint32_t cells, bool ballot)
                       .sets = {{Binding::UniformBuffer, Binding::StorageBuffer, Binding::StorageBuffer,
                                 Binding::StorageBuffer, Binding::StorageBuffer, Binding::StorageBuffer,
                                 Binding::StorageBuffer}}}),
-      args_pipeline_(ctx, {.shader = "grid_live_args.comp.spv",
-                           .sets = {{Binding::StorageBuffer, Binding::StorageBuffer}},
+      list_pipeline_(ctx, {.shader = "grid_live_list.comp.spv",
+                           .sets = {{Binding::StorageBuffer, Binding::StorageBuffer, Binding::StorageBuffer}},
                            .push_constant_bytes = sizeof(std::uint32_t)}),
       params_(host_buffer(ctx, sizeof(shaders::GridParams), BufferUsage::Uniform, "grid params")),
       columns_(host_buffer(ctx, 16, BufferUsage::Storage, "grid columns")),
       mask_(host_buffer(ctx, 16, BufferUsage::Storage, "hidden mask")),
       counts_(host_buffer(ctx, sizeof(shaders::GridCounts), BufferUsage::Storage, "grid counts")),
       set_(ctx, pipeline_.set_layout(0)),
-      args_set_(ctx, args_pipeline_.set_layout(0)) {
+      list_set_(ctx, list_pipeline_.set_layout(0)) {
   set_.bind(0, params_).bind(1, columns_).bind(2, mask_).bind(4, counts_);
-  args_set_.bind(0, counts_);
+  list_set_.bind(0, counts_);
   reserve(std::max<std::uint32_t>(cells, 1));
 }
 
 void GridPass::reserve(std::uint32_t cells) {
-  if (cells <= capacity_) return;
-  capacity_ = cells;
-  list_ = Buffer(*ctx_, {.size = (VkDeviceSize(shaders::kLiveHeaderWords) + cells) * sizeof(std::uint32_t),
+  if (cells <= capacity_ * shaders::kLiveTileCells) return;
+  capacity_ = (cells + shaders::kLiveTileCells - 1) / shaders::kLiveTileCells;  // tiles
+  list_ = Buffer(*ctx_, {.size = (VkDeviceSize(shaders::kLiveHeaderWords) + capacity_) * sizeof(std::uint32_t),
                          .usage = BufferUsage::Storage | BufferUsage::Indirect,
                          .name = "grid live cells",
                          .texel_format = VK_FORMAT_R32_UINT});
-  history_ = Buffer(*ctx_, {.size = VkDeviceSize(cells) * sizeof(std::uint32_t), .name = "grid live history"});
-  set_.bind(5, list_).bind(6, history_);
-  args_set_.bind(1, list_);
+  history_ = Buffer(*ctx_, {.size = VkDeviceSize(capacity_) * shaders::kLiveTileCells * sizeof(std::uint32_t),
+                            .name = "grid live history"});
+  tile_state_ = Buffer(*ctx_, {.size = VkDeviceSize(capacity_) * sizeof(std::uint32_t), .name = "grid tile state"});
+  set_.bind(5, history_).bind(6, tile_state_);
+  list_set_.bind(1, list_).bind(2, tile_state_);
   history_fresh_ = true;
 }
 
@@ -83,7 +85,9 @@ void GridPass::prepare(const core::SampleDistribution& d, std::span<const std::u
   }
   params_.upload(std::span(&p, 1));
   // Host writes to coherent memory are visible to the next submission.
-  const shaders::GridCounts zero{};
+  shaders::GridCounts zero{};
+  zero.tiles_across = p.padded_columns / shaders::kPtTileColumns;
+  zero.tiles = zero.tiles_across * (p.padded_rows / shaders::kPtTileRows);
   counts_.upload(std::span(&zero, 1));
   padded_columns_ = p.padded_columns;
   padded_rows_ = p.padded_rows;
@@ -98,6 +102,7 @@ void GridPass::record(VkCommandBuffer cmd, const Buffer& samples) {
   }
   if (history_fresh_) {
     fill_buffer(cmd, history_, shaders::kLiveAllBefore);
+    fill_buffer(cmd, tile_state_, 0);  // after a new allocation; grid_live_list.comp leaves it zero
     transfer_to_compute(cmd);
     history_fresh_ = false;
   }
@@ -106,7 +111,7 @@ void GridPass::record(VkCommandBuffer cmd, const Buffer& samples) {
   pipeline_.dispatch(cmd, padded_columns_ / shaders::kPtTileColumns * pipeline_.workgroup_size()[0],
                      padded_rows_ / shaders::kPtTileRows);
   compute_to_compute(cmd);
-  args_pipeline_.run(cmd, {&args_set_}, ctx_->limits().maxComputeWorkGroupCount[0], 1);
+  list_pipeline_.run(cmd, {&list_set_}, ctx_->limits().maxComputeWorkGroupCount[0], 1);
 }
 
 GridPass::Counts GridPass::counts() const {

@@ -43,12 +43,16 @@ struct FramePipeline::Impl {
   int parity = 0;                 // history buffers written by the last frame
   bool temporal = false;          // the temporal error is measured on the device
   std::uint32_t temporal_frames = 0, temporal_pairs = 0;  // frames measured, consecutive pairs summed
-  std::optional<renderer::TraceOrder> forced_order;  // testing::set_trace_order (also sets settings.live_cells)
+  // testing::set_trace_order; it also sets settings.live_cells (to whether the order is Live)
+  std::optional<renderer::TraceOrder> forced_order;
 
   Impl(gpu::Context& c, const renderer::GpuScene& scene, const renderer::PathConfig& p,
        const reconstruct::ReconSettings& s)
       : ctx(c), settings(s), path(p), tracer(c, scene), timer(c) {
-    settings.live_cells = true;  // follows trace_order()
+    // The reconstruction's per-cell kernels over the live tiles: on lavapipe they took
+    // 1.2–1.7× the time of a dispatch over every cell (fove0, docs/renderer.md "Live cells"),
+    // so a CPU device dispatches every cell; a GPU runs no workgroup for a tile without a sample.
+    settings.live_cells = c.info().type != VK_PHYSICAL_DEVICE_TYPE_CPU;
   }
 
   const EyeState* other(const EyeState& e) const {
@@ -61,11 +65,10 @@ struct FramePipeline::Impl {
       e->mapping->write(e->pose, o ? &o->pose : nullptr);
     }
   }
-  // The grid pass's live cells, in tile order (docs/renderer.md, "Live cells"): no thread for
-  // a cell without a sample, and vectors of neighbours in φ on polar grids (whose grid-order
+  // The grid pass's live tiles, in tile order (docs/renderer.md, "Live cells"): no workgroup
+  // for a tile without a sample, and vectors of neighbours in φ on polar grids (whose grid-order
   // vectors span radii far apart on the display: docs/reconstruction-history.md, "Coherent
-  // Visual-Polar vectors"). Tests force the full dispatches (tile or grid order) to compare;
-  // the per-cell reconstruction kernels follow (ReconSettings::live_cells).
+  // Visual-Polar vectors"). Tests force the full dispatches (tile or grid order) to compare.
   renderer::TraceOrder trace_order() const { return forced_order.value_or(renderer::TraceOrder::Live); }
   void fill(std::uint32_t word);
   int index(core::Eye e, const char* what) const;  // throws InputError when `e` is not rendered

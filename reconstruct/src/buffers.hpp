@@ -39,14 +39,14 @@ gpu::ComputePipeline kernel(gpu::Context& ctx, const char* shader, std::vector<g
                                     .specialization = std::move(spec)});
 }
 
-// The grid pass's live-cell list of an eye (EyeGrid::live), which every per-cell kernel binds.
+// The grid pass's live-tile list of an eye (EyeGrid::live), which every per-cell kernel binds.
 inline const gpu::Buffer& live_list(const gpu::Buffer* live) {
-  if (!live) throw core::InputError("reconstruction: the eye's grid has no live-cell list (EyeGrid::live)");
+  if (!live) throw core::InputError("reconstruction: the eye's grid has no live-tile list (EyeGrid::live)");
   return *live;
 }
 
 // Records a per-cell kernel (bound with `set`, its push's `listed` set) over an eye's cells:
-// the live-cell list's live and reset cells, an indirect dispatch, or all `cells`.
+// the cells of the live-tile list's live and reset tiles, an indirect dispatch, or all `cells`.
 template <class Push>
 void run_cells(VkCommandBuffer cmd, const gpu::ComputePipeline& k, const gpu::DescriptorSet& set, const Push& push,
                std::uint32_t cells, const gpu::Buffer* live) {

@@ -47,8 +47,8 @@ TraceOutputs PathTracer::bind(const gpu::Buffer& grid, GridExtent extent, const 
   if (extent.columns == 0 || extent.rows == 0 || std::uint64_t(extent.columns) * extent.rows > 0xFFFFFFFFu)
     throw core::InputError("path tracer: grid extent " + std::to_string(extent.columns) + "x" +
                            std::to_string(extent.rows) + " out of range");
-  if (live && live->size() < (VkDeviceSize(shaders::kLiveHeaderWords) + extent.columns * extent.rows) * 4)
-    throw core::InputError("path tracer: the live-cell list holds fewer entries than the grid's cells");
+  if (live && live->size() < (VkDeviceSize(shaders::kLiveHeaderWords) + extent.columns * extent.rows / shaders::kLiveTileCells) * 4)
+    throw core::InputError("path tracer: the live-tile list holds fewer entries than the grid's tiles");
   TraceOutputs o = bind(grid, extent.columns * extent.rows);
   o.extent_ = extent;
   if (live) {

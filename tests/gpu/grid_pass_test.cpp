@@ -130,12 +130,12 @@ TEST_F(GpuTest, GridPassMaskMatchesCpuReference) {
   }
 }
 
-// The live-cell list (live_cells.h): exactly the cells with a sample, each once, runs of
-// one tile column in row order (with ballots); the reset cells exactly those without a sample
-// that had one in either of the two frames before (all of them in the first two frames); the
-// indirect dispatches cover each list with fewer than one row of idle workgroups. Under a
-// moving gaze and the lens mask, for both ways of appending.
-TEST_F(GpuTest, GridPassListsLiveAndResetCells) {
+// The live-tile list (live_cells.h): exactly the tiles with a cell with a sample, in tile
+// order, then those without one that hold a reset cell (one without a sample that had
+// one in either of the two frames before; every such cell in the first two frames); the
+// indirect dispatches cover each list with less than a row of idle workgroups. Under a
+// moving gaze and the lens mask, for both ways of counting.
+TEST_F(GpuTest, GridPassListsLiveAndResetTiles) {
   const core::DisplayPreset display = core::load_display("tiny");
   const core::EyeOptics optics(display, core::Eye::Left);
   const core::ViewMask mask = optics.view_mask();
@@ -148,7 +148,9 @@ TEST_F(GpuTest, GridPassListsLiveAndResetCells) {
       p.kind = kind;
       auto d = core::make_distribution(optics.view(), p);
       d->set_visibility(mask);
-      const std::size_t cells = std::size_t(d->padded_columns()) * d->padded_rows();
+      const std::uint32_t cells = std::uint32_t(d->padded_columns() * d->padded_rows());
+      const std::uint32_t across = std::uint32_t(d->padded_columns()) / shaders::kPtTileColumns;
+      const std::uint32_t tiles = cells / shaders::kLiveTileCells;
       gpu::GridPass pass(ctx(), 0, ballot);
       gpu::Buffer out(ctx(), {.size = gpu::GridPass::samples_bytes(*d), .memory = gpu::Memory::HostVisible});
       std::vector<std::uint32_t> history(cells, shaders::kLiveAllBefore);
@@ -159,41 +161,37 @@ TEST_F(GpuTest, GridPassListsLiveAndResetCells) {
         const auto grid = out.download<shaders::GridSample>();
         const auto list = pass.live_cells().download<std::uint32_t>();
         const std::uint32_t* header = list.data();
-        const std::uint32_t* entries = list.data() + shaders::kLiveHeaderWords;
+        std::vector<int> live_in(tiles, 0), reset_in(tiles, 0);
+        std::int64_t live_cells = 0, reset_cells = 0;
+        for (std::uint32_t t = 0; t < tiles; ++t)
+          for (std::uint32_t l = 0; l < shaders::kLiveTileCells; ++l) {
+            const std::uint32_t i = shaders::live_tile_cell(t, l, across, false);
+            const bool now = grid[i].flags == 0;
+            const bool reset = !now && history[i] != 0;
+            live_in[t] += now ? 1 : 0;
+            reset_in[t] += reset ? 1 : 0;
+            live_cells += now ? 1 : 0;
+            reset_cells += reset ? 1 : 0;
+            history[i] = ((history[i] << 1) | (now ? 1u : 0u)) & shaders::kLiveAllBefore;
+          }
+        EXPECT_EQ(f < 2, reset_cells + live_cells == cells) << what << " frame " << f;
         std::vector<std::uint32_t> live, reset;
-        for (std::uint32_t i = 0; i < cells; ++i) {
-          const bool now = grid[i].flags == 0;
-          (now ? live : reset).push_back(i);
-          if (!now && history[i] == 0) reset.pop_back();
-          history[i] = ((history[i] << 1) | (now ? 1u : 0u)) & shaders::kLiveAllBefore;
-        }
-        EXPECT_EQ(f < 2, reset.size() == cells - live.size()) << what << " frame " << f;
+        for (std::uint32_t t = 0; t < tiles; ++t)
+          if (live_in[t] > 0) live.push_back(t);
+          else if (reset_in[t] > 0) reset.push_back(t);
         ASSERT_EQ(header[shaders::kLiveCount], live.size()) << what << " frame " << f;
         ASSERT_EQ(header[shaders::kLiveResetCount], reset.size()) << what << " frame " << f;
-        EXPECT_EQ(pass.counts().traced, std::int64_t(live.size()));
-        EXPECT_EQ(pass.counts().reset, std::int64_t(reset.size()));
-        std::vector<std::uint32_t> got_live(entries, entries + live.size());
-        std::vector<std::uint32_t> got_reset(entries + cells - reset.size(), entries + cells);
-        if (ballot) {  // neighbours in the list from one tile follow its columns down their rows
-          const auto lane = [&](std::uint32_t i) {
-            const std::uint32_t col = i % d->padded_columns(), row = i / d->padded_columns();
-            return std::array{col / shaders::kPtTileColumns, row / shaders::kPtTileRows,
-                              col % shaders::kPtTileColumns * shaders::kPtTileRows + row % shaders::kPtTileRows};
-          };
-          int out_of_order = 0;
-          for (std::size_t k = 1; k < got_live.size(); ++k) {
-            const auto a = lane(got_live[k - 1]), b = lane(got_live[k]);
-            out_of_order += a[0] == b[0] && a[1] == b[1] && b[2] <= a[2] ? 1 : 0;
-          }
-          EXPECT_EQ(out_of_order, 0) << what << " frame " << f;
-        }
-        std::sort(got_live.begin(), got_live.end());
-        std::sort(got_reset.begin(), got_reset.end());
+        ASSERT_EQ(header[shaders::kLiveTilesAcross], across);
+        EXPECT_EQ(pass.counts().traced, live_cells);
+        EXPECT_EQ(pass.counts().reset, reset_cells);
+        const std::uint32_t* entries = header + shaders::kLiveHeaderWords;
+        // In tile order: the per-cell kernels sweep their buffers in order.
+        const std::vector<std::uint32_t> got_live(entries, entries + live.size());
+        const std::vector<std::uint32_t> got_reset(entries + live.size(), entries + live.size() + reset.size());
         EXPECT_EQ(got_live, live) << what << " frame " << f;
         EXPECT_EQ(got_reset, reset) << what << " frame " << f;
-        for (const auto& [at, n] : {std::pair{shaders::kLiveArgsLive, live.size()},
-                                   std::pair{shaders::kLiveArgsChanged, live.size() + reset.size()}}) {
-          const std::uint64_t groups = (n + shaders::kLiveGroupSize - 1) / shaders::kLiveGroupSize;
+        for (const auto& [at, groups] : {std::pair{shaders::kLiveArgsLive, std::uint64_t(live.size())},
+                                         std::pair{shaders::kLiveArgsChanged, std::uint64_t(live.size() + reset.size())}}) {
           const std::uint64_t x = header[at], y = header[at + 1];
           EXPECT_EQ(header[at + 2], 1u);
           EXPECT_LE(x, max_x);

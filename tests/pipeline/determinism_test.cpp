@@ -130,11 +130,12 @@ TEST_F(GpuTest, FramePipelineIsDeterministicWithoutDenoiserAlternating) {
   check_determinism(ctx(), "stereo-occluders", s);
 }
 
-// The pipeline's order (the grid pass's live cells: no thread for a cell without a sample)
-// and the full dispatches in tile and grid order give bit-identical buffers and images,
-// under the lens' hidden area and a moving gaze (cells gain and lose their samples from frame
-// to frame): the cell keys everything, and the live list's reset cells leave every
-// per-cell buffer as the full dispatches do.
+// The pipeline's order (the grid pass's live tiles: no workgroup for a tile without a sample;
+// the reconstruction's per-cell kernels as the device has them), the live tiles for the
+// trace and the reconstruction, and the full dispatches in tile and grid order give
+// bit-identical buffers and images, under the lens' hidden area and a moving gaze (cells gain
+// and lose their samples from frame to frame): the cell keys everything, and the list's reset
+// tiles leave every per-cell buffer as the full dispatches do.
 TEST_F(GpuTest, FramePipelineTraceOrderChangesNoBufferOrImage) {
   const renderer::Scene scene = renderer::load_scene("default");
   renderer::GpuScene gs(ctx(), scene);
@@ -152,7 +153,7 @@ TEST_F(GpuTest, FramePipelineTraceOrderChangesNoBufferOrImage) {
     masked(a);
     ASSERT_EQ(pipeline::testing::trace_order(a, core::Eye::Right), renderer::TraceOrder::Live);
     const Snapshot own = render_sequence(a, poses);
-    for (const auto other : {renderer::TraceOrder::Tiles, renderer::TraceOrder::Grid}) {
+    for (const auto other : {renderer::TraceOrder::Live, renderer::TraceOrder::Tiles, renderer::TraceOrder::Grid}) {
       pipeline::FramePipeline b(ctx(), gs, core::stereo_views(display), dp, settings);
       masked(b);
       pipeline::testing::set_trace_order(b, other);

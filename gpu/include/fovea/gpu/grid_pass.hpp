@@ -3,9 +3,9 @@
 // padded grid (row-major, index = row * padded_columns + column) for its current frame.
 // The CPU builds the per-frame uniforms and column table (core::SampleDistribution);
 // the shader (shaders/grid_generate.comp) evaluates the mapping per cell. It also lists the
-// live cells (those with a sample) in a coherent order and the cells that lost their sample
+// tiles with a live cell (one with a sample) and those whose cells lost their sample
 // (live_cells.h), with the indirect dispatches over them, so that the per-cell kernels start
-// no thread for a cell without a sample (docs/renderer.md, "Live cells").
+// no workgroup for a tile without a sample (docs/renderer.md, "Live cells").
 #include <cstdint>
 #include <span>
 
@@ -22,9 +22,9 @@ namespace fovea::gpu {
 class GridPass {
  public:
   // `cells`: the list's capacity to start with (it grows with the grids prepared, and
-  // live_cells() then is a new buffer). The list is appended with subgroup ballots where the
-  // device has them; `ballot = false` takes the variant for devices without (one atomic per
-  // listed cell) on any device, for tests.
+  // live_cells() then is a new buffer). Cells are counted with subgroup ballots where the
+  // device has them; `ballot = false` takes the variant for devices without (atomics per
+  // cell) on any device, for tests.
   explicit GridPass(Context& ctx, std::uint32_t cells = 0, bool ballot = true);
 
   // Bytes needed for the samples of `d`'s padded grid.
@@ -49,7 +49,7 @@ class GridPass {
   };
   Counts counts() const;
 
-  // The live-cell list of the last recorded dispatch (live_cells.h): header, then the cells;
+  // The live-tile list of the last recorded dispatch (live_cells.h): header, then the tiles;
   // a texel buffer of R32_UINT and the indirect dispatches' arguments.
   const Buffer& live_cells() const { return list_; }
   // The next record() treats every cell as having had a sample in the two frames before, so
@@ -61,14 +61,15 @@ class GridPass {
   Context* ctx_;
   void reserve(std::uint32_t cells);
 
-  ComputePipeline pipeline_, args_pipeline_;
+  ComputePipeline pipeline_, list_pipeline_;
   Buffer params_;
   Buffer columns_;
   Buffer mask_;
   Buffer counts_;   // shaders::GridCounts, host-visible
-  Buffer list_;     // header + capacity cells
-  Buffer history_;  // a word per cell: kLiveAllBefore's bits
-  DescriptorSet set_, args_set_;
+  Buffer list_;        // header + capacity tiles
+  Buffer history_;     // a word per cell: kLiveAllBefore's bits
+  Buffer tile_state_;  // a word per tile, zero between frames (grid_generate.comp, grid_live_list.comp)
+  DescriptorSet set_, list_set_;
   VkBuffer bound_samples_ = VK_NULL_HANDLE;
   std::uint32_t padded_columns_ = 0, padded_rows_ = 0, capacity_ = 0;
   bool history_fresh_ = true;

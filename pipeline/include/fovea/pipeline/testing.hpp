@@ -33,10 +33,13 @@ void fill_buffers(FramePipeline& p, std::uint32_t word);
 
 // The order in which the path tracer takes eye `e`'s cells: the one the pipeline picks for the
 // distribution, or the one set_trace_order forced. set_trace_order makes it take every
-// grid's cells in `order` from the next frame on; for tests and benchmarks of the order.
+// grid's cells in `order` from the next frame on, and the reconstruction's per-cell kernels
+// over the live tiles for TraceOrder::Live, over every cell for the others (whatever the
+// device); for tests and benchmarks of the order.
 renderer::TraceOrder trace_order(const FramePipeline& p, core::Eye e);
 void set_trace_order(FramePipeline& p, renderer::TraceOrder order);
-// The live cells the last frame's grid pass listed for eye `e`, in the list's order.
+// The cells of the tiles the last frame's grid pass listed as live for eye `e`, in the order the
+// trace's invocations take them (with the cells without a sample in those tiles).
 std::vector<std::uint32_t> live_cells(const FramePipeline& p, core::Eye e);
 
 // Resolves a grid image given in the padded grid layout (premultiplied rgb, .w coverage)

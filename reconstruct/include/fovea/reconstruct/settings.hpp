@@ -70,8 +70,8 @@ struct ReconSettings {
   // needs no TAA: recon_taa.comp).
   float still = 0;
   // Set by the frame pipeline: the per-cell kernels (accumulation, sharing, post,
-  // TAA) run over the grid pass's live and reset cells (EyeGrid::live, an indirect dispatch)
-  // instead of every cell of the padded grid.
+  // TAA) run over the cells of the grid pass's live and reset tiles (EyeGrid::live, an
+  // indirect dispatch) instead of every cell of the padded grid.
   bool live_cells = false;
   bool block_offsets = true;     // 16 static block-grid displacements
   bool blur = true;              // peripheral blur

@@ -1,7 +1,7 @@
 #pragma once
 // The grid path tracer: traces one eye's per-sample rays of any sample grid (a storage
 // buffer of shaders::GridSample, index = row * columns + column, cells with flags != 0
-// skipped, or only the live cells listed by the grid pass) and writes per-cell fp32 outputs
+// skipped, or only the tiles with a sample listed by the grid pass) and writes per-cell fp32 outputs
 // in the same layout (pt_trace.h):
 // demodulated radiance split into direct+specular and indirect diffuse, albedo, shading
 // normal + linear depth, world position + material id, and plain radiance.
@@ -28,9 +28,10 @@ namespace fovea::renderer {
 enum class TraceOrder {
   Grid,   // invocation n traces cell n: a SIMD vector runs along a row of the grid
   Tiles,  // tiles of the grid, each SIMD vector down one column (pt_order.h); needs the grid's extents
-  // The grid pass's live cells (gpu::GridPass::live_cells(), bound with the outputs), an
-  // indirect dispatch: no thread starts for a cell without a sample, whose outputs then stay
-  // as they were (the frame pipeline reads none of them).
+  // The grid pass's live tiles (gpu::GridPass::live_cells(), bound with the outputs), an
+  // indirect dispatch of a workgroup per tile with a sample, each in tile order: no workgroup
+  // starts for a tile without one, and the outputs of cells without a sample stay as they
+  // were (the frame pipeline reads none of them).
   Live,
 };
 
@@ -88,7 +89,7 @@ class TraceOutputs {
   friend class PathTracer;
   std::uint32_t cells_ = 0;
   GridExtent extent_;                   // zero when bound by cell count: grid order only
-  const gpu::Buffer* live_ = nullptr;   // the grid pass's live-cell list (live order), or none
+  const gpu::Buffer* live_ = nullptr;   // the grid pass's live-tile list (live order), or none
   gpu::Buffer direct_, indirect_, albedo_, normal_depth_, position_material_, radiance_;
   gpu::DescriptorSet set_;
 };
@@ -104,7 +105,7 @@ class PathTracer {
   // only), or of `extent.columns * extent.rows` cells laid out row by row (either order;
   // tile order needs extents that are whole tiles: core::SampleDistribution's padded ones).
   TraceOutputs bind(const gpu::Buffer& grid, std::uint32_t cells) const;
-  // `live`: the grid pass's live-cell list of this grid (live order); it must outlive the outputs.
+  // `live`: the grid pass's live-tile list of this grid (live order); it must outlive the outputs.
   TraceOutputs bind(const gpu::Buffer& grid, GridExtent extent, const gpu::Buffer* live = nullptr) const;
 
   // Records one frame (split into dispatches of at most kPtMaxSppPerDispatch samples).

@@ -1,48 +1,68 @@
-// The live-cell list of a sample grid (gpu::GridPass, docs/renderer.md "Live cells"): the
-// grid pass lists the cells it gives a sample (flags 0), so that the per-cell kernels start a
-// thread for those alone, and, from the back of the list, the cells it gave none this frame
-// though it gave them one in either of the two frames before ("reset" cells): the
-// reconstruction writes those once more, so that every per-cell buffer (double-buffered ones
-// included) holds the empty values of a cell without a sample, and a cell that stays without
-// one is never dispatched again. Shared C++/GLSL.
+// The live tiles of a sample grid (gpu::GridPass, docs/renderer.md "Live cells"): the grid
+// pass lists the tiles of kPtTileColumns × kPtTileRows cells that hold a cell with a sample
+// (flags 0), so that the per-cell kernels start a workgroup for those tiles alone, and after
+// them the tiles without one that hold a "reset" cell: one without a sample
+// this frame that had one in either of the two frames before. The reconstruction writes those
+// once more, so that every per-cell buffer (double-buffered ones included) holds the empty
+// values of a cell without a sample, and a tile that stays without samples is never
+// dispatched again. A workgroup takes one tile (live_tile_cell). Shared C++/GLSL.
 //
-// The buffer: kLiveHeaderWords header words, then one cell index per list entry (capacity:
-// the grid's cells). Live entries from the front, in tile order (pt_order.h: each run of
-// kPtTileRows entries one column of a tile, down the rows, as far as its cells are live);
-// the reset entries from the back (entry k at header + capacity - 1 - k).
+// The buffer: kLiveHeaderWords header words, then one tile index (row of tiles × tiles across
+// + tile column) per entry, capacity one per tile: the live tiles, then the reset tiles, each
+// in tile order (shaders/grid_live_list.comp).
 #ifndef FOVEA_SHADERS_LIVE_CELLS_H
 #define FOVEA_SHADERS_LIVE_CELLS_H
 #include "fovea/shaders/common.h"
+#include "fovea/shaders/pt_order.h"
 
 #ifdef __cplusplus
 namespace fovea::shaders {
 #endif
 
-FOVEA_CONST FOVEA_UINT kLiveHeaderWords = 8u;
-// Header words: a VkDispatchIndirectCommand for the live cells, their count, one for the
-// live and reset cells, the reset count. The dispatches are for workgroups of
-// kLiveGroupSize invocations, folded into rows like gpu::ComputePipeline::dispatch_linear.
-FOVEA_CONST FOVEA_UINT kLiveArgsLive = 0u;      // word offset of the live cells' dispatch
+FOVEA_CONST FOVEA_UINT kLiveHeaderWords = 12u;
+// Header words: a VkDispatchIndirectCommand for the live tiles (a workgroup each, folded into
+// rows like gpu::ComputePipeline::dispatch_linear), their count, one for the live and reset
+// tiles, the reset count and the grid's tiles across.
+FOVEA_CONST FOVEA_UINT kLiveArgsLive = 0u;  // word offset of the live tiles' dispatch
 FOVEA_CONST FOVEA_UINT kLiveCount = 3u;
-FOVEA_CONST FOVEA_UINT kLiveArgsChanged = 4u;   // word offset of the live + reset cells' dispatch
+FOVEA_CONST FOVEA_UINT kLiveArgsChanged = 4u;  // word offset of the live + reset tiles' dispatch
 FOVEA_CONST FOVEA_UINT kLiveResetCount = 7u;
-FOVEA_CONST FOVEA_UINT kLiveGroupSize = 64u;
+FOVEA_CONST FOVEA_UINT kLiveTilesAcross = 8u;
+FOVEA_CONST FOVEA_UINT kLiveTileCells = kPtTileColumns * kPtTileRows;  // = the kernels' workgroup size
 
 // The grid pass's counters (host-visible, zeroed by the host before each frame).
 struct GridCounts {
   FOVEA_UINT live;    // cells with a sample (flags 0)
   FOVEA_UINT hidden;  // cells only the hidden-area mask skipped (flags kCellHidden)
   FOVEA_UINT reset;   // cells without a sample now that had one in either frame before
-  FOVEA_UINT pad;
+  FOVEA_UINT tiles, tiles_across;  // the grid's (set by the host)
+  FOVEA_UINT pad0, pad1, pad2;
 };
+
+// A tile's bits (grid_generate.comp's per-tile word, zero between frames): a live cell, a
+// reset cell.
+FOVEA_CONST FOVEA_UINT kTileLive = 1u;
+FOVEA_CONST FOVEA_UINT kTileReset = 2u;
 
 // A cell's liveness over the frames (the grid pass's per-cell history word): bit 0 this
 // frame, bit 1 the frame before. New buffers start at kLiveAllBefore, so that every cell
 // without a sample is reset in the first two frames.
 FOVEA_CONST FOVEA_UINT kLiveAllBefore = 3u;
 
+// The cell of lane l of tile t, in a grid of `tiles_across` tiles per row (index = row *
+// columns + column): down the tile's columns (the trace: a SIMD vector's rays are neighbours
+// in φ on a polar grid), or with `along_rows` along its rows (the reconstruction's kernels,
+// which read and write per-cell buffers: a vector's cells are then adjacent in memory).
+FOVEA_FN FOVEA_UINT live_tile_cell(FOVEA_UINT t, FOVEA_UINT l, FOVEA_UINT tiles_across, bool along_rows) {
+  const FOVEA_UINT across = along_rows ? l % kPtTileColumns : l / kPtTileRows;
+  const FOVEA_UINT down = along_rows ? l / kPtTileColumns : l % kPtTileRows;
+  const FOVEA_UINT column = (t % tiles_across) * kPtTileColumns + across;
+  const FOVEA_UINT row = (t / tiles_across) * kPtTileRows + down;
+  return row * tiles_across * kPtTileColumns + column;
+}
+
 #ifdef __cplusplus
-static_assert(sizeof(GridCounts) == 16);
+static_assert(sizeof(GridCounts) == 32);
 }  // namespace fovea::shaders
 #else
 #ifdef LIVE_CELLS_LAYOUT
@@ -52,23 +72,25 @@ LIVE_CELLS_LAYOUT uniform utextureBuffer live_list;
 
 const uint kNoLiveCell = 0xFFFFFFFFu;
 
-// The cell of list entry n (FOVEA_LINEAR_INVOCATION of an indirect dispatch from the
-// header), or kNoLiveCell past the end: the live cells, then with `with_reset` the reset
-// ones. `capacity`: the grid's cells.
-uint live_cell(uint n, uint capacity, bool with_reset) {
-  const uint live = texelFetch(live_list, int(kLiveCount)).x;
-  if (n < live) return texelFetch(live_list, int(kLiveHeaderWords + n)).x;
-  n -= live;
-  if (!with_reset || n >= texelFetch(live_list, int(kLiveResetCount)).x) return kNoLiveCell;
-  return texelFetch(live_list, int(kLiveHeaderWords + capacity - 1u - n)).x;
+// The cell this invocation takes in an indirect dispatch from the header (one workgroup of
+// kLiveTileCells per entry), or kNoLiveCell past the end: the live tiles, then with
+// `with_reset` the reset ones. A cell without a sample in a listed tile is taken too.
+// `along_rows`: live_tile_cell's.
+uint live_cell(bool with_reset, bool along_rows) {
+  const uint n = gl_WorkGroupID.y * gl_NumWorkGroups.x + gl_WorkGroupID.x;
+  uint entries = texelFetch(live_list, int(kLiveCount)).x;
+  if (with_reset) entries += texelFetch(live_list, int(kLiveResetCount)).x;
+  if (n >= entries) return kNoLiveCell;
+  return live_tile_cell(texelFetch(live_list, int(kLiveHeaderWords + n)).x, gl_LocalInvocationIndex,
+                        texelFetch(live_list, int(kLiveTilesAcross)).x, along_rows);
 }
 
-// The cell this invocation of a per-cell kernel takes, or kNoLiveCell: with `listed` the
-// list's live cells, then its reset ones (an indirect dispatch from kLiveArgsChanged), else
-// cell n of a dispatch_linear over all `cells`. After the shader's local_size declaration.
+// The cell this invocation of a per-cell kernel takes, or kNoLiveCell: with `listed` a cell of
+// the live and reset tiles (an indirect dispatch from kLiveArgsChanged), else cell n of a
+// dispatch_linear over all `cells`. After the shader's local_size declaration.
 uint cell_of_invocation(uint cells, bool listed) {
+  if (listed) return live_cell(true, true);
   const uint n = FOVEA_LINEAR_INVOCATION;
-  if (listed) return live_cell(n, cells, true);
   return n < cells ? n : kNoLiveCell;
 }
 #endif
