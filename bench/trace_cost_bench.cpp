@@ -2,8 +2,8 @@
 // (docs/reconstruction-history.md, "Whole frame on fove0"): the `default` scene on a display preset
 // with the lens' hidden area skipped, gaze at the centre, both eyes, the default
 // reconstruction with stereo gather. Per configuration and trace order (grid: cell n in
-// invocation n; tiles: pt_order.h; live: the live-cell list) it prints the grid's cells and traced cells, and how the
-// path tracer's invocations fall into SIMD vectors of LANES lanes: vectors with a traced cell
+// invocation n; tiles: pt_order.h; live: the grid pass's live tiles) it prints the grid's
+// cells and traced cells, and how the path tracer's invocations fall into SIMD vectors of LANES lanes: vectors with a traced cell
 // ("busy"), those among them that also hold skipped cells ("mixed": a SIMD device such as
 // lavapipe pays a vector's slowest lane for all its lanes), and the mean diagonal of the
 // display box a busy vector's samples span (how far apart the rays it traces in lockstep
@@ -71,9 +71,9 @@ Vectors vectors(const std::vector<fovea::shaders::GridSample>& grid, std::size_t
     glm::vec2 lo(1e30f), hi(-1e30f);
     int traced = 0, n = 0;
     for (std::size_t i = start; i < std::min(invocations, start + lanes); ++i, ++n) {
-      const auto cell = order == fr::TraceOrder::Live    ? live[i]
-                        : order == fr::TraceOrder::Tiles ? fovea::shaders::pt_tile_cell(std::uint32_t(i), columns, cells)
-                                                         : i;
+      std::size_t cell = i;
+      if (order == fr::TraceOrder::Live) cell = live[i];
+      if (order == fr::TraceOrder::Tiles) cell = fovea::shaders::pt_tile_cell(std::uint32_t(i), columns, cells);
       const auto& g = grid[cell];
       if (g.flags != 0) continue;
       ++traced;
@@ -178,8 +178,8 @@ int run(int argc, char** argv) {
       if (round == 0) {
         const auto grid = p.grid_samples(fc::Eye::Left);
         for (const fr::TraceOrder o : orders) {
-          const Vectors v = vectors(grid, std::size_t(lanes), o, std::uint32_t(p.distribution(fc::Eye::Left).padded_columns()),
-                                    fp::testing::live_cells(p, fc::Eye::Left));
+          const auto columns = std::uint32_t(p.distribution(fc::Eye::Left).padded_columns());
+          const Vectors v = vectors(grid, std::size_t(lanes), o, columns, fp::testing::live_cells(p, fc::Eye::Left));
           std::printf("| %s | %s | %zu | %lld | %ld | %ld | %.1f |\n", c.name().c_str(), order_name(o), grid.size(),
                       static_cast<long long>(p.traced_cells(fc::Eye::Left)), v.busy, v.mixed, v.extent_px);
         }

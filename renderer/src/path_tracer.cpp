@@ -47,7 +47,8 @@ TraceOutputs PathTracer::bind(const gpu::Buffer& grid, GridExtent extent, const 
   if (extent.columns == 0 || extent.rows == 0 || std::uint64_t(extent.columns) * extent.rows > 0xFFFFFFFFu)
     throw core::InputError("path tracer: grid extent " + std::to_string(extent.columns) + "x" +
                            std::to_string(extent.rows) + " out of range");
-  if (live && live->size() < (VkDeviceSize(shaders::kLiveHeaderWords) + extent.columns * extent.rows / shaders::kLiveTileCells) * 4)
+  const VkDeviceSize tiles = VkDeviceSize(extent.columns) * extent.rows / shaders::kLiveTileCells;
+  if (live && live->size() < (shaders::kLiveHeaderWords + tiles) * sizeof(std::uint32_t))
     throw core::InputError("path tracer: the live-tile list holds fewer entries than the grid's tiles");
   TraceOutputs o = bind(grid, extent.columns * extent.rows);
   o.extent_ = extent;
@@ -106,7 +107,8 @@ void PathTracer::record(VkCommandBuffer cmd, TraceOutputs& out, const core::View
   p.pixel_ty = float((view.tan_up() - view.tan_down()) / view.height());
   p.columns = out.extent_.columns;
   const bool tiles = c.order == TraceOrder::Tiles, listed = c.order == TraceOrder::Live;
-  if (listed && !out.live_) throw core::InputError("path tracer: live order needs the grid pass's live-cell list bound");
+  if (listed && !out.live_)
+    throw core::InputError("path tracer: live order needs the grid pass's live-tile list bound");
   if (tiles && (out.extent_.columns == 0 || out.extent_.columns % shaders::kPtTileColumns != 0 ||
                 out.extent_.rows % shaders::kPtTileRows != 0))
     throw core::InputError("path tracer: tile order needs a grid of whole " + std::to_string(shaders::kPtTileColumns) +

@@ -154,7 +154,8 @@ TEST_F(GpuTest, GridPassListsLiveAndResetTiles) {
       gpu::GridPass pass(ctx(), 0, ballot);
       gpu::Buffer out(ctx(), {.size = gpu::GridPass::samples_bytes(*d), .memory = gpu::Memory::HostVisible});
       std::vector<std::uint32_t> history(cells, shaders::kLiveAllBefore);
-      const glm::dvec3 gazes[] = {{0, 0, -1}, {0, 0, -1}, {0, 0, -1}, {0.3, -0.2, -1}, {-0.4, 0.1, -1}, {-0.4, 0.1, -1}};
+      const glm::dvec3 gazes[] = {{0, 0, -1},      {0, 0, -1},       {0, 0, -1},
+                                  {0.3, -0.2, -1}, {-0.4, 0.1, -1}, {-0.4, 0.1, -1}};
       for (std::uint32_t f = 0; f < std::size(gazes); ++f) {
         d->set_frame(glm::normalize(gazes[f]), 7);  // one frame index: the moves alone change the cells
         pass.generate(*d, out, mask.words());
@@ -190,8 +191,9 @@ TEST_F(GpuTest, GridPassListsLiveAndResetTiles) {
         const std::vector<std::uint32_t> got_reset(entries + live.size(), entries + live.size() + reset.size());
         EXPECT_EQ(got_live, live) << what << " frame " << f;
         EXPECT_EQ(got_reset, reset) << what << " frame " << f;
+        const std::uint64_t changed = live.size() + reset.size();
         for (const auto& [at, groups] : {std::pair{shaders::kLiveArgsLive, std::uint64_t(live.size())},
-                                         std::pair{shaders::kLiveArgsChanged, std::uint64_t(live.size() + reset.size())}}) {
+                                         std::pair{shaders::kLiveArgsChanged, changed}}) {
           const std::uint64_t x = header[at], y = header[at + 1];
           EXPECT_EQ(header[at + 2], 1u);
           EXPECT_LE(x, max_x);

@@ -147,7 +147,8 @@ TEST_F(GpuTest, FramePipelineTraceOrderChangesNoBufferOrImage) {
     core::DistributionParams dp;
     dp.kind = kind;
     const auto masked = [&](pipeline::FramePipeline& p) {
-      for (core::Eye e : {core::Eye::Left, core::Eye::Right}) p.set_visibility(e, core::EyeOptics(display, e).view_mask());
+      for (core::Eye e : {core::Eye::Left, core::Eye::Right})
+        p.set_visibility(e, core::EyeOptics(display, e).view_mask());
     };
     pipeline::FramePipeline a(ctx(), gs, core::stereo_views(display), dp, settings);
     masked(a);
