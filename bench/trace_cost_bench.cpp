@@ -7,15 +7,16 @@
 // ("busy"), those among them that also hold skipped cells ("mixed": a SIMD device such as
 // lavapipe pays a vector's slowest lane for all its lanes), and the mean diagonal of the
 // display box a busy vector's samples span (how far apart the rays it traces in lockstep
-// start). Then per round and configuration the second frame's GPU ms: trace, the trace
+// start). Then per round and configuration the third frame's GPU ms: trace, the trace
 // again alone in the order the pipeline picks (live: the grid pass's live cells, docs/renderer.md
 // "Live cells") and in the other one (every cell; testing::time_trace,
 // GPU and process CPU ms), the reconstruction kernels (timed again one submission each,
 // testing::time_reconstruct) with each one's process CPU / GPU time (how many of lavapipe's
 // threads were busy on average: 2 for a dispatch split evenly), resolve and frame, and the
 // trace ms per 1000 traced samples; last, the same frames in a pipeline that dispatches every
-// cell (the other order; the reconstruction's per-cell kernels over all cells): its trace,
-// reconstruction and frame GPU ms.
+// cell (the other order; the reconstruction's per-cell kernels over all cells) and in one
+// with the reconstruction over the live tiles too (a GPU's default; a CPU device's is every
+// cell): their trace, reconstruction and frame GPU ms.
 // Rounds interleave the configurations, so load on a shared machine spreads over all of
 // them; compare configurations within a round.
 //   fovea_bench_trace_cost [DISPLAY [ROUNDS [LANES]]]     defaults: fove0 1 8
@@ -54,6 +55,8 @@ struct Config {
     return n;
   }
 };
+
+constexpr std::uint32_t kTimedFrame = 2;  // frames 0 and 1 before it
 
 struct Vectors {
   long busy = 0, mixed = 0;
@@ -147,12 +150,13 @@ int run(int argc, char** argv) {
       if (c.budget > 0) dp.budget = c.budget;
       fp::FramePipeline p(ctx, gs, fc::stereo_views(display), dp, settings);
       for (fc::Eye e : {fc::Eye::Left, fc::Eye::Right}) p.set_visibility(e, fc::EyeOptics(display, e).view_mask());
-      // Frame 0 has no history (and its dispatches compile the shaders); the second frame is
-      // the one a running session pays. Its trace is then timed again alone in both orders,
-      // twice each (ABBA, A alternating between rounds): GPU ms, and the process's CPU ms,
-      // which other processes on a shared machine inflate less than elapsed time.
-      p.render(poses, {gaze, gaze}, 0);
-      const fp::FrameTimes t = p.render(poses, {gaze, gaze}, 1);
+      // Frame 0 has no history (and its dispatches compile the shaders), and the first two
+      // frames reconstruct every tile (the live tiles' reset rule, docs/renderer.md "Live
+      // cells"); the third is the one a running session pays. Its trace is then timed again
+      // alone in both orders, twice each (ABBA, A alternating between rounds): GPU ms, and the
+      // process's CPU ms, which other processes on a shared machine inflate less than elapsed time.
+      for (std::uint32_t f = 0; f < kTimedFrame; ++f) p.render(poses, {gaze, gaze}, f);
+      const fp::FrameTimes t = p.render(poses, {gaze, gaze}, kTimedFrame);
       const fr::TraceOrder picked = fp::testing::trace_order(p, fc::Eye::Left);
       // The other: every cell dispatched, in tile order on polar grids, grid order on rasters.
       const bool polar = p.distribution(fc::Eye::Left).gpu_params().family != fovea::shaders::kFamilyCartesian;
@@ -161,19 +165,23 @@ int run(int argc, char** argv) {
       const double load0 = load_average();
       for (int k = 0; k < 4; ++k) {
         const int which = ((k == 0 || k == 3) ? 0 : 1) ^ int(round % 2);
-        const fp::testing::KernelTime kt = fp::testing::time_trace(p, 1, orders[which]);
+        const fp::testing::KernelTime kt = fp::testing::time_trace(p, kTimedFrame, orders[which]);
         trace[which].gpu_ms += 0.5 * kt.gpu_ms;
         trace[which].cpu_ms += 0.5 * kt.cpu_ms;
       }
       const double load1 = load_average();
-      const fp::testing::ReconKernelTimes r = fp::testing::time_reconstruct(p, 1);
+      const fp::testing::ReconKernelTimes r = fp::testing::time_reconstruct(p, kTimedFrame);
       // The same frames with every cell dispatched (the other order, and the reconstruction's
-      // per-cell kernels over all cells): what the live-cell list saves in the whole frame.
-      fp::FramePipeline q(ctx, gs, fc::stereo_views(display), dp, settings);
-      for (fc::Eye e : {fc::Eye::Left, fc::Eye::Right}) q.set_visibility(e, fc::EyeOptics(display, e).view_mask());
-      fp::testing::set_trace_order(q, orders[1]);
-      q.render(poses, {gaze, gaze}, 0);
-      const fp::FrameTimes all = q.render(poses, {gaze, gaze}, 1);
+      // per-cell kernels over all cells), and with the live tiles for the reconstruction too
+      // (a GPU's default): what the live-tile list saves in the whole frame.
+      const auto frame_in_order = [&](fr::TraceOrder order) {
+        fp::FramePipeline q(ctx, gs, fc::stereo_views(display), dp, settings);
+        for (fc::Eye e : {fc::Eye::Left, fc::Eye::Right}) q.set_visibility(e, fc::EyeOptics(display, e).view_mask());
+        fp::testing::set_trace_order(q, order);
+        for (std::uint32_t f = 0; f < kTimedFrame; ++f) q.render(poses, {gaze, gaze}, f);
+        return q.render(poses, {gaze, gaze}, kTimedFrame);
+      };
+      const fp::FrameTimes all = frame_in_order(orders[1]), live = frame_in_order(fr::TraceOrder::Live);
       const long long traced = p.traced_cells(fc::Eye::Left) + p.traced_cells(fc::Eye::Right);
       if (round == 0) {
         const auto grid = p.grid_samples(fc::Eye::Left);
@@ -188,26 +196,27 @@ int run(int argc, char** argv) {
       std::snprintf(row, sizeof row,
                     "| %ld | %s | %.2f → %.2f | %.0f | %s | %.0f / %.0f | %s | %.0f / %.0f | %.3f / %.3f | %.0f | %.0f |"
                     " %.0f | %.0f | %.0f | %.2f / %.2f / %.2f / %.2f / %.2f | %.0f | %.0f | %.0f | %.2f |"
-                    " %.0f / %.0f / %.0f |",
+                    " %.0f / %.0f / %.0f | %.0f / %.0f / %.0f |",
                     round + 1, c.name().c_str(), load0, load1, t.trace.gpu_ms, order_name(orders[0]), trace[0].gpu_ms,
                     trace[0].cpu_ms, order_name(orders[1]), trace[1].gpu_ms, trace[1].cpu_ms,
                     trace[1].gpu_ms / trace[0].gpu_ms, trace[1].cpu_ms / trace[0].cpu_ms, r.accumulate.gpu_ms,
                     r.share.gpu_ms, r.fit.gpu_ms, r.post.gpu_ms, r.taa.gpu_ms, threads_busy(r.accumulate), threads_busy(r.share), threads_busy(r.fit),
                     threads_busy(r.post), threads_busy(r.taa), t.reconstruct.gpu_ms, t.resolve.gpu_ms,
                     t.gpu_ms(), 1000.0 * t.trace.gpu_ms / double(traced), all.trace.gpu_ms, all.reconstruct.gpu_ms,
-                    all.gpu_ms());
+                    all.gpu_ms(), live.trace.gpu_ms, live.reconstruct.gpu_ms, live.gpu_ms());
       rows.emplace_back(row);
       std::fprintf(stderr, "%s\n", row);  // progress: a round of fove0 takes minutes under load
       std::fflush(stdout);
     }
-  std::printf("\nGPU ms of the second frame, both eyes; its trace again alone in the order the pipeline picks"
+  std::printf("\nGPU ms of the third frame, both eyes; its trace again alone in the order the pipeline picks"
               " and in the other one (GPU / process CPU ms, mean of 2), the reconstruction kernels one submission each\n");
   std::printf("| round | configuration | load | trace (frame) | order picked | trace GPU / CPU | other order |"
               " trace GPU / CPU | other / picked, GPU / CPU | accumulate | share | BMFR fit | post | TAA |"
               " CPU / GPU ms, accumulate / share / fit / post / TAA |"
               " reconstruct (frame) | resolve | frame | trace ms per 1000 samples |"
-              " every cell dispatched: trace / reconstruct / frame |\n"
-              "|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|\n");
+              " every cell dispatched: trace / reconstruct / frame |"
+              " live tiles for the reconstruction too: trace / reconstruct / frame |\n"
+              "|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|\n");
   for (const auto& row : rows) std::printf("%s\n", row.c_str());
   return 0;
 }

@@ -6,7 +6,7 @@
 // nobody reads the grid back for them, and lists the live and reset cells (live_cells.h).
 //
 // One workgroup per tile of kPtTileColumns × kPtTileRows cells, invocation l at column
-// l / kPtTileRows, row l % kPtTileRows of its tile (live_tile_cell down the columns). Each
+// l / kPtTileRows, row l % kPtTileRows of its tile (live_tile_cell). Each
 // subgroup sets its tile's bits (a live cell, a reset cell: live_cells.h) with one atomic,
 // from which grid_live_list.comp lists the tiles; no barrier: a workgroup-wide sum in shared
 // memory needs barriers, which doubled this pass's time on lavapipe (fove0: 345 -> 703 ms).
@@ -60,7 +60,8 @@ void main() {
   // The grid is whole tiles (gpu::GridPass checks) and a workgroup one tile: every
   // invocation has a cell and takes part in its subgroup's ballots.
   const uint tile = gl_WorkGroupID.y * gl_NumWorkGroups.x + gl_WorkGroupID.x;
-  const uint idx = live_tile_cell(tile, gl_LocalInvocationIndex, gl_NumWorkGroups.x, false);
+  const uint first = gl_WorkGroupID.y * kPtTileRows * P.padded_columns + gl_WorkGroupID.x * kPtTileColumns;
+  const uint idx = live_tile_cell(first, gl_LocalInvocationIndex, P.padded_columns);
   GridSample s = gm_sample(idx % P.padded_columns, idx / P.padded_columns, vec2(P.jitter_u, P.jitter_v));
   if (s.flags == 0u && P.has_mask > 0.5) {
     // The view pixel containing the sample, clamped into the raster (ViewMask::visible_at).

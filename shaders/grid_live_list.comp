@@ -49,8 +49,8 @@ void main() {
   }
   for (uint t = first; t < last; ++t) {
     const uint s = tile_state[t];
-    if ((s & kTileLive) != 0u) list[live_before++] = t;
-    else if (s == kTileReset) list[live_all + reset_before++] = t;
+    if ((s & kTileLive) != 0u) list[live_before++] = live_tile_first(t, counts.tiles_across);
+    else if (s == kTileReset) list[live_all + reset_before++] = live_tile_first(t, counts.tiles_across);
     tile_state[t] = 0u;
   }
   if (l == 0u) {
@@ -58,6 +58,6 @@ void main() {
     header[kLiveCount] = live_all;
     write_args(kLiveArgsChanged, live_all + reset_all);
     header[kLiveResetCount] = reset_all;
-    header[kLiveTilesAcross] = counts.tiles_across;
+    header[kLiveColumns] = counts.tiles_across * kPtTileColumns;
   }
 }

@@ -29,7 +29,7 @@ layout(std430, set = 0, binding = 11) buffer OutNormalDepth { vec4 out_normal_de
 layout(std430, set = 0, binding = 12) buffer OutPosMat { vec4 out_position_material[]; };
 layout(std430, set = 0, binding = 13) buffer OutRadiance { vec4 out_radiance[]; };
 layout(set = 0, binding = 14) uniform textureBuffer ggx_albedo;  // read by pt_sampling.h
-#define LIVE_CELLS_LAYOUT layout(set = 0, binding = 15)
+#define LIVE_CELLS_LAYOUT layout(std430, set = 0, binding = 15)
 #include "fovea/shaders/live_cells.h"
 layout(push_constant) uniform Params { PtFrameParams pc; };
 // What the scene uses (PathTracer sets them from GpuScene::features()); false removes the
@@ -315,7 +315,7 @@ void main() {
   uint idx;
   const bool listed = (pc.flags & kPtLiveList) != 0u;
   if (listed) {
-    idx = live_cell(false, false);
+    idx = live_cell(false);
     if (idx == kNoLiveCell || cells[idx].flags != 0u) return;
   } else {
     if (invocation >= pc.cell_count) return;

@@ -50,7 +50,7 @@ layout(std430, binding = RECON_ACC_OUT_ALBEDO) writeonly buffer AccAlbedo { vec4
 #include "fovea/shaders/recon_map.h"
 
 layout(push_constant) uniform Push { ReconAccumulatePush pc; };
-#define LIVE_CELLS_LAYOUT layout(binding = RECON_ACC_LIVE)
+#define LIVE_CELLS_LAYOUT layout(std430, binding = RECON_ACC_LIVE)
 #include "fovea/shaders/live_cells.h"
 
 // Whether the previous frame saw the sample's surface (rg_tap_valid) in cell j of mapping m

@@ -35,7 +35,7 @@ layout(binding = RECON_POST_EXCESS) uniform textureBuffer excess;  // unread wit
 layout(std430, binding = RECON_POST_SUM) writeonly buffer Sum { vec4 sum[]; };          // TAA's input
 
 layout(push_constant) uniform Push { ReconPostPush pc; };
-#define LIVE_CELLS_LAYOUT layout(binding = RECON_POST_LIVE)
+#define LIVE_CELLS_LAYOUT layout(std430, binding = RECON_POST_LIVE)
 #include "fovea/shaders/live_cells.h"
 
 void main() {

@@ -35,7 +35,7 @@ layout(binding = RECON_SHARE_LUTS) uniform utextureBuffer radius_luts;
 #include "fovea/shaders/recon_map.h"
 
 layout(push_constant) uniform Push { ReconSharePush pc; };
-#define LIVE_CELLS_LAYOUT layout(binding = RECON_SHARE_LIVE)
+#define LIVE_CELLS_LAYOUT layout(std430, binding = RECON_SHARE_LIVE)
 #include "fovea/shaders/live_cells.h"
 
 // Whether cell i's area straddles a surface edge: a 3×3 grid neighbour (this frame's samples)

@@ -71,7 +71,7 @@ layout(binding = RECON_TAA_RESTART) uniform textureBuffer restart;  // Phase I's
 #include "fovea/shaders/recon_map.h"
 
 layout(push_constant) uniform Push { ReconPostPush pc; };
-#define LIVE_CELLS_LAYOUT layout(binding = RECON_TAA_LIVE)
+#define LIVE_CELLS_LAYOUT layout(std430, binding = RECON_TAA_LIVE)
 #include "fovea/shaders/live_cells.h"
 
 const float kCentreSigma = 0.25;

@@ -46,8 +46,7 @@ void GridPass::reserve(std::uint32_t cells) {
   capacity_ = (cells + shaders::kLiveTileCells - 1) / shaders::kLiveTileCells;  // tiles
   list_ = Buffer(*ctx_, {.size = (VkDeviceSize(shaders::kLiveHeaderWords) + capacity_) * sizeof(std::uint32_t),
                          .usage = BufferUsage::Storage | BufferUsage::Indirect,
-                         .name = "grid live cells",
-                         .texel_format = VK_FORMAT_R32_UINT});
+                         .name = "grid live cells"});
   history_ = Buffer(*ctx_, {.size = VkDeviceSize(capacity_) * shaders::kLiveTileCells * sizeof(std::uint32_t),
                             .name = "grid live history"});
   tile_state_ = Buffer(*ctx_, {.size = VkDeviceSize(capacity_) * sizeof(std::uint32_t), .name = "grid tile state"});

@@ -49,9 +49,10 @@ struct FramePipeline::Impl {
   Impl(gpu::Context& c, const renderer::GpuScene& scene, const renderer::PathConfig& p,
        const reconstruct::ReconSettings& s)
       : ctx(c), settings(s), path(p), tracer(c, scene), timer(c) {
-    // The reconstruction's per-cell kernels over the live tiles: on lavapipe they took
-    // 1.2–1.7× the time of a dispatch over every cell (fove0, docs/renderer.md "Live cells"),
-    // so a CPU device dispatches every cell; a GPU runs no workgroup for a tile without a sample.
+    // The reconstruction's per-cell kernels over the live tiles: on lavapipe they saved
+    // nothing consistent over a dispatch of every cell (0.89–1.24× its time, docs/renderer.md
+    // "Live cells"), so a CPU device dispatches every cell; a GPU starts no workgroup for a
+    // tile without a sample.
     settings.live_cells = c.info().type != VK_PHYSICAL_DEVICE_TYPE_CPU;
   }
 

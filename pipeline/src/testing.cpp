@@ -55,7 +55,7 @@ std::vector<std::uint32_t> live_cells(const FramePipeline& pipeline, core::Eye e
   for (std::uint32_t k = 0; k < list[shaders::kLiveCount]; ++k)
     for (std::uint32_t l = 0; l < shaders::kLiveTileCells; ++l)
       cells.push_back(
-          shaders::live_tile_cell(list[shaders::kLiveHeaderWords + k], l, list[shaders::kLiveTilesAcross], false));
+          shaders::live_tile_cell(list[shaders::kLiveHeaderWords + k], l, list[shaders::kLiveColumns]));
   return cells;
 }
 

@@ -16,13 +16,13 @@ namespace fovea::renderer {
 
 namespace {
 constexpr int kOutputs = 6;
-constexpr int kBindings = 8 + kOutputs + 2;  // scene, grid, outputs, GGX albedo table, live-cell list
+constexpr int kBindings = 8 + kOutputs + 2;  // scene, grid, outputs, GGX albedo table, live-tile list
 
 // The scene data read per ray or path vertex are texel buffers (nodes, triangles, shading,
 // materials, lights, texture texels, GGX albedo), the rest storage buffers.
 std::vector<gpu::Binding> set0_bindings() {
   std::vector<gpu::Binding> b(kBindings, gpu::Binding::StorageBuffer);
-  for (const int i : {0, 1, 2, 3, 4, 6, kBindings - 2, kBindings - 1}) b[std::size_t(i)] = gpu::Binding::TexelBuffer;
+  for (const int i : {0, 1, 2, 3, 4, 6, kBindings - 2}) b[std::size_t(i)] = gpu::Binding::TexelBuffer;
   return b;
 }
 }  // namespace
@@ -39,8 +39,7 @@ PathTracer::PathTracer(gpu::Context& ctx, const GpuScene& scene, const SceneFeat
                            {SpecConstant::boolean(shaders::kPtSpecTextures, f.textures),
                             SpecConstant::boolean(shaders::kPtSpecGlossy, f.glossy),
                             SpecConstant::boolean(shaders::kPtSpecEmitters, f.emitters)}));
-  no_list_ = gpu::Buffer(ctx, {.size = shaders::kLiveHeaderWords * sizeof(std::uint32_t), .name = "pt.no_live_list",
-                               .texel_format = VK_FORMAT_R32_UINT});
+  no_list_ = gpu::Buffer(ctx, {.size = shaders::kLiveHeaderWords * sizeof(std::uint32_t), .name = "pt.no_live_list"});
 }
 
 TraceOutputs PathTracer::bind(const gpu::Buffer& grid, GridExtent extent, const gpu::Buffer* live) const {

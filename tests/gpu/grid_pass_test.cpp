@@ -166,7 +166,8 @@ TEST_F(GpuTest, GridPassListsLiveAndResetTiles) {
         std::int64_t live_cells = 0, reset_cells = 0;
         for (std::uint32_t t = 0; t < tiles; ++t)
           for (std::uint32_t l = 0; l < shaders::kLiveTileCells; ++l) {
-            const std::uint32_t i = shaders::live_tile_cell(t, l, across, false);
+            const std::uint32_t i =
+                shaders::live_tile_cell(shaders::live_tile_first(t, across), l, std::uint32_t(d->padded_columns()));
             const bool now = grid[i].flags == 0;
             const bool reset = !now && history[i] != 0;
             live_in[t] += now ? 1 : 0;
@@ -178,11 +179,11 @@ TEST_F(GpuTest, GridPassListsLiveAndResetTiles) {
         EXPECT_EQ(f < 2, reset_cells + live_cells == cells) << what << " frame " << f;
         std::vector<std::uint32_t> live, reset;
         for (std::uint32_t t = 0; t < tiles; ++t)
-          if (live_in[t] > 0) live.push_back(t);
-          else if (reset_in[t] > 0) reset.push_back(t);
+          if (live_in[t] > 0) live.push_back(shaders::live_tile_first(t, across));
+          else if (reset_in[t] > 0) reset.push_back(shaders::live_tile_first(t, across));
         ASSERT_EQ(header[shaders::kLiveCount], live.size()) << what << " frame " << f;
         ASSERT_EQ(header[shaders::kLiveResetCount], reset.size()) << what << " frame " << f;
-        ASSERT_EQ(header[shaders::kLiveTilesAcross], across);
+        ASSERT_EQ(header[shaders::kLiveColumns], std::uint32_t(d->padded_columns()));
         EXPECT_EQ(pass.counts().traced, live_cells);
         EXPECT_EQ(pass.counts().reset, reset_cells);
         const std::uint32_t* entries = header + shaders::kLiveHeaderWords;

@@ -50,7 +50,7 @@ class GridPass {
   Counts counts() const;
 
   // The live-tile list of the last recorded dispatch (live_cells.h): header, then the tiles;
-  // a texel buffer of R32_UINT and the indirect dispatches' arguments.
+  // a storage buffer and the indirect dispatches' arguments.
   const Buffer& live_cells() const { return list_; }
   // The next record() treats every cell as having had a sample in the two frames before, so
   // that those without one now are listed as reset (after the per-cell buffers were

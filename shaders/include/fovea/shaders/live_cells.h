@@ -7,9 +7,10 @@
 // values of a cell without a sample, and a tile that stays without samples is never
 // dispatched again. A workgroup takes one tile (live_tile_cell). Shared C++/GLSL.
 //
-// The buffer: kLiveHeaderWords header words, then one tile index (row of tiles × tiles across
-// + tile column) per entry, capacity one per tile: the live tiles, then the reset tiles, each
-// in tile order (shaders/grid_live_list.comp).
+// The buffer: kLiveHeaderWords header words, then per entry the index of the tile's first
+// cell (its top-left: row × columns + column), capacity one per tile: the live tiles, then
+// the reset tiles, each in tile order (shaders/grid_live_list.comp). A cell index, not a tile
+// index: lanes find their cell without an integer division, which lavapipe runs lane by lane.
 #ifndef FOVEA_SHADERS_LIVE_CELLS_H
 #define FOVEA_SHADERS_LIVE_CELLS_H
 #include "fovea/shaders/common.h"
@@ -22,12 +23,12 @@ namespace fovea::shaders {
 FOVEA_CONST FOVEA_UINT kLiveHeaderWords = 12u;
 // Header words: a VkDispatchIndirectCommand for the live tiles (a workgroup each, folded into
 // rows like gpu::ComputePipeline::dispatch_linear), their count, one for the live and reset
-// tiles, the reset count and the grid's tiles across.
+// tiles, the reset count and the grid's padded column count.
 FOVEA_CONST FOVEA_UINT kLiveArgsLive = 0u;  // word offset of the live tiles' dispatch
 FOVEA_CONST FOVEA_UINT kLiveCount = 3u;
 FOVEA_CONST FOVEA_UINT kLiveArgsChanged = 4u;  // word offset of the live + reset tiles' dispatch
 FOVEA_CONST FOVEA_UINT kLiveResetCount = 7u;
-FOVEA_CONST FOVEA_UINT kLiveTilesAcross = 8u;
+FOVEA_CONST FOVEA_UINT kLiveColumns = 8u;
 FOVEA_CONST FOVEA_UINT kLiveTileCells = kPtTileColumns * kPtTileRows;  // = the kernels' workgroup size
 
 // The grid pass's counters (host-visible, zeroed by the host before each frame).
@@ -49,16 +50,17 @@ FOVEA_CONST FOVEA_UINT kTileReset = 2u;
 // without a sample is reset in the first two frames.
 FOVEA_CONST FOVEA_UINT kLiveAllBefore = 3u;
 
-// The cell of lane l of tile t, in a grid of `tiles_across` tiles per row (index = row *
-// columns + column): down the tile's columns (the trace: a SIMD vector's rays are neighbours
-// in φ on a polar grid), or with `along_rows` along its rows (the reconstruction's kernels,
-// which read and write per-cell buffers: a vector's cells are then adjacent in memory).
-FOVEA_FN FOVEA_UINT live_tile_cell(FOVEA_UINT t, FOVEA_UINT l, FOVEA_UINT tiles_across, bool along_rows) {
-  const FOVEA_UINT across = along_rows ? l % kPtTileColumns : l / kPtTileRows;
-  const FOVEA_UINT down = along_rows ? l / kPtTileColumns : l % kPtTileRows;
-  const FOVEA_UINT column = (t % tiles_across) * kPtTileColumns + across;
-  const FOVEA_UINT row = (t / tiles_across) * kPtTileRows + down;
-  return row * tiles_across * kPtTileColumns + column;
+// The cell of lane l of the tile whose first cell is `first`, in a grid of `columns` columns
+// (index = row * columns + column): down the tile's columns as in the tile order (a SIMD
+// vector's cells are neighbours in φ on a polar grid). Along the rows instead (a vector's
+// cells adjacent in memory), the reconstruction's kernels took 1.5–2.7× as long on lavapipe.
+FOVEA_FN FOVEA_UINT live_tile_cell(FOVEA_UINT first, FOVEA_UINT l, FOVEA_UINT columns) {
+  return first + (l % kPtTileRows) * columns + l / kPtTileRows;
+}
+
+// The first cell of tile t (row of tiles × tiles across + tile column).
+FOVEA_FN FOVEA_UINT live_tile_first(FOVEA_UINT t, FOVEA_UINT tiles_across) {
+  return (t / tiles_across) * kPtTileRows * tiles_across * kPtTileColumns + (t % tiles_across) * kPtTileColumns;
 }
 
 #ifdef __cplusplus
@@ -66,30 +68,31 @@ static_assert(sizeof(GridCounts) == 32);
 }  // namespace fovea::shaders
 #else
 #ifdef LIVE_CELLS_LAYOUT
-// A shader that reads the list defines LIVE_CELLS_LAYOUT as its layout qualifier. A texel
-// buffer (R32_UINT): lavapipe fetches texels as one gather (docs/gpu.md, "Texel buffers").
-LIVE_CELLS_LAYOUT uniform utextureBuffer live_list;
+// A shader that reads the list defines LIVE_CELLS_LAYOUT as its layout qualifier. A storage
+// buffer: every invocation of a workgroup reads the same words.
+LIVE_CELLS_LAYOUT readonly buffer LiveList {
+  uint live_header[kLiveHeaderWords];
+  uint live_first[];
+};
 
 const uint kNoLiveCell = 0xFFFFFFFFu;
 
 // The cell this invocation takes in an indirect dispatch from the header (one workgroup of
 // kLiveTileCells per entry), or kNoLiveCell past the end: the live tiles, then with
 // `with_reset` the reset ones. A cell without a sample in a listed tile is taken too.
-// `along_rows`: live_tile_cell's.
-uint live_cell(bool with_reset, bool along_rows) {
+uint live_cell(bool with_reset) {
   const uint n = gl_WorkGroupID.y * gl_NumWorkGroups.x + gl_WorkGroupID.x;
-  uint entries = texelFetch(live_list, int(kLiveCount)).x;
-  if (with_reset) entries += texelFetch(live_list, int(kLiveResetCount)).x;
+  uint entries = live_header[kLiveCount];
+  if (with_reset) entries += live_header[kLiveResetCount];
   if (n >= entries) return kNoLiveCell;
-  return live_tile_cell(texelFetch(live_list, int(kLiveHeaderWords + n)).x, gl_LocalInvocationIndex,
-                        texelFetch(live_list, int(kLiveTilesAcross)).x, along_rows);
+  return live_tile_cell(live_first[n], gl_LocalInvocationIndex, live_header[kLiveColumns]);
 }
 
 // The cell this invocation of a per-cell kernel takes, or kNoLiveCell: with `listed` a cell of
 // the live and reset tiles (an indirect dispatch from kLiveArgsChanged), else cell n of a
 // dispatch_linear over all `cells`. After the shader's local_size declaration.
 uint cell_of_invocation(uint cells, bool listed) {
-  if (listed) return live_cell(true, true);
+  if (listed) return live_cell(true);
   const uint n = FOVEA_LINEAR_INVOCATION;
   return n < cells ? n : kNoLiveCell;
 }
