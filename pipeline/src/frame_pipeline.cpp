@@ -118,6 +118,13 @@ FramePipeline::FramePipeline(gpu::Context& ctx, const renderer::GpuScene& scene,
                      .albedo = &t.albedo(),
                      .live = &e->grid_pass->live_cells()});
   }
+  // The reconstruction's per-cell kernels over the live tiles, except for a Cartesian raster
+  // on a CPU device: lavapipe's SIMD vectors then run down a tile's column, 8 raster rows
+  // apart in memory, which took 1.27× the time of a dispatch over every cell (on a polar
+  // grid those are neighbours in φ, which the kernels read together: 0.86–1.07×;
+  // docs/renderer.md "Live cells").
+  m.settings.live_cells = m.eyes[0]->dist->gpu_params().family != shaders::kFamilyCartesian ||
+                          ctx.info().type != VK_PHYSICAL_DEVICE_TYPE_CPU;
   m.accumulation = std::make_unique<reconstruct::Accumulation>(ctx, grids, m.tracer.scene().materials());
   m.gather = std::make_unique<reconstruct::StereoGather>(ctx, grids, *m.accumulation);
   if (settings.denoiser == reconstruct::Denoiser::Bmfr)

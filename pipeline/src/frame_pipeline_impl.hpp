@@ -48,13 +48,7 @@ struct FramePipeline::Impl {
 
   Impl(gpu::Context& c, const renderer::GpuScene& scene, const renderer::PathConfig& p,
        const reconstruct::ReconSettings& s)
-      : ctx(c), settings(s), path(p), tracer(c, scene), timer(c) {
-    // The reconstruction's per-cell kernels over the live tiles: on lavapipe they saved
-    // nothing consistent over a dispatch of every cell (0.89–1.24× its time, docs/renderer.md
-    // "Live cells"), so a CPU device dispatches every cell; a GPU starts no workgroup for a
-    // tile without a sample.
-    settings.live_cells = c.info().type != VK_PHYSICAL_DEVICE_TYPE_CPU;
-  }
+      : ctx(c), settings(s), path(p), tracer(c, scene), timer(c) {}
 
   const EyeState* other(const EyeState& e) const {
     if (eyes.size() < 2) return nullptr;

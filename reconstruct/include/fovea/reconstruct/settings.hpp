@@ -71,7 +71,7 @@ struct ReconSettings {
   float still = 0;
   // Set by the frame pipeline: the per-cell kernels (accumulation, sharing, post,
   // TAA) run over the cells of the grid pass's live and reset tiles (EyeGrid::live, an
-  // indirect dispatch) instead of every cell of the padded grid. Off on CPU devices.
+  // indirect dispatch) instead of every cell of the padded grid.
   bool live_cells = false;
   bool block_offsets = true;     // 16 static block-grid displacements
   bool blur = true;              // peripheral blur

@@ -53,7 +53,7 @@ FOVEA_CONST FOVEA_UINT kLiveAllBefore = 3u;
 // The cell of lane l of the tile whose first cell is `first`, in a grid of `columns` columns
 // (index = row * columns + column): down the tile's columns as in the tile order (a SIMD
 // vector's cells are neighbours in φ on a polar grid). Along the rows instead (a vector's
-// cells adjacent in memory), the reconstruction's kernels took 1.5–2.7× as long on lavapipe.
+// cells adjacent in memory), the reconstruction's kernels took 1.0–2.8× as long on lavapipe.
 FOVEA_FN FOVEA_UINT live_tile_cell(FOVEA_UINT first, FOVEA_UINT l, FOVEA_UINT columns) {
   return first + (l % kPtTileRows) * columns + l / kPtTileRows;
 }
