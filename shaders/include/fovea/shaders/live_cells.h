@@ -9,8 +9,8 @@
 //
 // The buffer: kLiveHeaderWords header words, then per entry the index of the tile's first
 // cell (its top-left: row × columns + column), capacity one per tile: the live tiles, then
-// the reset tiles, each in tile order (shaders/grid_live_list.comp). A cell index, not a tile
-// index: lanes find their cell without an integer division, which lavapipe runs lane by lane.
+// the reset tiles, each in tile order (shaders/grid_live_list.comp). A cell index, so that
+// lanes find their cell without an integer division.
 #ifndef FOVEA_SHADERS_LIVE_CELLS_H
 #define FOVEA_SHADERS_LIVE_CELLS_H
 #include "fovea/shaders/common.h"
@@ -23,7 +23,8 @@ namespace fovea::shaders {
 FOVEA_CONST FOVEA_UINT kLiveHeaderWords = 12u;
 // Header words: a VkDispatchIndirectCommand for the live tiles (a workgroup each, folded into
 // rows like gpu::ComputePipeline::dispatch_linear), their count, one for the live and reset
-// tiles, the reset count and the grid's padded column count.
+// tiles, the reset count and the grid's padded column count (words 9-11 unused: the entries
+// start on a 16-byte boundary).
 FOVEA_CONST FOVEA_UINT kLiveArgsLive = 0u;  // word offset of the live tiles' dispatch
 FOVEA_CONST FOVEA_UINT kLiveCount = 3u;
 FOVEA_CONST FOVEA_UINT kLiveArgsChanged = 4u;  // word offset of the live + reset tiles' dispatch
