@@ -4,9 +4,9 @@
 // with the indirect dispatches (a workgroup per tile, folded into rows of at most max_groups_x
 // as evenly as the rounding allows, like gpu::ComputePipeline::dispatch_linear). Clears the
 // bits for the next frame. One workgroup; each invocation takes a contiguous part of the
-// tiles. In tile order, not in the order the tiles finished (an atomic append): the per-cell
-// kernels then sweep their buffers in order, where a scattered list made the reconstruction
-// 1.2–1.4× slower on lavapipe (docs/renderer.md, "Live cells").
+// tiles. In tile order, not in the order the tiles finished (an atomic append): the list is
+// the same from run to run, and a contiguous part of it (what llvmpipe gives one thread) is
+// one region of the grid.
 #extension GL_GOOGLE_include_directive : require
 
 layout(local_size_x = 256) in;

@@ -316,7 +316,7 @@ void main() {
   const bool listed = (pc.flags & kPtLiveList) != 0u;
   if (listed) {
     idx = live_cell(false);
-    if (idx == kNoLiveCell || cells[idx].flags != 0u) return;
+    if (idx == kNoLiveCell) return;
   } else {
     if (invocation >= pc.cell_count) return;
     idx = (pc.flags & kPtTileOrder) != 0u ? pt_tile_cell(invocation, pc.columns, pc.cell_count) : invocation;
@@ -324,6 +324,7 @@ void main() {
   const GridSample g = cells[idx];
   const bool accumulate = (pc.flags & kPtAccumulate) != 0u && pc.accumulated_samples > 0u;
   if (g.flags != 0u) {
+    if (listed) return;  // nothing reads a skipped cell's outputs in the live order
     out_direct[idx] = vec4(0.0);
     out_indirect[idx] = vec4(0.0);
     out_albedo[idx] = vec4(0.0);

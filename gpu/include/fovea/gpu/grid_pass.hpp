@@ -35,7 +35,7 @@ class GridPass {
   // ceil(W / 32) words, bit x & 31 of word y·ceil(W / 32) + x / 32), empty if none.
   void prepare(const core::SampleDistribution& d, std::span<const std::uint32_t> hidden_mask = {});
   // Records the dispatches writing into `samples` (at least samples_bytes(d) bytes) and the
-  // live-cell list. Order later reads of either with compute_to_indirect.
+  // live-tile list. Order later reads of either with compute_to_indirect.
   void record(VkCommandBuffer cmd, const Buffer& samples);
   // prepare + record in one submission, waiting for completion.
   void generate(const core::SampleDistribution& d, const Buffer& samples,

@@ -31,8 +31,8 @@ std::vector<glm::vec4> grid_buffer(const FramePipeline& p, core::Eye e, GridBuff
 // no stage reads memory the frames since have not written.
 void fill_buffers(FramePipeline& p, std::uint32_t word);
 
-// The order in which the path tracer takes eye `e`'s cells: the one the pipeline picks for the
-// distribution, or the one set_trace_order forced. set_trace_order makes it take every
+// The order in which the path tracer takes eye `e`'s cells: the live tiles (the pipeline's),
+// or the one set_trace_order forced. set_trace_order makes it take every
 // grid's cells in `order` from the next frame on, and the reconstruction's per-cell kernels
 // over the live tiles for TraceOrder::Live, over every cell for the others (whatever the
 // device); for tests and benchmarks of the order.

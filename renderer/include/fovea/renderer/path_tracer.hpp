@@ -124,7 +124,7 @@ class PathTracer {
   gpu::Context& ctx_;
   const GpuScene& scene_;
   gpu::ComputePipeline pipeline_;
-  gpu::Buffer no_list_;  // bound in place of a live-cell list (never read then)
+  gpu::Buffer no_list_;  // bound in place of a live-tile list (never read then)
 };
 
 // Cartesian grid of a view's raster, built on the CPU: one cell per pixel centre.

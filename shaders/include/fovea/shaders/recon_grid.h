@@ -52,7 +52,7 @@ FOVEA_CONST float kReconRestartFrames = 8.0f;
 
 struct ReconAccumulatePush {
   FOVEA_UINT cells, has_history, indirect_fresh;  // indirect_fresh = 0: reuse history only
-  FOVEA_UINT listed;  // 1: the cells of the live-cell list (live_cells.h), an indirect dispatch
+  FOVEA_UINT listed;  // 1: the cells of the live and reset tiles (live_cells.h), an indirect dispatch
   float alpha_min;                                     // EMA floor (BMFR Phase I: 0.2)
   float coarse_keep, coarse_reject, pad1;              // cell-size test (ReconSettings, rg_coarse_weight)
 };
