@@ -22,6 +22,7 @@
 #include <openxr/openxr_platform.h>
 
 #include "eye_gaze.hpp"
+#include "fovea/xrcommon/loader_interface.hpp"
 #include "frame_log.hpp"
 #include "frame_queue.hpp"
 #include "frame_renderer.hpp"
@@ -147,6 +148,11 @@ struct Layer {
 };
 
 Layer& layer();
+
+// What the loader negotiation hands the loader (instance.cpp).
+XrResult XRAPI_CALL get_instance_proc_addr(XrInstance instance, const char* name, PFN_xrVoidFunction* function);
+XrResult XRAPI_CALL create_api_layer_instance(const XrInstanceCreateInfo* info, const XrApiLayerCreateInfo* layer_info,
+                                              XrInstance* instance);
 
 // The next layer's table for the instance owning `session`; for an unknown session (the
 // application's mistake) the most recent instance's, so the runtime reports the error.

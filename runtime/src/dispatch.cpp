@@ -2,7 +2,7 @@
 #include <cstring>
 
 #include "api.hpp"
-#include "fovea/runtime/loader_interface.hpp"
+#include "fovea/xrcommon/loader_interface.hpp"
 #include "state.hpp"
 
 namespace fovea::runtime {

@@ -20,7 +20,7 @@
 #include <openxr/openxr.h>
 #include <openxr/openxr_platform.h>
 
-#include "fovea/runtime/loader_interface.hpp"
+#include "fovea/xrcommon/loader_interface.hpp"
 
 namespace {
 

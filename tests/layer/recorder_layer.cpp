@@ -10,7 +10,7 @@
 
 #include <openxr/openxr.h>
 
-#include "fovea/runtime/loader_interface.hpp"
+#include "fovea/xrcommon/loader_interface.hpp"
 
 namespace {
 
