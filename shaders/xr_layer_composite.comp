@@ -20,12 +20,12 @@ layout(push_constant) uniform Push {
   uint eye;
 } pc;
 
-layout(std430, set = 0, binding = 0) readonly buffer Params { LayerCompositeParams p; };
-layout(std430, set = 0, binding = 1) readonly buffer Traced { uint traced[]; };
-layout(std430, set = 0, binding = 2) readonly buffer App { uint app[]; };
-layout(std430, set = 0, binding = 3) writeonly buffer Out { uint outp[]; };
-layout(std430, set = 0, binding = 4) buffer Background { uint background[2]; };
-layout(std430, set = 0, binding = 5) readonly buffer AppDepth { uint app_depth[]; };
+layout(std430, set = 0, binding = LAYER_BINDING_PARAMS) readonly buffer Params { LayerCompositeParams p; };
+layout(std430, set = 0, binding = LAYER_BINDING_TRACED) readonly buffer Traced { uint traced[]; };
+layout(std430, set = 0, binding = LAYER_BINDING_APP) readonly buffer App { uint app[]; };
+layout(std430, set = 0, binding = LAYER_BINDING_OUT) writeonly buffer Out { uint outp[]; };
+layout(std430, set = 0, binding = LAYER_BINDING_BACKGROUND) buffer Background { uint background[2]; };
+layout(std430, set = 0, binding = LAYER_BINDING_APP_DEPTH) readonly buffer AppDepth { uint app_depth[]; };
 
 shared uint best_count[kLayerBorderGroup];
 shared uint best_key[kLayerBorderGroup];

@@ -3,18 +3,15 @@
 // usage it adds to every colour swapchain, as compositors do), never by a transfer the
 // application did not ask for: out[y * width + x] = the texel at (offset + (x, y)) of the
 // array layer, as the image view decodes it (sRGB formats to linear, BGRA swizzled).
-layout(local_size_x = 8, local_size_y = 8) in;
+#extension GL_GOOGLE_include_directive : require
+#include "fovea/shaders/xr_readback.h"
 
-layout(push_constant) uniform Push {
-  int offset_x;
-  int offset_y;
-  uint width;
-  uint height;
-  uint layer;
-} pc;
+layout(local_size_x = kReadbackGroup, local_size_y = kReadbackGroup) in;
 
-layout(set = 0, binding = 0) uniform sampler2DArray src;
-layout(std430, set = 0, binding = 1) writeonly buffer Out { vec4 texels[]; };
+layout(push_constant) uniform Push { ReadbackPush pc; };
+
+layout(set = 0, binding = READBACK_BINDING_SOURCE) uniform sampler2DArray src;
+layout(std430, set = 0, binding = READBACK_BINDING_OUT) writeonly buffer Out { vec4 texels[]; };
 
 void main() {
   uvec2 p = gl_GlobalInvocationID.xy;

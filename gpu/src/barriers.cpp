@@ -17,18 +17,23 @@ void barrier(VkCommandBuffer cmd, Access src, Access dst) {
                        dst_stage(dst), 0, 1, &b, 0, nullptr, 0, nullptr);
 }
 
-void image_barrier(VkCommandBuffer cmd, VkImage image, VkImageLayout from, VkImageLayout to, Access src, Access dst) {
+VkImageMemoryBarrier image_barrier_info(VkImage image, VkImageLayout from, VkImageLayout to, VkAccessFlags src,
+                                        VkAccessFlags dst, VkImageSubresourceRange range) {
   VkImageMemoryBarrier b{VK_STRUCTURE_TYPE_IMAGE_MEMORY_BARRIER};
-  b.srcAccessMask = src.access;
-  b.dstAccessMask = dst.access;
+  b.srcAccessMask = src;
+  b.dstAccessMask = dst;
   b.oldLayout = from;
   b.newLayout = to;
   b.srcQueueFamilyIndex = VK_QUEUE_FAMILY_IGNORED;
   b.dstQueueFamilyIndex = VK_QUEUE_FAMILY_IGNORED;
   b.image = image;
-  b.subresourceRange = {VK_IMAGE_ASPECT_COLOR_BIT, 0, 1, 0, 1};
-  vkCmdPipelineBarrier(cmd, src_stage(src),
-                       dst_stage(dst), 0, 0, nullptr, 0, nullptr, 1, &b);
+  b.subresourceRange = range;
+  return b;
+}
+
+void image_barrier(VkCommandBuffer cmd, VkImage image, VkImageLayout from, VkImageLayout to, Access src, Access dst) {
+  const VkImageMemoryBarrier b = image_barrier_info(image, from, to, src.access, dst.access);
+  vkCmdPipelineBarrier(cmd, src_stage(src), dst_stage(dst), 0, 0, nullptr, 0, nullptr, 1, &b);
 }
 
 }  // namespace fovea::gpu

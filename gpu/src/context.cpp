@@ -1,4 +1,5 @@
 #include "fovea/gpu/context.hpp"
+#include "fovea/gpu/memory_type.hpp"
 
 #include <unistd.h>
 
@@ -438,16 +439,9 @@ void Context::submit_and_wait(const std::function<void(VkCommandBuffer)>& record
 
 std::uint32_t Context::memory_type(std::uint32_t type_bits, VkMemoryPropertyFlags required,
                                    VkMemoryPropertyFlags preferred) const {
-  std::optional<std::uint32_t> fallback;
-  for (std::uint32_t i = 0; i < memory_.memoryTypeCount; ++i) {
-    if ((type_bits & (1u << i)) == 0) continue;
-    const VkMemoryPropertyFlags f = memory_.memoryTypes[i].propertyFlags;
-    if ((f & required) != required) continue;
-    if ((f & preferred) == preferred) return i;
-    if (!fallback) fallback = i;
-  }
-  if (!fallback) throw VulkanError(VK_ERROR_OUT_OF_DEVICE_MEMORY, "finding a memory type with the required properties");
-  return *fallback;
+  const auto type = find_memory_type(memory_, type_bits, required, preferred);
+  if (!type) throw VulkanError(VK_ERROR_OUT_OF_DEVICE_MEMORY, "finding a memory type with the required properties");
+  return *type;
 }
 
 VkDeviceSize Context::memory_type_heap_size(std::uint32_t index) const {

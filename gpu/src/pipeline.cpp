@@ -55,6 +55,90 @@ std::vector<std::uint32_t> spirv_words(const std::string& shader, const std::str
   return words;
 }
 
+// The creation commands of one device: the loader's for Fovea's own, the device's own table
+// for one it was handed.
+struct PipelineFunctions {
+  PFN_vkCreateShaderModule create_module = nullptr;
+  PFN_vkDestroyShaderModule destroy_module = nullptr;
+  PFN_vkCreateComputePipelines create_pipelines = nullptr;
+  PFN_vkDestroyPipeline destroy_pipeline = nullptr;
+};
+
+// One compute pipeline per specialisation from one shader module, made and destroyed here.
+// On a failure the pipelines made so far are destroyed and VulkanError is thrown.
+std::vector<VkPipeline> build_pipelines(const PipelineFunctions& f, VkDevice dev, std::span<const std::uint32_t> words,
+                                        VkPipelineLayout layout, std::span<const VkSpecializationInfo* const> specs) {
+  VkShaderModuleCreateInfo mci{VK_STRUCTURE_TYPE_SHADER_MODULE_CREATE_INFO};
+  mci.codeSize = words.size() * 4;
+  mci.pCode = words.data();
+  VkShaderModule module = VK_NULL_HANDLE;
+  check(f.create_module(dev, &mci, nullptr, &module), "vkCreateShaderModule");
+  std::vector<VkPipeline> out;
+  VkResult r = VK_SUCCESS;
+  for (const VkSpecializationInfo* spec : specs) {
+    VkComputePipelineCreateInfo pci{VK_STRUCTURE_TYPE_COMPUTE_PIPELINE_CREATE_INFO};
+    pci.stage = {VK_STRUCTURE_TYPE_PIPELINE_SHADER_STAGE_CREATE_INFO};
+    pci.stage.stage = VK_SHADER_STAGE_COMPUTE_BIT;
+    pci.stage.module = module;
+    pci.stage.pName = "main";
+    pci.stage.pSpecializationInfo = spec;
+    pci.layout = layout;
+    VkPipeline pipeline = VK_NULL_HANDLE;
+    r = f.create_pipelines(dev, VK_NULL_HANDLE, 1, &pci, nullptr, &pipeline);
+    if (r != VK_SUCCESS) break;
+    out.push_back(pipeline);
+  }
+  f.destroy_module(dev, module, nullptr);
+  if (r != VK_SUCCESS) {
+    for (VkPipeline p : out) f.destroy_pipeline(dev, p, nullptr);
+    check(r, "vkCreateComputePipelines");
+  }
+  return out;
+}
+
+// A pipeline layout with the sets in order and one compute push-constant range (none for 0).
+VkPipelineLayout build_layout(PFN_vkCreatePipelineLayout create, VkDevice dev, std::span<const VkDescriptorSetLayout> sets,
+                              std::uint32_t push_constant_bytes) {
+  const VkPushConstantRange range{VK_SHADER_STAGE_COMPUTE_BIT, 0, push_constant_bytes};
+  VkPipelineLayoutCreateInfo lci{VK_STRUCTURE_TYPE_PIPELINE_LAYOUT_CREATE_INFO};
+  lci.setLayoutCount = static_cast<std::uint32_t>(sets.size());
+  lci.pSetLayouts = sets.data();
+  lci.pushConstantRangeCount = push_constant_bytes > 0 ? 1 : 0;
+  lci.pPushConstantRanges = &range;
+  VkPipelineLayout layout = VK_NULL_HANDLE;
+  check(create(dev, &lci, nullptr, &layout), "vkCreatePipelineLayout");
+  return layout;
+}
+
+// The SPIR-V's type for a descriptor type of a layout.
+Binding binding_of(VkDescriptorType t) {
+  switch (t) {
+    case VK_DESCRIPTOR_TYPE_STORAGE_BUFFER:
+    case VK_DESCRIPTOR_TYPE_STORAGE_BUFFER_DYNAMIC: return Binding::StorageBuffer;
+    case VK_DESCRIPTOR_TYPE_UNIFORM_BUFFER:
+    case VK_DESCRIPTOR_TYPE_UNIFORM_BUFFER_DYNAMIC: return Binding::UniformBuffer;
+    case VK_DESCRIPTOR_TYPE_STORAGE_IMAGE: return Binding::StorageImage;
+    case VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER: return Binding::SampledImage;
+    case VK_DESCRIPTOR_TYPE_UNIFORM_TEXEL_BUFFER: return Binding::TexelBuffer;
+    case VK_DESCRIPTOR_TYPE_ACCELERATION_STRUCTURE_KHR: return Binding::AccelerationStructure;
+    default: throw core::InputError("descriptor type " + std::to_string(int(t)) + " is not one the pipelines bind");
+  }
+}
+
+template <class F>
+F device_function(VkDevice dev, PFN_vkGetDeviceProcAddr get, const char* name) {
+  const auto f = reinterpret_cast<F>(get(dev, name));
+  if (!f) throw VulkanError(VK_ERROR_INITIALIZATION_FAILED, std::string("the device has no ") + name);
+  return f;
+}
+
+PipelineFunctions pipeline_functions(VkDevice dev, PFN_vkGetDeviceProcAddr get) {
+  return {device_function<PFN_vkCreateShaderModule>(dev, get, "vkCreateShaderModule"),
+          device_function<PFN_vkDestroyShaderModule>(dev, get, "vkDestroyShaderModule"),
+          device_function<PFN_vkCreateComputePipelines>(dev, get, "vkCreateComputePipelines"),
+          device_function<PFN_vkDestroyPipeline>(dev, get, "vkDestroyPipeline")};
+}
+
 }  // namespace
 
 std::vector<Binding> declared_bindings(const std::string& shader, std::uint32_t set) {
@@ -91,26 +175,12 @@ ComputePipeline::ComputePipeline(Context& ctx, const ComputePipelineDesc& desc)
   check_bindings(what, words, desc.sets);
 
   const VkDevice dev = ctx.device();
-  VkShaderModuleCreateInfo mci{VK_STRUCTURE_TYPE_SHADER_MODULE_CREATE_INFO};
-  mci.codeSize = words.size() * 4;
-  mci.pCode = words.data();
-  VkShaderModule module_handle = VK_NULL_HANDLE;
-  check(vkCreateShaderModule(dev, &mci, nullptr, &module_handle), "vkCreateShaderModule");
-  const DeviceHandle<VkShaderModule, vkDestroyShaderModule> module(dev, module_handle);
-
   std::vector<VkDescriptorSetLayout> set_handles;
   for (const auto& bindings : desc.sets) {
     set_layouts_.emplace_back(ctx, bindings);
     set_handles.push_back(set_layouts_.back().handle());
   }
-  const VkPushConstantRange range{VK_SHADER_STAGE_COMPUTE_BIT, 0, desc.push_constant_bytes};
-  VkPipelineLayoutCreateInfo lci{VK_STRUCTURE_TYPE_PIPELINE_LAYOUT_CREATE_INFO};
-  lci.setLayoutCount = static_cast<std::uint32_t>(set_handles.size());
-  lci.pSetLayouts = set_handles.data();
-  lci.pushConstantRangeCount = desc.push_constant_bytes > 0 ? 1 : 0;
-  lci.pPushConstantRanges = &range;
-  VkPipelineLayout layout = VK_NULL_HANDLE;
-  check(vkCreatePipelineLayout(dev, &lci, nullptr, &layout), "vkCreatePipelineLayout");
+  const VkPipelineLayout layout = build_layout(&vkCreatePipelineLayout, dev, set_handles, desc.push_constant_bytes);
   layout_ = {dev, layout};
 
   std::vector<VkSpecializationMapEntry> entries;
@@ -120,15 +190,10 @@ ComputePipeline::ComputePipeline(Context& ctx, const ComputePipelineDesc& desc)
   for (const SpecConstant& c : desc.specialization) data.push_back(c.bits);
   VkSpecializationInfo spec{static_cast<std::uint32_t>(entries.size()), entries.data(), data.size() * 4, data.data()};
 
-  VkComputePipelineCreateInfo pci{VK_STRUCTURE_TYPE_COMPUTE_PIPELINE_CREATE_INFO};
-  pci.stage = {VK_STRUCTURE_TYPE_PIPELINE_SHADER_STAGE_CREATE_INFO};
-  pci.stage.stage = VK_SHADER_STAGE_COMPUTE_BIT;
-  pci.stage.module = module.get();
-  pci.stage.pName = "main";
-  pci.stage.pSpecializationInfo = entries.empty() ? nullptr : &spec;
-  pci.layout = layout;
-  VkPipeline pipeline = VK_NULL_HANDLE;
-  check(vkCreateComputePipelines(dev, VK_NULL_HANDLE, 1, &pci, nullptr, &pipeline), "vkCreateComputePipelines");
+  const VkSpecializationInfo* specs[1] = {entries.empty() ? nullptr : &spec};
+  const PipelineFunctions loader{&vkCreateShaderModule, &vkDestroyShaderModule, &vkCreateComputePipelines,
+                                 &vkDestroyPipeline};
+  const VkPipeline pipeline = build_pipelines(loader, dev, words, layout, specs).front();
   pipeline_ = {dev, pipeline};
   ctx.set_name(VK_OBJECT_TYPE_PIPELINE, reinterpret_cast<std::uint64_t>(pipeline), desc.shader);
 }
@@ -179,6 +244,60 @@ void ComputePipeline::dispatch_linear(VkCommandBuffer cmd, std::uint32_t count) 
                            " invocations need " + std::to_string(rows) + " rows of workgroups, more than the device's " +
                            std::to_string(max_groups_[1]));
   vkCmdDispatch(cmd, std::uint32_t(per_row), std::uint32_t(rows), 1);
+}
+
+ForeignPipelines create_foreign_pipelines(VkDevice dev, PFN_vkGetDeviceProcAddr get, const ForeignPipelineDesc& desc) {
+  const std::string what = "gpu::create_foreign_pipelines '" + desc.shader + "'";
+  const std::vector<std::uint32_t> words = spirv_words(desc.shader, what);
+  std::vector<Binding> types;
+  for (VkDescriptorType t : desc.bindings) types.push_back(binding_of(t));
+  check_bindings(what, words, {types});
+  if (desc.push_constant_bytes % 4 != 0)
+    throw core::InputError(what + ": push_constant_bytes " + std::to_string(desc.push_constant_bytes) +
+                           " is not a multiple of 4");
+  const PipelineFunctions f = pipeline_functions(dev, get);
+  const auto create_set_layout =
+      device_function<PFN_vkCreateDescriptorSetLayout>(dev, get, "vkCreateDescriptorSetLayout");
+  const auto create_layout = device_function<PFN_vkCreatePipelineLayout>(dev, get, "vkCreatePipelineLayout");
+
+  ForeignPipelines out;
+  try {
+    std::vector<VkDescriptorSetLayoutBinding> bindings;
+    for (std::uint32_t b = 0; b < desc.bindings.size(); ++b)
+      bindings.push_back({b, desc.bindings[b], 1, VK_SHADER_STAGE_COMPUTE_BIT, nullptr});
+    VkDescriptorSetLayoutCreateInfo li{VK_STRUCTURE_TYPE_DESCRIPTOR_SET_LAYOUT_CREATE_INFO};
+    li.bindingCount = std::uint32_t(bindings.size());
+    li.pBindings = bindings.data();
+    check(create_set_layout(dev, &li, nullptr, &out.set_layout), "vkCreateDescriptorSetLayout");
+    out.layout = build_layout(create_layout, dev, {&out.set_layout, 1}, desc.push_constant_bytes);
+
+    std::vector<std::vector<VkSpecializationMapEntry>> entries;
+    std::vector<VkSpecializationInfo> infos;
+    for (const std::vector<std::uint32_t>& values : desc.specializations) {
+      auto& e = entries.emplace_back();
+      for (std::uint32_t id = 0; id < values.size(); ++id) e.push_back({id, id * 4, 4});
+      infos.push_back({std::uint32_t(e.size()), e.data(), values.size() * 4, values.data()});
+    }
+    std::vector<const VkSpecializationInfo*> specs;
+    for (const VkSpecializationInfo& i : infos) specs.push_back(&i);
+    if (specs.empty()) specs.push_back(nullptr);
+    out.pipelines = build_pipelines(f, dev, words, out.layout, specs);
+  } catch (...) {
+    destroy_foreign_pipelines(dev, get, out);
+    throw;
+  }
+  return out;
+}
+
+void destroy_foreign_pipelines(VkDevice dev, PFN_vkGetDeviceProcAddr get, ForeignPipelines& p) {
+  for (VkPipeline pipeline : p.pipelines)
+    device_function<PFN_vkDestroyPipeline>(dev, get, "vkDestroyPipeline")(dev, pipeline, nullptr);
+  if (p.layout)
+    device_function<PFN_vkDestroyPipelineLayout>(dev, get, "vkDestroyPipelineLayout")(dev, p.layout, nullptr);
+  if (p.set_layout)
+    device_function<PFN_vkDestroyDescriptorSetLayout>(dev, get, "vkDestroyDescriptorSetLayout")(dev, p.set_layout,
+                                                                                                  nullptr);
+  p = {};
 }
 
 }  // namespace fovea::gpu

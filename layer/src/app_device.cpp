@@ -6,6 +6,9 @@
 #include <stdexcept>
 #include <string>
 
+#include "fovea/gpu/barriers.hpp"
+#include "fovea/gpu/memory_type.hpp"
+
 namespace fovea::layer {
 void app_check(VkResult r, const char* what) {
   if (r != VK_SUCCESS) throw std::runtime_error(std::string(what) + " failed on the application's device: VkResult " + std::to_string(int(r)));
@@ -16,15 +19,7 @@ namespace {
 VkImageMemoryBarrier image_barrier(VkImage image, std::uint32_t layer, VkImageLayout from, VkImageLayout to,
                                    VkAccessFlags src, VkAccessFlags dst,
                                    VkImageAspectFlags aspect = VK_IMAGE_ASPECT_COLOR_BIT) {
-  VkImageMemoryBarrier b{VK_STRUCTURE_TYPE_IMAGE_MEMORY_BARRIER};
-  b.srcAccessMask = src;
-  b.dstAccessMask = dst;
-  b.oldLayout = from;
-  b.newLayout = to;
-  b.srcQueueFamilyIndex = b.dstQueueFamilyIndex = VK_QUEUE_FAMILY_IGNORED;
-  b.image = image;
-  b.subresourceRange = {aspect, 0, 1, layer, 1};
-  return b;
+  return gpu::image_barrier_info(image, from, to, src, dst, {aspect, 0, 1, layer, 1});
 }
 
 // Bytes per texel of a depth aspect copied to a buffer (Vulkan's packing for buffer copies:
@@ -131,21 +126,16 @@ void AppDevice::reserve(Buffer& b, VkDeviceSize size, VkBufferUsageFlags usage, 
   // Host-coherent memory: no flush/invalidate around the copies.
   const VkMemoryPropertyFlags want = host ? VK_MEMORY_PROPERTY_HOST_VISIBLE_BIT | VK_MEMORY_PROPERTY_HOST_COHERENT_BIT
                                           : VK_MEMORY_PROPERTY_DEVICE_LOCAL_BIT;
-  std::uint32_t type = ~0u;
-  const auto find = [&](VkMemoryPropertyFlags flags) {
-    for (std::uint32_t i = 0; i < memory_.memoryTypeCount && type == ~0u; ++i)
-      if ((req.memoryTypeBits & (1u << i)) && (memory_.memoryTypes[i].propertyFlags & flags) == flags) type = i;
-  };
-  if (prefer_device_local) find(want | VK_MEMORY_PROPERTY_DEVICE_LOCAL_BIT);
-  find(want);
-  if (type == ~0u) {
+  const VkMemoryPropertyFlags preferred = prefer_device_local ? VK_MEMORY_PROPERTY_DEVICE_LOCAL_BIT : 0;
+  const std::optional<std::uint32_t> type = gpu::find_memory_type(memory_, req.memoryTypeBits, want, preferred);
+  if (!type) {
     release(b);
     throw std::runtime_error(std::string("the application's device has no ") +
                              (host ? "host-visible coherent" : "device-local") + " memory for the layer's buffers");
   }
   VkMemoryAllocateInfo mi{VK_STRUCTURE_TYPE_MEMORY_ALLOCATE_INFO};
   mi.allocationSize = req.size;
-  mi.memoryTypeIndex = type;
+  mi.memoryTypeIndex = *type;
   try {
     app_check(vkAllocateMemory_(device_, &mi, nullptr, &b.memory), "vkAllocateMemory");
     app_check(vkBindBufferMemory_(device_, b.buffer, b.memory, 0), "vkBindBufferMemory");

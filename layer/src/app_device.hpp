@@ -17,6 +17,7 @@
 #include <openxr/openxr.h>
 
 #include "composite.hpp"
+#include "fovea/gpu/pipeline.hpp"
 #include "fovea/xrcommon/foreign_queue.hpp"
 #include "frame_renderer.hpp"
 #include "traced_slots.hpp"
@@ -181,10 +182,8 @@ class AppDevice {
   };
   static constexpr std::size_t kPasses = 8;
   struct Gpu {
-    VkShaderModule shader = VK_NULL_HANDLE;
-    VkDescriptorSetLayout set_layout = VK_NULL_HANDLE;
-    VkPipelineLayout layout = VK_NULL_HANDLE;
-    VkPipeline pipeline = VK_NULL_HANDLE, border_pipeline = VK_NULL_HANDLE;  // the composite and border passes
+    gpu::ForeignPipelines program;  // the border and composite passes' pipelines, their layouts
+    VkPipeline pipeline = VK_NULL_HANDLE, border_pipeline = VK_NULL_HANDLE;  // in program: composite, border
     VkDescriptorPool pool = VK_NULL_HANDLE;
     VkDescriptorSet set = VK_NULL_HANDLE;
     VkCommandPool commands = VK_NULL_HANDLE;
@@ -217,15 +216,13 @@ class AppDevice {
   void release_retired(bool wait);
 
 #define FOVEA_APP_VK(X)                                                                                          \
-  X(vkGetDeviceQueue) X(vkCmdPipelineBarrier) X(vkCmdCopyImageToBuffer) X(vkCmdCopyBufferToImage)             \
-  X(vkCreateBuffer) X(vkDestroyBuffer) X(vkGetBufferMemoryRequirements) X(vkAllocateMemory) X(vkFreeMemory)     \
-  X(vkBindBufferMemory) X(vkMapMemory) X(vkUnmapMemory) X(vkCreateShaderModule)                              \
-  X(vkDestroyShaderModule) X(vkCreateDescriptorSetLayout) X(vkDestroyDescriptorSetLayout)                       \
-  X(vkCreatePipelineLayout) X(vkDestroyPipelineLayout) X(vkCreateComputePipelines) X(vkDestroyPipeline)         \
-  X(vkCreateDescriptorPool) X(vkDestroyDescriptorPool) X(vkAllocateDescriptorSets) X(vkUpdateDescriptorSets)    \
-  X(vkCmdBindPipeline) X(vkCmdBindDescriptorSets) X(vkCmdPushConstants) X(vkCmdDispatch)                     \
-  X(vkCreateCommandPool) X(vkDestroyCommandPool) X(vkAllocateCommandBuffers) X(vkBeginCommandBuffer)           \
-  X(vkEndCommandBuffer) X(vkQueueSubmit) X(vkCreateFence) X(vkDestroyFence) X(vkWaitForFences) X(vkResetFences) \
+  X(vkGetDeviceQueue) X(vkCmdPipelineBarrier) X(vkCmdCopyImageToBuffer) X(vkCmdCopyBufferToImage)                \
+  X(vkCreateBuffer) X(vkDestroyBuffer) X(vkGetBufferMemoryRequirements) X(vkAllocateMemory) X(vkFreeMemory)      \
+  X(vkBindBufferMemory) X(vkMapMemory) X(vkUnmapMemory) X(vkCreateDescriptorPool)                                \
+  X(vkDestroyDescriptorPool) X(vkAllocateDescriptorSets) X(vkUpdateDescriptorSets)                               \
+  X(vkCmdBindPipeline) X(vkCmdBindDescriptorSets) X(vkCmdPushConstants) X(vkCmdDispatch)                         \
+  X(vkCreateCommandPool) X(vkDestroyCommandPool) X(vkAllocateCommandBuffers) X(vkBeginCommandBuffer)             \
+  X(vkEndCommandBuffer) X(vkQueueSubmit) X(vkCreateFence) X(vkDestroyFence) X(vkWaitForFences) X(vkResetFences)  \
   X(vkGetFenceStatus)
 #define FOVEA_APP_VK_MEMBER(name) PFN_##name name##_ = nullptr;
   FOVEA_APP_VK(FOVEA_APP_VK_MEMBER)

@@ -21,6 +21,7 @@
 
 #include "app_device.hpp"
 #include "fovea/core/image.hpp"
+#include "fovea/gpu/pipeline.hpp"
 #include "fovea/shaders/embedded.hpp"
 #include "fovea/shaders/layer_composite.h"
 
@@ -28,7 +29,7 @@ namespace fovea::layer {
 
 namespace {
 
-constexpr std::uint32_t kBindings = 6;
+constexpr std::uint32_t kBindings = LAYER_BINDING_COUNT;
 // The composite pass's workgroup.
 constexpr std::uint32_t kGroupX = 32, kGroupY = 8;
 // A lost or hung device fails the session instead of hanging the application's call.
@@ -109,48 +110,19 @@ void AppDevice::enable_gpu_composition(int traced_width, int traced_height, int 
     throw std::runtime_error("the session's queue family " + std::to_string(queue_family_) + " has no compute");
   if (traced_width <= 0 || traced_height <= 0)
     throw std::runtime_error("enable_gpu_composition: an empty traced raster");
-  const auto spv = shaders::find("xr_layer_composite.comp.spv");
-  if (spv.empty()) throw std::runtime_error("xr_layer_composite.comp.spv is not embedded");
   gpu_ = std::make_unique<Gpu>();
   Gpu& g = *gpu_;
   try {
-    // Binding 0, the parameters: a dynamic offset names the pass's own block.
-    VkDescriptorSetLayoutBinding b[kBindings]{};
-    for (std::uint32_t i = 0; i < kBindings; ++i)
-      b[i] = {i, i == 0 ? VK_DESCRIPTOR_TYPE_STORAGE_BUFFER_DYNAMIC : VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, 1,
-              VK_SHADER_STAGE_COMPUTE_BIT, nullptr};
-    VkDescriptorSetLayoutCreateInfo li{VK_STRUCTURE_TYPE_DESCRIPTOR_SET_LAYOUT_CREATE_INFO};
-    li.bindingCount = kBindings;
-    li.pBindings = b;
-    app_check(vkCreateDescriptorSetLayout_(device_, &li, nullptr, &g.set_layout), "vkCreateDescriptorSetLayout");
-    const VkPushConstantRange push{VK_SHADER_STAGE_COMPUTE_BIT, 0, sizeof(Push)};
-    VkPipelineLayoutCreateInfo pli{VK_STRUCTURE_TYPE_PIPELINE_LAYOUT_CREATE_INFO};
-    pli.setLayoutCount = 1;
-    pli.pSetLayouts = &g.set_layout;
-    pli.pushConstantRangeCount = 1;
-    pli.pPushConstantRanges = &push;
-    app_check(vkCreatePipelineLayout_(device_, &pli, nullptr, &g.layout), "vkCreatePipelineLayout");
-    VkShaderModuleCreateInfo mi{VK_STRUCTURE_TYPE_SHADER_MODULE_CREATE_INFO};
-    mi.codeSize = spv.size();
-    mi.pCode = reinterpret_cast<const std::uint32_t*>(spv.data());
-    app_check(vkCreateShaderModule_(device_, &mi, nullptr, &g.shader), "vkCreateShaderModule");
-    // One pipeline per pass (specialisation constants 0: the pass, 1 and 2: the workgroup size).
-    for (const std::uint32_t pass : {shaders::kLayerPassBorder, shaders::kLayerPassComposite}) {
-      const bool border = pass == shaders::kLayerPassBorder;
-      const std::uint32_t values[3] = {pass, border ? shaders::kLayerBorderGroup : kGroupX, border ? 1u : kGroupY};
-      const VkSpecializationMapEntry entries[3] = {{0, 0, 4}, {1, 4, 4}, {2, 8, 4}};
-      const VkSpecializationInfo spec{3, entries, sizeof values, values};
-      VkComputePipelineCreateInfo ci{VK_STRUCTURE_TYPE_COMPUTE_PIPELINE_CREATE_INFO};
-      ci.stage = {VK_STRUCTURE_TYPE_PIPELINE_SHADER_STAGE_CREATE_INFO};
-      ci.stage.stage = VK_SHADER_STAGE_COMPUTE_BIT;
-      ci.stage.module = g.shader;
-      ci.stage.pName = "main";
-      ci.stage.pSpecializationInfo = &spec;
-      ci.layout = g.layout;
-      app_check(vkCreateComputePipelines_(device_, VK_NULL_HANDLE, 1, &ci, nullptr,
-                                          pass == shaders::kLayerPassBorder ? &g.border_pipeline : &g.pipeline),
-                "vkCreateComputePipelines");
-    }
+    // The parameters with a dynamic offset: each pass reads its own block. One pipeline per
+    // pass (specialisation constants 0: the pass, 1 and 2: the workgroup size).
+    gpu::ForeignPipelineDesc desc{"xr_layer_composite.comp.spv", {}, sizeof(Push), {}};
+    desc.bindings.assign(kBindings, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER);
+    desc.bindings[LAYER_BINDING_PARAMS] = VK_DESCRIPTOR_TYPE_STORAGE_BUFFER_DYNAMIC;
+    desc.specializations = {{shaders::kLayerPassBorder, shaders::kLayerBorderGroup, 1u},
+                            {shaders::kLayerPassComposite, kGroupX, kGroupY}};
+    g.program = gpu::create_foreign_pipelines(device_, get_device_proc_, desc);
+    g.border_pipeline = g.program.pipelines[0];
+    g.pipeline = g.program.pipelines[1];
     const VkDescriptorPoolSize sizes[2] = {{VK_DESCRIPTOR_TYPE_STORAGE_BUFFER_DYNAMIC, 1},
                                            {VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, kBindings - 1}};
     VkDescriptorPoolCreateInfo pi{VK_STRUCTURE_TYPE_DESCRIPTOR_POOL_CREATE_INFO};
@@ -161,7 +133,7 @@ void AppDevice::enable_gpu_composition(int traced_width, int traced_height, int 
     VkDescriptorSetAllocateInfo ai{VK_STRUCTURE_TYPE_DESCRIPTOR_SET_ALLOCATE_INFO};
     ai.descriptorPool = g.pool;
     ai.descriptorSetCount = 1;
-    ai.pSetLayouts = &g.set_layout;
+    ai.pSetLayouts = &g.program.set_layout;
     app_check(vkAllocateDescriptorSets_(device_, &ai, &g.set), "vkAllocateDescriptorSets");
     // Command buffers re-recorded in place when their images change.
     VkCommandPoolCreateInfo cpi{VK_STRUCTURE_TYPE_COMMAND_POOL_CREATE_INFO};
@@ -301,11 +273,7 @@ void AppDevice::destroy_gpu() {
   if (g.commands) vkDestroyCommandPool_(device_, g.commands, nullptr);  // frees the command buffers
   for (Buffer* b : {&g.params, &g.traced, &g.app, &g.app_depth, &g.out, &g.background}) release(*b);
   if (g.pool) vkDestroyDescriptorPool_(device_, g.pool, nullptr);
-  if (g.pipeline) vkDestroyPipeline_(device_, g.pipeline, nullptr);
-  if (g.border_pipeline) vkDestroyPipeline_(device_, g.border_pipeline, nullptr);
-  if (g.shader) vkDestroyShaderModule_(device_, g.shader, nullptr);
-  if (g.layout) vkDestroyPipelineLayout_(device_, g.layout, nullptr);
-  if (g.set_layout) vkDestroyDescriptorSetLayout_(device_, g.set_layout, nullptr);
+  gpu::destroy_foreign_pipelines(device_, get_device_proc_, g.program);
   gpu_.reset();
 }
 
@@ -323,16 +291,20 @@ void AppDevice::reserve_gpu_buffers(VkDeviceSize app_bytes, VkDeviceSize depth_b
   constexpr VkBufferUsageFlags dst = VK_BUFFER_USAGE_STORAGE_BUFFER_BIT | VK_BUFFER_USAGE_TRANSFER_DST_BIT;
   reserve(g.app, app_bytes, dst, false);
   reserve(g.app_depth, depth_bytes, dst, false);
-  const Buffer* bound[kBindings] = {&g.params, &g.traced, &g.app, &g.out, &g.background, &g.app_depth};
+  const std::pair<std::uint32_t, const Buffer*> bound[kBindings] = {
+      {LAYER_BINDING_PARAMS, &g.params}, {LAYER_BINDING_TRACED, &g.traced},         {LAYER_BINDING_APP, &g.app},
+      {LAYER_BINDING_OUT, &g.out},       {LAYER_BINDING_BACKGROUND, &g.background}, {LAYER_BINDING_APP_DEPTH, &g.app_depth}};
   VkDescriptorBufferInfo infos[kBindings];
   VkWriteDescriptorSet writes[kBindings];
   for (std::uint32_t i = 0; i < kBindings; ++i) {
-    infos[i] = {bound[i]->buffer, 0, i == 0 ? VkDeviceSize(sizeof(shaders::LayerCompositeParams)) : VK_WHOLE_SIZE};
+    const auto [binding, buffer] = bound[i];
+    const bool params = binding == LAYER_BINDING_PARAMS;
+    infos[i] = {buffer->buffer, 0, params ? VkDeviceSize(sizeof(shaders::LayerCompositeParams)) : VK_WHOLE_SIZE};
     writes[i] = {VK_STRUCTURE_TYPE_WRITE_DESCRIPTOR_SET};
     writes[i].dstSet = g.set;
-    writes[i].dstBinding = i;
+    writes[i].dstBinding = binding;
     writes[i].descriptorCount = 1;
-    writes[i].descriptorType = i == 0 ? VK_DESCRIPTOR_TYPE_STORAGE_BUFFER_DYNAMIC : VK_DESCRIPTOR_TYPE_STORAGE_BUFFER;
+    writes[i].descriptorType = params ? VK_DESCRIPTOR_TYPE_STORAGE_BUFFER_DYNAMIC : VK_DESCRIPTOR_TYPE_STORAGE_BUFFER;
     writes[i].pBufferInfo = &infos[i];
   }
   vkUpdateDescriptorSets_(device_, kBindings, writes, 0, nullptr);
@@ -371,12 +343,12 @@ void AppDevice::record_pass(Pass& pass, std::size_t index) {
   vkCmdPipelineBarrier_(cb, VK_PIPELINE_STAGE_TRANSFER_BIT, VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT, 0, 1, &to_compute, 0,
                         nullptr, 0, nullptr);
   const std::uint32_t params_offset = std::uint32_t(g.params_stride * index);
-  vkCmdBindDescriptorSets_(cb, VK_PIPELINE_BIND_POINT_COMPUTE, g.layout, 0, 1, &g.set, 1, &params_offset);
+  vkCmdBindDescriptorSets_(cb, VK_PIPELINE_BIND_POINT_COMPUTE, g.program.layout, 0, 1, &g.set, 1, &params_offset);
   if (k.border) {
     vkCmdBindPipeline_(cb, VK_PIPELINE_BIND_POINT_COMPUTE, g.border_pipeline);
     for (std::uint32_t e = 0; e < 2; ++e) {
       const Push push{e};
-      vkCmdPushConstants_(cb, g.layout, VK_SHADER_STAGE_COMPUTE_BIT, 0, sizeof push, &push);
+      vkCmdPushConstants_(cb, g.program.layout, VK_SHADER_STAGE_COMPUTE_BIT, 0, sizeof push, &push);
       vkCmdDispatch_(cb, 1, 1, 1);
     }
     const VkMemoryBarrier border = memory_barrier(VK_ACCESS_SHADER_WRITE_BIT, VK_ACCESS_SHADER_READ_BIT);
@@ -386,7 +358,7 @@ void AppDevice::record_pass(Pass& pass, std::size_t index) {
   vkCmdBindPipeline_(cb, VK_PIPELINE_BIND_POINT_COMPUTE, g.pipeline);
   for (std::uint32_t e = 0; e < 2; ++e) {
     const Push push{e};
-    vkCmdPushConstants_(cb, g.layout, VK_SHADER_STAGE_COMPUTE_BIT, 0, sizeof push, &push);
+    vkCmdPushConstants_(cb, g.program.layout, VK_SHADER_STAGE_COMPUTE_BIT, 0, sizeof push, &push);
     vkCmdDispatch_(cb, (std::uint32_t(k.out_w[e]) + kGroupX - 1) / kGroupX,
                   (std::uint32_t(k.out_h[e]) + kGroupY * shaders::kLayerRowsPerInvocation - 1) /
                       (kGroupY * shaders::kLayerRowsPerInvocation), 1);

@@ -11,18 +11,15 @@
 #include "fovea/compositor/distortion.hpp"
 #include "fovea/core/clock.hpp"
 #include "fovea/core/error.hpp"
-#include "fovea/shaders/embedded.hpp"
+#include "fovea/gpu/pipeline.hpp"
+#include "fovea/shaders/xr_readback.h"
 #include "log.hpp"
 
 namespace fovea::runtime {
 namespace {
 
-// xr_readback.comp's push constants.
-struct ReadbackPush {
-  std::int32_t offset_x, offset_y;
-  std::uint32_t width, height, layer;
-};
-constexpr std::uint32_t kReadbackGroup = 8;  // local size in x and y
+using shaders::kReadbackGroup;
+using shaders::ReadbackPush;
 
 bool same_fov(const core::Fov& a, const core::Fov& b) {
   constexpr double eps = 1e-6;
@@ -90,10 +87,7 @@ Compositor::~Compositor() {
   for (auto& p : passes_) p.reset();  // before their context
   gpu_.reset();
   if (pool_) vkDestroyDescriptorPool(device_, pool_, nullptr);
-  if (pipeline_) vkDestroyPipeline(device_, pipeline_, nullptr);
-  if (shader_) vkDestroyShaderModule(device_, shader_, nullptr);
-  if (pipeline_layout_) vkDestroyPipelineLayout(device_, pipeline_layout_, nullptr);
-  if (set_layout_) vkDestroyDescriptorSetLayout(device_, set_layout_, nullptr);
+  gpu::destroy_foreign_pipelines(device_, &vkGetDeviceProcAddr, program_);
   if (sampler_) vkDestroySampler(device_, sampler_, nullptr);
   if (staging_) vkDestroyBuffer(device_, staging_, nullptr);
   if (staging_memory_) vkFreeMemory(device_, staging_memory_, nullptr);
@@ -123,38 +117,16 @@ void Compositor::ensure_staging(VkDeviceSize bytes) {
 }
 
 void Compositor::ensure_pipeline() {
-  if (pipeline_) return;
+  if (!program_.pipelines.empty()) return;
   VkSamplerCreateInfo si{VK_STRUCTURE_TYPE_SAMPLER_CREATE_INFO};
   si.magFilter = si.minFilter = VK_FILTER_NEAREST;
   si.addressModeU = si.addressModeV = si.addressModeW = VK_SAMPLER_ADDRESS_MODE_CLAMP_TO_EDGE;
   vk_check(vkCreateSampler(device_, &si, nullptr, &sampler_), "vkCreateSampler");
-  const VkDescriptorSetLayoutBinding bindings[2] = {
-      {0, VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER, 1, VK_SHADER_STAGE_COMPUTE_BIT, nullptr},
-      {1, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, 1, VK_SHADER_STAGE_COMPUTE_BIT, nullptr}};
-  VkDescriptorSetLayoutCreateInfo li{VK_STRUCTURE_TYPE_DESCRIPTOR_SET_LAYOUT_CREATE_INFO};
-  li.bindingCount = 2;
-  li.pBindings = bindings;
-  vk_check(vkCreateDescriptorSetLayout(device_, &li, nullptr, &set_layout_), "vkCreateDescriptorSetLayout");
-  const VkPushConstantRange push{VK_SHADER_STAGE_COMPUTE_BIT, 0, sizeof(ReadbackPush)};
-  VkPipelineLayoutCreateInfo pli{VK_STRUCTURE_TYPE_PIPELINE_LAYOUT_CREATE_INFO};
-  pli.setLayoutCount = 1;
-  pli.pSetLayouts = &set_layout_;
-  pli.pushConstantRangeCount = 1;
-  pli.pPushConstantRanges = &push;
-  vk_check(vkCreatePipelineLayout(device_, &pli, nullptr, &pipeline_layout_), "vkCreatePipelineLayout");
-  const auto spv = shaders::find("xr_readback.comp.spv");
-  if (spv.empty()) throw std::runtime_error("xr_readback.comp.spv is not embedded");
-  VkShaderModuleCreateInfo mi{VK_STRUCTURE_TYPE_SHADER_MODULE_CREATE_INFO};
-  mi.codeSize = spv.size();
-  mi.pCode = reinterpret_cast<const std::uint32_t*>(spv.data());
-  vk_check(vkCreateShaderModule(device_, &mi, nullptr, &shader_), "vkCreateShaderModule");
-  VkComputePipelineCreateInfo ci{VK_STRUCTURE_TYPE_COMPUTE_PIPELINE_CREATE_INFO};
-  ci.stage = {VK_STRUCTURE_TYPE_PIPELINE_SHADER_STAGE_CREATE_INFO};
-  ci.stage.stage = VK_SHADER_STAGE_COMPUTE_BIT;
-  ci.stage.module = shader_;
-  ci.stage.pName = "main";
-  ci.layout = pipeline_layout_;
-  vk_check(vkCreateComputePipelines(device_, VK_NULL_HANDLE, 1, &ci, nullptr, &pipeline_), "vkCreateComputePipelines");
+  gpu::ForeignPipelineDesc desc{"xr_readback.comp.spv", {}, sizeof(ReadbackPush), {}};
+  desc.bindings.resize(2);
+  desc.bindings[READBACK_BINDING_SOURCE] = VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER;
+  desc.bindings[READBACK_BINDING_OUT] = VK_DESCRIPTOR_TYPE_STORAGE_BUFFER;
+  program_ = gpu::create_foreign_pipelines(device_, &vkGetDeviceProcAddr, desc);
   const VkDescriptorPoolSize sizes[2] = {{VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER, 1},
                                          {VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, 1}};
   VkDescriptorPoolCreateInfo pi{VK_STRUCTURE_TYPE_DESCRIPTOR_POOL_CREATE_INFO};
@@ -165,7 +137,7 @@ void Compositor::ensure_pipeline() {
   VkDescriptorSetAllocateInfo ai{VK_STRUCTURE_TYPE_DESCRIPTOR_SET_ALLOCATE_INFO};
   ai.descriptorPool = pool_;
   ai.descriptorSetCount = 1;
-  ai.pSetLayouts = &set_layout_;
+  ai.pSetLayouts = &program_.set_layout;
   vk_check(vkAllocateDescriptorSets(device_, &ai, &set_), "vkAllocateDescriptorSets");
 }
 
@@ -189,11 +161,11 @@ core::Image Compositor::read_back(const LayerView& v) {
   const VkDescriptorBufferInfo bi{staging_, 0, VK_WHOLE_SIZE};
   VkWriteDescriptorSet writes[2] = {{VK_STRUCTURE_TYPE_WRITE_DESCRIPTOR_SET}, {VK_STRUCTURE_TYPE_WRITE_DESCRIPTOR_SET}};
   writes[0].dstSet = writes[1].dstSet = set_;
-  writes[0].dstBinding = 0;
+  writes[0].dstBinding = READBACK_BINDING_SOURCE;
   writes[0].descriptorCount = 1;
   writes[0].descriptorType = VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER;
   writes[0].pImageInfo = &ii;
-  writes[1].dstBinding = 1;
+  writes[1].dstBinding = READBACK_BINDING_OUT;
   writes[1].descriptorCount = 1;
   writes[1].descriptorType = VK_DESCRIPTOR_TYPE_STORAGE_BUFFER;
   writes[1].pBufferInfo = &bi;
@@ -203,9 +175,9 @@ core::Image Compositor::read_back(const LayerView& v) {
     transition(cmd, v.image, false, VK_IMAGE_LAYOUT_COLOR_ATTACHMENT_OPTIMAL, VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL,
                VK_ACCESS_COLOR_ATTACHMENT_WRITE_BIT, VK_ACCESS_SHADER_READ_BIT,
                VK_PIPELINE_STAGE_COLOR_ATTACHMENT_OUTPUT_BIT, VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT);
-    vkCmdBindPipeline(cmd, VK_PIPELINE_BIND_POINT_COMPUTE, pipeline_);
-    vkCmdBindDescriptorSets(cmd, VK_PIPELINE_BIND_POINT_COMPUTE, pipeline_layout_, 0, 1, &set_, 0, nullptr);
-    vkCmdPushConstants(cmd, pipeline_layout_, VK_SHADER_STAGE_COMPUTE_BIT, 0, sizeof push, &push);
+    vkCmdBindPipeline(cmd, VK_PIPELINE_BIND_POINT_COMPUTE, program_.pipelines[0]);
+    vkCmdBindDescriptorSets(cmd, VK_PIPELINE_BIND_POINT_COMPUTE, program_.layout, 0, 1, &set_, 0, nullptr);
+    vkCmdPushConstants(cmd, program_.layout, VK_SHADER_STAGE_COMPUTE_BIT, 0, sizeof push, &push);
     vkCmdDispatch(cmd, (std::uint32_t(w) + kReadbackGroup - 1) / kReadbackGroup,
                   (std::uint32_t(h) + kReadbackGroup - 1) / kReadbackGroup, 1);
     transition(cmd, v.image, false, VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL, VK_IMAGE_LAYOUT_COLOR_ATTACHMENT_OPTIMAL,

@@ -21,6 +21,7 @@
 #include "fovea/devices/saccade_predict.hpp"
 #include "gaze.hpp"
 #include "fovea/gpu/context.hpp"
+#include "fovea/gpu/pipeline.hpp"
 #include "vk_util.hpp"
 #include "xr.hpp"
 
@@ -102,10 +103,7 @@ class Compositor {
   std::int64_t lit_frame_ = -1;  // the frame index observe_frame() lit
   // The read-back pipeline (created at the first composed frame).
   VkSampler sampler_ = VK_NULL_HANDLE;
-  VkDescriptorSetLayout set_layout_ = VK_NULL_HANDLE;
-  VkPipelineLayout pipeline_layout_ = VK_NULL_HANDLE;
-  VkShaderModule shader_ = VK_NULL_HANDLE;
-  VkPipeline pipeline_ = VK_NULL_HANDLE;
+  gpu::ForeignPipelines program_;  // xr_readback.comp
   VkDescriptorPool pool_ = VK_NULL_HANDLE;
   VkDescriptorSet set_ = VK_NULL_HANDLE;
   VkBuffer staging_ = VK_NULL_HANDLE;

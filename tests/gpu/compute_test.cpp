@@ -167,6 +167,40 @@ TEST_F(Compute, BindingMismatchFailsAtStartUp) {
   EXPECT_NO_THROW(set.bind_all(all));
 }
 
+// Pipelines on a device through its own function table (as the layer and the runtime make
+// them on the application's): one per specialisation, the layout checked against the shader
+// like ComputePipeline's, nothing left behind by a failure or by destroy (the validation
+// layer reports leaked objects when the device goes).
+TEST_F(Compute, ForeignPipelinesFollowTheShader) {
+  gpu::ForeignPipelineDesc desc{"test_gpu_fill.comp.spv",
+                                {VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, VK_DESCRIPTOR_TYPE_UNIFORM_BUFFER_DYNAMIC},
+                                sizeof(FillPush),
+                                {{3u, 32u}, {5u, 64u}}};
+  gpu::ForeignPipelines p = gpu::create_foreign_pipelines(ctx().device(), &vkGetDeviceProcAddr, desc);
+  ASSERT_EQ(p.pipelines.size(), 2u);
+  EXPECT_NE(p.pipelines[0], p.pipelines[1]);
+  EXPECT_NE(p.layout, VK_NULL_HANDLE);
+  EXPECT_NE(p.set_layout, VK_NULL_HANDLE);
+  gpu::destroy_foreign_pipelines(ctx().device(), &vkGetDeviceProcAddr, p);
+  EXPECT_TRUE(p.pipelines.empty());
+  EXPECT_EQ(p.layout, VK_NULL_HANDLE);
+
+  desc.specializations.clear();
+  p = gpu::create_foreign_pipelines(ctx().device(), &vkGetDeviceProcAddr, desc);
+  EXPECT_EQ(p.pipelines.size(), 1u) << "no specialisation: one pipeline";
+  gpu::destroy_foreign_pipelines(ctx().device(), &vkGetDeviceProcAddr, p);
+
+  desc.bindings[1] = VK_DESCRIPTOR_TYPE_STORAGE_BUFFER;
+  try {
+    p = gpu::create_foreign_pipelines(ctx().device(), &vkGetDeviceProcAddr, desc);
+    FAIL() << "expected InputError";
+  } catch (const fovea::core::InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("binding 1 is a uniform buffer in the shader"), std::string::npos) << e.what();
+  }
+  desc.bindings = {VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, VK_DESCRIPTOR_TYPE_UNIFORM_BUFFER, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER};
+  EXPECT_THROW(gpu::create_foreign_pipelines(ctx().device(), &vkGetDeviceProcAddr, desc), fovea::core::InputError);
+}
+
 // Synchronization validation is on: a dispatch writing a buffer right after a transfer
 // wrote it, without a barrier, is reported. (This layer version does not flag
 // dispatch-after-dispatch write hazards, so compute_to_compute must not be forgotten.)

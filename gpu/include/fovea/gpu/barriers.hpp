@@ -2,6 +2,8 @@
 // Pipeline barriers. Within one command buffer every dependency between dispatches and
 // transfers needs one of these; submit_and_wait already orders whole submissions
 // against each other and against host reads.
+#include <cstdint>
+
 #include <vulkan/vulkan_core.h>
 
 namespace fovea::gpu {
@@ -42,6 +44,17 @@ inline void transfer_to_compute(VkCommandBuffer cmd) {
 inline void compute_to_transfer(VkCommandBuffer cmd) {
   barrier(cmd, access::compute_write, access::transfer_read | access::transfer_write);
 }
+
+// The subresources of a colour image's first mip in array layer `layer`.
+constexpr VkImageSubresourceRange colour_layer(std::uint32_t layer = 0) {
+  return {VK_IMAGE_ASPECT_COLOR_BIT, 0, 1, layer, 1};
+}
+
+// An image memory barrier with a layout transition, as a struct: for command buffers recorded
+// through a device's own function table (the application's device, in the layer and the
+// runtime) or with several barriers in one call.
+VkImageMemoryBarrier image_barrier_info(VkImage image, VkImageLayout from, VkImageLayout to, VkAccessFlags src,
+                                        VkAccessFlags dst, VkImageSubresourceRange range = colour_layer());
 
 // Image memory barrier with a layout transition (whole colour image, one mip, one layer).
 // Fovea's own images stay in VK_IMAGE_LAYOUT_GENERAL; this is for images handed over

@@ -99,4 +99,28 @@ class ComputePipeline {
   DeviceHandle<VkPipeline, vkDestroyPipeline> pipeline_;
 };
 
+// Compute pipelines on a device Fovea does not own (the application's, in the API layer and
+// the runtime), made through that device's own vkGetDeviceProcAddr: one descriptor set layout
+// (set 0, checked against the shader's declarations like ComputePipeline's), one pipeline
+// layout with one push-constant range, and one pipeline per specialisation. The caller owns
+// the handles and destroys them with destroy_foreign_pipelines.
+struct ForeignPipelineDesc {
+  std::string shader;                      // embedded name
+  std::vector<VkDescriptorType> bindings;  // binding b at index b (dynamic buffers allowed)
+  std::uint32_t push_constant_bytes = 0;
+  // One pipeline per entry: the values of constant_id 0, 1, ... (an empty list: one pipeline
+  // without specialisation).
+  std::vector<std::vector<std::uint32_t>> specializations;
+};
+struct ForeignPipelines {
+  VkDescriptorSetLayout set_layout = VK_NULL_HANDLE;
+  VkPipelineLayout layout = VK_NULL_HANDLE;
+  std::vector<VkPipeline> pipelines;
+};
+// Throws core::InputError for a layout that does not match the shader, VulkanError for a
+// failed call (nothing is left created then).
+ForeignPipelines create_foreign_pipelines(VkDevice device, PFN_vkGetDeviceProcAddr get_device_proc,
+                                          const ForeignPipelineDesc& desc);
+void destroy_foreign_pipelines(VkDevice device, PFN_vkGetDeviceProcAddr get_device_proc, ForeignPipelines& p);
+
 }  // namespace fovea::gpu

@@ -10,6 +10,16 @@
 namespace fovea::shaders {
 #endif
 
+// The bindings of set 0 (storage buffers; the parameters' with a dynamic offset: each pass
+// reads its own block).
+#define LAYER_BINDING_PARAMS 0
+#define LAYER_BINDING_TRACED 1
+#define LAYER_BINDING_APP 2
+#define LAYER_BINDING_OUT 3
+#define LAYER_BINDING_BACKGROUND 4
+#define LAYER_BINDING_APP_DEPTH 5
+#define LAYER_BINDING_COUNT 6
+
 // LayerCompositeParams.mode (layer::Composite)
 FOVEA_CONST FOVEA_UINT kLayerAppOnTop = 0u;
 FOVEA_CONST FOVEA_UINT kLayerAlpha = 1u;
