@@ -96,7 +96,7 @@ AppDevice::AppDevice(const VulkanBinding& vk) : device_(vk.device), queue_family
   // Bounded: a lost or hung device fails the session (the layer then passes it through)
   // instead of hanging the application's xrEndFrame.
   constexpr std::uint64_t kTimeoutNs = 10'000'000'000;
-  queue_ = std::make_unique<xrcommon::ForeignQueue>(device_, gdpa, vk.queue_family, queue_handle_, kTimeoutNs,
+  queue_ = std::make_unique<gpu::ForeignQueue>(device_, gdpa, vk.queue_family, queue_handle_, kTimeoutNs,
                                                     "the application's device");
 }
 

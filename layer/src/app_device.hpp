@@ -18,7 +18,7 @@
 
 #include "composite.hpp"
 #include "fovea/gpu/pipeline.hpp"
-#include "fovea/xrcommon/foreign_queue.hpp"
+#include "fovea/gpu/foreign_queue.hpp"
 #include "frame_renderer.hpp"
 #include "traced_slots.hpp"
 
@@ -162,7 +162,7 @@ class AppDevice {
   VkQueue queue_handle_ = VK_NULL_HANDLE;
   std::uint32_t queue_family_ = 0;
   bool family_has_compute_ = false;
-  std::unique_ptr<xrcommon::ForeignQueue> queue_;  // the session queue, bounded waits
+  std::unique_ptr<gpu::ForeignQueue> queue_;  // the session queue, bounded waits
   Buffer download_, upload_;
   VkPhysicalDeviceMemoryProperties memory_{};
   VkDeviceSize storage_alignment_ = 256;  // minStorageBufferOffsetAlignment

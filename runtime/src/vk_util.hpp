@@ -7,13 +7,13 @@
 
 #include <vulkan/vulkan.h>
 
-#include "fovea/xrcommon/foreign_queue.hpp"
+#include "fovea/gpu/foreign_queue.hpp"
 
 namespace fovea::runtime {
 
 // The session queue's one-shot submit-and-wait (xrcommon's), waiting without a bound as the
 // application's own submissions would.
-class OneShotQueue : public xrcommon::ForeignQueue {
+class OneShotQueue : public gpu::ForeignQueue {
  public:
   OneShotQueue(VkDevice device, std::uint32_t family, VkQueue queue)
       : ForeignQueue(device, &vkGetDeviceProcAddr, family, queue, kNoTimeout, "the application's device") {}

@@ -9,7 +9,7 @@
 
 #include <vulkan/vulkan.h>
 
-namespace fovea::xrcommon {
+namespace fovea::gpu {
 
 class ForeignQueue {
  public:
@@ -55,4 +55,4 @@ class ForeignQueue {
 #undef FOVEA_FOREIGN_VK_MEMBER
 };
 
-}  // namespace fovea::xrcommon
+}  // namespace fovea::gpu

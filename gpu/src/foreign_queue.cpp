@@ -1,8 +1,8 @@
-#include "fovea/xrcommon/foreign_queue.hpp"
+#include "fovea/gpu/foreign_queue.hpp"
 
 #include <stdexcept>
 
-namespace fovea::xrcommon {
+namespace fovea::gpu {
 
 ForeignQueue::ForeignQueue(VkDevice device, PFN_vkGetDeviceProcAddr get_device_proc, std::uint32_t family,
                            VkQueue queue, std::uint64_t timeout_ns, std::string device_name)
@@ -80,4 +80,4 @@ void ForeignQueue::wait() {
   pending_ = false;
 }
 
-}  // namespace fovea::xrcommon
+}  // namespace fovea::gpu

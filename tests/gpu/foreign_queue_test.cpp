@@ -7,10 +7,10 @@
 #include <gtest/gtest.h>
 
 #include "fovea/gpu/buffer.hpp"
-#include "fovea/xrcommon/foreign_queue.hpp"
+#include "fovea/gpu/foreign_queue.hpp"
 #include "gpu_fixture.hpp"
 
-namespace fovea::xrcommon {
+namespace fovea::gpu {
 namespace {
 
 using ForeignQueueTest = test::GpuTest;
@@ -77,4 +77,4 @@ TEST(ForeignQueue, RefusesAMissingDeviceNamingIt) {
 }
 
 }  // namespace
-}  // namespace fovea::xrcommon
+}  // namespace fovea::gpu
