@@ -133,9 +133,9 @@ std::vector<AppView> replaceable_views(XrSession session, const XrCompositionLay
 XrResult intercept::xrWaitFrame(XrSession session, const XrFrameWaitInfo* info, XrFrameState* state) {
   const SessionRefs s = refs(session);
   if (!s.next) return XR_ERROR_HANDLE_INVALID;
-  const std::int64_t t0 = now_ns();
+  const std::int64_t t0 = core::now_ns();
   const XrResult r = s.next->xrWaitFrame(session, info, state);
-  const std::int64_t t1 = now_ns();
+  const std::int64_t t1 = core::now_ns();
   if (XR_SUCCEEDED(r) && s.frames) {
     std::lock_guard lock(s.frames->mutex);
     s.frames->queue.waited(state->predictedDisplayTime, t0, t1);
@@ -149,7 +149,7 @@ XrResult intercept::xrBeginFrame(XrSession session, const XrFrameBeginInfo* info
   const XrResult r = s.next->xrBeginFrame(session, info);
   if (XR_SUCCEEDED(r) && s.frames) {
     std::lock_guard lock(s.frames->mutex);
-    s.frames->queue.begun(now_ns());
+    s.frames->queue.begun(core::now_ns());
   }
   return r;
 }
@@ -157,7 +157,7 @@ XrResult intercept::xrBeginFrame(XrSession session, const XrFrameBeginInfo* info
 XrResult intercept::xrEndFrame(XrSession session, const XrFrameEndInfo* info) {
   const SessionRefs s = refs(session);
   if (!s.next) return XR_ERROR_HANDLE_INVALID;
-  const std::int64_t t_call = now_ns();
+  const std::int64_t t_call = core::now_ns();
   // The frame this call ends (its record leaves the queue): a frame begun before, with a valid
   // end info, is one the runtime may accept and the only kind rendered.
   std::optional<FrameTimes> record;
@@ -198,9 +198,9 @@ XrResult intercept::xrEndFrame(XrSession session, const XrFrameEndInfo* info) {
       shown = Shown{};
     }
   }
-  const std::int64_t t_down = now_ns();
+  const std::int64_t t_down = core::now_ns();
   const XrResult r = s.next->xrEndFrame(session, submit);
-  const std::int64_t t_return = now_ns();
+  const std::int64_t t_return = core::now_ns();
   if (record) {
     FrameTimes& t = *record;
     t.end_call_ns = t_call;

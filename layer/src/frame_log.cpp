@@ -3,7 +3,6 @@
 #include <pthread.h>
 #include <sys/resource.h>
 #include <sys/syscall.h>
-#include <time.h>
 #include <unistd.h>
 
 #include <cerrno>
@@ -16,12 +15,6 @@
 #include "log.hpp"
 
 namespace fovea::layer {
-
-std::int64_t now_ns() {
-  timespec ts;
-  clock_gettime(CLOCK_MONOTONIC, &ts);
-  return std::int64_t(ts.tv_sec) * 1'000'000'000 + ts.tv_nsec;
-}
 
 // About 3.5 s of frames at 72 Hz before write() has to grow a buffer.
 constexpr std::size_t kBufferedRecords = 256;

@@ -12,12 +12,11 @@
 #include <thread>
 #include <vector>
 
+#include "fovea/core/clock.hpp"
 #include "fovea/xrcommon/timing_writer.hpp"
 #include "frame_renderer.hpp"
 
 namespace fovea::layer {
-
-std::int64_t now_ns();
 
 struct FrameTimes {
   std::int64_t frame = 0;

@@ -34,6 +34,7 @@
 
 #include "app_device.hpp"
 #include "composite.hpp"
+#include "fovea/core/clock.hpp"
 #include "fovea/core/display.hpp"
 #include "fovea/core/eye_optics.hpp"
 #include "fovea/core/stereo_views.hpp"
@@ -49,9 +50,7 @@
 namespace fovea::layer {
 namespace {
 
-double ms_since(std::chrono::steady_clock::time_point t0) {
-  return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
-}
+double ms_since(core::TimeNs t0) { return core::ns_to_ms(core::now_ns() - t0); }
 
 core::Fov to_fov(const XrFovf& f) { return {f.angleLeft, f.angleRight, f.angleUp, f.angleDown}; }
 
@@ -135,10 +134,6 @@ struct TracedFrame {
   RenderTimes times;
 };
 
-std::int64_t monotonic_ns() {
-  return std::chrono::duration_cast<std::chrono::nanoseconds>(std::chrono::steady_clock::now().time_since_epoch()).count();
-}
-
 // The render thread's side: Fovea's pipeline on its own gpu::Context (its own VkDevice and
 // queue), created on the render thread so that the application's first frames do not wait
 // for the scene upload and shader setup either.
@@ -171,9 +166,9 @@ class PathTracer {
   std::shared_ptr<const TracedFrame> trace(const TraceRequest& in) {
     auto f = std::make_shared<TracedFrame>();
     RenderTimes& times = f->times;
-    const auto t0 = std::chrono::steady_clock::now();
+    const auto t0 = core::now_ns();
     update_visibility(in);
-    const auto t_gaze = std::chrono::steady_clock::now();
+    const auto t_gaze = core::now_ns();
     // Eye poses: the application's view poses (its reference space) placed at the scene's camera.
     std::array<core::Pose, 2> poses;
     std::array<glm::dvec3, 2> gaze;
@@ -206,7 +201,7 @@ class PathTracer {
     times.wait_cpu = gt.wait_cpu_ms;
     // Counted by the grid pass (no read-back); reported while a mask is set.
     if (mask_set_) times.samples_hidden = pipeline_->hidden_cells(core::Eye::Left) + pipeline_->hidden_cells(core::Eye::Right);
-    const auto r0 = std::chrono::steady_clock::now();
+    const auto r0 = core::now_ns();
     for (int e = 0; e < 2; ++e) {
       const core::Image linear = pipeline_->image(core::Eye(e));
       times.host_bytes += std::int64_t(linear.pixels.size() * sizeof(linear.pixels[0]));
@@ -239,7 +234,7 @@ class PathTracer {
     f->id = in.id;
     f->traced_for = in.display_time;
     f->traced_for_frame = in.app_frame_index;
-    f->done_ns = monotonic_ns();
+    f->done_ns = core::now_ns();
     return f;
   }
 
@@ -371,7 +366,7 @@ class PathTraceRenderer final : public FrameRenderer {
     }
     const std::shared_ptr<const TracedFrame> frame = seen_;
     if (!frame) return nullptr;  // nothing traced yet: the application's own frame
-    const auto t0 = std::chrono::steady_clock::now();
+    const auto t0 = core::now_ns();
     const XrFrameEndInfo* out = compose(in, *frame, shown);
     shown.times.transfer = ms_since(t0);
     return out;
@@ -463,7 +458,7 @@ class PathTraceRenderer final : public FrameRenderer {
                                                     std::uint8_t((*config_.app_background)[1]),
                                                     std::uint8_t((*config_.app_background)[2])};
     rule.blend = layer_blend(in.app_frame->layers[in.projection_layer]->layerFlags, pixel_format(format_));
-    const auto t_acquire = std::chrono::steady_clock::now();
+    const auto t_acquire = core::now_ns();
     std::vector<VkImage> targets;
     for (Eye& eye : eyes_) {
       std::uint32_t index = 0;
@@ -474,8 +469,8 @@ class PathTraceRenderer final : public FrameRenderer {
       if (index >= eye.images.size()) throw std::runtime_error("the runtime acquired an unknown swapchain image");
       targets.push_back(eye.images[index]);
     }
-    const auto t_compose = std::chrono::steady_clock::now();
-    shown.acquire_ms = std::chrono::duration<double, std::milli>(t_compose - t_acquire).count();
+    const auto t_compose = core::now_ns();
+    shown.acquire_ms = core::ns_to_ms(t_compose - t_acquire);
     if (on_gpu) {
       std::array<AppDevice::GpuEye, 2> jobs;
       for (std::size_t e = 0; e < 2; ++e)
@@ -496,8 +491,8 @@ class PathTraceRenderer final : public FrameRenderer {
     }
     shown.composited_on_gpu = on_gpu;
     shown.host_readbacks = app_.host_readbacks() - readbacks;
-    const auto t_release = std::chrono::steady_clock::now();
-    shown.compose_ms = std::chrono::duration<double, std::milli>(t_release - t_compose).count();
+    const auto t_release = core::now_ns();
+    shown.compose_ms = core::ns_to_ms(t_release - t_compose);
     for (Eye& eye : eyes_) xr_check(next_.xrReleaseSwapchainImage(eye.swapchain, nullptr), "xrReleaseSwapchainImage");
     shown.release_ms = ms_since(t_release);
 

@@ -11,7 +11,6 @@
 #include <sys/resource.h>
 
 #include <algorithm>
-#include <chrono>
 #include <cmath>
 #include <cstring>
 #include <stdexcept>
@@ -20,6 +19,7 @@
 #include <glm/gtc/quaternion.hpp>
 
 #include "app_device.hpp"
+#include "fovea/core/clock.hpp"
 #include "fovea/core/image.hpp"
 #include "fovea/gpu/pipeline.hpp"
 #include "fovea/shaders/embedded.hpp"
@@ -515,9 +515,9 @@ void AppDevice::composite_gpu(int slot, const std::array<GpuEye, 2>& eyes, const
   // wakes the device's queue thread, which runs the pass and may take this thread's core.
   rusage before{}, after{};
   getrusage(RUSAGE_THREAD, &before);
-  const auto t_submit = std::chrono::steady_clock::now();
+  const core::TimeNs t_submit = core::now_ns();
   app_check(vkQueueSubmit_(queue_handle_, 1, &si, pass.fence), "vkQueueSubmit");
-  g.counters.submit_ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t_submit).count();
+  g.counters.submit_ms = core::ns_to_ms(core::now_ns() - t_submit);
   getrusage(RUSAGE_THREAD, &after);
   g.counters.submit_preemptions = after.ru_nivcsw - before.ru_nivcsw;
   pass.pending = true;
