@@ -39,8 +39,7 @@
 #include "fovea/core/eye_optics.hpp"
 #include "fovea/core/stereo_views.hpp"
 #include "fovea/gpu/context.hpp"
-#include "fovea/pipeline/frame_pipeline.hpp"
-#include "fovea/renderer/gpu_scene.hpp"
+#include "fovea/pipeline/frame_driver.hpp"
 #include "fovea/renderer/trace_choice.hpp"
 #include "fovea/renderer/scene_io.hpp"
 #include "layer.hpp"
@@ -143,23 +142,20 @@ class PathTracer {
   // (null: the host path, frames kept in host memory).
   PathTracer(const LayerConfig& config, const renderer::Scene& scene, const core::StereoViews& views,
              const core::DisplayPreset& display, VkFormat format, XrSession session, const AppDevice* slots)
-      : config_(config), scene_(scene), views_(views), format_(format), session_(session), slots_(slots),
+      : config_(config), views_(views), format_(format), session_(session), slots_(slots),
         gaze_(std::make_unique<LayerGaze>(config.gaze, display)), ctx_(std::make_unique<gpu::Context>()),
-        // A measurement would delay the first traced frame by seconds: the cached one, or none.
-        trace_choice_(renderer::choose_tracing(*ctx_, config.frame.tracing, renderer::default_trace_choice_cache(),
-                                               false)),
-        gpu_scene_(std::make_unique<renderer::GpuScene>(*ctx_, scene_, renderer::BvhOptions{}, trace_choice_.tracing)) {
-    // The frame of `fovea render`: its defaults and options (pipeline/frame_config.hpp).
-    pipeline_ = std::make_unique<pipeline::FramePipeline>(*ctx_, *gpu_scene_, views_, config_.frame.distribution,
-                                                          config_.frame.recon,
-                                                          pipeline::path_config(config_.frame.bounces, scene_));
+        // The frame of `fovea render` (pipeline/frame_driver.hpp) on the application's views. A
+        // measurement would delay the first traced frame by seconds: the cached choice, or none.
+        driver_(std::make_unique<pipeline::FrameDriver>(*ctx_, scene, views_,
+                                                        pipeline::FrameDriverOptions{config_.frame, false, false})),
+        pipeline_(&driver_->pipeline()) {
     FOVEA_LAYER_INFO("rendering scene \"%s\" (from %s) at %dx%d per eye on %s, composite %s, gaze %s, render %s, "
                      "render thread %s, frame %s, tracing %s (%s)",
                      config_.scene.c_str(), config_.origin.c_str(), display.width, display.height,
                      ctx_->info().name.c_str(), composite_name(config_.composite), gaze_->describe().c_str(),
                      config_.lockstep ? "lockstep" : "async", render_priority_name(config_.render_priority).c_str(),
-                     pipeline::to_json(config_.frame).dump().c_str(), renderer::tracing_name(trace_choice_.tracing),
-                     trace_choice_.why.c_str());
+                     pipeline::to_json(config_.frame).dump().c_str(),
+                     renderer::tracing_name(driver_->trace_choice().tracing), driver_->trace_choice().why.c_str());
   }
 
   // Null when stopped while waiting for a free slot.
@@ -187,8 +183,7 @@ class PathTracer {
       const auto ei = std::size_t(e);
       const core::Pose p = to_pose(in.poses[ei]);
       f->orientation[ei] = p.orientation;
-      poses[ei].orientation = scene_.camera.orientation * p.orientation;
-      poses[ei].position = scene_.camera.position + scene_.camera.orientation * p.position;
+      poses[ei] = driver_->at_camera(p);
       gaze[ei] = fg.eye(core::Eye(e)).dir;
     }
     times.gaze_cpu = ms_since(t_gaze);
@@ -260,7 +255,6 @@ class PathTracer {
   }
 
   const LayerConfig& config_;
-  const renderer::Scene& scene_;
   const core::StereoViews views_;
   const VkFormat format_;
   const XrSession session_;
@@ -270,9 +264,8 @@ class PathTracer {
   std::optional<std::uint64_t> mask_generation_;  // of the mask fetched last (none yet)
   bool mask_set_ = false;                         // the pipeline culls with a runtime mask
   std::unique_ptr<gpu::Context> ctx_;
-  renderer::TraceChoice trace_choice_;
-  std::unique_ptr<renderer::GpuScene> gpu_scene_;
-  std::unique_ptr<pipeline::FramePipeline> pipeline_;
+  std::unique_ptr<pipeline::FrameDriver> driver_;
+  pipeline::FramePipeline* pipeline_;  // the driver's
 };
 
 // The calling thread's scheduling set to `p`; the reason on failure, else empty.

@@ -283,7 +283,6 @@ int run(std::vector<std::string> argv) {
   }
   // The frame of `fovea render`: the same defaults and option names (pipeline/frame_config.hpp).
   const pipeline::FrameConfig frame = frame_config_of(args, {"jitter"});
-  const RenderSetupOptions render_options{frame, true};
   const std::string gaze_uri = args.str("gaze", kDefaultGaze);
   devices::SourceOptions so;
   so.display = display;
@@ -295,10 +294,10 @@ int run(std::vector<std::string> argv) {
   for (const auto& w : scene.warnings) std::cerr << "warning: " << w << "\n";
   core::prepare_output_dir(out.string(), "--out");
   // The defaults of `fovea render`: distribution, reconstruction, tracing, the hidden area culled.
-  RenderSetup setup(scene, display, render_options);
+  RenderSetup setup(scene, display, frame);
   gpu::Context& ctx = setup.ctx;
-  const std::array<core::Pose, 2>& poses = setup.poses;
-  pipeline::FramePipeline& pipe = setup.pipeline;
+  const std::array<core::Pose, 2> poses = setup.driver.static_poses();
+  pipeline::FramePipeline& pipe = setup.driver.pipeline();
 
   // The main run: every frame rendered; its cost is the measured CPU time of the frame (the
   // submission waits for the GPU, so the GPU's work is inside it) or the fixed one.
@@ -400,7 +399,7 @@ int run(std::vector<std::string> argv) {
       req.settings.until_pixel_rel_error = ref_error;
       req.cache_dir = ref_cache;
       if (!quiet) std::fprintf(stderr, "reference, up to %ld spp...\n", ref_spp);
-      CachedReference ref = cached_reference(ctx, setup.gpu_scene, pipe.view(core::Eye::Left), core::Eye::Left, req);
+      CachedReference ref = cached_reference(ctx, setup.driver.gpu_scene(), pipe.view(core::Eye::Left), core::Eye::Left, req);
       j["quality_reference"] = {{"transport", pipeline::transport_json(pipeline::path_config(frame.bounces, scene),
                                                                         "the render's")},
                                 {"spp", ref.result.spp},

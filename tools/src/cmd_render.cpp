@@ -470,11 +470,11 @@ int run(std::vector<std::string> argv) {
   for (const auto& w : scene.warnings) std::cerr << "warning: " << w << "\n";
 
   const bool cull = !args.has("no-cull");
-  RenderSetup setup(scene, display, {frame_config, cull});
+  RenderSetup setup(scene, display, frame_config, cull);
   gpu::Context& ctx = setup.ctx;
-  renderer::GpuScene& gpu_scene = setup.gpu_scene;
-  const std::array<core::Pose, 2>& poses = setup.poses;
-  pipeline::FramePipeline& pipeline = setup.pipeline;
+  const renderer::GpuScene& gpu_scene = setup.driver.gpu_scene();
+  const std::array<core::Pose, 2> poses = setup.driver.static_poses();
+  pipeline::FramePipeline& pipeline = setup.driver.pipeline();
   // Each eye's lens mask: the pixels no score counts (built once, used per scored frame).
   const std::array<core::ViewMask, 2> lens{core::EyeOptics(display, core::Eye::Left).view_mask(),
                                            core::EyeOptics(display, core::Eye::Right).view_mask()};
@@ -672,7 +672,7 @@ int run(std::vector<std::string> argv) {
   // Which Vulkan driver produced the timings (lavapipe 22.3 and 25 differ ~2x).
   j["device"] = {{"name", ctx.info().name}, {"driver", ctx.info().driver}};
   j["trace"] = renderer::tracing_name(gpu_scene.tracing());
-  const renderer::TraceChoice& choice = setup.trace_choice;
+  const renderer::TraceChoice& choice = setup.driver.trace_choice();
   j["trace_choice"] = {{"requested", args.str("trace", "auto")},
                        {"why", choice.why},
                        {"compute_ms", choice.compute_ms ? nlohmann::json(*choice.compute_ms) : nlohmann::json()},

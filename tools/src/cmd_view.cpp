@@ -94,12 +94,6 @@ compositor::OpticsEval parse_optics(const std::string& s) {
 }
 
 // What draws the resolved view images: the foveated pipeline on a scene.
-struct SceneRenderer {
-  std::unique_ptr<renderer::GpuScene> gpu_scene;
-  std::unique_ptr<pipeline::FramePipeline> pipeline;
-  std::array<core::Pose, 2> poses;  // a static head at the scene camera
-};
-
 std::pair<int, int> parse_size(const std::string& s) {
   const auto x = s.find('x');
   try {
@@ -141,8 +135,6 @@ int run(std::vector<std::string> argv) {
   const compositor::OpticsEval eval = parse_optics(args.str("optics", "direct"));
   // The frame of `fovea render`: the same defaults and option names (pipeline/frame_config.hpp).
   const pipeline::FrameConfig frame = frame_config_of(args);
-  core::DistributionParams dp = frame.distribution;
-  dp.display = d.origin;
   const core::EyeOptics optics[2] = {core::EyeOptics(d, core::Eye::Left), core::EyeOptics(d, core::Eye::Right)};
 
   // The gaze: the mouse, a fixed direction, or a gaze source (recording, synthetic).
@@ -179,18 +171,13 @@ int run(std::vector<std::string> argv) {
     passes[size_t(e)] = std::make_unique<compositor::DistortionPass>(ctx, optics[e].hidden(),
                                                                       compositor::ChannelSelect::All, eval);
   compositor::PanelImage panels[2];
-  std::optional<SceneRenderer> sr;
+  // A static head at the scene's camera, each eye's lens hidden area skipped.
+  std::optional<pipeline::FrameDriver> driver;
   if (scene) {
-    sr.emplace();
-    const renderer::TraceChoice choice = renderer::choose_tracing(ctx, frame.tracing, renderer::default_trace_choice_cache());
+    driver.emplace(ctx, *scene, d, pipeline::FrameDriverOptions{frame, true});
     std::cerr << "fovea view: frame " << to_json(frame).dump() << "\n";
-    std::cerr << "fovea view: tracing " << renderer::tracing_name(choice.tracing) << ": " << choice.why << "\n";
-    sr->gpu_scene = std::make_unique<renderer::GpuScene>(ctx, *scene, renderer::BvhOptions{}, choice.tracing);
-    const core::StereoViews views = core::stereo_views(d, scene->camera);
-    sr->poses = views.poses();
-    sr->pipeline = std::make_unique<pipeline::FramePipeline>(ctx, *sr->gpu_scene, views, dp, frame.recon,
-                                                             pipeline::path_config(frame.bounces, *scene));
-    for (int e = 0; e < 2; ++e) sr->pipeline->set_visibility(core::Eye(e), optics[e].view_mask());
+    std::cerr << "fovea view: tracing " << renderer::tracing_name(driver->trace_choice().tracing) << ": "
+              << driver->trace_choice().why << "\n";
   } else {
     // The direction grid is static: distort it once.
     for (int e = 0; e < 2; ++e) panels[e] = passes[size_t(e)]->run(compositor::direction_grid(optics[e].view()));
@@ -208,10 +195,10 @@ int run(std::vector<std::string> argv) {
       const devices::FoveaGaze g = source->at_frame_time(core::TimeNs(std::llround(double(frame) / d.refresh_hz * 1e9)));
       for (int e = 0; e < 2; ++e) gaze[size_t(e)] = g.eye(core::Eye(e)).dir;
     }
-    if (sr) {
-      sr->pipeline->render(sr->poses, gaze, std::uint32_t(frame));
+    if (driver) {
+      driver->pipeline().render(driver->static_poses(), gaze, std::uint32_t(frame));
       for (int e = 0; e < 2; ++e)
-        panels[e] = passes[size_t(e)]->run(renderer::tone_map(sr->pipeline->image(core::Eye(e))));
+        panels[e] = passes[size_t(e)]->run(renderer::tone_map(driver->pipeline().image(core::Eye(e))));
     }
     std::optional<glm::dvec2> marker[2];
     for (int e = 0; e < 2; ++e) marker[e] = core::gaze_panel_uv(optics[e].lens(), gaze[size_t(e)]);
