@@ -24,17 +24,18 @@ layout(local_size_x = 64) in;
 #include "fovea/shaders/hash.h"
 #include "fovea/shaders/live_cells.h"
 #include "fovea/shaders/pt_order.h"
+#include "fovea/shaders/grid_bindings.h"
 
-layout(std140, set = 0, binding = 0) uniform Params { GridParams P; };
-layout(std430, set = 0, binding = 1) readonly buffer Columns { GridColumn cols[]; };
+layout(std140, set = 0, binding = GRID_BINDING_PARAMS) uniform Params { GridParams P; };
+layout(std430, set = 0, binding = GRID_BINDING_COLUMNS) readonly buffer Columns { GridColumn cols[]; };
 // Hidden view pixels (core::ViewMask): row-major, each row padded to whole 32-bit words.
-layout(std430, set = 0, binding = 2) readonly buffer Mask { uint hidden_mask[]; };
-layout(std430, set = 0, binding = 3) writeonly buffer Samples { GridSample samples[]; };
+layout(std430, set = 0, binding = GRID_BINDING_MASK) readonly buffer Mask { uint hidden_mask[]; };
+layout(std430, set = 0, binding = GRID_BINDING_SAMPLES) writeonly buffer Samples { GridSample samples[]; };
 // Zeroed by the host before the dispatch (gpu::GridPass::prepare).
-layout(std430, set = 0, binding = 4) buffer Counts { GridCounts counts; };
-layout(std430, set = 0, binding = 5) buffer History { uint history[]; };  // kLiveAllBefore
+layout(std430, set = 0, binding = GRID_BINDING_COUNTS) buffer Counts { GridCounts counts; };
+layout(std430, set = 0, binding = GRID_BINDING_HISTORY) buffer History { uint history[]; };  // kLiveAllBefore
 // Per tile: kTileLive | kTileReset; zero between frames (grid_live_list.comp clears it).
-layout(std430, set = 0, binding = 6) buffer TileState { uint tile_state[]; };
+layout(std430, set = 0, binding = GRID_BINDING_TILE_STATE) buffer TileState { uint tile_state[]; };
 
 #include "fovea/shaders/grid_map.glsl"
 

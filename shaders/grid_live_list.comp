@@ -12,10 +12,11 @@
 layout(local_size_x = 256) in;
 
 #include "fovea/shaders/live_cells.h"
+#include "fovea/shaders/grid_bindings.h"
 
-layout(std430, set = 0, binding = 0) readonly buffer Counts { GridCounts counts; };
-layout(std430, set = 0, binding = 1) writeonly buffer List { uint header[kLiveHeaderWords]; uint list[]; };
-layout(std430, set = 0, binding = 2) buffer TileState { uint tile_state[]; };
+layout(std430, set = 0, binding = LIVE_LIST_BINDING_COUNTS) readonly buffer Counts { GridCounts counts; };
+layout(std430, set = 0, binding = LIVE_LIST_BINDING_LIST) writeonly buffer List { uint header[kLiveHeaderWords]; uint list[]; };
+layout(std430, set = 0, binding = LIVE_LIST_BINDING_TILE_STATE) buffer TileState { uint tile_state[]; };
 layout(push_constant) uniform Push { uint max_groups_x; };
 
 shared uint s_live[gl_WorkGroupSize.x], s_reset[gl_WorkGroupSize.x];

@@ -3,19 +3,22 @@
 // bilinear taps of the resolved view (one per colour channel at that channel's source
 // position through the lens), black in the hidden area, explicit linear → sRGB encode.
 // The optics are evaluated directly per pixel, or read from the optional LUT cache.
+#extension GL_GOOGLE_include_directive : require
+#include "fovea/shaders/distortion_bindings.h"
+
 layout(local_size_x = 8, local_size_y = 8) in;
 
-layout(set = 0, binding = 0, rgba32f) uniform readonly image2D source_image;
-layout(set = 0, binding = 1, rgba8) uniform writeonly image2D panel_image;
+layout(set = 0, binding = DISTORT_BINDING_SOURCE, rgba32f) uniform readonly image2D source_image;
+layout(set = 0, binding = DISTORT_BINDING_PANEL, rgba8) uniform writeonly image2D panel_image;
 // Per channel 16 floats (compositor/src/distortion.cpp, pack_optics): display centre (2),
 // to-radial scale (2), source centre (2), from-radial scale (2), Vive-profile flag, k0..k4,
 // edge radius, padding.
-layout(set = 0, binding = 2, std430) readonly buffer Optics { float optics[48]; };
+layout(set = 0, binding = DISTORT_BINDING_OPTICS, std430) readonly buffer Optics { float optics[48]; };
 // Hidden-area bitmask, words_per_row 32-bit words per row, bit set = hidden.
-layout(set = 0, binding = 3, std430) readonly buffer Mask { uint mask_words[]; };
+layout(set = 0, binding = DISTORT_BINDING_MASK, std430) readonly buffer Mask { uint mask_words[]; };
 // Optional optics cache (core/lens_lut.hpp): lut_size² nodes spanning the panel, per node
 // and channel the source uv, float pair at ((j·N + i)·3 + c)·2.
-layout(set = 0, binding = 4, std430) readonly buffer Lut { float lut[]; };
+layout(set = 0, binding = DISTORT_BINDING_LUT, std430) readonly buffer Lut { float lut[]; };
 
 layout(push_constant) uniform Push {
   uint width, height;          // panel

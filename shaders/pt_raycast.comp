@@ -9,12 +9,13 @@
 #include "fovea/shaders/pt_order.h"
 #include "fovea/shaders/pt_scene.h"
 #include "fovea/shaders/pt_raycast.h"
+#include "fovea/shaders/pt_bindings.h"
 
 layout(local_size_x = 64) in;
-layout(set = 0, binding = 0) uniform utextureBuffer nodes;  // PtBvhNode: pt_node()
-layout(set = 0, binding = 1) uniform utextureBuffer tris;   // PtTriangle: pt_tri()
-layout(std430, set = 0, binding = 2) readonly buffer Rays { PtRay rays[]; };
-layout(std430, set = 0, binding = 3) writeonly buffer Hits { PtHitRecord hits[]; };
+layout(set = 0, binding = PT_BINDING_NODES) uniform utextureBuffer nodes;  // PtBvhNode: pt_node()
+layout(set = 0, binding = PT_BINDING_TRIS) uniform utextureBuffer tris;   // PtTriangle: pt_tri()
+layout(std430, set = 0, binding = RAYCAST_BINDING_RAYS) readonly buffer Rays { PtRay rays[]; };
+layout(std430, set = 0, binding = RAYCAST_BINDING_HITS) writeonly buffer Hits { PtHitRecord hits[]; };
 layout(push_constant) uniform Params { PtRaycastParams pc; };
 
 #include "fovea/shaders/pt_traverse.h"

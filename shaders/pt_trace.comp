@@ -10,26 +10,27 @@
 #include "fovea/shaders/pt_scene.h"
 #include "fovea/shaders/pt_trace.h"
 #include "fovea/shaders/pt_order.h"
+#include "fovea/shaders/pt_bindings.h"
 
 layout(local_size_x = 64) in;  // one tile of the tile order (pt_order.h)
-layout(set = 0, binding = 0) uniform utextureBuffer nodes;  // PtBvhNode: pt_node()
-layout(set = 0, binding = 1) uniform utextureBuffer tris;   // PtTriangle: pt_tri()
+layout(set = 0, binding = PT_BINDING_NODES) uniform utextureBuffer nodes;  // PtBvhNode: pt_node()
+layout(set = 0, binding = PT_BINDING_TRIS) uniform utextureBuffer tris;   // PtTriangle: pt_tri()
 // Scene data read per path vertex are texel buffers (pt_traverse.h says why): decoded by
 // pt_shading(), pt_material(), pt_light() below.
-layout(set = 0, binding = 2) uniform textureBuffer shading;    // PtShading: 4 texels each
-layout(set = 0, binding = 3) uniform textureBuffer materials;  // PtMaterial: 3 texels each
-layout(set = 0, binding = 4) uniform textureBuffer lights;     // PtLight: 1 texel each
-layout(std430, set = 0, binding = 5) readonly buffer TexTable { PtTextureInfo tex_table[]; };
-layout(set = 0, binding = 6) uniform utextureBuffer texels;    // RGBA8 per texel
-layout(std430, set = 0, binding = 7) readonly buffer Grid { GridSample cells[]; };
-layout(std430, set = 0, binding = 8) buffer OutDirect { vec4 out_direct[]; };
-layout(std430, set = 0, binding = 9) buffer OutIndirect { vec4 out_indirect[]; };
-layout(std430, set = 0, binding = 10) buffer OutAlbedo { vec4 out_albedo[]; };
-layout(std430, set = 0, binding = 11) buffer OutNormalDepth { vec4 out_normal_depth[]; };
-layout(std430, set = 0, binding = 12) buffer OutPosMat { vec4 out_position_material[]; };
-layout(std430, set = 0, binding = 13) buffer OutRadiance { vec4 out_radiance[]; };
-layout(set = 0, binding = 14) uniform textureBuffer ggx_albedo;  // read by pt_sampling.h
-#define LIVE_CELLS_LAYOUT layout(std430, set = 0, binding = 15)
+layout(set = 0, binding = PT_BINDING_SHADING) uniform textureBuffer shading;    // PtShading: 4 texels each
+layout(set = 0, binding = PT_BINDING_MATERIALS) uniform textureBuffer materials;  // PtMaterial: 3 texels each
+layout(set = 0, binding = PT_BINDING_LIGHTS) uniform textureBuffer lights;     // PtLight: 1 texel each
+layout(std430, set = 0, binding = PT_BINDING_TEX_TABLE) readonly buffer TexTable { PtTextureInfo tex_table[]; };
+layout(set = 0, binding = PT_BINDING_TEXELS) uniform utextureBuffer texels;    // RGBA8 per texel
+layout(std430, set = 0, binding = PT_BINDING_GRID) readonly buffer Grid { GridSample cells[]; };
+layout(std430, set = 0, binding = PT_BINDING_OUT_DIRECT) buffer OutDirect { vec4 out_direct[]; };
+layout(std430, set = 0, binding = PT_BINDING_OUT_INDIRECT) buffer OutIndirect { vec4 out_indirect[]; };
+layout(std430, set = 0, binding = PT_BINDING_OUT_ALBEDO) buffer OutAlbedo { vec4 out_albedo[]; };
+layout(std430, set = 0, binding = PT_BINDING_OUT_NORMAL_DEPTH) buffer OutNormalDepth { vec4 out_normal_depth[]; };
+layout(std430, set = 0, binding = PT_BINDING_OUT_POSITION_MATERIAL) buffer OutPosMat { vec4 out_position_material[]; };
+layout(std430, set = 0, binding = PT_BINDING_OUT_RADIANCE) buffer OutRadiance { vec4 out_radiance[]; };
+layout(set = 0, binding = PT_BINDING_GGX_ALBEDO) uniform textureBuffer ggx_albedo;  // read by pt_sampling.h
+#define LIVE_CELLS_LAYOUT layout(std430, set = 0, binding = PT_BINDING_LIVE_LIST)
 #include "fovea/shaders/live_cells.h"
 layout(push_constant) uniform Params { PtFrameParams pc; };
 // What the scene uses (PathTracer sets them from GpuScene::features()); false removes the

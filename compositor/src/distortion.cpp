@@ -8,6 +8,7 @@
 #include "fovea/core/error.hpp"
 #include "fovea/gpu/barriers.hpp"
 #include "fovea/gpu/descriptors.hpp"
+#include "fovea/shaders/distortion_bindings.h"
 
 namespace fovea::compositor {
 
@@ -144,7 +145,8 @@ void DistortionPass::record(VkCommandBuffer cmd, const gpu::Image2D& source, con
   while (i < set_keys_.size() && set_keys_[i] != key) ++i;
   if (i == set_keys_.size()) {
     auto set = std::make_unique<gpu::DescriptorSet>(*ctx_, pipeline_.set_layout(0));
-    set->bind(0, source).bind(1, target).bind(2, optics_).bind(3, mask_).bind(4, lut_);
+    set->bind(DISTORT_BINDING_SOURCE, source).bind(DISTORT_BINDING_PANEL, target);
+    set->bind(DISTORT_BINDING_OPTICS, optics_).bind(DISTORT_BINDING_MASK, mask_).bind(DISTORT_BINDING_LUT, lut_);
     sets_.push_back(std::move(set));
     set_keys_.push_back(key);
   }

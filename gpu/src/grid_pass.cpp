@@ -9,6 +9,7 @@
 #include "fovea/core/distribution.hpp"
 #include "fovea/gpu/barriers.hpp"
 #include "fovea/gpu/context.hpp"
+#include "fovea/shaders/grid_bindings.h"
 #include "fovea/shaders/live_cells.h"
 #include "fovea/shaders/pt_order.h"
 
@@ -36,8 +37,9 @@ GridPass::GridPass(Context& ctx, std::uint32_t cells, bool ballot)
       counts_(host_buffer(ctx, sizeof(shaders::GridCounts), BufferUsage::Storage, "grid counts")),
       set_(ctx, pipeline_.set_layout(0)),
       list_set_(ctx, list_pipeline_.set_layout(0)) {
-  set_.bind(0, params_).bind(1, columns_).bind(2, mask_).bind(4, counts_);
-  list_set_.bind(0, counts_);
+  set_.bind(GRID_BINDING_PARAMS, params_).bind(GRID_BINDING_COLUMNS, columns_).bind(GRID_BINDING_MASK, mask_);
+  set_.bind(GRID_BINDING_COUNTS, counts_);
+  list_set_.bind(LIVE_LIST_BINDING_COUNTS, counts_);
   reserve(std::max<std::uint32_t>(cells, 1));
 }
 
@@ -50,8 +52,8 @@ void GridPass::reserve(std::uint32_t cells) {
   history_ = Buffer(*ctx_, {.size = VkDeviceSize(capacity_) * shaders::kLiveTileCells * sizeof(std::uint32_t),
                             .name = "grid live history"});
   tile_state_ = Buffer(*ctx_, {.size = VkDeviceSize(capacity_) * sizeof(std::uint32_t), .name = "grid tile state"});
-  set_.bind(5, history_).bind(6, tile_state_);
-  list_set_.bind(1, list_).bind(2, tile_state_);
+  set_.bind(GRID_BINDING_HISTORY, history_).bind(GRID_BINDING_TILE_STATE, tile_state_);
+  list_set_.bind(LIVE_LIST_BINDING_LIST, list_).bind(LIVE_LIST_BINDING_TILE_STATE, tile_state_);
   history_fresh_ = true;
 }
 
@@ -69,7 +71,7 @@ void GridPass::prepare(const core::SampleDistribution& d, std::span<const std::u
   const VkDeviceSize table_bytes = table.size() * sizeof(shaders::GridColumn);
   if (table_bytes > columns_.size()) {
     columns_ = host_buffer(*ctx_, table_bytes, BufferUsage::Storage, "grid columns");
-    set_.bind(1, columns_);
+    set_.bind(GRID_BINDING_COLUMNS, columns_);
   }
   if (!table.empty()) columns_.upload(table);
   if (!hidden_mask.empty()) {
@@ -77,7 +79,7 @@ void GridPass::prepare(const core::SampleDistribution& d, std::span<const std::u
     if (hidden_mask.size_bytes() < need) throw std::invalid_argument("hidden mask smaller than the view raster");
     if (hidden_mask.size_bytes() > mask_.size()) {
       mask_ = host_buffer(*ctx_, hidden_mask.size_bytes(), BufferUsage::Storage, "hidden mask");
-      set_.bind(2, mask_);
+      set_.bind(GRID_BINDING_MASK, mask_);
     }
     mask_.upload(hidden_mask);
     p.has_mask = 1.0f;
@@ -96,7 +98,7 @@ void GridPass::record(VkCommandBuffer cmd, const Buffer& samples) {
   if (samples.size() < VkDeviceSize(padded_columns_) * padded_rows_ * sizeof(shaders::GridSample))
     throw std::invalid_argument("grid samples buffer too small for the grid");
   if (bound_samples_ != samples.handle()) {
-    set_.bind(3, samples);
+    set_.bind(GRID_BINDING_SAMPLES, samples);
     bound_samples_ = samples.handle();
   }
   if (history_fresh_) {

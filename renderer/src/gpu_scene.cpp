@@ -199,7 +199,7 @@ GpuScene::GpuScene(gpu::Context& ctx, const Scene& s, const BvhOptions& bvh_opti
     stats_.accel_bytes = accel_->bytes();
     accel_layout_ = gpu::DescriptorSetLayout(ctx, {gpu::Binding::AccelerationStructure});
     accel_set_ = gpu::DescriptorSet(ctx, accel_layout_);
-    accel_set_.bind(0, *accel_);
+    accel_set_.bind(PT_BINDING_TLAS, *accel_);
   }
 }
 

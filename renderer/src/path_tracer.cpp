@@ -9,20 +9,20 @@
 #include "fovea/core/error.hpp"
 #include "fovea/gpu/barriers.hpp"
 #include "fovea/shaders/live_cells.h"
+#include "fovea/shaders/pt_bindings.h"
 #include "fovea/shaders/pt_order.h"
 #include "tracer_pipeline.hpp"
 
 namespace fovea::renderer {
 
 namespace {
-constexpr int kOutputs = 6;
-constexpr int kBindings = 8 + kOutputs + 2;  // scene, grid, outputs, GGX albedo table, live-tile list
-
 // The scene data read per ray or path vertex are texel buffers (nodes, triangles, shading,
 // materials, lights, texture texels, GGX albedo), the rest storage buffers.
 std::vector<gpu::Binding> set0_bindings() {
-  std::vector<gpu::Binding> b(kBindings, gpu::Binding::StorageBuffer);
-  for (const int i : {0, 1, 2, 3, 4, 6, kBindings - 2}) b[std::size_t(i)] = gpu::Binding::TexelBuffer;
+  std::vector<gpu::Binding> b(PT_BINDING_COUNT, gpu::Binding::StorageBuffer);
+  for (const int i : {PT_BINDING_NODES, PT_BINDING_TRIS, PT_BINDING_SHADING, PT_BINDING_MATERIALS, PT_BINDING_LIGHTS,
+                      PT_BINDING_TEXELS, PT_BINDING_GGX_ALBEDO})
+    b[std::size_t(i)] = gpu::Binding::TexelBuffer;
   return b;
 }
 }  // namespace
@@ -53,7 +53,7 @@ TraceOutputs PathTracer::bind(const gpu::Buffer& grid, GridExtent extent, const 
   o.extent_ = extent;
   if (live) {
     o.live_ = live;
-    o.set_.bind(15, *live);
+    o.set_.bind(PT_BINDING_LIVE_LIST, *live);
   }
   return o;
 }
@@ -76,10 +76,14 @@ TraceOutputs PathTracer::bind(const gpu::Buffer& grid, std::uint32_t cells) cons
   o.position_material_ = make("pt.out.position_material");
   o.radiance_ = make("pt.out.radiance");
   o.set_ = gpu::DescriptorSet(ctx_, pipeline_.set_layout(0));
-  o.set_.bind(0, scene_.nodes()).bind(1, scene_.triangles()).bind(2, scene_.shading()).bind(3, scene_.materials());
-  o.set_.bind(4, scene_.lights()).bind(5, scene_.texture_table()).bind(6, scene_.texels()).bind(7, grid);
-  o.set_.bind(8, o.direct_).bind(9, o.indirect_).bind(10, o.albedo_).bind(11, o.normal_depth_);
-  o.set_.bind(12, o.position_material_).bind(13, o.radiance_).bind(14, scene_.ggx_albedo()).bind(15, no_list_);
+  o.set_.bind(PT_BINDING_NODES, scene_.nodes()).bind(PT_BINDING_TRIS, scene_.triangles());
+  o.set_.bind(PT_BINDING_SHADING, scene_.shading()).bind(PT_BINDING_MATERIALS, scene_.materials());
+  o.set_.bind(PT_BINDING_LIGHTS, scene_.lights()).bind(PT_BINDING_TEX_TABLE, scene_.texture_table());
+  o.set_.bind(PT_BINDING_TEXELS, scene_.texels()).bind(PT_BINDING_GRID, grid);
+  o.set_.bind(PT_BINDING_OUT_DIRECT, o.direct_).bind(PT_BINDING_OUT_INDIRECT, o.indirect_);
+  o.set_.bind(PT_BINDING_OUT_ALBEDO, o.albedo_).bind(PT_BINDING_OUT_NORMAL_DEPTH, o.normal_depth_);
+  o.set_.bind(PT_BINDING_OUT_POSITION_MATERIAL, o.position_material_).bind(PT_BINDING_OUT_RADIANCE, o.radiance_);
+  o.set_.bind(PT_BINDING_GGX_ALBEDO, scene_.ggx_albedo()).bind(PT_BINDING_LIVE_LIST, no_list_);
   return o;
 }
 

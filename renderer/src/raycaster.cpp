@@ -48,7 +48,8 @@ void Raycaster::set_rays(std::span<const shaders::PtRay> rays) {
   hits_ = gpu::Buffer(ctx_, {rays.size() * sizeof(shaders::PtHitRecord), gpu::BufferUsage::Storage,
                              gpu::Memory::DeviceLocal, "pt.hits"});
   set_ = gpu::DescriptorSet(ctx_, pipeline_.set_layout(0));
-  set_.bind(0, scene_.nodes()).bind(1, scene_.triangles()).bind(2, rays_).bind(3, hits_);
+  set_.bind(PT_BINDING_NODES, scene_.nodes()).bind(PT_BINDING_TRIS, scene_.triangles());
+  set_.bind(RAYCAST_BINDING_RAYS, rays_).bind(RAYCAST_BINDING_HITS, hits_);
 }
 
 std::vector<shaders::PtHitRecord> Raycaster::trace(RayQuery query, int repeat) {

@@ -5,6 +5,7 @@
 
 #include "fovea/gpu/pipeline.hpp"
 #include "fovea/renderer/gpu_scene.hpp"
+#include "fovea/shaders/pt_bindings.h"
 
 namespace fovea::renderer {
 

@@ -1,6 +1,6 @@
 // GLSL only: pt_trace_ray, the scene query the tracers call. Compiled with FOVEA_RAYQUERY
 // (the *.rayquery.comp.spv variants) it asks the device's acceleration structure through
-// GL_EXT_ray_query (set 1, binding 0: the top level of the scene's TriangleAccel, whose
+// GL_EXT_ray_query (set 1, binding PT_BINDING_TLAS: the top level of the scene's TriangleAccel, whose
 // primitive i is pt_tri(i)); otherwise it is pt_traverse, the compute BVH traversal.
 // Include after pt_traverse.h. Same semantics either way: closest hit, or any hit when
 // any_hit (shadow rays stop at the first); both faces; every triangle opaque (no alpha
@@ -9,10 +9,11 @@
 // offsets and shortened shadow rays keep away).
 #ifndef FOVEA_SHADERS_PT_RAYQUERY_H
 #define FOVEA_SHADERS_PT_RAYQUERY_H
+#include "fovea/shaders/pt_bindings.h"
 
 #ifdef FOVEA_RAYQUERY
 #extension GL_EXT_ray_query : require
-layout(set = 1, binding = 0) uniform accelerationStructureEXT pt_scene_tlas;
+layout(set = 1, binding = PT_BINDING_TLAS) uniform accelerationStructureEXT pt_scene_tlas;
 
 bool pt_trace_ray(vec3 org, vec3 dir, float tmin, float tmax, bool any_hit, out PtHit hit) {
   hit.t = tmax;
