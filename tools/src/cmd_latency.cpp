@@ -314,8 +314,7 @@ int run(std::vector<std::string> argv) {
     w.cost_ns = fixed_cost ? *fixed_cost : core::ms_to_ns(t.cpu_ms());
     measured.push_back(w.cost_ns);
     pipeline_ms.push_back(t.cpu_ms());
-    for (const auto& [name, st] : {std::pair{"grid", t.grid}, {"trace", t.trace}, {"reconstruct", t.reconstruct},
-                                   {"resolve", t.resolve}}) {
+    for (const auto& [name, st] : t.stages()) {
       w.cpu_ms.emplace_back(name, st.cpu_ms);
       w.gpu_ms.emplace_back(name, st.gpu_ms);
     }

@@ -550,8 +550,7 @@ int run(std::vector<std::string> argv) {
       gaze_fallback_frames[e] += t.gaze[e].fallback;
       gaze_clamped_frames[e] += t.gaze[e].clamped;
     }
-    for (const auto& [name, st] : {std::pair{"grid", t.grid}, {"trace", t.trace}, {"reconstruct", t.reconstruct},
-                                   {"resolve", t.resolve}}) {
+    for (const auto& [name, st] : t.stages()) {
       gpu_ms[name].push_back(st.gpu_ms);
       cpu_ms[name].push_back(st.cpu_ms);
     }

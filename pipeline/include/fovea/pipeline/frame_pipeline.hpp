@@ -7,6 +7,7 @@
 #include <array>
 #include <cstdint>
 #include <memory>
+#include <utility>
 #include <vector>
 
 #include "fovea/core/distribution.hpp"
@@ -44,6 +45,10 @@ struct FrameTimes {
   // The share of the EMA floors this frame kept (reconstruct::with_history_floors): 0 for a
   // still view (history weights 1/n: it converges), 1 once it moved kFullFloorMotionDeg.
   float history_floor = 1;
+  // The stages by the names every report and timing record uses.
+  std::array<std::pair<const char*, StageTime>, 4> stages() const {
+    return {{{"grid", grid}, {"trace", trace}, {"reconstruct", reconstruct}, {"resolve", resolve}}};
+  }
   double gpu_ms() const { return grid.gpu_ms + trace.gpu_ms + reconstruct.gpu_ms + resolve.gpu_ms; }
   double cpu_ms() const {
     return grid.cpu_ms + trace.cpu_ms + reconstruct.cpu_ms + resolve.cpu_ms + submit_cpu_ms + wait_cpu_ms;
