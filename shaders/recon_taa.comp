@@ -191,6 +191,13 @@ void main() {
   // No cap for emitters, the sky and a cell without neighbours.
   float cap = here.w < 0.0 || brightest < 0.0 ? 3.0e38 : kFireflyRatio * brightest;
   vec3 c = avg / avg_w * max(texelFetch(albedo, int(i)).rgb, vec3(kPtMinDemodAlbedo));
+  // The frame a gaze jump lands (ReconSettings::landing_deg): the new fovea's history is the
+  // previous frame's periphery resampled, too coarse to blend in, yet mostly within the
+  // coarse-cell test's limits; blended, it made BMFR's landed fovea worse than no denoiser's.
+  if (pc.landing_deg > 0.0) {
+    vec3 d = normalize(rg_world_to_view(m, here.xyz, abs(here.w - kReconSky) < 0.5));
+    if (dot(d, vec3(m.g.gaze_x, m.g.gaze_y, m.g.gaze_z)) >= cos(radians(pc.landing_deg))) history = false;
+  }
   // Accumulation only, nothing to blend, or a history that is the coarse periphery's.
   if (!denoise || !history || since == 1.0) {  // nothing to blend, or the history is the coarse periphery's
     final_color[i] = vec4(capped(c, cap), 1.0);

@@ -175,9 +175,15 @@ FrameTimes FramePipeline::render(const std::array<core::Pose, 2>& eye_pose, cons
     e->grid_pass->prepare(*e->dist, e->mask);
   }
   // A still view converges (history weights 1/n); a moving one keeps the EMA floors.
-  const reconstruct::ReconSettings settings = reconstruct::with_history_floors(m.settings, motion);
+  reconstruct::ReconSettings settings = reconstruct::with_history_floors(m.settings, motion);
   t.history_floor = 1.0f - settings.still;
-  if (jump >= reconstruct::kLandingJumpDeg) m.landing_left = reconstruct::kLandingFrames;
+  // The new fovea (and the distribution's margin) traces more samples for the landing's
+  // frames, and takes no TAA history on its first.
+  const double landing_deg = core::acuity::kFoveaDeg + m.eyes.front()->dist->params().margin_deg;
+  if (jump >= reconstruct::kLandingJumpDeg) {
+    m.landing_left = reconstruct::kLandingFrames;
+    settings.landing_deg = float(landing_deg);
+  }
   const bool landing = m.landing_left > 0;
   if (landing) --m.landing_left;
   t.grid.cpu_ms = lap_ms(t0);
@@ -206,7 +212,7 @@ FrameTimes FramePipeline::render(const std::array<core::Pose, 2>& eye_pose, cons
       cfg.texture_lod = true;  // one sample per cell and frame: textures prefiltered at the cell's size
       if (landing) {
         cfg.boost_spp = m.settings.landing_spp;
-        cfg.boost_deg = core::acuity::kFoveaDeg + e.dist->params().margin_deg;
+        cfg.boost_deg = landing_deg;
       }
       m.tracer.record(cmd, e.trace, core::View(e.base_view.fov(), e.base_view.width(), e.base_view.height(), e.pose),
                       e.eye, frame, cfg);

@@ -42,7 +42,7 @@ PostTaa::PostTaa(gpu::Context& ctx, std::span<const EyeGrid> eyes, const Accumul
 namespace {
 shaders::ReconPostPush post_push(bool history, const ReconSettings& s) {
   return {0, history ? 1u : 0u, s.denoiser == Denoiser::Bmfr ? 1u : 0u, s.live_cells ? 1u : 0u, s.post_alpha_min,
-          s.taa_alpha, s.still, 0};
+          s.taa_alpha, s.still, s.landing_deg};
 }
 }  // namespace
 

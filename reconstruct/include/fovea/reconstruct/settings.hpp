@@ -69,6 +69,12 @@ struct ReconSettings {
   // Set per frame by with_history_floors: 1 − the floors' share (1: a still view, which
   // needs no TAA: recon_taa.comp).
   float still = 0;
+  // Set by the frame pipeline on the frame a gaze jump lands (kLandingJumpDeg): the cells
+  // within this angle of the gaze (the new fovea and the distribution's margin) take no TAA
+  // history this frame. 0: none. That history is the previous frame's periphery, resampled:
+  // blended in, it made BMFR's landed fovea worse than no denoiser's (docs/reconstruction.md,
+  // "A 32° gaze step").
+  float landing_deg = 0;
   // Set by the frame pipeline: the per-cell kernels (accumulation, sharing, post,
   // TAA) run over the cells of the grid pass's live and reset tiles (EyeGrid::live, an
   // indirect dispatch) instead of every cell of the padded grid.

@@ -76,7 +76,7 @@ struct ReconPostPush {
   FOVEA_UINT listed;  // as ReconAccumulatePush
   float alpha_min, taa_alpha;  // BMFR Phase III: 0.1, TAA: 0.2
   float still;                // 0..1: how still the view is (1 − the EMA floors' share); recon_taa.comp
-  float pad1;
+  float landing_deg;          // > 0: a landing frame; TAA takes no history within this angle of the gaze
 };
 
 struct ReconMipPush {
