@@ -97,8 +97,8 @@ std::vector<VkPipeline> build_pipelines(const PipelineFunctions& f, VkDevice dev
 }
 
 // A pipeline layout with the sets in order and one compute push-constant range (none for 0).
-VkPipelineLayout build_layout(PFN_vkCreatePipelineLayout create, VkDevice dev, std::span<const VkDescriptorSetLayout> sets,
-                              std::uint32_t push_constant_bytes) {
+VkPipelineLayout build_layout(PFN_vkCreatePipelineLayout create, VkDevice dev,
+                              std::span<const VkDescriptorSetLayout> sets, std::uint32_t push_constant_bytes) {
   const VkPushConstantRange range{VK_SHADER_STAGE_COMPUTE_BIT, 0, push_constant_bytes};
   VkPipelineLayoutCreateInfo lci{VK_STRUCTURE_TYPE_PIPELINE_LAYOUT_CREATE_INFO};
   lci.setLayoutCount = static_cast<std::uint32_t>(sets.size());

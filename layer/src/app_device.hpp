@@ -183,7 +183,6 @@ class AppDevice {
   static constexpr std::size_t kPasses = 8;
   struct Gpu {
     gpu::ForeignPipelines program;  // the border and composite passes' pipelines, their layouts
-    VkPipeline pipeline = VK_NULL_HANDLE, border_pipeline = VK_NULL_HANDLE;  // in program: composite, border
     VkDescriptorPool pool = VK_NULL_HANDLE;
     VkDescriptorSet set = VK_NULL_HANDLE;
     VkCommandPool commands = VK_NULL_HANDLE;

@@ -30,6 +30,8 @@ namespace fovea::layer {
 namespace {
 
 constexpr std::uint32_t kBindings = LAYER_BINDING_COUNT;
+// The pipelines of the two passes, in Gpu::program.
+constexpr std::size_t kBorderPipeline = 0, kCompositePipeline = 1;
 // The composite pass's workgroup.
 constexpr std::uint32_t kGroupX = 32, kGroupY = 8;
 // A lost or hung device fails the session instead of hanging the application's call.
@@ -118,11 +120,10 @@ void AppDevice::enable_gpu_composition(int traced_width, int traced_height, int 
     gpu::ForeignPipelineDesc desc{"xr_layer_composite.comp.spv", {}, sizeof(Push), {}};
     desc.bindings.assign(kBindings, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER);
     desc.bindings[LAYER_BINDING_PARAMS] = VK_DESCRIPTOR_TYPE_STORAGE_BUFFER_DYNAMIC;
-    desc.specializations = {{shaders::kLayerPassBorder, shaders::kLayerBorderGroup, 1u},
-                            {shaders::kLayerPassComposite, kGroupX, kGroupY}};
+    desc.specializations.resize(2);
+    desc.specializations[kBorderPipeline] = {shaders::kLayerPassBorder, shaders::kLayerBorderGroup, 1u};
+    desc.specializations[kCompositePipeline] = {shaders::kLayerPassComposite, kGroupX, kGroupY};
     g.program = gpu::create_foreign_pipelines(device_, get_device_proc_, desc);
-    g.border_pipeline = g.program.pipelines[0];
-    g.pipeline = g.program.pipelines[1];
     const VkDescriptorPoolSize sizes[2] = {{VK_DESCRIPTOR_TYPE_STORAGE_BUFFER_DYNAMIC, 1},
                                            {VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, kBindings - 1}};
     VkDescriptorPoolCreateInfo pi{VK_STRUCTURE_TYPE_DESCRIPTOR_POOL_CREATE_INFO};
@@ -292,8 +293,9 @@ void AppDevice::reserve_gpu_buffers(VkDeviceSize app_bytes, VkDeviceSize depth_b
   reserve(g.app, app_bytes, dst, false);
   reserve(g.app_depth, depth_bytes, dst, false);
   const std::pair<std::uint32_t, const Buffer*> bound[kBindings] = {
-      {LAYER_BINDING_PARAMS, &g.params}, {LAYER_BINDING_TRACED, &g.traced},         {LAYER_BINDING_APP, &g.app},
-      {LAYER_BINDING_OUT, &g.out},       {LAYER_BINDING_BACKGROUND, &g.background}, {LAYER_BINDING_APP_DEPTH, &g.app_depth}};
+      {LAYER_BINDING_PARAMS, &g.params}, {LAYER_BINDING_TRACED, &g.traced},
+      {LAYER_BINDING_APP, &g.app},       {LAYER_BINDING_OUT, &g.out},
+      {LAYER_BINDING_BACKGROUND, &g.background}, {LAYER_BINDING_APP_DEPTH, &g.app_depth}};
   VkDescriptorBufferInfo infos[kBindings];
   VkWriteDescriptorSet writes[kBindings];
   for (std::uint32_t i = 0; i < kBindings; ++i) {
@@ -345,7 +347,7 @@ void AppDevice::record_pass(Pass& pass, std::size_t index) {
   const std::uint32_t params_offset = std::uint32_t(g.params_stride * index);
   vkCmdBindDescriptorSets_(cb, VK_PIPELINE_BIND_POINT_COMPUTE, g.program.layout, 0, 1, &g.set, 1, &params_offset);
   if (k.border) {
-    vkCmdBindPipeline_(cb, VK_PIPELINE_BIND_POINT_COMPUTE, g.border_pipeline);
+    vkCmdBindPipeline_(cb, VK_PIPELINE_BIND_POINT_COMPUTE, g.program.pipelines[kBorderPipeline]);
     for (std::uint32_t e = 0; e < 2; ++e) {
       const Push push{e};
       vkCmdPushConstants_(cb, g.program.layout, VK_SHADER_STAGE_COMPUTE_BIT, 0, sizeof push, &push);
@@ -355,7 +357,7 @@ void AppDevice::record_pass(Pass& pass, std::size_t index) {
     vkCmdPipelineBarrier_(cb, VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT, VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT, 0, 1, &border,
                           0, nullptr, 0, nullptr);
   }
-  vkCmdBindPipeline_(cb, VK_PIPELINE_BIND_POINT_COMPUTE, g.pipeline);
+  vkCmdBindPipeline_(cb, VK_PIPELINE_BIND_POINT_COMPUTE, g.program.pipelines[kCompositePipeline]);
   for (std::uint32_t e = 0; e < 2; ++e) {
     const Push push{e};
     vkCmdPushConstants_(cb, g.program.layout, VK_SHADER_STAGE_COMPUTE_BIT, 0, sizeof push, &push);

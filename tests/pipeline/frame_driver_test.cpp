@@ -14,11 +14,8 @@ namespace renderer = fovea::renderer;
 using fovea::test::GpuTest;
 
 namespace {
-double distance(const core::Pose& a, const core::Pose& b) {
-  return glm::length(a.position - b.position) + glm::length(glm::dvec4(a.orientation.x - b.orientation.x,
-                                                                       a.orientation.y - b.orientation.y,
-                                                                       a.orientation.z - b.orientation.z,
-                                                                       a.orientation.w - b.orientation.w));
+double pose_distance(const core::Pose& a, const core::Pose& b) {
+  return glm::length(a.position - b.position) + glm::length(a.orientation - b.orientation);
 }
 }  // namespace
 
@@ -35,7 +32,7 @@ TEST_F(GpuTest, FrameDriverSetsUpEveryEntryPointAlike) {
   EXPECT_EQ(tools.trace_choice().tracing, renderer::Tracing::Compute);
   EXPECT_EQ(tools.pipeline().distribution(core::Eye::Left).params().budget, 0.2);
   const auto expected = core::eye_poses(scene.camera, display);
-  for (int e = 0; e < 2; ++e) EXPECT_LT(distance(tools.static_poses()[std::size_t(e)], expected[std::size_t(e)]), 1e-12);
+  for (std::size_t e = 0; e < 2; ++e) EXPECT_LT(pose_distance(tools.static_poses()[e], expected[e]), 1e-12);
   const std::array<glm::dvec3, 2> gaze{glm::dvec3(0, 0, -1), glm::dvec3(0, 0, -1)};
   tools.pipeline().render(tools.static_poses(), gaze, 0);
   EXPECT_GT(tools.pipeline().hidden_cells(core::Eye::Left), 0);
@@ -50,10 +47,10 @@ TEST_F(GpuTest, FrameDriverSetsUpEveryEntryPointAlike) {
   const core::StereoViews views = core::stereo_views(display);
   pipeline::FrameDriver layer(ctx(), scene, views, {frame, true, false});
   const core::Pose identity{};
-  EXPECT_LT(distance(layer.at_camera(identity), scene.camera), 1e-12);
+  EXPECT_LT(pose_distance(layer.at_camera(identity), scene.camera), 1e-12);
   const auto app = views.poses();  // the head at the reference space's origin
-  for (int e = 0; e < 2; ++e)
-    EXPECT_LT(distance(layer.at_camera(app[std::size_t(e)]), expected[std::size_t(e)]), 1e-9) << "eye " << e;
+  for (std::size_t e = 0; e < 2; ++e)
+    EXPECT_LT(pose_distance(layer.at_camera(app[e]), expected[e]), 1e-9) << "eye " << e;
   layer.pipeline().render({layer.at_camera(app[0]), layer.at_camera(app[1])}, gaze, 0);
   EXPECT_EQ(layer.pipeline().hidden_cells(core::Eye::Left), 0);
   EXPECT_EQ(layer.pipeline().distribution(core::Eye::Left).params().budget, 0.2);

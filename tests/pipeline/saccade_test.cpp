@@ -356,8 +356,10 @@ TEST_P(LandingBmfrAgainstNone, BmfrIsNoWorseOnAnyFrameAfterTheLanding) {
       jump.render(poses, {gaze, gaze}, std::uint32_t(f));
       if (ref.image.pixels.empty())
         ref = fovea_reference(ctx(), gs, jump.view(core::Eye::Left), target, 256);
-      if (f >= kSettle)
-        flip[denoiser == reconstruct::Denoiser::Bmfr].push_back(fovea_scores(jump.image(core::Eye::Left), ref).hdr_flip);
+      if (f >= kSettle) {
+        const double score = fovea_scores(jump.image(core::Eye::Left), ref).hdr_flip;
+        flip[denoiser == reconstruct::Denoiser::Bmfr].push_back(score);
+      }
     }
   }
   std::printf("%s: fovea HDR-FLIP per frame after the landing, bmfr / none:", GetParam());
