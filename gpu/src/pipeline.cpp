@@ -271,8 +271,9 @@ ForeignPipelines create_foreign_pipelines(VkDevice dev, PFN_vkGetDeviceProcAddr 
     check(create_set_layout(dev, &li, nullptr, &out.set_layout), "vkCreateDescriptorSetLayout");
     out.layout = build_layout(create_layout, dev, {&out.set_layout, 1}, desc.push_constant_bytes);
 
-    std::vector<std::vector<VkSpecializationMapEntry>> entries;
+    std::vector<std::vector<VkSpecializationMapEntry>> entries;  // each info points into one
     std::vector<VkSpecializationInfo> infos;
+    entries.reserve(desc.specializations.size());
     for (const std::vector<std::uint32_t>& values : desc.specializations) {
       auto& e = entries.emplace_back();
       for (std::uint32_t id = 0; id < values.size(); ++id) e.push_back({id, id * 4, 4});

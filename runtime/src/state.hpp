@@ -39,7 +39,7 @@ struct Object {
 
 // Settings read from the environment when the instance is created.
 struct Config {
-  std::string display = "small";      // FOVEA_DISPLAY
+  std::string display = core::kDefaultDisplay;  // FOVEA_DISPLAY
   std::int64_t exit_after_frames = 0;  // FOVEA_EXIT_AFTER_FRAMES (0: never)
   std::string out_dir;                 // FOVEA_RUNTIME_OUT
   std::int64_t png_every = 1;          // FOVEA_RUNTIME_PNG_EVERY

@@ -107,7 +107,7 @@ int run(std::vector<std::string> argv) {
   const Args a(argv,
                {"display", "eye", "gaze", "gaze-dir", "distribution", "budget", "margin", "gamma", "cap", "aniso", "out"},
                {"json", "staircase", "hidden-area"});
-  const core::DisplayPreset preset = core::load_display(a.str("display", "small"));
+  const core::DisplayPreset preset = core::load_display(a.str("display", core::kDefaultDisplay));
   const core::Eye eye = core::parse_eye(a.str("eye", "left"));
   const core::View view = preset.view(eye);
 

@@ -55,7 +55,7 @@ const std::vector<std::string> kGeometryOpts = {"format", "display", "screen", "
 
 dv::SourceOptions gaze_source_options(const Args& a) {
   dv::SourceOptions opt;
-  opt.display = core::load_display(a.str("display", "small"));
+  opt.display = core::load_display(a.str("display", core::kDefaultDisplay));
   if (auto s = a.opt("screen")) opt.screen = dv::parse_screen(*s, "--screen");
   opt.format = a.str("format", "");
   opt.min_confidence = a.num("min-confidence", opt.min_confidence);
@@ -268,7 +268,7 @@ int cmd_synth(const std::vector<std::string>& argv) {
   p.noise_deg = a.num("noise", p.noise_deg);
   p.noise_color = a.num("color", p.noise_color);
   p.dropout_per_s = a.num("dropouts", p.dropout_per_s);
-  const core::DisplayPreset display = core::load_display(a.str("display", "small"));
+  const core::DisplayPreset display = core::load_display(a.str("display", core::kDefaultDisplay));
   p.ipd_m = display.ipd_m;
   dv::SyntheticStream stream(p);
   std::ostringstream cmd;

@@ -237,7 +237,7 @@ int run(std::vector<std::string> argv) {
     return run_records(args, out);
   }
 
-  const core::DisplayPreset display = core::load_display(args.str("display", "small"));
+  const core::DisplayPreset display = core::load_display(args.str("display", core::kDefaultDisplay));
   const double seconds = args.num("seconds", 2);
   if (!(seconds > 0 && seconds <= 600)) throw core::InputError("--seconds must be in (0, 600]");
   const std::string predict = args.str("predict", "none");

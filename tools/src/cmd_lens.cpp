@@ -32,7 +32,7 @@ grid of view directions (lines every 5 degrees) warped through the optics, each 
 through its own channel's optics (chromatic aberration shows as fringes), the hidden area
 in dark red.
 
-  --display NAME|FILE   display preset (fove0, vive, modern, wide, small, tiny) or JSON file [fove0]
+  --display NAME|FILE   display preset (fove0, vive, modern, wide, small, tiny) or JSON file [small]
   --channel r|g|b       use one channel's optics for all colours (that channel's distortion)
   --grid                overlay the panel's own straight grid (every 1/16 of the panel)
   --out PNG             picture to write [out/lens/lens-<display>.png]
@@ -123,7 +123,7 @@ int run(std::vector<std::string> argv) {
       return 0;
     }
   const Args args(argv, {"display", "channel", "out"}, {"grid", "json"});
-  const core::DisplayPreset d = core::load_display(args.str("display", "fove0"));
+  const core::DisplayPreset d = core::load_display(args.str("display", core::kDefaultDisplay));
   compositor::ChannelSelect select = compositor::ChannelSelect::All;
   if (auto c = args.opt("channel")) {
     if (*c == "r") select = compositor::ChannelSelect::Red;

@@ -119,7 +119,7 @@ int run(std::vector<std::string> argv) {
   const auto cache_opt = args.opt("reference-cache");
   const std::string cache = reference_cache_arg(cache_opt ? &*cache_opt : nullptr);
 
-  const core::DisplayPreset display = core::load_display(args.str("display", "small"));
+  const core::DisplayPreset display = core::load_display(args.str("display", core::kDefaultDisplay));
   const core::Eye eye = core::parse_eye(args.str("eye", "left"));
   const renderer::Tracing tracing = renderer::parse_tracing(args.str("trace", "auto"));
   for (const auto& w : scene.warnings) std::cerr << "warning: " << w << "\n";

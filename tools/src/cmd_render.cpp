@@ -442,7 +442,7 @@ int run(std::vector<std::string> argv) {
   const double ref_window_deg = args.num("reference-window", 0);
   const long png_every = args.integer("png-every", 1);
   if (png_every < 0) throw core::InputError("--png-every must be >= 0");
-  const core::DisplayPreset display = core::load_display(args.str("display", "small"));
+  const core::DisplayPreset display = core::load_display(args.str("display", core::kDefaultDisplay));
   pipeline::FrameConfig frame_config = frame_config_of(args);
   core::DistributionParams& dp = frame_config.distribution;
   reconstruct::ReconSettings& settings = frame_config.recon;

@@ -129,7 +129,7 @@ int run(std::vector<std::string> argv) {
                    "distribution", "denoiser", "bmfr-precision", "stereo-share", "bounces",
                    "screenshot", "panels"},
                   {});
-  const core::DisplayPreset d = core::load_display(args.str("display", "small"));
+  const core::DisplayPreset d = core::load_display(args.str("display", core::kDefaultDisplay));
   const long frames = args.integer("frames", 0);
   if (frames < 0) throw core::InputError("option --frames: must be 0 or more");
   const compositor::OpticsEval eval = parse_optics(args.str("optics", "direct"));

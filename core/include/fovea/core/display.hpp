@@ -41,6 +41,10 @@ struct DisplayPreset {
   View view(Eye e, const Pose& pose = {}) const { return View(fov(e), width, height, pose); }
 };
 
+// The preset every entry point takes when none is given (--display, FOVEA_DISPLAY): small
+// enough for the embedded CPU device's frame rate.
+inline constexpr const char* kDefaultDisplay = "small";
+
 // A name of an embedded preset, or a path to a JSON file. Throws InputError naming the
 // input and the offending field, also for a lens that leaves (almost) no visible area.
 DisplayPreset load_display(std::string_view name_or_path);

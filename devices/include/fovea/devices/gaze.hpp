@@ -77,7 +77,7 @@ const char* predict_mode_name(PredictMode m);
 // micrometres on a calibrated screen, normalised coordinates) into view directions:
 // a pinhole View (field of view + raster). Normalised inputs are scaled to the raster.
 struct SourceOptions {
-  core::DisplayPreset display = core::load_display("small");
+  core::DisplayPreset display = core::load_display(core::kDefaultDisplay);
   // The 2D surface the gaze coordinates refer to; default: the display's left view.
   std::optional<core::View> screen;
   std::string format;   // replay: force a format instead of auto-detection
