@@ -18,6 +18,7 @@ struct EyeState {
   core::View base_view;
   core::Pose pose;
   glm::dvec3 gaze_used{0, 0, -1};  // the gaze the grid used in the last frame
+  glm::dvec3 grid_gaze{0, 0, 0};   // the gaze the grid is laid out for (kGridHoldDeg); 0: none yet
   std::unique_ptr<gpu::GridPass> grid_pass;
   gpu::Buffer grid;
   renderer::TraceOutputs trace;

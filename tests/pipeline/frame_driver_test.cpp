@@ -55,3 +55,28 @@ TEST_F(GpuTest, FrameDriverSetsUpEveryEntryPointAlike) {
   EXPECT_EQ(layer.pipeline().hidden_cells(core::Eye::Left), 0);
   EXPECT_EQ(layer.pipeline().distribution(core::Eye::Left).params().budget, 0.2);
 }
+
+// A fixating eye's drift does not move the grid: within kGridHoldDeg (0.5°) of the gaze the
+// grid was laid out for it stays there; a larger move, and the first frame after reset(),
+// lay it out again at the gaze.
+TEST_F(GpuTest, GridHoldsStillThroughAFixationalDrift) {
+  const renderer::Scene scene = renderer::load_scene("cornell");
+  renderer::GpuScene gs(ctx(), scene);
+  const core::DisplayPreset display = core::load_display("tiny");
+  pipeline::FramePipeline p(ctx(), gs, core::stereo_views(display), {}, {}, {}, /*mono=*/true);
+  const auto poses = core::eye_poses(scene.camera, display);
+  const auto at = [](double yaw_deg) {
+    const double a = glm::radians(yaw_deg);
+    return glm::dvec3(std::sin(a), 0, -std::cos(a));
+  };
+  const auto used = [&](double yaw_deg, std::uint32_t f) {
+    return p.render(poses, {at(yaw_deg), at(yaw_deg)}, f).gaze[0].used;
+  };
+  EXPECT_LT(glm::length(used(2.0, 0) - at(2.0)), 1e-9);
+  EXPECT_LT(glm::length(used(2.3, 1) - at(2.0)), 1e-9) << "0.3°: held";
+  EXPECT_LT(glm::length(used(1.6, 2) - at(2.0)), 1e-9) << "0.4° the other way: held";
+  EXPECT_LT(glm::length(used(2.8, 3) - at(2.8)), 1e-9) << "0.8°: laid out again";
+  EXPECT_LT(glm::length(used(3.1, 4) - at(2.8)), 1e-9) << "held at the new place";
+  p.reset();
+  EXPECT_LT(glm::length(used(3.1, 5) - at(3.1)), 1e-9) << "after reset";
+}

@@ -122,11 +122,11 @@ TEST_F(GrazingTexture, BricksKeptWithoutMoire) {
   EXPECT_GT(cart_still.ssim, 0.95);
   EXPECT_GT(cart_drift.ssim, 0.95);  // the raster does not move with the gaze
   EXPECT_GT(vp_still.ssim, 0.75);
-  // A drifting gaze moves the polar grid every frame: the albedo takes each frame's sample,
-  // prefiltered at the cell's size (an accumulated history resampled every frame blurred
-  // the bricks away: 0.47). The remaining gap to Cartesian is the resolve's resampling and
-  // the per-frame sample (docs/reconstruction.md, "Textures under sparse cells").
-  EXPECT_GT(vp_drift.ssim, 0.65);
+  // A drift within the grid's hold (0.5°) leaves the polar grid where it is, so the cells keep
+  // their history as under a still gaze (moving the grid every frame: 0.74 against 0.83).
+  // The remaining gap to Cartesian is the resolve's resampling (docs/reconstruction.md,
+  // "Textures under sparse cells").
+  EXPECT_GT(vp_drift.ssim, vp_still.ssim - 0.02);
 }
 
 }  // namespace grazing_texture
