@@ -13,11 +13,6 @@ namespace fovea::pipeline {
 
 namespace {
 
-// A fixating eye's drift and tremor stay within a few tenths of a degree: within this angle
-// of where it is laid out the grid does not follow the gaze (the fovea's margin, 1° by
-// default, covers the offset).
-constexpr double kGridHoldDeg = 0.5;
-
 gpu::Buffer storage(gpu::Context& ctx, VkDeviceSize bytes, const char* name) {
   return gpu::Buffer(ctx, {.size = std::max<VkDeviceSize>(bytes, 16), .usage = gpu::BufferUsage::Storage, .name = name});
 }
@@ -173,11 +168,8 @@ FrameTimes FramePipeline::render(const std::array<core::Pose, 2>& eye_pose, cons
     const core::Pose pose_before = e->pose;
     const glm::dvec3 gaze_before = e->gaze_used;
     e->pose = eye_pose[i];
-    // A fixating eye drifts: the grid stays where it is while the gaze moves less than
-    // kGridHoldDeg from the gaze it was laid out for, so that the cells keep their history.
-    const bool hold = history && glm::length(e->grid_gaze) > 0 && core::angle_deg(gaze[i], e->grid_gaze) < kGridHoldDeg;
-    if (!hold) e->grid_gaze = gaze[i];
-    t.gaze[i] = e->dist->set_frame(e->grid_gaze, frame);
+    if (!history) e->hold.reset();
+    t.gaze[i] = e->dist->set_frame(e->hold.place(gaze[i]), frame);
     e->gaze_used = t.gaze[i].used;
     motion = std::max(motion, reconstruct::view_motion_deg(gaze_before, e->gaze_used, pose_before, e->pose));
     if (history) jump = std::max(jump, core::angle_deg(gaze_before, e->gaze_used));

@@ -4,6 +4,7 @@
 #include <optional>
 #include <vector>
 
+#include "fovea/core/grid_hold.hpp"
 #include "fovea/gpu/grid_pass.hpp"
 #include "fovea/gpu/timer.hpp"
 #include "fovea/pipeline/frame_pipeline.hpp"
@@ -18,7 +19,7 @@ struct EyeState {
   core::View base_view;
   core::Pose pose;
   glm::dvec3 gaze_used{0, 0, -1};  // the gaze the grid used in the last frame
-  glm::dvec3 grid_gaze{0, 0, 0};   // the gaze the grid is laid out for (kGridHoldDeg); 0: none yet
+  core::GridHold hold;              // where the grid is laid out (through a fixational drift)
   std::unique_ptr<gpu::GridPass> grid_pass;
   gpu::Buffer grid;
   renderer::TraceOutputs trace;

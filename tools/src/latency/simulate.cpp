@@ -4,6 +4,7 @@
 #include <cmath>
 
 #include "fovea/core/error.hpp"
+#include "fovea/core/grid_hold.hpp"
 #include "fovea/core/view.hpp"
 #include "fovea/devices/ivt.hpp"
 
@@ -82,6 +83,7 @@ Simulation simulate(devices::TrackerModel& tracker, const Scenario& sc, const Re
   devices::FoveationGaze gaze(std::make_unique<Borrowed>(tracker));
   gaze.set_epoch(0);
   xrcommon::FramePacer pacer(sc.display);
+  std::array<core::GridHold, 3> hold;  // left, right, combined
   core::TimeNs now = 0;
   for (std::int64_t f = 0;; ++f) {
     xrcommon::FrameSlot slot = pacer.next(now);
@@ -91,7 +93,8 @@ Simulation simulate(devices::TrackerModel& tracker, const Scenario& sc, const Re
     // What the tracker had delivered at the wake, predicted to the display time when the
     // tracker's source predicts (--predict).
     const devices::FoveaGaze g = gaze.read(wake, slot.display_ns);
-    const std::array<glm::dvec3, 2> dirs{g.left.dir, g.right.dir};
+    // Each eye's grid as the frame pipeline lays it out (held through a fixational drift).
+    const std::array<glm::dvec3, 2> dirs{hold[0].place(g.left.dir), hold[1].place(g.right.dir)};
     FrameWork work = render(f, dirs);
     const core::TimeNs submit = wake + work.cost_ns;
     const xrcommon::DisplayModel& m = pacer.model();
@@ -120,7 +123,7 @@ Simulation simulate(devices::TrackerModel& tracker, const Scenario& sc, const Re
     r.photon_ns = ph;
     r.cpu_ms = std::move(work.cpu_ms);
     r.gpu_ms = std::move(work.gpu_ms);
-    r.fovea_dir = g.combined.dir;
+    r.fovea_dir = hold[2].place(g.combined.dir);
     const devices::GazeSample truth = tracker.truth_at(ph[0].mid);
     if (truth.t_ns != devices::kNoSample && truth.tracked()) r.true_gaze_dir = truth.combined.dir;
     sim.records.push_back(std::move(r));
