@@ -53,7 +53,7 @@ std::unique_ptr<EyeState> make_eye(gpu::Context& ctx, renderer::PathTracer& trac
   e->trace = tracer.bind(e->grid,
                          renderer::GridExtent{std::uint32_t(e->dist->padded_columns()),
                                               std::uint32_t(e->dist->padded_rows())},
-                         &e->grid_pass->live_cells());
+                         &e->grid_pass->live_tiles());
   return e;
 }
 
@@ -116,7 +116,7 @@ FramePipeline::FramePipeline(gpu::Context& ctx, const renderer::GpuScene& scene,
                      .normal_depth = &t.normal_depth(),
                      .position_material = &t.position_material(),
                      .albedo = &t.albedo(),
-                     .live = &e->grid_pass->live_cells()});
+                     .live = &e->grid_pass->live_tiles()});
   }
   // The reconstruction's per-cell kernels over the live tiles, except for a Cartesian raster
   // on a CPU device: lavapipe's SIMD vectors then run down a tile's column, 8 raster rows

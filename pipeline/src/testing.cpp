@@ -50,7 +50,7 @@ renderer::TraceOrder trace_order(const FramePipeline& pipeline, core::Eye e) {
 
 std::vector<std::uint32_t> live_cells(const FramePipeline& pipeline, core::Eye e) {
   const auto& m = Access::impl(pipeline);
-  const auto list = m.eyes[std::size_t(m.index(e, "live_cells"))]->grid_pass->live_cells().download<std::uint32_t>();
+  const auto list = m.eyes[std::size_t(m.index(e, "live_cells"))]->grid_pass->live_tiles().download<std::uint32_t>();
   std::vector<std::uint32_t> cells;
   for (std::uint32_t k = 0; k < list[shaders::kLiveCount]; ++k)
     for (std::uint32_t l = 0; l < shaders::kLiveTileCells; ++l)

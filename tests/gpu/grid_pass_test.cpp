@@ -160,7 +160,7 @@ TEST_F(GpuTest, GridPassListsLiveAndResetTiles) {
         d->set_frame(glm::normalize(gazes[f]), 7);  // one frame index: the moves alone change the cells
         pass.generate(*d, out, mask.words());
         const auto grid = out.download<shaders::GridSample>();
-        const auto list = pass.live_cells().download<std::uint32_t>();
+        const auto list = pass.live_tiles().download<std::uint32_t>();
         const std::uint32_t* header = list.data();
         std::vector<int> live_in(tiles, 0), reset_in(tiles, 0);
         std::int64_t live_cells = 0, reset_cells = 0;

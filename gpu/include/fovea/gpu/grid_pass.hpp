@@ -22,7 +22,7 @@ namespace fovea::gpu {
 class GridPass {
  public:
   // `cells`: the list's capacity to start with (it grows with the grids prepared, and
-  // live_cells() then is a new buffer). Cells are counted with subgroup ballots where the
+  // live_tiles() then is a new buffer). Cells are counted with subgroup ballots where the
   // device has them; `ballot = false` takes the variant for devices without (atomics per
   // cell) on any device, for tests.
   explicit GridPass(Context& ctx, std::uint32_t cells = 0, bool ballot = true);
@@ -51,7 +51,7 @@ class GridPass {
 
   // The live-tile list of the last recorded dispatch (live_cells.h): header, then the tiles;
   // a storage buffer and the indirect dispatches' arguments.
-  const Buffer& live_cells() const { return list_; }
+  const Buffer& live_tiles() const { return list_; }
   // The next record() treats every cell as having had a sample in the two frames before, so
   // that those without one now are listed as reset (after the per-cell buffers were
   // overwritten, e.g. filled).

@@ -32,7 +32,7 @@ struct EyeGrid {
   // The path tracer's per-cell outputs (renderer::TraceOutputs) and the grid itself.
   const gpu::Buffer *samples = nullptr, *direct = nullptr, *indirect = nullptr, *normal_depth = nullptr,
                     *position_material = nullptr, *albedo = nullptr;
-  // The grid pass's live-tile list (gpu::GridPass::live_cells()): with
+  // The grid pass's live-tile list (gpu::GridPass::live_tiles()): with
   // ReconSettings::live_cells the per-cell kernels run over its live and reset tiles alone.
   const gpu::Buffer* live = nullptr;
 };

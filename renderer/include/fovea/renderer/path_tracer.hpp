@@ -28,7 +28,7 @@ namespace fovea::renderer {
 enum class TraceOrder {
   Grid,   // invocation n traces cell n: a SIMD vector runs along a row of the grid
   Tiles,  // tiles of the grid, each SIMD vector down one column (pt_order.h); needs the grid's extents
-  // The grid pass's live tiles (gpu::GridPass::live_cells(), bound with the outputs), an
+  // The grid pass's live tiles (gpu::GridPass::live_tiles(), bound with the outputs), an
   // indirect dispatch of a workgroup per tile with a sample, each in tile order: no workgroup
   // starts for a tile without one, and the outputs of cells without a sample stay as they
   // were (the frame pipeline reads none of them).
