@@ -147,8 +147,7 @@ class PathTracer {
         // The frame of `fovea render` (pipeline/frame_driver.hpp) on the application's views. A
         // measurement would delay the first traced frame by seconds: the cached choice, or none.
         driver_(std::make_unique<pipeline::FrameDriver>(*ctx_, scene, views_,
-                                                        pipeline::FrameDriverOptions{config_.frame, false, false})),
-        pipeline_(&driver_->pipeline()) {
+                                                        pipeline::FrameDriverOptions{config_.frame, false, false})) {
     FOVEA_LAYER_INFO("rendering scene \"%s\" (from %s) at %dx%d per eye on %s, composite %s, gaze %s, render %s, "
                      "render thread %s, frame %s, tracing %s (%s)",
                      config_.scene.c_str(), config_.origin.c_str(), display.width, display.height,
@@ -187,7 +186,7 @@ class PathTracer {
       gaze[ei] = fg.eye(core::Eye(e)).dir;
     }
     times.gaze_cpu = ms_since(t_gaze);
-    const pipeline::FrameTimes gt = pipeline_->render(poses, gaze, std::uint32_t(in.id));
+    const pipeline::FrameTimes gt = driver_->pipeline().render(poses, gaze, std::uint32_t(in.id));
     times.trace = gt.grid.gpu_ms + gt.trace.gpu_ms;
     times.reconstruct = gt.reconstruct.gpu_ms;
     times.resolve = gt.resolve.gpu_ms;
@@ -195,15 +194,15 @@ class PathTracer {
     times.submit_cpu = gt.submit_cpu_ms;
     times.wait_cpu = gt.wait_cpu_ms;
     // Counted by the grid pass (no read-back); reported while a mask is set.
-    if (mask_set_) times.samples_hidden = pipeline_->hidden_cells(core::Eye::Left) + pipeline_->hidden_cells(core::Eye::Right);
+    if (mask_set_) times.samples_hidden = driver_->pipeline().hidden_cells(core::Eye::Left) + driver_->pipeline().hidden_cells(core::Eye::Right);
     const auto r0 = core::now_ns();
     for (int e = 0; e < 2; ++e) {
-      const core::Image linear = pipeline_->image(core::Eye(e));
+      const core::Image linear = driver_->pipeline().image(core::Eye(e));
       times.host_bytes += std::int64_t(linear.pixels.size() * sizeof(linear.pixels[0]));
       f->colour[std::size_t(e)] = encode_scene(linear, pixel_format(format_));
       times.host_bytes += std::int64_t(f->colour[std::size_t(e)].data.size());  // written into the app's memory
       if (config_.composite != Composite::SceneOnly) {
-        f->depth[std::size_t(e)] = pipeline_->depth(core::Eye(e));
+        f->depth[std::size_t(e)] = driver_->pipeline().depth(core::Eye(e));
         times.host_bytes += 2 * std::int64_t(f->depth[std::size_t(e)].size() * sizeof(float));  // read, written
       }
     }
@@ -244,7 +243,7 @@ class PathTracer {
       const core::Eye eye = core::Eye(e);
       try {
         const core::ViewMask mask = fetch_visibility_mask(in.get_visibility_mask, session_, std::uint32_t(e), views_[eye]);
-        pipeline_->set_visibility(eye, mask);
+        driver_->pipeline().set_visibility(eye, mask);
         mask_set_ = true;
         FOVEA_LAYER_INFO("visibility mask of the %s view: %.1f%% of its pixels hidden, not traced", core::eye_name(eye),
                          100.0 * mask.hidden_fraction());
@@ -265,7 +264,6 @@ class PathTracer {
   bool mask_set_ = false;                         // the pipeline culls with a runtime mask
   std::unique_ptr<gpu::Context> ctx_;
   std::unique_ptr<pipeline::FrameDriver> driver_;
-  pipeline::FramePipeline* pipeline_;  // the driver's
 };
 
 // The calling thread's scheduling set to `p`; the reason on failure, else empty.
