@@ -194,7 +194,10 @@ class PathTracer {
     times.submit_cpu = gt.submit_cpu_ms;
     times.wait_cpu = gt.wait_cpu_ms;
     // Counted by the grid pass (no read-back); reported while a mask is set.
-    if (mask_set_) times.samples_hidden = driver_->pipeline().hidden_cells(core::Eye::Left) + driver_->pipeline().hidden_cells(core::Eye::Right);
+    if (mask_set_) {
+      const pipeline::FramePipeline& p = driver_->pipeline();
+      times.samples_hidden = p.hidden_cells(core::Eye::Left) + p.hidden_cells(core::Eye::Right);
+    }
     const auto r0 = core::now_ns();
     for (int e = 0; e < 2; ++e) {
       const core::Image linear = driver_->pipeline().image(core::Eye(e));
