@@ -142,11 +142,11 @@ class PathTracer {
   // (null: the host path, frames kept in host memory).
   PathTracer(const LayerConfig& config, const renderer::Scene& scene, const core::StereoViews& views,
              const core::DisplayPreset& display, VkFormat format, XrSession session, const AppDevice* slots)
-      : config_(config), views_(views), format_(format), session_(session), slots_(slots),
+      : config_(config), format_(format), session_(session), slots_(slots),
         gaze_(std::make_unique<LayerGaze>(config.gaze, display)), ctx_(std::make_unique<gpu::Context>()),
         // The frame of `fovea render` (pipeline/frame_driver.hpp) on the application's views. A
         // measurement would delay the first traced frame by seconds: the cached choice, or none.
-        driver_(std::make_unique<pipeline::FrameDriver>(*ctx_, scene, views_,
+        driver_(std::make_unique<pipeline::FrameDriver>(*ctx_, scene, views,
                                                         pipeline::FrameDriverOptions{config_.frame, false, false})) {
     FOVEA_LAYER_INFO("rendering scene \"%s\" (from %s) at %dx%d per eye on %s, composite %s, gaze %s, render %s, "
                      "render thread %s, frame %s, tracing %s (%s)",
@@ -245,7 +245,8 @@ class PathTracer {
     for (int e = 0; e < 2; ++e) {
       const core::Eye eye = core::Eye(e);
       try {
-        const core::ViewMask mask = fetch_visibility_mask(in.get_visibility_mask, session_, std::uint32_t(e), views_[eye]);
+        const core::ViewMask mask =
+            fetch_visibility_mask(in.get_visibility_mask, session_, std::uint32_t(e), driver_->views()[eye]);
         driver_->pipeline().set_visibility(eye, mask);
         mask_set_ = true;
         FOVEA_LAYER_INFO("visibility mask of the %s view: %.1f%% of its pixels hidden, not traced", core::eye_name(eye),
@@ -257,7 +258,6 @@ class PathTracer {
   }
 
   const LayerConfig& config_;
-  const core::StereoViews views_;
   const VkFormat format_;
   const XrSession session_;
   const AppDevice* slots_;
