@@ -145,6 +145,75 @@ TEST(SweepReport, SyntheticSweepGivesKnownFrontsTablesAndPlots) {
   fs::remove_all(dir);
 }
 
+TEST(SweepReport, SectionsByTwoSettingsAndSpeedUpAtEqualQuality) {
+  const std::string dir = test::temp_dir("sweep-report-speedup");
+  const std::vector<RenderOption> opts = {{"scene", true}, {"display", true}, {"distribution", true},
+                                          {"budget", true}, {"out", true},     {"quiet", false}};
+  const json file = core::parse_json(R"([
+    {"scenes": "default", "displays": ["p1", "p2"], "distribution": "vp", "budget": [0.1, 0.2, 0.4],
+     "report": {"quality": ["fovea_flip", "fovea_psnr"], "section": ["scene", "display"],
+                "speedup": {"of": "vp", "over": "full", "tolerance": 0.05}}},
+    {"scenes": "default", "displays": ["p1", "p2"], "distribution": "full"}])");
+  const Plan plan = expand_sweep(file, "synthetic.json", opts);
+  ASSERT_EQ(plan.jobs.size(), 8u);
+  // full: 100 ms, FLIP 0.200, 1000 samples. vp on p1: FLIP 0.30, 0.209 (within 5%), 0.19 at
+  // 10, 20, 40 ms with budget * 1000 samples: the pick is budget 0.2, 5.00x for a samples
+  // ratio of 5. On p2 vp never gets within 5% (best 0.25).
+  for (const Job& j : plan.jobs) {
+    const json& st = j.settings;
+    const bool full = st["distribution"] == "full", p1 = st["display"] == "p1";
+    const double budget = full ? 1.0 : st["budget"].get<double>();
+    const double flip = full ? 0.2 : !p1 ? 0.25 + budget : budget < 0.15 ? 0.3 : budget < 0.3 ? 0.209 : 0.19;
+    json rep = render_report(100 * budget, full ? 30 : 31, flip, 40);
+    rep["samples_traced_per_eye"] = 1000 * budget;
+    rep["cpu_ms"] = {{"total", 110 * budget}};
+    fs::create_directories(dir + "/" + j.out);
+    core::write_file_atomic(dir + "/" + j.out + "/report.json", rep.dump());
+  }
+  const std::string plan_path = dir + "/plan.jsonl";
+  core::write_file_atomic(plan_path, plan_to_jsonl(plan));
+  const auto r = test::run_fovea("sweep report " + plan_path + " --out " + dir + "/report --markdown " + dir + "/page.md");
+  ASSERT_EQ(r.status, 0) << r.err;
+  const std::string page = test::read_text(dir + "/page.md");
+  for (const char* text :
+       {"One section per display: [p1](#display-p1), [p2](#display-p2)", "## display p1\n", "## display p2\n",
+        "## vp against full at equal fovea_flip",
+        "| display p1 | 1000 | 100 / 110 | 0.2000 | 0.2 | 200 | 20 / 22 | 0.2090 | **5.00×** | 5.00× | 5.00 | 1.00 | fovea_psnr 30.00 → 31.00 |",
+        "| display p2 | 1000 | 100 / 110 | 0.2000 | none as good (best: 0.3500 at budget 0.1) | – | – | – | – | – | – | – | – |"})
+    EXPECT_NE(page.find(text), std::string::npos) << text << "\n" << page;
+  // The scene does not vary: it names no section; the fronts and plots are per display.
+  const json j = core::parse_json(test::read_text(dir + "/report/results.json"));
+  EXPECT_TRUE(j["pareto"]["fovea_flip"].contains("p1/vp")) << j["pareto"].dump();
+  EXPECT_TRUE(fs::exists(dir + "/report/quality_vs_time_fovea_flip_p2.png"));
+
+  // Both keys vary: sections by scene and display, titled with both.
+  const json two = core::parse_json(R"({"scenes": ["a", "b"], "displays": ["p1", "p2"], "distribution": "vp",
+                                        "report": {"quality": ["fovea_flip"], "section": ["scene", "display"]}})");
+  const Plan plan2 = expand_sweep(two, "synthetic.json", opts);
+  const std::string dir2 = dir + "/two";
+  for (const Job& jb : plan2.jobs) {
+    fs::create_directories(dir2 + "/" + jb.out);
+    core::write_file_atomic(dir2 + "/" + jb.out + "/report.json", render_report(10, 30, 0.2, 40).dump());
+  }
+  core::write_file_atomic(dir2 + "/plan.jsonl", plan_to_jsonl(plan2));
+  const auto r2 = test::run_fovea("sweep report " + dir2 + "/plan.jsonl --out " + dir2 + "/report --markdown " + dir2 + "/page.md");
+  ASSERT_EQ(r2.status, 0) << r2.err;
+  const std::string page2 = test::read_text(dir2 + "/page.md");
+  EXPECT_NE(page2.find("One section per scene and display: [a p1](#scene-a-display-p1),"), std::string::npos) << page2;
+  EXPECT_NE(page2.find("## scene b, display p2\n"), std::string::npos) << page2;
+  EXPECT_EQ(page2.find("## vp against"), std::string::npos);  // no speedup configured, no such table
+  EXPECT_TRUE(fs::exists(dir2 + "/report/quality_vs_time_fovea_flip_b_p2.png"));
+
+  // A malformed speedup names the key.
+  json bad = file;
+  bad[0]["report"]["speedup"] = {{"of", "vp"}};
+  core::write_file_atomic(plan_path, plan_to_jsonl(expand_sweep(bad, "synthetic.json", opts)));
+  const auto r3 = test::run_fovea("sweep report " + plan_path + " --out " + dir + "/report");
+  EXPECT_EQ(r3.status, 2);
+  EXPECT_NE(r3.err.find("report.speedup"), std::string::npos) << r3.err;
+  fs::remove_all(dir);
+}
+
 TEST(SweepReport, WithoutPythonWritesTheDataAndSaysHowToDrawTheFigures) {
   const std::string dir = test::temp_dir("sweep-report-nopython");
   const std::vector<RenderOption> opts = {{"distribution", true}, {"budget", true}, {"out", true}, {"quiet", false}};

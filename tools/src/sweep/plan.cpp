@@ -208,7 +208,8 @@ Plan expand_sweep(const json& sweep, const std::string& source, const CommandOpt
       if (!it->is_object()) throw InputError(where(source, key) + ": expected an object");
       static const std::set<std::string> fields = {"quality",         "time",    "group",           "budget",
                                                    "section",         "bands",   "latency",         "latency_quality",
-                                                   "latency_group",   "lower_is_better", "higher_is_better"};
+                                                   "latency_group",   "lower_is_better", "higher_is_better",
+                                                   "speedup"};
       for (auto f = it->begin(); f != it->end(); ++f)
         if (!fields.count(f.key())) {
           std::string names;

@@ -1,11 +1,13 @@
 #include "sweep/report.hpp"
 
 #include <algorithm>
+#include <cctype>
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
 #include <numeric>
+#include <optional>
 #include <set>
 #include <sstream>
 
@@ -96,10 +98,18 @@ struct Row {
 
 std::string setting_text(const json& v) { return v.is_string() ? v.get<std::string>() : v.dump(); }
 
+// report.speedup: one group's whole-frame speed-up over another's at equal quality, per section.
+struct SpeedUp {
+  std::string of, over, quality;  // quality: empty = the first quality metric
+  double tolerance = 0;           // relative: "as good" allows this much worse
+};
+
 struct Config {
   std::vector<std::string> quality, bands, latency_quality;
-  std::string time = "gpu_ms.total", group = "distribution", budget = "budget", section = "scene", latency,
-              latency_group;
+  std::string time = "gpu_ms.total", group = "distribution", budget = "budget", latency, latency_group;
+  std::vector<std::string> section = {"scene"};  // as configured
+  std::vector<std::string> section_keys;          // of those, the ones whose value differs between render jobs
+  std::optional<SpeedUp> speedup;
   std::set<std::string> lower, higher;
   bool lower_better(const std::string& m) const {
     if (lower.count(m)) return true;
@@ -108,9 +118,33 @@ struct Config {
   }
 };
 
-// The section a render job's tables and plots belong to: its value of the section setting.
+// The section a render job's tables and plots belong to: its values of the section settings
+// ("default", or "default/fove0" when both the scene and the display vary), and its title
+// ("scene default, display fove0").
 std::string section_of(const Row& r, const Config& c) {
-  return r.settings.contains(c.section) ? setting_text(r.settings[c.section]) : std::string();
+  std::string s;
+  for (std::size_t i = 0; i < c.section_keys.size(); ++i)
+    s += (i ? "/" : "") + (r.settings.contains(c.section_keys[i]) ? setting_text(r.settings[c.section_keys[i]]) : "");
+  return s;
+}
+std::string section_title(const Row& r, const Config& c) {
+  std::string s;
+  for (const auto& k : c.section_keys)
+    s += (s.empty() ? "" : ", ") + k + " " + (r.settings.contains(k) ? setting_text(r.settings[k]) : "–");
+  return s;
+}
+struct Section {
+  std::string id, title;
+};
+// A heading's anchor as Markdown renderers make it: lower case, spaces to hyphens, other
+// punctuation dropped.
+std::string anchor_of(const std::string& heading) {
+  std::string a;
+  for (unsigned char c : heading)
+    if (std::isalnum(c)) a += char(std::tolower(c));
+    else if (c == ' ' || c == '-') a += '-';
+    else if (c == '_' || c >= 0x80) a += char(c);
+  return a;
 }
 // The plots of latency jobs: their own section of the page, after the render sections.
 const std::string kLatencySection = "\n latency";
@@ -150,7 +184,33 @@ Config read_config(const json& r, const std::vector<Row>& rows) {
   if (auto t = strings("time"); !t.empty()) c.time = t[0];
   if (auto g = strings("group"); !g.empty()) c.group = g[0];
   if (auto b = strings("budget"); !b.empty()) c.budget = b[0];
-  if (auto s = strings("section"); !s.empty()) c.section = s[0];
+  if (auto s = strings("section"); !s.empty()) c.section = s;
+  for (const auto& k : c.section) {
+    std::set<std::string> values;
+    for (const auto& row : rows)
+      if (job_command(row.settings) == "render") values.insert(row.settings.contains(k) ? setting_text(row.settings[k]) : "");
+    if (values.size() > 1) c.section_keys.push_back(k);
+  }
+  if (c.section_keys.empty()) c.section_keys.push_back(c.section[0]);
+  if (r.contains("speedup")) {
+    const json& x = r["speedup"];
+    const auto bad = [](const std::string& what) { return core::InputError("report.speedup: " + what); };
+    if (!x.is_object()) throw bad("expected an object {\"of\": GROUP, \"over\": GROUP, \"quality\": METRIC, \"tolerance\": N}");
+    SpeedUp s;
+    for (const auto& [k, v] : x.items()) {
+      if (k == "of" || k == "over" || k == "quality") {
+        if (!v.is_string() || v.get<std::string>().empty()) throw bad(k + ": expected a non-empty name");
+        (k == "of" ? s.of : k == "over" ? s.over : s.quality) = v.get<std::string>();
+      } else if (k == "tolerance") {
+        if (!v.is_number() || !(v.get<double>() >= 0 && v.get<double>() < 1)) throw bad("tolerance: expected a number in [0, 1)");
+        s.tolerance = v.get<double>();
+      } else {
+        throw bad("unknown key \"" + k + "\" (of, over, quality, tolerance)");
+      }
+    }
+    if (s.of.empty() || s.over.empty()) throw bad("\"of\" and \"over\" are required");
+    c.speedup = s;
+  }
   c.bands = strings("bands");
   if (auto l = strings("latency"); !l.empty()) c.latency = l[0];
   else if (present.count("gaze_to_photon_ms.median")) c.latency = "gaze_to_photon_ms.median";  // fovea latency's
@@ -309,7 +369,7 @@ struct MarkdownInput {
   const std::vector<Row>& rows;
   const Config& cfg;
   const std::map<std::string, std::map<std::string, bool>>& on_front;
-  const std::vector<std::string>& sections;                         // of the render jobs, in plan order
+  const std::vector<Section>& sections;                             // of the render jobs, in plan order
   const std::map<std::string, std::vector<std::string>>& images;  // per section, relative to the page
   const std::string& command;
 };
@@ -328,6 +388,7 @@ std::string job_argv_text(const Plan& plan, const std::string& id) {
 void markdown_section(std::ostringstream& md, const MarkdownInput& in, const std::vector<const Row*>& done,
                       const std::string& h, const std::vector<std::string>& images);
 void markdown_latency(std::ostringstream& md, const MarkdownInput& in, const std::vector<std::string>& images);
+void markdown_speedup(std::ostringstream& md, const MarkdownInput& in, const std::vector<const Row*>& done);
 
 // The page: settings, every job, equal samples, equal time, per band, the plots, and what
 // the Pareto front means for a 90 Hz frame.
@@ -352,17 +413,23 @@ std::string markdown_page(const MarkdownInput& in) {
         "weighted by acuity. Means of both eyes.\n\n";
   const bool sectioned = in.sections.size() > 1;
   if (sectioned) {
-    md << "One section per " << cfg.section << ":";
-    for (const auto& s : in.sections)
-      md << " [" << s << "](#" << cfg.section << "-" << s << ")" << (s == in.sections.back() ? "" : ",");
+    std::string keys;
+    for (const auto& k : cfg.section_keys) keys += (keys.empty() ? "" : " and ") + k;
+    md << "One section per " << keys << ":";
+    for (std::size_t i = 0; i < in.sections.size(); ++i) {
+      std::string text = in.sections[i].id;
+      std::replace(text.begin(), text.end(), '/', ' ');
+      md << " [" << text << "](#" << anchor_of(in.sections[i].title) << ")" << (i + 1 == in.sections.size() ? "" : ",");
+    }
     md << (in.images.count(kLatencySection) ? "; then [latency against quality](#latency-against-quality)" : "") << ".\n\n";
   }
+  if (cfg.speedup) markdown_speedup(md, in, done);
   for (const auto& section : in.sections) {
     std::vector<const Row*> rows;
     for (const Row* r : done)
-      if (job_command(r->settings) == "render" && section_of(*r, cfg) == section) rows.push_back(r);
-    if (sectioned) md << "## " << cfg.section << " " << section << "\n\n";
-    const auto images = in.images.find(section);
+      if (job_command(r->settings) == "render" && section_of(*r, cfg) == section.id) rows.push_back(r);
+    if (sectioned) md << "## " << section.title << "\n\n";
+    const auto images = in.images.find(section.id);
     markdown_section(md, in, rows, sectioned ? "### " : "## ",
                      images != in.images.end() ? images->second : std::vector<std::string>{});
   }
@@ -561,6 +628,81 @@ void markdown_section(std::ostringstream& md, const MarkdownInput& in, const std
   }
 }
 
+// report.speedup: per section, the `over` job against the cheapest `of` job whose quality is
+// at least as good (within the tolerance): whole-frame times on the GPU and the CPU, traced
+// samples, and how much of the samples' ratio the time's ratio keeps.
+void markdown_speedup(std::ostringstream& md, const MarkdownInput& in, const std::vector<const Row*>& done) {
+  const Config& cfg = in.cfg;
+  const SpeedUp& su = *cfg.speedup;
+  const std::string q = !su.quality.empty() ? su.quality : cfg.quality.empty() ? "" : cfg.quality[0];
+  if (q.empty()) return;
+  const bool lower = cfg.lower_better(q);
+  const std::string cpu = "cpu_ms.total", samples = "samples_traced_per_eye";
+  const auto group = [&](const Row& r) { return r.settings.contains(cfg.group) ? setting_text(r.settings[cfg.group]) : ""; };
+  const auto ratio = [](const Row& a, const Row& b, const std::string& m) {
+    return a.metrics.count(m) && b.metrics.count(m) && b.metrics.at(m) > 0 ? fixed(a.metrics.at(m) / b.metrics.at(m), 2)
+                                                                           : std::string("–");
+  };
+  md << "## " << su.of << " against " << su.over << " at equal " << q << "\n\n"
+     << "Per section: the " << su.over << " job, and the cheapest " << su.of << " job (by `" << cfg.time
+     << "`) whose " << q << " is at least as good as its, within " << fixed(100 * su.tolerance, 0)
+     << "% (\"as good\": " << (lower ? "at most" : "at least") << " " << (lower ? "1 + " : "1 − ")
+     << fixed(su.tolerance, 2) << " times the " << su.over << " job's). *Speed-up*: the " << su.over
+     << " job's whole-frame time over the " << su.of << " job's (GPU: `" << cfg.time << "`, CPU: `" << cpu
+     << "`, both per stereo frame, every stage); *samples ratio*: traced samples per eye, " << su.over << " over "
+     << su.of << "; the last column is how much of the samples' ratio the GPU speed-up keeps (1 = cost follows "
+     << "the samples); *other quality*: the other quality metrics, " << su.over << " → " << su.of << ".\n\n"
+     << "| section | " << su.over << " samples/eye | " << su.over << " GPU / CPU ms | " << su.over << " " << q << " | "
+     << su.of << " " << cfg.budget << " | " << su.of << " samples/eye | " << su.of << " GPU / CPU ms | " << su.of << " "
+     << q << " | GPU speed-up | CPU speed-up | samples ratio | speed-up / samples ratio | other quality |\n"
+     << "|---|---|---|---|---|---|---|---|---|---|---|---|---|\n";
+  for (const Section& section : in.sections) {
+    const Row* over = nullptr;
+    std::vector<const Row*> of;
+    for (const Row* r : done) {
+      if (job_command(r->settings) != "render" || section_of(*r, cfg) != section.id || !r->metrics.count(cfg.time) ||
+          !r->metrics.count(q))
+        continue;
+      if (group(*r) == su.over && (!over || r->metrics.at(cfg.time) < over->metrics.at(cfg.time))) over = r;
+      if (group(*r) == su.of) of.push_back(r);
+    }
+    if (!over || of.empty()) continue;
+    const double ref = over->metrics.at(q), slack = su.tolerance * std::abs(ref);
+    const Row* pick = nullptr;
+    for (const Row* r : of) {
+      const double v = r->metrics.at(q);
+      if ((lower ? v <= ref + slack : v >= ref - slack) && (!pick || r->metrics.at(cfg.time) < pick->metrics.at(cfg.time)))
+        pick = r;
+    }
+    const auto times = [&](const Row& r) { return md_value(r, cfg.time) + " / " + md_value(r, cpu); };
+    md << "| " << section.title << " | " << md_value(*over, samples) << " | " << times(*over) << " | " << md_value(*over, q)
+       << " | ";
+    if (!pick) {
+      const Row* best = of.front();
+      for (const Row* r : of)
+        if (lower ? r->metrics.at(q) < best->metrics.at(q) : r->metrics.at(q) > best->metrics.at(q)) best = r;
+      md << "none as good (best: " << md_value(*best, q) << " at " << cfg.budget << " "
+         << (best->settings.contains(cfg.budget) ? setting_text(best->settings[cfg.budget]) : "–")
+         << ") | – | – | – | – | – | – | – | – |\n";
+      continue;
+    }
+    const std::string speed_up = ratio(*over, *pick, cfg.time), samples_ratio = ratio(*over, *pick, samples);
+    const double kept = pick->metrics.count(samples) && over->metrics.count(samples) && pick->metrics.at(samples) > 0
+                            ? (over->metrics.at(cfg.time) / pick->metrics.at(cfg.time)) /
+                                  (over->metrics.at(samples) / pick->metrics.at(samples))
+                            : NAN;
+    md << (pick->settings.contains(cfg.budget) ? setting_text(pick->settings[cfg.budget]) : "–") << " | "
+       << md_value(*pick, samples) << " | " << times(*pick) << " | " << md_value(*pick, q) << " | **" << speed_up << "×** | "
+       << ratio(*over, *pick, cpu) << "× | " << samples_ratio << " | " << (std::isfinite(kept) ? fixed(kept, 2) : "–")
+       << " |";
+    std::string other;
+    for (const auto& m : cfg.quality)
+      if (m != q) other += (other.empty() ? " " : "; ") + m + " " + md_value(*over, m) + " → " + md_value(*pick, m);
+    md << other << " |\n";
+  }
+  md << "\n";
+}
+
 // Latency jobs: their settings, gaze-to-photon, foveal error and fovea quality, the plots.
 void markdown_latency(std::ostringstream& md, const MarkdownInput& in, const std::vector<std::string>& images) {
   const Config& cfg = in.cfg;
@@ -650,15 +792,16 @@ ReportSummary write_report(const Plan& plan, const ReportOptions& o) {
   auto label_of = [&](const Row& r) {
     std::string s;
     for (const auto& k : varied)
-      if (k != cfg.group && k != cfg.section && r.settings.contains(k)) s += (s.empty() ? "" : " ") + k + "=" + setting_text(r.settings[k]);
+      if (k != cfg.group && std::count(cfg.section_keys.begin(), cfg.section_keys.end(), k) == 0 && r.settings.contains(k))
+        s += (s.empty() ? "" : " ") + k + "=" + setting_text(r.settings[k]);
     return s;
   };
   // Render jobs are compared within a section (a scene): their own fronts, plots and tables.
-  std::vector<std::string> sections;
+  std::vector<Section> sections;
   for (const auto& r : rows)
     if (r.status == "done" && job_command(r.settings) == "render" &&
-        std::find(sections.begin(), sections.end(), section_of(r, cfg)) == sections.end())
-      sections.push_back(section_of(r, cfg));
+        std::none_of(sections.begin(), sections.end(), [&](const Section& s) { return s.id == section_of(r, cfg); }))
+      sections.push_back({section_of(r, cfg), section_title(r, cfg)});
   const bool sectioned = sections.size() > 1;
   fs::create_directories(out);
   std::map<std::string, std::vector<std::string>> section_files;  // section -> PNGs; latency plots under kLatencySection
@@ -671,7 +814,7 @@ ReportSummary write_report(const Plan& plan, const ReportOptions& o) {
 
   std::map<std::string, std::map<std::string, bool>> on_front;  // quality -> id -> flag
   json fronts = json::object();
-  for (const std::string& section : sections) {
+  for (const auto& [section, title] : sections) {
     std::vector<const Row*> members_of_section;
     for (const auto& r : rows)
       if (r.status == "done" && job_command(r.settings) == "render" && section_of(r, cfg) == section) members_of_section.push_back(&r);
@@ -679,7 +822,7 @@ ReportSummary write_report(const Plan& plan, const ReportOptions& o) {
     for (const Row* r : members_of_section)
       if (std::find(groups.begin(), groups.end(), group_of(*r)) == groups.end()) groups.push_back(group_of(*r));
     const std::string suffix = sectioned ? "_" + file_stem(section) : "";
-    const std::string where = sectioned ? ", " + cfg.section + " " + section : "";
+    const std::string where = sectioned ? ", " + title : "";
     // Pareto fronts of quality against time, per group.
     for (const auto& q : cfg.quality) {
       Chart ch;
