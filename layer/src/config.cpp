@@ -83,9 +83,9 @@ void apply_section(const nlohmann::json& s, const std::string& where, LayerConfi
       pipeline::apply_frame_option(c.frame, key, v.is_string() ? v.get<std::string>() : v.dump(), field);
       c.budget_given |= key == "budget";
     } else {
-      throw core::InputError(field + ": unknown key (scene, composite, app_background, gaze, render, compositor, "
-                                     "render_priority, budget, distribution, jitter, denoiser, bmfr-precision, "
-                                     "stereo-share, trace)");
+      std::string known = "scene, composite, app_background, gaze, render, compositor, render_priority";
+      for (const std::string& n : pipeline::frame_option_names()) known += ", " + n;
+      throw core::InputError(field + ": unknown key (" + known + ")");
     }
   }
 }

@@ -104,12 +104,10 @@ void FrameLog::write_now(const FrameTimes& t) {
   r.cpu_ms = {{"app", double(t.end_call_ns - t.begin_ns) * 1e-6},
               {"end_frame", double(t.end_return_ns - t.end_call_ns) * 1e-6},
               {"end_frame_layer", double(t.end_down_ns - t.end_call_ns) * 1e-6},
-              {"gaze", rt.gaze_cpu},
-              {"grid", rt.grid_cpu},
-              {"submit", rt.submit_cpu},
-              {"wait", rt.wait_cpu},
               {"readback", rt.readback_cpu}};
-  r.gpu_ms = {{"trace", rt.trace}, {"reconstruct", rt.reconstruct}, {"resolve", rt.resolve}};
+  const auto frame_cpu = rt.frame.cpu_record(rt.gaze_cpu);  // the frame driver's step: gaze ... total
+  r.cpu_ms.insert(r.cpu_ms.end(), frame_cpu.begin(), frame_cpu.end());
+  r.gpu_ms = rt.frame.gpu_record();
   r.extra = {// Which clock the runtime's XrTime values are on (FrameTimes::xr_time_converted).
              {"xr_time_converted", t.xr_time_converted},
              {"layers", std::int64_t(t.layers)},     {"projection_views", std::int64_t(t.projection_views)},

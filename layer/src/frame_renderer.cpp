@@ -166,7 +166,6 @@ class PathTracer {
     const auto t_gaze = core::now_ns();
     // Eye poses: the application's view poses (its reference space) placed at the scene's camera.
     std::array<core::Pose, 2> poses;
-    std::array<glm::dvec3, 2> gaze;
     const devices::FoveaGaze fg = gaze_->frame(in.display_time, in.gaze_from_action ? &in.action_gaze : nullptr);
     if (in.gaze_from_action != gaze_from_action_) {
       FOVEA_LAYER_INFO("gaze: %s", in.gaze_from_action ? "the eye-gaze action" : gaze_->describe().c_str());
@@ -183,16 +182,9 @@ class PathTracer {
       const core::Pose p = to_pose(in.poses[ei]);
       f->orientation[ei] = p.orientation;
       poses[ei] = driver_->at_camera(p);
-      gaze[ei] = fg.eye(core::Eye(e)).dir;
     }
     times.gaze_cpu = ms_since(t_gaze);
-    const pipeline::FrameTimes gt = driver_->pipeline().render(poses, gaze, std::uint32_t(in.id));
-    times.trace = gt.grid.gpu_ms + gt.trace.gpu_ms;
-    times.reconstruct = gt.reconstruct.gpu_ms;
-    times.resolve = gt.resolve.gpu_ms;
-    times.grid_cpu = gt.grid.cpu_ms;
-    times.submit_cpu = gt.submit_cpu_ms;
-    times.wait_cpu = gt.wait_cpu_ms;
+    times.frame = driver_->step(std::uint32_t(in.id), fg, poses, times.gaze_cpu).times;
     // Counted by the grid pass (no read-back); reported while a mask is set.
     if (mask_set_) {
       const pipeline::FramePipeline& p = driver_->pipeline();

@@ -18,6 +18,7 @@
 
 #include "composite.hpp"
 #include "config.hpp"
+#include "fovea/pipeline/frame_pipeline.hpp"
 #include "gaze_input.hpp"
 
 namespace fovea::layer {
@@ -73,14 +74,14 @@ struct FrameInput {
 
 // Where the layer's time went in the last render() (milliseconds).
 struct RenderTimes {
-  double total = 0;        // wall time of the render on the render thread (trace, read-back, encoding)
-  double trace = 0;        // GPU: grid generation + path tracing, both eyes
-  double reconstruct = 0;  // GPU: accumulation, stereo sharing, BMFR, TAA
-  double resolve = 0;      // GPU: resolve to the display, blur
-  double transfer = 0;     // in xrEndFrame: the composition (GPU pass, or read-back, host compositing and upload)
-  // CPU (monotonic clock): the gaze sample, the grids' per-frame build, the submission, the
-  // fence wait until the GPU finished, read-back of the rendered images.
-  double gaze_cpu = 0, grid_cpu = 0, submit_cpu = 0, wait_cpu = 0, readback_cpu = 0;
+  double total = 0;     // wall time of the render on the render thread (trace, read-back, encoding)
+  double transfer = 0;  // in xrEndFrame: the composition (GPU pass, or read-back, host compositing and upload)
+  // The frame driver's step (pipeline/frame_driver.hpp): the pipeline's stages on the GPU and
+  // the CPU, and reading the gaze (CPU, monotonic clock); recorded by the names every timing
+  // record uses (FrameTimes::gpu_record, cpu_record).
+  pipeline::FrameTimes frame;
+  double gaze_cpu = 0;
+  double readback_cpu = 0;  // CPU: read-back and encoding of the rendered images
   // The gaze sample the frame was foveated for (CLOCK_MONOTONIC ns; 0: none measured yet):
   // when it was measured, when the host received it, when the renderer read it.
   std::int64_t gaze_sample_ns = 0, gaze_receive_ns = 0, gaze_read_ns = 0;

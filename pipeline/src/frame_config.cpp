@@ -16,7 +16,8 @@ reconstruct::ReconSettings FrameConfig::default_recon() {
 
 const std::vector<std::string>& frame_option_names() {
   static const std::vector<std::string> names = {"budget",         "distribution", "jitter", "denoiser",
-                                                 "bmfr-precision", "stereo-share", "trace", "bounces"};
+                                                 "bmfr-precision", "stereo-share", "trace",  "bounces",
+                                                 "seed"};
   return names;
 }
 
@@ -57,6 +58,15 @@ void apply_frame_option(FrameConfig& c, std::string_view name, std::string_view 
                                  ", got \"" + v + "\"");
         c.bounces = {false, int(n)};
       }
+    } else if (name == "seed") {
+      const std::string v(value);
+      char* end = nullptr;
+      errno = 0;
+      const long n = std::strtol(v.c_str(), &end, 10);
+      if (v.empty() || *end != '\0' || errno == ERANGE || n < 0 || n > long(FrameConfig::kMaxSeed))
+        throw core::InputError("expected a whole number in 0.." + std::to_string(FrameConfig::kMaxSeed) + ", got \"" + v +
+                               "\"");
+      c.seed = std::uint32_t(n);
     } else {
       throw core::InputError("not a frame option");
     }
@@ -87,7 +97,8 @@ nlohmann::json to_json(const FrameConfig& c) {
           {"bmfr-precision", c.recon.bmfr_precision == reconstruct::BmfrPrecision::Fp16 ? "fp16" : "fp32"},
           {"stereo-share", reconstruct::stereo_share_name(c.recon.share)},
           {"trace", renderer::tracing_name(c.tracing)},
-          {"bounces", c.bounces.from_albedo ? nlohmann::json("auto") : nlohmann::json(c.bounces.count)}};
+          {"bounces", c.bounces.from_albedo ? nlohmann::json("auto") : nlohmann::json(c.bounces.count)},
+          {"seed", c.seed}};
 }
 
 renderer::PathConfig path_config(const Bounces& bounces, const renderer::Scene& scene) {

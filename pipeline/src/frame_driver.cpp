@@ -1,5 +1,9 @@
 #include "fovea/pipeline/frame_driver.hpp"
 
+#include <cmath>
+#include <stdexcept>
+
+#include "fovea/core/clock.hpp"
 #include "fovea/core/eye_optics.hpp"
 
 namespace fovea::pipeline {
@@ -23,6 +27,7 @@ FrameDriver::FrameDriver(gpu::Context& ctx, const renderer::Scene& scene, const 
 FrameDriver::FrameDriver(gpu::Context& ctx, const renderer::Scene& scene, const core::StereoViews& views,
                          const FrameDriverOptions& options, const std::optional<core::DisplayPreset>& display)
     : frame_(options.frame),
+      refresh_hz_(display ? display->refresh_hz : 0),
       camera_(scene.camera),
       trace_choice_(renderer::choose_tracing(ctx, frame_.tracing, renderer::default_trace_choice_cache(),
                                              options.measure_trace)),
@@ -30,6 +35,7 @@ FrameDriver::FrameDriver(gpu::Context& ctx, const renderer::Scene& scene, const 
       views_(views),
       pipeline_(ctx, gpu_scene_, views_, named(frame_.distribution, display), frame_.recon,
                 path_config(frame_.bounces, scene)) {
+  pipeline_.set_seed(frame_.seed);
   if (display && options.cull)
     for (core::Eye e : {core::Eye::Left, core::Eye::Right})
       pipeline_.set_visibility(e, core::EyeOptics(*display, e).view_mask());
@@ -40,6 +46,33 @@ core::Pose FrameDriver::at_camera(const core::Pose& eye) const {
   p.orientation = camera_.orientation * eye.orientation;
   p.position = camera_.position + camera_.orientation * eye.position;
   return p;
+}
+
+void FrameDriver::set_gaze(std::unique_ptr<devices::FoveationGaze> gaze) {
+  if (refresh_hz_ <= 0) throw std::logic_error("FrameDriver::set_gaze: a driver of given views has no frame timeline");
+  gaze_ = std::move(gaze);
+}
+
+core::TimeNs frame_time_ns(std::uint32_t index, double refresh_hz) {
+  return core::TimeNs(std::llround(double(index) / refresh_hz * 1e9));
+}
+
+DrivenFrame FrameDriver::step(std::uint32_t index) {
+  if (!gaze_) throw std::logic_error("FrameDriver::step: no gaze source (set_gaze)");
+  const core::TimeNs t0 = core::now_ns();
+  const devices::FoveaGaze g = gaze_->at_frame_time(frame_ns(index));
+  return step(index, g, static_poses(), core::ns_to_ms(core::now_ns() - t0));
+}
+
+DrivenFrame FrameDriver::step(std::uint32_t index, const devices::FoveaGaze& gaze, const std::array<core::Pose, 2>& poses,
+                              double gaze_cpu_ms) {
+  DrivenFrame d;
+  d.index = index;
+  d.frame_ns = frame_ns(index);
+  d.gaze = gaze;
+  d.gaze_cpu_ms = gaze_cpu_ms;
+  d.times = pipeline_.render(poses, {gaze.eye(core::Eye::Left).dir, gaze.eye(core::Eye::Right).dir}, index);
+  return d;
 }
 
 }  // namespace fovea::pipeline

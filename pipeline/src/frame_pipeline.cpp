@@ -154,6 +154,21 @@ void FramePipeline::set_visibility(core::Eye eye, const core::ViewMask& mask) {
   e.mask.assign(mask.words().begin(), mask.words().end());
 }
 
+std::vector<std::pair<std::string, double>> FrameTimes::gpu_record() const {
+  std::vector<std::pair<std::string, double>> r;
+  for (const auto& [name, st] : stages()) r.emplace_back(name, st.gpu_ms);
+  r.insert(r.end(), {{"bmfr_fit", bmfr_fit_gpu_ms}, {"mip", mip_gpu_ms}, {"resample", resample_gpu_ms},
+                     {"blur", blur_gpu_ms}, {"total", gpu_ms()}});
+  return r;
+}
+
+std::vector<std::pair<std::string, double>> FrameTimes::cpu_record(double gaze_cpu_ms) const {
+  std::vector<std::pair<std::string, double>> r{{"gaze", gaze_cpu_ms}};
+  for (const auto& [name, st] : stages()) r.emplace_back(name, st.cpu_ms);
+  r.insert(r.end(), {{"submit", submit_cpu_ms}, {"wait", wait_cpu_ms}, {"total", gaze_cpu_ms + cpu_ms()}});
+  return r;
+}
+
 FrameTimes FramePipeline::render(const std::array<core::Pose, 2>& eye_pose, const std::array<glm::dvec3, 2>& gaze,
                                  std::uint32_t frame) {
   Impl& m = *impl_;
@@ -194,6 +209,7 @@ FrameTimes FramePipeline::render(const std::array<core::Pose, 2>& eye_pose, cons
   const bool alternate = stereo && m.settings.share == reconstruct::StereoShare::Alternate;
   // Alternating sharing: only one eye traces indirect diffuse this frame.
   bool fresh[2] = {true, true};
+  const std::uint32_t noise = frame + kSeedStride * m.seed;
   for (std::size_t i = 0; i < m.eyes.size(); ++i) fresh[i] = !alternate || int(m.eyes[i]->eye) == int(frame % 2);
 
   double recording_ms = 0;  // inside submit_and_wait, counted to the stages
@@ -216,7 +232,7 @@ FrameTimes FramePipeline::render(const std::array<core::Pose, 2>& eye_pose, cons
         cfg.boost_deg = landing_deg;
       }
       m.tracer.record(cmd, e.trace, core::View(e.base_view.fov(), e.base_view.width(), e.base_view.height(), e.pose),
-                      e.eye, frame, cfg);
+                      e.eye, noise, cfg);
     }
     gpu::compute_to_compute(cmd);
     m.timer.stage(cmd, "trace");
@@ -225,7 +241,7 @@ FrameTimes FramePipeline::render(const std::array<core::Pose, 2>& eye_pose, cons
     m.gather->record(cmd, p, stereo && m.settings.share != reconstruct::StereoShare::Off, settings);
     m.timer.stage(cmd, "accumulate");
     if (m.bmfr)
-      m.bmfr->record(cmd, p, frame, m.settings.block_offsets ? reconstruct::bmfr_block_offset(frame) : glm::ivec2(0),
+      m.bmfr->record(cmd, p, noise, m.settings.block_offsets ? reconstruct::bmfr_block_offset(noise) : glm::ivec2(0),
                      m.settings.noise);
     m.timer.stage(cmd, "bmfr_fit");
     m.post->record(cmd, p, history, settings);
@@ -276,6 +292,8 @@ FrameTimes FramePipeline::render(const std::array<core::Pose, 2>& eye_pose, cons
 }
 
 void FramePipeline::enable_temporal_error() { impl_->temporal = true; }
+
+void FramePipeline::set_seed(std::uint32_t seed) { impl_->seed = seed; }
 
 double FramePipeline::temporal_error(core::Eye e) const {
   const Impl& m = *impl_;

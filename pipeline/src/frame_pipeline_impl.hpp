@@ -44,6 +44,7 @@ struct FramePipeline::Impl {
   std::uint32_t landing_left = 0;  // frames still tracing the new fovea's extra samples
   int parity = 0;                 // history buffers written by the last frame
   bool temporal = false;          // the temporal error is measured on the device
+  std::uint32_t seed = 0;         // FramePipeline::set_seed
   std::uint32_t temporal_frames = 0, temporal_pairs = 0;  // frames measured, consecutive pairs summed
   // testing::set_trace_order; it also sets settings.live_cells (to whether the order is Live)
   std::optional<renderer::TraceOrder> forced_order;

@@ -1,8 +1,13 @@
 // The frame driver every entry point sets its frames up with (pipeline/frame_driver.hpp): the
 // display's views with the head at the scene's camera and the lens hidden area culled, or the
-// views it is given with nothing culled; the frame configuration reaches the pipeline.
+// views it is given with nothing culled; the frame configuration reaches the pipeline; each
+// frame's step reads the gaze and records the frame's times.
+#include <cmath>
+#include <stdexcept>
+
 #include <glm/gtc/quaternion.hpp>
 
+#include "fovea/core/error.hpp"
 #include "fovea/core/eye_optics.hpp"
 #include "fovea/pipeline/frame_driver.hpp"
 #include "fovea/renderer/scene_io.hpp"
@@ -10,6 +15,7 @@
 
 namespace pipeline = fovea::pipeline;
 namespace core = fovea::core;
+namespace devices = fovea::devices;
 namespace renderer = fovea::renderer;
 using fovea::test::GpuTest;
 
@@ -54,6 +60,95 @@ TEST_F(GpuTest, FrameDriverSetsUpEveryEntryPointAlike) {
   layer.pipeline().render({layer.at_camera(app[0]), layer.at_camera(app[1])}, gaze, 0);
   EXPECT_EQ(layer.pipeline().hidden_cells(core::Eye::Left), 0);
   EXPECT_EQ(layer.pipeline().distribution(core::Eye::Left).params().budget, 0.2);
+}
+
+// Each frame is one step: the gaze read at the frame's time on the display's timeline (as a
+// source of its own reads it), the pipeline's frame with it, and its times by the names every
+// timing record uses.
+TEST_F(GpuTest, FrameDriverStepReadsTheGazeAtTheFrameTimeAndRecordsItsTimes) {
+  const renderer::Scene scene = renderer::load_scene("cornell");
+  const core::DisplayPreset display = core::load_display("tiny");
+  pipeline::FrameConfig frame;
+  frame.tracing = renderer::Tracing::Compute;
+  pipeline::finish(frame, false);
+  pipeline::FrameDriver driver(ctx(), scene, display, {frame, true, false});
+  EXPECT_THROW(driver.step(0), std::logic_error);  // no gaze source yet
+  devices::SourceOptions so;
+  so.display = display;
+  driver.set_gaze(std::make_unique<devices::FoveationGaze>("synthetic:7", so));
+  devices::FoveationGaze twin("synthetic:7", so);
+  for (std::uint32_t f = 0; f < 3; ++f) {
+    const pipeline::DrivenFrame d = driver.step(f);
+    EXPECT_EQ(d.index, f);
+    EXPECT_EQ(d.frame_ns, std::llround(f / display.refresh_hz * 1e9));
+    const devices::FoveaGaze g = twin.at_frame_time(d.frame_ns);
+    for (core::Eye e : {core::Eye::Left, core::Eye::Right}) {
+      EXPECT_EQ(d.gaze.eye(e).dir, g.eye(e).dir) << "frame " << f;
+      // The grid used that gaze (in the view, no fixational hold between these frames' jumps
+      // or the same direction again).
+      EXPECT_GT(glm::dot(glm::normalize(d.times.gaze[std::size_t(e)].used), glm::normalize(g.eye(e).dir)),
+                std::cos(glm::radians(0.5)))
+          << "frame " << f;
+    }
+    std::vector<std::string> gpu, cpu;
+    for (const auto& [name, v] : d.gpu_ms()) {
+      gpu.push_back(name);
+      EXPECT_TRUE(std::isfinite(v) && v >= 0) << name;
+    }
+    for (const auto& [name, v] : d.cpu_ms()) {
+      cpu.push_back(name);
+      EXPECT_TRUE(std::isfinite(v) && v >= 0) << name;
+    }
+    EXPECT_EQ(gpu, (std::vector<std::string>{"grid", "trace", "reconstruct", "resolve", "bmfr_fit", "mip", "resample",
+                                             "blur", "total"}));
+    EXPECT_EQ(cpu, (std::vector<std::string>{"gaze", "grid", "trace", "reconstruct", "resolve", "submit", "wait", "total"}));
+    EXPECT_DOUBLE_EQ(d.gpu_ms().back().second, d.times.gpu_ms());
+    EXPECT_DOUBLE_EQ(d.cpu_ms().back().second, d.gaze_cpu_ms + d.times.cpu_ms());
+    EXPECT_GT(d.times.gpu_ms(), 0);
+  }
+  // A gaze read elsewhere (the layer, the latency harness): used as given, at the given poses.
+  devices::FoveaGaze given;
+  given.left.dir = given.right.dir = given.combined.dir = glm::normalize(glm::dvec3(0.1, 0.05, -1));
+  const pipeline::DrivenFrame d = driver.step(9, given, driver.static_poses(), 0.25);
+  EXPECT_LT(glm::length(d.times.gaze[0].used - given.left.dir), 1e-9);
+  EXPECT_EQ(d.cpu_ms().front(), (std::pair<std::string, double>{"gaze", 0.25}));
+  // A driver of given views has no frame timeline to read a source on.
+  pipeline::FrameDriver layer(ctx(), scene, core::stereo_views(display), {frame, true, false});
+  EXPECT_THROW(layer.set_gaze(std::make_unique<devices::FoveationGaze>("synthetic:7", so)), std::logic_error);
+}
+
+// --seed changes the noise and nothing else: the same seed renders the same bits, another seed
+// another realisation of the same frames (the same grid, the same mean).
+TEST_F(GpuTest, SeedChangesOnlyTheNoise) {
+  const renderer::Scene scene = renderer::load_scene("cornell");
+  const core::DisplayPreset display = core::load_display("tiny");
+  const auto render = [&](std::uint32_t seed) {
+    pipeline::FrameConfig frame;
+    frame.tracing = renderer::Tracing::Compute;
+    pipeline::apply_frame_option(frame, "seed", std::to_string(seed), "--seed");
+    pipeline::finish(frame, false);
+    EXPECT_EQ(pipeline::to_json(frame)["seed"], seed);
+    pipeline::FrameDriver driver(ctx(), scene, display, {frame, true, false});
+    devices::FoveaGaze g;
+    g.left.dir = g.right.dir = g.combined.dir = glm::normalize(glm::dvec3(0.05, 0.02, -1));
+    std::pair<core::Image, glm::dvec3> out;
+    for (std::uint32_t f = 0; f < 3; ++f) out.second = driver.step(f, g, driver.static_poses()).times.gaze[0].used;
+    out.first = driver.pipeline().image(core::Eye::Left);
+    return out;
+  };
+  const auto mean = [](const core::Image& im) {
+    double m = 0;
+    for (const auto& p : im.pixels) m += double(p.x + p.y + p.z);
+    return m / double(im.pixels.size());
+  };
+  const auto a = render(0), again = render(0), b = render(7);
+  EXPECT_EQ(a.first.pixels, again.first.pixels);
+  EXPECT_NE(a.first.pixels, b.first.pixels);
+  EXPECT_EQ(a.second, b.second);  // the grid followed the same gaze
+  EXPECT_NEAR(mean(b.first), mean(a.first), 0.05 * mean(a.first));
+  pipeline::FrameConfig bad;
+  EXPECT_THROW(pipeline::apply_frame_option(bad, "seed", "-1", "--seed"), fovea::core::InputError);
+  EXPECT_THROW(pipeline::apply_frame_option(bad, "seed", "1000001", "--seed"), fovea::core::InputError);
 }
 
 // A fixating eye's drift does not move the grid: within kGridHoldDeg (0.5°) of the gaze the

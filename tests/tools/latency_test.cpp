@@ -31,7 +31,7 @@ TrackerChoice ideal(core::TimeNs delay, double rate_hz, core::TimeNs inject = 0)
 }
 
 RenderFn fixed(core::TimeNs cost) {
-  return [cost](std::int64_t, const std::array<glm::dvec3, 2>&) {
+  return [cost](std::int64_t, const devices::FoveaGaze&) {
     FrameWork w;
     w.cost_ns = cost;
     w.cpu_ms = {{"total", core::ns_to_ms(cost)}};
@@ -88,7 +88,7 @@ TEST(LatencySimulation, LateFrameIsMissedAndShownOnePeriodLater) {
   auto tracker = open_tracker(kTruth, ideal(0, 1000), source_options());
   const Scenario sc = panel(90, 200'000'000);
   const xrcommon::DisplayModel m(sc.display);
-  const RenderFn slow_third = [&](std::int64_t f, const std::array<glm::dvec3, 2>&) {
+  const RenderFn slow_third = [&](std::int64_t f, const devices::FoveaGaze&) {
     FrameWork w;
     w.cost_ns = f == 3 ? m.period() + 2'000'000 : 2'000'000;  // frame 3 takes over a period
     return w;

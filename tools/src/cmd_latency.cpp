@@ -74,6 +74,9 @@ Prints the summary JSON on stdout; writes into --out:
   --bmfr-precision P    fp32 | fp16 [fp32]
   --stereo-share M      off | gather | alternate [gather]
   --bounces N|auto      BSDF-sampled bounces after the primary hit [1]
+  --seed N              noise seed: another N, another noise realisation of the same frames
+                        (path tracing and BMFR keyed by frame + 1024·N; gaze and jitter
+                        unchanged) [0]
   --trace T             auto | rayquery | compute [auto]; the grid's sub-cell jitter is on
                         (--jitter here is the tracker's)
   --tracker PRESET      eye-tracker model preset: fove0 | ideal [fove0]
@@ -225,7 +228,7 @@ int run(std::vector<std::string> argv) {
                                              "inject-latency", "quality-frames", "reference-spp", "budget",
                                              "quality-at", "quality-radius", "reference-error", "reference-cache",
                                              "distribution", "denoiser", "bmfr-precision", "stereo-share", "trace",
-                                             "bounces"};
+                                             "bounces", "seed"};
   std::vector<std::string> valued = sim_options;
   valued.insert(valued.end(), {"records", "out"});
   const Args args(argv, valued, {"quiet", "no-main-render"});
@@ -296,30 +299,27 @@ int run(std::vector<std::string> argv) {
   // The defaults of `fovea render`: distribution, reconstruction, tracing, the hidden area culled.
   RenderSetup setup(scene, display, frame);
   gpu::Context& ctx = setup.ctx;
-  const std::array<core::Pose, 2> poses = setup.driver.static_poses();
-  pipeline::FramePipeline& pipe = setup.driver.pipeline();
+  pipeline::FrameDriver& driver = setup.driver;
+  pipeline::FramePipeline& pipe = driver.pipeline();
 
   // The main run: every frame rendered; its cost is the measured CPU time of the frame (the
   // submission waits for the GPU, so the GPU's work is inside it) or the fixed one.
   std::vector<core::TimeNs> measured;  // the cost each frame was given
   std::vector<double> pipeline_ms;     // what each frame took here
-  const latency::RenderFn render = [&](std::int64_t f, const std::array<glm::dvec3, 2>& gaze) {
+  const latency::RenderFn render = [&](std::int64_t f, const devices::FoveaGaze& gaze) {
     latency::FrameWork w;
     if (!main_render) {
       w.cost_ns = *fixed_cost;
       measured.push_back(w.cost_ns);
       return w;
     }
-    const pipeline::FrameTimes t = pipe.render(poses, gaze, std::uint32_t(f));
-    w.cost_ns = fixed_cost ? *fixed_cost : core::ms_to_ns(t.cpu_ms());
+    // The simulation read the gaze (modelled as instant on its timeline).
+    const pipeline::DrivenFrame d = driver.step(std::uint32_t(f), gaze, driver.static_poses());
+    w.cost_ns = fixed_cost ? *fixed_cost : core::ms_to_ns(d.times.cpu_ms());
     measured.push_back(w.cost_ns);
-    pipeline_ms.push_back(t.cpu_ms());
-    for (const auto& [name, st] : t.stages()) {
-      w.cpu_ms.emplace_back(name, st.cpu_ms);
-      w.gpu_ms.emplace_back(name, st.gpu_ms);
-    }
-    w.cpu_ms.emplace_back("submit", t.submit_cpu_ms);
-    w.cpu_ms.emplace_back("total", t.cpu_ms());
+    pipeline_ms.push_back(d.times.cpu_ms());
+    w.cpu_ms = d.cpu_ms();
+    w.gpu_ms = d.gpu_ms();
     if (!quiet) std::fprintf(stderr, "\rframe %lld", static_cast<long long>(f + 1));
     return w;
   };
@@ -369,7 +369,7 @@ int run(std::vector<std::string> argv) {
 
   // The comparisons replay the main run's costs frame by frame, so every run has the same
   // frames at the same times and differs only by the gaze the frames were foveated for.
-  const latency::RenderFn replay = [&](std::int64_t f, const std::array<glm::dvec3, 2>&) {
+  const latency::RenderFn replay = [&](std::int64_t f, const devices::FoveaGaze&) {
     latency::FrameWork w;
     w.cost_ns = measured.empty() ? 0 : measured[std::min<std::size_t>(std::size_t(f), measured.size() - 1)];
     return w;
@@ -431,7 +431,7 @@ int run(std::vector<std::string> argv) {
                            {"saccades_recovered", p.recovered}};
       if (reference && std::find(quality_at.begin(), quality_at.end(), inj) != quality_at.end()) {
         if (!quiet) std::fprintf(stderr, "quality at +%.0f ms...\n", p.inject_ms);
-        const Quality q = fovea_quality(pipe, poses, s, std::size_t(quality_frames), warm, radius, *reference,
+        const Quality q = fovea_quality(pipe, driver.static_poses(), s, std::size_t(quality_frames), warm, radius, *reference,
                                         core::EyeOptics(display, core::Eye::Left).view_mask());
         if (q.frames) {
           p.fovea_psnr_db = q.psnr;

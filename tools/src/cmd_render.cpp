@@ -104,6 +104,9 @@ With no options: a short demo on the shipped scene and gaze.
                         the BMFR/P5 configuration); auto: the bounce limit and Russian
                         roulette from the scene's albedo, i.e. full global illumination as
                         `fovea reference` traces it [1]
+  --seed N              noise seed: another N, another noise realisation of the same frames
+                        (path tracing and BMFR keyed by frame + 1024·N; gaze and jitter
+                        unchanged) [0]
   --no-blur             skip the peripheral blur
   --no-cull             trace the lens' hidden area too
   --reference SPP|DIR   SPP: converged reference of the last frame with the render's own light
@@ -420,7 +423,7 @@ int run(std::vector<std::string> argv) {
   const Args args(argv,
                   {"scene", "display", "gaze", "frames", "distribution", "budget", "jitter", "denoiser", "bmfr-precision",
                    "stereo-share", "bounces", "reference", "reference-error", "reference-cache", "reference-window", "recovery-frames", "png-every",
-                   "out", "screen", "trace"},
+                   "out", "screen", "trace", "seed"},
                   {"no-blur", "no-cull", "no-marker", "quiet", "full-gi-score"});
   const long frames = args.integer("frames", 24);
   if (frames < 1 || frames > 100000) throw core::InputError("--frames must be in 1..100000");
@@ -462,7 +465,7 @@ int run(std::vector<std::string> argv) {
   devices::SourceOptions so;
   so.display = display;
   if (auto sc = args.opt("screen")) so.screen = devices::parse_screen(*sc, "--screen");
-  devices::FoveationGaze gaze_source(gaze_uri, so);
+  auto gaze_source = std::make_unique<devices::FoveationGaze>(gaze_uri, so);
   for (const auto& n : devices::recording_notes(gaze_uri, so)) std::cerr << "warning: " << n << "\n";
 
   const std::string scene_arg = args.str("scene", "default");
@@ -472,9 +475,10 @@ int run(std::vector<std::string> argv) {
   const bool cull = !args.has("no-cull");
   RenderSetup setup(scene, display, frame_config, cull);
   gpu::Context& ctx = setup.ctx;
-  const renderer::GpuScene& gpu_scene = setup.driver.gpu_scene();
-  const std::array<core::Pose, 2> poses = setup.driver.static_poses();
-  pipeline::FramePipeline& pipeline = setup.driver.pipeline();
+  pipeline::FrameDriver& driver = setup.driver;
+  driver.set_gaze(std::move(gaze_source));
+  const renderer::GpuScene& gpu_scene = driver.gpu_scene();
+  pipeline::FramePipeline& pipeline = driver.pipeline();
   // Each eye's lens mask: the pixels no score counts (built once, used per scored frame).
   const std::array<core::ViewMask, 2> lens{core::EyeOptics(display, core::Eye::Left).view_mask(),
                                            core::EyeOptics(display, core::Eye::Right).view_mask()};
@@ -540,39 +544,27 @@ int run(std::vector<std::string> argv) {
   FrameLog frame_log((out_dir / "frames.jsonl").string(), (out_dir / "frame_times.jsonl").string());
   const core::TimeNs start = core::now_ns();
   for (long f = 0; f < frames; ++f) {
-    core::TimeNs t0 = core::now_ns();
-    const auto t_ns = core::TimeNs(std::llround(double(f) / display.refresh_hz * 1e9));
-    const devices::FoveaGaze g = gaze_source.at_frame_time(t_ns);
-    for (int e = 0; e < 2; ++e) gaze[e] = g.eye(core::Eye(e)).dir;
-    cpu_ms["gaze"].push_back(core::ns_to_ms(core::now_ns() - t0));
-    const pipeline::FrameTimes t = pipeline.render(poses, gaze, std::uint32_t(f));
+    const pipeline::DrivenFrame step = driver.step(std::uint32_t(f));
+    const pipeline::FrameTimes& t = step.times;
+    const devices::FoveaGaze& g = step.gaze;
     for (int e = 0; e < 2; ++e) {
+      gaze[e] = g.eye(core::Eye(e)).dir;
       gaze_fallback_frames[e] += t.gaze[e].fallback;
       gaze_clamped_frames[e] += t.gaze[e].clamped;
     }
-    for (const auto& [name, st] : t.stages()) {
-      gpu_ms[name].push_back(st.gpu_ms);
-      cpu_ms[name].push_back(st.cpu_ms);
-    }
-    gpu_ms["total"].push_back(t.gpu_ms());
-    gpu_ms["bmfr_fit"].push_back(t.bmfr_fit_gpu_ms);
-    gpu_ms["mip"].push_back(t.mip_gpu_ms);
-    gpu_ms["resample"].push_back(t.resample_gpu_ms);
-    gpu_ms["blur"].push_back(t.blur_gpu_ms);
-    cpu_ms["submit"].push_back(t.submit_cpu_ms);
-    cpu_ms["wait"].push_back(t.wait_cpu_ms);
-    // The frame's CPU time: the gaze read and the pipeline's recording, submit and wait.
-    cpu_ms["total"].push_back(cpu_ms["gaze"].back() + t.cpu_ms());
+    FrameRecord rec{f, step.frame_ns, g, {t.gaze[0].used, t.gaze[1].used}, driver.static_poses(), 0, 0,
+                    step.cpu_ms(), step.gpu_ms(), driver.gaze()->live()};
+    for (const auto& [name, v] : rec.gpu_ms) gpu_ms[name].push_back(v);
+    for (const auto& [name, v] : rec.cpu_ms) cpu_ms[name].push_back(v);
     temporal_gpu_ms.push_back(t.temporal_gpu_ms);
     const bool write = png_every > 0 ? f % png_every == 0 || f == frames - 1 : f == frames - 1;
     // Flicker is measured over the trailing still frames, at most kFlickerFrames of them.
     const bool flicker_window = f >= frames - long(kFlickerFrames);
     const auto& dist = pipeline.distribution(core::Eye::Left);
-    FrameRecord rec{f, t_ns, g, {t.gaze[0].used, t.gaze[1].used}, poses, dist.columns(), dist.rows(), {}, {}, gaze_source.live()};
-    for (const auto& [name, v] : gpu_ms) rec.gpu_ms.emplace_back(name, v.back());
-    for (const auto& [name, v] : cpu_ms) rec.cpu_ms.emplace_back(name, v.back());
+    rec.grid_columns = dist.columns();
+    rec.grid_rows = dist.rows();
     if (write || flicker_window) {
-      t0 = core::now_ns();
+      const core::TimeNs t0 = core::now_ns();
       for (int e = 0; e < 2; ++e) {
         last[e] = pipeline.image(core::Eye(e));
         host_bytes += std::int64_t(last[e].pixels.size() * sizeof(last[e].pixels[0]));
@@ -601,7 +593,7 @@ int run(std::vector<std::string> argv) {
         if (still[e].size() > kFlickerFrames) still[e].pop_front();
       }
     if (write) {
-      t0 = core::now_ns();
+      const core::TimeNs t0 = core::now_ns();
       char name[64];
       for (int e = 0; e < 2; ++e) {
         ldr[e] = renderer::tone_map(last[e]);

@@ -63,6 +63,9 @@ of view directions (lines every 5 degrees), a picture of the optics.
   --bmfr-precision P    fp32 | fp16 [fp32]
   --stereo-share M      off | gather | alternate [gather]
   --bounces N|auto      BSDF-sampled bounces after the primary hit [1]
+  --seed N              noise seed: another N, another noise realisation of the same frames
+                        (path tracing and BMFR keyed by frame + 1024·N; gaze and jitter
+                        unchanged) [0]
   --optics direct|lut   distortion pass: evaluate the optics per pixel, or read them from
                         the 128x128 LUT cache [direct]
   --window WxH          window size [fits both panels in 1280x720]
@@ -126,7 +129,7 @@ int run(std::vector<std::string> argv) {
     }
   const Args args(argv,
                   {"display", "scene", "trace", "gaze", "gaze-dir", "budget", "jitter", "optics", "window", "frames",
-                   "distribution", "denoiser", "bmfr-precision", "stereo-share", "bounces",
+                   "distribution", "denoiser", "bmfr-precision", "stereo-share", "bounces", "seed",
                    "screenshot", "panels"},
                   {});
   const core::DisplayPreset d = core::load_display(args.str("display", core::kDefaultDisplay));
@@ -175,6 +178,7 @@ int run(std::vector<std::string> argv) {
   std::optional<pipeline::FrameDriver> driver;
   if (scene) {
     driver.emplace(ctx, *scene, d, pipeline::FrameDriverOptions{frame, true});
+    if (source) driver->set_gaze(std::move(source));  // frames read it at their time
     std::cerr << "fovea view: frame " << to_json(frame).dump() << "\n";
     std::cerr << "fovea view: tracing " << renderer::tracing_name(driver->trace_choice().tracing) << ": "
               << driver->trace_choice().why << "\n";
@@ -191,12 +195,17 @@ int run(std::vector<std::string> argv) {
       // Both eyes look along the direction seen through the lens under the cursor
       // (parallel eyes: vergence is ignored); off the panels the last gaze holds.
       if (const auto p = window.cursor()) gaze[0] = gaze[1] = core::gaze_direction(optics[int(p->eye)].lens(), p->uv);
-    } else if (source) {
-      const devices::FoveaGaze g = source->at_frame_time(core::TimeNs(std::llround(double(frame) / d.refresh_hz * 1e9)));
+    } else if (source) {  // no scene: the gaze for the marker only
+      const devices::FoveaGaze g = source->at_frame_time(pipeline::frame_time_ns(std::uint32_t(frame), d.refresh_hz));
       for (int e = 0; e < 2; ++e) gaze[size_t(e)] = g.eye(core::Eye(e)).dir;
     }
     if (driver) {
-      driver->pipeline().render(driver->static_poses(), gaze, std::uint32_t(frame));
+      devices::FoveaGaze given;  // the mouse's or the fixed direction
+      given.left.dir = given.combined.dir = gaze[0];
+      given.right.dir = gaze[1];
+      const pipeline::DrivenFrame f =
+          driver->gaze() ? driver->step(std::uint32_t(frame)) : driver->step(std::uint32_t(frame), given, driver->static_poses());
+      for (int e = 0; e < 2; ++e) gaze[size_t(e)] = f.gaze.eye(core::Eye(e)).dir;
       for (int e = 0; e < 2; ++e)
         panels[e] = passes[size_t(e)]->run(renderer::tone_map(driver->pipeline().image(core::Eye(e))));
     }

@@ -93,9 +93,9 @@ Simulation simulate(devices::TrackerModel& tracker, const Scenario& sc, const Re
     // What the tracker had delivered at the wake, predicted to the display time when the
     // tracker's source predicts (--predict).
     const devices::FoveaGaze g = gaze.read(wake, slot.display_ns);
+    FrameWork work = render(f, g);
     // Each eye's grid as the frame pipeline lays it out (held through a fixational drift).
     const std::array<glm::dvec3, 2> dirs{hold[0].place(g.left.dir), hold[1].place(g.right.dir)};
-    FrameWork work = render(f, dirs);
     const core::TimeNs submit = wake + work.cost_ns;
     const xrcommon::DisplayModel& m = pacer.model();
     const xrcommon::Presentation shown = m.present(slot.vsync, submit);

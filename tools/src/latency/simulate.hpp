@@ -41,8 +41,9 @@ struct FrameWork {
   core::TimeNs cost_ns = 0;
   std::vector<std::pair<std::string, double>> cpu_ms, gpu_ms;
 };
-// Renders frame `index` foveated at each eye's `gaze` (view space; left, right).
-using RenderFn = std::function<FrameWork(std::int64_t index, const std::array<glm::dvec3, 2>& gaze)>;
+// Renders frame `index` foveated for `gaze`, as read at the frame's wake (its eyes' view-space
+// directions; the frame pipeline holds each eye's grid through a fixational drift).
+using RenderFn = std::function<FrameWork(std::int64_t index, const devices::FoveaGaze& gaze)>;
 
 // Gaze compensation is the tracker's: its source options' predict mode and horizon
 // (open_tracker) predict the delivered samples to each frame's display time.

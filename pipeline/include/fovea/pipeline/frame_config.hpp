@@ -4,6 +4,7 @@
 // sample distribution and its budget, jitter, the denoiser and its precision, stereo
 // sharing, the traversal, the light transport (bounces). Each entry point starts from FrameConfig{} and applies its options
 // by the same names (`--budget 0.2` on the command line, "budget": 0.2 in the layer's file).
+#include <cstdint>
 #include <string>
 #include <string_view>
 #include <vector>
@@ -32,6 +33,11 @@ struct FrameConfig {
   reconstruct::ReconSettings recon = default_recon();
   renderer::Tracing tracing = renderer::Tracing::Auto;
   Bounces bounces;
+  // The noise: frame i's random numbers (path tracing, BMFR's block offsets) are keyed by
+  // i + FramePipeline::kSeedStride·seed, so another seed is another realisation of the same
+  // frames (the same gaze and jitter pattern): repeated runs measure a score's noise.
+  std::uint32_t seed = 0;
+  static constexpr std::uint32_t kMaxSeed = 1'000'000;
 
   // BMFR at fp32, the peripheral blur, and stereo sharing by gather: the reconstruction a
   // render shows (ReconSettings{} itself leaves sharing off, for the stage tests).
@@ -40,7 +46,7 @@ struct FrameConfig {
 
 // The option names, shared by the command line (--NAME VALUE) and the layer's configuration
 // ("NAME": VALUE): budget, distribution, jitter, denoiser, bmfr-precision, stereo-share, trace,
-// bounces.
+// bounces, seed.
 const std::vector<std::string>& frame_option_names();
 
 // Sets option `name` from its text `value`; core::InputError naming `where` (e.g. "--budget",

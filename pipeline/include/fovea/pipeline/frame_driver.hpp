@@ -6,11 +6,19 @@
 // the display preset's views with a static head at the scene's camera and skip each eye's lens
 // hidden area; the layer renders the views the application submits, its eye poses placed at
 // the scene's camera, and sets the runtime's hidden area itself.
+// Each frame is one step(): the gaze read for it, the pipeline's frame, and its times by the
+// names every timing record uses.
 #include <array>
+#include <cstdint>
+#include <memory>
 #include <optional>
+#include <string>
+#include <utility>
+#include <vector>
 
 #include "fovea/core/display.hpp"
 #include "fovea/core/stereo_views.hpp"
+#include "fovea/devices/foveation_gaze.hpp"
 #include "fovea/gpu/context.hpp"
 #include "fovea/pipeline/frame_config.hpp"
 #include "fovea/pipeline/frame_pipeline.hpp"
@@ -27,6 +35,21 @@ struct FrameDriverOptions {
   // `--trace auto` may measure both traversals (seconds at start-up; cached per device and
   // driver). false: the cached choice, or the static one (the layer's first frame waits for none).
   bool measure_trace = true;
+};
+
+// Frame `index`'s time on a display's frame timeline: index / refresh rate, from 0.
+core::TimeNs frame_time_ns(std::uint32_t index, double refresh_hz);
+
+// One frame through the driver.
+struct DrivenFrame {
+  std::uint32_t index = 0;
+  core::TimeNs frame_ns = 0;  // the frame's time on the frame timeline (index / refresh rate)
+  devices::FoveaGaze gaze;    // read for the frame (the eyes' directions and the sample's times)
+  FrameTimes times;           // the pipeline's: stages, submission, what each eye's grid did with its gaze
+  double gaze_cpu_ms = 0;     // reading the gaze (CPU, monotonic clock; 0 when read elsewhere)
+  // The frame's times by the names every timing record uses (FrameTimes::gpu_record, cpu_record).
+  std::vector<std::pair<std::string, double>> gpu_ms() const { return times.gpu_record(); }
+  std::vector<std::pair<std::string, double>> cpu_ms() const { return times.cpu_record(gaze_cpu_ms); }
 };
 
 class FrameDriver {
@@ -53,11 +76,29 @@ class FrameDriver {
   // origin at the camera) in world coordinates.
   core::Pose at_camera(const core::Pose& eye) const;
 
+  // The gaze source frames read (`fovea render`, `view`): frame i at its time on the frame
+  // timeline, i / the display preset's refresh rate from 0 (a live source: the host clock
+  // now). Display-preset drivers only.
+  void set_gaze(std::unique_ptr<devices::FoveationGaze> gaze);
+  const devices::FoveationGaze* gaze() const { return gaze_.get(); }
+  // Frame `index`'s time on the display preset's frame timeline (0 for given views).
+  core::TimeNs frame_ns(std::uint32_t index) const { return refresh_hz_ > 0 ? frame_time_ns(index, refresh_hz_) : 0; }
+
+  // One frame with the static head: the gaze read from set_gaze's source.
+  DrivenFrame step(std::uint32_t index);
+  // One frame with a gaze read elsewhere (the layer: the eye-gaze action or its source at the
+  // display time; `fovea latency`: the tracker model at the frame's wake; `fovea view`: the
+  // mouse) at the given eye poses, `gaze_cpu_ms` what reading it took.
+  DrivenFrame step(std::uint32_t index, const devices::FoveaGaze& gaze, const std::array<core::Pose, 2>& poses,
+                   double gaze_cpu_ms = 0);
+
  private:
   FrameDriver(gpu::Context& ctx, const renderer::Scene& scene, const core::StereoViews& views,
               const FrameDriverOptions& options, const std::optional<core::DisplayPreset>& display);
 
   FrameConfig frame_;
+  double refresh_hz_ = 0;  // the display preset's (0: given views)
+  std::unique_ptr<devices::FoveationGaze> gaze_;
   core::Pose camera_;
   renderer::TraceChoice trace_choice_;
   renderer::GpuScene gpu_scene_;

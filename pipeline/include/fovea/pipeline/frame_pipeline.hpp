@@ -7,6 +7,7 @@
 #include <array>
 #include <cstdint>
 #include <memory>
+#include <string>
 #include <utility>
 #include <vector>
 
@@ -53,6 +54,12 @@ struct FrameTimes {
   double cpu_ms() const {
     return grid.cpu_ms + trace.cpu_ms + reconstruct.cpu_ms + resolve.cpu_ms + submit_cpu_ms + wait_cpu_ms;
   }
+  // The frame's times as every timing record and report names them (docs/openxr.md, "Timing
+  // records"). GPU: the stages, the parts bmfr_fit, mip, resample and blur, and total. CPU:
+  // gaze (reading it, given here), the stages, submit, wait, and total (the gaze read and the
+  // pipeline's recording, submission and fence wait).
+  std::vector<std::pair<std::string, double>> gpu_record() const;
+  std::vector<std::pair<std::string, double>> cpu_record(double gaze_cpu_ms) const;
 };
 
 // Mean indirect-diffuse samples per traced cell: the eye's own and after stereo sharing.
@@ -84,6 +91,10 @@ class FramePipeline {
   // Measure the temporal error of the displayed images on the device from the next frame on
   // (shaders/recon_temporal.comp), so that nothing is read back for it; reset() keeps it.
   void enable_temporal_error();
+  // The noise seed (FrameConfig::seed): frame f's random numbers are keyed by
+  // f + kSeedStride·seed; the jitter (period 1024) and the stereo parity keep f.
+  static constexpr std::uint32_t kSeedStride = 1024;
+  void set_seed(std::uint32_t seed);
   // core::temporal_error averaged over the consecutive frame pairs since it was enabled (0
   // before the second frame).
   double temporal_error(core::Eye e) const;
