@@ -214,6 +214,51 @@ TEST(SweepReport, SectionsByTwoSettingsAndSpeedUpAtEqualQuality) {
   fs::remove_all(dir);
 }
 
+// report.repeat: runs that differ only in the seed are one row on the page and in the plots,
+// their mean ± standard deviation; the CSV keeps every run.
+TEST(SweepReport, RepeatedRunsAreOneRowWithTheirSpread) {
+  const std::string dir = test::temp_dir("sweep-report-repeat");
+  const std::vector<RenderOption> opts = {{"distribution", true}, {"budget", true}, {"seed", true}, {"out", true},
+                                          {"quiet", false}};
+  const Plan plan = expand_sweep(core::parse_json(R"([
+    {"distribution": "a", "budget": [0.1, 0.2], "seed": [0, 1, 2],
+     "report": {"quality": ["fovea_flip"], "repeat": "seed"}},
+    {"distribution": "b", "budget": 0.1}])"), "synthetic.json", opts);
+  ASSERT_EQ(plan.jobs.size(), 7u);
+  for (const Job& j : plan.jobs) {
+    const bool a = j.settings["distribution"] == "a";
+    const double seed = a ? j.settings["seed"].get<double>() : 0, budget = j.settings["budget"].get<double>();
+    // a at 0.1: times 10, 12, 14 and FLIP 0.20, 0.21, 0.22 over the seeds; at 0.2 all 20 / 0.15.
+    json rep = budget < 0.15 && a ? render_report(10 + 2 * seed, 30, 0.2 + 0.01 * seed, 40)
+                                  : render_report(a ? 20 : 30, 30, a ? 0.15 : 0.3, 40);
+    fs::create_directories(dir + "/" + j.out);
+    core::write_file_atomic(dir + "/" + j.out + "/report.json", rep.dump());
+  }
+  core::write_file_atomic(dir + "/plan.jsonl", plan_to_jsonl(plan));
+  const auto r = test::run_fovea("sweep report " + dir + "/plan.jsonl --out " + dir + "/report --markdown " + dir + "/page.md");
+  ASSERT_EQ(r.status, 0) << r.err;
+  const std::string page = test::read_text(dir + "/page.md");
+  for (const char* text : {"Jobs: 7 done of 7.", "differ only in `seed` are one row",
+                           "| a | 0.1 | – | 12 ± 2 | 0.2100 ± 0.0100 | yes |", "| a | 0.2 | – | 20 | 0.1500 | yes |",
+                           "| b | 0.1 | – | 30 | 0.3000 | yes |"})
+    EXPECT_NE(page.find(text), std::string::npos) << text << "\n" << page;
+  // One point per (distribution, budget) in the plot; every run in the CSV, each with its
+  // row's front membership.
+  const json fig = core::parse_json(test::read_text(dir + "/report/figures.json"));
+  for (const auto& c : fig["charts"]) {
+    if (c["file"] != "quality_vs_time_fovea_flip") continue;
+    for (const auto& series : c["series"]) {
+      if (series["label"] == "a") {
+        EXPECT_EQ(series["points"].size(), 2u);
+      }
+    }
+  }
+  const json res = core::parse_json(test::read_text(dir + "/report/results.json"));
+  ASSERT_EQ(res["jobs"].size(), 7u);
+  for (const auto& job : res["jobs"]) EXPECT_EQ(job["pareto"]["fovea_flip"], true) << job.dump();
+  fs::remove_all(dir);
+}
+
 TEST(SweepReport, WithoutPythonWritesTheDataAndSaysHowToDrawTheFigures) {
   const std::string dir = test::temp_dir("sweep-report-nopython");
   const std::vector<RenderOption> opts = {{"distribution", true}, {"budget", true}, {"out", true}, {"quiet", false}};

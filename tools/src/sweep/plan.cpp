@@ -209,7 +209,7 @@ Plan expand_sweep(const json& sweep, const std::string& source, const CommandOpt
       static const std::set<std::string> fields = {"quality",         "time",    "group",           "budget",
                                                    "section",         "bands",   "latency",         "latency_quality",
                                                    "latency_group",   "lower_is_better", "higher_is_better",
-                                                   "speedup"};
+                                                   "speedup",         "repeat"};
       for (auto f = it->begin(); f != it->end(); ++f)
         if (!fields.count(f.key())) {
           std::string names;

@@ -94,6 +94,7 @@ struct Row {
   std::string device;  // the Vulkan device and driver of its report
   std::map<std::string, double> metrics;
   std::map<std::string, std::vector<BandValue>> bands;
+  std::vector<std::string> members;  // the jobs a row of repeated runs stands for (report.repeat)
 };
 
 std::string setting_text(const json& v) { return v.is_string() ? v.get<std::string>() : v.dump(); }
@@ -107,6 +108,7 @@ struct SpeedUp {
 struct Config {
   std::vector<std::string> quality, bands, latency_quality;
   std::string time = "gpu_ms.total", group = "distribution", budget = "budget", latency, latency_group;
+  std::string repeat;  // the setting whose values are repeated runs of one job (e.g. "seed")
   std::vector<std::string> section = {"scene"};  // as configured
   std::vector<std::string> section_keys;          // of those, the ones whose value differs between render jobs
   std::optional<SpeedUp> speedup;
@@ -185,6 +187,7 @@ Config read_config(const json& r, const std::vector<Row>& rows) {
   if (auto g = strings("group"); !g.empty()) c.group = g[0];
   if (auto b = strings("budget"); !b.empty()) c.budget = b[0];
   if (auto s = strings("section"); !s.empty()) c.section = s;
+  if (auto s = strings("repeat"); !s.empty()) c.repeat = s[0];
   for (const auto& k : c.section) {
     std::set<std::string> values;
     for (const auto& row : rows)
@@ -355,13 +358,75 @@ std::string fixed(double v, int decimals) {
 }
 
 // A metric's value as table text: dB and milliseconds with 1-2 decimals, the rest with 4.
+// Repeated runs (report.repeat): their mean ± standard deviation, where it is not 0.
 std::string md_value(const Row& r, const std::string& m) {
   if (!r.metrics.count(m)) return "–";
+  const auto text = [&](double v) {
+    if (m.find("psnr") != std::string::npos) return fixed(v, 2);
+    if (m.find("_ms") != std::string::npos) return fixed(v, 0);
+    if (m.find("samples") != std::string::npos) return fixed(v, 0);
+    return fixed(v, 4);
+  };
+  const auto sd = r.metrics.find(m + ".sd");
   const double v = r.metrics.at(m);
-  if (m.find("psnr") != std::string::npos) return fixed(v, 2);
-  if (m.find("_ms") != std::string::npos) return fixed(v, 0);
-  if (m.find("samples") != std::string::npos) return fixed(v, 0);
-  return fixed(v, 4);
+  const bool spread = sd != r.metrics.end() && sd->second > 1e-9 * std::max(1.0, std::abs(v));  // not rounding alone
+  return text(v) + (spread ? " ± " + text(sd->second) : "");
+}
+
+// report.repeat: the done render jobs that differ only in the repeat setting (seeds) become one
+// row without it: each metric's mean over them (where every run has it), "<metric>.sd" its
+// sample standard deviation, "repeats" their count, each band's mean; `members` their ids.
+// Every other row stays as it is.
+std::vector<Row> merge_repeats(const std::vector<Row>& rows, const std::string& key) {
+  std::vector<Row> out;
+  std::vector<std::vector<const Row*>> runs;
+  std::map<std::string, std::size_t> at;  // settings without the key -> index in out
+  for (const Row& r : rows) {
+    if (r.status != "done" || job_command(r.settings) != "render") {
+      out.push_back(r);
+      runs.emplace_back();
+      continue;
+    }
+    json settings = r.settings;
+    settings.erase(key);
+    const auto [it, fresh] = at.emplace(settings.dump(), out.size());
+    if (fresh) {
+      out.push_back(r);
+      out.back().settings = settings;
+      runs.emplace_back();
+    }
+    runs[it->second].push_back(&r);
+  }
+  for (std::size_t i = 0; i < out.size(); ++i) {
+    const std::vector<const Row*>& g = runs[i];
+    for (const Row* r : g) out[i].members.push_back(r->id);
+    if (g.size() < 2) continue;
+    Row& m = out[i];
+    const double n = double(g.size());
+    m.metrics.clear();
+    for (const auto& [name, first] : g[0]->metrics) {
+      std::vector<double> v;
+      for (const Row* r : g)
+        if (const auto x = r->metrics.find(name); x != r->metrics.end()) v.push_back(x->second);
+      if (v.size() != g.size()) continue;
+      const double mean = std::accumulate(v.begin(), v.end(), 0.0) / n;
+      double sq = 0;
+      for (double x : v) sq += (x - mean) * (x - mean);
+      m.metrics[name] = mean;
+      m.metrics[name + ".sd"] = std::sqrt(sq / (n - 1));
+    }
+    m.metrics["repeats"] = n;
+    for (auto& [series, bands] : m.bands)
+      for (std::size_t b = 0; b < bands.size(); ++b) {
+        double sum = 0;
+        int k = 0;
+        for (const Row* r : g)
+          if (const auto s = r->bands.find(series); s != r->bands.end() && s->second.size() == bands.size())
+            sum += s->second[b].value, ++k;
+        bands[b].value = sum / k;  // the runs that have the band (g[0] has it)
+      }
+  }
+  return out;
 }
 
 struct MarkdownInput {
@@ -404,13 +469,18 @@ std::string markdown_page(const MarkdownInput& in) {
         "resumably, then writes this page; docs/sweep.md gives its run time):\n\n    "
      << in.command << "\n\n";
   std::set<std::string> devices;
-  for (const Row* r : done) devices.insert(r->device);
-  md << "Jobs: " << done.size() << " done of " << in.rows.size() << ". Device: ";
+  std::size_t jobs_done = 0;
+  for (const Row* r : done) devices.insert(r->device), jobs_done += std::max<std::size_t>(1, r->members.size());
+  md << "Jobs: " << jobs_done << " done of " << in.plan.jobs.size() << ". Device: ";
   for (const auto& d : devices) md << (d == *devices.begin() ? "" : "; ") << d;
   md << ". Times are GPU timestamp medians per stereo frame (`" << cfg.time
      << "`), both eyes; quality is of the last frame against the shared converged reference (docs/metrics.md): "
         "FLIP is lower-is-better, PSNR (tone-mapped) higher-is-better; `fovea_*` over e ≤ 5.79°, `foveated_*` "
-        "weighted by acuity. Means of both eyes.\n\n";
+        "weighted by acuity. Means of both eyes.";
+  if (!cfg.repeat.empty())
+    md << " Jobs that differ only in `" << cfg.repeat << "` are one row: the mean of those runs ± their standard "
+       << "deviation (the command shown is the first run's).";
+  md << "\n\n";
   const bool sectioned = in.sections.size() > 1;
   if (sectioned) {
     std::string keys;
@@ -787,7 +857,9 @@ ReportSummary write_report(const Plan& plan, const ReportOptions& o) {
     rows.push_back(std::move(r));
   }
   const Config cfg = read_config(plan.header.value("report", json::object()), rows);
-  const std::vector<std::string> varied = varied_keys(rows);
+  // The page and the plots show repeated runs as one row (report.repeat); the CSV and JSON list every job.
+  const std::vector<Row> shown = cfg.repeat.empty() ? rows : merge_repeats(rows, cfg.repeat);
+  const std::vector<std::string> varied = varied_keys(shown);
   auto group_of = [&](const Row& r) { return r.settings.contains(cfg.group) ? setting_text(r.settings[cfg.group]) : std::string("all"); };
   auto label_of = [&](const Row& r) {
     std::string s;
@@ -798,7 +870,7 @@ ReportSummary write_report(const Plan& plan, const ReportOptions& o) {
   };
   // Render jobs are compared within a section (a scene): their own fronts, plots and tables.
   std::vector<Section> sections;
-  for (const auto& r : rows)
+  for (const auto& r : shown)
     if (r.status == "done" && job_command(r.settings) == "render" &&
         std::none_of(sections.begin(), sections.end(), [&](const Section& s) { return s.id == section_of(r, cfg); }))
       sections.push_back({section_of(r, cfg), section_title(r, cfg)});
@@ -816,7 +888,7 @@ ReportSummary write_report(const Plan& plan, const ReportOptions& o) {
   json fronts = json::object();
   for (const auto& [section, title] : sections) {
     std::vector<const Row*> members_of_section;
-    for (const auto& r : rows)
+    for (const auto& r : shown)
       if (r.status == "done" && job_command(r.settings) == "render" && section_of(r, cfg) == section) members_of_section.push_back(&r);
     std::vector<std::string> groups;
     for (const Row* r : members_of_section)
@@ -918,7 +990,7 @@ ReportSummary write_report(const Plan& plan, const ReportOptions& o) {
     auto lgroup_of = [&](const Row& r) {
       return r.settings.contains(cfg.latency_group) ? setting_text(r.settings[cfg.latency_group]) : std::string("all");
     };
-    for (const auto& r : rows)
+    for (const auto& r : shown)
       if (r.status == "done" && r.metrics.count(cfg.latency) &&
           std::find(lgroups.begin(), lgroups.end(), lgroup_of(r)) == lgroups.end())
         lgroups.push_back(lgroup_of(r));
@@ -931,7 +1003,7 @@ ReportSummary write_report(const Plan& plan, const ReportOptions& o) {
       cl.y_label = axis_label(q);
       for (std::size_t g = 0; g < lgroups.size(); ++g) {
         Series s{cfg.latency_group + " " + lgroups[g], g, {}, true, true};
-        for (const auto& r : rows)
+        for (const auto& r : shown)
           if (r.status == "done" && lgroup_of(r) == lgroups[g] && r.metrics.count(q) && r.metrics.count(cfg.latency))
             s.points.push_back({r.metrics.at(cfg.latency), r.metrics.at(q)});
         std::sort(s.points.begin(), s.points.end(), [](const glm::dvec2& a, const glm::dvec2& b) { return a.x < b.x; });
@@ -941,6 +1013,10 @@ ReportSummary write_report(const Plan& plan, const ReportOptions& o) {
     }
   }
   sum.files = write_charts(out.string(), "figures.json", charts);
+  for (const Row& r : shown)  // a row of repeated runs: its front membership is each run's
+    for (const std::string& id : r.members)
+      for (auto& [q, flags] : on_front)
+        if (flags.count(r.id)) flags[id] = flags[r.id];
   // results.csv: one row per job; settings, metrics and bands as columns.
   std::set<std::string> setting_cols, metric_cols, band_cols;
   for (const auto& r : rows) {
@@ -1003,7 +1079,7 @@ ReportSummary write_report(const Plan& plan, const ReportOptions& o) {
         images[section].push_back(
             fs::relative(out / f, page.parent_path().empty() ? fs::path(".") : page.parent_path()).string());
     if (!page.parent_path().empty()) fs::create_directories(page.parent_path());
-    core::write_file_atomic(page.string(), markdown_page({plan, rows, cfg, on_front, sections, images, o.command}));
+    core::write_file_atomic(page.string(), markdown_page({plan, shown, cfg, on_front, sections, images, o.command}));
   }
   return sum;
 }
