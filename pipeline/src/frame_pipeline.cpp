@@ -44,6 +44,7 @@ std::unique_ptr<EyeState> make_eye(gpu::Context& ctx, renderer::PathTracer& trac
   e->base_view = view;
   e->pose = view.pose();
   e->dist = core::make_distribution(core::View(view.fov(), view.width(), view.height()), dp);
+  e->hold = core::GridHold(core::GridHold::radius_for_margin(dp.margin_deg));
   if (!e->dist->invertible())
     throw core::InputError(std::string("--distribution: ") + core::distribution_name(dp.kind) +
                            " has no screen-to-grid mapping; the reconstruction needs one");

@@ -29,4 +29,21 @@ TEST(GridHold, HoldsThroughADriftAndFollowsALargerMove) {
   EXPECT_TRUE(same(h.place(yaw(10.3)), yaw(10.3)));
 }
 
+// The hold is at most half the fovea margin: a held fovea keeps half the margin for the
+// tracker's error; without a margin nothing is held.
+TEST(GridHold, RadiusFollowsTheMargin) {
+  using fovea::core::GridHold;
+  EXPECT_EQ(GridHold::radius_for_margin(1.0), GridHold::kHoldDeg);  // the default margin
+  EXPECT_EQ(GridHold::radius_for_margin(3.0), GridHold::kHoldDeg);
+  EXPECT_EQ(GridHold::radius_for_margin(0.4), 0.2);
+  EXPECT_EQ(GridHold::radius_for_margin(0.0), 0.0);
+  GridHold narrow(GridHold::radius_for_margin(0.4));
+  EXPECT_TRUE(same(narrow.place(yaw(10)), yaw(10)));
+  EXPECT_TRUE(same(narrow.place(yaw(10.15)), yaw(10)));
+  EXPECT_TRUE(same(narrow.place(yaw(10.3)), yaw(10.3))) << "past 0.2°";
+  GridHold none(GridHold::radius_for_margin(0.0));
+  EXPECT_TRUE(same(none.place(yaw(10)), yaw(10)));
+  EXPECT_TRUE(same(none.place(yaw(10.01)), yaw(10.01))) << "no margin: every gaze laid out";
+}
+
 }  // namespace

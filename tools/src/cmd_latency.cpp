@@ -286,6 +286,7 @@ int run(std::vector<std::string> argv) {
   }
   // The frame of `fovea render`: the same defaults and option names (pipeline/frame_config.hpp).
   const pipeline::FrameConfig frame = frame_config_of(args, {"jitter"});
+  sc.hold_deg = core::GridHold::radius_for_margin(frame.distribution.margin_deg);
   const std::string gaze_uri = args.str("gaze", kDefaultGaze);
   devices::SourceOptions so;
   so.display = display;

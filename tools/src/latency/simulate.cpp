@@ -83,7 +83,8 @@ Simulation simulate(devices::TrackerModel& tracker, const Scenario& sc, const Re
   devices::FoveationGaze gaze(std::make_unique<Borrowed>(tracker));
   gaze.set_epoch(0);
   xrcommon::FramePacer pacer(sc.display);
-  std::array<core::GridHold, 3> hold;  // left, right, combined
+  std::array<core::GridHold, 3> hold{core::GridHold(sc.hold_deg), core::GridHold(sc.hold_deg),
+                                     core::GridHold(sc.hold_deg)};  // left, right, combined
   core::TimeNs now = 0;
   for (std::int64_t f = 0;; ++f) {
     xrcommon::FrameSlot slot = pacer.next(now);

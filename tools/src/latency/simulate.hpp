@@ -16,6 +16,7 @@
 
 #include <glm/vec3.hpp>
 
+#include "fovea/core/grid_hold.hpp"
 #include "fovea/devices/foveation_gaze.hpp"
 #include "fovea/devices/tracker_model.hpp"
 #include "fovea/xrcommon/display_model.hpp"
@@ -50,6 +51,9 @@ using RenderFn = std::function<FrameWork(std::int64_t index, const devices::Fove
 struct Scenario {
   xrcommon::DisplayParams display;
   core::TimeNs duration_ns = 2'000'000'000;  // frames are started until this time
+  // The frame pipeline's grid hold (core::GridHold::radius_for_margin of the distribution's
+  // fovea margin): what each frame's grid was laid out for.
+  double hold_deg = core::GridHold::kHoldDeg;
 };
 
 struct FrameTruth {
