@@ -1,6 +1,10 @@
 // Angular Visual-Polar sampling (docs/visual-polar.md; Koskela et al. 2019, "Foveated
 // real-time path tracing in Visual-Polar space", P5 §3.2, made angular and derived):
-//   σ(e)  = min(κ·σ_disp, σ0·a(e)),  a(e) = m(max(e − s, 0))^γ        target samples/deg²
+//   σ(e)  = min(κ·D(e), σ0·a(e)),  a(e) = m(max(e − s, 0))^γ           target samples/deg²
+//   D(e)  = σ_disp, the display's densest pixels in the fovea disk; on a view where κ·σ_disp
+//           over the whole view cannot pay the budget at some gaze (a wide view, whose
+//           periphery is denser than its fovea): σ_disp out to the fovea disk, then the
+//           densest pixels any ring out to e has, so κ samples per pixel where the pixels are
 //   H(e)  = min(N_φ, circ(e)·√σ(e)),  circ(e) = 360°·sin e            rows per column
 //   columns: each column's ring holds exactly H_i samples of σ, i.e.
 //            ∫_{e_i}^{e_i+1} σ(e)·circ(e) de = H_i                    (density exact per column)
@@ -17,6 +21,7 @@
 #include <numbers>
 #include <stdexcept>
 #include <utility>
+#include <vector>
 
 #include <glm/geometric.hpp>
 
@@ -157,7 +162,7 @@ class VisualPolar final : public PolarDistribution {
     return sr * arc_fraction(column) / (kDeg * kDeg) / h_[column] * view_.pixels_per_deg2(dir);
   }
 
-  VisualPolarState state() const { return {sigma0_, row_scale_, sigma_disp_, e_max_, evaluations_}; }
+  VisualPolarState state() const { return {sigma0_, row_scale_, sigma_disp_, e_max_, evaluations_, ring_cap_}; }
   void set_reference_solve(bool on) {
     reference_solve_ = on;
     on_frame();
@@ -198,7 +203,7 @@ class VisualPolar final : public PolarDistribution {
   double scaled_rows(int i, double c) const override {
     if (c == 1.0) return full_[size_t(i)];
     const size_t k = size_t(i);
-    const double a = column_acuity_[k], cap = params_.cap * sigma_disp_;
+    const double a = column_acuity_[k], cap = cap_at(0.5 * (r_[k] + r_[k + 1]));
     const double rows = full_[k] * std::min(cap, c * sigma0_ * a) / std::max(std::min(cap, sigma0_ * a), 1e-300);
     const double least = circumference_deg(0.5 * (r_[k] + r_[k + 1])) / (params_.aniso * (r_[k + 1] - r_[k]));
     return std::max(rows, std::min(least, full_[k]));
@@ -218,7 +223,7 @@ class VisualPolar final : public PolarDistribution {
     sides_ = frustum_sides(view_, gaze_, b1_, b2_);
     const double previous_e_max = e_max_;
     const double e_max = e_max_ = farthest_view_angle(gaze_);
-    sigma_disp_ = fovea_pixel_density(gaze_);
+    set_density_cap(gaze_);
     // Warm start: the previous root, moved by the columns the change of e_max adds at the
     // previous outermost column's width (relative to N_ρ: the solve is in log columns).
     const double last_width = r_.size() > 1 ? r_.back() - r_[r_.size() - 2] : 0;
@@ -245,8 +250,14 @@ class VisualPolar final : public PolarDistribution {
     const double m = acuity::m(std::max(e - params_.margin_deg, 0.0));
     return params_.gamma == 1.0 ? m : std::pow(m, params_.gamma);
   }
-  double sigma(double e, double s0) const { return std::min(params_.cap * sigma_disp_, s0 * acuity_term(e)); }
-  double sigma_node(int k, double s0) const { return std::min(params_.cap * sigma_disp_, s0 * a_[k]); }
+  double sigma(double e, double s0) const { return std::min(cap_at(e), s0 * acuity_term(e)); }
+  double sigma_node(int k, double s0) const { return std::min(cap_[size_t(k)], s0 * a_[size_t(k)]); }
+  // κ·D(e) (the header), per node; linear between nodes.
+  double cap_at(double e) const {
+    const double x = std::clamp(e / kStep, 0.0, double(kNodes));
+    const int k = std::min(int(x), kNodes - 1);
+    return cap_[size_t(k)] + (x - k) * (cap_[size_t(k) + 1] - cap_[size_t(k)]);
+  }
 
   // Prefix table S(e_k) = ∫0^{e_k} σ·circ de with σ·circ linear between nodes, so S is
   // piecewise quadratic and exactly invertible.
@@ -304,11 +315,10 @@ class VisualPolar final : public PolarDistribution {
   int rows_at(double e, double s0) const { return rows_for(circumference_deg(e), sigma(e, s0)); }
 
   // d S(e)/d log σ0 (to within one node): the prefix without its capped part, σ0·a >=
-  // κσ_disp on [0, e_K) as a(e) is non-increasing.
+  // κD on [0, e_K) as a(e) is non-increasing and D(e) non-decreasing.
   double prefix_dlog(double s0, double e) const {
-    const double cap = params_.cap * sigma_disp_;
-    const auto capped = [&](double a) { return s0 * a >= cap; };
-    const int k = int(std::partition_point(a_.begin(), a_.begin() + int(s_.size()), capped) - a_.begin());
+    int k = 0;
+    for (int n = int(s_.size()); k < n && s0 * a_[size_t(k)] >= cap_[size_t(k)];) ++k;
     return k * kStep >= e ? 0.0 : prefix(e) - s_[std::min(k, int(s_.size()) - 1)];
   }
 
@@ -401,6 +411,44 @@ class VisualPolar final : public PolarDistribution {
     return best;
   }
 
+  // σ_disp and the cap per node (the header's D(e)) for gaze g: κ·σ_disp everywhere, or with
+  // ring_cap_ κ·σ_disp out to the fovea disk and beyond it the densest visible pixels of
+  // each ring (48 directions on 96 rings out to the farthest view angle, linear between
+  // them), never less than nearer rings'.
+  void set_density_cap(glm::dvec3 g) {
+    sigma_disp_ = fovea_pixel_density(g);
+    cap_.assign(size_t(kNodes) + 1, params_.cap * sigma_disp_);
+    if (!ring_cap_) return;
+    const double fovea = acuity::kFoveaDeg + params_.margin_deg + 1.0, e_far = farthest_view_angle(g);
+    glm::dvec3 b1, b2;
+    orthonormal_basis(g, b1, b2);
+    constexpr int kRings = 96, kDirs = 48;
+    std::array<double, kRings + 1> ring{};
+    double most = sigma_disp_;
+    for (int j = 0; j <= kRings; ++j) {
+      const double e = fovea + (e_far - fovea) * j / kRings;
+      if (e > fovea) {
+        const double se = std::sin(e * kDeg), ce = std::cos(e * kDeg);
+        for (int k = 0; k < kDirs; ++k) {
+          const double phi = 2 * kPi * k / kDirs;
+          const glm::dvec3 d = ce * g + se * (std::cos(phi) * b1 + std::sin(phi) * b2);
+          if (view_.dir_to_pixel(d)) most = std::max(most, view_.pixels_per_deg2(d));
+        }
+      }
+      ring[size_t(j)] = most;
+    }
+    for (int k = 0; k <= kNodes; ++k) {
+      const double e = k * kStep;
+      double d = sigma_disp_;
+      if (e > fovea && e_far > fovea) {
+        const double x = std::min((e - fovea) / (e_far - fovea) * kRings, double(kRings));
+        const int j = std::min(int(x), kRings - 1);
+        d = ring[size_t(j)] + (x - j) * (ring[size_t(j) + 1] - ring[size_t(j)]);
+      }
+      cap_[size_t(k)] = params_.cap * d;
+    }
+  }
+
   // σ_disp: the display's pixel density, maximised over the fovea disk (e <= 5.79° + s,
   // plus 1° so that the fovea edge is inside the capped region) within the frustum, so the
   // fovea gets >= κ samples per pixel even where the tangent projection packs pixels
@@ -420,6 +468,26 @@ class VisualPolar final : public PolarDistribution {
 
   bool packing() const { return params_.pack && !params_.staircase; }
 
+  // Whether one cap, κ·σ_disp over the whole view, falls short of the budget at a gaze on a
+  // 9×9 lattice over the raster: σ_disp is lowest where the view's pixels are sparsest, which
+  // on a wide, canted view is straight ahead, not its raster's centre. The view's solid angle
+  // in deg² is summed over a 64×64 lattice of pixel blocks. Where one cap does pay the
+  // budget (the headsets' presets at their default budget) the grid is what it always was.
+  bool needs_ring_cap(double budget) const {
+    constexpr int kBlocks = 64, kProbes = 9;
+    double solid_deg2 = 0;
+    const double bw = double(view_.width()) / kBlocks, bh = double(view_.height()) / kBlocks;
+    for (int y = 0; y < kBlocks; ++y)
+      for (int x = 0; x < kBlocks; ++x)
+        solid_deg2 += bw * bh / view_.pixels_per_deg2(view_.pixel_to_dir({(x + 0.5) * bw, (y + 0.5) * bh}));
+    for (int y = 0; y < kProbes; ++y)
+      for (int x = 0; x < kProbes; ++x) {
+        const glm::dvec3 g = view_.pixel_to_dir({x * view_.width() / (kProbes - 1.0), y * view_.height() / (kProbes - 1.0)});
+        if (params_.cap * fovea_pixel_density(g) * solid_deg2 < budget) return true;
+      }
+    return false;
+  }
+
   void apply_staircase() {
     for (int b = 0; b < columns_; b += 32) {
       const int end = std::min(b + 32, columns_);
@@ -433,6 +501,7 @@ class VisualPolar final : public PolarDistribution {
   // the grid must serve (centre, edges, corners), N_ρ is the columns that budget needs.
   void setup_session() {
     const double budget = budget_samples();
+    ring_cap_ = needs_ring_cap(budget);
     const glm::dvec3 centre = gaze_ = view_.centre_dir();
     orthonormal_basis(centre, b1_, b2_);
     sides_ = frustum_sides(view_, centre, b1_, b2_);
@@ -445,7 +514,7 @@ class VisualPolar final : public PolarDistribution {
     }
     double dlog = 1;  // d log(samples) / d log σ0 at the budget's root
     auto solve_budget = [&](glm::dvec3 g, double& e_max) {
-      sigma_disp_ = fovea_pixel_density(g);
+      set_density_cap(g);
       e_max = farthest_view_angle(g);
       double slope = 1;  // samples ∝ σ0 where σ is not capped
       return std::exp(solve_increasing(
@@ -484,12 +553,14 @@ class VisualPolar final : public PolarDistribution {
     double e_centre;
     double s0 = solve_budget(centre, e_centre);
     const double disp_centre = sigma_disp_;
+    const std::vector<double> cap_centre = cap_;
     rows_ = int(std::min(std::ceil(rows_needed(s0, e_centre) - 1e-9), 1e8));
     // Off-centre gazes re-solve σ0 with the same N_ρ and may need more rows to keep the
     // anisotropy bound; more rows per column in turn mean fewer columns for the budget.
     const glm::dvec2 probes[] = {{0, 0}, {0.5, 0}, {1, 0}, {0, 0.5}, {1, 0.5}, {0, 1}, {0.5, 1}, {1, 1}};
     for (int round = 0; round < 2; ++round) {
       sigma_disp_ = disp_centre;
+      cap_ = cap_centre;
       s0 = fit_packed(s0, e_centre);
       rows_ = std::max(rows_, int(std::min(std::ceil(rows_needed(s0, e_centre) - 1e-9), 1e8)));
       columns_ = std::max(1, int(std::ceil(march(s0, e_centre, 1 << 24) - 1e-9)));
@@ -499,17 +570,20 @@ class VisualPolar final : public PolarDistribution {
       if (round == 1) break;
       for (const glm::dvec2 q : probes) {
         const glm::dvec3 g = view_.pixel_to_dir({q.x * view_.width(), q.y * view_.height()});
-        sigma_disp_ = fovea_pixel_density(g);
+        set_density_cap(g);
         const double e_max = farthest_view_angle(g);
         const double x = solve_columns(e_max, std::log(s0));
         rows_ = std::max(rows_, int(std::ceil(rows_needed(std::exp(x), e_max) - 1e-9)));
       }
     }
     sigma_disp_ = disp_centre;
+    cap_ = cap_centre;
     sigma0_ = s0;  // the first frame's warm start
   }
 
   std::vector<double> a_, circ_;        // per node: a(e), circ(e)
+  std::vector<double> cap_;             // per node: κ·D(e) for the current gaze (set_density_cap)
+  bool ring_cap_ = false;               // D(e) follows the rings' densest pixels (needs_ring_cap)
   mutable std::vector<double> f_, s_;   // per node for the current σ0: σ·circ and prefix
   glm::dvec3 b1_{1, 0, 0}, b2_{0, 1, 0};
   std::array<FrustumSide, 4> sides_{};  // the frustum seen from the gaze (per frame)

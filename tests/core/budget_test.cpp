@@ -63,19 +63,14 @@ TEST(Budget, EveryDistributionMeetsItOrNamesWhatItReaches) {
 
 TEST(Budget, RefusalsNameTheReachableLimit) {
   const View v = left_view("small");
-  // Visual-Polar saturates when κ caps σ everywhere: 0.49 of the pixels on `small` (packed
-  // rings hold only the visible part of the capped density).
-  const Outcome vp = try_budget(v, DistributionKind::VisualPolar, 0.6);
-  ASSERT_FALSE(vp.met);
-  EXPECT_NE(vp.error.find("at most 0.49"), std::string::npos) << vp.error;
-  EXPECT_TRUE(try_budget(v, DistributionKind::VisualPolar, 0.5).met);
   // Linear fall-off keeps at least Pp = 0.2 of the pixels.
   const Outcome lf = try_budget(v, DistributionKind::LinearFalloff, 0.1);
   ASSERT_FALSE(lf.met);
   EXPECT_NE(lf.error.find("no less than 0.2"), std::string::npos) << lf.error;
-  // Every other kind reaches the whole range.
-  for (DistributionKind k : {DistributionKind::PaperVisualPolar, DistributionKind::CartesianUniform,
-                             DistributionKind::LogPolar})
+  // Every other kind reaches the whole range. Visual-Polar with one cap (κ·σ_disp) would
+  // saturate at 0.49 of `small`'s pixels; past that its cap follows the rings' own pixels.
+  for (DistributionKind k : {DistributionKind::VisualPolar, DistributionKind::PaperVisualPolar,
+                             DistributionKind::CartesianUniform, DistributionKind::LogPolar})
     for (double b : {0.05, 1.0}) EXPECT_TRUE(try_budget(v, k, b).met) << distribution_name(k) << " " << b;
 }
 
@@ -86,11 +81,17 @@ TEST(Budget, RefusalNamesTheDisplayFile) {
       R"({"name":"wide","width":320,"height":360,"fov_deg":{"left":-85,"right":85,"up":85,"down":-85}})", "wide.json");
   DistributionParams p;
   p.display = d.origin;
+  // Visual-Polar meets the default budget here (its cap follows the rings' pixels); linear
+  // fall-off cannot go below its peripheral floor.
+  EXPECT_TRUE(visual_polar_state(*make_distribution(d.view(Eye::Left), p))->ring_cap);
+  p.kind = DistributionKind::LinearFalloff;
+  p.budget = 0.05;
   try {
     (void)make_distribution(d.view(Eye::Left), p);
     ADD_FAILURE() << "budget met";
   } catch (const InputError& e) {
-    EXPECT_EQ(std::string(e.what()).rfind("display wide.json: budget: visual-polar reaches at most", 0), 0u) << e.what();
+    EXPECT_EQ(std::string(e.what()).rfind("display wide.json: budget: linear-falloff reaches no less than", 0), 0u)
+        << e.what();
   }
 }
 
@@ -136,7 +137,7 @@ constexpr DistributionKind kAllButCartesian[] = {DistributionKind::VisualPolar, 
                                                   DistributionKind::LogPolar};
 
 void expect_budget_everywhere(const std::string& preset, bool lens,
-                              std::span<const DistributionKind> kinds = kAllButCartesian) {
+                              std::span<const DistributionKind> kinds = kAllButCartesian, double reference_tol = 0.15) {
   const DisplayPreset display = load_display(preset);
   const View v = display.view(Eye::Left);
   const ViewMask mask = EyeOptics(display, Eye::Left).view_mask();
@@ -147,7 +148,7 @@ void expect_budget_everywhere(const std::string& preset, bool lens,
     if (lens) d->set_visibility(mask);
     const double requested = 0.39 * v.width() * v.height() * (lens ? 1 - mask.hidden_fraction() : 1.0);
     const double budget = d->budget_samples();
-    EXPECT_NEAR(budget / requested, 1.0, 0.15) << preset << " " << distribution_name(k);
+    EXPECT_NEAR(budget / requested, 1.0, reference_tol) << preset << " " << distribution_name(k);
     for (double deg : {0.0, 15.0, 35.0, -1.0}) {
       // A gaze the lens hides (the display's corner; nobody looks there): the screen-polar
       // kinds cannot move their rings' radii away from it (docs/visual-polar.md).
@@ -168,14 +169,17 @@ TEST(Budget, KeptAtEveryGazeUnderTheLens) { expect_budget_everywhere("small", tr
 #ifndef FOVEA_SANITIZED_BUILD
 TEST(Budget, KeptAtEveryGazeFove0) { expect_budget_everywhere("fove0", false); }
 TEST(Budget, KeptAtEveryGazeFove0UnderTheLens) { expect_budget_everywhere("fove0", true); }
-// The wide preset: the baselines keep their budget. Visual-Polar does not yet: its cap of κ
-// samples per pixel of the fovea's display density leaves it 0.60 of its budget with the
-// gaze straight ahead, where this asymmetric raster's pixels are sparsest
-// (docs/visual-polar.md, "Wide fields of view").
-TEST(Budget, KeptAtEveryGazeWideUnderTheLensByTheBaselines) {
+// The wide preset: every kind keeps its budget at every gaze. Visual-Polar's cap follows the
+// rings' own pixels there (with one cap of κ samples per pixel of the fovea's density it
+// traced 0.60 of its budget with the gaze straight ahead, where this asymmetric raster's
+// pixels are sparsest). Not solved: under the lens its reference, what the centred gaze
+// traces, is 1.29 of the requested budget (docs/visual-polar.md, "Wide fields of view").
+TEST(Budget, KeptAtEveryGazeWideUnderTheLens) {
   const DistributionKind baselines[] = {DistributionKind::PaperVisualPolar, DistributionKind::CartesianUniform,
                                         DistributionKind::LinearFalloff, DistributionKind::LogPolar};
   expect_budget_everywhere("wide", true, baselines);
+  const DistributionKind vp[] = {DistributionKind::VisualPolar};
+  expect_budget_everywhere("wide", true, vp, 0.35);
 }
 #endif
 

@@ -158,14 +158,14 @@ TEST(HostileInputs, AReferenceOfOneBatchHasNoErrorEstimate) {
 
 TEST(HostileInputs, BudgetRefusalsNameTheDisplayFile) {
   const std::string dir = fovea::test::temp_dir("wide-display");
-  // The small preset widened to +-85 degrees: Visual-Polar cannot spend the default budget.
+  // The small preset widened to +-85 degrees: linear fall-off cannot go below its floor.
   const std::string file = dir + "/wide.json";
   std::ofstream(file) << R"({"name": "wide", "width": 320, "height": 360, "refresh_hz": 70, "ipd_m": 0.063,
     "fov_deg": {"left": -85, "right": 85, "up": 53.28, "down": -53.28}})";
   for (const std::string& cmd : {"render --frames 1 --quiet --out " + dir + "/r", std::string("density --json")}) {
-    const auto r = run_fovea(cmd + " --display " + file);
+    const auto r = run_fovea(cmd + " --distribution linear-falloff --budget 0.05 --display " + file);
     EXPECT_EQ(r.status, 2) << cmd << ": " << r.err;
-    EXPECT_NE(r.err.find("display " + file + ": budget: visual-polar reaches at most"), std::string::npos)
+    EXPECT_NE(r.err.find("display " + file + ": budget: linear-falloff reaches no less than"), std::string::npos)
         << cmd << ": " << r.err;
   }
   fs::remove_all(dir);

@@ -159,7 +159,10 @@ int run(std::vector<std::string> argv) {
     j["traced_fraction"] = double(r.traced) / (double(view.width()) * view.height());
     j["traced_of_budget"] = double(r.traced) / dist->budget_samples();
     if (const auto vp = core::visual_polar_state(*dist))
-      j["visual_polar"] = {{"sigma0", vp->sigma0}, {"row_scale", vp->row_scale}, {"sigma_disp", vp->sigma_disp}};
+      j["visual_polar"] = {{"sigma0", vp->sigma0},
+                           {"row_scale", vp->row_scale},
+                           {"sigma_disp", vp->sigma_disp},
+                           {"ring_cap", vp->ring_cap}};
     j["fovea_spp"] = r.fovea_spp;
     auto& bands = j["bands"] = nlohmann::ordered_json::array();
     for (const auto& b : r.bands)

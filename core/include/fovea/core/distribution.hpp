@@ -170,6 +170,9 @@ struct VisualPolarState {
   double sigma_disp = 0;   // display pixel density that κ caps against (pixels/deg²)
   double e_max = 0;        // farthest view direction from the gaze, degrees
   int evaluations = 0;     // column marches the σ0 solve of this frame used
+  // The cap follows the rings' densest pixels beyond the fovea, not σ_disp alone: one cap
+  // could not pay the budget at some gaze (a wide view, or a budget near the pixel count).
+  bool ring_cap = false;
 };
 std::optional<VisualPolarState> visual_polar_state(const SampleDistribution& d);
 
