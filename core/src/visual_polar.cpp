@@ -417,9 +417,13 @@ class VisualPolar final : public PolarDistribution {
   // them), never less than nearer rings'.
   void set_density_cap(glm::dvec3 g) {
     sigma_disp_ = fovea_pixel_density(g);
-    cap_.assign(size_t(kNodes) + 1, params_.cap * sigma_disp_);
-    if (!ring_cap_) return;
-    const double fovea = acuity::kFoveaDeg + params_.margin_deg + 1.0, e_far = farthest_view_angle(g);
+    if (!ring_cap_) {  // one cap: rewritten only when it changes
+      const double cap = params_.cap * sigma_disp_;
+      if (cap_.empty() || cap_[0] != cap) cap_.assign(size_t(kNodes) + 1, cap);
+      return;
+    }
+    cap_.resize(size_t(kNodes) + 1);
+    const double fovea = fovea_disk_deg(), e_far = farthest_view_angle(g);
     glm::dvec3 b1, b2;
     orthonormal_basis(g, b1, b2);
     constexpr int kRings = 96, kDirs = 48;
@@ -453,10 +457,11 @@ class VisualPolar final : public PolarDistribution {
   // plus 1° so that the fovea edge is inside the capped region) within the frustum, so the
   // fovea gets >= κ samples per pixel even where the tangent projection packs pixels
   // densest (gaze towards the edges).
+  double fovea_disk_deg() const { return acuity::kFoveaDeg + params_.margin_deg + 1.0; }
   double fovea_pixel_density(glm::dvec3 g) const {
     glm::dvec3 b1, b2;
     orthonormal_basis(g, b1, b2);
-    const double r = (acuity::kFoveaDeg + params_.margin_deg + 1.0) * kDeg;
+    const double r = fovea_disk_deg() * kDeg;
     double best = view_.pixels_per_deg2(g);
     for (int k = 0; k < 64; ++k) {
       const double phi = 2 * kPi * k / 64;
@@ -482,7 +487,8 @@ class VisualPolar final : public PolarDistribution {
         solid_deg2 += bw * bh / view_.pixels_per_deg2(view_.pixel_to_dir({(x + 0.5) * bw, (y + 0.5) * bh}));
     for (int y = 0; y < kProbes; ++y)
       for (int x = 0; x < kProbes; ++x) {
-        const glm::dvec3 g = view_.pixel_to_dir({x * view_.width() / (kProbes - 1.0), y * view_.height() / (kProbes - 1.0)});
+        const double fx = x / (kProbes - 1.0), fy = y / (kProbes - 1.0);
+        const glm::dvec3 g = view_.pixel_to_dir({fx * view_.width(), fy * view_.height()});
         if (params_.cap * fovea_pixel_density(g) * solid_deg2 < budget) return true;
       }
     return false;

@@ -191,21 +191,24 @@ Config read_config(const json& r, const std::vector<Row>& rows) {
   for (const auto& k : c.section) {
     std::set<std::string> values;
     for (const auto& row : rows)
-      if (job_command(row.settings) == "render") values.insert(row.settings.contains(k) ? setting_text(row.settings[k]) : "");
+      if (job_command(row.settings) == "render")
+        values.insert(row.settings.contains(k) ? setting_text(row.settings[k]) : "");
     if (values.size() > 1) c.section_keys.push_back(k);
   }
   if (c.section_keys.empty()) c.section_keys.push_back(c.section[0]);
   if (r.contains("speedup")) {
     const json& x = r["speedup"];
     const auto bad = [](const std::string& what) { return core::InputError("report.speedup: " + what); };
-    if (!x.is_object()) throw bad("expected an object {\"of\": GROUP, \"over\": GROUP, \"quality\": METRIC, \"tolerance\": N}");
+    if (!x.is_object())
+      throw bad("expected an object {\"of\": GROUP, \"over\": GROUP, \"quality\": METRIC, \"tolerance\": N}");
     SpeedUp s;
     for (const auto& [k, v] : x.items()) {
       if (k == "of" || k == "over" || k == "quality") {
         if (!v.is_string() || v.get<std::string>().empty()) throw bad(k + ": expected a non-empty name");
         (k == "of" ? s.of : k == "over" ? s.over : s.quality) = v.get<std::string>();
       } else if (k == "tolerance") {
-        if (!v.is_number() || !(v.get<double>() >= 0 && v.get<double>() < 1)) throw bad("tolerance: expected a number in [0, 1)");
+        if (!v.is_number() || !(v.get<double>() >= 0 && v.get<double>() < 1))
+          throw bad("tolerance: expected a number in [0, 1)");
         s.tolerance = v.get<double>();
       } else {
         throw bad("unknown key \"" + k + "\" (of, over, quality, tolerance)");
