@@ -552,17 +552,15 @@ int run(std::vector<std::string> argv) {
       gaze_fallback_frames[e] += t.gaze[e].fallback;
       gaze_clamped_frames[e] += t.gaze[e].clamped;
     }
-    FrameRecord rec{f, step.frame_ns, g, {t.gaze[0].used, t.gaze[1].used}, driver.static_poses(), 0, 0,
-                    step.cpu_ms(), step.gpu_ms(), driver.gaze()->live()};
+    const auto& dist = pipeline.distribution(core::Eye::Left);
+    FrameRecord rec{f, step.frame_ns, g, {t.gaze[0].used, t.gaze[1].used}, driver.static_poses(), dist.columns(),
+                    dist.rows(), step.cpu_ms(), step.gpu_ms(), driver.gaze()->live()};
     for (const auto& [name, v] : rec.gpu_ms) gpu_ms[name].push_back(v);
     for (const auto& [name, v] : rec.cpu_ms) cpu_ms[name].push_back(v);
     temporal_gpu_ms.push_back(t.temporal_gpu_ms);
     const bool write = png_every > 0 ? f % png_every == 0 || f == frames - 1 : f == frames - 1;
     // Flicker is measured over the trailing still frames, at most kFlickerFrames of them.
     const bool flicker_window = f >= frames - long(kFlickerFrames);
-    const auto& dist = pipeline.distribution(core::Eye::Left);
-    rec.grid_columns = dist.columns();
-    rec.grid_rows = dist.rows();
     if (write || flicker_window) {
       const core::TimeNs t0 = core::now_ns();
       for (int e = 0; e < 2; ++e) {
