@@ -1,5 +1,8 @@
 #include "fovea/gpu/buffer.hpp"
 
+#include <unistd.h>
+
+#include <cstdio>
 #include <stdexcept>
 #include <string>
 #include <utility>
@@ -17,6 +20,12 @@ void check_range(const Buffer& b, VkDeviceSize offset, std::size_t bytes, const 
                             std::to_string(offset) + " exceed the buffer's " + std::to_string(b.size()) + " bytes");
 }
 
+std::string hex(std::uint32_t v) {
+  char s[16];
+  std::snprintf(s, sizeof s, "%x", v);
+  return s;
+}
+
 }  // namespace
 
 VkDeviceSize texel_buffer_bytes(VkFormat format) {
@@ -29,6 +38,15 @@ VkDeviceSize texel_buffer_bytes(VkFormat format) {
 }
 
 Buffer::Buffer(Context& ctx, const BufferDesc& desc) : ctx_(&ctx), size_(desc.size) {
+  // An imported descriptor is closed on every failure before the import took it.
+  struct Fd {
+    int fd;
+    ~Fd() {
+      if (fd >= 0) close(fd);
+    }
+  } imported_fd{desc.imported ? desc.imported->fd : -1};
+  if (desc.imported && !ctx.external_memory_fd())
+    throw core::InputError("gpu::Buffer '" + desc.name + "': imported memory on a context without external memory");
   if (desc.size == 0) throw core::InputError("gpu::Buffer '" + desc.name + "': size must be > 0");
   const bool texels = desc.texel_format != VK_FORMAT_UNDEFINED;
   const VkDeviceSize texel = texel_buffer_bytes(desc.texel_format);
@@ -45,6 +63,9 @@ Buffer::Buffer(Context& ctx, const BufferDesc& desc) : ctx_(&ctx), size_(desc.si
   ci.usage = static_cast<VkBufferUsageFlags>(desc.usage | BufferUsage::TransferSrc | BufferUsage::TransferDst);
   if (texels) ci.usage |= VK_BUFFER_USAGE_UNIFORM_TEXEL_BUFFER_BIT;
   ci.sharingMode = VK_SHARING_MODE_EXCLUSIVE;
+  VkExternalMemoryBufferCreateInfo external{VK_STRUCTURE_TYPE_EXTERNAL_MEMORY_BUFFER_CREATE_INFO};
+  external.handleTypes = VK_EXTERNAL_MEMORY_HANDLE_TYPE_OPAQUE_FD_BIT;
+  if (desc.imported) ci.pNext = &external;
   VkBuffer buffer = VK_NULL_HANDLE;
   const std::string what = "gpu::Buffer '" + desc.name + "'";
   check_fits(vkCreateBuffer(dev, &ci, nullptr, &buffer), "vkCreateBuffer", what, desc.size, 0);
@@ -52,23 +73,43 @@ Buffer::Buffer(Context& ctx, const BufferDesc& desc) : ctx_(&ctx), size_(desc.si
 
   VkMemoryRequirements req;
   vkGetBufferMemoryRequirements(dev, buffer, &req);
-  const bool host = desc.memory == Memory::HostVisible;
+  const bool host = desc.memory == Memory::HostVisible && !desc.imported;
   // Host-visible memory is also asked to be coherent so no flushes are needed; cached
   // memory is preferred because readback is its main use.
-  const std::uint32_t type =
-      host ? ctx.memory_type(req.memoryTypeBits, VK_MEMORY_PROPERTY_HOST_VISIBLE_BIT | VK_MEMORY_PROPERTY_HOST_COHERENT_BIT,
-                             VK_MEMORY_PROPERTY_HOST_CACHED_BIT)
-           : ctx.memory_type(req.memoryTypeBits, 0, VK_MEMORY_PROPERTY_DEVICE_LOCAL_BIT);
+  std::uint32_t type = 0;
+  if (desc.imported) {
+    type = desc.imported->memory_type;
+    if (type >= 32 || (req.memoryTypeBits & (1u << type)) == 0 || desc.imported->allocation_size < req.size)
+      throw core::InputError(what + ": the imported memory (type " + std::to_string(type) + ", " +
+                             std::to_string(desc.imported->allocation_size) + " bytes) cannot hold it (" +
+                             std::to_string(req.size) + " bytes, memory types 0x" + hex(req.memoryTypeBits) + ")");
+  } else {
+    type = host ? ctx.memory_type(req.memoryTypeBits,
+                                  VK_MEMORY_PROPERTY_HOST_VISIBLE_BIT | VK_MEMORY_PROPERTY_HOST_COHERENT_BIT,
+                                  VK_MEMORY_PROPERTY_HOST_CACHED_BIT)
+                : ctx.memory_type(req.memoryTypeBits, 0, VK_MEMORY_PROPERTY_DEVICE_LOCAL_BIT);
+  }
   VkMemoryAllocateInfo ai{VK_STRUCTURE_TYPE_MEMORY_ALLOCATE_INFO};
-  ai.allocationSize = req.size;
+  ai.allocationSize = desc.imported ? desc.imported->allocation_size : req.size;
   ai.memoryTypeIndex = type;
   VkMemoryAllocateFlagsInfo flags{VK_STRUCTURE_TYPE_MEMORY_ALLOCATE_FLAGS_INFO};
   flags.flags = VK_MEMORY_ALLOCATE_DEVICE_ADDRESS_BIT;
   if ((ci.usage & VK_BUFFER_USAGE_SHADER_DEVICE_ADDRESS_BIT) != 0) ai.pNext = &flags;
+  // An opaque import repeats the export's dedicated allocation.
+  VkMemoryDedicatedAllocateInfo dedicated{VK_STRUCTURE_TYPE_MEMORY_DEDICATED_ALLOCATE_INFO};
+  dedicated.buffer = buffer;
+  VkImportMemoryFdInfoKHR import{VK_STRUCTURE_TYPE_IMPORT_MEMORY_FD_INFO_KHR, &dedicated};
+  import.handleType = VK_EXTERNAL_MEMORY_HANDLE_TYPE_OPAQUE_FD_BIT;
+  import.fd = imported_fd.fd;
+  if (desc.imported) {
+    dedicated.pNext = ai.pNext;
+    ai.pNext = &import;
+  }
   charge_ = ctx.charge_memory(what, req.size, type);
   VkDeviceMemory memory = VK_NULL_HANDLE;
   check_fits(vkAllocateMemory(dev, &ai, nullptr, &memory), "vkAllocateMemory", what, req.size,
              ctx.memory_type_heap_size(type));
+  imported_fd.fd = -1;  // the memory owns it now
   memory_ = {dev, memory};
   check(vkBindBufferMemory(dev, buffer, memory, 0), "vkBindBufferMemory");
   if (host) {

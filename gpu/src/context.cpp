@@ -90,8 +90,8 @@ Context::Context(const ContextOptions& options) {
   }
   try {
     create_instance(validation);
-    pick_device(override);
-    create_device(options.ray_query);
+    pick_device(override, options);
+    create_device(options);
   } catch (...) {
     release();  // the destructor does not run for a constructor that throws
     throw;
@@ -244,13 +244,12 @@ void Context::create_instance(bool validation) {
         vkGetInstanceProcAddr(instance_, "vkSetDebugUtilsObjectNameEXT"));
 }
 
-void Context::pick_device(const std::string& override) {
+void Context::pick_device(const std::string& override, const ContextOptions& options) {
   std::uint32_t n = 0;
   check(vkEnumeratePhysicalDevices(instance_, &n, nullptr), "vkEnumeratePhysicalDevices");
   std::vector<VkPhysicalDevice> devices(n);
   check(vkEnumeratePhysicalDevices(instance_, &n, devices.data()), "vkEnumeratePhysicalDevices");
   devices.resize(n);
-
   std::vector<DeviceCandidate> candidates;
   for (VkPhysicalDevice d : devices) {
     VkPhysicalDeviceProperties p;
@@ -262,6 +261,22 @@ void Context::pick_device(const std::string& override) {
     bool compute = false;
     for (const auto& f : q) compute = compute || (f.queueFlags & VK_QUEUE_COMPUTE_BIT) != 0;
     candidates.push_back({p.deviceName, p.deviceType, p.apiVersion, compute});
+  }
+  if (options.device_uuid) {
+    // The device another instance uses: the same physical device, whatever this one prefers
+    // (still checked for Vulkan 1.2 and a compute queue).
+    for (std::size_t i = 0; i < devices.size(); ++i) {
+      VkPhysicalDeviceIDProperties id{VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_ID_PROPERTIES};
+      VkPhysicalDeviceProperties2 p2{VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_PROPERTIES_2, &id};
+      vkGetPhysicalDeviceProperties2(devices[i], &p2);
+      if (std::equal(options.device_uuid->begin(), options.device_uuid->end(), id.deviceUUID)) {
+        choose_device(std::span(&candidates[i], 1), "");
+        physical_device_ = devices[i];
+        return;
+      }
+    }
+    throw core::InputError("no Vulkan device of this process's instance has the device UUID asked for (" +
+                           std::to_string(n) + " devices enumerated)");
   }
   physical_device_ = devices[choose_device(candidates, override)];
 }
@@ -310,7 +325,8 @@ void Context::create_command_pool() {
   check(vkCreateCommandPool(device_, &pci, nullptr, &command_pool_), "vkCreateCommandPool");
 }
 
-void Context::create_device(bool ray_query) {
+void Context::create_device(const ContextOptions& options) {
+  const bool ray_query = options.ray_query;
   // Queue: the first compute family that has timestamps, else the first compute family.
   std::uint32_t nq = 0;
   vkGetPhysicalDeviceQueueFamilyProperties(physical_device_, &nq, nullptr);
@@ -355,6 +371,13 @@ void Context::create_device(bool ray_query) {
   std::vector<const char*> device_exts;
   // Portability implementations (MoltenVK) require their subset extension to be enabled.
   if (has_extension(exts, "VK_KHR_portability_subset")) device_exts.push_back("VK_KHR_portability_subset");
+  if (options.external_memory_fd) {
+    if (!has_extension(exts, VK_KHR_EXTERNAL_MEMORY_FD_EXTENSION_NAME))
+      throw core::InputError(info_.name + " has no " VK_KHR_EXTERNAL_MEMORY_FD_EXTENSION_NAME
+                             ": it cannot share memory with another device");
+    device_exts.push_back(VK_KHR_EXTERNAL_MEMORY_FD_EXTENSION_NAME);
+    external_memory_fd_ = true;
+  }
 
   // Ray queries: all three extensions and both features, or none (Vulkan 1.2 devices
   // without them keep the compute BVH traversal).

@@ -92,6 +92,26 @@ AppDevice::AppDevice(const VulkanBinding& vk) : device_(vk.device), queue_family
     family_has_compute_ = vk.queue_family < n && (f[vk.queue_family].queueFlags & VK_QUEUE_COMPUTE_BIT);
   }
   get_device_proc_ = gdpa;
+  physical_device_ = vk.physical_device;
+  no_shared_ = vk.no_external_memory;
+  if (vk.external_memory_fd) {
+    // The instance is Vulkan 1.1 or later here (vulkan_enable.cpp raised it): the device's
+    // UUID, for the layer's device to be made on the same physical device.
+    const auto props2 = reinterpret_cast<PFN_vkGetPhysicalDeviceProperties2>(
+        vkGetInstanceProcAddr(vk.instance, "vkGetPhysicalDeviceProperties2"));
+    external_buffer_properties_ = reinterpret_cast<PFN_vkGetPhysicalDeviceExternalBufferProperties>(
+        vkGetInstanceProcAddr(vk.instance, "vkGetPhysicalDeviceExternalBufferProperties"));
+    get_memory_fd_ = reinterpret_cast<PFN_vkGetMemoryFdKHR>(gdpa(device_, "vkGetMemoryFdKHR"));
+    if (props2 && external_buffer_properties_ && get_memory_fd_) {
+      VkPhysicalDeviceIDProperties id{VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_ID_PROPERTIES};
+      VkPhysicalDeviceProperties2 p2{VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_PROPERTIES_2, &id};
+      props2(vk.physical_device, &p2);
+      std::copy(std::begin(id.deviceUUID), std::end(id.deviceUUID), device_uuid_.begin());
+      external_memory_ = true;
+    } else {
+      no_shared_ = "the application's Vulkan instance or device does not resolve the external-memory commands";
+    }
+  }
   vkGetDeviceQueue_(device_, vk.queue_family, vk.queue_index, &queue_handle_);
   // Bounded: a lost or hung device fails the session (the layer then passes it through)
   // instead of hanging the application's xrEndFrame.
@@ -145,6 +165,55 @@ void AppDevice::reserve(Buffer& b, VkDeviceSize size, VkBufferUsageFlags usage, 
     throw;
   }
   b.size = size;
+}
+
+void AppDevice::reserve_exported(Buffer& b, VkDeviceSize size, VkBufferUsageFlags usage) {
+  if (!external_memory_) throw std::runtime_error(no_shared_);
+  constexpr auto kOpaqueFd = VK_EXTERNAL_MEMORY_HANDLE_TYPE_OPAQUE_FD_BIT;
+  VkPhysicalDeviceExternalBufferInfo query{VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_EXTERNAL_BUFFER_INFO};
+  query.usage = usage;
+  query.handleType = kOpaqueFd;
+  VkExternalBufferProperties can{VK_STRUCTURE_TYPE_EXTERNAL_BUFFER_PROPERTIES};
+  external_buffer_properties_(physical_device_, &query, &can);
+  const VkExternalMemoryFeatureFlags need = VK_EXTERNAL_MEMORY_FEATURE_EXPORTABLE_BIT |
+                                            VK_EXTERNAL_MEMORY_FEATURE_IMPORTABLE_BIT;
+  if ((can.externalMemoryProperties.externalMemoryFeatures & need) != need)
+    throw std::runtime_error("the application's device cannot export and import storage buffers as opaque file descriptors");
+  release(b);
+  VkExternalMemoryBufferCreateInfo external{VK_STRUCTURE_TYPE_EXTERNAL_MEMORY_BUFFER_CREATE_INFO};
+  external.handleTypes = kOpaqueFd;
+  VkBufferCreateInfo bi{VK_STRUCTURE_TYPE_BUFFER_CREATE_INFO, &external};
+  bi.size = size;
+  bi.usage = usage;
+  bi.sharingMode = VK_SHARING_MODE_EXCLUSIVE;
+  app_check(vkCreateBuffer_(device_, &bi, nullptr, &b.buffer), "vkCreateBuffer");
+  VkMemoryRequirements req;
+  vkGetBufferMemoryRequirements_(device_, b.buffer, &req);
+  const std::optional<std::uint32_t> type =
+      gpu::find_memory_type(memory_, req.memoryTypeBits, 0, VK_MEMORY_PROPERTY_DEVICE_LOCAL_BIT);
+  if (!type) {
+    release(b);
+    throw std::runtime_error("the application's device has no memory type for an exported buffer");
+  }
+  // Dedicated, so that the importing device can repeat the allocation whatever the driver requires.
+  VkMemoryDedicatedAllocateInfo dedicated{VK_STRUCTURE_TYPE_MEMORY_DEDICATED_ALLOCATE_INFO};
+  dedicated.buffer = b.buffer;
+  VkExportMemoryAllocateInfo exported{VK_STRUCTURE_TYPE_EXPORT_MEMORY_ALLOCATE_INFO, &dedicated};
+  exported.handleTypes = kOpaqueFd;
+  VkMemoryAllocateInfo mi{VK_STRUCTURE_TYPE_MEMORY_ALLOCATE_INFO, &exported};
+  mi.allocationSize = req.size;
+  mi.memoryTypeIndex = *type;
+  try {
+    app_check(vkAllocateMemory_(device_, &mi, nullptr, &b.memory), "vkAllocateMemory (exportable)");
+    app_check(vkBindBufferMemory_(device_, b.buffer, b.memory, 0), "vkBindBufferMemory");
+  } catch (...) {
+    release(b);
+    throw;
+  }
+  b.size = size;
+  b.exported = true;
+  b.memory_type = *type;
+  b.allocation = req.size;
 }
 
 std::vector<Pixels8> AppDevice::read(const std::vector<Read>& reads) {

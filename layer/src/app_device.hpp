@@ -9,6 +9,7 @@
 #include <memory>
 #include <mutex>
 #include <optional>
+#include <string>
 #include <vector>
 
 #include <vulkan/vulkan.h>
@@ -17,6 +18,7 @@
 #include <openxr/openxr.h>
 
 #include "composite.hpp"
+#include "fovea/gpu/buffer.hpp"
 #include "fovea/gpu/pipeline.hpp"
 #include "fovea/gpu/foreign_queue.hpp"
 #include "frame_renderer.hpp"
@@ -72,8 +74,20 @@ class AppDevice {
   // `traced_width` x `traced_height` per eye in host-visible memory of this device; throws
   // std::runtime_error with the reason when the device cannot run it (the session queue's
   // family has no compute, no memory type).
+  // With VK_KHR_external_memory_fd on the device (VulkanBinding::external_memory_fd) the slots
+  // are exportable device memory instead (shared_slots(); slot_colour and slot_depth then
+  // throw), unless the export fails: shared_slots() is empty then, and no_shared_slots() says why.
   void enable_gpu_composition(int traced_width, int traced_height, int slots = 3);
   bool gpu_composition() const { return gpu_ != nullptr; }
+  // The slots' memory as a new opaque file descriptor for the layer's device to import, with
+  // the device's VkPhysicalDeviceIDProperties::deviceUUID (the layer's device must be on the
+  // same physical device); empty on the host-written path.
+  struct SharedSlots {
+    gpu::ExternalMemory memory;
+    std::array<std::uint8_t, VK_UUID_SIZE> device_uuid{};
+  };
+  std::optional<SharedSlots> shared_slots() const;
+  const std::string& no_shared_slots() const { return no_shared_; }
   // The traced-frame slots (null before enable_gpu_composition). A thread that claimed slot `s`
   // writes its frame at slot_colour(s, eye) (4-byte pixels in the swapchain's encoding,
   // row-major) and slot_depth(s, eye) (FramePipeline::depth's view distances): persistently
@@ -130,12 +144,18 @@ class AppDevice {
     VkDeviceMemory memory = VK_NULL_HANDLE;
     void* mapped = nullptr;  // host-visible buffers only
     VkDeviceSize size = 0;
+    bool exported = false;  // dedicated memory exportable as an opaque file descriptor
+    std::uint32_t memory_type = 0;
+    VkDeviceSize allocation = 0;
   };
   // At least `size` bytes: host-visible and coherent (mapped), or device-local when `host` is
   // false; `prefer_device_local` picks host-visible memory that is device-local too when the
   // device has it (what a shader reads every frame).
   void reserve(Buffer& b, VkDeviceSize size, VkBufferUsageFlags usage, bool host = true,
                bool prefer_device_local = false);
+  // Dedicated memory of `size` bytes that another device of this physical device can import
+  // (opaque file descriptor), device-local where the device has it; throws with the reason.
+  void reserve_exported(Buffer& b, VkDeviceSize size, VkBufferUsageFlags usage);
   void release(Buffer& b);
   // One region of an attachment image copied into `buffer` at `offset`: transition to
   // TRANSFER_SRC after the application's writes, copy `copy_aspect`, transition back.
@@ -166,6 +186,13 @@ class AppDevice {
   Buffer download_, upload_;
   VkPhysicalDeviceMemoryProperties memory_{};
   VkDeviceSize storage_alignment_ = 256;  // minStorageBufferOffsetAlignment
+  // The shared path (VulkanBinding::external_memory_fd): the device's UUID and its export.
+  bool external_memory_ = false;
+  std::string no_shared_;
+  std::array<std::uint8_t, VK_UUID_SIZE> device_uuid_{};
+  PFN_vkGetMemoryFdKHR get_memory_fd_ = nullptr;
+  PFN_vkGetPhysicalDeviceExternalBufferProperties external_buffer_properties_ = nullptr;
+  VkPhysicalDevice physical_device_ = VK_NULL_HANDLE;
   std::int64_t host_readbacks_ = 0;
   // The composition pass's objects (gpu_composite.cpp).
   using PassKey = CompositionPassKey;

@@ -33,6 +33,8 @@ bool parse_render_mode(const std::string& v, const std::string& where) {
 
 bool parse_compositor(const std::string& v, const std::string& where) { return parse_either(v, where, "gpu", "host"); }
 
+bool parse_handover(const std::string& v, const std::string& where) { return parse_either(v, where, "shared", "host"); }
+
 RenderPriority parse_render_priority(const std::string& v, const std::string& where) {
   if (v == "idle") return {true, 19};
   // A whole number 0..19 (no sign, no spaces): nice values below the default are not the layer's to take.
@@ -57,6 +59,8 @@ void apply_section(const nlohmann::json& s, const std::string& where, LayerConfi
       else throw core::InputError(field + ": must be \"app-on-top\", \"alpha\" or \"scene-only\"");
     } else if (key == "compositor") {
       c.gpu_compositor = parse_compositor(v.is_string() ? v.get<std::string>() : v.dump(), field);
+    } else if (key == "handover") {
+      c.shared_handover = parse_handover(v.is_string() ? v.get<std::string>() : v.dump(), field);
     } else if (key == "render_priority") {
       c.render_priority = parse_render_priority(v.is_string() ? v.get<std::string>() : v.dump(), field);
     } else if (key == "render") {
@@ -164,6 +168,8 @@ LayerConfig load_config(const std::string& application) {
   if (!env("FOVEA_LAYER_RENDER").empty()) c.lockstep = parse_render_mode(env("FOVEA_LAYER_RENDER"), "FOVEA_LAYER_RENDER");
   if (!env("FOVEA_LAYER_COMPOSITOR").empty())
     c.gpu_compositor = parse_compositor(env("FOVEA_LAYER_COMPOSITOR"), "FOVEA_LAYER_COMPOSITOR");
+  if (!env("FOVEA_LAYER_HANDOVER").empty())
+    c.shared_handover = parse_handover(env("FOVEA_LAYER_HANDOVER"), "FOVEA_LAYER_HANDOVER");
   if (!env("FOVEA_LAYER_RENDER_PRIORITY").empty())
     c.render_priority = parse_render_priority(env("FOVEA_LAYER_RENDER_PRIORITY"), "FOVEA_LAYER_RENDER_PRIORITY");
   for (const std::string& name : pipeline::frame_option_names()) {

@@ -2,12 +2,13 @@
 // The layer's configuration for one application. Sources, later ones winning:
 //   $XDG_CONFIG_HOME/fovea/layer.json (else ~/.config/fovea/layer.json):
 //     {"default": {...}, "applications": {"<XrApplicationInfo::applicationName>": {...}}}
-//     with keys "scene", "composite", "app_background", "gaze", "render", "compositor",
+//     with keys "scene", "composite", "app_background", "gaze", "render", "compositor", "handover",
 //     "render_priority" and the frame options of `fovea render` by their names ("budget",
 //     "distribution", "jitter", "denoiser", "bmfr-precision", "stereo-share", "trace", "bounces":
 //     pipeline/frame_config.hpp) (an application's section over "default");
 //   env FOVEA_LAYER_SCENE, then FOVEA_SCENE (the scene); FOVEA_GAZE (the gaze source);
 //   FOVEA_LAYER_RENDER (the render mode); FOVEA_LAYER_COMPOSITOR (where compositing runs);
+//   FOVEA_LAYER_HANDOVER (how traced frames reach the application's device);
 //   FOVEA_LAYER_RENDER_PRIORITY (the render thread's CPU priority); FOVEA_LAYER_<OPTION> for
 //   each frame option (FOVEA_LAYER_BUDGET, FOVEA_LAYER_STEREO_SHARE, ...).
 #include <array>
@@ -49,6 +50,11 @@ struct LayerConfig {
   // "compositor": "gpu" (true): a compute pass on the application's device, the host path
   // when that device cannot run it; "host" (false): always the host round trip.
   bool gpu_compositor = true;
+  // "handover": "shared" (true): the GPU composition's traced frames are written by the
+  // layer's device into memory it imports from the application's device, when the runtime
+  // created that device through the layer (XR_KHR_vulkan_enable2: the layer enables
+  // VK_KHR_external_memory_fd on it); "host" (false): read back and written by the host.
+  bool shared_handover = true;
   // "render_priority": a nice value 0..19 (SCHED_OTHER; default 19) or "idle" (SCHED_IDLE) for the render
   // thread and the threads of the device it creates (Linux threads inherit both), so that on a
   // CPU device the path tracer runs below the application's threads.

@@ -45,6 +45,7 @@
 #include "layer.hpp"
 #include "log.hpp"
 #include "next_chain.hpp"
+#include "slot_writer.hpp"
 
 namespace fovea::layer {
 namespace {
@@ -143,11 +144,21 @@ class PathTracer {
   PathTracer(const LayerConfig& config, const renderer::Scene& scene, const core::StereoViews& views,
              const core::DisplayPreset& display, VkFormat format, XrSession session, const AppDevice* slots)
       : config_(config), format_(format), session_(session), slots_(slots),
-        gaze_(std::make_unique<LayerGaze>(config.gaze, display)), ctx_(std::make_unique<gpu::Context>()),
+        gaze_(std::make_unique<LayerGaze>(config.gaze, display)), ctx_(make_context(slots, shared_)),
         // The frame of `fovea render` (pipeline/frame_driver.hpp) on the application's views. A
         // measurement would delay the first traced frame by seconds: the cached choice, or none.
         driver_(std::make_unique<pipeline::FrameDriver>(*ctx_, scene, views,
                                                         pipeline::FrameDriverOptions{config_.frame, false, false})) {
+    if (shared_) {
+      writer_ = std::make_unique<SlotWriter>(*ctx_, shared_->memory, SlotLayout{views[core::Eye::Left].width(),
+                                                                                views[core::Eye::Left].height()},
+                                             slots->traced_slots()->slots(), pixel_format(format));
+      FOVEA_LAYER_INFO("hand-over: shared memory (the layer's device encodes each traced frame into the application's "
+                       "device memory, no host copy)");
+    } else if (slots) {
+      FOVEA_LAYER_INFO("hand-over: through the host (read back, encoded, written into the application's device memory): %s",
+                       slots->no_shared_slots().c_str());
+    }
     FOVEA_LAYER_INFO("rendering scene \"%s\" (from %s) at %dx%d per eye on %s, composite %s, gaze %s, render %s, "
                      "render thread %s, frame %s, tracing %s (%s)",
                      config_.scene.c_str(), config_.origin.c_str(), display.width, display.height,
@@ -191,6 +202,22 @@ class PathTracer {
       times.samples_hidden = p.hidden_cells(core::Eye::Left) + p.hidden_cells(core::Eye::Right);
     }
     const auto r0 = core::now_ns();
+    if (writer_) {
+      // Encoded into a slot by the layer's device, in the application's device memory.
+      const std::shared_ptr<SlotPool> pool = slots_->traced_slots();
+      const int slot = pool->claim();
+      if (slot < 0) return nullptr;
+      f->slot = std::make_unique<SlotLease>(pool, slot);
+      const pipeline::FramePipeline& p = driver_->pipeline();
+      const bool depth = config_.composite != Composite::SceneOnly;
+      std::array<SlotWriter::Eye, 2> eyes;
+      for (int e = 0; e < 2; ++e)
+        eyes[std::size_t(e)] = {&p.screen_buffer(core::Eye(e)), depth ? &p.depth_buffer(core::Eye(e)) : nullptr};
+      writer_->write(eyes, slot);
+      times.handover = "shared-memory";
+      times.readback_cpu = ms_since(r0);
+      return finish(std::move(f), in, t0);
+    }
     for (int e = 0; e < 2; ++e) {
       const core::Image linear = driver_->pipeline().image(core::Eye(e));
       times.host_bytes += std::int64_t(linear.pixels.size() * sizeof(linear.pixels[0]));
@@ -219,7 +246,12 @@ class PathTracer {
       }
     }
     times.readback_cpu = ms_since(r0);
-    times.total = ms_since(t0);
+    return finish(std::move(f), in, t0);
+  }
+
+ private:
+  std::shared_ptr<const TracedFrame> finish(std::shared_ptr<TracedFrame> f, const TraceRequest& in, core::TimeNs t0) {
+    f->times.total = ms_since(t0);
     f->id = in.id;
     f->traced_for = in.display_time;
     f->traced_for_frame = in.app_frame_index;
@@ -227,7 +259,21 @@ class PathTracer {
     return f;
   }
 
- private:
+  // The layer's device: on the application's physical device, importing its slots, where it
+  // exported them (the hand-over without the host); else the automatic choice.
+  static std::unique_ptr<gpu::Context> make_context(const AppDevice* slots, std::optional<AppDevice::SharedSlots>& shared) {
+    shared = slots ? slots->shared_slots() : std::nullopt;
+    if (!shared) return std::make_unique<gpu::Context>();
+    gpu::ContextOptions o;
+    o.device_uuid = shared->device_uuid;
+    o.external_memory_fd = true;
+    try {
+      return std::make_unique<gpu::Context>(o);
+    } catch (...) {
+      close(shared->memory.fd);
+      throw;
+    }
+  }
   // The runtime's hidden area for the submitted views: fetched at the first frame and after
   // each change event. A failed fetch is reported and leaves the previous mask (none at
   // first): culling saves work, the image is right without it.
@@ -253,12 +299,14 @@ class PathTracer {
   const VkFormat format_;
   const XrSession session_;
   const AppDevice* slots_;
+  std::optional<AppDevice::SharedSlots> shared_;  // the slots' memory, imported by writer_
   std::unique_ptr<LayerGaze> gaze_;
   bool gaze_from_action_ = false;
   std::optional<std::uint64_t> mask_generation_;  // of the mask fetched last (none yet)
   bool mask_set_ = false;                         // the pipeline culls with a runtime mask
   std::unique_ptr<gpu::Context> ctx_;
   std::unique_ptr<pipeline::FrameDriver> driver_;
+  std::unique_ptr<SlotWriter> writer_;  // the shared-memory hand-over (null: through the host)
 };
 
 // The calling thread's scheduling set to `p`; the reason on failure, else empty.
@@ -645,7 +693,12 @@ class PathTraceRenderer final : public FrameRenderer {
 std::unique_ptr<FrameRenderer> make_frame_renderer(const LayerConfig& config, const VulkanBinding& vk,
                                                    const Dispatch& next, XrSession session) {
   if (config.scene.empty()) return nullptr;
-  return std::make_unique<PathTraceRenderer>(config, vk, next, session);
+  VulkanBinding binding = vk;
+  if (!config.shared_handover && binding.external_memory_fd) {
+    binding.external_memory_fd = false;
+    binding.no_external_memory = "configured (\"handover\": \"host\")";
+  }
+  return std::make_unique<PathTraceRenderer>(config, binding, next, session);
 }
 
 }  // namespace fovea::layer

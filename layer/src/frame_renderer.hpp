@@ -31,6 +31,11 @@ struct VulkanBinding {
   VkPhysicalDevice physical_device = VK_NULL_HANDLE;
   VkDevice device = VK_NULL_HANDLE;
   std::uint32_t queue_family = 0, queue_index = 0;
+  // VK_KHR_external_memory_fd is enabled on `device` (the layer added it when the runtime
+  // created the device, vulkan_enable.cpp): the traced frames reach it without the host.
+  // Otherwise why not, for the log.
+  bool external_memory_fd = false;
+  std::string no_external_memory = "the application created its Vulkan device itself (XR_KHR_vulkan_enable)";
   bool valid() const { return device != VK_NULL_HANDLE; }
 };
 
@@ -91,9 +96,11 @@ struct RenderTimes {
   bool gaze_on_host_clock = false;
   std::int64_t samples_hidden = 0;  // grid cells under the runtime's hidden area, both eyes: not traced
   // How the traced frame reached the application's device, and the bytes that crossed the
-  // host on the way: "host-slot" (read back, encoded and written by the host into the GPU
-  // composition's slot in the application's device memory) or "host" (read back and encoded
-  // for the host composition, which uploads its result: those bytes are counted too).
+  // host on the way: "shared-memory" (encoded by the layer's device into the GPU
+  // composition's slot, memory of the application's device it imported: 0 bytes),
+  // "host-slot" (read back, encoded and written by the host into that slot) or "host" (read
+  // back and encoded for the host composition, which uploads its result: those bytes are
+  // counted too).
   const char* handover = "";
   std::int64_t host_bytes = 0;
 };

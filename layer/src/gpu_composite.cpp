@@ -19,6 +19,7 @@
 #include <glm/gtc/quaternion.hpp>
 
 #include "app_device.hpp"
+#include "slot_writer.hpp"
 #include "fovea/core/clock.hpp"
 #include "fovea/core/image.hpp"
 #include "fovea/gpu/pipeline.hpp"
@@ -158,9 +159,17 @@ void AppDevice::enable_gpu_composition(int traced_width, int traced_height, int 
     g.traced_w = traced_width;
     g.traced_h = traced_height;
     g.slots = std::make_shared<SlotPool>(slots);
-    // Per slot both eyes' colour, then both eyes' view distances: 4 bytes per pixel each.
-    reserve(g.traced, VkDeviceSize(slots) * 4 * VkDeviceSize(traced_width) * VkDeviceSize(traced_height) * 4, storage,
-            true, true);
+    // Per slot both eyes' colour, then both eyes' view distances: 4 bytes per pixel each
+    // (SlotLayout). Written by the layer's device where it can import them, else by the host.
+    const VkDeviceSize traced_bytes = SlotLayout{traced_width, traced_height}.bytes(slots);
+    if (external_memory_) {
+      try {
+        reserve_exported(g.traced, traced_bytes, storage);
+      } catch (const std::exception& e) {
+        no_shared_ = e.what();
+      }
+    }
+    if (!g.traced.exported) reserve(g.traced, traced_bytes, storage, true, true);
     reserve(g.out, 2 * VkDeviceSize(traced_width) * VkDeviceSize(traced_height) * 4,
             storage | VK_BUFFER_USAGE_TRANSFER_SRC_BIT, false);
     reserve(g.background, 2 * sizeof(std::uint32_t), storage, false);
@@ -172,19 +181,30 @@ void AppDevice::enable_gpu_composition(int traced_width, int traced_height, int 
 
 std::shared_ptr<SlotPool> AppDevice::traced_slots() const { return gpu_ ? gpu_->slots : nullptr; }
 
+std::optional<AppDevice::SharedSlots> AppDevice::shared_slots() const {
+  if (!gpu_ || !gpu_->traced.exported) return std::nullopt;
+  VkMemoryGetFdInfoKHR gi{VK_STRUCTURE_TYPE_MEMORY_GET_FD_INFO_KHR};
+  gi.memory = gpu_->traced.memory;
+  gi.handleType = VK_EXTERNAL_MEMORY_HANDLE_TYPE_OPAQUE_FD_BIT;
+  int fd = -1;
+  app_check(get_memory_fd_(device_, &gi, &fd), "vkGetMemoryFdKHR");
+  return SharedSlots{{fd, gpu_->traced.allocation, gpu_->traced.memory_type}, device_uuid_};
+}
+
 std::uint8_t* AppDevice::slot_colour(int slot, int eye) const {
-  if (!gpu_ || slot < 0 || slot >= gpu_->slots->slots() || eye < 0 || eye > 1)
+  if (!gpu_ || !gpu_->traced.mapped) throw std::logic_error("slot_colour: the slots are not host-visible");
+  if (slot < 0 || slot >= gpu_->slots->slots() || eye < 0 || eye > 1)
     throw std::logic_error("slot_colour: no such slot");
-  const std::size_t px = std::size_t(gpu_->traced_w) * std::size_t(gpu_->traced_h);
-  return static_cast<std::uint8_t*>(gpu_->traced.mapped) + (std::size_t(slot) * 4 + std::size_t(eye)) * px * 4;
+  const SlotLayout l{gpu_->traced_w, gpu_->traced_h};
+  return static_cast<std::uint8_t*>(gpu_->traced.mapped) + l.colour_word(slot, eye) * 4;
 }
 
 float* AppDevice::slot_depth(int slot, int eye) const {
-  if (!gpu_ || slot < 0 || slot >= gpu_->slots->slots() || eye < 0 || eye > 1)
+  if (!gpu_ || !gpu_->traced.mapped) throw std::logic_error("slot_depth: the slots are not host-visible");
+  if (slot < 0 || slot >= gpu_->slots->slots() || eye < 0 || eye > 1)
     throw std::logic_error("slot_depth: no such slot");
-  const std::size_t px = std::size_t(gpu_->traced_w) * std::size_t(gpu_->traced_h);
-  return reinterpret_cast<float*>(static_cast<std::uint8_t*>(gpu_->traced.mapped) +
-                                  (std::size_t(slot) * 4 + 2 + std::size_t(eye)) * px * 4);
+  const SlotLayout l{gpu_->traced_w, gpu_->traced_h};
+  return reinterpret_cast<float*>(static_cast<std::uint8_t*>(gpu_->traced.mapped) + l.depth_word(slot, eye) * 4);
 }
 
 AppDevice::GpuStats AppDevice::gpu_stats() const {
@@ -339,11 +359,19 @@ void AppDevice::record_pass(Pass& pass, std::size_t index) {
                       depth_download({k.depth[e], k.depth_format[e], rect_of(k.depth_rect[e]), k.depth_layer[e], {}},
                                      VkDeviceSize(l.depth_offset[e])),
                       g.app_depth.buffer);
-  // After the copies above; the host's writes (the parameters, the traced slot) are visible
-  // through the submission.
+  // After the copies above; the host's writes (the parameters, a host-written traced slot)
+  // are visible through the submission. Slots the layer's device wrote (exported memory) are
+  // acquired from it (an external queue family) and released back after the pass.
   const VkMemoryBarrier to_compute = memory_barrier(VK_ACCESS_TRANSFER_WRITE_BIT, VK_ACCESS_SHADER_READ_BIT);
-  vkCmdPipelineBarrier_(cb, VK_PIPELINE_STAGE_TRANSFER_BIT, VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT, 0, 1, &to_compute, 0,
-                        nullptr, 0, nullptr);
+  VkBufferMemoryBarrier slots{VK_STRUCTURE_TYPE_BUFFER_MEMORY_BARRIER};
+  slots.dstAccessMask = VK_ACCESS_SHADER_READ_BIT;
+  slots.srcQueueFamilyIndex = VK_QUEUE_FAMILY_EXTERNAL;
+  slots.dstQueueFamilyIndex = queue_family_;
+  slots.buffer = g.traced.buffer;
+  slots.size = VK_WHOLE_SIZE;
+  const std::uint32_t shared = g.traced.exported ? 1u : 0u;
+  vkCmdPipelineBarrier_(cb, VK_PIPELINE_STAGE_TRANSFER_BIT | VK_PIPELINE_STAGE_TOP_OF_PIPE_BIT,
+                        VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT, 0, 1, &to_compute, shared, &slots, 0, nullptr);
   const std::uint32_t params_offset = std::uint32_t(g.params_stride * index);
   vkCmdBindDescriptorSets_(cb, VK_PIPELINE_BIND_POINT_COMPUTE, g.program.layout, 0, 1, &g.set, 1, &params_offset);
   if (k.border) {
@@ -366,8 +394,12 @@ void AppDevice::record_pass(Pass& pass, std::size_t index) {
                       (kGroupY * shaders::kLayerRowsPerInvocation), 1);
   }
   const VkMemoryBarrier to_transfer = memory_barrier(VK_ACCESS_SHADER_WRITE_BIT, VK_ACCESS_TRANSFER_READ_BIT);
-  vkCmdPipelineBarrier_(cb, VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT, VK_PIPELINE_STAGE_TRANSFER_BIT, 0, 1, &to_transfer, 0,
-                        nullptr, 0, nullptr);
+  slots.srcAccessMask = 0;  // reads only: nothing to make available
+  slots.dstAccessMask = 0;
+  slots.srcQueueFamilyIndex = queue_family_;
+  slots.dstQueueFamilyIndex = VK_QUEUE_FAMILY_EXTERNAL;
+  vkCmdPipelineBarrier_(cb, VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT, VK_PIPELINE_STAGE_TRANSFER_BIT, 0, 1, &to_transfer,
+                        shared, &slots, 0, nullptr);
   for (std::size_t e = 0; e < 2; ++e)
     record_upload(cb, g.out.buffer, VkDeviceSize(l.out_offset[e]) * 4, k.target[e], k.out_w[e], k.out_h[e]);
   app_check(vkEndCommandBuffer_(cb), "vkEndCommandBuffer");
@@ -390,7 +422,6 @@ void AppDevice::composite_gpu(int slot, const std::array<GpuEye, 2>& eyes, const
   key.by_depth = by_depth;
   key.border = with_app && !by_depth && rule.mode == Composite::AppOnTop && !rule.background;
   shaders::LayerCompositeParams p{};
-  const std::uint32_t traced_px = std::uint32_t(g.traced_w * g.traced_h);
   for (std::size_t e = 0; e < 2; ++e) {
     const EyeComposition& c = eyes[e].composition;
     if (c.traced_view.width() != g.traced_w || c.traced_view.height() != g.traced_h ||
@@ -435,8 +466,8 @@ void AppDevice::composite_gpu(int slot, const std::array<GpuEye, 2>& eyes, const
     pe.app_w = key.app_rect[e][2];
     pe.app_h = key.app_rect[e][3];
     // The slot: both eyes' colour, then both eyes' distances (slot_colour, slot_depth).
-    pe.traced_offset = (std::uint32_t(slot) * 4 + std::uint32_t(e)) * traced_px;
-    pe.traced_depth_offset = (std::uint32_t(slot) * 4 + 2 + std::uint32_t(e)) * traced_px;
+    pe.traced_offset = std::uint32_t(SlotLayout{g.traced_w, g.traced_h}.colour_word(slot, int(e)));
+    pe.traced_depth_offset = std::uint32_t(SlotLayout{g.traced_w, g.traced_h}.depth_word(slot, int(e)));
     pe.app_offset = l.app_offset[e];
     pe.out_offset = l.out_offset[e];
     // resample()'s shortcut, taken alike: a copy without resampling.

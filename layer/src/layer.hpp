@@ -145,6 +145,12 @@ struct Layer {
   std::map<XrSwapchain, SwapchainState> swapchains;
   std::map<XrActionSet, XrInstance> action_sets;  // the application's, for xrCreateAction's instance
   XrInstance last_instance = XR_NULL_HANDLE;  // dispatch for handles the layer does not know
+  // The Vulkan objects the runtime created for the application through the layer
+  // (XR_KHR_vulkan_enable2, vulkan_enable.cpp): the last instance and its API version, and
+  // per device why VK_KHR_external_memory_fd could not be enabled on it (empty: it was).
+  VkInstance vulkan_instance = VK_NULL_HANDLE;
+  std::uint32_t vulkan_instance_version = 0;
+  std::map<VkDevice, std::string> vulkan_devices;
 };
 
 Layer& layer();
@@ -190,7 +196,9 @@ namespace intercept {
   X(xrSyncActions)                 \
   X(xrPollEvent)                   \
   X(xrGetSystemProperties)         \
-  X(xrGetCurrentInteractionProfile)
+  X(xrGetCurrentInteractionProfile) \
+  X(xrCreateVulkanInstanceKHR)     \
+  X(xrCreateVulkanDeviceKHR)
 #define FOVEA_LAYER_DECLARE(name) std::remove_pointer_t<PFN_##name> name;
 FOVEA_LAYER_INTERCEPTED(FOVEA_LAYER_DECLARE)
 #undef FOVEA_LAYER_DECLARE

@@ -39,6 +39,11 @@ XrResult intercept::xrCreateSession(XrInstance instance, const XrSessionCreateIn
       if (p->type == XR_TYPE_GRAPHICS_BINDING_VULKAN_KHR) {
         const auto* b = reinterpret_cast<const XrGraphicsBindingVulkanKHR*>(p);
         st.vulkan = {b->instance, b->physicalDevice, b->device, b->queueFamilyIndex, b->queueIndex};
+        std::lock_guard lock(layer().mutex);
+        if (auto d = layer().vulkan_devices.find(b->device); d != layer().vulkan_devices.end()) {
+          st.vulkan.external_memory_fd = d->second.empty();
+          st.vulkan.no_external_memory = d->second;
+        }
       }
     st.frames->log.open(env("FOVEA_LAYER_OUT"));
     st.renderer = make_frame_renderer(load_config(application), st.vulkan, *dispatch, *session);

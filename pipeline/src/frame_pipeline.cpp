@@ -321,6 +321,14 @@ std::vector<float> FramePipeline::depth(core::Eye e) const {
   return d;
 }
 
+const gpu::Buffer& FramePipeline::screen_buffer(core::Eye e) const {
+  return impl_->resolve->screen(impl_->index(e, "screen_buffer"));
+}
+
+const gpu::Buffer& FramePipeline::depth_buffer(core::Eye e) const {
+  return impl_->resolve->depth(impl_->index(e, "depth_buffer"));
+}
+
 std::vector<shaders::GridSample> FramePipeline::grid_samples(core::Eye eye) const {
   const EyeState& e = *impl_->eyes[std::size_t(impl_->index(eye, "grid_samples"))];
   std::vector<shaders::GridSample> v = e.grid.download<shaders::GridSample>();

@@ -19,6 +19,7 @@
 #include "composite.hpp"
 #include "fovea/gpu/buffer.hpp"
 #include "gpu_fixture.hpp"
+#include "slot_writer.hpp"
 
 namespace fovea::layer {
 namespace {
@@ -443,6 +444,106 @@ TEST_F(GpuComposite, RecordsOncePerImagesAndWaitsOnlyForPassesOnTheImage) {
   n = dev.gpu_stats();
   EXPECT_EQ(n.recordings, 3);
   EXPECT_EQ(n.descriptor_updates, 1);
+}
+
+// The hand-over without the host: the slots are memory of the application's device (a device
+// of its own here, with VK_KHR_external_memory_fd, standing in for one the runtime created
+// through the layer), exported and imported into the layer's device (another VkDevice of the
+// same physical device, chosen by UUID), where SlotWriter encodes linear frames, extreme values
+// included, as encode_scene does on the host and copies their depths; the application's
+// composition pass reads what was written. Both devices validated, no validation message.
+TEST_F(GpuComposite, SharedSlotsHandTheFrameOverWithoutTheHost) {
+  constexpr int W = 24, H = 20;
+  const std::size_t px = std::size_t(W) * H;
+  gpu::ContextOptions app_options;
+  app_options.validation = true;
+  app_options.external_memory_fd = true;
+  gpu::Context app(app_options);
+  VulkanBinding vk{app.instance(), app.physical_device(), app.device(), app.queue_family(), 0};
+  {
+    // Without the extension the slots are host-written, and say why.
+    AppDevice host_written(vk);
+    host_written.enable_gpu_composition(W, H);
+    EXPECT_FALSE(host_written.shared_slots().has_value());
+    EXPECT_NE(host_written.no_shared_slots().find("XR_KHR_vulkan_enable"), std::string::npos);
+    EXPECT_NO_THROW(host_written.slot_colour(0, 0));
+  }
+  vk.external_memory_fd = true;
+  AppDevice dev(vk);
+  ASSERT_NO_THROW(dev.enable_gpu_composition(W, H));
+  std::optional<AppDevice::SharedSlots> shared = dev.shared_slots();
+  ASSERT_TRUE(shared.has_value()) << dev.no_shared_slots();
+  EXPECT_THROW(dev.slot_colour(0, 0), std::logic_error);  // nothing for the host to write
+  gpu::ContextOptions layer_options;
+  layer_options.validation = true;
+  layer_options.device_uuid = shared->device_uuid;
+  layer_options.external_memory_fd = true;
+  gpu::Context layer_ctx(layer_options);
+  const int slots = dev.traced_slots()->slots();
+  // What the slots hold, read on the layer's device through a second import of the memory.
+  std::optional<AppDevice::SharedSlots> probe_memory = dev.shared_slots();
+  ASSERT_TRUE(probe_memory.has_value());
+  gpu::BufferDesc probe_desc{SlotLayout{W, H}.bytes(slots), gpu::BufferUsage::Storage, gpu::Memory::DeviceLocal, "probe"};
+  probe_desc.imported = probe_memory->memory;
+  const gpu::Buffer probe(layer_ctx, probe_desc);
+
+  std::mt19937 rng(7);
+  std::uniform_real_distribution<float> radiance(0.0f, 4.0f), distance(0.1f, 50.0f);
+  const float inf = std::numeric_limits<float>::infinity();
+  const float extremes[] = {std::numeric_limits<float>::quiet_NaN(), inf, -inf, -1.0f, 0.0f, 1e-30f, 1e30f,
+                            std::numeric_limits<float>::max(), 1.0f};
+  TestImage app_img[2] = {{app, W, H}, {app, W, H}}, target[2] = {{app, W, H}, {app, W, H}};
+  const core::Fov fov{-0.7, 0.6, 0.65, -0.7};
+  const Geometry g{"same views", W, H, W, H, fov, fov, 0.0, 0.0};
+  for (const PixelFormat fmt : {PixelFormat{false, true}, PixelFormat{true, false}}) {
+    SCOPED_TRACE(std::string(fmt.bgra ? "BGRA" : "RGBA") + (fmt.srgb ? " sRGB" : " UNORM"));
+    SlotWriter writer(layer_ctx, dev.shared_slots()->memory, {W, H}, slots, fmt);
+    std::array<core::Image, 2> linear;
+    std::array<std::vector<float>, 2> depth;
+    std::array<gpu::Buffer, 2> screen_buf, depth_buf;
+    for (std::size_t e = 0; e < 2; ++e) {
+      linear[e] = core::Image(W, H);
+      for (std::size_t i = 0; i < px; ++i)
+        for (int c = 0; c < 3; ++c)
+          linear[e].pixels[i][c] = i < 40 ? extremes[(i + std::size_t(c) + e) % std::size(extremes)] : radiance(rng);
+      depth[e].resize(px);
+      for (float& d : depth[e]) d = distance(rng);
+      screen_buf[e] = gpu::Buffer(layer_ctx, {px * 16, gpu::BufferUsage::Storage, gpu::Memory::DeviceLocal, "screen"});
+      screen_buf[e].upload(linear[e].pixels);
+      depth_buf[e] = gpu::Buffer(layer_ctx, {px * 4, gpu::BufferUsage::Storage, gpu::Memory::DeviceLocal, "depth"});
+      depth_buf[e].upload(depth[e]);
+    }
+    const int slot = dev.traced_slots()->claim();
+    ASSERT_GE(slot, 0);
+    writer.write({SlotWriter::Eye{&screen_buf[0], &depth_buf[0]}, SlotWriter::Eye{&screen_buf[1], &depth_buf[1]}}, slot);
+
+    const std::vector<std::uint32_t> words = probe.download<std::uint32_t>();
+    std::array<Pixels8, 2> traced;
+    for (std::size_t e = 0; e < 2; ++e) {
+      traced[e] = {W, H, std::vector<std::uint8_t>(px * 4)};
+      std::memcpy(traced[e].data.data(), &words[SlotLayout{W, H}.colour_word(slot, int(e))], px * 4);
+      const Pixels8 host = encode_scene(linear[e], fmt);
+      const auto [exact, rounding, other] = differences(traced[e], host);
+      EXPECT_EQ(other, 0u) << "eye " << e;
+      EXPECT_LE(double(rounding), 0.01 * double(px)) << "eye " << e;  // float against double at a rounding edge
+      EXPECT_EQ(std::memcmp(&words[SlotLayout{W, H}.depth_word(slot, int(e))], depth[e].data(), px * 4), 0)
+          << "eye " << e << ": the depths differ";
+    }
+    // The application's device composites what the layer's device wrote.
+    std::array<AppDevice::GpuEye, 2> jobs;
+    for (std::size_t e = 0; e < 2; ++e)
+      jobs[e] = {eye_of(g, traced[e], e), {app_img[e].get(), 0, {{0, 0}, {W, H}}}, std::nullopt, target[e].get()};
+    CompositionRule rule;
+    rule.mode = Composite::SceneOnly;
+    rule.blend = layer_blend(0, fmt);
+    dev.composite_gpu(slot, jobs, rule);
+    dev.traced_slots()->retire(slot);
+    dev.finish();
+    const std::vector<Pixels8> out = dev.read({{target[0].get(), 0, {{0, 0}, {W, H}}}, {target[1].get(), 0, {{0, 0}, {W, H}}}});
+    for (std::size_t e = 0; e < 2; ++e) EXPECT_EQ(out[e].data, compose_eye(jobs[e].composition, rule).data) << "eye " << e;
+  }
+  EXPECT_EQ(app.validation_errors(), 0);
+  EXPECT_EQ(layer_ctx.validation_errors(), 0);
 }
 
 }  // namespace

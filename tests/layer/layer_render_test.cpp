@@ -1,7 +1,8 @@
 // End to end: hello_xr -g Vulkan2 on the Fovea runtime with the layer path tracing a
 // configured scene. Three runs on the same lockstep clock (head pose and gaze are functions
 // of the frame index, so the runs see the same views): the application alone, the layer
-// compositing hello_xr's cubes over the scene, and the layer showing the scene alone.
+// compositing hello_xr's cubes over the scene, and the layer showing the scene alone (there
+// hello_xr -g Vulkan, which creates its device itself: the traced frames cross the host).
 #include <cmath>
 #include <cstdlib>
 #include <filesystem>
@@ -44,7 +45,8 @@ std::string write_config(const std::string& dir, const std::string& composite) {
   return dir;
 }
 
-ProcessResult run(const std::string& out, const std::string& display, const std::string& config_home, bool layer) {
+ProcessResult run(const std::string& out, const std::string& display, const std::string& config_home, bool layer,
+                  const char* graphics = "Vulkan2") {
   auto env = runtime_env(out, kFrames, kFrames - 1);
   env["FOVEA_DISPLAY"] = display;
   env["XDG_CONFIG_HOME"] = config_home;
@@ -58,7 +60,7 @@ ProcessResult run(const std::string& out, const std::string& display, const std:
     // Each frame shows the path-traced frame of its own views (deterministic panels to compare).
     env["FOVEA_LAYER_RENDER"] = "lockstep";
   }
-  return run_process({FOVEA_HELLO_XR, "-g", "Vulkan2"}, env, 120);
+  return run_process({FOVEA_HELLO_XR, "-g", graphics}, env, 120);
 }
 
 struct Rgb {
@@ -77,7 +79,7 @@ TEST(LayerRender, HelloXrCubesCompositedOverThePathTracedScene) {
   ASSERT_EQ(a.exit_code, 0) << a.output;
   const ProcessResult b = run(both.path(), display, write_config(cfg_both.path(), "app-on-top"), true);
   ASSERT_EQ(b.exit_code, 0) << b.output;
-  const ProcessResult c = run(scene.path(), display, write_config(cfg_scene.path(), "scene-only"), true);
+  const ProcessResult c = run(scene.path(), display, write_config(cfg_scene.path(), "scene-only"), true, "Vulkan");
   ASSERT_EQ(c.exit_code, 0) << c.output;
   for (const ProcessResult* r : {&b, &c}) {
     EXPECT_EQ(r->output.find("VUID-"), std::string::npos) << r->output;
@@ -120,11 +122,34 @@ TEST(LayerRender, HelloXrCubesCompositedOverThePathTracedScene) {
       // Composited by a compute pass on hello_xr's device: none of its images went to the host.
       EXPECT_TRUE(j["composited_on_gpu"].get<bool>()) << line;
       EXPECT_EQ(j["host_readbacks"].get<std::int64_t>(), 0) << line;
+      // And the traced frame reached hello_xr's device without the host: the runtime created
+      // that device through the layer (XR_KHR_vulkan_enable2), which enabled external memory.
+      EXPECT_EQ(j["handover"], "shared-memory") << line;
+      EXPECT_EQ(j["host_bytes"].get<std::int64_t>(), 0) << line;
       ++replaced;
     }
     EXPECT_EQ(n, kFrames);
     EXPECT_GE(replaced, kFrames - 1);
     EXPECT_GE(with_gaze, replaced - 1);
+  }
+  {
+    // XR_KHR_vulkan_enable: hello_xr made its device, without external memory. The frames
+    // went through the host into the composition's slots, and the log says why.
+    std::ifstream in(scene.path() + "/layer_timing.jsonl");
+    int replaced = 0;
+    for (std::string line; std::getline(in, line);) {
+      const auto j = fovea::core::parse_json(line);
+      if (!j["replaced"].get<bool>()) continue;
+      EXPECT_EQ(j["handover"], "host-slot") << line;
+      EXPECT_GT(j["host_bytes"].get<std::int64_t>(), 0) << line;
+      ++replaced;
+    }
+    EXPECT_GE(replaced, kFrames - 1);
+    const std::string scene_log = read_text(scene.path() + "/layer.log");
+    EXPECT_NE(scene_log.find("hand-over: through the host (read back, encoded, written into the application's device "
+                             "memory): the application created its Vulkan device itself (XR_KHR_vulkan_enable)"),
+              std::string::npos)
+        << scene_log;
   }
 
   char name[64];

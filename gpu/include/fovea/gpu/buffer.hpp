@@ -5,6 +5,7 @@
 #include <cstddef>
 #include <cstdint>
 #include <cstring>
+#include <optional>
 #include <ranges>
 #include <span>
 #include <string>
@@ -39,6 +40,15 @@ enum class Memory {
   HostVisible,  // mapped and coherent; for readback, uniforms and per-frame uploads
 };
 
+// Memory another VkDevice of the same physical device allocated (dedicated to one buffer)
+// and exported as an opaque file descriptor (VK_KHR_external_memory_fd): the allocation's
+// size and memory type index, which an opaque import must repeat.
+struct ExternalMemory {
+  int fd = -1;
+  VkDeviceSize allocation_size = 0;
+  std::uint32_t memory_type = 0;
+};
+
 struct BufferDesc {
   VkDeviceSize size = 0;  // bytes, > 0
   BufferUsage usage = BufferUsage::Storage;
@@ -50,6 +60,10 @@ struct BufferDesc {
   // gather, where a storage-buffer load whose address differs per invocation is a loop over
   // the SIMD lanes with a bounds test per component (docs/gpu.md, "Texel buffers").
   VkFormat texel_format = VK_FORMAT_UNDEFINED;
+  // Bound to imported memory instead of its own (the Context enables external_memory_fd;
+  // `memory` is ignored, the buffer is not mapped). The descriptor is the buffer's from then
+  // on, closed also when the import fails.
+  std::optional<ExternalMemory> imported;
 };
 
 class Buffer {

@@ -35,6 +35,14 @@ struct ContextOptions {
   // Ray queries (VK_KHR_acceleration_structure + VK_KHR_ray_query) are enabled when the
   // device offers them; false leaves them off, as on a device without them.
   bool ray_query = true;
+  // The physical device whose VkPhysicalDeviceIDProperties::deviceUUID this is (another
+  // instance's device in the process, whose memory the Context is to share): chosen over
+  // `device` and FOVEA_VK_DEVICE. Throws core::InputError when no device has it.
+  std::optional<std::array<std::uint8_t, VK_UUID_SIZE>> device_uuid;
+  // Enable VK_KHR_external_memory_fd: memory another device of the same physical device
+  // exported as an opaque file descriptor is imported (BufferDesc::imported). Throws
+  // core::InputError when the device lacks it.
+  bool external_memory_fd = false;
 };
 
 // A Vulkan device made elsewhere in the process (an OpenXR application's, or another
@@ -122,6 +130,7 @@ class Context {
   explicit Context(const GivenDevice& given);
   ~Context();
   bool owns_device() const { return owns_device_; }
+  bool external_memory_fd() const { return external_memory_fd_; }  // ContextOptions::external_memory_fd
   Context(const Context&) = delete;
   Context& operator=(const Context&) = delete;
 
@@ -168,8 +177,8 @@ class Context {
 
  private:
   void create_instance(bool validation);
-  void pick_device(const std::string& override);
-  void create_device(bool ray_query);
+  void pick_device(const std::string& override, const ContextOptions& options);
+  void create_device(const ContextOptions& options);
   // Properties, limits, memory and queue of physical_device_ for queue_family_.
   void describe_device();
   void create_command_pool();
@@ -181,6 +190,7 @@ class Context {
   bool validation_ = false;
   bool debug_utils_ = false;
   bool owns_device_ = true;  // false: a GivenDevice's instance and device
+  bool external_memory_fd_ = false;
   VkInstance instance_ = VK_NULL_HANDLE;
   VkDebugUtilsMessengerEXT messenger_ = VK_NULL_HANDLE;
   VkPhysicalDevice physical_device_ = VK_NULL_HANDLE;

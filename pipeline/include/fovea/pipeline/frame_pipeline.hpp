@@ -104,6 +104,11 @@ class FramePipeline {
   // view-space distance along -Z (scene units) of the nearest grid sample's surface; 0 where
   // that sample saw the sky or none exists. For depth compositing; the image ignores it.
   std::vector<float> depth(core::Eye e) const;
+  // The same two on the device, for work that keeps the frame there (the API layer's
+  // hand-over): vec4 and float per pixel, row-major, the first width × height elements.
+  // Written by each render().
+  const gpu::Buffer& screen_buffer(core::Eye e) const;
+  const gpu::Buffer& depth_buffer(core::Eye e) const;
   std::vector<shaders::GridSample> grid_samples(core::Eye e) const;
   std::int64_t traced_cells(core::Eye e) const;  // cells with a sample in the last frame
   std::int64_t hidden_cells(core::Eye e) const;  // cells the visibility mask skipped in the last frame
