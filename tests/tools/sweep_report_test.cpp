@@ -256,6 +256,18 @@ TEST(SweepReport, RepeatedRunsAreOneRowWithTheirSpread) {
   const json res = core::parse_json(test::read_text(dir + "/report/results.json"));
   ASSERT_EQ(res["jobs"].size(), 7u);
   for (const auto& job : res["jobs"]) EXPECT_EQ(job["pareto"]["fovea_flip"], true) << job.dump();
+
+  // A block another tool wrote into the page survives the page's regeneration, once; text
+  // outside such a block does not.
+  const std::string block = "<!-- kept: bench -->\n## measured elsewhere\n\n| a | b |\n<!-- /kept: bench -->";
+  core::write_file_atomic(dir + "/page.md", page + "\nstale text\n" + block + "\n");
+  for (int run = 0; run < 2; ++run) {
+    const auto again =
+        test::run_fovea("sweep report " + dir + "/plan.jsonl --out " + dir + "/report --markdown " + dir + "/page.md");
+    ASSERT_EQ(again.status, 0) << again.err;
+  }
+  const std::string regenerated = test::read_text(dir + "/page.md");
+  EXPECT_EQ(regenerated, page + "\n" + block + "\n");
   fs::remove_all(dir);
 }
 

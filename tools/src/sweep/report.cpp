@@ -13,6 +13,7 @@
 
 #include "fovea/core/error.hpp"
 #include "fovea/core/image.hpp"
+#include "fovea/core/input_limits.hpp"
 #include "fovea/core/json.hpp"
 #include "sweep/plot.hpp"
 
@@ -460,6 +461,24 @@ void markdown_speedup(std::ostringstream& md, const MarkdownInput& in, const std
 
 // The page: settings, every job, equal samples, equal time, per band, the plots, and what
 // the Pareto front means for a 90 Hz frame.
+// The blocks of an existing page that other tools write (a line `<!-- kept: NAME -->` to a
+// line `<!-- /kept: NAME -->`, e.g. bench/handover.py's measurement), in their order: a
+// regenerated page keeps them at its end.
+std::string kept_blocks(const std::string& page) {
+  std::string out;
+  std::size_t at = 0;
+  while ((at = page.find("<!-- kept: ", at)) != std::string::npos) {
+    const std::size_t name_end = page.find(" -->", at);
+    if (name_end == std::string::npos) break;
+    const std::string close = "<!-- /kept: " + page.substr(at + 11, name_end - at - 11) + " -->";
+    const std::size_t end = page.find(close, name_end);
+    if (end == std::string::npos) break;
+    out += "\n" + page.substr(at, end + close.size() - at) + "\n";
+    at = end + close.size();
+  }
+  return out;
+}
+
 std::string markdown_page(const MarkdownInput& in) {
   const Config& cfg = in.cfg;
   std::vector<const Row*> done;
@@ -1082,7 +1101,11 @@ ReportSummary write_report(const Plan& plan, const ReportOptions& o) {
         images[section].push_back(
             fs::relative(out / f, page.parent_path().empty() ? fs::path(".") : page.parent_path()).string());
     if (!page.parent_path().empty()) fs::create_directories(page.parent_path());
-    core::write_file_atomic(page.string(), markdown_page({plan, shown, cfg, on_front, sections, images, o.command}));
+    std::error_code ec;
+    const std::string kept =
+        fs::is_regular_file(page, ec) ? kept_blocks(core::read_file_bounded(page.string(), 64 << 20)) : std::string();
+    core::write_file_atomic(page.string(),
+                            markdown_page({plan, shown, cfg, on_front, sections, images, o.command}) + kept);
   }
   return sum;
 }
