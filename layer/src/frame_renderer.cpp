@@ -145,14 +145,17 @@ class PathTracer {
              const core::DisplayPreset& display, VkFormat format, XrSession session, const AppDevice* slots)
       : config_(config), format_(format), session_(session), slots_(slots),
         gaze_(std::make_unique<LayerGaze>(config.gaze, display)), ctx_(make_context(slots, shared_)),
+        // Imported before anything else can fail: the slots' descriptor is the writer's then.
+        writer_(shared_ ? std::make_unique<SlotWriter>(
+                              *ctx_, shared_->memory,
+                              SlotLayout{views[core::Eye::Left].width(), views[core::Eye::Left].height()},
+                              slots->traced_slots()->slots(), pixel_format(format))
+                        : nullptr),
         // The frame of `fovea render` (pipeline/frame_driver.hpp) on the application's views. A
         // measurement would delay the first traced frame by seconds: the cached choice, or none.
         driver_(std::make_unique<pipeline::FrameDriver>(*ctx_, scene, views,
                                                         pipeline::FrameDriverOptions{config_.frame, false, false})) {
-    if (shared_) {
-      writer_ = std::make_unique<SlotWriter>(*ctx_, shared_->memory, SlotLayout{views[core::Eye::Left].width(),
-                                                                                views[core::Eye::Left].height()},
-                                             slots->traced_slots()->slots(), pixel_format(format));
+    if (writer_) {
       FOVEA_LAYER_INFO("hand-over: shared memory (the layer's device encodes each traced frame into the application's "
                        "device memory, no host copy)");
     } else if (slots) {
@@ -305,8 +308,8 @@ class PathTracer {
   std::optional<std::uint64_t> mask_generation_;  // of the mask fetched last (none yet)
   bool mask_set_ = false;                         // the pipeline culls with a runtime mask
   std::unique_ptr<gpu::Context> ctx_;
-  std::unique_ptr<pipeline::FrameDriver> driver_;
   std::unique_ptr<SlotWriter> writer_;  // the shared-memory hand-over (null: through the host)
+  std::unique_ptr<pipeline::FrameDriver> driver_;
 };
 
 // The calling thread's scheduling set to `p`; the reason on failure, else empty.
