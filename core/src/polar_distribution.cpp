@@ -199,6 +199,7 @@ double PolarDistribution::pack_measured(double c) {
 
 double PolarDistribution::fit_budget() {
   measure_columns();
+  bool reference = false;
   if (!(centre_traced_ > 0)) {  // the centred gaze the session starts with: the reference
     const double own = traced_for(1.0);
     centre_traced_ = centre_reference(own);
@@ -206,6 +207,7 @@ double PolarDistribution::fit_budget() {
       pack_measured(1.0);
       return 1.0;
     }
+    reference = true;
   }
   const double target = budget_samples();
   double lo = std::log(kScaleLo), hi = std::log(kScaleHi);
@@ -214,6 +216,12 @@ double PolarDistribution::fit_budget() {
     (traced_for(std::exp(mid)) < target ? lo : hi) = mid;
   }
   const double c = std::exp(hi);
+  // A reference the grid cannot come down to (rows at their bounds, beyond the bisection's
+  // rounding) is what it reaches: every gaze then keeps that.
+  if (reference) {
+    const double reached = traced_for(c);
+    if (reached > 1.01 * centre_traced_) centre_traced_ = reached;
+  }
   pack_measured(c);
   return c;
 }

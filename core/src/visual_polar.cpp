@@ -203,10 +203,22 @@ class VisualPolar final : public PolarDistribution {
   double scaled_rows(int i, double c) const override {
     if (c == 1.0) return full_[size_t(i)];
     const size_t k = size_t(i);
+    // A budget below the layout's (under a lens) is taken from beyond the fovea disk only.
+    if (c < 1.0 && r_[k] < fovea_disk_deg()) return full_[k];
     const double a = column_acuity_[k], cap = cap_at(0.5 * (r_[k] + r_[k + 1]));
     const double rows = full_[k] * std::min(cap, c * sigma0_ * a) / std::max(std::min(cap, sigma0_ * a), 1e-300);
     const double least = circumference_deg(0.5 * (r_[k] + r_[k + 1])) / (params_.aniso * (r_[k + 1] - r_[k]));
     return std::max(rows, std::min(least, full_[k]));
+  }
+
+  // Under a mask the budget is its fraction of the pixels the mask leaves visible, as for the
+  // raster kinds: the layout solved for the whole view loses fewer samples to a lens' hidden
+  // periphery than pixels (its density falls with eccentricity), so its own count at the
+  // centred gaze would exceed that (1.29 of it under the wide preset's lens). The scale on
+  // the uncapped columns' rows (scaled_rows) takes the surplus back from the periphery.
+  double centre_reference(double own) const override {
+    if (!(visible_fraction_ < 1)) return own;
+    return std::max(1.0, params_.budget * view_.width() * view_.height() * visible_fraction_);
   }
 
   // The per-frame solve starts from the previous frame's root; its several close roots
