@@ -133,27 +133,52 @@ void AppDevice::release(Buffer& b) {
   b = Buffer{};
 }
 
-void AppDevice::reserve(Buffer& b, VkDeviceSize size, VkBufferUsageFlags usage, bool host, bool prefer_device_local) {
-  if (b.size >= size) return;
+void AppDevice::reserve(Buffer& b, VkDeviceSize size, VkBufferUsageFlags usage, bool host, bool prefer_device_local,
+                        bool exported) {
+  if (b.size >= size && b.exported == exported) return;
+  constexpr auto kOpaqueFd = VK_EXTERNAL_MEMORY_HANDLE_TYPE_OPAQUE_FD_BIT;
+  if (exported) {
+    if (!external_memory_) throw std::runtime_error(no_shared_);
+    VkPhysicalDeviceExternalBufferInfo query{VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_EXTERNAL_BUFFER_INFO};
+    query.usage = usage;
+    query.handleType = kOpaqueFd;
+    VkExternalBufferProperties can{VK_STRUCTURE_TYPE_EXTERNAL_BUFFER_PROPERTIES};
+    external_buffer_properties_(physical_device_, &query, &can);
+    const VkExternalMemoryFeatureFlags need =
+        VK_EXTERNAL_MEMORY_FEATURE_EXPORTABLE_BIT | VK_EXTERNAL_MEMORY_FEATURE_IMPORTABLE_BIT;
+    if ((can.externalMemoryProperties.externalMemoryFeatures & need) != need)
+      throw std::runtime_error("the application's device cannot export and import storage buffers as opaque file "
+                               "descriptors");
+  }
   release(b);
-  VkBufferCreateInfo bi{VK_STRUCTURE_TYPE_BUFFER_CREATE_INFO};
+  VkExternalMemoryBufferCreateInfo external{VK_STRUCTURE_TYPE_EXTERNAL_MEMORY_BUFFER_CREATE_INFO};
+  external.handleTypes = kOpaqueFd;
+  VkBufferCreateInfo bi{VK_STRUCTURE_TYPE_BUFFER_CREATE_INFO, exported ? &external : nullptr};
   bi.size = size;
   bi.usage = usage;
   bi.sharingMode = VK_SHARING_MODE_EXCLUSIVE;
   app_check(vkCreateBuffer_(device_, &bi, nullptr, &b.buffer), "vkCreateBuffer");
   VkMemoryRequirements req;
   vkGetBufferMemoryRequirements_(device_, b.buffer, &req);
-  // Host-coherent memory: no flush/invalidate around the copies.
-  const VkMemoryPropertyFlags want = host ? VK_MEMORY_PROPERTY_HOST_VISIBLE_BIT | VK_MEMORY_PROPERTY_HOST_COHERENT_BIT
-                                          : VK_MEMORY_PROPERTY_DEVICE_LOCAL_BIT;
-  const VkMemoryPropertyFlags preferred = prefer_device_local ? VK_MEMORY_PROPERTY_DEVICE_LOCAL_BIT : 0;
+  // Host-coherent memory: no flush/invalidate around the copies. Exported memory: any type,
+  // device-local where there is one.
+  const VkMemoryPropertyFlags want = host       ? VK_MEMORY_PROPERTY_HOST_VISIBLE_BIT | VK_MEMORY_PROPERTY_HOST_COHERENT_BIT
+                                     : exported ? 0
+                                                : VK_MEMORY_PROPERTY_DEVICE_LOCAL_BIT;
+  const VkMemoryPropertyFlags preferred = prefer_device_local || exported ? VK_MEMORY_PROPERTY_DEVICE_LOCAL_BIT : 0;
   const std::optional<std::uint32_t> type = gpu::find_memory_type(memory_, req.memoryTypeBits, want, preferred);
   if (!type) {
     release(b);
     throw std::runtime_error(std::string("the application's device has no ") +
                              (host ? "host-visible coherent" : "device-local") + " memory for the layer's buffers");
   }
-  VkMemoryAllocateInfo mi{VK_STRUCTURE_TYPE_MEMORY_ALLOCATE_INFO};
+  // Exported: dedicated, so that the importing device can repeat the allocation whatever the
+  // driver requires.
+  VkMemoryDedicatedAllocateInfo dedicated{VK_STRUCTURE_TYPE_MEMORY_DEDICATED_ALLOCATE_INFO};
+  dedicated.buffer = b.buffer;
+  VkExportMemoryAllocateInfo exporting{VK_STRUCTURE_TYPE_EXPORT_MEMORY_ALLOCATE_INFO, &dedicated};
+  exporting.handleTypes = kOpaqueFd;
+  VkMemoryAllocateInfo mi{VK_STRUCTURE_TYPE_MEMORY_ALLOCATE_INFO, exported ? &exporting : nullptr};
   mi.allocationSize = req.size;
   mi.memoryTypeIndex = *type;
   try {
@@ -165,53 +190,7 @@ void AppDevice::reserve(Buffer& b, VkDeviceSize size, VkBufferUsageFlags usage, 
     throw;
   }
   b.size = size;
-}
-
-void AppDevice::reserve_exported(Buffer& b, VkDeviceSize size, VkBufferUsageFlags usage) {
-  if (!external_memory_) throw std::runtime_error(no_shared_);
-  constexpr auto kOpaqueFd = VK_EXTERNAL_MEMORY_HANDLE_TYPE_OPAQUE_FD_BIT;
-  VkPhysicalDeviceExternalBufferInfo query{VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_EXTERNAL_BUFFER_INFO};
-  query.usage = usage;
-  query.handleType = kOpaqueFd;
-  VkExternalBufferProperties can{VK_STRUCTURE_TYPE_EXTERNAL_BUFFER_PROPERTIES};
-  external_buffer_properties_(physical_device_, &query, &can);
-  const VkExternalMemoryFeatureFlags need = VK_EXTERNAL_MEMORY_FEATURE_EXPORTABLE_BIT |
-                                            VK_EXTERNAL_MEMORY_FEATURE_IMPORTABLE_BIT;
-  if ((can.externalMemoryProperties.externalMemoryFeatures & need) != need)
-    throw std::runtime_error("the application's device cannot export and import storage buffers as opaque file descriptors");
-  release(b);
-  VkExternalMemoryBufferCreateInfo external{VK_STRUCTURE_TYPE_EXTERNAL_MEMORY_BUFFER_CREATE_INFO};
-  external.handleTypes = kOpaqueFd;
-  VkBufferCreateInfo bi{VK_STRUCTURE_TYPE_BUFFER_CREATE_INFO, &external};
-  bi.size = size;
-  bi.usage = usage;
-  bi.sharingMode = VK_SHARING_MODE_EXCLUSIVE;
-  app_check(vkCreateBuffer_(device_, &bi, nullptr, &b.buffer), "vkCreateBuffer");
-  VkMemoryRequirements req;
-  vkGetBufferMemoryRequirements_(device_, b.buffer, &req);
-  const std::optional<std::uint32_t> type =
-      gpu::find_memory_type(memory_, req.memoryTypeBits, 0, VK_MEMORY_PROPERTY_DEVICE_LOCAL_BIT);
-  if (!type) {
-    release(b);
-    throw std::runtime_error("the application's device has no memory type for an exported buffer");
-  }
-  // Dedicated, so that the importing device can repeat the allocation whatever the driver requires.
-  VkMemoryDedicatedAllocateInfo dedicated{VK_STRUCTURE_TYPE_MEMORY_DEDICATED_ALLOCATE_INFO};
-  dedicated.buffer = b.buffer;
-  VkExportMemoryAllocateInfo exported{VK_STRUCTURE_TYPE_EXPORT_MEMORY_ALLOCATE_INFO, &dedicated};
-  exported.handleTypes = kOpaqueFd;
-  VkMemoryAllocateInfo mi{VK_STRUCTURE_TYPE_MEMORY_ALLOCATE_INFO, &exported};
-  mi.allocationSize = req.size;
-  mi.memoryTypeIndex = *type;
-  try {
-    app_check(vkAllocateMemory_(device_, &mi, nullptr, &b.memory), "vkAllocateMemory (exportable)");
-    app_check(vkBindBufferMemory_(device_, b.buffer, b.memory, 0), "vkBindBufferMemory");
-  } catch (...) {
-    release(b);
-    throw;
-  }
-  b.size = size;
-  b.exported = true;
+  b.exported = exported;
   b.memory_type = *type;
   b.allocation = req.size;
 }

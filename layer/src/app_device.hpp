@@ -151,11 +151,11 @@ class AppDevice {
   // At least `size` bytes: host-visible and coherent (mapped), or device-local when `host` is
   // false; `prefer_device_local` picks host-visible memory that is device-local too when the
   // device has it (what a shader reads every frame).
+  // `exported`: dedicated memory, device-local where the device has it, that another device
+  // of this physical device can import (an opaque file descriptor); throws with the reason
+  // when the device cannot.
   void reserve(Buffer& b, VkDeviceSize size, VkBufferUsageFlags usage, bool host = true,
-               bool prefer_device_local = false);
-  // Dedicated memory of `size` bytes that another device of this physical device can import
-  // (opaque file descriptor), device-local where the device has it; throws with the reason.
-  void reserve_exported(Buffer& b, VkDeviceSize size, VkBufferUsageFlags usage);
+               bool prefer_device_local = false, bool exported = false);
   void release(Buffer& b);
   // One region of an attachment image copied into `buffer` at `offset`: transition to
   // TRANSFER_SRC after the application's writes, copy `copy_aspect`, transition back.

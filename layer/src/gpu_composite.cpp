@@ -164,7 +164,7 @@ void AppDevice::enable_gpu_composition(int traced_width, int traced_height, int 
     const VkDeviceSize traced_bytes = SlotLayout{traced_width, traced_height}.bytes(slots);
     if (external_memory_) {
       try {
-        reserve_exported(g.traced, traced_bytes, storage);
+        reserve(g.traced, traced_bytes, storage, false, true, true);
       } catch (const std::exception& e) {
         no_shared_ = e.what();
       }
