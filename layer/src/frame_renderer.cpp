@@ -155,6 +155,7 @@ class PathTracer {
         // measurement would delay the first traced frame by seconds: the cached choice, or none.
         driver_(std::make_unique<pipeline::FrameDriver>(*ctx_, scene, views,
                                                         pipeline::FrameDriverOptions{config_.frame, false, false})) {
+    shared_.reset();  // its descriptor is the imported memory's now
     if (writer_) {
       FOVEA_LAYER_INFO("hand-over: shared memory (the layer's device encodes each traced frame into the application's "
                        "device memory, no host copy)");
@@ -302,7 +303,7 @@ class PathTracer {
   const VkFormat format_;
   const XrSession session_;
   const AppDevice* slots_;
-  std::optional<AppDevice::SharedSlots> shared_;  // the slots' memory, imported by writer_
+  std::optional<AppDevice::SharedSlots> shared_;  // the slots' memory until writer_ imports it
   std::unique_ptr<LayerGaze> gaze_;
   bool gaze_from_action_ = false;
   std::optional<std::uint64_t> mask_generation_;  // of the mask fetched last (none yet)

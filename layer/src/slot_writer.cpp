@@ -46,13 +46,15 @@ SlotWriter::SlotWriter(gpu::Context& ctx, const gpu::ExternalMemory& memory, Slo
 void SlotWriter::write(const std::array<Eye, 2>& eyes, int slot) {
   if (slot < 0 || slot >= slots_) throw std::logic_error("SlotWriter::write: no slot " + std::to_string(slot));
   const std::uint64_t px = layout_.pixels();
-  // The previous write waited for the device: the sets are idle, re-pointed at this frame's
-  // buffers (the pipeline keeps its buffers, but nothing here relies on it).
   for (std::size_t e = 0; e < 2; ++e) {
     if (!eyes[e].screen || eyes[e].screen->size() < px * 16 || (eyes[e].depth && eyes[e].depth->size() < px * 4))
       throw std::logic_error("SlotWriter::write: an eye's buffers are smaller than the slots' raster");
+    // The pipeline keeps its buffers: the sets are written at the first frame, and again only
+    // for another buffer (the previous write waited for the device, so they are idle).
+    if (bound_[e] == eyes[e].screen->handle()) continue;
     const gpu::BufferSlot bound[] = {{ENCODE_BINDING_SCREEN, eyes[e].screen}, {ENCODE_BINDING_SLOTS, &memory_}};
     sets_[e].bind_all(bound);
+    bound_[e] = eyes[e].screen->handle();
   }
   ctx_.submit_and_wait([&](VkCommandBuffer cmd) {
     // The slots come from the application's device (an external queue family) and go back to

@@ -52,6 +52,7 @@ class SlotWriter {
   gpu::Buffer memory_;  // the imported slots
   gpu::ComputePipeline encode_;
   std::array<gpu::DescriptorSet, 2> sets_;  // per eye: its displayed image, the slots
+  std::array<VkBuffer, 2> bound_{};          // the displayed images the sets name
 };
 
 }  // namespace fovea::layer
