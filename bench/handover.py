@@ -213,8 +213,7 @@ def main():
     if a.markdown:
         page = open(a.markdown).read() if os.path.exists(a.markdown) else ""
         rel = os.path.relpath(stem + ".png", os.path.dirname(os.path.abspath(a.markdown)))
-        block = markdown(rows, device, "python3 bench/handover.py --markdown docs/results.md "
-                         "--image-dir docs/images/handover", rel)
+        block = markdown(rows, device, "./x handover", rel)
         if BEGIN in page and END in page:
             page = page[:page.index(BEGIN)] + block.rstrip("\n") + page[page.index(END) + len(END):]
         else:
