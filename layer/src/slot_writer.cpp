@@ -64,7 +64,8 @@ void SlotWriter::write(const std::array<Eye, 2>& eyes, int slot) {
     own.srcQueueFamilyIndex = VK_QUEUE_FAMILY_EXTERNAL;
     own.dstQueueFamilyIndex = ctx_.queue_family();
     own.buffer = memory_.handle();
-    own.size = VK_WHOLE_SIZE;
+    own.offset = layout_.colour_word(slot, 0) * 4;  // this slot only: the application reads others meanwhile
+    own.size = layout_.bytes(1);
     vkCmdPipelineBarrier(cmd, VK_PIPELINE_STAGE_TOP_OF_PIPE_BIT,
                          VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT | VK_PIPELINE_STAGE_TRANSFER_BIT, 0, 0, nullptr, 1, &own,
                          0, nullptr);
