@@ -697,8 +697,10 @@ class PathTraceRenderer final : public FrameRenderer {
 std::unique_ptr<FrameRenderer> make_frame_renderer(const LayerConfig& config, const VulkanBinding& vk,
                                                    const Dispatch& next, XrSession session) {
   if (config.scene.empty()) return nullptr;
+  // "handover": "host" is the reason whatever the device was created with (without it the
+  // layer does not add the extension, and the device's record would name another reason).
   VulkanBinding binding = vk;
-  if (!config.shared_handover && binding.external_memory_fd) {
+  if (!config.shared_handover) {
     binding.external_memory_fd = false;
     binding.no_external_memory = "configured (\"handover\": \"host\")";
   }

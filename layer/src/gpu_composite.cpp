@@ -422,6 +422,7 @@ void AppDevice::composite_gpu(int slot, const std::array<GpuEye, 2>& eyes, const
   key.by_depth = by_depth;
   key.border = with_app && !by_depth && rule.mode == Composite::AppOnTop && !rule.background;
   shaders::LayerCompositeParams p{};
+  const SlotLayout layout{g.traced_w, g.traced_h};
   for (std::size_t e = 0; e < 2; ++e) {
     const EyeComposition& c = eyes[e].composition;
     if (c.traced_view.width() != g.traced_w || c.traced_view.height() != g.traced_h ||
@@ -466,8 +467,8 @@ void AppDevice::composite_gpu(int slot, const std::array<GpuEye, 2>& eyes, const
     pe.app_w = key.app_rect[e][2];
     pe.app_h = key.app_rect[e][3];
     // The slot: both eyes' colour, then both eyes' distances (slot_colour, slot_depth).
-    pe.traced_offset = std::uint32_t(SlotLayout{g.traced_w, g.traced_h}.colour_word(slot, int(e)));
-    pe.traced_depth_offset = std::uint32_t(SlotLayout{g.traced_w, g.traced_h}.depth_word(slot, int(e)));
+    pe.traced_offset = std::uint32_t(layout.colour_word(slot, int(e)));
+    pe.traced_depth_offset = std::uint32_t(layout.depth_word(slot, int(e)));
     pe.app_offset = l.app_offset[e];
     pe.out_offset = l.out_offset[e];
     // resample()'s shortcut, taken alike: a copy without resampling.

@@ -235,6 +235,9 @@ TEST_P(AsyncLayer, PipelinedFramesOnTwoThreadsNeverWaitForTheRenderThread) {
     EXPECT_NE(log.find(handover == "shared-memory" ? "hand-over: shared memory" : "hand-over: through the host"),
               std::string::npos)
         << log;
+    if (handover == "host-slot") {  // and why: the configuration asked for it
+      EXPECT_NE(log.find("configured (\"handover\": \"host\")"), std::string::npos) << log;
+    }
   }
 
   // CPU priority: the render thread and the threads of the device it created (lavapipe's
