@@ -152,6 +152,14 @@ void main() {
   // history counts for its share only, which raises α.
   hd.w *= confidence;
   hi.w *= confidence;
+  // On the frame a gaze jump lands, the new fovea's history is the periphery's, resampled
+  // from another layout: it counts for pc.landing_history samples at most, so that the
+  // landing's own samples outweigh its blur within a few frames instead of the tens of
+  // frames its full count would take (docs/reconstruction.md, "A 32° gaze step").
+  if (pc.landing_deg > 0.0 && s.ecc_deg <= pc.landing_deg) {
+    hd.w = min(hd.w, pc.landing_history);
+    hi.w = min(hi.w, pc.landing_history);
+  }
   // This frame's mean holds `held` samples (the tracer's .a: more in a new fovea's first
   // frames), so it counts for that many.
   vec4 now_d = texelFetch(direct, int(i));

@@ -5,8 +5,11 @@
 #include <cstdlib>
 
 #include "fovea/core/error.hpp"
+#include "fovea/shaders/pt_trace.h"
 
 namespace fovea::pipeline {
+
+static_assert(FrameConfig::kMaxLandingSpp == shaders::kPtMaxSppPerDispatch, "the landing's samples take one dispatch");
 
 reconstruct::ReconSettings FrameConfig::default_recon() {
   reconstruct::ReconSettings s;
@@ -17,7 +20,7 @@ reconstruct::ReconSettings FrameConfig::default_recon() {
 const std::vector<std::string>& frame_option_names() {
   static const std::vector<std::string> names = {"budget",         "distribution", "jitter", "denoiser",
                                                  "bmfr-precision", "stereo-share", "trace",  "bounces",
-                                                 "seed"};
+                                                 "seed",           "landing-spp"};
   return names;
 }
 
@@ -58,6 +61,15 @@ void apply_frame_option(FrameConfig& c, std::string_view name, std::string_view 
                                  ", got \"" + v + "\"");
         c.bounces = {false, int(n)};
       }
+    } else if (name == "landing-spp") {
+      const std::string v(value);
+      char* end = nullptr;
+      errno = 0;
+      const long n = std::strtol(v.c_str(), &end, 10);
+      if (v.empty() || *end != '\0' || errno == ERANGE || n < 1 || n > long(FrameConfig::kMaxLandingSpp))
+        throw core::InputError("expected a whole number in 1.." + std::to_string(FrameConfig::kMaxLandingSpp) + ", got \"" + v +
+                               "\"");
+      c.recon.landing_spp = std::uint32_t(n);
     } else if (name == "seed") {
       const std::string v(value);
       char* end = nullptr;
@@ -98,7 +110,8 @@ nlohmann::json to_json(const FrameConfig& c) {
           {"stereo-share", reconstruct::stereo_share_name(c.recon.share)},
           {"trace", renderer::tracing_name(c.tracing)},
           {"bounces", c.bounces.from_albedo ? nlohmann::json("auto") : nlohmann::json(c.bounces.count)},
-          {"seed", c.seed}};
+          {"seed", c.seed},
+          {"landing-spp", c.recon.landing_spp}};
 }
 
 renderer::PathConfig path_config(const Bounces& bounces, const renderer::Scene& scene) {

@@ -43,7 +43,8 @@ void Accumulation::record(VkCommandBuffer cmd, int parity, bool history, std::sp
     const Eye& e = eyes_[i];
     run_cells(cmd, kernel_, e.set[parity],
               shaders::ReconAccumulatePush{e.cells, history ? 1u : 0u, fresh[i] ? 1u : 0u, s.live_cells ? 1u : 0u,
-                                           s.alpha_min, s.coarse_keep, s.coarse_reject, 0},
+                                           s.alpha_min, s.coarse_keep, s.coarse_reject, s.landing_deg,
+                                           s.landing_history, 0, 0, 0},
               e.cells, e.live);
   }
   gpu::compute_to_compute(cmd);

@@ -151,6 +151,28 @@ TEST_F(GpuTest, SeedChangesOnlyTheNoise) {
   EXPECT_THROW(pipeline::apply_frame_option(bad, "seed", "1000001", "--seed"), fovea::core::InputError);
 }
 
+// --landing-spp sets the new fovea's samples per cell after a gaze jump, 1..8, by the same name
+// everywhere (command line, the layer's file, reports); anything else is refused naming it.
+TEST(FrameOptions, LandingSamplesAreAWholeNumberFromOneToEight) {
+  pipeline::FrameConfig c;
+  EXPECT_EQ(c.recon.landing_spp, 8u);
+  EXPECT_EQ(pipeline::to_json(c)["landing-spp"], 8);
+  pipeline::apply_frame_option(c, "landing-spp", "1", "--landing-spp");
+  EXPECT_EQ(c.recon.landing_spp, 1u);
+  EXPECT_EQ(pipeline::to_json(c)["landing-spp"], 1);
+  for (const char* bad : {"0", "9", "-1", "4.5", "", "four", "99999999999999999999"}) {
+    try {
+      pipeline::apply_frame_option(c, "landing-spp", bad, "layer.json: default.landing-spp");
+      ADD_FAILURE() << bad;
+    } catch (const fovea::core::InputError& e) {
+      EXPECT_NE(std::string(e.what()).find("layer.json: default.landing-spp: expected a whole number in 1..8"),
+                std::string::npos)
+          << e.what();
+    }
+  }
+  EXPECT_EQ(c.recon.landing_spp, 1u);  // a refused value changes nothing
+}
+
 // A fixating eye's drift does not move the grid: within kGridHoldDeg (0.5°) of the gaze the
 // grid was laid out for it stays there; a larger move, and the first frame after reset(),
 // lay it out again at the gaze.

@@ -74,6 +74,8 @@ Prints the summary JSON on stdout; writes into --out:
   --bmfr-precision P    fp32 | fp16 [fp32]
   --stereo-share M      off | gather | alternate [gather]
   --bounces N|auto      BSDF-sampled bounces after the primary hit [1]
+  --landing-spp N       samples per cell in a new fovea's first 4 frames after a gaze jump
+                        of 5° or more (1..8; 1: one, as every other frame) [8]
   --seed N              noise seed: another N, another noise realisation of the same frames
                         (path tracing and BMFR keyed by frame + 1024·N; gaze and jitter
                         unchanged) [0]
@@ -228,7 +230,7 @@ int run(std::vector<std::string> argv) {
                                              "inject-latency", "quality-frames", "reference-spp", "budget",
                                              "quality-at", "quality-radius", "reference-error", "reference-cache",
                                              "distribution", "denoiser", "bmfr-precision", "stereo-share", "trace",
-                                             "bounces", "seed"};
+                                             "bounces", "seed", "landing-spp"};
   std::vector<std::string> valued = sim_options;
   valued.insert(valued.end(), {"records", "out"});
   const Args args(argv, valued, {"quiet", "no-main-render"});

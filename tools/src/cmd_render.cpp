@@ -104,6 +104,8 @@ With no options: a short demo on the shipped scene and gaze.
                         the BMFR/P5 configuration); auto: the bounce limit and Russian
                         roulette from the scene's albedo, i.e. full global illumination as
                         `fovea reference` traces it [1]
+  --landing-spp N       samples per cell in a new fovea's first 4 frames after a gaze jump
+                        of 5° or more (1..8; 1: one, as every other frame) [8]
   --seed N              noise seed: another N, another noise realisation of the same frames
                         (path tracing and BMFR keyed by frame + 1024·N; gaze and jitter
                         unchanged) [0]
@@ -423,7 +425,7 @@ int run(std::vector<std::string> argv) {
   const Args args(argv,
                   {"scene", "display", "gaze", "frames", "distribution", "budget", "jitter", "denoiser", "bmfr-precision",
                    "stereo-share", "bounces", "reference", "reference-error", "reference-cache", "reference-window", "recovery-frames", "png-every",
-                   "out", "screen", "trace", "seed"},
+                   "out", "screen", "trace", "seed", "landing-spp"},
                   {"no-blur", "no-cull", "no-marker", "quiet", "full-gi-score"});
   const long frames = args.integer("frames", 24);
   if (frames < 1 || frames > 100000) throw core::InputError("--frames must be in 1..100000");

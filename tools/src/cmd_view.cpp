@@ -63,6 +63,8 @@ of view directions (lines every 5 degrees), a picture of the optics.
   --bmfr-precision P    fp32 | fp16 [fp32]
   --stereo-share M      off | gather | alternate [gather]
   --bounces N|auto      BSDF-sampled bounces after the primary hit [1]
+  --landing-spp N       samples per cell in a new fovea's first 4 frames after a gaze jump
+                        of 5° or more (1..8; 1: one, as every other frame) [8]
   --seed N              noise seed: another N, another noise realisation of the same frames
                         (path tracing and BMFR keyed by frame + 1024·N; gaze and jitter
                         unchanged) [0]
@@ -129,7 +131,7 @@ int run(std::vector<std::string> argv) {
     }
   const Args args(argv,
                   {"display", "scene", "trace", "gaze", "gaze-dir", "budget", "jitter", "optics", "window", "frames",
-                   "distribution", "denoiser", "bmfr-precision", "stereo-share", "bounces", "seed",
+                   "distribution", "denoiser", "bmfr-precision", "stereo-share", "bounces", "seed", "landing-spp",
                    "screenshot", "panels"},
                   {});
   const core::DisplayPreset d = core::load_display(args.str("display", core::kDefaultDisplay));

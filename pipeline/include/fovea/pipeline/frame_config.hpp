@@ -38,6 +38,9 @@ struct FrameConfig {
   // frames (the same gaze and jitter pattern): repeated runs measure a score's noise.
   std::uint32_t seed = 0;
   static constexpr std::uint32_t kMaxSeed = 1'000'000;
+  // recon.landing_spp (`landing-spp`): samples per cell in a new fovea's first frames after a
+  // gaze jump, 1 (off) up to what one trace dispatch takes.
+  static constexpr std::uint32_t kMaxLandingSpp = 8;
 
   // BMFR at fp32, the peripheral blur, and stereo sharing by gather: the reconstruction a
   // render shows (ReconSettings{} itself leaves sharing off, for the stage tests).
@@ -46,7 +49,7 @@ struct FrameConfig {
 
 // The option names, shared by the command line (--NAME VALUE) and the layer's configuration
 // ("NAME": VALUE): budget, distribution, jitter, denoiser, bmfr-precision, stereo-share, trace,
-// bounces, seed.
+// bounces, seed, landing-spp.
 const std::vector<std::string>& frame_option_names();
 
 // Sets option `name` from its text `value`; core::InputError naming `where` (e.g. "--budget",

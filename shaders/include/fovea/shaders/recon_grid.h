@@ -54,7 +54,10 @@ struct ReconAccumulatePush {
   FOVEA_UINT cells, has_history, indirect_fresh;  // indirect_fresh = 0: reuse history only
   FOVEA_UINT listed;  // 1: the cells of the live and reset tiles (live_cells.h), an indirect dispatch
   float alpha_min;                                     // EMA floor (BMFR Phase I: 0.2)
-  float coarse_keep, coarse_reject, pad1;              // cell-size test (ReconSettings, rg_coarse_weight)
+  float coarse_keep, coarse_reject;                    // cell-size test (ReconSettings, rg_coarse_weight)
+  float landing_deg;      // as ReconPostPush: > 0 on a landing frame, the new fovea's angle
+  float landing_history;  // samples the new fovea's history counts for there at most (ReconSettings)
+  float pad0, pad1, pad2;
 };
 
 struct ReconSharePush {
@@ -120,7 +123,7 @@ struct ReconGridBlurPush {
 #ifdef __cplusplus
 static_assert(sizeof(ReconGrid) == 192);
 static_assert(sizeof(ReconGridBlurPush) == 32);
-static_assert(sizeof(ReconAccumulatePush) == 32);
+static_assert(sizeof(ReconAccumulatePush) == 48);
 static_assert(sizeof(ReconSharePush) == 32);
 static_assert(sizeof(ReconBmfrPush) == 32);
 static_assert(sizeof(ReconPostPush) == 32);
