@@ -115,12 +115,13 @@ void main() {
     ReconGrid prev = maps[kReconPrevious];
     vec2 uv;
     if (rg_world_to_grid(prev, p, sky, uv)) {
-      uint col = i % cur.g.padded_columns;
+      GridColumn col = rg_column(cur, i % cur.g.padded_columns);
       uvec2 cols;
-      rg_taps(prev, rg_unjitter(cur, col, prev, uv), idx, w, cols);
-      float own = rg_cell_size(cur, col), valid = 0.0, kept = 0.0;
-      vec2 coarse = vec2(rg_coarse_weight(prev, cols.x, own, pc.coarse_keep, pc.coarse_reject),
-                         rg_coarse_weight(prev, cols.y, own, pc.coarse_keep, pc.coarse_reject));
+      vec2 sizes;
+      rg_taps(prev, rg_unjitter(cur, col, prev, uv), idx, w, cols, sizes);
+      float own = rg_column_cell_size(cur, col), valid = 0.0, kept = 0.0;
+      vec2 coarse = vec2(rg_coarse_weight(sizes.x, own, pc.coarse_keep, pc.coarse_reject),
+                         rg_coarse_weight(sizes.y, own, pc.coarse_keep, pc.coarse_reject));
       for (int k = 0; k < 4; ++k) {
         if (w[k] <= 0.0 || !seen_near(prev, idx[k], here, n, depth)) w[k] = 0.0;
         valid += w[k];

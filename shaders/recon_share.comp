@@ -85,13 +85,14 @@ void main() {
       uvec4 idx;
       vec4 w;
       ReconGrid cur = maps[kReconCurrent];
-      uint col = i % cur.g.padded_columns;
+      GridColumn col = rg_column(cur, i % cur.g.padded_columns);
       uvec2 cols;
-      rg_taps(other, rg_unjitter(cur, col, other, uv), idx, w, cols);
+      vec2 sizes;
+      rg_taps(other, rg_unjitter(cur, col, other, uv), idx, w, cols, sizes);
       vec4 n = texelFetch(vnrm, int(i));
-      float wsum = 0.0, own_size = rg_cell_size(cur, col);
-      vec2 coarse = vec2(rg_coarse_weight(other, cols.x, own_size, pc.coarse_keep, pc.coarse_reject),
-                         rg_coarse_weight(other, cols.y, own_size, pc.coarse_keep, pc.coarse_reject));
+      float wsum = 0.0, own_size = rg_column_cell_size(cur, col);
+      vec2 coarse = vec2(rg_coarse_weight(sizes.x, own_size, pc.coarse_keep, pc.coarse_reject),
+                         rg_coarse_weight(sizes.y, own_size, pc.coarse_keep, pc.coarse_reject));
       vec4 acc = vec4(0.0);
       for (int k = 0; k < 4; ++k) {
         int o = int(idx[k]);

@@ -96,18 +96,27 @@ vec3 remodulated(uint i) {
 }
 
 // The history at grid coordinate uv of the previous mapping by Catmull–Rom, in the compressed
-// space; false when a tap holds no sample (the caller then keeps Phase I's taps).
-bool history_catmull_rom(ReconGrid prev, vec2 uv, out vec3 h) {
+// space, where Phase I kept all four bilinear taps of uv at their bilinear weights `kept` (no
+// tap rejected as another surface or reweighted as coarser; the bilinear weights come from
+// the middle two of the four columns, each column's entry read once); false otherwise, or
+// when a tap holds no sample (the caller then keeps Phase I's taps).
+bool history_catmull_rom(ReconGrid prev, vec2 uv, vec4 kept, out vec3 h) {
   h = vec3(0.0);
-  float uc = uv.x - 0.5, c0f = floor(uc);
-  vec4 wx = rg_catmull_rom(uc - c0f);
+  float uc = uv.x - 0.5, c0f = floor(uc), fx = uc - c0f;
+  vec4 wx = rg_catmull_rom(fx);
+  bool ok = true;
   for (int a = 0; a < 4; ++a) {
     uint c = uint(clamp(int(c0f) - 1 + a, 0, int(prev.g.columns) - 1));
     GridColumn col = rg_column(prev, c);
     int rows = int(max(col.rows, 1u));
     bool wraps = rg_column_wraps(prev, col);
-    float vr = rg_row_coord_of(col, uv.y) - 0.5, r0f = floor(vr);
-    vec4 wy = rg_catmull_rom(vr - r0f);
+    float vr = rg_row_coord_of(col, uv.y) - 0.5, r0f = floor(vr), fy = vr - r0f;
+    if (a == 1 || a == 2) {  // rg_taps' columns and weights
+      float wc = a == 1 ? 1.0 - fx : fx;
+      vec2 d = abs(vec2(wc * (1.0 - fy), wc * fy) - (a == 1 ? kept.xy : kept.zw));
+      ok = ok && max(d.x, d.y) < 1e-4;
+    }
+    vec4 wy = rg_catmull_rom(fy);
     for (int b = 0; b < 4; ++b) {
       int r = int(r0f) - 1 + b;
       r = wraps ? rg_wrap(r, rows) : clamp(r, 0, rows - 1);
@@ -116,18 +125,7 @@ bool history_catmull_rom(ReconGrid prev, vec2 uv, out vec3 h) {
       h += wx[a] * wy[b] * compress(v.rgb);
     }
   }
-  return true;
-}
-
-// Phase I kept all four bilinear taps of uv in the previous mapping at their bilinear
-// weights (no tap rejected as another surface or reweighted as coarser).
-bool taps_all_kept(ReconGrid prev, vec2 uv, vec4 kept) {
-  uvec4 idx;
-  vec4 w;
-  uvec2 cols;
-  rg_taps(prev, uv, idx, w, cols);
-  vec4 d = abs(w - kept);
-  return max(max(d.x, d.y), max(d.z, d.w)) < 1e-4;
+  return ok;
 }
 
 // The history of a cell of column `col` whose sample is `here` (position, code) by
@@ -137,8 +135,7 @@ bool sharp_history(ReconGrid cur, uint col, vec4 here, vec4 kept, out vec3 h) {
   ReconGrid prev = maps[kReconPrevious];
   vec2 uv;
   if (!rg_world_to_grid(prev, here.xyz, abs(here.w - kReconSky) < 0.5, uv)) return false;
-  uv = rg_unjitter(cur, col, prev, uv);
-  return taps_all_kept(prev, uv, kept) && history_catmull_rom(prev, uv, h);
+  return history_catmull_rom(prev, rg_unjitter(cur, rg_column(cur, col), prev, uv), kept, h);
 }
 
 vec3 capped(vec3 c, float cap) {

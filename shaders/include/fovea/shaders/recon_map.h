@@ -76,11 +76,6 @@ uvec2 rg_column_range(ReconGrid m, float r) {
 uvec2 rg_column_range(ReconGrid m, float r) { return uvec2(0u, m.g.columns); }
 #endif
 
-// Fraction of the full turn column c's rows cover (1: a full ring or the raster).
-float rg_arc_turns(ReconGrid m, uint c) {
-  return m.g.family == kFamilyCartesian ? 1.0 : 1.0 - rg_table(m.table_offset + c).phi_gap / (2.0 * kRgPi);
-}
-
 // Column c's table entry; for the Cartesian raster a full "ring" of the raster's rows (no
 // gap), so the helpers below that take an entry serve every family. Kernels that need
 // several of a column's properties load its entry a single time.
@@ -195,11 +190,23 @@ bool rg_world_to_grid(ReconGrid m, vec3 p, bool is_direction, out vec2 uv) {
   return true;
 }
 
+// Linear size of a cell of column c: the square root of its area in the family's radius
+// units (degrees of visual angle for angular polar, pixels for screen polar); 1 for the
+// Cartesian raster, whose cells never change size. From the column's entry (rg_column).
+float rg_column_cell_size(ReconGrid m, GridColumn col) {
+  if (m.g.family == kFamilyCartesian) return 1.0;
+  float rm = 0.5 * (col.r0 + col.r1);
+  float circumference = m.g.family == kFamilyAngularPolar ? 360.0 * sin(rm * (kRgPi / 180.0)) : 2.0 * kRgPi * rm;
+  float turns = 1.0 - col.phi_gap / (2.0 * kRgPi);
+  return sqrt(max((col.r1 - col.r0) * circumference * turns / float(max(col.rows, 1u)), 0.0));
+}
+
 // The four bilinear taps of (u, t): two columns (ρ clamped; `cols`, taps 0–1 in cols.x and
 // 2–3 in cols.y), and in each column the two rows around its row coordinate of t (φ wraps on
 // full rings, clamps on packed columns and the raster); each column's table entry read
-// once. Cell indices row * padded_columns + column; weights sum to 1.
-void rg_taps(ReconGrid m, vec2 uv, out uvec4 idx, out vec4 w, out uvec2 cols) {
+// once, and the linear size of each column's cells from it (rg_column_cell_size). Cell indices
+// row * padded_columns + column; weights sum to 1.
+void rg_taps(ReconGrid m, vec2 uv, out uvec4 idx, out vec4 w, out uvec2 cols, out vec2 sizes) {
   float uc = uv.x - 0.5;
   float c0f = floor(uc);
   float fx = uc - c0f;
@@ -224,6 +231,7 @@ void rg_taps(ReconGrid m, vec2 uv, out uvec4 idx, out vec4 w, out uvec2 cols) {
     idx[2 * i + 1] = uint(r1) * m.g.padded_columns + c;
     w[2 * i] = wc * (1.0 - fy);
     w[2 * i + 1] = wc * fy;
+    sizes[i] = rg_column_cell_size(m, col);
   }
 }
 
@@ -286,29 +294,18 @@ bool rg_row_next_to(ReconGrid m, RgColumnNear n, int dr, out uint k) {
 // taken off, so taps read cells whose accumulated content stands for their centres (TAA's
 // unjittered reprojection). Exact when m shares cur's gaze (a still gaze, the other eye);
 // under gaze motion the offset (≤ half a cell) is applied in m's cells.
-vec2 rg_unjitter(ReconGrid cur, uint col, ReconGrid m, vec2 uv) {
-  float t = uv.y - cur.g.jitter_v * rg_arc_turns(cur, col) / float(max(rg_rows(cur, col), 1u));
+// `col` is the cell's column entry in cur (rg_column).
+vec2 rg_unjitter(ReconGrid cur, GridColumn col, ReconGrid m, vec2 uv) {
+  float t = uv.y - cur.g.jitter_v * (1.0 - col.phi_gap / (2.0 * kRgPi)) / float(max(col.rows, 1u));
   return vec2(uv.x - cur.g.jitter_u, m.g.family != kFamilyCartesian ? fract(t) : t);
 }
 
-// Linear size of a cell of column c: the square root of its area in the family's radius
-// units (degrees of visual angle for angular polar, pixels for screen polar); 1 for the
-// Cartesian raster, whose cells never change size.
-float rg_cell_size(ReconGrid m, uint c) {
-  if (m.g.family == kFamilyCartesian) return 1.0;
-  GridColumn col = rg_table(m.table_offset + min(c, m.g.columns - 1u));
-  float rm = 0.5 * (col.r0 + col.r1);
-  float circumference = m.g.family == kFamilyAngularPolar ? 360.0 * sin(rm * (kRgPi / 180.0)) : 2.0 * kRgPi * rm;
-  float turns = 1.0 - col.phi_gap / (2.0 * kRgPi);
-  return sqrt(max((col.r1 - col.r0) * circumference * turns / float(max(col.rows, 1u)), 0.0));
-}
-
-// Weight of the taps in column c of mapping m, whose cells are `ratio` = their size / the
-// sample's own cell size: 1 up to `keep`, falling linearly to 0 at `reject` (ReconSettings).
-// A coarser cell holds a blurred estimate (after a saccade the new fovea lands on old
-// periphery); reusing it would keep the fovea blurred for many frames.
-float rg_coarse_weight(ReconGrid m, uint c, float own_size, float keep, float reject) {
-  float ratio = rg_cell_size(m, c) / max(own_size, 1e-12);
+// Weight of taps from cells of linear size `size`, at `ratio` = size / the sample's own cell
+// size: 1 up to `keep`, falling linearly to 0 at `reject` (ReconSettings). A coarser cell
+// holds a blurred estimate (after a saccade the new fovea lands on old periphery); reusing it
+// would keep the fovea blurred for many frames.
+float rg_coarse_weight(float size, float own_size, float keep, float reject) {
+  float ratio = size / max(own_size, 1e-12);
   return clamp((reject - ratio) / max(reject - keep, 1e-6), 0.0, 1.0);
 }
 
