@@ -24,6 +24,21 @@ const std::vector<std::string>& frame_option_names() {
   return names;
 }
 
+namespace {
+// A whole number in [lo, hi] written in full; otherwise InputError "expected [or_what]a whole
+// number in lo..hi, got "value"".
+long whole_number(std::string_view value, long lo, long hi, const char* or_what = "") {
+  const std::string v(value);
+  char* end = nullptr;
+  errno = 0;
+  const long n = std::strtol(v.c_str(), &end, 10);
+  if (v.empty() || *end != '\0' || errno == ERANGE || n < lo || n > hi)
+    throw core::InputError(std::string("expected ") + or_what + "a whole number in " + std::to_string(lo) + ".." +
+                           std::to_string(hi) + ", got \"" + v + "\"");
+  return n;
+}
+}  // namespace
+
 void apply_frame_option(FrameConfig& c, std::string_view name, std::string_view value, const std::string& where) {
   try {
     if (name == "budget") {
@@ -49,36 +64,12 @@ void apply_frame_option(FrameConfig& c, std::string_view name, std::string_view 
     } else if (name == "trace") {
       c.tracing = renderer::parse_tracing(value, "--trace");
     } else if (name == "bounces") {
-      const std::string v(value);
-      if (v == "auto") {
-        c.bounces.from_albedo = true;
-      } else {
-        char* end = nullptr;
-        errno = 0;
-        const long n = std::strtol(v.c_str(), &end, 10);
-        if (v.empty() || *end != '\0' || errno == ERANGE || n < 0 || n > Bounces::kMaxBounces)
-          throw core::InputError("expected auto or a whole number in 0.." + std::to_string(Bounces::kMaxBounces) +
-                                 ", got \"" + v + "\"");
-        c.bounces = {false, int(n)};
-      }
+      if (value == "auto") c.bounces.from_albedo = true;
+      else c.bounces = {false, int(whole_number(value, 0, Bounces::kMaxBounces, "auto or "))};
     } else if (name == "landing-spp") {
-      const std::string v(value);
-      char* end = nullptr;
-      errno = 0;
-      const long n = std::strtol(v.c_str(), &end, 10);
-      if (v.empty() || *end != '\0' || errno == ERANGE || n < 1 || n > long(FrameConfig::kMaxLandingSpp))
-        throw core::InputError("expected a whole number in 1.." + std::to_string(FrameConfig::kMaxLandingSpp) + ", got \"" + v +
-                               "\"");
-      c.recon.landing_spp = std::uint32_t(n);
+      c.recon.landing_spp = std::uint32_t(whole_number(value, 1, FrameConfig::kMaxLandingSpp));
     } else if (name == "seed") {
-      const std::string v(value);
-      char* end = nullptr;
-      errno = 0;
-      const long n = std::strtol(v.c_str(), &end, 10);
-      if (v.empty() || *end != '\0' || errno == ERANGE || n < 0 || n > long(FrameConfig::kMaxSeed))
-        throw core::InputError("expected a whole number in 0.." + std::to_string(FrameConfig::kMaxSeed) + ", got \"" + v +
-                               "\"");
-      c.seed = std::uint32_t(n);
+      c.seed = std::uint32_t(whole_number(value, 0, FrameConfig::kMaxSeed));
     } else {
       throw core::InputError("not a frame option");
     }

@@ -5,6 +5,8 @@
 // history), so the rejection is checked directly on the fovea's history count.
 #include <array>
 #include <cmath>
+#include <string>
+#include <tuple>
 
 #include "fovea/core/flip.hpp"
 #include "fovea/core/metrics.hpp"
@@ -286,6 +288,13 @@ TEST_F(GpuTest, SaccadeRecoveryCurveOnTheDefaultScene) {
 // highlights). Scores are printed, not
 // bounded otherwise: 8 frames after the jump hold fewer samples than the control's history
 // (stereo-occluders stays 1.1-2.4 dB below it; docs/reconstruction.md).
+// A shipped scene's name as a test name ("stereo-occluders" -> "stereooccluders").
+std::string scene_test_name(const ::testing::TestParamInfo<const char*>& i) {
+  std::string n = i.param;
+  std::erase(n, '-');
+  return n;
+}
+
 class SaccadeRecoveryPerScene : public GpuTest, public ::testing::WithParamInterface<const char*> {};
 
 TEST_P(SaccadeRecoveryPerScene, BmfrRecoversWithinThreeFrames) {
@@ -326,11 +335,18 @@ TEST_P(SaccadeRecoveryPerScene, BmfrRecoversWithinThreeFrames) {
 
 INSTANTIATE_TEST_SUITE_P(ShippedScenes, SaccadeRecoveryPerScene,
                          ::testing::Values("cornell", "glossy-spheres", "stereo-occluders"),
-                         [](const auto& i) {
-                           std::string n = i.param;
-                           std::erase(n, '-');
-                           return n;
-                         });
+                         scene_test_name);
+
+// A 32° gaze step as `fovea render` renders it: a shipped scene from its camera on `small`,
+// the gaze at −16° before, +16° after.
+struct SmallStep {
+  renderer::Scene scene;
+  core::DisplayPreset display = core::load_display("small");
+  std::array<core::Pose, 2> poses;
+  glm::dvec3 before = fovea::test::horizontal_gaze(-16), target = fovea::test::horizontal_gaze(16);
+
+  explicit SmallStep(const char* name) : scene(renderer::load_scene(name)), poses(core::eye_poses(scene.camera, display)) {}
+};
 
 // BMFR is never worse than no denoiser on the frames after a landing (docs/reconstruction.md,
 // "A 32° gaze step"), as `fovea render` renders it: `small`, both eyes, the frame defaults (one
@@ -341,11 +357,9 @@ INSTANTIATE_TEST_SUITE_P(ShippedScenes, SaccadeRecoveryPerScene,
 class LandingBmfrAgainstNone : public GpuTest, public ::testing::WithParamInterface<const char*> {};
 
 TEST_P(LandingBmfrAgainstNone, BmfrIsNoWorseOnAnyFrameAfterTheLanding) {
-  const renderer::Scene scene = renderer::load_scene(GetParam());
-  renderer::GpuScene gs(ctx(), scene);
-  const core::DisplayPreset display = core::load_display("small");
-  const auto poses = core::eye_poses(scene.camera, display);
-  const glm::dvec3 before = fovea::test::horizontal_gaze(-16), target = fovea::test::horizontal_gaze(16);
+  const SmallStep c(GetParam());
+  const auto& [display, poses, before, target] = std::tie(c.display, c.poses, c.before, c.target);
+  renderer::GpuScene gs(ctx(), c.scene);
   constexpr int kSettle = 10;
   FoveaReference ref;
   std::array<std::vector<double>, 2> flip;  // none, bmfr
@@ -373,11 +387,7 @@ TEST_P(LandingBmfrAgainstNone, BmfrIsNoWorseOnAnyFrameAfterTheLanding) {
 }
 
 INSTANTIATE_TEST_SUITE_P(ShippedScenes, LandingBmfrAgainstNone, ::testing::Values("default", "stereo-occluders"),
-                         [](const auto& i) {
-                           std::string n = i.param;
-                           std::erase(n, '-');
-                           return n;
-                         });
+                         scene_test_name);
 
 // Saccade recovery within 50 ms (docs/reconstruction.md, "A 32° gaze step"): as `fovea render`
 // renders it (`small`, both eyes, the frame defaults, BMFR), 30 frames at −16° and a 32° step,
@@ -388,11 +398,9 @@ INSTANTIATE_TEST_SUITE_P(ShippedScenes, LandingBmfrAgainstNone, ::testing::Value
 class LandingRecovery : public GpuTest, public ::testing::WithParamInterface<const char*> {};
 
 TEST_P(LandingRecovery, WithinTenPercentOfSteadyByTheFourthFrame) {
-  const renderer::Scene scene = renderer::load_scene(GetParam());
-  renderer::GpuScene gs(ctx(), scene);
-  const core::DisplayPreset display = core::load_display("small");
-  const auto poses = core::eye_poses(scene.camera, display);
-  const glm::dvec3 before = fovea::test::horizontal_gaze(-16), target = fovea::test::horizontal_gaze(16);
+  const SmallStep c(GetParam());
+  const auto& [display, poses, before, target] = std::tie(c.display, c.poses, c.before, c.target);
+  renderer::GpuScene gs(ctx(), c.scene);
   constexpr int kSettle = 30, kSteady = 40;
   const reconstruct::ReconSettings s = pipeline::FrameConfig::default_recon();
   FoveaReference ref;
@@ -418,8 +426,4 @@ TEST_P(LandingRecovery, WithinTenPercentOfSteadyByTheFourthFrame) {
 
 INSTANTIATE_TEST_SUITE_P(ShippedScenes, LandingRecovery,
                          ::testing::Values("default", "cornell", "glossy-spheres", "stereo-occluders"),
-                         [](const auto& i) {
-                           std::string n = i.param;
-                           std::erase(n, '-');
-                           return n;
-                         });
+                         scene_test_name);
