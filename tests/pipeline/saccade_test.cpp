@@ -392,9 +392,9 @@ INSTANTIATE_TEST_SUITE_P(ShippedScenes, LandingBmfrAgainstNone, ::testing::Value
 // Saccade recovery within 50 ms (docs/reconstruction.md, "A 32° gaze step"): as `fovea render`
 // renders it (`small`, both eyes, the frame defaults, BMFR), 30 frames at −16° and a 32° step,
 // the fovea's HDR-FLIP on the 4th frame from the landing (57 ms at 70 Hz) within 10 % of the
-// steady value: the same frames' count at +16° from the start (40 frames). Before the landed
+// steady value: the 40th frame of a gaze held at +16° from the start. Before the landed
 // fovea's history was capped (ReconSettings::landing_history) and it traced 8 samples per
-// cell: 1.17-1.51 on these scenes.
+// cell, tools/recovery-curves.sh measured 1.17-1.51 on these scenes (BMFR).
 class LandingRecovery : public GpuTest, public ::testing::WithParamInterface<const char*> {};
 
 TEST_P(LandingRecovery, WithinTenPercentOfSteadyByTheFourthFrame) {
