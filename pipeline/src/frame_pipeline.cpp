@@ -158,8 +158,8 @@ void FramePipeline::set_visibility(core::Eye eye, const core::ViewMask& mask) {
 std::vector<std::pair<std::string, double>> FrameTimes::gpu_record() const {
   std::vector<std::pair<std::string, double>> r;
   for (const auto& [name, st] : stages()) r.emplace_back(name, st.gpu_ms);
-  r.insert(r.end(), {{"bmfr_fit", bmfr_fit_gpu_ms}, {"mip", mip_gpu_ms}, {"resample", resample_gpu_ms},
-                     {"blur", blur_gpu_ms}, {"total", gpu_ms()}});
+  r.insert(r.end(), {{"accumulate", accumulate_gpu_ms}, {"bmfr_fit", bmfr_fit_gpu_ms}, {"post", post_gpu_ms},
+                     {"mip", mip_gpu_ms}, {"resample", resample_gpu_ms}, {"blur", blur_gpu_ms}, {"total", gpu_ms()}});
   return r;
 }
 
@@ -283,7 +283,9 @@ FrameTimes FramePipeline::render(const std::array<core::Pose, 2>& eye_pose, cons
       else if (s.name == "resolve" || s.name == "grid_blur" || s.name == "mip" || s.name == "resample" || s.name == "blur")
         t.resolve.gpu_ms += ms;
       else t.reconstruct.gpu_ms += ms;
+      if (s.name == "accumulate") t.accumulate_gpu_ms = ms;
       if (s.name == "bmfr_fit") t.bmfr_fit_gpu_ms = ms;
+      if (s.name == "post") t.post_gpu_ms = ms;
       if (s.name == "mip") t.mip_gpu_ms = ms;
       if (s.name == "resample") t.resample_gpu_ms = ms;
       if (s.name == "blur" || s.name == "grid_blur") t.blur_gpu_ms += ms;

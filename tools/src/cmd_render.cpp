@@ -56,7 +56,8 @@ the peripheral blur. Writes to --out:
                 and CPU ms per stage
   report.json   {"frames", "samples_traced_per_eye", "samples_hidden": {"left", "right"},
                  "device": {name, driver}, "trace": "rayquery" or "compute",
-                 "gpu_ms": {grid, trace, reconstruct, resolve, total, bmfr_fit, mip, resample, blur},
+                 "gpu_ms": {grid, trace, reconstruct, resolve, total, accumulate, bmfr_fit, post,
+                            mip, resample, blur},
                  "cpu_ms": {gaze, grid, trace, reconstruct, resolve, submit, wait, total}
                  (medians per frame; submit: vkQueueSubmit, wait: the fence; total: the
                  frame alone, without output),

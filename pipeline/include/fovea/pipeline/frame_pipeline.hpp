@@ -35,7 +35,8 @@ struct FrameTimes {
   StageTime trace;        // CPU: recording; GPU: path tracing
   StageTime reconstruct;  // CPU: grid mappings and recording; GPU: accumulation, sharing, BMFR, post, TAA
   StageTime resolve;      // CPU: recording; GPU: mips, resolve, depth, blur
-  double bmfr_fit_gpu_ms = 0;  // part of reconstruct: the regression alone
+  // Parts of reconstruct: Phase I with the stereo gather, the BMFR regression, Phase III with TAA.
+  double accumulate_gpu_ms = 0, bmfr_fit_gpu_ms = 0, post_gpu_ms = 0;
   double mip_gpu_ms = 0, resample_gpu_ms = 0, blur_gpu_ms = 0;  // parts of resolve: its three kernels
   double submit_cpu_ms = 0;    // ending the command buffer and vkQueueSubmit (recording is in the stages)
   double wait_cpu_ms = 0;      // the fence wait until the GPU finished (on a CPU device: its work)
@@ -55,7 +56,8 @@ struct FrameTimes {
     return grid.cpu_ms + trace.cpu_ms + reconstruct.cpu_ms + resolve.cpu_ms + submit_cpu_ms + wait_cpu_ms;
   }
   // The frame's times as every timing record and report names them (docs/openxr.md, "Timing
-  // records"). GPU: the stages, the parts bmfr_fit, mip, resample and blur, and total. CPU:
+  // records"). GPU: the stages, the parts accumulate, bmfr_fit, post, mip, resample and blur,
+  // and total. CPU:
   // gaze (reading it, given here), the stages, submit, wait, and total (the gaze read and the
   // pipeline's recording, submission and fence wait).
   std::vector<std::pair<std::string, double>> gpu_record() const;
