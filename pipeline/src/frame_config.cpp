@@ -18,9 +18,9 @@ reconstruct::ReconSettings FrameConfig::default_recon() {
 }
 
 const std::vector<std::string>& frame_option_names() {
-  static const std::vector<std::string> names = {"budget",         "distribution", "jitter", "denoiser",
-                                                 "bmfr-precision", "stereo-share", "trace",  "bounces",
-                                                 "seed",           "landing-spp"};
+  static const std::vector<std::string> names = {"budget",         "cap",          "distribution", "jitter",
+                                                 "denoiser",       "bmfr-precision", "stereo-share", "trace",
+                                                 "bounces",        "seed",           "landing-spp"};
   return names;
 }
 
@@ -37,18 +37,25 @@ long whole_number(std::string_view value, long lo, long hi, const char* or_what 
                            std::to_string(hi) + ", got \"" + v + "\"");
   return n;
 }
+
+// A finite number written in full; otherwise InputError "expected a finite number, got "value"".
+double finite_number(std::string_view value) {
+  const std::string v(value);
+  char* end = nullptr;
+  errno = 0;
+  const double x = std::strtod(v.c_str(), &end);
+  if (v.empty() || *end != '\0' || errno == ERANGE || !std::isfinite(x))
+    throw core::InputError("expected a finite number, got \"" + v + "\"");
+  return x;
+}
 }  // namespace
 
 void apply_frame_option(FrameConfig& c, std::string_view name, std::string_view value, const std::string& where) {
   try {
     if (name == "budget") {
-      const std::string v(value);
-      char* end = nullptr;
-      errno = 0;
-      const double b = std::strtod(v.c_str(), &end);
-      if (v.empty() || *end != '\0' || errno == ERANGE || !std::isfinite(b))
-        throw core::InputError("expected a finite number, got \"" + v + "\"");
-      c.distribution.budget = b;
+      c.distribution.budget = finite_number(value);
+    } else if (name == "cap") {
+      c.distribution.cap = finite_number(value);  // its range: finish() (DistributionParams::validate)
     } else if (name == "distribution") {
       c.distribution.kind = core::parse_distribution(value);
     } else if (name == "jitter") {
@@ -95,6 +102,7 @@ void finish(FrameConfig& c, bool budget_given) {
 nlohmann::json to_json(const FrameConfig& c) {
   return {{"distribution", core::distribution_name(c.distribution.kind)},
           {"budget", c.distribution.budget},
+          {"cap", c.distribution.cap},
           {"jitter", c.distribution.jitter ? "on" : "off"},
           {"denoiser", reconstruct::denoiser_name(c.recon.denoiser)},
           {"bmfr-precision", c.recon.bmfr_precision == reconstruct::BmfrPrecision::Fp16 ? "fp16" : "fp32"},

@@ -7,6 +7,7 @@
 
 #include <glm/gtc/quaternion.hpp>
 
+#include "fovea/core/density_report.hpp"
 #include "fovea/core/error.hpp"
 #include "fovea/core/eye_optics.hpp"
 #include "fovea/pipeline/frame_driver.hpp"
@@ -171,6 +172,33 @@ TEST(FrameOptions, LandingSamplesAreAWholeNumberFromOneToEight) {
     }
   }
   EXPECT_EQ(c.recon.landing_spp, 1u);  // a refused value changes nothing
+}
+
+// --cap sets Visual-Polar's samples per display pixel at most (κ) by the same name everywhere;
+// the grid then puts that many in the fovea. A cap outside (0, 16] or not a number is refused
+// naming where it came from.
+TEST(FrameOptions, CapSetsTheFoveaSamplesPerPixel) {
+  pipeline::FrameConfig c;
+  EXPECT_EQ(pipeline::to_json(c)["cap"], c.distribution.cap);
+  pipeline::apply_frame_option(c, "cap", "2", "--cap");
+  pipeline::finish(c, false);
+  EXPECT_EQ(pipeline::to_json(c)["cap"], 2.0);
+  const core::View view(core::Fov::from_degrees(-40, 40, 40, -40), 200, 200);
+  const auto d = core::make_distribution(view, c.distribution);
+  EXPECT_NEAR(core::measure_density(*d).fovea_spp, 2.0, 0.05);
+  for (const char* bad : {"0", "-1", "16.5", "nan", "inf", "", "two"}) {
+    pipeline::FrameConfig b;
+    try {
+      pipeline::apply_frame_option(b, "cap", bad, "layer.json: default.cap");
+      pipeline::finish(b, false);
+      ADD_FAILURE() << bad;
+    } catch (const fovea::core::InputError& e) {
+      const std::string what = e.what();
+      EXPECT_TRUE(what.find("layer.json: default.cap: expected a finite number") != std::string::npos ||
+                  what.find("cap: must be in (0, 16]") != std::string::npos)
+          << bad << ": " << what;
+    }
+  }
 }
 
 // A fixating eye's drift does not move the grid: within kGridHoldDeg (0.5°) of the gaze the

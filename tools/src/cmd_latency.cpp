@@ -67,6 +67,8 @@ Prints the summary JSON on stdout; writes into --out:
                         [synthetic:1?task=search&rate=1000&noise=0&dropouts=0]
   --budget B            grid samples as a fraction of display pixels: the foveation's
                         strength (docs/visual-polar.md) [0.39]
+  --cap K               visual-polar: at most K samples per display pixel, the fovea's
+                        density (κ, docs/visual-polar.md), in (0, 16] [1]
   --distribution D      as `fovea render` (the frame's options and defaults are the same):
                         visual-polar | paper-visual-polar | cartesian | cartesian-uniform |
                         linear-falloff | log-polar [visual-polar]
@@ -227,7 +229,7 @@ int run(std::vector<std::string> argv) {
     }
   const std::vector<std::string> sim_options{"scene", "display", "gaze", "tracker", "tracker-delay", "jitter", "rate",
                                              "predict", "seconds", "render-time", "scan-out", "persistence",
-                                             "inject-latency", "quality-frames", "reference-spp", "budget",
+                                             "inject-latency", "quality-frames", "reference-spp", "budget", "cap",
                                              "quality-at", "quality-radius", "reference-error", "reference-cache",
                                              "distribution", "denoiser", "bmfr-precision", "stereo-share", "trace",
                                              "bounces", "seed", "landing-spp"};

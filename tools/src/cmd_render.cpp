@@ -97,6 +97,8 @@ With no options: a short demo on the shipped scene and gaze.
   --budget B            grid samples as a fraction of display pixels, met within 5% or
                         refused with exit 2 naming what the distribution reaches
                         (cartesian: 1 only) [0.39]
+  --cap K               visual-polar: at most K samples per display pixel, the fovea's
+                        density (κ, docs/visual-polar.md), in (0, 16] [1]
   --jitter on|off       per-frame sub-cell jitter (Halton 2, 3) of every grid [on]
   --denoiser D          bmfr | none (accumulation only) [bmfr]
   --bmfr-precision P    fp32 | fp16: storage of BMFR's regression matrix [fp32]
@@ -424,7 +426,7 @@ int run(std::vector<std::string> argv) {
       return 0;
     }
   const Args args(argv,
-                  {"scene", "display", "gaze", "frames", "distribution", "budget", "jitter", "denoiser", "bmfr-precision",
+                  {"scene", "display", "gaze", "frames", "distribution", "budget", "cap", "jitter", "denoiser", "bmfr-precision",
                    "stereo-share", "bounces", "reference", "reference-error", "reference-cache", "reference-window", "recovery-frames", "png-every",
                    "out", "screen", "trace", "seed", "landing-spp"},
                   {"no-blur", "no-cull", "no-marker", "quiet", "full-gi-score"});

@@ -55,6 +55,8 @@ of view directions (lines every 5 degrees), a picture of the optics.
                         (docs/gaze.md), sampled at frame / refresh rate [0.5,0.5]
   --gaze-dir x,y,z      fixed gaze as a view-space direction (OpenXR: -Z forward, +Y up)
   --budget B            grid samples as a fraction of display pixels [0.39]
+  --cap K               visual-polar: at most K samples per display pixel, the fovea's
+                        density (κ, docs/visual-polar.md), in (0, 16] [1]
   --jitter on|off       per-frame sub-cell jitter (Halton 2, 3) of every grid [on]
   --distribution D      as `fovea render` (the frame's options and defaults are the same):
                         visual-polar | paper-visual-polar | cartesian | cartesian-uniform |
@@ -130,7 +132,7 @@ int run(std::vector<std::string> argv) {
       return 0;
     }
   const Args args(argv,
-                  {"display", "scene", "trace", "gaze", "gaze-dir", "budget", "jitter", "optics", "window", "frames",
+                  {"display", "scene", "trace", "gaze", "gaze-dir", "budget", "cap", "jitter", "optics", "window", "frames",
                    "distribution", "denoiser", "bmfr-precision", "stereo-share", "bounces", "seed", "landing-spp",
                    "screenshot", "panels"},
                   {});

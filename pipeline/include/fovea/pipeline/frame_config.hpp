@@ -1,9 +1,10 @@
 #pragma once
 // What every entry point of the pipeline — `fovea render`, `view`, `latency` and the OpenXR
 // layer — configures about a foveated frame, with every default defined here once: the
-// sample distribution and its budget, jitter, the denoiser and its precision, stereo
-// sharing, the traversal, the light transport (bounces). Each entry point starts from FrameConfig{} and applies its options
-// by the same names (`--budget 0.2` on the command line, "budget": 0.2 in the layer's file).
+// sample distribution, its budget and Visual-Polar's cap on samples per pixel, jitter, the
+// denoiser and its precision, stereo sharing, the traversal, the light transport (bounces).
+// Each entry point starts from FrameConfig{} and applies its options by the same names
+// (`--budget 0.2` on the command line, "budget": 0.2 in the layer's file).
 #include <cstdint>
 #include <string>
 #include <string_view>
@@ -48,13 +49,13 @@ struct FrameConfig {
 };
 
 // The option names, shared by the command line (--NAME VALUE) and the layer's configuration
-// ("NAME": VALUE): budget, distribution, jitter, denoiser, bmfr-precision, stereo-share, trace,
-// bounces, seed, landing-spp.
+// ("NAME": VALUE): budget, cap, distribution, jitter, denoiser, bmfr-precision, stereo-share,
+// trace, bounces, seed, landing-spp.
 const std::vector<std::string>& frame_option_names();
 
 // Sets option `name` from its text `value`; core::InputError naming `where` (e.g. "--budget",
 // "layer.json: default.budget") and the accepted values. The distribution's own constraints
-// (the budget's range, Cartesian's budget of 1) are checked by finish().
+// (the budget's range, the cap's, Cartesian's budget of 1) are checked by finish().
 void apply_frame_option(FrameConfig& c, std::string_view name, std::string_view value, const std::string& where);
 
 // After the options: Cartesian traces every pixel (budget 1; a smaller one explicitly given is
