@@ -96,6 +96,9 @@ void finish(FrameConfig& c, bool budget_given) {
                              "the pixels");
     c.distribution.budget = 1.0;
   }
+  if (c.distribution.kind != core::DistributionKind::VisualPolar && c.distribution.cap != core::DistributionParams{}.cap)
+    throw core::InputError(std::string("cap: only visual-polar caps its samples per pixel, not ") +
+                           core::distribution_name(c.distribution.kind));
   c.distribution.validate();
 }
 

@@ -199,6 +199,10 @@ TEST(FrameOptions, CapSetsTheFoveaSamplesPerPixel) {
           << bad << ": " << what;
     }
   }
+  pipeline::FrameConfig other;  // the other distributions have no cap to set
+  pipeline::apply_frame_option(other, "distribution", "log-polar", "--distribution");
+  pipeline::apply_frame_option(other, "cap", "2", "--cap");
+  EXPECT_THROW(pipeline::finish(other, false), fovea::core::InputError);
 }
 
 // A fixating eye's drift does not move the grid: within kGridHoldDeg (0.5°) of the gaze the

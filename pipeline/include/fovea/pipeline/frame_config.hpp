@@ -59,7 +59,8 @@ const std::vector<std::string>& frame_option_names();
 void apply_frame_option(FrameConfig& c, std::string_view name, std::string_view value, const std::string& where);
 
 // After the options: Cartesian traces every pixel (budget 1; a smaller one explicitly given is
-// refused, cartesian-uniform's job), then DistributionParams::validate().
+// refused, cartesian-uniform's job), a cap other than the default is refused for any
+// distribution but visual-polar (the others have none), then DistributionParams::validate().
 void finish(FrameConfig& c, bool budget_given);
 
 // The configuration by the option names, for reports (report.json's config, the layer's log).
