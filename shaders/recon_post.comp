@@ -11,7 +11,7 @@
 //   (post.w), floored at α_min (EMA, 10% new data). The first frames' fits, of 1–2 samples
 //   per cell, spread their blocks' noise over whole surfaces; with equal weights frame 0
 //   still weighed 5% after 16 frames, with count weights 0.7%. The history keeps the share
-//   Phase I kept of its own (cell-size test, rounding of the counts).
+//   Phase I kept of its own (cell-size test, the landing's cap, rounding of the counts).
 // - The outlier excess (recon_bmfr_fit.comp) is already Phase I's temporal mean: accumulated
 //   again it would outlive the same firefly without BMFR several times over.
 // Without denoising the Phase I result (direct + indirect) passes through.
@@ -33,6 +33,7 @@ layout(std430, binding = RECON_POST_OUT) writeonly buffer Post { vec4 post[]; };
 layout(binding = RECON_POST_PREV_ACC_DIRECT) uniform textureBuffer prev_acc_direct;
 layout(binding = RECON_POST_EXCESS) uniform textureBuffer excess;  // unread without BMFR
 layout(std430, binding = RECON_POST_SUM) writeonly buffer Sum { vec4 sum[]; };          // TAA's input
+layout(binding = RECON_POST_FRAME_DIRECT) uniform textureBuffer frame_direct;  // .w: this frame's samples
 
 layout(push_constant) uniform Push { ReconPostPush pc; };
 #define LIVE_CELLS_LAYOUT layout(std430, binding = RECON_POST_LIVE)
@@ -60,7 +61,11 @@ void main() {
       hw += w[k] * p.w;
       hd += w[k] * texelFetch(prev_acc_direct, int(idx[k])).w;
     }
-    hw *= hd > 0.0 ? clamp((texelFetch(acc_direct, int(i)).w - 1.0) / hd, 0.0, 1.0) : 0.0;
+    // Phase I's count less this frame's samples (more than one in a new fovea's first
+    // frames) is the history it kept: a landing's 8 samples counted as history kept most
+    // of the old periphery's fit here while Phase I had dropped it.
+    const float held = max(texelFetch(frame_direct, int(i)).w, 1.0);
+    hw *= hd > 0.0 ? clamp((texelFetch(acc_direct, int(i)).w - held) / hd, 0.0, 1.0) : 0.0;
     float a = max(n / (hw + n), pc.alpha_min);
     acc = vec4(mix(h, c, a), n / a);
   }

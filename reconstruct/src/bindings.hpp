@@ -92,7 +92,7 @@ struct BmfrBindings {
 
 struct PostBindings {
   FOVEA_BINDING_COUNT(RECON_POST_COUNT)
-  Buf pos, tap_idx, tap_w, source, acc_direct, prev, out, prev_acc_direct, excess, sum, live;
+  Buf pos, tap_idx, tap_w, source, acc_direct, prev, out, prev_acc_direct, excess, sum, live, frame_direct;
   Slots slots() const {
     return {{{RECON_POST_POS, pos},
              {RECON_POST_TAP_IDX, tap_idx},
@@ -104,7 +104,8 @@ struct PostBindings {
              {RECON_POST_PREV_ACC_DIRECT, prev_acc_direct},
              {RECON_POST_EXCESS, excess},
              {RECON_POST_SUM, sum},
-             {RECON_POST_LIVE, live}}};
+             {RECON_POST_LIVE, live},
+             {RECON_POST_FRAME_DIRECT, frame_direct}}};
   }
 };
 

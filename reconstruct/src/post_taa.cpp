@@ -30,7 +30,7 @@ PostTaa::PostTaa(gpu::Context& ctx, std::span<const EyeGrid> eyes, const Accumul
       e.post_set[p] = make_set(ctx, post_,
                                PostBindings{&acc.position(me, p), &acc.tap_index(me), &acc.tap_weight(me), source,
                                             &acc.direct(me, p), &e.post[q], &e.post[p], &acc.direct(me, q), excess,
-                                            &e.sum, e.live});
+                                            &e.sum, e.live, g.direct});
       e.taa_set[p] = make_set(ctx, taa_,
                               TaaBindings{g.maps, g.tables, &acc.position(me, p), &acc.tap_index(me),
                                           &acc.tap_weight(me), &e.sum, &acc.albedo(me, p), &e.final_[q], &e.final_[p],

@@ -79,7 +79,8 @@
 #define RECON_POST_EXCESS 8
 #define RECON_POST_SUM 9
 #define RECON_POST_LIVE 10
-#define RECON_POST_COUNT 11
+#define RECON_POST_FRAME_DIRECT 11  // the tracer's direct light this frame: .w its samples
+#define RECON_POST_COUNT 12
 
 // recon_taa.comp
 #define RECON_TAA_POS 2
