@@ -57,9 +57,8 @@ struct FrameTimes {
   }
   // The frame's times as every timing record and report names them (docs/openxr.md, "Timing
   // records"). GPU: the stages, the parts accumulate, bmfr_fit, post, mip, resample and blur,
-  // and total. CPU:
-  // gaze (reading it, given here), the stages, submit, wait, and total (the gaze read and the
-  // pipeline's recording, submission and fence wait).
+  // and total. CPU: gaze (reading it, given here), the stages, submit, wait, and total (the
+  // gaze read and the pipeline's recording, submission and fence wait).
   std::vector<std::pair<std::string, double>> gpu_record() const;
   std::vector<std::pair<std::string, double>> cpu_record(double gaze_cpu_ms) const;
 };
