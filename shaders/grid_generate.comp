@@ -63,10 +63,11 @@ void main() {
   const uint tile = gl_WorkGroupID.y * gl_NumWorkGroups.x + gl_WorkGroupID.x;
   const uint first = gl_WorkGroupID.y * kPtTileRows * P.padded_columns + gl_WorkGroupID.x * kPtTileColumns;
   const uint idx = live_tile_cell(first, gl_LocalInvocationIndex, P.padded_columns);
-  GridSample s = gm_sample(idx % P.padded_columns, idx / P.padded_columns, vec2(P.jitter_u, P.jitter_v));
+  vec2 centre;
+  GridSample s = gm_sample(idx % P.padded_columns, idx / P.padded_columns, vec2(P.jitter_u, P.jitter_v), centre);
   if (s.flags == 0u && P.has_mask > 0.5) {
-    // The view pixel containing the sample, clamped into the raster (ViewMask::visible_at).
-    uvec2 p = uvec2(clamp(vec2(s.screen_x, s.screen_y), vec2(0.0), vec2(P.width - 1.0, P.height - 1.0)));
+    // The view pixel containing the cell's centre, clamped into the raster (ViewMask::visible_at).
+    uvec2 p = uvec2(clamp(centre, vec2(0.0), vec2(P.width - 1.0, P.height - 1.0)));
     uint words_per_row = (uint(P.width) + 31u) >> 5;
     if ((hidden_mask[p.y * words_per_row + (p.x >> 5)] & (1u << (p.x & 31u))) != 0u) s.flags |= kCellHidden;
   }

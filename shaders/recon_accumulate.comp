@@ -75,6 +75,13 @@ bool seen_near(ReconGrid m, uint j, vec4 here, vec3 n, float depth) {
   return false;
 }
 
+// The cell's angular size (degrees): its sample spacing in display pixels times a pixel's
+// smaller angle at its direction.
+float cell_deg(ReconGrid m, GridSample s) {
+  vec2 t = vec2(s.dir_x, s.dir_y) / max(-s.dir_z, 1e-6);
+  return degrees(s.footprint * min(rg_pixel_angle(m, t, false), rg_pixel_angle(m, t, true)));
+}
+
 void main() {
   const uint i = cell_of_invocation(pc.cells, pc.listed != 0u);
   if (i == kNoLiveCell) return;
@@ -114,16 +121,22 @@ void main() {
   if (pc.has_history != 0u && maps[kReconPrevious].valid != 0u) {
     ReconGrid prev = maps[kReconPrevious];
     vec2 uv;
-    if (rg_world_to_grid(prev, p, sky, uv)) {
+    if (rg_world_to_grid(prev, p, sky, true, uv)) {
       GridColumn col = rg_column(cur, i % cur.g.padded_columns);
       uvec2 cols;
       vec2 sizes;
       rg_taps(prev, rg_unjitter(cur, col, prev, uv), idx, w, cols, sizes);
       float own = rg_column_cell_size(cur, col), valid = 0.0, kept = 0.0;
+      // A cell the view moved by less than kHeldCellShare of its size holds the same part of
+      // the static scene as the frame before, and its history is the box mean of that area
+      // whichever surfaces the jittered samples hit: tested by surface, a large cell on an
+      // edge or against the sky restarted whenever its sample changed sides, never converged
+      // and showed single samples as blobs.
+      bool held = pc.held_deg <= cell_deg(cur, s);
       vec2 coarse = vec2(rg_coarse_weight(sizes.x, own, pc.coarse_keep, pc.coarse_reject),
                          rg_coarse_weight(sizes.y, own, pc.coarse_keep, pc.coarse_reject));
       for (int k = 0; k < 4; ++k) {
-        if (w[k] <= 0.0 || !seen_near(prev, idx[k], here, n, depth)) w[k] = 0.0;
+        if (w[k] <= 0.0 || !(held || seen_near(prev, idx[k], here, n, depth))) w[k] = 0.0;
         valid += w[k];
         w[k] *= coarse[k >> 1];
         kept += w[k];

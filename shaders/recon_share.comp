@@ -81,7 +81,7 @@ void main() {
     ReconGrid other = maps[kReconOther];
     bool sky = here.w == kReconSky;
     vec2 uv;
-    if (rg_world_to_grid(other, here.xyz, sky, uv)) {
+    if (rg_world_to_grid(other, here.xyz, sky, false, uv)) {
       uvec4 idx;
       vec4 w;
       ReconGrid cur = maps[kReconCurrent];

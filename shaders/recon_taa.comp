@@ -134,7 +134,7 @@ bool sharp_history(ReconGrid cur, uint col, vec4 here, vec4 kept, out vec3 h) {
   h = vec3(0.0);
   ReconGrid prev = maps[kReconPrevious];
   vec2 uv;
-  if (!rg_world_to_grid(prev, here.xyz, abs(here.w - kReconSky) < 0.5, uv)) return false;
+  if (!rg_world_to_grid(prev, here.xyz, abs(here.w - kReconSky) < 0.5, false, uv)) return false;
   return history_catmull_rom(prev, rg_unjitter(cur, rg_column(cur, col), prev, uv), kept, h);
 }
 

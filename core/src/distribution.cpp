@@ -126,10 +126,19 @@ shaders::GridSample SampleDistribution::sample_at(int column, int row, glm::dvec
   glm::dvec2 px;
   map({column + 0.5 + j.x, row + 0.5 + j.y}, column, dir, px);
   std::uint32_t flags = cell_flags(column, row, dir);
-  if (!view_.contains_pixel(px)) flags |= shaders::kCellOffscreen;
+  // On the display and not hidden is the cell centre's, whatever the jitter: a cell at an
+  // edge that came and went with the jitter lost its history every time it went.
+  glm::dvec2 centre = px;
+  if (j != glm::dvec2(0)) {
+    glm::dvec3 centre_dir;
+    map({column + 0.5, row + 0.5}, column, centre_dir, centre);
+  }
+  const double tol = shaders::kCellEdgeTolPx;
+  if (!(centre.x >= -tol && centre.y >= -tol && centre.x <= view_.width() + tol && centre.y <= view_.height() + tol))
+    flags |= shaders::kCellOffscreen;
   // Only cells that would be traced are tested against the mask (as the GPU does): a
   // packed column's clipped rows map beyond its arc, often into the hidden area.
-  else if (flags == 0 && mask_ && !mask_->visible_at(px)) flags |= shaders::kCellHidden;
+  else if (flags == 0 && mask_ && !mask_->visible_at(centre)) flags |= shaders::kCellHidden;
   s.dir_x = float(dir.x);
   s.dir_y = float(dir.y);
   s.dir_z = float(dir.z);

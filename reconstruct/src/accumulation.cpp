@@ -44,7 +44,7 @@ void Accumulation::record(VkCommandBuffer cmd, int parity, bool history, std::sp
     run_cells(cmd, kernel_, e.set[parity],
               shaders::ReconAccumulatePush{e.cells, history ? 1u : 0u, fresh[i] ? 1u : 0u, s.live_cells ? 1u : 0u,
                                            s.alpha_min, s.coarse_keep, s.coarse_reject, s.landing_deg,
-                                           s.landing_history, 0, 0, 0},
+                                           s.landing_history, s.motion_deg / kHeldCellShare, 0, 0},
               e.cells, e.live);
   }
   gpu::compute_to_compute(cmd);

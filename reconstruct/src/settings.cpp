@@ -45,6 +45,7 @@ ReconSettings with_history_floors(const ReconSettings& s, double motion_deg) {
   r.post_alpha_min *= k;
   r.taa_alpha *= k;
   r.still = 1.0f - k;
+  r.motion_deg = float(std::isfinite(motion_deg) ? std::max(motion_deg, 0.0) : kFullFloorMotionDeg);
   return r;
 }
 

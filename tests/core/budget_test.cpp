@@ -165,6 +165,39 @@ void expect_budget_everywhere(const std::string& preset, bool lens,
   }
 }
 
+// Whether a cell is traced is its centre's (on the view, not under the lens), whatever the
+// frame's sub-cell jitter: a cell at an edge that came and went with the jitter lost its
+// history each time it went, never converged and showed its single samples as blobs.
+TEST(Budget, TracedCellsDoNotFollowTheJitter) {
+  const DisplayPreset display = load_display("small");
+  const View v = display.view(Eye::Left);
+  const ViewMask mask = EyeOptics(display, Eye::Left).view_mask();
+  for (DistributionKind k : {DistributionKind::VisualPolar, DistributionKind::PaperVisualPolar,
+                             DistributionKind::CartesianUniform, DistributionKind::LogPolar}) {
+    DistributionParams p;
+    p.kind = k;
+    p.budget = 0.05;
+    auto d = make_distribution(v, p);
+    d->set_visibility(mask);
+    std::vector<std::uint32_t> first;
+    int edge_cells = 0;  // cells whose jittered sample leaves the view or enters the hidden area
+    for (std::uint32_t f = 0; f < 16; ++f) {
+      d->set_frame(gaze_at(v, 15), f);
+      ASSERT_NE(d->jitter(), glm::dvec2(0)) << "frame " << f;
+      std::size_t i = 0;
+      for (int row = 0; row < d->rows(); ++row)
+        for (int col = 0; col < d->columns(); ++col, ++i) {
+          const shaders::GridSample s = d->sample(col, row);
+          if (f == 0) first.push_back(s.flags);
+          ASSERT_EQ(s.flags, first[i]) << distribution_name(k) << " cell " << col << "," << row << " frame " << f;
+          const glm::dvec2 px{s.screen_x, s.screen_y};
+          if (s.flags == 0 && (!v.contains_pixel(px) || !mask.visible_at(px))) ++edge_cells;
+        }
+    }
+    EXPECT_GT(edge_cells, 0) << distribution_name(k) << ": the jitter never crossed an edge";
+  }
+}
+
 TEST(Budget, KeptAtEveryGaze) { expect_budget_everywhere("small", false); }
 TEST(Budget, KeptAtEveryGazeUnderTheLens) { expect_budget_everywhere("small", true); }
 #ifndef FOVEA_SANITIZED_BUILD

@@ -58,10 +58,12 @@ TEST_P(GridPassTest, MatchesCpuReference) {
         if ((r.flags & shaders::kCellClipped) && (g.flags & shaders::kCellClipped)) continue;
         if (g.flags != r.flags) {
           // Only cells within float rounding of a decision boundary may differ: the display
-          // edge, or a linear fall-off threshold.
-          const bool near_edge = std::min({std::abs(r.screen_x), std::abs(r.screen_y),
-                                           std::abs(r.screen_x - view.width()),
-                                           std::abs(r.screen_y - view.height())}) < 1e-3;
+          // edge (the cell centre's, kCellEdgeTolPx outside), or a linear fall-off threshold.
+          const auto centre = d->sample_at(col, row, {0, 0});
+          const double tol = shaders::kCellEdgeTolPx;
+          const bool near_edge = std::min({std::abs(centre.screen_x + tol), std::abs(centre.screen_y + tol),
+                                           std::abs(centre.screen_x - view.width() - tol),
+                                           std::abs(centre.screen_y - view.height() - tol)}) < 1e-3;
           const bool kill_only = ((g.flags ^ r.flags) == shaders::kCellKilled);
           EXPECT_TRUE(near_edge || kill_only) << "cell " << col << "," << row << " gpu " << g.flags << " cpu " << r.flags;
           ++flag_mismatch;

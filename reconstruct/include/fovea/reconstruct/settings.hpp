@@ -45,6 +45,10 @@ constexpr double kMotionParallaxM = 1.0;
 // trace ReconSettings::landing_spp samples per fovea cell.
 constexpr double kLandingJumpDeg = 5.0;
 constexpr std::uint32_t kLandingFrames = 4;
+// A cell whose area the view moved by less than this share of its size holds the same part
+// of the (static) scene as the frame before: its history is the box mean of its own area,
+// whichever surfaces the jittered samples hit (shaders/recon_accumulate.comp).
+constexpr float kHeldCellShare = 0.1f;
 double view_motion_deg(glm::dvec3 gaze_before, glm::dvec3 gaze_now, const core::Pose& before, const core::Pose& now);
 ReconSettings with_history_floors(const ReconSettings& s, double motion_deg);
 
@@ -77,6 +81,10 @@ struct ReconSettings {
   // Set per frame by with_history_floors: 1 − the floors' share (1: a still view, which
   // needs no TAA: recon_taa.comp).
   float still = 0;
+  // Set per frame by with_history_floors: the view's motion since the last frame (degrees,
+  // view_motion_deg). Phase I keeps the history of a cell the view moved by less than
+  // kHeldCellShare of its size whatever surfaces its samples hit (recon_accumulate.comp).
+  float motion_deg = 0;
   // Set by the frame pipeline on the frame a gaze jump lands (kLandingJumpDeg): the cells
   // within this angle of the gaze (the new fovea and the distribution's margin) take no TAA
   // history this frame. 0: none. That history is the previous frame's periphery, resampled:

@@ -10,10 +10,13 @@ namespace fovea::shaders {
 
 // flags: 0 means "trace this cell"; any bit set means the thread skips it.
 FOVEA_CONST FOVEA_UINT kCellClipped = 1u;    // beyond the column's row count (VP clip)
-FOVEA_CONST FOVEA_UINT kCellOffscreen = 2u;  // direction outside the view frustum
-FOVEA_CONST FOVEA_UINT kCellHidden = 4u;     // inside the lens' hidden area
+FOVEA_CONST FOVEA_UINT kCellOffscreen = 2u;  // cell centre outside the view frustum
+FOVEA_CONST FOVEA_UINT kCellHidden = 4u;     // cell centre inside the lens' hidden area
 FOVEA_CONST FOVEA_UINT kCellKilled = 8u;     // randomly killed (linear fall-off)
 FOVEA_CONST FOVEA_UINT kCellPadding = 16u;   // padding to whole 32x32 blocks
+// A cell centre this close outside the display (pixels) is on it: a packed column's end rows
+// are centred on the display's edge by construction, and float rounding must not decide.
+FOVEA_CONST float kCellEdgeTolPx = 0.01f;
 
 struct GridSample {
   float dir_x, dir_y, dir_z;  // unit view-space direction (OpenXR: -Z forward, +Y up)

@@ -57,7 +57,8 @@ struct ReconAccumulatePush {
   float coarse_keep, coarse_reject;                    // cell-size test (ReconSettings, rg_coarse_weight)
   float landing_deg;      // as ReconPostPush: > 0 on a landing frame, the new fovea's angle
   float landing_history;  // samples the new fovea's history counts for there at most (ReconSettings)
-  float pad0, pad1, pad2;
+  float held_deg;         // the view's motion since the last frame over kHeldCellShare (degrees)
+  float pad1, pad2;
 };
 
 struct ReconSharePush {

@@ -180,13 +180,15 @@ vec2 rg_grid_coord(ReconGrid m, vec3 d, vec2 px) {
 }
 
 // World point (or, is_direction, world direction of a sky sample) -> grid coordinate of
-// mapping m; false when it is behind the eye or off the display.
-bool rg_world_to_grid(ReconGrid m, vec3 p, bool is_direction, out vec2 uv) {
+// mapping m; false when it is behind the eye, or off the display unless `off_display`: then
+// such a point maps beyond the grid's edge, where the taps clamp (a cell is traced when its
+// centre is on the display, and its jittered sample may leave it: grid_map.glsl).
+bool rg_world_to_grid(ReconGrid m, vec3 p, bool is_direction, bool off_display, out vec2 uv) {
   uv = vec2(0.0);
   vec3 d = rg_world_to_view(m, p, is_direction);
   vec2 px;
-  if (!rg_dir_to_pixel(m, d, px)) return false;
-  uv = rg_grid_coord(m, normalize(d), px);
+  if (!rg_dir_to_pixel(m, d, px) && !(off_display && d.z < 0.0)) return false;
+  uv = rg_grid_coord(m, normalize(d), clamp(px, vec2(-1e6), vec2(1e6)));
   return true;
 }
 
