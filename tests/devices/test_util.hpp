@@ -16,13 +16,29 @@
 
 namespace fovea::devices::test {
 
+inline std::filesystem::path scratch_path(const ::testing::TestInfo& info) {
+  return std::filesystem::temp_directory_path() /
+         ("fovea_devices_" + std::to_string(::getpid()) + "_" + info.test_suite_name() + "_" + info.name());
+}
+
 inline std::string scratch_dir() {
-  const auto* info = ::testing::UnitTest::GetInstance()->current_test_info();
-  const std::filesystem::path d = std::filesystem::temp_directory_path() /
-                                  ("fovea_devices_" + std::to_string(::getpid()) + "_" + info->test_suite_name() + "_" + info->name());
+  const std::filesystem::path d = scratch_path(*::testing::UnitTest::GetInstance()->current_test_info());
   std::filesystem::create_directories(d);
   return d.string();
 }
+
+// A passed test's scratch directory goes when it ends; a failed one's stays for a look.
+class ScratchCleaner : public ::testing::EmptyTestEventListener {
+  void OnTestEnd(const ::testing::TestInfo& info) override {
+    if (!info.result()->Passed()) return;
+    std::error_code ignored;
+    std::filesystem::remove_all(scratch_path(info), ignored);
+  }
+};
+inline const bool kScratchCleanerInstalled = [] {
+  ::testing::UnitTest::GetInstance()->listeners().Append(new ScratchCleaner);
+  return true;
+}();
 
 inline std::string write_text(const std::string& name, const std::string& text) {
   const std::string p = scratch_dir() + "/" + name;
