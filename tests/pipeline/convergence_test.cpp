@@ -36,18 +36,29 @@ double fovea_hdr_flip(const core::Image& img, const core::Image& ref, const core
       .hdr_flip;
 }
 
+// The Cornell box on the test's raster with the tiny preset's optics.
+struct Cornell {
+  explicit Cornell(fovea::gpu::Context& ctx)
+      : scene(renderer::load_scene("cornell")),
+        gs(ctx, scene),
+        display(fovea::test::display_of_size(kWidth, kHeight)),
+        poses(core::eye_poses(scene.camera, display)),
+        views(core::stereo_views(display)) {}
+  renderer::Scene scene;
+  renderer::GpuScene gs;
+  core::DisplayPreset display;
+  std::array<core::Pose, 2> poses;
+  core::StereoViews views;
+};
+
 TEST_F(GpuTest, StillViewConvergesForEveryDistribution) {
-  const renderer::Scene scene = renderer::load_scene("cornell");
-  renderer::GpuScene gs(ctx(), scene);
-  const core::DisplayPreset display = fovea::test::display_of_size(kWidth, kHeight);
-  const auto poses = core::eye_poses(scene.camera, display);
-  const core::StereoViews views = core::stereo_views(display);
+  Cornell c(ctx());
   // The render's transport (one bounce, PathConfig{}), converged.
   renderer::ReferenceOptions o;
   o.path.spp = 64;
   o.max_spp = 2048;
-  const core::View view(views[core::Eye::Left].fov(), kWidth, kHeight, poses[0]);
-  const core::Image ref = renderer::render_reference(ctx(), gs, view, core::Eye::Left, o).image;
+  const core::View view(c.views[core::Eye::Left].fov(), kWidth, kHeight, c.poses[0]);
+  const core::Image ref = renderer::render_reference(ctx(), c.gs, view, core::Eye::Left, o).image;
 
   const std::vector<std::uint32_t> checkpoints = {8, 16, 32, 64};
   for (const core::DistributionKind kind :
@@ -57,11 +68,11 @@ TEST_F(GpuTest, StillViewConvergesForEveryDistribution) {
     core::DistributionParams dp;
     dp.kind = kind;
     if (kind == core::DistributionKind::Cartesian) dp.budget = 1.0;
-    pipeline::FramePipeline p(ctx(), gs, views, dp, reconstruct::ReconSettings{}, {}, /*mono=*/true);
+    pipeline::FramePipeline p(ctx(), c.gs, c.views, dp, reconstruct::ReconSettings{}, {}, /*mono=*/true);
     std::vector<double> flip;
     std::uint32_t next = 0;
     for (std::uint32_t f = 0; f < checkpoints.back(); ++f) {
-      const pipeline::FrameTimes t = p.render(poses, kGaze, f);
+      const pipeline::FrameTimes t = p.render(c.poses, kGaze, f);
       if (f > 0) {
         EXPECT_EQ(t.history_floor, 0.0f) << "a still view keeps no EMA floor";
       }
@@ -86,11 +97,7 @@ TEST_F(GpuTest, StillViewConvergesForEveryDistribution) {
 // they never converged and showed single samples. Linear fall-off kills cells at random
 // every frame, by design.
 TEST_F(GpuTest, StillViewKeepsTheHistoryOfEveryCell) {
-  const renderer::Scene scene = renderer::load_scene("cornell");
-  renderer::GpuScene gs(ctx(), scene);
-  const core::DisplayPreset display = fovea::test::display_of_size(kWidth, kHeight);
-  const auto poses = core::eye_poses(scene.camera, display);
-  const core::StereoViews views = core::stereo_views(display);
+  Cornell c(ctx());
   reconstruct::ReconSettings s;
   s.denoiser = reconstruct::Denoiser::None;  // Phase I's counts do not depend on it
   const std::uint32_t frames = 12;
@@ -102,9 +109,9 @@ TEST_F(GpuTest, StillViewKeepsTheHistoryOfEveryCell) {
       core::DistributionParams dp;
       dp.kind = kind;
       dp.budget = kind == core::DistributionKind::Cartesian ? 1.0 : 0.02;
-      pipeline::FramePipeline p(ctx(), gs, views, dp, s, {}, /*mono=*/true);
+      pipeline::FramePipeline p(ctx(), c.gs, c.views, dp, s, {}, /*mono=*/true);
       for (std::uint32_t f = 0; f < frames; ++f) {
-        auto turned = poses;
+        auto turned = c.poses;
         for (core::Pose& pose : turned)
           pose.orientation = glm::angleAxis(glm::radians(turn_deg * f), glm::dvec3(0, 1, 0)) * pose.orientation;
         p.render(turned, kGaze, f);
