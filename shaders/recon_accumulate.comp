@@ -129,14 +129,16 @@ void main() {
       float own = rg_column_cell_size(cur, col), valid = 0.0, kept = 0.0;
       // A cell the view moved by less than kHeldCellShare of its size holds the same part of
       // the static scene as the frame before, and its history is the box mean of that area
-      // whichever surfaces the jittered samples hit: tested by surface, a large cell on an
-      // edge or against the sky restarted whenever its sample changed sides, never converged
-      // and showed single samples as blobs.
+      // whichever surfaces the jittered samples hit (a tap without a sample still counts for
+      // nothing): tested by surface, a large cell on an edge or against the sky restarted
+      // whenever its sample changed sides, never converged and showed single samples as blobs.
       bool held = pc.held_deg <= cell_deg(cur, s);
       vec2 coarse = vec2(rg_coarse_weight(sizes.x, own, pc.coarse_keep, pc.coarse_reject),
                          rg_coarse_weight(sizes.y, own, pc.coarse_keep, pc.coarse_reject));
       for (int k = 0; k < 4; ++k) {
-        if (w[k] <= 0.0 || !(held || seen_near(prev, idx[k], here, n, depth))) w[k] = 0.0;
+        bool usable = held ? !rg_no_sample(texelFetch(prev_pos, int(idx[k])).w)  // any surface, not none
+                           : seen_near(prev, idx[k], here, n, depth);
+        if (w[k] <= 0.0 || !usable) w[k] = 0.0;
         valid += w[k];
         w[k] *= coarse[k >> 1];
         kept += w[k];
