@@ -133,9 +133,7 @@ shaders::GridSample SampleDistribution::sample_at(int column, int row, glm::dvec
     glm::dvec3 centre_dir;
     map({column + 0.5, row + 0.5}, column, centre_dir, centre);
   }
-  const double tol = shaders::kCellEdgeTolPx;
-  if (!(centre.x >= -tol && centre.y >= -tol && centre.x <= view_.width() + tol && centre.y <= view_.height() + tol))
-    flags |= shaders::kCellOffscreen;
+  if (!view_.contains_pixel(centre, shaders::kCellEdgeTolPx)) flags |= shaders::kCellOffscreen;
   // Only cells that would be traced are tested against the mask (as the GPU does): a
   // packed column's clipped rows map beyond its arc, often into the hidden area.
   else if (flags == 0 && mask_ && !mask_->visible_at(centre)) flags |= shaders::kCellHidden;

@@ -47,8 +47,9 @@ class View {
   // Unit (or any non-zero) view-space direction -> continuous pixel position; nullopt if
   // the direction does not point into the front half-space (z >= 0) or is not finite.
   std::optional<glm::dvec2> dir_to_pixel(glm::dvec3 dir) const;
-  bool contains_pixel(glm::dvec2 px) const {
-    return px.x >= 0 && px.y >= 0 && px.x <= width_ && px.y <= height_;
+  // On the raster, or within `margin` pixels outside it.
+  bool contains_pixel(glm::dvec2 px, double margin = 0) const {
+    return px.x >= -margin && px.y >= -margin && px.x <= width_ + margin && px.y <= height_ + margin;
   }
   // Direction through the centre of the raster.
   glm::dvec3 centre_dir() const;
