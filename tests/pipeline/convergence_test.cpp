@@ -158,6 +158,11 @@ TEST(HistoryFloors, ScaleWithTheViewsMotion) {
   EXPECT_FLOAT_EQ(reconstruct::with_history_floors(s, 0.5).alpha_min, 0.5f * s.alpha_min);
   EXPECT_FLOAT_EQ(reconstruct::with_history_floors(s, 0.5).taa_alpha, 0.5f * s.taa_alpha);
   EXPECT_EQ(reconstruct::with_history_floors(s, 30).post_alpha_min, s.post_alpha_min);
+  // The motion Phase I holds large cells by: unknown until set, which holds none.
+  EXPECT_FALSE(std::isfinite(s.motion_deg));
+  EXPECT_EQ(reconstruct::with_history_floors(s, 0).motion_deg, 0.0f);
+  EXPECT_FLOAT_EQ(reconstruct::with_history_floors(s, 0.5).motion_deg, 0.5f);
+  EXPECT_EQ(reconstruct::with_history_floors(s, nan).motion_deg, float(reconstruct::kFullFloorMotionDeg));
 }
 
 }  // namespace convergence

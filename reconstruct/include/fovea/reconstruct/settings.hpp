@@ -1,5 +1,6 @@
 #pragma once
 // Reconstruction in grid space (docs/reconstruction.md): the settings every stage reads.
+#include <limits>
 #include <string_view>
 
 #include <glm/vec3.hpp>
@@ -84,7 +85,8 @@ struct ReconSettings {
   // Set per frame by with_history_floors: the view's motion since the last frame (degrees,
   // view_motion_deg). Phase I keeps the history of a cell the view moved by less than
   // kHeldCellShare of its size whatever surfaces its samples hit (recon_accumulate.comp).
-  float motion_deg = 0;
+  // Unset it is unknown, which counts as moving (as `still` = 0 does): no cell is held.
+  float motion_deg = std::numeric_limits<float>::infinity();
   // Set by the frame pipeline on the frame a gaze jump lands (kLandingJumpDeg): the cells
   // within this angle of the gaze (the new fovea and the distribution's margin) take no TAA
   // history this frame. 0: none. That history is the previous frame's periphery, resampled:
