@@ -31,11 +31,6 @@ using fovea::test::GpuTest;
 constexpr int kWidth = 128, kHeight = 144;  // the tiny preset's optics at this raster
 const std::array<glm::dvec3, 2> kGaze{glm::dvec3(0, 0, -1), glm::dvec3(0, 0, -1)};
 
-double fovea_hdr_flip(const core::Image& img, const core::Image& ref, const core::View& view) {
-  return core::pool(core::error_maps(img, ref, core::flip_ppd(view)), fovea::test::fovea_pixel_weights(view, kGaze[0]))
-      .hdr_flip;
-}
-
 // The Cornell box on the test's raster with the tiny preset's optics.
 struct Cornell {
   explicit Cornell(fovea::gpu::Context& ctx)
@@ -58,7 +53,7 @@ TEST_F(GpuTest, StillViewConvergesForEveryDistribution) {
   o.path.spp = 64;
   o.max_spp = 2048;
   const core::View view(c.views[core::Eye::Left].fov(), kWidth, kHeight, c.poses[0]);
-  const core::Image ref = renderer::render_reference(ctx(), c.gs, view, core::Eye::Left, o).image;
+  const fovea::test::FoveaReference ref = fovea::test::fovea_reference(ctx(), c.gs, view, kGaze[0], o);
 
   const std::vector<std::uint32_t> checkpoints = {8, 16, 32, 64};
   for (const core::DistributionKind kind :
@@ -77,7 +72,7 @@ TEST_F(GpuTest, StillViewConvergesForEveryDistribution) {
         EXPECT_EQ(t.history_floor, 0.0f) << "a still view keeps no EMA floor";
       }
       if (f + 1 == checkpoints[next]) {
-        flip.push_back(fovea_hdr_flip(p.image(core::Eye::Left), ref, p.view(core::Eye::Left)));
+        flip.push_back(fovea::test::fovea_scores(p.image(core::Eye::Left), ref).hdr_flip);
         ++next;
       }
     }

@@ -81,8 +81,7 @@ class GrazingTexture : public GpuTest {
     renderer::ReferenceOptions o;  // the pipeline's transport: PathConfig{}
     o.path.spp = 32;
     o.max_spp = 256;
-    o.window.discs.push_back({gaze_at(kFrames - 1), core::acuity::kFoveaDeg + 1.0});
-    reference_ = renderer::render_reference(ctx(), *gs_, view, core::Eye::Left, o).image;
+    reference_ = fovea::test::fovea_reference(ctx(), *gs_, view, gaze_at(kFrames - 1), o);
   }
 
   // The last frame's fovea; `still`: every frame at the last frame's gaze.
@@ -97,15 +96,13 @@ class GrazingTexture : public GpuTest {
       const glm::dvec3 g = still ? gaze_at(kFrames - 1) : gaze_at(f);
       p.render(poses, {g, g}, f);
     }
-    const core::View view = p.view(core::Eye::Left);
-    const core::ErrorMaps maps = core::error_maps(p.image(core::Eye::Left), reference_, core::flip_ppd(view));
-    const core::Scores s = core::pool(maps, fovea::test::fovea_pixel_weights(view, gaze_at(kFrames - 1)));
+    const core::Scores s = fovea::test::fovea_scores(p.image(core::Eye::Left), reference_);
     return {s.ssim, s.hdr_flip};
   }
 
   renderer::Scene scene_;
   std::unique_ptr<renderer::GpuScene> gs_;
-  core::Image reference_;
+  fovea::test::FoveaReference reference_;
 };
 
 TEST_F(GrazingTexture, BricksKeptWithoutMoire) {

@@ -100,36 +100,13 @@ double fovea_history(const pipeline::FramePipeline& p) {
   return n ? sum / double(n) : 0.0;
 }
 
-// A converged reference of the fovea around `gaze` and the pixels within 5° of it whose
-// error maps it gives exactly (their FLIP/SSIM neighbourhood inside the rendered window).
-struct FoveaReference {
-  core::Image image;
-  std::vector<bool> valid;     // the rendered window
-  std::vector<float> weights;  // 1: a fovea pixel, 0: not scored
-  double ppd = 0;
-};
-
-FoveaReference fovea_reference(fovea::gpu::Context& ctx, const renderer::GpuScene& gs, const core::View& view,
-                               glm::dvec3 gaze, std::uint32_t spp) {
-  FoveaReference r;
-  r.ppd = core::flip_ppd(view);
-  const int support = core::error_map_support_px(r.ppd);
+// A converged reference of the fovea, the pixels within 5° of `gaze`, at up to `spp`.
+fovea::test::FoveaReference fovea_reference(fovea::gpu::Context& ctx, const renderer::GpuScene& gs,
+                                            const core::View& view, glm::dvec3 gaze, std::uint32_t spp) {
   renderer::ReferenceOptions o;
   o.path.spp = 64;
   o.max_spp = spp;
-  o.window.discs.push_back({gaze, 5.0 + 1.5 * support / r.ppd});
-  r.image = renderer::render_reference(ctx, gs, view, core::Eye::Left, o).image;
-  r.valid = renderer::window_coverage(o.window, view, "fovea window");
-  const std::vector<bool> scored = core::scorable_pixels(r.valid, view.width(), view.height(), support);
-  const std::vector<float> ecc = core::eccentricity_map(view, gaze);
-  r.weights.assign(ecc.size(), 0.0f);
-  for (std::size_t i = 0; i < ecc.size(); ++i)
-    if (scored[i] && ecc[i] <= 5) r.weights[i] = 1.0f;
-  return r;
-}
-
-core::Scores fovea_scores(const core::Image& img, const FoveaReference& ref) {
-  return core::pool(core::error_maps(img, ref.image, ref.ppd, 0.0, ref.valid), ref.weights);
+  return fovea::test::fovea_reference(ctx, gs, view, gaze, o, 5.0);
 }
 
 // The recovery curves' setting: a shipped scene from its camera, 256×288 at 60°×66° (≈ 4 px/°
@@ -211,7 +188,7 @@ TEST_F(GpuTest, FoveaIsSharpWithinThreeFramesAfterA40DegreeSaccade) {
 TEST_F(GpuTest, SaccadeRecoveryCurveOnTheDefaultScene) {
   const CurveSetting c("default");
   renderer::GpuScene gs(ctx(), c.scene);
-  FoveaReference ref;
+  fovea::test::FoveaReference ref;
   for (const auto denoiser : {reconstruct::Denoiser::None, reconstruct::Denoiser::Bmfr}) {
     reconstruct::ReconSettings s;
     s.denoiser = denoiser;
@@ -225,7 +202,7 @@ TEST_F(GpuTest, SaccadeRecoveryCurveOnTheDefaultScene) {
       if (f >= c.settle) {
         sharp[std::size_t(f - c.settle)] =
             fovea_sharpness(control.image(core::Eye::Left), control.view(core::Eye::Left), c.target);
-        control_scores[std::size_t(f - c.settle)] = fovea_scores(control.image(core::Eye::Left), ref);
+        control_scores[std::size_t(f - c.settle)] = fovea::test::fovea_scores(control.image(core::Eye::Left), ref);
       }
     }
     for (const bool check : {true, false}) {
@@ -239,7 +216,7 @@ TEST_F(GpuTest, SaccadeRecoveryCurveOnTheDefaultScene) {
         const double r = fovea_sharpness(jump.image(core::Eye::Left), jump.view(core::Eye::Left), c.target) /
                          sharp[std::size_t(f)];
         const double count = fovea_history(jump);
-        const core::Scores q = fovea_scores(jump.image(core::Eye::Left), ref);
+        const core::Scores q = fovea::test::fovea_scores(jump.image(core::Eye::Left), ref);
         const core::Scores& qc = control_scores[std::size_t(f)];
         std::printf(" %.3f (%.2f) [%.2f dB %.3f | control %.2f dB %.3f]", r, count, q.psnr, q.hdr_flip, qc.psnr,
                     qc.hdr_flip);
@@ -304,7 +281,7 @@ TEST_P(SaccadeRecoveryPerScene, BmfrRecoversWithinThreeFrames) {
   s.denoiser = reconstruct::Denoiser::Bmfr;
   pipeline::FramePipeline control(ctx(), gs, core::stereo_views(c.display), {}, s, c.path, true);
   pipeline::FramePipeline jump(ctx(), gs, core::stereo_views(c.display), {}, s, c.path, true);
-  FoveaReference ref;
+  fovea::test::FoveaReference ref;
   std::printf("%s, bmfr: sharpness / control [fovea PSNR dB, HDR-FLIP | the control's] per frame after the jump:",
               GetParam());
   for (int f = 0; f < c.settle + c.after; ++f) {
@@ -317,8 +294,8 @@ TEST_P(SaccadeRecoveryPerScene, BmfrRecoversWithinThreeFrames) {
     const int k = f - c.settle + 1;  // frames since the jump
     const double r = fovea_sharpness(jump.image(core::Eye::Left), jump.view(core::Eye::Left), c.target) /
                      fovea_sharpness(control.image(core::Eye::Left), control.view(core::Eye::Left), c.target);
-    const core::Scores q = fovea_scores(jump.image(core::Eye::Left), ref);
-    const core::Scores qc = fovea_scores(control.image(core::Eye::Left), ref);
+    const core::Scores q = fovea::test::fovea_scores(jump.image(core::Eye::Left), ref);
+    const core::Scores qc = fovea::test::fovea_scores(control.image(core::Eye::Left), ref);
     std::printf(" %.3f [%.2f %.3f | %.2f %.3f]", r, q.psnr, q.hdr_flip, qc.psnr, qc.hdr_flip);
     ASSERT_TRUE(std::isfinite(r));
     if (k >= 3) {
@@ -361,7 +338,7 @@ TEST_P(LandingBmfrAgainstNone, BmfrIsNoWorseOnAnyFrameAfterTheLanding) {
   const auto& [display, poses, before, target] = std::tie(c.display, c.poses, c.before, c.target);
   renderer::GpuScene gs(ctx(), c.scene);
   constexpr int kSettle = 10;
-  FoveaReference ref;
+  fovea::test::FoveaReference ref;
   std::array<std::vector<double>, 2> flip;  // none, bmfr
   for (const auto denoiser : {reconstruct::Denoiser::None, reconstruct::Denoiser::Bmfr}) {
     reconstruct::ReconSettings s = pipeline::FrameConfig::default_recon();
@@ -373,7 +350,7 @@ TEST_P(LandingBmfrAgainstNone, BmfrIsNoWorseOnAnyFrameAfterTheLanding) {
       if (ref.image.pixels.empty())
         ref = fovea_reference(ctx(), gs, jump.view(core::Eye::Left), target, 256);
       if (f >= kSettle) {
-        const double score = fovea_scores(jump.image(core::Eye::Left), ref).hdr_flip;
+        const double score = fovea::test::fovea_scores(jump.image(core::Eye::Left), ref).hdr_flip;
         flip[denoiser == reconstruct::Denoiser::Bmfr].push_back(score);
       }
     }
@@ -403,18 +380,18 @@ TEST_P(LandingRecovery, WithinTenPercentOfSteadyByTheFourthFrame) {
   renderer::GpuScene gs(ctx(), c.scene);
   constexpr int kSettle = 30, kSteady = 40;
   const reconstruct::ReconSettings s = pipeline::FrameConfig::default_recon();
-  FoveaReference ref;
+  fovea::test::FoveaReference ref;
   pipeline::FramePipeline steady(ctx(), gs, core::stereo_views(display), {}, s);
   for (int f = 0; f < kSteady; ++f) steady.render(poses, {target, target}, std::uint32_t(f));
   ref = fovea_reference(ctx(), gs, steady.view(core::Eye::Left), target, 256);
-  const double control = fovea_scores(steady.image(core::Eye::Left), ref).hdr_flip;
+  const double control = fovea::test::fovea_scores(steady.image(core::Eye::Left), ref).hdr_flip;
   pipeline::FramePipeline jump(ctx(), gs, core::stereo_views(display), {}, s);
   std::printf("%s: fovea HDR-FLIP per frame after the landing / steady %.4f:", GetParam(), control);
   for (int f = 0; f < kSettle + int(reconstruct::kLandingFrames); ++f) {
     const glm::dvec3 gaze = f < kSettle ? before : target;
     jump.render(poses, {gaze, gaze}, std::uint32_t(f));
     if (f < kSettle) continue;
-    const double r = fovea_scores(jump.image(core::Eye::Left), ref).hdr_flip / control;
+    const double r = fovea::test::fovea_scores(jump.image(core::Eye::Left), ref).hdr_flip / control;
     std::printf(" %.3f", r);
     ASSERT_TRUE(std::isfinite(r));
     if (f == kSettle + int(reconstruct::kLandingFrames) - 1) {

@@ -3,7 +3,7 @@
 // stereo sharing and BMFR, and multiplied back after, so a textured wall lit only by light
 // bounced off a white panel keeps its texture as well as the same wall lit directly. Fovea
 // SSIM against a converged reference of the same light transport, after 16 still frames
-// (measured: directly 0.966, only indirectly 0.959). The indirectly lit wall's reference
+// (measured: directly 0.995, only indirectly 0.986). The indirectly lit wall's reference
 // needs ~4096 spp: at 1024 its own noise held its SSIM near 0.91.
 #include <cstdio>
 #include <vector>
@@ -78,21 +78,18 @@ Fovea fovea_ssim(fovea::gpu::Context& ctx, const renderer::Scene& scene) {
   pipeline::FramePipeline p(ctx, gs, core::stereo_views(display), {}, reconstruct::ReconSettings{}, {}, /*mono=*/true);
   const auto poses = core::eye_poses(scene.camera, display);
   for (std::uint32_t f = 0; f < 16; ++f) p.render(poses, kGaze, f);
-  const core::View view = p.view(core::Eye::Left);
   renderer::ReferenceOptions o;  // the pipeline's transport: PathConfig{}
   o.path.spp = 64;
   o.max_spp = 4096;
   o.until_pixel_rel_error = 0.01;  // the indirectly lit wall needs ~4096, the lit one far fewer
-  const core::Image ref = renderer::render_reference(ctx, gs, view, core::Eye::Left, o).image;
-  const core::ErrorMaps maps = core::error_maps(p.image(core::Eye::Left), ref, core::flip_ppd(view));
-  const std::vector<float> w = fovea::test::fovea_pixel_weights(view, kGaze[0]);
+  const fovea::test::FoveaReference ref = fovea::test::fovea_reference(ctx, gs, p.view(core::Eye::Left), kGaze[0], o);
   double lum = 0, n = 0;
-  for (std::size_t i = 0; i < w.size(); ++i) {
-    const glm::vec4 c = ref.pixels[i];
-    lum += w[i] * (0.2126 * c.x + 0.7152 * c.y + 0.0722 * c.z);
-    n += w[i];
+  for (std::size_t i = 0; i < ref.weights.size(); ++i) {
+    const glm::vec4 c = ref.image.pixels[i];
+    lum += ref.weights[i] * (0.2126 * c.x + 0.7152 * c.y + 0.0722 * c.z);
+    n += ref.weights[i];
   }
-  return {core::pool(maps, w).ssim, lum / n};
+  return {fovea::test::fovea_scores(p.image(core::Eye::Left), ref).ssim, lum / n};
 }
 
 TEST_F(GpuTest, TextureLitOnlyIndirectlyKeepsItsDetail) {
