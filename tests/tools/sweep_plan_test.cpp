@@ -211,13 +211,18 @@ TEST(SweepPlan, PlanFileRoundTripsAndTheProgramUsesRenderOptions) {
 TEST(SweepPlan, HelpOptionsParsed) {
   const auto o = parse_help_options(
       "usage: x\n  --scene S             a scene\n  --display NAME|FILE   preset\n  --no-blur             skip\n"
-      "                        --not-an-option here\n  --help                this text\n");
-  ASSERT_EQ(o.size(), 3u);
+      "                        --not-an-option here\n  --help                this text\n  --quiet\n"
+      "  --eq=1  not one\n  ---x  not one\n  --Upper  not one\n  --trailing \n   --indented  not one\n  --2d X\n");
+  ASSERT_EQ(o.size(), 5u);
   EXPECT_EQ(o[0].name, "scene");
   EXPECT_TRUE(o[0].valued);
   EXPECT_TRUE(o[1].valued);
   EXPECT_EQ(o[2].name, "no-blur");
   EXPECT_FALSE(o[2].valued);
+  EXPECT_EQ(o[3].name, "quiet");  // a flag at the line's end
+  EXPECT_FALSE(o[3].valued);
+  EXPECT_EQ(o[4].name, "2d");
+  EXPECT_TRUE(o[4].valued);
 }
 
 TEST(SweepShard, EveryJobInExactlyOneShard) {

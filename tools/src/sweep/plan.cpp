@@ -5,7 +5,6 @@
 #include <cstdio>
 #include <fstream>
 #include <map>
-#include <regex>
 #include <set>
 #include <sstream>
 
@@ -123,13 +122,23 @@ const SharedInput* Plan::find_shared(const std::string& id) const {
 }
 
 std::vector<RenderOption> parse_help_options(const std::string& help) {
-  static const std::regex line(R"(^  --([a-z0-9][a-z0-9-]*)( [^ ]|  |$))");
+  // An option's line: "  --name" (a lower-case letter or digit, then those and '-'), then
+  // " VALUE" (the option takes one), or two spaces or the line's end (a flag).
+  const auto name_char = [](char c) { return (c >= 'a' && c <= 'z') || (c >= '0' && c <= '9') || c == '-'; };
   std::vector<RenderOption> out;
   std::istringstream in(help);
   std::string l;
   while (std::getline(in, l)) {
-    std::smatch m;
-    if (std::regex_search(l, m, line) && m[1] != "help") out.push_back({m[1], m[2].str().size() == 2 && m[2].str()[1] != ' '});
+    if (!l.starts_with("  --") || l.size() == 4 || l[4] == '-' || !name_char(l[4])) continue;
+    std::size_t end = 4;
+    while (end < l.size() && name_char(l[end])) ++end;
+    bool takes_value = false;
+    if (end < l.size()) {
+      if (l[end] != ' ' || end + 1 == l.size()) continue;
+      takes_value = l[end + 1] != ' ';
+    }
+    std::string name = l.substr(4, end - 4);
+    if (name != "help") out.push_back({std::move(name), takes_value});
   }
   return out;
 }
