@@ -11,8 +11,6 @@
 
 #include <glm/gtc/quaternion.hpp>
 
-#include "fovea/core/acuity.hpp"
-#include "fovea/core/flip.hpp"
 #include "fovea/core/metrics.hpp"
 #include "fovea/reconstruct/settings.hpp"
 #include "fovea/renderer/reference.hpp"

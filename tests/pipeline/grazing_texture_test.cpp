@@ -9,7 +9,6 @@
 #include <numbers>
 #include <vector>
 
-#include "fovea/core/flip.hpp"
 #include "fovea/core/metrics.hpp"
 #include "fovea/renderer/reference.hpp"
 #include "gpu_fixture.hpp"

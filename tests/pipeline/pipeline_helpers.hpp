@@ -56,15 +56,6 @@ inline core::Image cells_image(const std::vector<glm::vec4>& v, Keep keep) {
   return img;
 }
 
-// Weight 1 for the pixels of `view` within the fovea (e <= 5.79°) around `gaze`, else 0:
-// the pooling weights of the fovea scores.
-inline std::vector<float> fovea_pixel_weights(const core::View& view, glm::dvec3 gaze) {
-  const std::vector<float> ecc = core::eccentricity_map(view, gaze);
-  std::vector<float> w(ecc.size());
-  for (std::size_t i = 0; i < ecc.size(); ++i) w[i] = ecc[i] <= core::acuity::kFoveaDeg ? 1.0f : 0.0f;
-  return w;
-}
-
 // A converged reference of the fovea alone: the pixels within `radius_deg` of `gaze` and the
 // margin their FLIP/SSIM neighbourhoods read, at a fraction of the whole view's cost. The
 // fovea's scores equal those against a whole reference (its pixels are traced alike) but

@@ -8,8 +8,6 @@
 #include <cstdio>
 #include <vector>
 
-#include "fovea/core/acuity.hpp"
-#include "fovea/core/flip.hpp"
 #include "fovea/core/metrics.hpp"
 #include "fovea/renderer/reference.hpp"
 #include "gpu_fixture.hpp"
