@@ -1,8 +1,8 @@
 # Run after a GoogleTest executable is built (cmake -P): lists its tests and writes the CTest
 # file that registers them one CTest test per test suite, up to GROUP_MAX tests each
 # (`Suite.*`, `Suite.*#2`, ... for a larger suite), so that one process runs several tests.
-# Tests matching a regular expression of SINGLE_FILE (one per line, # comments) are registered
-# alone under their own names, as gtest_discover_tests would. A process's start (the Vulkan
+# Tests matching a regular expression of SINGLE_FILE (one per line, # comments), and every test
+# when GROUP_MAX is 1, are registered alone under their GoogleTest names. A process's start (the Vulkan
 # loader, driver and validation layer, the sanitizer runtime) costs more than most tests
 # (docs/building.md, "Build and test time").
 #
@@ -61,6 +61,9 @@ foreach(suite IN LISTS suites)
   foreach(test IN LISTS tests_${key})
     set(full "${suite}.${test}")
     set(alone FALSE)
+    if(GROUP_MAX EQUAL 1)
+      set(alone TRUE)
+    endif()
     foreach(p IN LISTS single_patterns)
       if(full MATCHES "${p}")
         set(alone TRUE)
