@@ -48,7 +48,7 @@ Rendered render(fovea::gpu::Context& ctx, const renderer::GpuScene& gs, const re
 
 void expect_bmfr_not_worse(fovea::gpu::Context& ctx, const char* scene_name) {
   const renderer::Scene scene = renderer::load_scene(scene_name);
-  renderer::GpuScene gs(ctx, scene);
+  renderer::GpuScene gs(ctx, scene, {}, fovea::test::kStatisticsTracing);
   const Rendered rb = render(ctx, gs, scene, reconstruct::Denoiser::Bmfr);
   const core::Image& bmfr = rb.image;
   const core::Image none = render(ctx, gs, scene, reconstruct::Denoiser::None).image;

@@ -33,7 +33,7 @@ const std::array<glm::dvec3, 2> kGaze{glm::dvec3(0, 0, -1), glm::dvec3(0, 0, -1)
 struct Cornell {
   explicit Cornell(fovea::gpu::Context& ctx)
       : scene(renderer::load_scene("cornell")),
-        gs(ctx, scene),
+        gs(ctx, scene, {}, fovea::test::kStatisticsTracing),
         display(fovea::test::display_of_size(kWidth, kHeight)),
         poses(core::eye_poses(scene.camera, display)),
         views(core::stereo_views(display)) {}

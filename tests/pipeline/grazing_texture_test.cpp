@@ -75,7 +75,7 @@ class GrazingTexture : public GpuTest {
   void SetUp() override {
     GpuTest::SetUp();
     scene_ = brick_floor();
-    gs_ = std::make_unique<renderer::GpuScene>(ctx(), scene_);
+    gs_ = std::make_unique<renderer::GpuScene>(ctx(), scene_, renderer::BvhOptions{}, fovea::test::kStatisticsTracing);
     const core::View view = narrow_display().view(core::Eye::Left);
     renderer::ReferenceOptions o;  // the pipeline's transport: PathConfig{}
     o.path.spp = 32;

@@ -65,7 +65,7 @@ class ResolveInverse : public GpuTest, public ::testing::WithParamInterface<cons
 
 TEST_P(ResolveInverse, MatchesTheExactInverseOnEveryPixel) {
   const renderer::Scene scene = renderer::load_scene("cornell");
-  renderer::GpuScene gs(ctx(), scene);
+  renderer::GpuScene gs(ctx(), scene, {}, fovea::test::kStatisticsTracing);
   const core::DisplayPreset display = core::load_display(GetParam());
   reconstruct::ReconSettings s;
   s.denoiser = reconstruct::Denoiser::None;

@@ -187,7 +187,7 @@ TEST_F(GpuTest, FoveaIsSharpWithinThreeFramesAfterA40DegreeSaccade) {
 // reference as the control from the second frame (the lower ratio is not blur).
 TEST_F(GpuTest, SaccadeRecoveryCurveOnTheDefaultScene) {
   const CurveSetting c("default");
-  renderer::GpuScene gs(ctx(), c.scene);
+  renderer::GpuScene gs(ctx(), c.scene, {}, fovea::test::kStatisticsTracing);
   fovea::test::FoveaReference ref;
   for (const auto denoiser : {reconstruct::Denoiser::None, reconstruct::Denoiser::Bmfr}) {
     reconstruct::ReconSettings s;
@@ -276,7 +276,7 @@ class SaccadeRecoveryPerScene : public GpuTest, public ::testing::WithParamInter
 
 TEST_P(SaccadeRecoveryPerScene, BmfrRecoversWithinThreeFrames) {
   const CurveSetting c(GetParam());
-  renderer::GpuScene gs(ctx(), c.scene);
+  renderer::GpuScene gs(ctx(), c.scene, {}, fovea::test::kStatisticsTracing);
   reconstruct::ReconSettings s;
   s.denoiser = reconstruct::Denoiser::Bmfr;
   pipeline::FramePipeline control(ctx(), gs, core::stereo_views(c.display), {}, s, c.path, true);
@@ -336,7 +336,7 @@ class LandingBmfrAgainstNone : public GpuTest, public ::testing::WithParamInterf
 TEST_P(LandingBmfrAgainstNone, BmfrIsNoWorseOnAnyFrameAfterTheLanding) {
   const SmallStep c(GetParam());
   const auto& [display, poses, before, target] = std::tie(c.display, c.poses, c.before, c.target);
-  renderer::GpuScene gs(ctx(), c.scene);
+  renderer::GpuScene gs(ctx(), c.scene, {}, fovea::test::kStatisticsTracing);
   constexpr int kSettle = 10;
   fovea::test::FoveaReference ref;
   std::array<std::vector<double>, 2> flip;  // none, bmfr
@@ -377,7 +377,7 @@ class LandingRecovery : public GpuTest, public ::testing::WithParamInterface<con
 TEST_P(LandingRecovery, WithinTenPercentOfSteadyByTheFourthFrame) {
   const SmallStep c(GetParam());
   const auto& [display, poses, before, target] = std::tie(c.display, c.poses, c.before, c.target);
-  renderer::GpuScene gs(ctx(), c.scene);
+  renderer::GpuScene gs(ctx(), c.scene, {}, fovea::test::kStatisticsTracing);
   constexpr int kSettle = 30, kSteady = 40;
   const reconstruct::ReconSettings s = pipeline::FrameConfig::default_recon();
   fovea::test::FoveaReference ref;

@@ -71,7 +71,7 @@ struct Fovea {
 };
 
 Fovea fovea_ssim(fovea::gpu::Context& ctx, const renderer::Scene& scene) {
-  renderer::GpuScene gs(ctx, scene);
+  renderer::GpuScene gs(ctx, scene, {}, fovea::test::kStatisticsTracing);
   const core::DisplayPreset display = fovea::test::display_of_size(kWidth, kHeight);
   pipeline::FramePipeline p(ctx, gs, core::stereo_views(display), {}, reconstruct::ReconSettings{}, {}, /*mono=*/true);
   const auto poses = core::eye_poses(scene.camera, display);

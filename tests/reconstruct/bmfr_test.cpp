@@ -173,7 +173,7 @@ TEST_F(Bmfr, CornellAfter32FramesBeatsInputAndAccumulation) {
   const int size = 128;
   const std::uint32_t frames = 32, ref_frames = 256;
   const renderer::Scene scene = renderer::load_scene("cornell");
-  renderer::GpuScene gs(ctx(), scene);
+  renderer::GpuScene gs(ctx(), scene, {}, fovea::test::kStatisticsTracing);
   const core::DisplayPreset display = fovea::test::display_of_size(size, size);
   core::DistributionParams dp;
   dp.kind = core::DistributionKind::Cartesian;

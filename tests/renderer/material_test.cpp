@@ -48,7 +48,7 @@ Albedo sphere_albedo(fovea::gpu::Context& ctx, const fr::Material& m) {
   const glm::vec3 centre(0, 0, -3);
   fr::add_sphere(s, centre, 1.0f, s.add_material(m), 64, 128);
   fr::sanitize(s, "albedo-sphere");
-  fr::GpuScene g(ctx, s);
+  fr::GpuScene g(ctx, s, {}, fovea::test::kStatisticsTracing);
   const fc::View v(fc::Fov::from_degrees(-20, 20, 20, -20), 32, 32);  // the sphere spans ±19.5°
   fr::PathConfig c;
   c.spp = 64;

@@ -11,6 +11,13 @@
 
 namespace fovea::test {
 
+// The traversal of the image-statistics tests (tests/image-statistics-tests.txt). What they
+// measure (sample statistics, reconstruction, denoising, energy) does not depend on how a hit
+// is found, and both traversals find the same hits (RayQuery.*). The compute BVH is the one
+// `--trace auto` takes on lavapipe, where it traces at twice the ray queries' rate; every
+// other GPU test keeps GpuScene's default, ray queries where the device has them.
+inline constexpr renderer::Tracing kStatisticsTracing = renderer::Tracing::Compute;
+
 struct Traced {
   std::vector<glm::vec4> radiance, direct, indirect, albedo, normal_depth, position_material;
 };
