@@ -8,6 +8,7 @@
 #include <sys/stat.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <chrono>
 #include <cstdlib>
 #include <filesystem>
@@ -15,6 +16,7 @@
 #include <random>
 #include <sstream>
 #include <thread>
+#include <vector>
 
 #include <nlohmann/json.hpp>
 
@@ -159,16 +161,18 @@ class OneNodeSlurm {
     return "the node did not become idle within 30 s: " + test::read_text(dir_ + "/slurmctld.log");
   }
 
+  // All three told at once: each takes 1-2 s to exit, one after the other 5 s.
   void stop() {
+    std::vector<pid_t> pids;
     for (const char* d : {"slurmd", "slurmctld", "munged"}) {
-      const std::string pid_text = test::read_text(dir_ + "/" + d + ".pid");
-      const pid_t pid = pid_t(std::atol(pid_text.c_str()));
-      if (pid <= 0) continue;
-      ::kill(pid, SIGTERM);
-      for (int i = 0; i < 50 && ::kill(pid, 0) == 0; ++i) std::this_thread::sleep_for(std::chrono::milliseconds(100));
-      if (::kill(pid, 0) == 0) ::kill(pid, SIGKILL);
+      const pid_t pid = pid_t(std::atol(test::read_text(dir_ + "/" + d + ".pid").c_str()));
       fs::remove(dir_ + "/" + d + ".pid");
+      if (pid > 0 && ::kill(pid, SIGTERM) == 0) pids.push_back(pid);
     }
+    const auto alive = [&] { return std::ranges::any_of(pids, [](pid_t p) { return ::kill(p, 0) == 0; }); };
+    for (int i = 0; i < 50 && alive(); ++i) std::this_thread::sleep_for(std::chrono::milliseconds(100));
+    for (const pid_t p : pids)
+      if (::kill(p, 0) == 0) ::kill(p, SIGKILL);
     ::unsetenv("SLURM_CONF");
   }
 

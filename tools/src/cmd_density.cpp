@@ -20,7 +20,7 @@
 #include "figures.hpp"
 #include "gaze_arg.hpp"
 
-namespace fovea::tools {
+namespace fovea::tools::cmd_density {
 namespace {
 
 constexpr const char* kHelp = R"(usage: fovea density [options]
@@ -181,4 +181,4 @@ int run(std::vector<std::string> argv) {
 
 FOVEA_COMMAND(density_command, "density", "heat map and JSON of a sample distribution's density", run);
 
-}  // namespace fovea::tools
+}  // namespace fovea::tools::cmd_density

@@ -7,7 +7,7 @@
 #include "command.hpp"
 #include "fovea/devices/hid_transport.hpp"
 
-namespace fovea::tools {
+namespace fovea::tools::cmd_devices {
 
 namespace {
 
@@ -44,4 +44,4 @@ int run(std::vector<std::string> args) {
 
 FOVEA_COMMAND(devices_cmd, "devices", "list HID eye trackers (usage page 0x12) via hidapi and libusb", run);
 
-}  // namespace fovea::tools
+}  // namespace fovea::tools::cmd_devices

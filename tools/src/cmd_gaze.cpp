@@ -22,7 +22,7 @@
 #include "fovea/devices/screen.hpp"
 #include "fovea/devices/synthetic.hpp"
 
-namespace fovea::tools {
+namespace fovea::tools::cmd_gaze {
 
 namespace dv = fovea::devices;
 
@@ -484,4 +484,4 @@ int run(std::vector<std::string> args) {
 
 FOVEA_COMMAND(gaze_cmd, "gaze", "recorded, synthetic and live gaze: info, convert, synth, plot, record", run);
 
-}  // namespace fovea::tools
+}  // namespace fovea::tools::cmd_gaze

@@ -25,7 +25,7 @@
 #include "reference_cache.hpp"
 #include "render_setup.hpp"
 
-namespace fovea::tools {
+namespace fovea::tools::cmd_latency {
 namespace {
 
 namespace fs = std::filesystem;
@@ -463,4 +463,4 @@ int run(std::vector<std::string> argv) {
 FOVEA_COMMAND(latency_command, "latency", "latency harness: tracker + pipeline + display model, gaze-to-photon, foveal error",
               run);
 
-}  // namespace fovea::tools
+}  // namespace fovea::tools::cmd_latency

@@ -22,7 +22,7 @@
 #include "fovea/core/image.hpp"
 #include "fovea/core/lens.hpp"
 
-namespace fovea::tools {
+namespace fovea::tools::cmd_lens {
 namespace {
 
 constexpr const char* kHelp = R"(usage: fovea lens [options]
@@ -168,4 +168,4 @@ int run(std::vector<std::string> argv) {
 
 FOVEA_COMMAND(lens_command, "lens", "picture and measure a display preset's lens optics and hidden area", run);
 
-}  // namespace fovea::tools
+}  // namespace fovea::tools::cmd_lens

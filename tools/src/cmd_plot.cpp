@@ -11,7 +11,7 @@
 #include "fovea/core/error.hpp"
 #include "fovea/core/json.hpp"
 
-namespace fovea::tools {
+namespace fovea::tools::cmd_plot {
 namespace {
 
 constexpr const char* kHelp = R"(usage: fovea plot DATA.json
@@ -50,4 +50,4 @@ int run(std::vector<std::string> argv) {
 
 FOVEA_COMMAND(plot_command, "plot", "draw the figures of a data file (matplotlib; PNG and SVG)", run);
 
-}  // namespace fovea::tools
+}  // namespace fovea::tools::cmd_plot

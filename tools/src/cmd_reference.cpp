@@ -20,7 +20,7 @@
 #include "fovea/renderer/scene_io.hpp"
 #include "reference_cache.hpp"
 
-namespace fovea::tools {
+namespace fovea::tools::cmd_reference {
 namespace {
 
 constexpr const char* kHelp = R"(usage: fovea reference --scene S --out F.exr|F.png [options]
@@ -174,4 +174,4 @@ int run(std::vector<std::string> argv) {
 
 FOVEA_COMMAND(reference_command, "reference", "progressive Cartesian path-traced reference image (EXR + PNG)", run);
 
-}  // namespace fovea::tools
+}  // namespace fovea::tools::cmd_reference

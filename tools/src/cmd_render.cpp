@@ -36,7 +36,7 @@
 #include "fovea/renderer/reference.hpp"
 #include "fovea/renderer/scene_io.hpp"
 
-namespace fovea::tools {
+namespace fovea::tools::cmd_render {
 namespace {
 
 namespace fs = std::filesystem;
@@ -807,4 +807,4 @@ int run(std::vector<std::string> argv) {
 
 FOVEA_COMMAND(render_command, "render", "foveated stereo path tracing + reconstruction; PNGs, EXR, report.json", run);
 
-}  // namespace fovea::tools
+}  // namespace fovea::tools::cmd_render

@@ -17,7 +17,7 @@
 #include "fovea/core/json.hpp"
 #include "fovea/core/metrics.hpp"
 
-namespace fovea::tools {
+namespace fovea::tools::cmd_replay_diff {
 namespace {
 
 namespace fs = std::filesystem;
@@ -175,4 +175,4 @@ int run(std::vector<std::string> argv) {
 
 FOVEA_COMMAND(replay_diff_command, "replay-diff", "compare two render outputs (gaze per frame, images) with tolerances", run);
 
-}  // namespace fovea::tools
+}  // namespace fovea::tools::cmd_replay_diff

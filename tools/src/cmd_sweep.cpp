@@ -17,7 +17,7 @@
 #include "sweep/run.hpp"
 #include "sweep/slurm.hpp"
 
-namespace fovea::tools {
+namespace fovea::tools::cmd_sweep {
 namespace {
 
 namespace fs = std::filesystem;
@@ -208,4 +208,4 @@ int run(std::vector<std::string> argv) {
 
 FOVEA_COMMAND(sweep_command, "sweep", "speed/accuracy sweeps: plan, run (local pool or shard), slurm, report", run);
 
-}  // namespace fovea::tools
+}  // namespace fovea::tools::cmd_sweep

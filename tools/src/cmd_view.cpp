@@ -29,7 +29,7 @@
 #include "fovea/renderer/scene_io.hpp"
 #include "gaze_arg.hpp"
 
-namespace fovea::tools {
+namespace fovea::tools::cmd_view {
 namespace {
 
 constexpr const char* kHelp = R"(usage: fovea view [options]
@@ -228,4 +228,4 @@ int run(std::vector<std::string> argv) {
 
 FOVEA_COMMAND(view_command, "view", "mirror window: foveated path tracing of a scene through the lens, gaze marker, mouse gaze", run);
 
-}  // namespace fovea::tools
+}  // namespace fovea::tools::cmd_view
