@@ -66,7 +66,9 @@ struct StillCornell {
   std::array<glm::dvec3, 2> gaze{glm::dvec3(0, 0, -1), glm::dvec3(0, 0, -1)};
   reconstruct::ReconSettings settings;
   StillCornell(gpu::Context& ctx, int w, int h)
-      : gs(ctx, scene, {}, fovea::test::kStatisticsTracing), display(fovea::test::display_of_size(w, h)), poses(core::eye_poses(scene.camera, display)) {
+      : gs(ctx, scene, {}, fovea::test::kStatisticsTracing),
+        display(fovea::test::display_of_size(w, h)),
+        poses(core::eye_poses(scene.camera, display)) {
     settings.denoiser = reconstruct::Denoiser::None;
     settings.blur = false;
   }

@@ -14,8 +14,9 @@ namespace fovea::test {
 // The traversal of the image-statistics tests (tests/image-statistics-tests.txt). What they
 // measure (sample statistics, reconstruction, denoising, energy) does not depend on how a hit
 // is found, and both traversals find the same hits (RayQuery.*). The compute BVH is the one
-// `--trace auto` takes on lavapipe, where it traces at twice the ray queries' rate; every
-// other GPU test keeps GpuScene's default, ray queries where the device has them.
+// `--trace auto` takes on lavapipe, where it traces at twice the ray queries' rate. The other
+// GPU tests (but the few that share these tests' fixtures) keep GpuScene's default, ray
+// queries where the device has them.
 inline constexpr renderer::Tracing kStatisticsTracing = renderer::Tracing::Compute;
 
 struct Traced {
