@@ -245,7 +245,7 @@ TEST(SweepLatency, ReportDrawsLatencyAgainstQualityAndSectionsPerScene) {
                            // Equal quality at equal budget, a cheaper: a is never better, and
                            // a at 0.4 is the fastest within 5% of the best.
                            "- a against b in fovea_psnr at equal budget: better at 0 of 2.",
-                           "- The fastest within 5% of it: a at budget 0.4 (34.00, 40 ms)."})
+                           "- The fastest within 5% of it: a at budget 0.4 (34.00, 40.0 ms)."})
     EXPECT_NE(page.find(text), std::string::npos) << text;
   // Latency rows do not enter the render tables.
   const std::size_t latency_at = page.find("## Latency against quality");

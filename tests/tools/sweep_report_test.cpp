@@ -178,7 +178,7 @@ TEST(SweepReport, SectionsByTwoSettingsAndSpeedUpAtEqualQuality) {
   for (const char* text :
        {"One section per display: [p1](#display-p1), [p2](#display-p2)", "## display p1\n", "## display p2\n",
         "## vp against full at equal fovea_flip",
-        "| display p1 | 1000 | 100 / 110 | 0.2000 | 0.2 | 200 | 20 / 22 | 0.2090 | **5.00×** | 5.00× | 5.00 | 1.00 | fovea_psnr 30.00 → 31.00 |",
+        "| display p1 | 1000 | 100 / 110 | 0.2000 | 0.2 | 200 | 20.0 / 22.0 | 0.2090 | **5.00×** | 5.00× | 5.00 | 1.00 | fovea_psnr 30.00 → 31.00 |",
         "| display p2 | 1000 | 100 / 110 | 0.2000 | none as good (best: 0.3500 at budget 0.1) | – | – | – | – | – | – | – | – |"})
     EXPECT_NE(page.find(text), std::string::npos) << text << "\n" << page;
   // The scene does not vary: it names no section; the fronts and plots are per display.
@@ -204,6 +204,23 @@ TEST(SweepReport, SectionsByTwoSettingsAndSpeedUpAtEqualQuality) {
   EXPECT_EQ(page2.find("## vp against"), std::string::npos);  // no speedup configured, no such table
   EXPECT_TRUE(fs::exists(dir2 + "/report/quality_vs_time_fovea_flip_b_p2.png"));
 
+  // At listed budgets instead of equal quality (a sweep that measures time only): one row per
+  // budget a section has, whatever its quality; times below 10 ms keep three digits.
+  json at = file;
+  at[0]["report"]["speedup"] = {{"of", "vp"}, {"over", "full"}, {"at", {0.1, 0.4, 0.3}}};
+  core::write_file_atomic(plan_path, plan_to_jsonl(expand_sweep(at, "synthetic.json", opts)));
+  const auto r4 = test::run_fovea("sweep report " + plan_path + " --out " + dir + "/report --markdown " + dir + "/at.md");
+  ASSERT_EQ(r4.status, 0) << r4.err;
+  const std::string page4 = test::read_text(dir + "/at.md");
+  for (const char* text :
+       {"## vp against full at budget 0.1, 0.4, 0.3\n",
+        "| display p1 | 1000 | 100 / 110 | 0.2000 | 0.1 | 100 | 10.0 / 11.0 | 0.3000 | **10.00×** | 10.00× | 10.00 | 1.00 |",
+        "| display p1 | 1000 | 100 / 110 | 0.2000 | 0.4 | 400 | 40.0 / 44.0 | 0.1900 | **2.50×** | 2.50× | 2.50 | 1.00 |",
+        "| display p2 | 1000 | 100 / 110 | 0.2000 | 0.1 | 100 | 10.0 / 11.0 | 0.3500 | **10.00×** |"})
+    EXPECT_NE(page4.find(text), std::string::npos) << text << "\n" << page4;
+  EXPECT_EQ(page4.find("| 0.3 |"), std::string::npos) << "a budget no job ran got a row";
+  EXPECT_EQ(page4.find("at equal fovea_flip"), std::string::npos);
+
   // A malformed speedup names the key.
   json bad = file;
   bad[0]["report"]["speedup"] = {{"of", "vp"}};
@@ -211,6 +228,11 @@ TEST(SweepReport, SectionsByTwoSettingsAndSpeedUpAtEqualQuality) {
   const auto r3 = test::run_fovea("sweep report " + plan_path + " --out " + dir + "/report");
   EXPECT_EQ(r3.status, 2);
   EXPECT_NE(r3.err.find("report.speedup"), std::string::npos) << r3.err;
+  bad[0]["report"]["speedup"] = {{"of", "vp"}, {"over", "full"}, {"at", {"default"}}};
+  core::write_file_atomic(plan_path, plan_to_jsonl(expand_sweep(bad, "synthetic.json", opts)));
+  const auto r5 = test::run_fovea("sweep report " + plan_path + " --out " + dir + "/report");
+  EXPECT_EQ(r5.status, 2);
+  EXPECT_NE(r5.err.find("report.speedup: at"), std::string::npos) << r5.err;
   fs::remove_all(dir);
 }
 
@@ -239,8 +261,8 @@ TEST(SweepReport, RepeatedRunsAreOneRowWithTheirSpread) {
   ASSERT_EQ(r.status, 0) << r.err;
   const std::string page = test::read_text(dir + "/page.md");
   for (const char* text : {"Jobs: 7 done of 7.", "differ only in `seed` are one row",
-                           "| a | 0.1 | – | 12 ± 2 | 0.2100 ± 0.0100 | yes |", "| a | 0.2 | – | 20 | 0.1500 | yes |",
-                           "| b | 0.1 | – | 30 | 0.3000 | yes |"})
+                           "| a | 0.1 | – | 12.0 ± 2.0 | 0.2100 ± 0.0100 | yes |", "| a | 0.2 | – | 20.0 | 0.1500 | yes |",
+                           "| b | 0.1 | – | 30.0 | 0.3000 | yes |"})
     EXPECT_NE(page.find(text), std::string::npos) << text << "\n" << page;
   // One point per (distribution, budget) in the plot; every run in the CSV, each with its
   // row's front membership.

@@ -100,10 +100,12 @@ struct Row {
 
 std::string setting_text(const json& v) { return v.is_string() ? v.get<std::string>() : v.dump(); }
 
-// report.speedup: one group's whole-frame speed-up over another's at equal quality, per section.
+// report.speedup: one group's whole-frame speed-up over another's per section, at equal quality
+// or, with `at`, at the listed budgets (a sweep that measures time only, without references).
 struct SpeedUp {
   std::string of, over, quality;  // quality: empty = the first quality metric
   double tolerance = 0;           // relative: "as good" allows this much worse
+  std::vector<double> at;         // the `of` jobs' budgets compared; empty: at equal quality
 };
 
 struct Config {
@@ -201,7 +203,8 @@ Config read_config(const json& r, const std::vector<Row>& rows) {
     const json& x = r["speedup"];
     const auto bad = [](const std::string& what) { return core::InputError("report.speedup: " + what); };
     if (!x.is_object())
-      throw bad("expected an object {\"of\": GROUP, \"over\": GROUP, \"quality\": METRIC, \"tolerance\": N}");
+      throw bad("expected an object {\"of\": GROUP, \"over\": GROUP, \"quality\": METRIC, \"tolerance\": N} "
+                "or {\"of\": GROUP, \"over\": GROUP, \"at\": [BUDGET, ...]}");
     SpeedUp s;
     for (const auto& [k, v] : x.items()) {
       if (k == "of" || k == "over" || k == "quality") {
@@ -211,8 +214,14 @@ Config read_config(const json& r, const std::vector<Row>& rows) {
         if (!v.is_number() || !(v.get<double>() >= 0 && v.get<double>() < 1))
           throw bad("tolerance: expected a number in [0, 1)");
         s.tolerance = v.get<double>();
+      } else if (k == "at") {
+        for (const json& b : v.is_array() ? v : json::array({v})) {
+          if (!b.is_number()) throw bad("at: expected a budget or a list of budgets");
+          s.at.push_back(b.get<double>());
+        }
+        if (s.at.empty()) throw bad("at: expected a budget or a list of budgets");
       } else {
-        throw bad("unknown key \"" + k + "\" (of, over, quality, tolerance)");
+        throw bad("unknown key \"" + k + "\" (of, over, quality, tolerance, at)");
       }
     }
     if (s.of.empty() || s.over.empty()) throw bad("\"of\" and \"over\" are required");
@@ -363,18 +372,23 @@ std::string fixed(double v, int decimals) {
 
 // A metric's value as table text: dB and milliseconds with 1-2 decimals, the rest with 4.
 // Repeated runs (report.repeat): their mean ± standard deviation, where it is not 0.
+// Times to three significant digits from 10 ms down (a discrete GPU's frames take a few ms),
+// and factors to two.
+int ms_decimals(double v) { return std::abs(v) >= 100 ? 0 : std::abs(v) >= 10 ? 1 : 2; }
+std::string ms_text(double v) { return fixed(v, ms_decimals(v)); }
+std::string factor_text(double v) { return fixed(v, std::abs(v) >= 10 ? 0 : std::abs(v) >= 1 ? 1 : 2); }
+
 std::string md_value(const Row& r, const std::string& m) {
   if (!r.metrics.count(m)) return "–";
-  const auto text = [&](double v) {
-    if (m.find("psnr") != std::string::npos) return fixed(v, 2);
-    if (m.find("_ms") != std::string::npos) return fixed(v, 0);
-    if (m.find("samples") != std::string::npos) return fixed(v, 0);
-    return fixed(v, 4);
-  };
-  const auto sd = r.metrics.find(m + ".sd");
   const double v = r.metrics.at(m);
+  // The spread takes the value's decimals.
+  const int decimals = m.find("psnr") != std::string::npos      ? 2
+                       : m.find("_ms") != std::string::npos     ? ms_decimals(v)
+                       : m.find("samples") != std::string::npos ? 0
+                                                                : 4;
+  const auto sd = r.metrics.find(m + ".sd");
   const bool spread = sd != r.metrics.end() && sd->second > 1e-9 * std::max(1.0, std::abs(v));  // not rounding alone
-  return text(v) + (spread ? " ± " + text(sd->second) : "");
+  return fixed(v, decimals) + (spread ? " ± " + fixed(sd->second, decimals) : "");
 }
 
 // report.repeat: the done render jobs that differ only in the repeat setting (seeds) become one
@@ -625,7 +639,7 @@ void markdown_section(std::ostringstream& md, const MarkdownInput& in, const std
     for (std::size_t i = 0; i < groups.size(); ++i) md << "|---";
     md << "|\n";
     for (double t : limits) {
-      md << "| " << fixed(t, 0);
+      md << "| " << ms_text(t);
       for (const auto& g : groups) {
         const Row* best = nullptr;
         for (const Row* r : done)
@@ -690,14 +704,14 @@ void markdown_section(std::ostringstream& md, const MarkdownInput& in, const std
        << " | cost vs cartesian | speed-up for 11.1 ms | same for fove0 |\n|---|---|---|---|---|---|---|\n";
     for (const Row* r : front) {
       const double t = r->metrics.at(cfg.time);
-      md << "| " << setting(*r, cfg.group) << " | " << setting(*r, cfg.budget) << " | " << fixed(t, 0) << " | "
+      md << "| " << setting(*r, cfg.group) << " | " << setting(*r, cfg.budget) << " | " << ms_text(t) << " | "
          << md_value(*r, q0) << " | " << (full ? fixed(t / full->metrics.at(cfg.time), 2) : "–") << " | "
-         << fixed(t / 11.1, 0) << "× | " << fixed(16 * t / 11.1, 0) << "× |\n";
+         << factor_text(t / 11.1) << "× | " << factor_text(16 * t / 11.1) << "× |\n";
     }
     if (full)
-      md << "| cartesian (baseline) | – | " << fixed(full->metrics.at(cfg.time), 0) << " | " << md_value(*full, q0)
-         << " | 1.00 | " << fixed(full->metrics.at(cfg.time) / 11.1, 0) << "× | "
-         << fixed(16 * full->metrics.at(cfg.time) / 11.1, 0) << "× |\n";
+      md << "| cartesian (baseline) | – | " << ms_text(full->metrics.at(cfg.time)) << " | " << md_value(*full, q0)
+         << " | 1.00 | " << factor_text(full->metrics.at(cfg.time) / 11.1) << "× | "
+         << factor_text(16 * full->metrics.at(cfg.time) / 11.1) << "× |\n";
     // The pick: the cheapest front job within 10% of the best score any job reached.
     const Row* best = nullptr;
     for (const Row* r : done)
@@ -711,9 +725,9 @@ void markdown_section(std::ostringstream& md, const MarkdownInput& in, const std
       const double t = r->metrics.at(cfg.time);
       md << "\n**Pick** (rule: the cheapest front job whose " << q0 << " is within 10% of the best job's "
          << md_value(*best, q0) << "): " << setting(*r, cfg.group) << " at " << cfg.budget << " "
-         << setting(*r, cfg.budget) << ", " << md_value(*r, q0) << " in " << fixed(t, 0) << " ms"
+         << setting(*r, cfg.budget) << ", " << md_value(*r, q0) << " in " << ms_text(t) << " ms"
          << (full ? ", " + fixed(t / full->metrics.at(cfg.time), 2) + "× the cartesian job's time" : std::string())
-         << ". For 90 Hz on `fove0` a device must run it ≈" << fixed(16 * t / 11.1, 0)
+         << ". For 90 Hz on `fove0` a device must run it ≈" << factor_text(16 * t / 11.1)
          << "× faster than this machine did; the ranking, not the absolute time, is what carries over.\n";
       break;
     }
@@ -721,44 +735,89 @@ void markdown_section(std::ostringstream& md, const MarkdownInput& in, const std
 }
 
 // report.speedup: per section, the `over` job against the cheapest `of` job whose quality is
-// at least as good (within the tolerance): whole-frame times on the GPU and the CPU, traced
-// samples, and how much of the samples' ratio the time's ratio keeps.
+// at least as good (within the tolerance), or against the `of` job at each budget of `at`:
+// whole-frame times on the GPU and the CPU, traced samples, and how much of the samples'
+// ratio the time's ratio keeps.
 void markdown_speedup(std::ostringstream& md, const MarkdownInput& in, const std::vector<const Row*>& done) {
   const Config& cfg = in.cfg;
   const SpeedUp& su = *cfg.speedup;
   const std::string q = !su.quality.empty() ? su.quality : cfg.quality.empty() ? "" : cfg.quality[0];
-  if (q.empty()) return;
-  const bool lower = cfg.lower_better(q);
+  const bool at_budgets = !su.at.empty();
+  if (q.empty() && !at_budgets) return;
+  const bool lower = !q.empty() && cfg.lower_better(q);
   const std::string cpu = "cpu_ms.total", samples = "samples_traced_per_eye";
   const auto group = [&](const Row& r) { return r.settings.contains(cfg.group) ? setting_text(r.settings[cfg.group]) : ""; };
   const auto ratio = [](const Row& a, const Row& b, const std::string& m) {
     return a.metrics.count(m) && b.metrics.count(m) && b.metrics.at(m) > 0 ? fixed(a.metrics.at(m) / b.metrics.at(m), 2)
                                                                            : std::string("–");
   };
-  md << "## " << su.of << " against " << su.over << " at equal " << q << "\n\n"
-     << "Per section: the " << su.over << " job, and the cheapest " << su.of << " job (by `" << cfg.time
-     << "`) whose " << q << " is at least as good as its, within " << fixed(100 * su.tolerance, 0)
-     << "% (\"as good\": " << (lower ? "at most" : "at least") << " " << (lower ? "1 + " : "1 − ")
-     << fixed(su.tolerance, 2) << " times the " << su.over << " job's). *Speed-up*: the " << su.over
-     << " job's whole-frame time over the " << su.of << " job's (GPU: `" << cfg.time << "`, CPU: `" << cpu
-     << "`, both per stereo frame, every stage); *samples ratio*: traced samples per eye, " << su.over << " over "
-     << su.of << "; the last column is how much of the samples' ratio the GPU speed-up keeps (1 = cost follows "
-     << "the samples); *other quality*: the other quality metrics, " << su.over << " → " << su.of << ".\n\n"
-     << "| section | " << su.over << " samples/eye | " << su.over << " GPU / CPU ms | " << su.over << " " << q << " | "
-     << su.of << " " << cfg.budget << " | " << su.of << " samples/eye | " << su.of << " GPU / CPU ms | " << su.of << " "
-     << q << " | GPU speed-up | CPU speed-up | samples ratio | speed-up / samples ratio | other quality |\n"
+  const std::string quality_name = q.empty() ? "quality" : q;
+  if (at_budgets) {
+    std::string list;
+    for (double b : su.at) list += (list.empty() ? "" : ", ") + setting_text(json(b));
+    md << "## " << su.of << " against " << su.over << " at " << cfg.budget << " " << list << "\n\n"
+       << "Per section: the " << su.over << " job, and the " << su.of << " job at each " << cfg.budget << " listed.";
+  } else {
+    md << "## " << su.of << " against " << su.over << " at equal " << q << "\n\n"
+       << "Per section: the " << su.over << " job, and the cheapest " << su.of << " job (by `" << cfg.time
+       << "`) whose " << q << " is at least as good as its, within " << fixed(100 * su.tolerance, 0)
+       << "% (\"as good\": " << (lower ? "at most" : "at least") << " " << (lower ? "1 + " : "1 − ")
+       << fixed(su.tolerance, 2) << " times the " << su.over << " job's).";
+  }
+  md << " *Speed-up*: the " << su.over << " job's whole-frame time over the " << su.of << " job's (GPU: `" << cfg.time
+     << "`, CPU: `" << cpu << "`, both per stereo frame, every stage); *samples ratio*: traced samples per eye, "
+     << su.over << " over " << su.of << "; the last column is how much of the samples' ratio the GPU speed-up keeps "
+     << "(1 = cost follows the samples); *other quality*: the other quality metrics, " << su.over << " → " << su.of
+     << ".\n\n"
+     << "| section | " << su.over << " samples/eye | " << su.over << " GPU / CPU ms | " << su.over << " " << quality_name
+     << " | " << su.of << " " << cfg.budget << " | " << su.of << " samples/eye | " << su.of << " GPU / CPU ms | " << su.of
+     << " " << quality_name << " | GPU speed-up | CPU speed-up | samples ratio | speed-up / samples ratio | other quality |\n"
      << "|---|---|---|---|---|---|---|---|---|---|---|---|---|\n";
+  const auto budget_of = [&](const Row& r) {
+    return r.settings.contains(cfg.budget) && r.settings[cfg.budget].is_number() ? r.settings[cfg.budget].get<double>()
+                                                                                  : NAN;
+  };
   for (const Section& section : in.sections) {
     const Row* over = nullptr;
     std::vector<const Row*> of;
     for (const Row* r : done) {
       if (job_command(r->settings) != "render" || section_of(*r, cfg) != section.id || !r->metrics.count(cfg.time) ||
-          !r->metrics.count(q))
+          (!at_budgets && !r->metrics.count(q)))
         continue;
       if (group(*r) == su.over && (!over || r->metrics.at(cfg.time) < over->metrics.at(cfg.time))) over = r;
       if (group(*r) == su.of) of.push_back(r);
     }
     if (!over || of.empty()) continue;
+    const auto times = [&](const Row& r) { return md_value(r, cfg.time) + " / " + md_value(r, cpu); };
+    const auto row = [&](const Row* pick) {
+      md << "| " << section.title << " | " << md_value(*over, samples) << " | " << times(*over) << " | "
+         << (q.empty() ? "–" : md_value(*over, q)) << " | ";
+      const std::string speed_up = ratio(*over, *pick, cfg.time), samples_ratio = ratio(*over, *pick, samples);
+      const double kept = pick->metrics.count(samples) && over->metrics.count(samples) && pick->metrics.at(samples) > 0
+                              ? (over->metrics.at(cfg.time) / pick->metrics.at(cfg.time)) /
+                                    (over->metrics.at(samples) / pick->metrics.at(samples))
+                              : NAN;
+      md << (pick->settings.contains(cfg.budget) ? setting_text(pick->settings[cfg.budget]) : "–") << " | "
+         << md_value(*pick, samples) << " | " << times(*pick) << " | " << (q.empty() ? "–" : md_value(*pick, q))
+         << " | **" << speed_up << "×** | " << ratio(*over, *pick, cpu) << "× | " << samples_ratio << " | "
+         << (std::isfinite(kept) ? fixed(kept, 2) : "–") << " |";
+      std::string other;
+      for (const auto& m : cfg.quality)
+        if (m != q)
+          other += (other.empty() ? " " : "; ") + m + " " + md_value(*over, m) + " → " + md_value(*pick, m);
+      md << other << " |\n";
+    };
+    if (at_budgets) {
+      for (double b : su.at) {
+        const Row* pick = nullptr;
+        for (const Row* r : of)
+          if (std::abs(budget_of(*r) - b) <= 1e-9 * std::max(1.0, std::abs(b)) &&
+              (!pick || r->metrics.at(cfg.time) < pick->metrics.at(cfg.time)))
+            pick = r;
+        if (pick) row(pick);
+      }
+      continue;
+    }
     const double ref = over->metrics.at(q), slack = su.tolerance * std::abs(ref);
     const Row* pick = nullptr;
     for (const Row* r : of) {
@@ -766,31 +825,17 @@ void markdown_speedup(std::ostringstream& md, const MarkdownInput& in, const std
       if ((lower ? v <= ref + slack : v >= ref - slack) && (!pick || r->metrics.at(cfg.time) < pick->metrics.at(cfg.time)))
         pick = r;
     }
-    const auto times = [&](const Row& r) { return md_value(r, cfg.time) + " / " + md_value(r, cpu); };
-    md << "| " << section.title << " | " << md_value(*over, samples) << " | " << times(*over) << " | " << md_value(*over, q)
-       << " | ";
-    if (!pick) {
-      const Row* best = of.front();
-      for (const Row* r : of)
-        if (lower ? r->metrics.at(q) < best->metrics.at(q) : r->metrics.at(q) > best->metrics.at(q)) best = r;
-      md << "none as good (best: " << md_value(*best, q) << " at " << cfg.budget << " "
-         << (best->settings.contains(cfg.budget) ? setting_text(best->settings[cfg.budget]) : "–")
-         << ") | – | – | – | – | – | – | – | – |\n";
+    if (pick) {
+      row(pick);
       continue;
     }
-    const std::string speed_up = ratio(*over, *pick, cfg.time), samples_ratio = ratio(*over, *pick, samples);
-    const double kept = pick->metrics.count(samples) && over->metrics.count(samples) && pick->metrics.at(samples) > 0
-                            ? (over->metrics.at(cfg.time) / pick->metrics.at(cfg.time)) /
-                                  (over->metrics.at(samples) / pick->metrics.at(samples))
-                            : NAN;
-    md << (pick->settings.contains(cfg.budget) ? setting_text(pick->settings[cfg.budget]) : "–") << " | "
-       << md_value(*pick, samples) << " | " << times(*pick) << " | " << md_value(*pick, q) << " | **" << speed_up << "×** | "
-       << ratio(*over, *pick, cpu) << "× | " << samples_ratio << " | " << (std::isfinite(kept) ? fixed(kept, 2) : "–")
-       << " |";
-    std::string other;
-    for (const auto& m : cfg.quality)
-      if (m != q) other += (other.empty() ? " " : "; ") + m + " " + md_value(*over, m) + " → " + md_value(*pick, m);
-    md << other << " |\n";
+    const Row* best = of.front();
+    for (const Row* r : of)
+      if (lower ? r->metrics.at(q) < best->metrics.at(q) : r->metrics.at(q) > best->metrics.at(q)) best = r;
+    md << "| " << section.title << " | " << md_value(*over, samples) << " | " << times(*over) << " | "
+       << md_value(*over, q) << " | none as good (best: " << md_value(*best, q) << " at " << cfg.budget << " "
+       << (best->settings.contains(cfg.budget) ? setting_text(best->settings[cfg.budget]) : "–")
+       << ") | – | – | – | – | – | – | – | – |\n";
   }
   md << "\n";
 }
