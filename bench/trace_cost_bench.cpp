@@ -30,6 +30,7 @@
 #include <glm/vec2.hpp>
 
 #include "fovea/core/display.hpp"
+#include "fovea/core/duration.hpp"
 #include "fovea/core/error.hpp"
 #include "fovea/core/eye_optics.hpp"
 #include "fovea/core/stereo_views.hpp"
@@ -192,20 +193,30 @@ int run(int argc, char** argv) {
                       static_cast<long long>(p.traced_cells(fc::Eye::Left)), v.busy, v.mixed, v.extent_px);
         }
       }
-      char row[640];
-      std::snprintf(row, sizeof row,
-                    "| %ld | %s | %.2f → %.2f | %.0f | %s | %.0f / %.0f | %s | %.0f / %.0f | %.3f / %.3f | %.0f | %.0f |"
-                    " %.0f | %.0f | %.0f | %.2f / %.2f / %.2f / %.2f / %.2f | %.0f | %.0f | %.0f | %.2f |"
-                    " %.0f / %.0f / %.0f | %.0f / %.0f / %.0f |",
-                    round + 1, c.name().c_str(), load0, load1, t.trace.gpu_ms, order_name(orders[0]), trace[0].gpu_ms,
-                    trace[0].cpu_ms, order_name(orders[1]), trace[1].gpu_ms, trace[1].cpu_ms,
-                    trace[1].gpu_ms / trace[0].gpu_ms, trace[1].cpu_ms / trace[0].cpu_ms, r.accumulate.gpu_ms,
-                    r.share.gpu_ms, r.fit.gpu_ms, r.post.gpu_ms, r.taa.gpu_ms, threads_busy(r.accumulate), threads_busy(r.share), threads_busy(r.fit),
-                    threads_busy(r.post), threads_busy(r.taa), t.reconstruct.gpu_ms, t.resolve.gpu_ms,
-                    t.gpu_ms(), 1000.0 * t.trace.gpu_ms / double(traced), all.trace.gpu_ms, all.reconstruct.gpu_ms,
-                    all.gpu_ms(), live.trace.gpu_ms, live.reconstruct.gpu_ms, live.gpu_ms());
+      // Times to three significant digits: seconds on a CPU device, fractions of a ms on a GPU.
+      const auto ms = [](double v) {
+        char b[32];
+        std::snprintf(b, sizeof b, "%.*f", fc::significant_decimals(v), v);
+        return std::string(b);
+      };
+      const auto three = [&](double a, double b, double c) { return ms(a) + " / " + ms(b) + " / " + ms(c); };
+      char head[160], ratios[96], busy[96];
+      std::snprintf(head, sizeof head, "| %ld | %s | %.2f → %.2f | ", round + 1, c.name().c_str(), load0, load1);
+      std::snprintf(ratios, sizeof ratios, "%.3f / %.3f", trace[1].gpu_ms / trace[0].gpu_ms,
+                    trace[1].cpu_ms / trace[0].cpu_ms);
+      std::snprintf(busy, sizeof busy, "%.2f / %.2f / %.2f / %.2f / %.2f", threads_busy(r.accumulate),
+                    threads_busy(r.share), threads_busy(r.fit), threads_busy(r.post), threads_busy(r.taa));
+      const std::string row = std::string(head) + ms(t.trace.gpu_ms) + " | " + order_name(orders[0]) + " | " +
+                              ms(trace[0].gpu_ms) + " / " + ms(trace[0].cpu_ms) + " | " + order_name(orders[1]) +
+                              " | " + ms(trace[1].gpu_ms) + " / " + ms(trace[1].cpu_ms) + " | " + ratios + " | " +
+                              ms(r.accumulate.gpu_ms) + " | " + ms(r.share.gpu_ms) + " | " + ms(r.fit.gpu_ms) + " | " +
+                              ms(r.post.gpu_ms) + " | " + ms(r.taa.gpu_ms) + " | " + busy + " | " +
+                              ms(t.reconstruct.gpu_ms) + " | " + ms(t.resolve.gpu_ms) + " | " + ms(t.gpu_ms()) + " | " +
+                              ms(1000.0 * t.trace.gpu_ms / double(traced)) + " | " +
+                              three(all.trace.gpu_ms, all.reconstruct.gpu_ms, all.gpu_ms()) + " | " +
+                              three(live.trace.gpu_ms, live.reconstruct.gpu_ms, live.gpu_ms()) + " |";
       rows.emplace_back(row);
-      std::fprintf(stderr, "%s\n", row);  // progress: a round of fove0 takes minutes under load
+      std::fprintf(stderr, "%s\n", row.c_str());  // progress: a round of fove0 takes minutes under load
       std::fflush(stdout);
     }
   std::printf("\nGPU ms of the third frame, both eyes; its trace again alone in the order the pipeline picks"

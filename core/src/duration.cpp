@@ -1,5 +1,6 @@
 #include "fovea/core/duration.hpp"
 
+#include <algorithm>
 #include <charconv>
 #include <cmath>
 #include <string>
@@ -26,6 +27,12 @@ TimeNs parse_duration_ns(std::string_view text, std::string_view what) {
   const double ns = v * scale;
   if (ns > 9.0e18) throw bad();  // beyond int64 nanoseconds
   return static_cast<TimeNs>(std::llround(ns));
+}
+
+int significant_decimals(double v, int digits) {
+  if (!std::isfinite(v) || v == 0) return 0;
+  const int decade = int(std::floor(std::log10(std::abs(v))));
+  return std::clamp(digits - 1 - decade, 0, 12);
 }
 
 }  // namespace fovea::core

@@ -323,3 +323,19 @@ TEST(Duration, UnitsAndBareMilliseconds) {
     EXPECT_NE(std::string(e.what()).find("--tracker-delay"), std::string::npos);
   }
 }
+
+TEST(Duration, PrintedToThreeSignificantDigits) {
+  using fovea::core::significant_decimals;
+  // A CPU device's frame, a GPU's, a GPU's kernel, a cost per 1000 samples.
+  EXPECT_EQ(significant_decimals(1997.4), 0);
+  EXPECT_EQ(significant_decimals(452.0), 0);
+  EXPECT_EQ(significant_decimals(99.96), 1);  // prints 100.0: one digit more, never less
+  EXPECT_EQ(significant_decimals(45.3), 1);
+  EXPECT_EQ(significant_decimals(4.47), 2);
+  EXPECT_EQ(significant_decimals(-4.47), 2);
+  EXPECT_EQ(significant_decimals(0.0123), 4);
+  EXPECT_EQ(significant_decimals(0.4, 2), 2);
+  EXPECT_EQ(significant_decimals(5.2, 2), 1);
+  for (double v : {0.0, std::nan(""), HUGE_VAL, -HUGE_VAL}) EXPECT_EQ(significant_decimals(v), 0) << v;
+  EXPECT_EQ(significant_decimals(1e-300), 12);  // capped: a denormal-sized time prints as 0.000000000000
+}

@@ -11,6 +11,7 @@
 #include <set>
 #include <sstream>
 
+#include "fovea/core/duration.hpp"
 #include "fovea/core/error.hpp"
 #include "fovea/core/image.hpp"
 #include "fovea/core/input_limits.hpp"
@@ -372,18 +373,16 @@ std::string fixed(double v, int decimals) {
 
 // A metric's value as table text: dB and milliseconds with 1-2 decimals, the rest with 4.
 // Repeated runs (report.repeat): their mean ± standard deviation, where it is not 0.
-// Times to three significant digits from 10 ms down (a discrete GPU's frames take a few ms),
-// and factors to two.
-int ms_decimals(double v) { return std::abs(v) >= 100 ? 0 : std::abs(v) >= 10 ? 1 : 2; }
-std::string ms_text(double v) { return fixed(v, ms_decimals(v)); }
-std::string factor_text(double v) { return fixed(v, std::abs(v) >= 10 ? 0 : std::abs(v) >= 1 ? 1 : 2); }
+// Times to three significant digits (a discrete GPU's frames take a few ms), factors to two.
+std::string ms_text(double v) { return fixed(v, core::significant_decimals(v)); }
+std::string factor_text(double v) { return fixed(v, core::significant_decimals(v, 2)); }
 
 std::string md_value(const Row& r, const std::string& m) {
   if (!r.metrics.count(m)) return "–";
   const double v = r.metrics.at(m);
   // The spread takes the value's decimals.
   const int decimals = m.find("psnr") != std::string::npos      ? 2
-                       : m.find("_ms") != std::string::npos     ? ms_decimals(v)
+                       : m.find("_ms") != std::string::npos     ? core::significant_decimals(v)
                        : m.find("samples") != std::string::npos ? 0
                                                                 : 4;
   const auto sd = r.metrics.find(m + ".sd");
