@@ -28,6 +28,18 @@ env -i PATH=/usr/bin:/bin HOME="$work" ${VK_ICD_FILENAMES:+VK_ICD_FILENAMES=$VK_
   > "$work/render.log" 2>&1 || { cat "$work/render.log"; fail "the bundle's fovea render exited non-zero"; }
 [[ -s $work/render/report.json && -s $work/render/frame_0000_sbs.png ]] || fail "render wrote no report or frame"
 
+# The device measurements from the bundle, in their quick form (tiny display, small batches):
+# every step runs and the summary names the device.
+env -i PATH=/usr/bin:/bin HOME="$work" QUICK=1 ${VK_ICD_FILENAMES:+VK_ICD_FILENAMES=$VK_ICD_FILENAMES} \
+  ${VK_DRIVER_FILES:+VK_DRIVER_FILES=$VK_DRIVER_FILES} LP_NUM_THREADS="${LP_NUM_THREADS:-2}" \
+  bash "$b/run.sh" bash "$b/device-measure.sh" "$work/measure" > "$work/measure.log" 2>&1 ||
+  { cat "$work/measure.log"; fail "device-measure.sh exited non-zero"; }
+for s in device sweep-plan sweep sweep-report traversal trace-cost-tiny; do
+  grep -q "^| $s | ok |" "$work/measure/summary.md" || { cat "$work/measure/summary.md"; fail "device-measure: step $s not ok"; }
+done
+grep -q "^Device: llvmpipe" "$work/measure/summary.md" || fail "device-measure: the summary names no device"
+grep -q "| display tiny | " "$work/measure/sweep/results.md" || fail "device-measure: no speed-up row for tiny"
+
 mkdir "$work/mine" && touch "$work/mine/keep"
 bash "$src/tools/bundle.sh" "$build" "$work/mine" > /dev/null 2>&1
 [[ $? -eq 2 && -f $work/mine/keep ]] || fail "a directory that is not a bundle was not refused with exit 2"

@@ -6,6 +6,7 @@
 # Programs find their libraries through an $ORIGIN run path; run.sh sets the rest.
 # Usage: tools/bundle.sh BUILD_DIR OUT_DIR     (./x bundle OUT_DIR bundles build/release)
 #        OUT_DIR/run.sh bin/fovea render --display fove0 ...   (on the other machine)
+#        OUT_DIR/run.sh bash OUT_DIR/device-measure.sh OUT     (every measurement, one call)
 set -euo pipefail
 if [[ $# -ne 2 ]]; then
   echo "usage: tools/bundle.sh BUILD_DIR OUT_DIR" >&2
@@ -61,6 +62,7 @@ sed 's|"library_path": *"[^"]*"|"library_path": "../../../../lib/libfovea_runtim
 for f in "$tmp"/bin/*; do patchelf --set-rpath '$ORIGIN/../lib' "$f"; done
 for f in "$tmp"/lib/*; do patchelf --set-rpath '$ORIGIN' "$f"; done
 cp -r "$src/data" "$tmp/data"
+cp "$src/tools/device-measure.sh" "$tmp/"
 
 # The newest glibc symbol version any file asks for: the oldest C library it runs with.
 needs=$(for f in "$tmp"/bin/* "$tmp"/lib/*; do objdump -T "$f" 2> /dev/null; done |
@@ -86,6 +88,7 @@ chmod +x "$tmp/run.sh"
   echo "Runs on Linux $(uname -m) with glibc >= ${needs#GLIBC_} and a Vulkan 1.2 driver; nothing else is needed."
   echo "  ./run.sh bin/fovea render --display fove0 --out out/render"
   echo "  ./run.sh bin/fovea_gpu_tests   (FOVEA_VK_VALIDATION=1: the validation layer of share/vulkan)"
+  echo "  ./run.sh bash device-measure.sh out/measure   (every measurement of a device, in one call)"
   echo "The OpenXR layer: XR_API_LAYER_PATH=share/openxr/1/api_layers/explicit.d (run.sh sets it),"
   echo "XR_ENABLE_API_LAYERS=XR_APILAYER_FOVEA_path_tracing; the simulated runtime: share/openxr/1/runtime.d."
 } > "$tmp/README"
