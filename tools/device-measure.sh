@@ -6,6 +6,7 @@
 #               against full-resolution Cartesian, 16 frames, time only (no references: the
 #               images, so the scores, do not depend on the device), and its report: the
 #               per-preset speed-up table and every stage's GPU and CPU time
+#   frame       one stereo frame per stage, GPU and CPU, fove0 and modern (fovea_bench_frame)
 #   traversal   rays per second by ray type, both traversals (and Embree where it was built)
 #   trace-cost  trace time per traced sample and the SIMD vectors' use, fove0 and modern
 #   tests       the GPU test programs with the validation layer on
@@ -93,6 +94,10 @@ step sweep 300 "$fovea" sweep run "$OUT/sweep/plan.jsonl" --jobs 1
 step sweep-report 60 "$fovea" sweep report "$OUT/sweep/plan.jsonl" --out "$OUT/sweep/report" \
   --markdown "$OUT/sweep/results.md"
 
+# The frame's table (issue-style: GPU total, trace, reconstruction, BMFR fit, the frame's CPU
+# time, and reading both eyes back apart from it) per preset and distribution.
+displays_csv=$(IFS=,; echo "${displays[*]}")
+step frame 120 env FOVEA_BENCH_DISPLAYS="$displays_csv" "$bench/fovea_bench_frame" --benchmark_counters_tabular=true
 step traversal 90 "$bench/fovea_bench_traversal" --scenes "$scenes" --rays "$rays"
 for d in "${displays[@]}"; do
   step "trace-cost-$d" 120 "$bench/fovea_bench_trace_cost" "$d" 1 "$LANES"
