@@ -20,10 +20,12 @@
 # frames, small batches, no test programs (checks that the script works; CTest runs it so on
 # lavapipe); LANES, the device's SIMD width for the trace-cost table [32].
 set -uo pipefail
-OUT=${1:?usage: device-measure.sh OUT}
-DEADLINE=${DEADLINE:-420}
-QUICK=${QUICK:-0}
-LANES=${LANES:-32}
+[[ $# -eq 1 ]] || { echo "usage: device-measure.sh OUT" >&2; exit 2; }
+OUT=$1
+DEADLINE=${DEADLINE:-420} QUICK=${QUICK:-0} LANES=${LANES:-32}
+for v in DEADLINE QUICK LANES; do
+  [[ ${!v} =~ ^[0-9]+$ ]] || { echo "device-measure: $v=${!v} is not a whole number" >&2; exit 2; }
+done
 start=$SECONDS
 
 mkdir -p "$OUT" || exit 2
