@@ -29,8 +29,10 @@ env -i PATH=/usr/bin:/bin HOME="$work" ${VK_ICD_FILENAMES:+VK_ICD_FILENAMES=$VK_
 [[ -s $work/render/report.json && -s $work/render/frame_0000_sbs.png ]] || fail "render wrote no report or frame"
 
 # The device measurements from the bundle, in their quick form (tiny display, small batches):
-# every step runs and the summary names the device.
-env -i PATH=/usr/bin:/bin HOME="$work" QUICK=1 ${VK_ICD_FILENAMES:+VK_ICD_FILENAMES=$VK_ICD_FILENAMES} \
+# every step runs and the summary names the device. The render's caches (its traversal choice,
+# the driver's shaders) are shared, as a second call on the same machine would find them.
+env -i PATH=/usr/bin:/bin HOME="$work" XDG_CACHE_HOME="$work/.cache" QUICK=1 \
+  ${VK_ICD_FILENAMES:+VK_ICD_FILENAMES=$VK_ICD_FILENAMES} \
   ${VK_DRIVER_FILES:+VK_DRIVER_FILES=$VK_DRIVER_FILES} LP_NUM_THREADS="${LP_NUM_THREADS:-2}" \
   bash "$b/run.sh" bash "$b/device-measure.sh" "$work/measure" > "$work/measure.log" 2>&1 ||
   { cat "$work/measure.log"; fail "device-measure.sh exited non-zero"; }
