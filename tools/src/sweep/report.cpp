@@ -371,12 +371,13 @@ std::string fixed(double v, int decimals) {
   return buf;
 }
 
-// A metric's value as table text: dB and milliseconds with 1-2 decimals, the rest with 4.
-// Repeated runs (report.repeat): their mean ± standard deviation, where it is not 0.
 // Times to three significant digits (a discrete GPU's frames take a few ms), factors to two.
 std::string ms_text(double v) { return fixed(v, core::significant_decimals(v)); }
 std::string factor_text(double v) { return fixed(v, core::significant_decimals(v, 2)); }
 
+// A metric's value as table text: dB with 2 decimals, milliseconds to three significant
+// digits, samples whole, the rest with 4 decimals. Repeated runs (report.repeat): their mean ±
+// standard deviation, where it is not 0.
 std::string md_value(const Row& r, const std::string& m) {
   if (!r.metrics.count(m)) return "–";
   const double v = r.metrics.at(m);
