@@ -158,7 +158,8 @@ TEST(SweepReport, SectionsByTwoSettingsAndSpeedUpAtEqualQuality) {
   ASSERT_EQ(plan.jobs.size(), 8u);
   // full: 100 ms, FLIP 0.200, 1000 samples. vp on p1: FLIP 0.30, 0.209 (within 5%), 0.19 at
   // 10, 20, 40 ms with budget * 1000 samples: the pick is budget 0.2, 5.00x for a samples
-  // ratio of 5. On p2 vp never gets within 5% (best 0.25).
+  // ratio of 5. On p2 vp never gets within 5% (best 0.25). Tracing costs 50 ms per 1000 samples
+  // for full, 60 for vp.
   for (const Job& j : plan.jobs) {
     const json& st = j.settings;
     const bool full = st["distribution"] == "full", p1 = st["display"] == "p1";
@@ -167,6 +168,7 @@ TEST(SweepReport, SectionsByTwoSettingsAndSpeedUpAtEqualQuality) {
     json rep = render_report(100 * budget, full ? 30 : 31, flip, 40);
     rep["samples_traced_per_eye"] = 1000 * budget;
     rep["cpu_ms"] = {{"total", 110 * budget}};
+    if (!full) rep["gpu_ms"]["trace"] = 60 * budget;  // a vp sample costs 1.2x a full one to trace
     fs::create_directories(dir + "/" + j.out);
     core::write_file_atomic(dir + "/" + j.out + "/report.json", rep.dump());
   }
@@ -178,8 +180,8 @@ TEST(SweepReport, SectionsByTwoSettingsAndSpeedUpAtEqualQuality) {
   for (const char* text :
        {"One section per display: [p1](#display-p1), [p2](#display-p2)", "## display p1\n", "## display p2\n",
         "## vp against full at equal fovea_flip",
-        "| display p1 | 1000 | 100 / 110 | 0.2000 | 0.2 | 200 | 20.0 / 22.0 | 0.2090 | **5.00×** | 5.00× | 5.00 | 1.00 | fovea_psnr 30.00 → 31.00 |",
-        "| display p2 | 1000 | 100 / 110 | 0.2000 | none as good (best: 0.3500 at budget 0.1) | – | – | – | – | – | – | – | – |"})
+        "| display p1 | 1000 | 100 / 110 | 0.2000 | 0.2 | 200 | 20.0 / 22.0 | 0.2090 | **5.00×** | 5.00× | 5.00 | 1.00 | 50.0 / 60.0 (1.20) | fovea_psnr 30.00 → 31.00 |",
+        "| display p2 | 1000 | 100 / 110 | 0.2000 | none as good (best: 0.3500 at budget 0.1) | – | – | – | – | – | – | – | – | – |"})
     EXPECT_NE(page.find(text), std::string::npos) << text << "\n" << page;
   // The scene does not vary: it names no section; the fronts and plots are per display.
   const json j = core::parse_json(test::read_text(dir + "/report/results.json"));
@@ -214,7 +216,7 @@ TEST(SweepReport, SectionsByTwoSettingsAndSpeedUpAtEqualQuality) {
   const std::string page4 = test::read_text(dir + "/at.md");
   for (const char* text :
        {"## vp against full at budget 0.1, 0.4, 0.3\n",
-        "| display p1 | 1000 | 100 / 110 | 0.2000 | 0.1 | 100 | 10.0 / 11.0 | 0.3000 | **10.00×** | 10.00× | 10.00 | 1.00 |",
+        "| display p1 | 1000 | 100 / 110 | 0.2000 | 0.1 | 100 | 10.0 / 11.0 | 0.3000 | **10.00×** | 10.00× | 10.00 | 1.00 | 50.0 / 60.0 (1.20) |",
         "| display p1 | 1000 | 100 / 110 | 0.2000 | 0.4 | 400 | 40.0 / 44.0 | 0.1900 | **2.50×** | 2.50× | 2.50 | 1.00 |",
         "| display p2 | 1000 | 100 / 110 | 0.2000 | 0.1 | 100 | 10.0 / 11.0 | 0.3500 | **10.00×** |"})
     EXPECT_NE(page4.find(text), std::string::npos) << text << "\n" << page4;

@@ -745,7 +745,7 @@ void markdown_speedup(std::ostringstream& md, const MarkdownInput& in, const std
   const bool at_budgets = !su.at.empty();
   if (q.empty() && !at_budgets) return;
   const bool lower = !q.empty() && cfg.lower_better(q);
-  const std::string cpu = "cpu_ms.total", samples = "samples_traced_per_eye";
+  const std::string cpu = "cpu_ms.total", samples = "samples_traced_per_eye", trace = "gpu_ms.trace";
   const auto group = [&](const Row& r) { return r.settings.contains(cfg.group) ? setting_text(r.settings[cfg.group]) : ""; };
   const auto ratio = [](const Row& a, const Row& b, const std::string& m) {
     return a.metrics.count(m) && b.metrics.count(m) && b.metrics.at(m) > 0 ? fixed(a.metrics.at(m) / b.metrics.at(m), 2)
@@ -767,12 +767,14 @@ void markdown_speedup(std::ostringstream& md, const MarkdownInput& in, const std
   md << " *Speed-up*: the " << su.over << " job's whole-frame time over the " << su.of << " job's (GPU: `" << cfg.time
      << "`, CPU: `" << cpu << "`, both per stereo frame, every stage); *samples ratio*: traced samples per eye, "
      << su.over << " over " << su.of << "; the last column is how much of the samples' ratio the GPU speed-up keeps "
-     << "(1 = cost follows the samples); *other quality*: the other quality metrics, " << su.over << " → " << su.of
-     << ".\n\n"
+     << "(1 = cost follows the samples); *trace per 1000 samples*: `" << trace << "` per 1000 traced samples per eye, "
+     << su.over << " / " << su.of << " and the second over the first (1 = a sample costs the same to trace); *other "
+     << "quality*: the other quality metrics, " << su.over << " → " << su.of << ".\n\n"
      << "| section | " << su.over << " samples/eye | " << su.over << " GPU / CPU ms | " << su.over << " " << quality_name
      << " | " << su.of << " " << cfg.budget << " | " << su.of << " samples/eye | " << su.of << " GPU / CPU ms | " << su.of
-     << " " << quality_name << " | GPU speed-up | CPU speed-up | samples ratio | speed-up / samples ratio | other quality |\n"
-     << "|---|---|---|---|---|---|---|---|---|---|---|---|---|\n";
+     << " " << quality_name << " | GPU speed-up | CPU speed-up | samples ratio | speed-up / samples ratio | "
+     << "trace per 1000 samples | other quality |\n"
+     << "|---|---|---|---|---|---|---|---|---|---|---|---|---|---|\n";
   const auto budget_of = [&](const Row& r) {
     return r.settings.contains(cfg.budget) && r.settings[cfg.budget].is_number() ? r.settings[cfg.budget].get<double>()
                                                                                   : NAN;
@@ -800,7 +802,19 @@ void markdown_speedup(std::ostringstream& md, const MarkdownInput& in, const std
       md << (pick->settings.contains(cfg.budget) ? setting_text(pick->settings[cfg.budget]) : "–") << " | "
          << md_value(*pick, samples) << " | " << times(*pick) << " | " << (q.empty() ? "–" : md_value(*pick, q))
          << " | **" << speed_up << "×** | " << ratio(*over, *pick, cpu) << "× | " << samples_ratio << " | "
-         << (std::isfinite(kept) ? fixed(kept, 2) : "–") << " |";
+         << (std::isfinite(kept) ? fixed(kept, 2) : "–") << " | ";
+      // The trace's cost per traced sample (issue goal: the same for every distribution).
+      const auto per_1000 = [&](const Row& r) {
+        return r.metrics.count(trace) && r.metrics.count(samples) && r.metrics.at(samples) > 0
+                   ? 1000 * r.metrics.at(trace) / r.metrics.at(samples)
+                   : NAN;
+      };
+      const double a = per_1000(*over), b = per_1000(*pick);
+      if (std::isfinite(a) && std::isfinite(b) && a > 0)
+        md << ms_text(a) << " / " << ms_text(b) << " (" << fixed(b / a, 2) << ")";
+      else
+        md << "–";
+      md << " |";
       std::string other;
       for (const auto& m : cfg.quality)
         if (m != q)
@@ -835,7 +849,7 @@ void markdown_speedup(std::ostringstream& md, const MarkdownInput& in, const std
     md << "| " << section.title << " | " << md_value(*over, samples) << " | " << times(*over) << " | "
        << md_value(*over, q) << " | none as good (best: " << md_value(*best, q) << " at " << cfg.budget << " "
        << (best->settings.contains(cfg.budget) ? setting_text(best->settings[cfg.budget]) : "–")
-       << ") | – | – | – | – | – | – | – | – |\n";
+       << ") | – | – | – | – | – | – | – | – | – |\n";
   }
   md << "\n";
 }
