@@ -1,6 +1,7 @@
 #!/usr/bin/env bash
-# What the real-time issues measure, in one call on whatever Vulkan device the machine has
-# (docs/building.md, "Measuring another device"), each step within its share of a deadline:
+# Every measurement of the real-time work (GPU time per stage, speed-up per preset, traversal),
+# in one call on whatever Vulkan device the machine has (docs/building.md, "Measuring another
+# device"), each step within its share of a deadline:
 #   device      the device, the driver and the traversal `--trace auto` takes (a `tiny` render)
 #   sweep       data/sweeps/device.json: each display preset, Visual-Polar at budgets 0.1-0.39
 #               against full-resolution Cartesian, 16 frames, time only (no references: the
@@ -11,8 +12,9 @@
 #   trace-cost  trace time per traced sample and the SIMD vectors' use, fove0 and modern
 #   tests       the GPU test programs with the validation layer on
 # A step that would not finish before the deadline is cut short (the sweep keeps the jobs it
-# finished) or skipped, and says so. OUT/summary.md lists each step's status, wall time and
-# files; everything the programs print is kept beside it.
+# finished, and resumes when run again with the same OUT) or skipped, and says so.
+# OUT/summary.md lists each step's status, wall time and files; everything the programs print
+# is kept beside it.
 #
 #   tools/device-measure.sh OUT              from a source tree, after ./x build
 #   DIR/run.sh bash DIR/device-measure.sh OUT  from a bundle made by ./x bundle DIR
