@@ -194,11 +194,7 @@ int run(int argc, char** argv) {
         }
       }
       // Times to three significant digits: seconds on a CPU device, fractions of a ms on a GPU.
-      const auto ms = [](double v) {
-        char b[32];
-        std::snprintf(b, sizeof b, "%.*f", fc::significant_decimals(v), v);
-        return std::string(b);
-      };
+      const auto ms = [](double v) { return fc::fixed_significant(v); };
       const auto three = [&](double a, double b, double c) { return ms(a) + " / " + ms(b) + " / " + ms(c); };
       char head[160], ratios[96], busy[96];
       std::snprintf(head, sizeof head, "| %ld | %s | %.2f → %.2f | ", round + 1, c.name().c_str(), load0, load1);

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <charconv>
 #include <cmath>
+#include <cstdio>
 #include <string>
 
 #include "fovea/core/error.hpp"
@@ -33,6 +34,12 @@ int significant_decimals(double v, int digits) {
   if (!std::isfinite(v) || v == 0) return 0;
   const int decade = int(std::floor(std::log10(std::abs(v))));
   return std::clamp(digits - 1 - decade, 0, 12);
+}
+
+std::string fixed_significant(double v, int digits) {
+  char b[48];
+  std::snprintf(b, sizeof b, "%.*f", significant_decimals(v, digits), v);
+  return b;
 }
 
 }  // namespace fovea::core

@@ -338,4 +338,7 @@ TEST(Duration, PrintedToThreeSignificantDigits) {
   EXPECT_EQ(significant_decimals(5.2, 2), 1);
   for (double v : {0.0, std::nan(""), HUGE_VAL, -HUGE_VAL}) EXPECT_EQ(significant_decimals(v), 0) << v;
   EXPECT_EQ(significant_decimals(1e-300), 12);  // capped: a denormal-sized time prints as 0.000000000000
+  EXPECT_EQ(fovea::core::fixed_significant(4.4712), "4.47");
+  EXPECT_EQ(fovea::core::fixed_significant(1997.4), "1997");
+  EXPECT_EQ(fovea::core::fixed_significant(0.4, 2), "0.40");
 }

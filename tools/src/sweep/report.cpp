@@ -372,8 +372,8 @@ std::string fixed(double v, int decimals) {
 }
 
 // Times to three significant digits (a discrete GPU's frames take a few ms), factors to two.
-std::string ms_text(double v) { return fixed(v, core::significant_decimals(v)); }
-std::string factor_text(double v) { return fixed(v, core::significant_decimals(v, 2)); }
+std::string ms_text(double v) { return core::fixed_significant(v); }
+std::string factor_text(double v) { return core::fixed_significant(v, 2); }
 
 // A metric's value as table text: dB with 2 decimals, milliseconds to three significant
 // digits, samples whole, the rest with 4 decimals. Repeated runs (report.repeat): their mean ±
@@ -791,9 +791,12 @@ void markdown_speedup(std::ostringstream& md, const MarkdownInput& in, const std
     }
     if (!over || of.empty()) continue;
     const auto times = [&](const Row& r) { return md_value(r, cfg.time) + " / " + md_value(r, cpu); };
-    const auto row = [&](const Row* pick) {
+    const auto head = [&] {  // the section and its `over` job
       md << "| " << section.title << " | " << md_value(*over, samples) << " | " << times(*over) << " | "
          << (q.empty() ? "–" : md_value(*over, q)) << " | ";
+    };
+    const auto row = [&](const Row* pick) {
+      head();
       const std::string speed_up = ratio(*over, *pick, cfg.time), samples_ratio = ratio(*over, *pick, samples);
       const double kept = pick->metrics.count(samples) && over->metrics.count(samples) && pick->metrics.at(samples) > 0
                               ? (over->metrics.at(cfg.time) / pick->metrics.at(cfg.time)) /
@@ -846,8 +849,8 @@ void markdown_speedup(std::ostringstream& md, const MarkdownInput& in, const std
     const Row* best = of.front();
     for (const Row* r : of)
       if (lower ? r->metrics.at(q) < best->metrics.at(q) : r->metrics.at(q) > best->metrics.at(q)) best = r;
-    md << "| " << section.title << " | " << md_value(*over, samples) << " | " << times(*over) << " | "
-       << md_value(*over, q) << " | none as good (best: " << md_value(*best, q) << " at " << cfg.budget << " "
+    head();
+    md << "none as good (best: " << md_value(*best, q) << " at " << cfg.budget << " "
        << (best->settings.contains(cfg.budget) ? setting_text(best->settings[cfg.budget]) : "–")
        << ") | – | – | – | – | – | – | – | – | – |\n";
   }

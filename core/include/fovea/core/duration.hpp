@@ -2,6 +2,7 @@
 // Durations given by users (URI keys, command-line options): one parser for all of them; and
 // how measured times are printed, from a CPU device's seconds to a discrete GPU's fractions
 // of a millisecond.
+#include <string>
 #include <string_view>
 
 #include "fovea/core/clock.hpp"
@@ -16,5 +17,7 @@ TimeNs parse_duration_ns(std::string_view text, std::string_view what);
 // 10^(digits-1) up (1997, 452), then one more per decade down (45.3, 4.47, 0.0123); 0 for 0
 // and non-finite values.
 int significant_decimals(double v, int digits = 3);
+// `v` printed so ("4.47", "1997").
+std::string fixed_significant(double v, int digits = 3);
 
 }  // namespace fovea::core
