@@ -152,7 +152,7 @@ shaders::GridSample SampleDistribution::sample_at(int column, int row, glm::dvec
 
 std::uint32_t SampleDistribution::cell_flags(int, int, glm::dvec3) const { return 0; }
 
-void SampleDistribution::set_visibility(const ViewMask& mask) {
+void SampleDistribution::adopt_mask(const ViewMask& mask) {
   if (mask.width() != view_.width() || mask.height() != view_.height())
     throw InputError("visibility mask: " + std::to_string(mask.width()) + "x" + std::to_string(mask.height()) +
                      " differs from the view's raster " + std::to_string(view_.width()) + "x" +
@@ -174,6 +174,11 @@ void SampleDistribution::set_visibility(const ViewMask& mask) {
   // Two pixels of margin for the pixel-to-angle rounding above.
   mask_free_px_ -= 2;
   mask_free_deg_ -= 2 / std::sqrt(view_.pixels_per_deg2(centre));
+}
+
+void SampleDistribution::set_visibility(const ViewMask& mask) {
+  adopt_mask(mask);
+  const glm::dvec3 centre = view_.centre_dir();
   if (centre_traced_ > 0) {  // the polar kinds' reference: the centred gaze under the mask
     const glm::dvec3 gaze = gaze_;
     centre_traced_ = 0;
@@ -349,9 +354,12 @@ class RasterDistribution final : public SampleDistribution {
   double scale_ = 1, expected_kept_ = 0, expected_traced_ = 0;
 };
 
-std::unique_ptr<SampleDistribution> make_unchecked(const View& view, const DistributionParams& p) {
+// Visual-Polar lays its grid out for the pixels `visibility` leaves; the other kinds' layouts
+// do not depend on it (make_distribution sets it once their budget is checked).
+std::unique_ptr<SampleDistribution> make_unchecked(const View& view, const DistributionParams& p,
+                                                   const ViewMask* visibility) {
   switch (p.kind) {
-    case DistributionKind::VisualPolar: return make_visual_polar(view, p);
+    case DistributionKind::VisualPolar: return make_visual_polar(view, p, visibility);
     case DistributionKind::PaperVisualPolar:
     case DistributionKind::LogPolar: return make_screen_polar(view, p);
     default: return std::make_unique<RasterDistribution>(view, p);
@@ -366,23 +374,28 @@ std::string fraction(double f) {
 
 }  // namespace
 
-std::unique_ptr<SampleDistribution> make_distribution(const View& view, const DistributionParams& p) {
+std::unique_ptr<SampleDistribution> make_distribution(const View& view, const DistributionParams& p,
+                                                      const ViewMask* visibility) {
   p.validate();
-  auto d = make_unchecked(view, p);
+  auto d = make_unchecked(view, p, visibility);
+  const auto masked = [&] {
+    if (visibility && p.kind != DistributionKind::VisualPolar) d->set_visibility(*visibility);
+    return std::move(d);
+  };
   // Cartesian: every pixel, whatever the budget. P5's staircase rounds rows up per 32
   // columns on top of the budgeted grid (+12% on `small`): an option of the layout study.
-  if (p.kind == DistributionKind::Cartesian || p.staircase) return d;
+  if (p.kind == DistributionKind::Cartesian || p.staircase) return masked();
   // The budget is met at the centred gaze the distribution starts with, or refused; two
   // samples of slack let displays of a few pixels keep their minimal grids.
   const double pixels = double(view.width()) * view.height();
   const double got = d->budgeted_samples() / pixels;
-  if (std::abs(got - p.budget) * pixels <= std::max(0.05 * p.budget * pixels, 2.0)) return d;
+  if (std::abs(got - p.budget) * pixels <= std::max(0.05 * p.budget * pixels, 2.0)) return masked();
   const std::string name = (p.display.empty() ? "" : "display " + p.display + ": ") + "budget: " + distribution_name(p.kind);
   const std::string where = " on this " + std::to_string(view.width()) + "x" + std::to_string(view.height()) + " display";
   if (got < p.budget) {
     DistributionParams full = p;
     full.budget = 1.0;
-    const double most = make_unchecked(view, full)->budgeted_samples() / pixels;
+    const double most = make_unchecked(view, full, visibility)->budgeted_samples() / pixels;
     throw InputError(name + " reaches at most " + fraction(std::max(most, got)) + " of the display's pixels" +
                      where + " (requested " + fraction(p.budget) + ")");
   }

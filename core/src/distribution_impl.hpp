@@ -13,7 +13,8 @@
 
 namespace fovea::core {
 
-std::unique_ptr<SampleDistribution> make_visual_polar(const View& view, const DistributionParams& p);
+std::unique_ptr<SampleDistribution> make_visual_polar(const View& view, const DistributionParams& p,
+                                                      const ViewMask* visibility);
 std::unique_ptr<SampleDistribution> make_screen_polar(const View& view, const DistributionParams& p);
 
 // One straight edge of the view seen from a polar grid's centre, for one ring: the ring's

@@ -201,9 +201,12 @@ double PolarDistribution::fit_budget() {
   measure_columns();
   bool reference = false;
   if (!(centre_traced_ > 0)) {  // the centred gaze the session starts with: the reference
+    // A layout within 2 % of its reference is its own: c = 1, the cells as laid out (its
+    // whole columns and rounded rows: `tiny`'s 32 columns trace 1.01 of its budget).
     const double own = traced_for(1.0);
     centre_traced_ = centre_reference(own);
-    if (centre_traced_ == own) {
+    if (std::abs(centre_traced_ - own) <= 0.02 * centre_traced_) {
+      centre_traced_ = own;
       pack_measured(1.0);
       return 1.0;
     }
@@ -216,11 +219,11 @@ double PolarDistribution::fit_budget() {
     (traced_for(std::exp(mid)) < target ? lo : hi) = mid;
   }
   const double c = std::exp(hi);
-  // A reference the grid cannot come down to (rows at their bounds, beyond the bisection's
-  // rounding) is what it reaches: every gaze then keeps that.
+  // A reference the grid cannot come down or up to (rows at their bounds, beyond the
+  // bisection's rounding) is what it reaches: every gaze then keeps that.
   if (reference) {
     const double reached = traced_for(c);
-    if (reached > 1.01 * centre_traced_) centre_traced_ = reached;
+    if (std::abs(reached - centre_traced_) > 0.01 * centre_traced_) centre_traced_ = reached;
   }
   pack_measured(c);
   return c;

@@ -132,7 +132,8 @@ std::array<FrustumSide, 4> frustum_sides(const View& v, glm::dvec3 g, glm::dvec3
 
 class VisualPolar final : public PolarDistribution {
  public:
-  VisualPolar(const View& v, const DistributionParams& p) : PolarDistribution(v, p) {
+  VisualPolar(const View& v, const DistributionParams& p, const ViewMask* visibility) : PolarDistribution(v, p) {
+    if (visibility) adopt_mask(*visibility);  // the layout's budget: the pixels it leaves
     a_.resize(kNodes + 1);
     circ_.resize(kNodes + 1);
     for (int k = 0; k <= kNodes; ++k) {
@@ -211,14 +212,22 @@ class VisualPolar final : public PolarDistribution {
     return std::max(rows, std::min(least, full_[k]));
   }
 
-  // Under a mask the budget is its fraction of the pixels the mask leaves visible, as for the
-  // raster kinds: the layout solved for the whole view loses fewer samples to a lens' hidden
-  // periphery than pixels (its density falls with eccentricity), so its own count at the
-  // centred gaze would exceed that (1.29 of it under the wide preset's lens). The scale on
-  // the uncapped columns' rows (scaled_rows) takes the surplus back from the periphery.
+  // The budget is its fraction of the pixels the view (and a mask) leaves visible, as for
+  // the raster kinds; the session's layout traces that at the centred gaze (setup_session),
+  // under the mask given to make_distribution. A mask set later takes the layout's surplus
+  // back from the periphery (c < 1 on the uncapped columns' rows, scaled_rows): the layout
+  // solved for the whole view loses fewer samples to a lens' hidden periphery than pixels
+  // (its density falls with eccentricity). Unpacked full rings (a layout study's option,
+  // `pack = false`) keep their own count without a mask: the budget is their rings'.
   double centre_reference(double own) const override {
-    if (!(visible_fraction_ < 1)) return own;
+    if (!packing() && !(visible_fraction_ < 1)) return own;
     return std::max(1.0, params_.budget * view_.width() * view_.height() * visible_fraction_);
+  }
+  // What make_distribution checks: the samples traced on the view at the centred gaze over
+  // the view's share the mask leaves (the reference), not the rows the grid holds (an outer
+  // column's ring reaches past the view's edges); unpacked full rings, their rows.
+  double budgeted_samples() const override {
+    return packing() && centre_traced_ > 0 ? centre_traced_ / visible_fraction_ : grid_samples();
   }
 
   // The per-frame solve starts from the previous frame's root; its several close roots
@@ -544,19 +553,26 @@ class VisualPolar final : public PolarDistribution {
           },
           0.0, slope, 1e-12));
     };
-    // The packed columns take their arcs at their inner radius and round their rows: a few
-    // Newton steps on the rows they actually hold bring those to the budget. (What leaves
-    // the view at the columns' outer edges the frames' rows make up: fit_budget.)
+    // The packed columns take their arcs at their inner radius and round their rows, an
+    // outer column's ring is held out to its outer radius (part of it beyond the view's
+    // edges: 7.6 % of the rows on `fove0`), and a mask hides some of what is left: a few
+    // Newton steps on the samples the layout traces (on the view and not hidden, the
+    // estimate fit_budget keeps at every gaze) bring those to the budget. The continuous
+    // solve's slope starts them; then secants, since the traced samples grow more slowly in
+    // σ0 than the held rows (the outer columns move out past the view's edges).
     auto fit_packed = [&](double s0, double e_max) {
-      for (int it = 0; it < 4 && packing(); ++it) {
+      double x_prev = NAN, g_prev = NAN;
+      for (int it = 0; it < 6 && packing(); ++it) {
         march(s0, e_max, 1 << 24, 0, &r_, &h_);
         full_.assign(h_.begin(), h_.end());
-        pack(1.0);
-        double held = 0;
-        for (int h : h_) held += h;
-        const double g = std::log(std::max(held, 1.0) / budget);
+        const double traced = pack(1.0);
+        const double x = std::log(s0), g = std::log(std::max(traced, 1.0) / budget);
         if (std::abs(g) < 1e-3) break;
-        s0 *= std::exp(-g / std::max(dlog, 0.05));
+        const double secant = (g - g_prev) / (x - x_prev);
+        const double slope = std::isfinite(secant) && secant > 0.05 ? secant : std::max(dlog, 0.05);
+        x_prev = x;
+        g_prev = g;
+        s0 = std::exp(x - g / slope);
       }
       return s0;
     };
@@ -632,8 +648,9 @@ void set_reference_sigma0_solve(SampleDistribution& d, bool on) {
   vp->set_reference_solve(on);
 }
 
-std::unique_ptr<SampleDistribution> make_visual_polar(const View& view, const DistributionParams& p) {
-  return std::make_unique<VisualPolar>(view, p);
+std::unique_ptr<SampleDistribution> make_visual_polar(const View& view, const DistributionParams& p,
+                                                      const ViewMask* visibility) {
+  return std::make_unique<VisualPolar>(view, p, visibility);
 }
 
 }  // namespace fovea::core

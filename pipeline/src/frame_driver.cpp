@@ -14,6 +14,15 @@ core::DistributionParams named(core::DistributionParams p, const std::optional<c
   if (display) p.display = display->origin;
   return p;
 }
+
+// The lens' hidden area, culled from the first frame on (and each eye's grid laid out for the
+// pixels it leaves).
+EyeMasks culled(const std::optional<core::DisplayPreset>& display, bool cull) {
+  EyeMasks m;
+  if (display && cull)
+    for (core::Eye e : {core::Eye::Left, core::Eye::Right}) m[size_t(e)] = core::EyeOptics(*display, e).view_mask();
+  return m;
+}
 }  // namespace
 
 FrameDriver::FrameDriver(gpu::Context& ctx, const renderer::Scene& scene, const core::DisplayPreset& display,
@@ -34,11 +43,8 @@ FrameDriver::FrameDriver(gpu::Context& ctx, const renderer::Scene& scene, const 
       gpu_scene_(ctx, scene, renderer::BvhOptions{}, trace_choice_.tracing),
       views_(views),
       pipeline_(ctx, gpu_scene_, views_, named(frame_.distribution, display), frame_.recon,
-                path_config(frame_.bounces, scene)) {
+                path_config(frame_.bounces, scene), false, culled(display, options.cull)) {
   pipeline_.set_seed(frame_.seed);
-  if (display && options.cull)
-    for (core::Eye e : {core::Eye::Left, core::Eye::Right})
-      pipeline_.set_visibility(e, core::EyeOptics(*display, e).view_mask());
 }
 
 core::Pose FrameDriver::at_camera(const core::Pose& eye) const {

@@ -38,12 +38,14 @@ double max_pixels_per_deg(const core::View& v) {
 }
 
 std::unique_ptr<EyeState> make_eye(gpu::Context& ctx, renderer::PathTracer& tracer, core::Eye eye,
-                                   const core::View& view, const core::DistributionParams& dp) {
+                                   const core::View& view, const core::DistributionParams& dp,
+                                   const std::optional<core::ViewMask>& mask) {
   auto e = std::make_unique<EyeState>();
   e->eye = eye;
   e->base_view = view;
   e->pose = view.pose();
-  e->dist = core::make_distribution(core::View(view.fov(), view.width(), view.height()), dp);
+  e->dist = core::make_distribution(core::View(view.fov(), view.width(), view.height()), dp, mask ? &*mask : nullptr);
+  if (mask) e->mask.assign(mask->words().begin(), mask->words().end());
   e->hold = core::GridHold(core::GridHold::radius_for_margin(dp.margin_deg));
   if (!e->dist->invertible())
     throw core::InputError(std::string("--distribution: ") + core::distribution_name(dp.kind) +
@@ -88,13 +90,13 @@ void FramePipeline::Impl::fill(std::uint32_t word) {
 
 FramePipeline::FramePipeline(gpu::Context& ctx, const renderer::GpuScene& scene, const core::StereoViews& views,
                              const core::DistributionParams& distribution, const reconstruct::ReconSettings& settings,
-                             const renderer::PathConfig& path, bool mono)
+                             const renderer::PathConfig& path, bool mono, const EyeMasks& visibility)
     : impl_(std::make_unique<Impl>(ctx, scene, path, settings)) {
   if (mono && settings.share != reconstruct::StereoShare::Off)
     throw core::InputError("--stereo-share: sharing needs both eyes");
   Impl& m = *impl_;
   for (int i = 0; i < (mono ? 1 : 2); ++i)
-    m.eyes.push_back(make_eye(ctx, m.tracer, core::Eye(i), views[core::Eye(i)], distribution));
+    m.eyes.push_back(make_eye(ctx, m.tracer, core::Eye(i), views[core::Eye(i)], distribution, visibility[size_t(i)]));
   std::vector<reconstruct::EyeGrid> grids;
   for (auto& e : m.eyes) {
     const EyeState* o = m.other(*e);

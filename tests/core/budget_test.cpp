@@ -137,16 +137,19 @@ constexpr DistributionKind kAllButCartesian[] = {DistributionKind::VisualPolar, 
                                                   DistributionKind::CartesianUniform, DistributionKind::LinearFalloff,
                                                   DistributionKind::LogPolar};
 
+// `given`: the lens' mask goes to make_distribution (as `fovea render` culls) instead of
+// set_visibility afterwards (as the layer, once the application's hidden area is known).
 void expect_budget_everywhere(const std::string& preset, bool lens,
-                              std::span<const DistributionKind> kinds = kAllButCartesian, double reference_tol = 0.15) {
+                              std::span<const DistributionKind> kinds = kAllButCartesian, double reference_tol = 0.15,
+                              bool given = false) {
   const DisplayPreset display = load_display(preset);
   const View v = display.view(Eye::Left);
   const ViewMask mask = EyeOptics(display, Eye::Left).view_mask();
   for (DistributionKind k : kinds) {
     DistributionParams p;
     p.kind = k;
-    auto d = make_distribution(v, p);
-    if (lens) d->set_visibility(mask);
+    auto d = make_distribution(v, p, lens && given ? &mask : nullptr);
+    if (lens && !given) d->set_visibility(mask);
     const double requested = 0.39 * v.width() * v.height() * (lens ? 1 - mask.hidden_fraction() : 1.0);
     const double budget = d->budget_samples();
     EXPECT_NEAR(budget / requested, 1.0, reference_tol) << preset << " " << distribution_name(k);
@@ -198,11 +201,48 @@ TEST(Budget, TracedCellsDoNotFollowTheJitter) {
   }
 }
 
+// Visual-Polar's layout traces the budget on the view at the centred gaze with its cells as
+// laid out (the row scale c = 1): without a mask, though its outer columns' rings reach past
+// the view's edges (it traced 0.92–0.94 of the budget when the layout held the budget's
+// rows), and with the lens' mask given to make_distribution (laid out for the pixels the
+// mask leaves). The presets and square views of ±60° and ±85°, cells counted one by one.
+TEST(Budget, VisualPolarLayoutTracesTheBudgetOnTheView) {
+#ifdef FOVEA_SANITIZED_BUILD
+  const char* presets[] = {"small"};
+  const double squares[] = {60.0};
+#else
+  const char* presets[] = {"small", "vive", "fove0", "modern", "wide"};
+  const double squares[] = {60.0, 85.0};
+#endif
+  auto expect_laid_out = [](const View& v, const ViewMask* mask, const std::string& what) {
+    auto d = make_distribution(v, DistributionParams{}, mask);
+    const double requested = 0.39 * v.width() * v.height() * (mask ? 1 - mask->hidden_fraction() : 1.0);
+    EXPECT_NEAR(d->budget_samples() / requested, 1.0, 0.01) << what;
+    EXPECT_NEAR(double(test::measure_strided(*d).traced) / requested, 1.0, 0.02) << what;
+    EXPECT_EQ(visual_polar_state(*d)->row_scale, 1.0) << what;
+  };
+  for (const char* preset : presets) {
+    const DisplayPreset display = load_display(preset);
+    const View v = display.view(Eye::Left);
+    expect_laid_out(v, nullptr, preset);
+    const ViewMask mask = EyeOptics(display, Eye::Left).view_mask();
+    expect_laid_out(v, &mask, std::string(preset) + " lens");
+  }
+  for (double a : squares)
+    expect_laid_out(View(Fov::from_degrees(-a, a, a, -a), 640, 640), nullptr, "±" + std::to_string(a) + "°");
+}
+
 TEST(Budget, KeptAtEveryGaze) { expect_budget_everywhere("small", false); }
 TEST(Budget, KeptAtEveryGazeUnderTheLens) { expect_budget_everywhere("small", true); }
+TEST(Budget, KeptAtEveryGazeUnderTheLensGivenFirst) {
+  expect_budget_everywhere("small", true, kAllButCartesian, 0.15, true);
+}
 #ifndef FOVEA_SANITIZED_BUILD
 TEST(Budget, KeptAtEveryGazeFove0) { expect_budget_everywhere("fove0", false); }
 TEST(Budget, KeptAtEveryGazeFove0UnderTheLens) { expect_budget_everywhere("fove0", true); }
+TEST(Budget, KeptAtEveryGazeFove0UnderTheLensGivenFirst) {
+  expect_budget_everywhere("fove0", true, kAllButCartesian, 0.15, true);
+}
 // The wide preset: every kind keeps its budget at every gaze. Visual-Polar's cap follows the
 // rings' own pixels there (with one cap of κ samples per pixel of the fovea's density it
 // traced 0.60 of its budget with the gaze straight ahead, where this asymmetric raster's

@@ -276,10 +276,11 @@ TEST(VisualPolarExtremes, PaperAnchorGrid) {
   const auto r = measure_density(*d, 2.0, 4, 4);
   EXPECT_NEAR(r.fill, 0.81, 0.02);
   EXPECT_NEAR(double(r.traced) / r.grid_samples, 0.89, 0.02);
-  // Packed: the same budget, more of it on screen, so more traced samples.
+  // Packed: the budget's samples on screen (the full rings' grid holds them, 11% of them off
+  // the view), so more traced samples.
   auto packed = make_distribution(load_display("fove0").view(Eye::Left), DistributionParams{});
   const auto rp = measure_density(*packed, 2.0, 4, 4);
-  EXPECT_NEAR(double(rp.grid_samples) / double(r.grid_samples), 1.0, 0.02);
+  EXPECT_NEAR(double(rp.traced) / double(r.grid_samples), 1.0, 0.03);
   EXPECT_GE(double(rp.traced) / rp.grid_samples, 0.9);
   EXPECT_GT(rp.traced, r.traced);
 }
@@ -393,8 +394,10 @@ TEST(VisualPolarSolve, SecantMatchesBisection) {
                           std::abs(double(t[i].r1) - double(table[i].r1)) / width});
       }
       // A column's rounding flips where its ~N_φ·√σ0 rows cross a half: over Δlog σ0 about
-      // N_ρ·N_φ·Δlog σ0 / 2 columns (allowed: twice that, plus 3).
-      EXPECT_LE(row_mismatches, cells * dlog + 3);
+      // N_ρ·N_φ·Δlog σ0 / 2 columns (allowed: twice that), plus those the budget's row scale
+      // c, bisected again for each σ0, flips (allowed: 8; 7 on `vive` with the gaze off the
+      // view).
+      EXPECT_LE(row_mismatches, cells * dlog + 8);
       EXPECT_LE(worst, 0.1);
       ++cases;
       identical += row_mismatches == 0 && worst <= 1e-5;

@@ -122,8 +122,10 @@ int run(std::vector<std::string> argv) {
   p.display = preset.origin;
   const glm::dvec3 gaze = parse_gaze(a, view);
 
-  auto dist = core::make_distribution(view, p);
-  if (a.has("hidden-area")) dist->set_visibility(core::EyeOptics(preset, eye).view_mask());
+  // As `fovea render` culls: the grid laid out for the pixels the lens leaves.
+  std::optional<core::ViewMask> mask;
+  if (a.has("hidden-area")) mask = core::EyeOptics(preset, eye).view_mask();
+  auto dist = core::make_distribution(view, p, mask ? &*mask : nullptr);
   const core::GazeStatus st = dist->set_frame(gaze);
   const core::DensityReport r = core::measure_density(*dist);
   const glm::dvec2 gp = view.dir_to_pixel(st.used).value_or(glm::dvec2(0));

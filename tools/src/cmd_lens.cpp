@@ -101,10 +101,9 @@ struct SamplesHidden {
 SamplesHidden samples_hidden(const core::EyeOptics& optics, const std::string& display) {
   core::DistributionParams params;
   params.display = display;
-  auto dist = core::make_distribution(optics.view(), params);
-  dist->set_frame({0, 0, -1});
   const core::ViewMask mask = optics.view_mask();
-  dist->set_visibility(mask);
+  auto dist = core::make_distribution(optics.view(), params, &mask);
+  dist->set_frame({0, 0, -1});
   std::size_t traced = 0, hidden = 0;
   for (int row = 0; row < dist->rows(); ++row)
     for (int col = 0; col < dist->columns(); ++col) {

@@ -96,7 +96,10 @@ class SampleDistribution {
   glm::dvec2 jitter() const;  // this frame's cell offset in [-0.5, 0.5)²
 
   // The view pixels the lens hides (optional): cells there are flagged hidden, and the
-  // budget counts only the pixels it leaves visible. Rebuilds the current frame.
+  // budget counts only the pixels it leaves visible. Rebuilds the current frame. A mask
+  // known before the distribution is made goes to make_distribution instead: Visual-Polar
+  // then lays its session grid out for the pixels the mask leaves (set later, the rows of
+  // its periphery take up the difference).
   void set_visibility(const ViewMask& mask);
 
   // The sample of cell (column, row), 0 <= column < padded_columns, 0 <= row < padded_rows.
@@ -141,6 +144,8 @@ class SampleDistribution {
   virtual void fill_gpu(shaders::GridParams& g) const = 0;
   // Display pixels covered by one cell of `column` around direction `dir`.
   virtual double pixels_per_cell(int column, glm::dvec3 dir) const = 0;
+  // set_visibility's bookkeeping without the rebuild (a constructor's, before its layout).
+  void adopt_mask(const ViewMask& mask);
 
   View view_;
   DistributionParams params_;
@@ -159,7 +164,9 @@ class SampleDistribution {
   std::vector<shaders::GridColumn> table_;  // polar kinds: per column radius range and rows
 };
 
-std::unique_ptr<SampleDistribution> make_distribution(const View& view, const DistributionParams& p);
+// `visibility` (optional): the lens' mask of the view, as set_visibility.
+std::unique_ptr<SampleDistribution> make_distribution(const View& view, const DistributionParams& p,
+                                                      const ViewMask* visibility = nullptr);
 
 // The angular Visual-Polar construction's per-frame state (nullopt for other kinds).
 struct VisualPolarState {

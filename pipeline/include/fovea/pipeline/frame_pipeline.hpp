@@ -7,6 +7,7 @@
 #include <array>
 #include <cstdint>
 #include <memory>
+#include <optional>
 #include <string>
 #include <utility>
 #include <vector>
@@ -68,13 +69,19 @@ struct IndirectSamples {
   double own = 0, effective = 0;
 };
 
+// Each eye's lens mask (left, right), where it is known when the pipeline is made.
+using EyeMasks = std::array<std::optional<core::ViewMask>, 2>;
+
 class FramePipeline {
  public:
   // `views`: each eye's FOV and raster (their poses are the first frame's default);
-  // `mono` renders the left eye only (stereo sharing needs both).
+  // `mono` renders the left eye only (stereo sharing needs both). `visibility`: as
+  // set_visibility from the first frame on, and each eye's grid is laid out for the pixels
+  // its mask leaves (a Visual-Polar grid traces the budget there with the cells its layout
+  // gives them; set later, its periphery's rows make up the difference).
   FramePipeline(gpu::Context& ctx, const renderer::GpuScene& scene, const core::StereoViews& views,
                 const core::DistributionParams& distribution, const reconstruct::ReconSettings& settings,
-                const renderer::PathConfig& path = {}, bool mono = false);
+                const renderer::PathConfig& path = {}, bool mono = false, const EyeMasks& visibility = {});
   ~FramePipeline();
   FramePipeline(const FramePipeline&) = delete;
   FramePipeline& operator=(const FramePipeline&) = delete;
