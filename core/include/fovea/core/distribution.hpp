@@ -119,15 +119,19 @@ class SampleDistribution {
   // (linear fall-off: the expected count); offscreen and hidden cells included.
   virtual double grid_samples() const;
   // The samples the budget sets, which make_distribution checks at the centred gaze: the
-  // grid samples; the screen-polar kinds' published grid (packed, its rows are rescaled).
+  // grid samples; the screen-polar kinds' published grid (packed, its rows are rescaled);
+  // Visual-Polar's traced on the view over the share a mask leaves (its outer columns' rings
+  // reach past the view's edges).
   virtual double budgeted_samples() const { return grid_samples(); }
   // The samples this frame traces: grid samples on the view and not hidden (estimated per
   // column for polar grids, expected for linear fall-off). Every kind but cartesian keeps
   // it at budget_samples() at any gaze, as far as its grid allows.
   virtual double traced_samples() const;
-  // The samples every frame traces: raster kinds the budget fraction of the view pixels
-  // the mask leaves visible; polar kinds what their grid traces at the centred gaze (their
-  // layout there, P5's and Meng's as published: some of it beyond the view's edges).
+  // The samples every frame traces: raster kinds and Visual-Polar the budget fraction of the
+  // view pixels the mask leaves visible (Visual-Polar: as far as its rows can come down or up,
+  // or its layout's own count within 2 % of that); the screen-polar kinds what their grid
+  // traces at the centred gaze (P5's and Meng's layouts as published: some of it beyond the
+  // view's edges).
   double budget_samples() const;
 
   // GPU description of the current frame (uniforms + column table; see grid_params.h).
