@@ -202,7 +202,7 @@ double PolarDistribution::fit_budget() {
   bool reference = false;
   if (!(centre_traced_ > 0)) {  // the centred gaze the session starts with: the reference
     // A layout within 2 % of its reference is its own: c = 1, the cells as laid out (its
-    // whole columns and rounded rows: `tiny`'s 32 columns trace 1.01 of its budget).
+    // whole columns and rounded rows: `tiny`'s 32 columns trace 1.016 of its budget).
     const double own = traced_for(1.0);
     centre_traced_ = centre_reference(own);
     if (std::abs(centre_traced_ - own) <= 0.02 * centre_traced_) {
