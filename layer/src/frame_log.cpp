@@ -112,7 +112,8 @@ void FrameLog::write_now(const FrameTimes& t) {
              {"xr_time_converted", t.xr_time_converted},
              {"layers", std::int64_t(t.layers)},     {"projection_views", std::int64_t(t.projection_views)},
              {"replaced", t.replaced},                {"render_ms", rt.total},
-             {"transfer_ms", rt.transfer},            {"samples_hidden", rt.samples_hidden},
+             {"transfer_ms", rt.transfer},            {"samples_traced", rt.samples_traced},
+             {"samples_hidden", rt.samples_hidden},
              // Which path-traced frame this displayed frame shows (asynchronous rendering).
              {"traced_frame", t.shown.frame},         {"traced_for_ns", t.shown.traced_for_ns},
              {"traced_for_frame", t.shown.traced_for_frame},

@@ -23,6 +23,7 @@
 #include <condition_variable>
 #include <cstdlib>
 #include <mutex>
+#include <optional>
 #include <thread>
 #include <cmath>
 #include <cstring>
@@ -95,6 +96,13 @@ core::ViewMask fetch_visibility_mask(PFN_xrGetVisibilityMaskKHR get, XrSession s
   return core::ViewMask::from_hidden_triangles(view, vertices, indices, what.c_str());
 }
 
+// Where the runtime's hidden area comes from (XR_KHR_visibility_mask, when enabled below) and
+// the generation of its change events the application's frame saw.
+struct MaskSource {
+  PFN_xrGetVisibilityMaskKHR get = nullptr;
+  std::uint64_t generation = 0;
+};
+
 // The views the application submitted: FOV, raster from the imageRect, pose (its reference
 // space), IPD as the distance between the two view positions.
 core::StereoViews submitted_views(const std::vector<AppView>& v) {
@@ -115,8 +123,7 @@ struct TraceRequest {
   std::array<XrPosef, 2> poses{};
   bool gaze_from_action = false;
   ActionGaze action_gaze;
-  PFN_xrGetVisibilityMaskKHR get_visibility_mask = nullptr;
-  std::uint64_t visibility_mask_generation = 0;
+  MaskSource masks;
 };
 
 // A finished path-traced frame, encoded in the application's swapchain format: in `colour`
@@ -141,8 +148,10 @@ class PathTracer {
  public:
   // `slots`: the GPU composition's traced-frame slots, which finished frames are written into
   // (null: the host path, frames kept in host memory).
+  // `masks`: the runtime's hidden area at the first frame, which the grids are laid out for.
   PathTracer(const LayerConfig& config, const renderer::Scene& scene, const core::StereoViews& views,
-             const core::DisplayPreset& display, VkFormat format, XrSession session, const AppDevice* slots)
+             const core::DisplayPreset& display, VkFormat format, XrSession session, const AppDevice* slots,
+             const MaskSource& masks)
       : config_(config), format_(format), session_(session), slots_(slots),
         gaze_(std::make_unique<LayerGaze>(config.gaze, display)), ctx_(make_context(slots, shared_)),
         // Imported before anything else can fail: the slots' descriptor is the writer's then.
@@ -154,7 +163,8 @@ class PathTracer {
         // The frame of `fovea render` (pipeline/frame_driver.hpp) on the application's views. A
         // measurement would delay the first traced frame by seconds: the cached choice, or none.
         driver_(std::make_unique<pipeline::FrameDriver>(*ctx_, scene, views,
-                                                        pipeline::FrameDriverOptions{config_.frame, false, false})) {
+                                                        pipeline::FrameDriverOptions{config_.frame, false, false},
+                                                        first_visibility(masks, views))) {
     shared_.reset();  // its descriptor is the imported memory's now
     if (writer_) {
       FOVEA_LAYER_INFO("hand-over: shared memory (the layer's device encodes each traced frame into the application's "
@@ -200,10 +210,11 @@ class PathTracer {
     }
     times.gaze_cpu = ms_since(t_gaze);
     times.frame = driver_->step(std::uint32_t(in.id), fg, poses, times.gaze_cpu).times;
-    // Counted by the grid pass (no read-back); reported while a mask is set.
-    if (mask_set_) {
+    // Counted by the grid pass (no read-back); the hidden ones while a mask is set.
+    {
       const pipeline::FramePipeline& p = driver_->pipeline();
-      times.samples_hidden = p.hidden_cells(core::Eye::Left) + p.hidden_cells(core::Eye::Right);
+      times.samples_traced = p.traced_cells(core::Eye::Left) + p.traced_cells(core::Eye::Right);
+      if (mask_set_) times.samples_hidden = p.hidden_cells(core::Eye::Left) + p.hidden_cells(core::Eye::Right);
     }
     const auto r0 = core::now_ns();
     if (writer_) {
@@ -278,24 +289,38 @@ class PathTracer {
       throw;
     }
   }
-  // The runtime's hidden area for the submitted views: fetched at the first frame and after
-  // each change event. A failed fetch is reported and leaves the previous mask (none at
-  // first): culling saves work, the image is right without it.
+  // The runtime's hidden area for the submitted views: fetched at the first frame, before the
+  // pipeline exists, so that each eye's grid is laid out for the pixels it leaves (a
+  // Visual-Polar grid then traces its budget with the cells its layout gives them), and
+  // after each change event (culled from the next frame on, the grid's rows making up the
+  // difference). A failed fetch is reported and leaves the previous mask (none at first):
+  // culling saves work, the image is right without it.
+  pipeline::EyeMasks first_visibility(const MaskSource& masks, const core::StereoViews& views) {
+    pipeline::EyeMasks m;
+    if (!masks.get) return m;
+    mask_generation_ = masks.generation;
+    for (core::Eye eye : {core::Eye::Left, core::Eye::Right})
+      m[std::size_t(eye)] = fetch_visibility(masks, views, eye, "the grid laid out for the pixels it leaves");
+    return m;
+  }
   void update_visibility(const TraceRequest& in) {
-    if (!in.get_visibility_mask || mask_generation_ == in.visibility_mask_generation) return;
-    mask_generation_ = in.visibility_mask_generation;
-    for (int e = 0; e < 2; ++e) {
-      const core::Eye eye = core::Eye(e);
-      try {
-        const core::ViewMask mask =
-            fetch_visibility_mask(in.get_visibility_mask, session_, std::uint32_t(e), driver_->views()[eye]);
-        driver_->pipeline().set_visibility(eye, mask);
-        mask_set_ = true;
-        FOVEA_LAYER_INFO("visibility mask of the %s view: %.1f%% of its pixels hidden, not traced", core::eye_name(eye),
-                         100.0 * mask.hidden_fraction());
-      } catch (const std::exception& ex) {
-        FOVEA_LAYER_WARN("visibility mask of the %s view not used: %s", core::eye_name(eye), ex.what());
-      }
+    if (!in.masks.get || mask_generation_ == in.masks.generation) return;
+    mask_generation_ = in.masks.generation;
+    for (core::Eye eye : {core::Eye::Left, core::Eye::Right})
+      if (const auto mask = fetch_visibility(in.masks, driver_->views(), eye, "from this frame on"))
+        driver_->pipeline().set_visibility(eye, *mask);
+  }
+  std::optional<core::ViewMask> fetch_visibility(const MaskSource& masks, const core::StereoViews& views, core::Eye eye,
+                                                 const char* how) {
+    try {
+      core::ViewMask mask = fetch_visibility_mask(masks.get, session_, std::uint32_t(eye), views[eye]);
+      mask_set_ = true;
+      FOVEA_LAYER_INFO("visibility mask of the %s view: %.1f%% of its pixels hidden, not traced (%s)", core::eye_name(eye),
+                       100.0 * mask.hidden_fraction(), how);
+      return mask;
+    } catch (const std::exception& ex) {
+      FOVEA_LAYER_WARN("visibility mask of the %s view not used: %s", core::eye_name(eye), ex.what());
+      return std::nullopt;
     }
   }
 
@@ -374,8 +399,7 @@ class PathTraceRenderer final : public FrameRenderer {
     for (std::size_t e = 0; e < 2; ++e) req.poses[e] = in.app_views[e].pose;
     req.gaze_from_action = in.gaze_from_action;
     req.action_gaze = in.action_gaze;
-    req.get_visibility_mask = in.get_visibility_mask;
-    req.visibility_mask_generation = in.visibility_mask_generation;
+    req.masks = {in.get_visibility_mask, in.visibility_mask_generation};
     {
       // Asynchronous: never wait for the render thread. At its low priority it may hold the
       // mailbox while it waits for a core (priority inversion); a frame that finds the mailbox
@@ -431,7 +455,7 @@ class PathTraceRenderer final : public FrameRenderer {
     std::unique_ptr<PathTracer> tracer;
     try {
       tracer = std::make_unique<PathTracer>(config_, scene_, views_in_, display_, format_, session_,
-                                            app_.gpu_composition() ? &app_ : nullptr);
+                                            app_.gpu_composition() ? &app_ : nullptr, first_masks_);
       for (;;) {
         TraceRequest req;
         {
@@ -615,6 +639,7 @@ class PathTraceRenderer final : public FrameRenderer {
     format_ = v0.format;
     pixel_format(format_);  // throws for formats the layer cannot composite
     views_in_ = submitted_views(in.app_views);
+    first_masks_ = {in.get_visibility_mask, in.visibility_mask_generation};
     // The gaze source sees the submitted views as a display without a lens (nothing else of
     // a preset applies to them).
     display_.name = "openxr-views";
@@ -662,6 +687,7 @@ class PathTraceRenderer final : public FrameRenderer {
   XrSession session_;
   renderer::Scene scene_;
   core::StereoViews views_in_;  // the traced views: FOV, raster (the first frame's imageRect), pose, IPD
+  MaskSource first_masks_;      // the runtime's hidden area as the first frame saw it
   core::DisplayPreset display_;
   VkFormat format_ = VK_FORMAT_UNDEFINED;
   std::uint32_t vk_queue_family_ = 0;

@@ -94,6 +94,7 @@ struct RenderTimes {
   // source), else on the runtime's XrTime (the eye-gaze action's XrEyeGazeSampleTimeEXT, or
   // a recorded or synthetic source counted from the first frame's display time).
   bool gaze_on_host_clock = false;
+  std::int64_t samples_traced = 0;  // grid cells traced, both eyes
   std::int64_t samples_hidden = 0;  // grid cells under the runtime's hidden area, both eyes: not traced
   // How the traced frame reached the application's device, and the bytes that crossed the
   // host on the way: "shared-memory" (encoded by the layer's device into the GPU

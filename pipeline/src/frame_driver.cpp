@@ -17,24 +17,26 @@ core::DistributionParams named(core::DistributionParams p, const std::optional<c
 
 // The lens' hidden area, culled from the first frame on (and each eye's grid laid out for the
 // pixels it leaves).
-EyeMasks culled(const std::optional<core::DisplayPreset>& display, bool cull) {
+EyeMasks culled(const core::DisplayPreset& display, bool cull) {
   EyeMasks m;
-  if (display && cull)
-    for (core::Eye e : {core::Eye::Left, core::Eye::Right}) m[size_t(e)] = core::EyeOptics(*display, e).view_mask();
+  if (cull)
+    for (core::Eye e : {core::Eye::Left, core::Eye::Right}) m[size_t(e)] = core::EyeOptics(display, e).view_mask();
   return m;
 }
 }  // namespace
 
 FrameDriver::FrameDriver(gpu::Context& ctx, const renderer::Scene& scene, const core::DisplayPreset& display,
                          const FrameDriverOptions& options)
-    : FrameDriver(ctx, scene, core::stereo_views(display, scene.camera), options, display) {}
+    : FrameDriver(ctx, scene, core::stereo_views(display, scene.camera), options, display,
+                  culled(display, options.cull)) {}
 
 FrameDriver::FrameDriver(gpu::Context& ctx, const renderer::Scene& scene, const core::StereoViews& views,
-                         const FrameDriverOptions& options)
-    : FrameDriver(ctx, scene, views, options, std::nullopt) {}
+                         const FrameDriverOptions& options, const EyeMasks& visibility)
+    : FrameDriver(ctx, scene, views, options, std::nullopt, visibility) {}
 
 FrameDriver::FrameDriver(gpu::Context& ctx, const renderer::Scene& scene, const core::StereoViews& views,
-                         const FrameDriverOptions& options, const std::optional<core::DisplayPreset>& display)
+                         const FrameDriverOptions& options, const std::optional<core::DisplayPreset>& display,
+                         const EyeMasks& visibility)
     : frame_(options.frame),
       refresh_hz_(display ? display->refresh_hz : 0),
       camera_(scene.camera),
@@ -43,7 +45,7 @@ FrameDriver::FrameDriver(gpu::Context& ctx, const renderer::Scene& scene, const 
       gpu_scene_(ctx, scene, renderer::BvhOptions{}, trace_choice_.tracing),
       views_(views),
       pipeline_(ctx, gpu_scene_, views_, named(frame_.distribution, display), frame_.recon,
-                path_config(frame_.bounces, scene), false, culled(display, options.cull)) {
+                path_config(frame_.bounces, scene), false, visibility) {
   pipeline_.set_seed(frame_.seed);
 }
 

@@ -92,7 +92,10 @@ TEST(LayerRender, HelloXrCubesCompositedOverThePathTracedScene) {
   EXPECT_NE(log.find("composition: on the GPU"), std::string::npos) << log;
   // The runtime offers XR_EXT_eye_gaze_interaction: the layer's action rides along hello_xr's.
   EXPECT_NE(log.find("gaze: the eye-gaze action"), std::string::npos) << log;
+  // Fetched before the pipeline was made: each eye's grid laid out for the pixels it leaves.
   EXPECT_NE(log.find("visibility mask of the left view"), std::string::npos) << log;
+  EXPECT_NE(log.find("of its pixels hidden, not traced (the grid laid out for the pixels it leaves)"), std::string::npos)
+      << log;
   EXPECT_EQ(log.find("visibility mask of the left view not used"), std::string::npos) << log;
   {
     std::ifstream in(both.path() + "/layer_timing.jsonl");
@@ -119,6 +122,7 @@ TEST(LayerRender, HelloXrCubesCompositedOverThePathTracedScene) {
       // The runtime's hidden area (XR_KHR_visibility_mask, which hello_xr does not enable) is
       // not traced: the tiny preset's lens hides the views' corners.
       EXPECT_GT(j["samples_hidden"].get<std::int64_t>(), 0) << line;
+      EXPECT_GT(j["samples_traced"].get<std::int64_t>(), 0) << line;
       // Composited by a compute pass on hello_xr's device: none of its images went to the host.
       EXPECT_TRUE(j["composited_on_gpu"].get<bool>()) << line;
       EXPECT_EQ(j["host_readbacks"].get<std::int64_t>(), 0) << line;

@@ -1,7 +1,7 @@
 // The frame driver every entry point sets its frames up with (pipeline/frame_driver.hpp): the
 // display's views with the head at the scene's camera and the lens hidden area culled, or the
-// views it is given with nothing culled; the frame configuration reaches the pipeline; each
-// frame's step reads the gaze and records the frame's times.
+// views it is given with the hidden area it is given culled; the frame configuration reaches
+// the pipeline; each frame's step reads the gaze and records the frame's times.
 #include <cmath>
 #include <stdexcept>
 
@@ -50,7 +50,7 @@ TEST_F(GpuTest, FrameDriverSetsUpEveryEntryPointAlike) {
   EXPECT_EQ(uncut.pipeline().hidden_cells(core::Eye::Left), 0);
 
   // The layer: the application's views, its eye poses in the reference space placed at the
-  // scene's camera; nothing culled until it sets the runtime's hidden area.
+  // scene's camera; nothing culled without the runtime's hidden area.
   const core::StereoViews views = core::stereo_views(display);
   pipeline::FrameDriver layer(ctx(), scene, views, {frame, true, false});
   const core::Pose identity{};
@@ -61,6 +61,40 @@ TEST_F(GpuTest, FrameDriverSetsUpEveryEntryPointAlike) {
   layer.pipeline().render({layer.at_camera(app[0]), layer.at_camera(app[1])}, gaze, 0);
   EXPECT_EQ(layer.pipeline().hidden_cells(core::Eye::Left), 0);
   EXPECT_EQ(layer.pipeline().distribution(core::Eye::Left).params().budget, 0.2);
+}
+
+// The layer fetches the runtime's hidden area before its frame driver exists and gives it to
+// the given views' driver: each eye's Visual-Polar grid is laid out for the pixels the mask
+// leaves and traces the budget there with its cells as laid out (row scale 1). A mask set
+// after the grid was laid out is culled too, the budget kept by cutting the periphery's rows
+// (row scale 0.35 on `small`).
+TEST_F(GpuTest, FrameDriverLaysGivenViewsOutForTheMaskItIsGiven) {
+  const renderer::Scene scene = renderer::load_scene("cornell");
+  const core::DisplayPreset display = core::load_display("small");
+  pipeline::FrameConfig frame;
+  frame.tracing = renderer::Tracing::Compute;
+  pipeline::finish(frame, true);
+  const core::StereoViews views = core::stereo_views(display);
+  pipeline::EyeMasks masks;
+  for (core::Eye e : {core::Eye::Left, core::Eye::Right}) masks[std::size_t(e)] = core::EyeOptics(display, e).view_mask();
+  pipeline::FrameDriver given(ctx(), scene, views, {frame, true, false}, masks);
+  pipeline::FrameDriver late(ctx(), scene, views, {frame, true, false});
+  for (core::Eye e : {core::Eye::Left, core::Eye::Right}) late.pipeline().set_visibility(e, *masks[std::size_t(e)]);
+  const auto head = views.poses();
+  const std::array<glm::dvec3, 2> gaze{glm::dvec3(0, 0, -1), glm::dvec3(0, 0, -1)};
+  for (pipeline::FrameDriver* d : {&given, &late})
+    d->pipeline().render({d->at_camera(head[0]), d->at_camera(head[1])}, gaze, 0);
+  for (core::Eye e : {core::Eye::Left, core::Eye::Right}) {
+    SCOPED_TRACE(core::eye_name(e));
+    const double budget = frame.distribution.budget * display.width * display.height *
+                          (1 - masks[std::size_t(e)]->hidden_fraction());
+    for (pipeline::FrameDriver* d : {&given, &late}) {
+      EXPECT_GT(d->pipeline().hidden_cells(e), 0);
+      EXPECT_NEAR(double(d->pipeline().traced_cells(e)) / budget, 1.0, 0.02);
+    }
+    EXPECT_EQ(core::visual_polar_state(given.pipeline().distribution(e))->row_scale, 1.0);
+    EXPECT_LT(core::visual_polar_state(late.pipeline().distribution(e))->row_scale, 0.9);
+  }
 }
 
 // Each frame is one step: the gaze read at the frame's time on the display's timeline (as a

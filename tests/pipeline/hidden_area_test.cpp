@@ -55,8 +55,8 @@ void expect_hidden_cells_untouched(fovea::gpu::Context& ctx, core::DistributionK
   for (std::size_t i = 0; i < given_samples.size(); ++i) {
     given_hidden += given_samples[i].flags == shaders::kCellHidden;
     if (same_layout) {
-EXPECT_EQ(given_samples[i].flags, samples[i].flags) << "cell " << i;
-}
+      EXPECT_EQ(given_samples[i].flags, samples[i].flags) << "cell " << i;
+    }
   }
   EXPECT_GT(given_hidden, 0);
   EXPECT_EQ(given.hidden_cells(core::Eye::Left), given_hidden);
@@ -68,14 +68,14 @@ EXPECT_EQ(given_samples[i].flags, samples[i].flags) << "cell " << i;
   for (std::size_t i = 0; i < samples.size(); ++i) {
     if (samples[i].flags != shaders::kCellHidden) {
       if (same_layout) {
-EXPECT_EQ(samples[i].flags, unmasked[i].flags) << "cell " << i << ": only the mask differs";
-}
+        EXPECT_EQ(samples[i].flags, unmasked[i].flags) << "cell " << i << ": only the mask differs";
+      }
       continue;
     }
     ++hidden;
     if (same_layout) {
-ASSERT_EQ(unmasked[i].flags, 0u) << "cell " << i << " is traced without the mask";
-}
+      ASSERT_EQ(unmasked[i].flags, 0u) << "cell " << i << " is traced without the mask";
+    }
     // Hidden is the cell centre's (its jittered sample may fall either side of the edge).
     const int columns = culled.distribution(core::Eye::Left).padded_columns();
     const shaders::GridSample centre =
@@ -88,16 +88,16 @@ ASSERT_EQ(unmasked[i].flags, 0u) << "cell " << i << " is traced without the mask
     for (const std::uint32_t w : words) EXPECT_EQ(w, 0x7fc00001u) << "cell " << i;
     EXPECT_EQ(position[i].w, -2.0f) << "cell " << i;
     if (same_layout) {
-EXPECT_NE(full_position[i].w, -2.0f) << "cell " << i << " has a sample without the mask";
-}
+      EXPECT_NE(full_position[i].w, -2.0f) << "cell " << i << " has a sample without the mask";
+    }
     EXPECT_EQ(final_color[i], glm::vec4(0.0f)) << "cell " << i;
   }
   EXPECT_GT(hidden, 0) << "the tiny preset's lens hides the view's corners";
   EXPECT_EQ(culled.hidden_cells(core::Eye::Left), hidden);
   EXPECT_EQ(full.hidden_cells(core::Eye::Left), 0);
   if (same_layout) {
-EXPECT_EQ(culled.traced_cells(core::Eye::Left) + hidden, full.traced_cells(core::Eye::Left));
-}
+    EXPECT_EQ(culled.traced_cells(core::Eye::Left) + hidden, full.traced_cells(core::Eye::Left));
+  }
   EXPECT_TRUE(fovea::test::all_finite(final_color));
   // A mask of another raster is refused.
   const core::ViewMask other = core::EyeOptics(core::load_display("small"), core::Eye::Left).view_mask();

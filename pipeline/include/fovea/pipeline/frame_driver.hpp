@@ -57,9 +57,10 @@ class FrameDriver {
   // The display preset's views (core::stereo_views) with the head at the scene's camera.
   FrameDriver(gpu::Context& ctx, const renderer::Scene& scene, const core::DisplayPreset& display,
               const FrameDriverOptions& options);
-  // Given views (the application's, in the layer): no hidden area until set_visibility.
+  // Given views (the application's, in the layer) and each one's hidden area where it is
+  // known (the grids laid out for the pixels it leaves); a later one through set_visibility.
   FrameDriver(gpu::Context& ctx, const renderer::Scene& scene, const core::StereoViews& views,
-              const FrameDriverOptions& options);
+              const FrameDriverOptions& options, const EyeMasks& visibility = {});
   FrameDriver(const FrameDriver&) = delete;
   FrameDriver& operator=(const FrameDriver&) = delete;
 
@@ -94,7 +95,8 @@ class FrameDriver {
 
  private:
   FrameDriver(gpu::Context& ctx, const renderer::Scene& scene, const core::StereoViews& views,
-              const FrameDriverOptions& options, const std::optional<core::DisplayPreset>& display);
+              const FrameDriverOptions& options, const std::optional<core::DisplayPreset>& display,
+              const EyeMasks& visibility);
 
   FrameConfig frame_;
   double refresh_hz_ = 0;  // the display preset's (0: given views)
