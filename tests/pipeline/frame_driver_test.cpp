@@ -3,6 +3,7 @@
 // views it is given with the hidden area it is given culled; the frame configuration reaches
 // the pipeline; each frame's step reads the gaze and records the frame's times.
 #include <cmath>
+#include <optional>
 #include <stdexcept>
 
 #include <glm/gtc/quaternion.hpp>
@@ -24,15 +25,21 @@ namespace {
 double pose_distance(const core::Pose& a, const core::Pose& b) {
   return glm::length(a.position - b.position) + glm::length(a.orientation - b.orientation);
 }
+
+// The frame defaults, with `budget` where given, on the compute traversal (no start-up measurement).
+pipeline::FrameConfig compute_frame(std::optional<double> budget = std::nullopt) {
+  pipeline::FrameConfig frame;
+  if (budget) frame.distribution.budget = *budget;
+  frame.tracing = renderer::Tracing::Compute;
+  pipeline::finish(frame, budget.has_value());
+  return frame;
+}
 }  // namespace
 
 TEST_F(GpuTest, FrameDriverSetsUpEveryEntryPointAlike) {
   const renderer::Scene scene = renderer::load_scene("cornell");
   const core::DisplayPreset display = core::load_display("tiny");
-  pipeline::FrameConfig frame;
-  frame.distribution.budget = 0.2;
-  frame.tracing = renderer::Tracing::Compute;
-  pipeline::finish(frame, true);
+  const pipeline::FrameConfig frame = compute_frame(0.2);
 
   // The command-line tools: the preset's views at the scene's camera, the lens hidden area culled.
   pipeline::FrameDriver tools(ctx(), scene, display, {frame, true, false});
@@ -71,9 +78,7 @@ TEST_F(GpuTest, FrameDriverSetsUpEveryEntryPointAlike) {
 TEST_F(GpuTest, FrameDriverLaysGivenViewsOutForTheMaskItIsGiven) {
   const renderer::Scene scene = renderer::load_scene("cornell");
   const core::DisplayPreset display = core::load_display("small");
-  pipeline::FrameConfig frame;
-  frame.tracing = renderer::Tracing::Compute;
-  pipeline::finish(frame, true);
+  const pipeline::FrameConfig frame = compute_frame();
   const core::StereoViews views = core::stereo_views(display);
   pipeline::EyeMasks masks;
   for (core::Eye e : {core::Eye::Left, core::Eye::Right}) masks[std::size_t(e)] = core::EyeOptics(display, e).view_mask();
@@ -103,9 +108,7 @@ TEST_F(GpuTest, FrameDriverLaysGivenViewsOutForTheMaskItIsGiven) {
 TEST_F(GpuTest, FrameDriverStepReadsTheGazeAtTheFrameTimeAndRecordsItsTimes) {
   const renderer::Scene scene = renderer::load_scene("cornell");
   const core::DisplayPreset display = core::load_display("tiny");
-  pipeline::FrameConfig frame;
-  frame.tracing = renderer::Tracing::Compute;
-  pipeline::finish(frame, false);
+  const pipeline::FrameConfig frame = compute_frame();
   pipeline::FrameDriver driver(ctx(), scene, display, {frame, true, false});
   EXPECT_THROW(driver.step(0), std::logic_error);  // no gaze source yet
   devices::SourceOptions so;
