@@ -214,9 +214,10 @@ void main() {
                    : max(1.0 / max(texelFetch(post, int(i)).w, 1.0), pc.taa_alpha) * g;
   // A still view (pc.still 1) needs no TAA outside a restart window: Phase I's cumulative
   // mean of the jittered samples is each cell's box-filtered mean already, and TAA's blend
-  // kept a bias that never averages out (measured, docs/reconstruction.md "History weights":
-  // with the clamp; without it in the compressed space; in linear space as a weighted
-  // cumulative mean). A restart window keeps its running mean: its history is young.
+  // kept a bias that never averages out (measured, docs/reconstruction-history.md "TAA on a
+  // still view and the fit's hand-over: tried and not taken": with the clamp; without it in
+  // the compressed space; in linear space as a weighted cumulative mean). A restart window
+  // keeps its running mean: its history is young.
   if (!follow) a = mix(a, 1.0, pc.still);
   final_color[i] = vec4(capped(max(expand(mix(h, compress(c), a)), vec3(0.0)), cap), 1.0);
 }
