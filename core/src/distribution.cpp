@@ -372,21 +372,21 @@ std::string fraction(double f) {
   return buf;
 }
 
-}  // namespace
-
-std::unique_ptr<SampleDistribution> make_distribution(const View& view, const DistributionParams& p,
-                                                      const ViewMask* visibility) {
-  p.validate();
-  auto d = make_unchecked(view, p, visibility);
+// The distribution, its budget met at the centred gaze it starts with or refused.
+// `layout_mask`: its grid laid out for the pixels `visibility` leaves (Visual-Polar); else
+// the mask, where given, is set after the check.
+std::unique_ptr<SampleDistribution> checked(const View& view, const DistributionParams& p, const ViewMask* visibility,
+                                            bool layout_mask) {
+  const ViewMask* layout = layout_mask ? visibility : nullptr;
+  auto d = make_unchecked(view, p, layout);
   const auto masked = [&] {
-    if (visibility && p.kind != DistributionKind::VisualPolar) d->set_visibility(*visibility);
+    if (visibility && !layout_mask) d->set_visibility(*visibility);
     return std::move(d);
   };
   // Cartesian: every pixel, whatever the budget. P5's staircase rounds rows up per 32
   // columns on top of the budgeted grid (+12% on `small`): an option of the layout study.
   if (p.kind == DistributionKind::Cartesian || p.staircase) return masked();
-  // The budget is met at the centred gaze the distribution starts with, or refused; two
-  // samples of slack let displays of a few pixels keep their minimal grids.
+  // Two samples of slack let displays of a few pixels keep their minimal grids.
   const double pixels = double(view.width()) * view.height();
   const double got = d->budgeted_samples() / pixels;
   if (std::abs(got - p.budget) * pixels <= std::max(0.05 * p.budget * pixels, 2.0)) return masked();
@@ -395,12 +395,30 @@ std::unique_ptr<SampleDistribution> make_distribution(const View& view, const Di
   if (got < p.budget) {
     DistributionParams full = p;
     full.budget = 1.0;
-    const double most = make_unchecked(view, full, visibility)->budgeted_samples() / pixels;
+    const double most = make_unchecked(view, full, layout)->budgeted_samples() / pixels;
     throw InputError(name + " reaches at most " + fraction(std::max(most, got)) + " of the display's pixels" +
                      where + " (requested " + fraction(p.budget) + ")");
   }
   throw InputError(name + " reaches no less than " + fraction(got) + " of the display's pixels" + where +
                    " (requested " + fraction(p.budget) + ")");
+}
+
+}  // namespace
+
+std::unique_ptr<SampleDistribution> make_distribution(const View& view, const DistributionParams& p,
+                                                      const ViewMask* visibility) {
+  p.validate();
+  // Visual-Polar lays its grid out for the pixels a mask leaves. Where that layout cannot
+  // meet the budget (a mask that leaves no pixel, or fewer than the least grid traces), the
+  // grid is laid out for the whole view and the mask set after it, as a mask set later is:
+  // it traces what the mask leaves.
+  if (visibility && p.kind == DistributionKind::VisualPolar) {
+    try {
+      return checked(view, p, visibility, true);
+    } catch (const InputError&) {
+    }
+  }
+  return checked(view, p, visibility, false);
 }
 
 }  // namespace fovea::core

@@ -4,8 +4,11 @@
 // many at every gaze, the lens' hidden area counted out.
 #include <gtest/gtest.h>
 
+#include <cmath>
+#include <memory>
 #include <span>
 #include <string>
+#include <vector>
 
 #include "density_strided.hpp"
 #include "fovea/core/density_report.hpp"
@@ -289,3 +292,45 @@ TEST(Budget, VisualPolarUnderTheLensTracesTheRequestedBudget) {
 
 }  // namespace
 }  // namespace fovea::core
+
+// A mask that hides every pixel of the view, or all but 36 of its 4096 (a square at the
+// centre), given when the grid is laid out or set later: every kind takes it without an
+// error, traces no hidden cell and nothing where nothing is visible. (Visual-Polar cannot
+// lay a grid out for the budget of 36 pixels, nor for none: it lays its grid out for the
+// whole view and sets the mask after, as a mask set later is.)
+TEST(Budget, MasksThatLeaveNothingOrAlmostNothing) {
+  const View v(Fov::from_degrees(-45, 45, 45, -45), 64, 64);
+  const float a = 0.1f;  // the visible square's half-width in tangent units: 3.2 pixels
+  const std::vector<glm::vec2> vertices{{-10, -10}, {10, -10}, {10, 10}, {-10, 10},
+                                        {-a, -a},   {a, -a},   {a, a},   {-a, a}};
+  const std::vector<std::uint32_t> everything{0, 1, 2, 0, 2, 3};
+  const std::vector<std::uint32_t> around{0, 1, 5, 0, 5, 4, 1, 2, 6, 1, 6, 5, 2, 3, 7, 2, 7, 6, 3, 0, 4, 3, 4, 7};
+  const ViewMask none = ViewMask::from_hidden_triangles(v, vertices, everything, "everything");
+  const ViewMask square = ViewMask::from_hidden_triangles(v, vertices, around, "all but a square");
+  ASSERT_EQ(none.hidden_fraction(), 1.0);
+  ASSERT_EQ(std::lround((1 - square.hidden_fraction()) * 64 * 64), 36);
+  for (DistributionKind k : {DistributionKind::VisualPolar, DistributionKind::PaperVisualPolar,
+                             DistributionKind::LogPolar, DistributionKind::Cartesian,
+                             DistributionKind::CartesianUniform, DistributionKind::LinearFalloff}) {
+    DistributionParams p;
+    p.kind = k;
+    for (const ViewMask* mask : {&none, &square})
+      for (bool given : {true, false}) {
+        const std::string what = std::string(distribution_name(k)) + (mask == &none ? ", nothing" : ", a square") +
+                                 (given ? " visible, given first" : " visible, set later");
+        std::unique_ptr<SampleDistribution> d;
+        ASSERT_NO_THROW(d = make_distribution(v, p, given ? mask : nullptr)) << what;
+        if (!given) {
+          ASSERT_NO_THROW(d->set_visibility(*mask)) << what;
+        }
+        EXPECT_TRUE(std::isfinite(d->budget_samples())) << what;
+        const auto traced = test::measure_strided(*d).traced;
+        if (mask == &none) {
+          EXPECT_EQ(traced, 0) << what;
+        } else {
+          EXPECT_GT(traced, 0) << what;
+          EXPECT_LE(traced, 36) << what;
+        }
+      }
+  }
+}

@@ -109,3 +109,36 @@ TEST_F(GpuTest, FramePipelineNeverTracesHiddenCells) {
   expect_hidden_cells_untouched(ctx(), core::DistributionKind::Cartesian);
   expect_hidden_cells_untouched(ctx(), core::DistributionKind::VisualPolar);
 }
+
+// A hidden area that covers the whole view (a runtime's bogus mesh, a display whose lens
+// shows nothing) given when the pipeline is made: nothing is traced, and the frames are
+// black, finite and pass validation, for the grid laid out by the budget and for the raster.
+TEST_F(GpuTest, FramePipelineWithEveryPixelHidden) {
+  const renderer::Scene scene = renderer::load_scene("cornell");
+  renderer::GpuScene gs(ctx(), scene);
+  const core::DisplayPreset display = core::load_display("tiny");
+  const core::StereoViews views = core::stereo_views(display);
+  const std::vector<glm::vec2> vertices{{-10, -10}, {10, -10}, {10, 10}, {-10, 10}};
+  const std::vector<std::uint32_t> indices{0, 1, 2, 0, 2, 3};
+  pipeline::EyeMasks masks;
+  for (core::Eye e : {core::Eye::Left, core::Eye::Right})
+    masks[std::size_t(e)] = core::ViewMask::from_hidden_triangles(views[e], vertices, indices, "everything");
+  ASSERT_EQ(masks[0]->hidden_fraction(), 1.0);
+  for (core::DistributionKind kind : {core::DistributionKind::VisualPolar, core::DistributionKind::Cartesian}) {
+    SCOPED_TRACE(core::distribution_name(kind));
+    core::DistributionParams dp;
+    dp.kind = kind;
+    pipeline::FramePipeline p(ctx(), gs, views, dp, reconstruct::ReconSettings{}, {}, false, masks);
+    const auto poses = core::eye_poses(scene.camera, display);
+    for (std::uint32_t f = 0; f < 2; ++f) p.render(poses, {glm::dvec3(0, 0, -1), glm::dvec3(0, 0, -1)}, f);
+    for (core::Eye e : {core::Eye::Left, core::Eye::Right}) {
+      EXPECT_EQ(p.traced_cells(e), 0);
+      EXPECT_GT(p.hidden_cells(e), 0);
+      const core::Image img = p.image(e);
+      double sum = 0;
+      for (const auto& px : img.pixels) sum += std::abs(px.x) + std::abs(px.y) + std::abs(px.z);
+      EXPECT_TRUE(std::isfinite(sum));
+      EXPECT_EQ(sum, 0.0);
+    }
+  }
+}
