@@ -16,6 +16,7 @@
 
 #include <cmath>
 #include <numbers>
+#include <optional>
 #include <random>
 #include <string>
 #include <vector>
@@ -56,9 +57,11 @@ std::vector<glm::dvec3> saccade_path(const fc::View& v) {
 void grid_build(benchmark::State& state, const std::string& preset, bool saccades, bool bisection, bool lens) {
   const fc::DisplayPreset display = fc::load_display(preset);
   const fc::View view = display.view(fc::Eye::Left);
-  const auto dist = fc::make_distribution(view, fc::DistributionParams{});
+  // The lens' hidden area given when the grid is laid out, as `fovea render` gives it.
+  const std::optional<fc::ViewMask> mask =
+      lens ? std::optional(fc::EyeOptics(display, fc::Eye::Left).view_mask()) : std::nullopt;
+  const auto dist = fc::make_distribution(view, fc::DistributionParams{}, mask ? &*mask : nullptr);
   fc::set_reference_sigma0_solve(*dist, bisection);
-  if (lens) dist->set_visibility(fc::EyeOptics(display, fc::Eye::Left).view_mask());
   const auto path = saccades ? saccade_path(view) : pursuit_path(view);
   std::size_t i = 0;
   double evaluations = 0;

@@ -149,8 +149,10 @@ int run(int argc, char** argv) {
       fc::DistributionParams dp;
       dp.kind = c.kind;
       if (c.budget > 0) dp.budget = c.budget;
-      fp::FramePipeline p(ctx, gs, fc::stereo_views(display), dp, settings);
-      for (fc::Eye e : {fc::Eye::Left, fc::Eye::Right}) p.set_visibility(e, fc::EyeOptics(display, e).view_mask());
+      // The lens' hidden area given when the grids are laid out, as `fovea render` gives it.
+      fp::EyeMasks masks;
+      for (fc::Eye e : {fc::Eye::Left, fc::Eye::Right}) masks[std::size_t(e)] = fc::EyeOptics(display, e).view_mask();
+      fp::FramePipeline p(ctx, gs, fc::stereo_views(display), dp, settings, {}, false, masks);
       // Frame 0 has no history (and its dispatches compile the shaders), and the first two
       // frames reconstruct every tile (the live tiles' reset rule, docs/renderer.md "Live
       // cells"); the third is the one a running session pays. Its trace is then timed again
@@ -176,8 +178,7 @@ int run(int argc, char** argv) {
       // per-cell kernels over all cells), and with the live tiles for the reconstruction too
       // (a GPU's default): what the live-tile list saves in the whole frame.
       const auto frame_in_order = [&](fr::TraceOrder order) {
-        fp::FramePipeline q(ctx, gs, fc::stereo_views(display), dp, settings);
-        for (fc::Eye e : {fc::Eye::Left, fc::Eye::Right}) q.set_visibility(e, fc::EyeOptics(display, e).view_mask());
+        fp::FramePipeline q(ctx, gs, fc::stereo_views(display), dp, settings, {}, false, masks);
         fp::testing::set_trace_order(q, order);
         for (std::uint32_t f = 0; f < kTimedFrame; ++f) q.render(poses, {gaze, gaze}, f);
         return q.render(poses, {gaze, gaze}, kTimedFrame);

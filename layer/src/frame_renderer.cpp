@@ -214,7 +214,7 @@ class PathTracer {
     {
       const pipeline::FramePipeline& p = driver_->pipeline();
       times.samples_traced = p.traced_cells(core::Eye::Left) + p.traced_cells(core::Eye::Right);
-      if (mask_set_) times.samples_hidden = p.hidden_cells(core::Eye::Left) + p.hidden_cells(core::Eye::Right);
+      if (masks_[0] || masks_[1]) times.samples_hidden = p.hidden_cells(core::Eye::Left) + p.hidden_cells(core::Eye::Right);
     }
     const auto r0 = core::now_ns();
     if (writer_) {
@@ -289,32 +289,34 @@ class PathTracer {
       throw;
     }
   }
-  // The runtime's hidden area for the submitted views: fetched at the first frame, before the
-  // pipeline exists, so that each eye's grid is laid out for the pixels it leaves (a
-  // Visual-Polar grid then traces its budget with the cells its layout gives them), and
-  // after each change event (culled from the next frame on, the grid's rows making up the
-  // difference). A failed fetch is reported and leaves the previous mask (none at first):
-  // culling saves work, the image is right without it.
-  pipeline::EyeMasks first_visibility(const MaskSource& masks, const core::StereoViews& views) {
-    pipeline::EyeMasks m;
-    if (!masks.get) return m;
+  // The runtime's hidden area for the submitted views, so that each eye's grid is laid out
+  // for the pixels it leaves (a Visual-Polar grid then traces its budget with the cells its
+  // layout gives them): fetched at the first frame, before the pipeline exists, and after
+  // each change event (the grids laid out again, the history starting over). A failed fetch
+  // is reported and leaves the previous mask (none at first): culling saves work, the image
+  // is right without it.
+  const pipeline::EyeMasks& first_visibility(const MaskSource& masks, const core::StereoViews& views) {
+    if (!masks.get) return masks_;
     mask_generation_ = masks.generation;
     for (core::Eye eye : {core::Eye::Left, core::Eye::Right})
-      m[std::size_t(eye)] = fetch_visibility(masks, views, eye, "the grid laid out for the pixels it leaves");
-    return m;
+      masks_[std::size_t(eye)] = fetch_visibility(masks, views, eye, "the grid laid out for the pixels it leaves");
+    return masks_;
   }
   void update_visibility(const TraceRequest& in) {
     if (!in.masks.get || mask_generation_ == in.masks.generation) return;
     mask_generation_ = in.masks.generation;
+    bool fetched = false;
     for (core::Eye eye : {core::Eye::Left, core::Eye::Right})
-      if (const auto mask = fetch_visibility(in.masks, driver_->views(), eye, "from this frame on"))
-        driver_->pipeline().set_visibility(eye, *mask);
+      if (auto mask = fetch_visibility(in.masks, driver_->views(), eye, "the grid laid out again from this frame on")) {
+        masks_[std::size_t(eye)] = std::move(mask);
+        fetched = true;
+      }
+    if (fetched) driver_->set_visibility(masks_);
   }
   std::optional<core::ViewMask> fetch_visibility(const MaskSource& masks, const core::StereoViews& views, core::Eye eye,
                                                  const char* how) {
     try {
       core::ViewMask mask = fetch_visibility_mask(masks.get, session_, std::uint32_t(eye), views[eye]);
-      mask_set_ = true;
       FOVEA_LAYER_INFO("visibility mask of the %s view: %.1f%% of its pixels hidden, not traced (%s)", core::eye_name(eye),
                        100.0 * mask.hidden_fraction(), how);
       return mask;
@@ -332,7 +334,7 @@ class PathTracer {
   std::unique_ptr<LayerGaze> gaze_;
   bool gaze_from_action_ = false;
   std::optional<std::uint64_t> mask_generation_;  // of the mask fetched last (none yet)
-  bool mask_set_ = false;                         // the pipeline culls with a runtime mask
+  pipeline::EyeMasks masks_;                      // the runtime's hidden area the grids are laid out for
   std::unique_ptr<gpu::Context> ctx_;
   std::unique_ptr<SlotWriter> writer_;  // the shared-memory hand-over (null: through the host)
   std::unique_ptr<pipeline::FrameDriver> driver_;

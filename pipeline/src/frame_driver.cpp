@@ -37,16 +37,23 @@ FrameDriver::FrameDriver(gpu::Context& ctx, const renderer::Scene& scene, const 
 FrameDriver::FrameDriver(gpu::Context& ctx, const renderer::Scene& scene, const core::StereoViews& views,
                          const FrameDriverOptions& options, const std::optional<core::DisplayPreset>& display,
                          const EyeMasks& visibility)
-    : frame_(options.frame),
+    : ctx_(ctx),
+      frame_(options.frame),
       refresh_hz_(display ? display->refresh_hz : 0),
       camera_(scene.camera),
       trace_choice_(renderer::choose_tracing(ctx, frame_.tracing, renderer::default_trace_choice_cache(),
                                              options.measure_trace)),
       gpu_scene_(ctx, scene, renderer::BvhOptions{}, trace_choice_.tracing),
       views_(views),
-      pipeline_(ctx, gpu_scene_, views_, named(frame_.distribution, display), frame_.recon,
-                path_config(frame_.bounces, scene), false, visibility) {
-  pipeline_.set_seed(frame_.seed);
+      distribution_(named(frame_.distribution, display)),
+      path_(path_config(frame_.bounces, scene)) {
+  set_visibility(visibility);
+}
+
+void FrameDriver::set_visibility(const EyeMasks& visibility) {
+  pipeline_.reset();  // its device memory first
+  pipeline_.emplace(ctx_, gpu_scene_, views_, distribution_, frame_.recon, path_, false, visibility);
+  pipeline_->set_seed(frame_.seed);
 }
 
 core::Pose FrameDriver::at_camera(const core::Pose& eye) const {
@@ -79,7 +86,7 @@ DrivenFrame FrameDriver::step(std::uint32_t index, const devices::FoveaGaze& gaz
   d.frame_ns = frame_ns(index);
   d.gaze = gaze;
   d.gaze_cpu_ms = gaze_cpu_ms;
-  d.times = pipeline_.render(poses, {gaze.eye(core::Eye::Left).dir, gaze.eye(core::Eye::Right).dir}, index);
+  d.times = pipeline_->render(poses, {gaze.eye(core::Eye::Left).dir, gaze.eye(core::Eye::Right).dir}, index);
   return d;
 }
 

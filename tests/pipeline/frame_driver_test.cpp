@@ -74,7 +74,7 @@ TEST_F(GpuTest, FrameDriverSetsUpEveryEntryPointAlike) {
 // the given views' driver: each eye's Visual-Polar grid is laid out for the pixels the mask
 // leaves and traces the budget there with its cells as laid out (row scale 1). A mask set
 // after the grid was laid out is culled too, the budget kept by cutting the periphery's rows
-// (row scale 0.35 on `small`).
+// (row scale 0.35 on `small`); given to the driver later, it lays the grids out again.
 TEST_F(GpuTest, FrameDriverLaysGivenViewsOutForTheMaskItIsGiven) {
   const renderer::Scene scene = renderer::load_scene("cornell");
   const core::DisplayPreset display = core::load_display("small");
@@ -99,6 +99,15 @@ TEST_F(GpuTest, FrameDriverLaysGivenViewsOutForTheMaskItIsGiven) {
     }
     EXPECT_EQ(core::visual_polar_state(given.pipeline().distribution(e))->row_scale, 1.0);
     EXPECT_LT(core::visual_polar_state(late.pipeline().distribution(e))->row_scale, 0.9);
+  }
+  // A hidden area given to the driver later (the runtime's change event) lays the grids out
+  // again: a new pipeline, as if it had been given first.
+  late.set_visibility(masks);
+  late.pipeline().render({late.at_camera(head[0]), late.at_camera(head[1])}, gaze, 1);
+  for (core::Eye e : {core::Eye::Left, core::Eye::Right}) {
+    EXPECT_EQ(late.pipeline().traced_cells(e), given.pipeline().traced_cells(e)) << core::eye_name(e);
+    EXPECT_EQ(late.pipeline().hidden_cells(e), given.pipeline().hidden_cells(e)) << core::eye_name(e);
+    EXPECT_EQ(core::visual_polar_state(late.pipeline().distribution(e))->row_scale, 1.0) << core::eye_name(e);
   }
 }
 

@@ -70,8 +70,13 @@ class FrameDriver {
   const core::StereoViews& views() const { return views_; }
   // The eyes of the static head at the scene's camera (the views' poses).
   std::array<core::Pose, 2> static_poses() const { return views_.poses(); }
-  FramePipeline& pipeline() { return pipeline_; }
-  const FramePipeline& pipeline() const { return pipeline_; }
+  FramePipeline& pipeline() { return *pipeline_; }
+  const FramePipeline& pipeline() const { return *pipeline_; }
+
+  // Each eye's hidden area from the next frame on, the grids laid out again for the pixels it
+  // leaves: a new pipeline (pipeline() refers to it; the history starts over). For a hidden
+  // area that changes during a session (the layer, after the runtime's change event).
+  void set_visibility(const EyeMasks& visibility);
 
   // An eye pose given in the scene camera's frame (the application's reference space, its
   // origin at the camera) in world coordinates.
@@ -98,6 +103,7 @@ class FrameDriver {
               const FrameDriverOptions& options, const std::optional<core::DisplayPreset>& display,
               const EyeMasks& visibility);
 
+  gpu::Context& ctx_;
   FrameConfig frame_;
   double refresh_hz_ = 0;  // the display preset's (0: given views)
   std::unique_ptr<devices::FoveationGaze> gaze_;
@@ -105,7 +111,9 @@ class FrameDriver {
   renderer::TraceChoice trace_choice_;
   renderer::GpuScene gpu_scene_;
   core::StereoViews views_;
-  FramePipeline pipeline_;
+  core::DistributionParams distribution_;  // frame_'s, named for the display preset
+  renderer::PathConfig path_;              // frame_'s transport, resolved for the scene
+  std::optional<FramePipeline> pipeline_;
 };
 
 }  // namespace fovea::pipeline
