@@ -86,7 +86,7 @@ DrivenFrame FrameDriver::step(std::uint32_t index, const devices::FoveaGaze& gaz
   d.frame_ns = frame_ns(index);
   d.gaze = gaze;
   d.gaze_cpu_ms = gaze_cpu_ms;
-  d.times = pipeline_->render(poses, {gaze.eye(core::Eye::Left).dir, gaze.eye(core::Eye::Right).dir}, index);
+  d.times = pipeline().render(poses, {gaze.eye(core::Eye::Left).dir, gaze.eye(core::Eye::Right).dir}, index);
   return d;
 }
 

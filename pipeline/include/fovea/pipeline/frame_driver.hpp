@@ -70,12 +70,13 @@ class FrameDriver {
   const core::StereoViews& views() const { return views_; }
   // The eyes of the static head at the scene's camera (the views' poses).
   std::array<core::Pose, 2> static_poses() const { return views_.poses(); }
-  FramePipeline& pipeline() { return *pipeline_; }
-  const FramePipeline& pipeline() const { return *pipeline_; }
+  FramePipeline& pipeline() { return pipeline_.value(); }
+  const FramePipeline& pipeline() const { return pipeline_.value(); }
 
   // Each eye's hidden area from the next frame on, the grids laid out again for the pixels it
   // leaves: a new pipeline (pipeline() refers to it; the history starts over). For a hidden
-  // area that changes during a session (the layer, after the runtime's change event).
+  // area that changes during a session (the layer, after the runtime's change event). Where
+  // making it throws, the driver is left without one (pipeline() throws).
   void set_visibility(const EyeMasks& visibility);
 
   // An eye pose given in the scene camera's frame (the application's reference space, its
