@@ -288,9 +288,6 @@ TEST(Budget, VisualPolarUnderTheLensTracesTheRequestedBudget) {
 }
 #endif
 
-}  // namespace
-}  // namespace fovea::core
-
 // A mask that hides every pixel of the view, or all but 36 of its 4096 (a square at the
 // centre), given when the grid is laid out or set later: every kind takes it without an
 // error, traces no hidden cell and nothing where nothing is visible. (Visual-Polar cannot
@@ -332,3 +329,6 @@ TEST(Budget, MasksThatLeaveNothingOrAlmostNothing) {
       }
   }
 }
+
+}  // namespace
+}  // namespace fovea::core
