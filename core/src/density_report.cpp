@@ -6,6 +6,36 @@
 #include "fovea/core/acuity.hpp"
 
 namespace fovea::core {
+namespace {
+
+// Every row_stride-th row's cells, each classified by its centre's flags and counted
+// row_stride times; `traced(col, row)` is called for each traced one.
+template <class Traced>
+CellCounts visit_cells(const SampleDistribution& d, int row_stride, Traced&& traced) {
+  CellCounts c;
+  row_stride = std::max(row_stride, 1);
+  for (int row = row_stride / 2; row < d.rows(); row += row_stride)
+    for (int col = 0; col < d.columns(); ++col) {
+      const std::uint32_t f = d.sample_at(col, row, {0, 0}).flags;
+      if (f & (shaders::kCellClipped | shaders::kCellPadding | shaders::kCellKilled)) continue;
+      c.grid_samples += row_stride;
+      if (f & shaders::kCellOffscreen) {
+        c.offscreen += row_stride;
+      } else if (f & shaders::kCellHidden) {
+        c.hidden += row_stride;
+      } else {
+        c.traced += row_stride;
+        traced(col, row);
+      }
+    }
+  return c;
+}
+
+}  // namespace
+
+CellCounts count_cells(const SampleDistribution& d, int row_stride) {
+  return visit_cells(d, row_stride, [](int, int) {});
+}
 
 DensityReport measure_density(const SampleDistribution& d, double band_deg, int stride, int row_stride) {
   const View& v = d.view();
@@ -43,31 +73,16 @@ DensityReport measure_density(const SampleDistribution& d, double band_deg, int 
   constexpr int kSub = 8;
   std::vector<double> counts(area.size(), 0);
   double fovea_samples = 0;
-  row_stride = std::max(row_stride, 1);
-  const double rw = row_stride;
-  for (int row = row_stride / 2; row < d.rows(); row += row_stride)
-    for (int col = 0; col < d.columns(); ++col) {
-      const shaders::GridSample s = d.sample_at(col, row, {0, 0});
-      const std::uint32_t f = s.flags;
-      if (f & (shaders::kCellClipped | shaders::kCellPadding | shaders::kCellKilled)) continue;
-      r.grid_samples += row_stride;
-      if (f & shaders::kCellOffscreen) {
-        r.offscreen += row_stride;
-        continue;
-      }
-      if (f & shaders::kCellHidden) {
-        r.hidden += row_stride;
-        continue;
-      }
-      r.traced += row_stride;
-      for (int k = 0; k < kSub; ++k) {
-        const shaders::GridSample q = d.sample_at(col, row, {(k + 0.5) / kSub - 0.5, 0});
-        if (q.flags & (shaders::kCellOffscreen | shaders::kCellHidden)) continue;
-        const double e = angle_deg(glm::dvec3(q.dir_x, q.dir_y, q.dir_z), g);
-        counts[std::min(size_t(e / band_deg), counts.size() - 1)] += rw / kSub;
-        if (e <= fovea) fovea_samples += rw / kSub;
-      }
+  const double rw = std::max(row_stride, 1);
+  static_cast<CellCounts&>(r) = visit_cells(d, row_stride, [&](int col, int row) {
+    for (int k = 0; k < kSub; ++k) {
+      const shaders::GridSample q = d.sample_at(col, row, {(k + 0.5) / kSub - 0.5, 0});
+      if (q.flags & (shaders::kCellOffscreen | shaders::kCellHidden)) continue;
+      const double e = angle_deg(glm::dvec3(q.dir_x, q.dir_y, q.dir_z), g);
+      counts[std::min(size_t(e / band_deg), counts.size() - 1)] += rw / kSub;
+      if (e <= fovea) fovea_samples += rw / kSub;
     }
+  });
   r.fill = double(r.grid_samples) / (double(d.columns()) * d.rows());
   r.fovea_spp = fovea_pixels > 0 ? fovea_samples / fovea_pixels : 0;
   for (size_t b = 0; b < area.size(); ++b) {

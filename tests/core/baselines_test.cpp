@@ -8,6 +8,7 @@
 #include "fovea/core/density_report.hpp"
 #include "fovea/core/display.hpp"
 #include "fovea/core/distribution.hpp"
+#include "fovea/core/eye_optics.hpp"
 
 using namespace fovea::core;
 namespace sh = fovea::shaders;
@@ -39,6 +40,29 @@ TEST(Cartesian, OneSamplePerPixelAtPixelCentres) {
   for (const auto& b : r.bands) {
     if (b.samples < 1000) continue;
     EXPECT_NEAR(b.samples_per_deg2 / b.display_pixels_per_deg2, 1.0, 0.05) << b.e_min;
+  }
+}
+
+// count_cells is measure_density's count without the bands: the same four numbers for every
+// kind, under the lens, at an off-centre gaze and with a row stride.
+TEST(DensityReport, CountCellsIsMeasureDensitysCount) {
+  const DisplayPreset display = load_display("small");
+  const ViewMask mask = EyeOptics(display, Eye::Left).view_mask();
+  for (DistributionKind k : {DistributionKind::Cartesian, DistributionKind::CartesianUniform, DistributionKind::VisualPolar,
+                             DistributionKind::PaperVisualPolar, DistributionKind::LogPolar}) {
+    auto d = make(k);
+    d->set_visibility(mask);
+    d->set_frame(d->view().pixel_to_dir({40, 200}));
+    for (int stride : {1, 3}) {
+      const CellCounts c = count_cells(*d, stride);
+      const DensityReport r = measure_density(*d, 2.0, 1, stride);
+      EXPECT_GT(c.traced, 0) << distribution_name(k);
+      EXPECT_GT(c.hidden, 0) << distribution_name(k);
+      EXPECT_EQ(c.traced, r.traced) << distribution_name(k) << " " << stride;
+      EXPECT_EQ(c.hidden, r.hidden) << distribution_name(k) << " " << stride;
+      EXPECT_EQ(c.offscreen, r.offscreen) << distribution_name(k) << " " << stride;
+      EXPECT_EQ(c.grid_samples, r.grid_samples) << distribution_name(k) << " " << stride;
+    }
   }
 }
 

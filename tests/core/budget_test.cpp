@@ -163,7 +163,7 @@ void expect_budget_everywhere(const std::string& preset, bool lens,
       const bool hidden_corner = lens && gaze_px && !mask.visible_at(*gaze_px);
       if (hidden_corner && (k == DistributionKind::PaperVisualPolar || k == DistributionKind::LogPolar)) continue;
       d->set_frame(gaze_at(v, deg), 3);
-      const DensityReport r = test::measure_strided(*d);
+      const CellCounts r = test::count_strided(*d);
       const std::string what = preset + (lens ? " lens " : " ") + distribution_name(k) + " " + std::to_string(deg);
       EXPECT_NEAR(double(r.traced) / budget, 1.0, hidden_corner ? 0.10 : 0.05) << what;
       EXPECT_NEAR(d->traced_samples() / double(r.traced), 1.0, 0.03) << what;
@@ -221,7 +221,7 @@ TEST(Budget, VisualPolarLayoutTracesTheBudgetOnTheView) {
     auto d = make_distribution(v, DistributionParams{}, mask);
     const double requested = 0.39 * v.width() * v.height() * (mask ? 1 - mask->hidden_fraction() : 1.0);
     EXPECT_NEAR(d->budget_samples() / requested, 1.0, 0.01) << what;
-    EXPECT_NEAR(double(test::measure_strided(*d).traced) / requested, 1.0, 0.02) << what;
+    EXPECT_NEAR(double(test::count_strided(*d).traced) / requested, 1.0, 0.02) << what;
     EXPECT_EQ(visual_polar_state(*d)->row_scale, 1.0) << what;
   };
   for (const char* preset : presets) {
@@ -274,7 +274,7 @@ TEST(Budget, VisualPolarUnderTheLensTracesTheRequestedBudget) {
     const double fovea_spp = d->samples_per_pixel({0.5 * v.width(), 0.5 * v.height()});
     d->set_visibility(mask);
     const double requested = 0.39 * v.width() * v.height() * (1 - mask.hidden_fraction());
-    const DensityReport r = test::measure_strided(*d);
+    const CellCounts r = test::count_strided(*d);
     if (wide) {
       EXPECT_GT(d->budget_samples() / requested, 1.10) << preset;
       EXPECT_LT(d->budget_samples() / requested, 1.17) << preset;
@@ -319,7 +319,7 @@ TEST(Budget, MasksThatLeaveNothingOrAlmostNothing) {
           ASSERT_NO_THROW(d->set_visibility(*mask)) << what;
         }
         EXPECT_TRUE(std::isfinite(d->budget_samples())) << what;
-        const auto traced = test::measure_strided(*d).traced;
+        const auto traced = test::count_strided(*d).traced;
         if (mask == &none) {
           EXPECT_EQ(traced, 0) << what;
         } else {

@@ -15,4 +15,7 @@ inline DensityReport measure_strided(const SampleDistribution& d) {
   return measure_density(d, 2.0, std::max(1, d.view().width() / 320), std::max(1, d.rows() / 360));
 }
 
+// Its cell counts alone, for the tests that count traced cells.
+inline CellCounts count_strided(const SampleDistribution& d) { return count_cells(d, std::max(1, d.rows() / 360)); }
+
 }  // namespace fovea::core::test
