@@ -20,12 +20,14 @@
 #include "fovea/devices/readers.hpp"
 #include "fovea/devices/screen.hpp"
 #include "fovea/devices/timeline.hpp"
+#include "scripted.hpp"
 #include "test_util.hpp"
 
 using namespace fovea::devices;
 using fovea::core::InputError;
 using fovea::core::TimeNs;
 using fovea::devices::test::scratch_dir;
+using fovea::devices::test::VectorStream;
 using fovea::devices::test::read_all;
 using fovea::devices::test::write_gz;
 using fovea::devices::test::write_text;
@@ -34,27 +36,10 @@ namespace {
 
 constexpr double kPi = 3.14159265358979323846;
 
-glm::dvec3 dir_deg(double az, double el) {  // (right, up) angles -> view direction
+glm::dvec3 dir_az_el(double az, double el) {  // (right, up) angles on the sphere -> view direction
   const double a = az * kPi / 180, e = el * kPi / 180;
   return {std::sin(a) * std::cos(e), std::sin(e), -std::cos(a) * std::cos(e)};
 }
-
-class VectorStream final : public SampleStream {
- public:
-  explicit VectorStream(std::vector<GazeSample> v) : v_(std::move(v)) {}
-  bool next(GazeSample& s) override {
-    if (i_ >= v_.size()) return false;
-    s = v_[i_++];
-    return true;
-  }
-  bool rewindable() const override { return true; }
-  void rewind() override { i_ = 0; }
-  std::string describe() const override { return "vector"; }
-
- private:
-  std::vector<GazeSample> v_;
-  std::size_t i_ = 0;
-};
 
 // Ground truth: fixations with white tracker noise (0.03° RMS per axis), saccades with a
 // raised-cosine position profile and the main-sequence duration D = 2.2·A + 21 ms, and
@@ -79,7 +64,7 @@ struct Script {
         s.t_ns = s.device_time_ns = s.host_time_ns = std::llround(next * 1e6);
         s.combined.flags = flags;
         s.combined.confidence = flags == kTracked ? 1 : 0;
-        s.combined.dir = dir_deg(p.x + noise(rng), p.y + noise(rng));
+        s.combined.dir = dir_az_el(p.x + noise(rng), p.y + noise(rng));
         s.left = s.right = s.combined;
         out.push_back(s);
       }
