@@ -26,7 +26,7 @@ namespace {
 
 constexpr int kWidth = 160, kHeight = 180;  // the tiny preset's optics at this raster
 constexpr std::uint32_t kFrames = 16;      // all 16 block offsets once
-constexpr std::uint32_t kReferenceSpp = 512;
+constexpr std::uint32_t kReferenceSpp = 256;  // 16× the samples of the renders' fovea (docs/reconstruction.md)
 
 const std::array<glm::dvec3, 2> kGaze{glm::dvec3(0, 0, -1), glm::dvec3(0, 0, -1)};
 
