@@ -1,5 +1,6 @@
 #pragma once
 // Runs the `fovea` binary built alongside the tests.
+#include <cstdlib>
 #include <string>
 
 namespace fovea::test {
@@ -17,5 +18,33 @@ std::string read_text(const std::string& path);
 
 // A fresh empty directory under the system temp dir, removed by the caller if wanted.
 std::string temp_dir(const std::string& tag);
+
+// FOVEA_PYTHON set for the scope: the interpreter the commands run.
+struct PythonOverride {
+  explicit PythonOverride(const char* p) { setenv("FOVEA_PYTHON", p, 1); }
+  ~PythonOverride() { unsetenv("FOVEA_PYTHON"); }
+  PythonOverride(const PythonOverride&) = delete;
+  PythonOverride& operator=(const PythonOverride&) = delete;
+};
+
+// Whether the commands draw their figures: matplotlib does in the Release build. Under the
+// sanitizers, which do not see Python, they run without it (FiguresAsData for the scope) and
+// the tests read the figures' data, which the sanitized program writes: drawing was most of
+// those tests' time there.
+#ifdef FOVEA_SANITIZED_BUILD
+inline constexpr bool kFiguresDrawn = false;
+#else
+inline constexpr bool kFiguresDrawn = true;
+#endif
+struct FiguresAsData {
+  FiguresAsData() {
+    if (!kFiguresDrawn) setenv("FOVEA_PYTHON", "/nonexistent/python3", 1);
+  }
+  ~FiguresAsData() {
+    if (!kFiguresDrawn) unsetenv("FOVEA_PYTHON");
+  }
+  FiguresAsData(const FiguresAsData&) = delete;
+  FiguresAsData& operator=(const FiguresAsData&) = delete;
+};
 
 }  // namespace fovea::test
