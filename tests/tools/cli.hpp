@@ -1,6 +1,7 @@
 #pragma once
 // Runs the `fovea` binary built alongside the tests.
 #include <cstdlib>
+#include <optional>
 #include <string>
 
 namespace fovea::test {
@@ -38,13 +39,9 @@ inline constexpr bool kFiguresDrawn = true;
 #endif
 struct FiguresAsData {
   FiguresAsData() {
-    if (!kFiguresDrawn) setenv("FOVEA_PYTHON", "/nonexistent/python3", 1);
+    if (!kFiguresDrawn) python.emplace("/nonexistent/python3");
   }
-  ~FiguresAsData() {
-    if (!kFiguresDrawn) unsetenv("FOVEA_PYTHON");
-  }
-  FiguresAsData(const FiguresAsData&) = delete;
-  FiguresAsData& operator=(const FiguresAsData&) = delete;
+  std::optional<PythonOverride> python;
 };
 
 }  // namespace fovea::test
