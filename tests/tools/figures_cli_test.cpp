@@ -97,8 +97,7 @@ TEST(Figures, LatencyChartsComeFromFiguresJson) {
   std::vector<std::string> files;
   for (const auto& c : j["charts"]) files.push_back(c["file"]);
   EXPECT_EQ(files, (std::vector<std::string>{"latency", "foveal_error", "sweep_error"}));
-  for (const auto& f : files) {
-    if (!kFiguresDrawn) break;
+  for (const auto& f : kFiguresDrawn ? files : std::vector<std::string>{}) {
     EXPECT_TRUE(is_png(dir + "/" + f + ".png")) << f;
     EXPECT_TRUE(is_svg(dir + "/" + f + ".svg")) << f;
   }
