@@ -161,6 +161,7 @@ void Context::release() {
     // A given device is its owner's: only what this context made on it goes.
     if (owns_device_) vkDeviceWaitIdle(device_);
     else if (queue_ != VK_NULL_HANDLE) vkQueueWaitIdle(queue_);
+    kernels_.clear();
     if (command_pool_ != VK_NULL_HANDLE) vkDestroyCommandPool(device_, command_pool_, nullptr);
     if (owns_device_) vkDestroyDevice(device_, nullptr);
   }
@@ -174,6 +175,14 @@ void Context::release() {
   device_ = VK_NULL_HANDLE;
   messenger_ = VK_NULL_HANDLE;
   instance_ = VK_NULL_HANDLE;
+}
+
+std::shared_ptr<const CompiledKernel> Context::kernel(
+    const std::string& key, const std::function<std::shared_ptr<const CompiledKernel>()>& make) {
+  const std::lock_guard lock(kernels_mutex_);
+  auto& kept = kernels_[key];
+  if (!kept) kept = make();  // a throw leaves the entry empty, to be made again
+  return kept;
 }
 
 void Context::create_instance(bool validation) {

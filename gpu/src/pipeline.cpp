@@ -153,22 +153,34 @@ std::vector<Binding> declared_bindings(const std::string& shader, std::uint32_t 
   return out;
 }
 
-ComputePipeline::ComputePipeline(Context& ctx, const ComputePipelineDesc& desc)
-    : shader_(desc.shader), push_bytes_(desc.push_constant_bytes) {
+namespace {
+
+// A description as the kernel cache's key: every field that changes the compiled kernel.
+std::string kernel_key(const ComputePipelineDesc& desc) {
+  std::string key = desc.shader + "|push " + std::to_string(desc.push_constant_bytes);
+  for (const auto& set : desc.sets) {
+    key += "|set";
+    for (const Binding b : set) key += ' ' + std::to_string(int(b));
+  }
+  for (const SpecConstant& c : desc.specialization) key += "|" + std::to_string(c.id) + '=' + std::to_string(c.bits);
+  return key;
+}
+
+std::shared_ptr<const CompiledKernel> compile_kernel(Context& ctx, const ComputePipelineDesc& desc) {
   const std::string what = "gpu::ComputePipeline '" + desc.shader + "'";
   const std::vector<std::uint32_t> words = spirv_words(desc.shader, what);
   if (desc.push_constant_bytes % 4 != 0 || desc.push_constant_bytes > ctx.limits().maxPushConstantsSize)
     throw core::InputError(what + ": push_constant_bytes " + std::to_string(desc.push_constant_bytes) +
                            " must be a multiple of 4 and at most " + std::to_string(ctx.limits().maxPushConstantsSize));
-  local_size_ = spirv::workgroup_size(words, desc.specialization);
-  for (int i = 0; i < 3; ++i) {
-    max_groups_[i] = ctx.limits().maxComputeWorkGroupCount[i];
-    if (local_size_[i] == 0 || local_size_[i] > ctx.limits().maxComputeWorkGroupSize[i])
-      throw core::InputError(what + ": workgroup size " + std::to_string(local_size_[i]) + " in dimension " +
+  auto kernel = std::make_shared<CompiledKernel>();
+  kernel->local_size = spirv::workgroup_size(words, desc.specialization);
+  for (int i = 0; i < 3; ++i)
+    if (kernel->local_size[i] == 0 || kernel->local_size[i] > ctx.limits().maxComputeWorkGroupSize[i])
+      throw core::InputError(what + ": workgroup size " + std::to_string(kernel->local_size[i]) + " in dimension " +
                              std::to_string(i) + " is outside the device limit " +
                              std::to_string(ctx.limits().maxComputeWorkGroupSize[i]));
-  }
-  if (std::uint64_t(local_size_[0]) * local_size_[1] * local_size_[2] > ctx.limits().maxComputeWorkGroupInvocations)
+  if (std::uint64_t(kernel->local_size[0]) * kernel->local_size[1] * kernel->local_size[2] >
+      ctx.limits().maxComputeWorkGroupInvocations)
     throw core::InputError(what + ": workgroup has more invocations than the device's " +
                            std::to_string(ctx.limits().maxComputeWorkGroupInvocations));
 
@@ -177,11 +189,11 @@ ComputePipeline::ComputePipeline(Context& ctx, const ComputePipelineDesc& desc)
   const VkDevice dev = ctx.device();
   std::vector<VkDescriptorSetLayout> set_handles;
   for (const auto& bindings : desc.sets) {
-    set_layouts_.emplace_back(ctx, bindings);
-    set_handles.push_back(set_layouts_.back().handle());
+    kernel->set_layouts.emplace_back(ctx, bindings);
+    set_handles.push_back(kernel->set_layouts.back().handle());
   }
   const VkPipelineLayout layout = build_layout(&vkCreatePipelineLayout, dev, set_handles, desc.push_constant_bytes);
-  layout_ = {dev, layout};
+  kernel->layout = {dev, layout};
 
   std::vector<VkSpecializationMapEntry> entries;
   for (std::size_t i = 0; i < desc.specialization.size(); ++i)
@@ -194,16 +206,27 @@ ComputePipeline::ComputePipeline(Context& ctx, const ComputePipelineDesc& desc)
   const PipelineFunctions loader{&vkCreateShaderModule, &vkDestroyShaderModule, &vkCreateComputePipelines,
                                  &vkDestroyPipeline};
   const VkPipeline pipeline = build_pipelines(loader, dev, words, layout, specs).front();
-  pipeline_ = {dev, pipeline};
+  kernel->pipeline = {dev, pipeline};
   ctx.set_name(VK_OBJECT_TYPE_PIPELINE, reinterpret_cast<std::uint64_t>(pipeline), desc.shader);
+  return kernel;
+}
+
+}  // namespace
+
+ComputePipeline::ComputePipeline(Context& ctx, const ComputePipelineDesc& desc)
+    : shader_(desc.shader),
+      push_bytes_(desc.push_constant_bytes),
+      kernel_(ctx.kernel(kernel_key(desc), [&] { return compile_kernel(ctx, desc); })) {
+  local_size_ = kernel_->local_size;
+  for (int i = 0; i < 3; ++i) max_groups_[i] = ctx.limits().maxComputeWorkGroupCount[i];
 }
 
 void ComputePipeline::bind(VkCommandBuffer cmd, std::initializer_list<const DescriptorSet*> sets) const {
-  vkCmdBindPipeline(cmd, VK_PIPELINE_BIND_POINT_COMPUTE, pipeline_.get());
+  vkCmdBindPipeline(cmd, VK_PIPELINE_BIND_POINT_COMPUTE, handle());
   if (sets.size() == 0) return;
   std::vector<VkDescriptorSet> handles;
   for (const DescriptorSet* s : sets) handles.push_back(s->handle());
-  vkCmdBindDescriptorSets(cmd, VK_PIPELINE_BIND_POINT_COMPUTE, layout_.get(), 0,
+  vkCmdBindDescriptorSets(cmd, VK_PIPELINE_BIND_POINT_COMPUTE, layout(), 0,
                           static_cast<std::uint32_t>(handles.size()), handles.data(), 0, nullptr);
 }
 
@@ -211,7 +234,7 @@ void ComputePipeline::push_bytes(VkCommandBuffer cmd, std::span<const std::byte>
   if (bytes.size() != push_bytes_)
     throw core::InputError("gpu::ComputePipeline '" + shader_ + "': " + std::to_string(bytes.size()) +
                            " push-constant bytes given, the layout has " + std::to_string(push_bytes_));
-  vkCmdPushConstants(cmd, layout_.get(), VK_SHADER_STAGE_COMPUTE_BIT, 0, push_bytes_, bytes.data());
+  vkCmdPushConstants(cmd, layout(), VK_SHADER_STAGE_COMPUTE_BIT, 0, push_bytes_, bytes.data());
 }
 
 void ComputePipeline::dispatch(VkCommandBuffer cmd, std::uint32_t x, std::uint32_t y, std::uint32_t z) const {

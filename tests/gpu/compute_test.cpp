@@ -1,4 +1,5 @@
 #include <cstdint>
+#include <memory>
 #include <vector>
 
 #include <glm/vec4.hpp>
@@ -49,6 +50,35 @@ TEST_F(Compute, DispatchWithPushAndSpecializationConstants) {
   const auto got = out.download<std::uint32_t>();
   for (std::uint32_t i = 0; i < capacity; ++i)
     ASSERT_EQ(got[i], i < n ? i * 3 + 5 + 100000 : 0xffffffffu) << "index " << i;
+}
+
+// A device compiles each description once (a pipeline takes ~15 ms to create on lavapipe, and
+// a frame pipeline has 15): pipelines of one description share the kernel, and it outlives
+// the pipeline that made it; another specialisation is another kernel; a description that
+// failed fails again.
+TEST_F(Compute, PipelinesOfOneDescriptionShareTheirKernel) {
+  auto first = std::make_unique<gpu::ComputePipeline>(ctx(), fill_desc({gpu::SpecConstant::u32(0, 3)}));
+  gpu::ComputePipeline same(ctx(), fill_desc({gpu::SpecConstant::u32(0, 3)}));
+  const gpu::ComputePipeline other(ctx(), fill_desc({gpu::SpecConstant::u32(0, 4)}));
+  EXPECT_EQ(first->handle(), same.handle());
+  EXPECT_EQ(first->layout(), same.layout());
+  EXPECT_EQ(first->set_layout(0).handle(), same.set_layout(0).handle());
+  EXPECT_NE(first->handle(), other.handle());
+  first.reset();
+
+  const std::uint32_t n = 100;
+  gpu::Buffer out(ctx(), {.size = n * 4, .name = "fill out"});
+  gpu::Buffer params(ctx(), {.size = 4, .usage = gpu::BufferUsage::Uniform, .memory = gpu::Memory::HostVisible});
+  params.upload(std::vector<std::uint32_t>{1000});
+  gpu::DescriptorSet set(ctx(), same.set_layout(0));
+  set.bind(0, out).bind(1, params);
+  ctx().submit_and_wait([&](VkCommandBuffer cmd) { same.run(cmd, {&set}, FillPush{n, 7}, n); });
+  const auto got = out.download<std::uint32_t>();
+  for (std::uint32_t i = 0; i < n; ++i) ASSERT_EQ(got[i], i * 3 + 7 + 1000) << "index " << i;
+
+  const gpu::ComputePipelineDesc bad{.shader = "test_gpu_fill.comp.spv", .sets = {{gpu::Binding::StorageBuffer}}};
+  EXPECT_THROW(gpu::ComputePipeline(ctx(), bad), fovea::core::InputError);
+  EXPECT_THROW(gpu::ComputePipeline(ctx(), bad), fovea::core::InputError);
 }
 
 // More workgroups than the device allows in x (65535 on lavapipe): dispatch refuses them,

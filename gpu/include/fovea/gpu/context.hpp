@@ -14,7 +14,9 @@
 #include <atomic>
 #include <cstdint>
 #include <functional>
+#include <map>
 #include <memory>
+#include <mutex>
 #include <optional>
 #include <span>
 #include <string>
@@ -121,6 +123,8 @@ struct EnabledFeatures {
   std::uint32_t as_scratch_alignment = 0;  // minAccelerationStructureScratchOffsetAlignment
 };
 
+struct CompiledKernel;  // pipeline.hpp
+
 class Context {
  public:
   explicit Context(const ContextOptions& options = {});
@@ -175,6 +179,12 @@ class Context {
   // Names an object for validation messages (no-op without VK_EXT_debug_utils).
   void set_name(VkObjectType type, std::uint64_t handle, const std::string& name) const;
 
+  // The kernel compiled for the description `key` (ComputePipeline): made by `make` on the
+  // first request, then shared by every pipeline made with that description, and kept until
+  // the context is released (before its device). `make` runs under the cache's lock.
+  std::shared_ptr<const CompiledKernel> kernel(const std::string& key,
+                                               const std::function<std::shared_ptr<const CompiledKernel>()>& make);
+
  private:
   void create_instance(bool validation);
   void pick_device(const std::string& override, const ContextOptions& options);
@@ -205,6 +215,8 @@ class Context {
   std::uint64_t host_available_ = 0;  // bytes available to the process at creation (CPU devices)
   EnabledFeatures features_;
   PFN_vkSetDebugUtilsObjectNameEXT set_object_name_ = nullptr;
+  std::mutex kernels_mutex_;
+  std::map<std::string, std::shared_ptr<const CompiledKernel>> kernels_;
 };
 
 }  // namespace fovea::gpu

@@ -2,11 +2,13 @@
 // Compute pipelines from the embedded SPIR-V (fovea::shaders::find), with their own
 // pipeline layout: descriptor set layouts, one push-constant range, optional 32-bit
 // specialization constants. The workgroup size is read from the SPIR-V (including
-// local_size_*_id specialization), so dispatches can be given in threads.
+// local_size_*_id specialization), so dispatches can be given in threads. A device compiles
+// each description once: pipelines made with the same description share its kernel.
 #include <array>
 #include <bit>
 #include <cstdint>
 #include <initializer_list>
+#include <memory>
 #include <span>
 #include <string>
 #include <vector>
@@ -38,15 +40,30 @@ struct ComputePipelineDesc {
 // core::InputError for an unknown shader or a binding number the set skips.
 std::vector<Binding> declared_bindings(const std::string& shader, std::uint32_t set = 0);
 
+// What a ComputePipeline binds: its layouts and the compiled pipeline. Made once per device
+// and description and kept by the Context until it is released (creating a pipeline takes
+// ~15 ms on lavapipe, and a frame pipeline has 15 of them).
+struct CompiledKernel {
+  std::vector<DescriptorSetLayout> set_layouts;
+  DeviceHandle<VkPipelineLayout, vkDestroyPipelineLayout> layout;
+  DeviceHandle<VkPipeline, vkDestroyPipeline> pipeline;
+  std::array<std::uint32_t, 3> local_size{1, 1, 1};
+};
+
 class ComputePipeline {
  public:
   ComputePipeline() = default;
-  // Throws core::InputError for an unknown shader name or an invalid description.
+  // Throws core::InputError for an unknown shader name or an invalid description. The kernel
+  // is the device's for this description (Context::kernel), compiled on first use.
   ComputePipeline(Context& ctx, const ComputePipelineDesc& desc);
+  ComputePipeline(const ComputePipeline&) = delete;
+  ComputePipeline& operator=(const ComputePipeline&) = delete;
+  ComputePipeline(ComputePipeline&&) = default;
+  ComputePipeline& operator=(ComputePipeline&&) = default;
 
-  VkPipeline handle() const { return pipeline_.get(); }
-  VkPipelineLayout layout() const { return layout_.get(); }
-  const DescriptorSetLayout& set_layout(std::size_t set) const { return set_layouts_.at(set); }
+  VkPipeline handle() const { return kernel_ ? kernel_->pipeline.get() : VK_NULL_HANDLE; }
+  VkPipelineLayout layout() const { return kernel_ ? kernel_->layout.get() : VK_NULL_HANDLE; }
+  const DescriptorSetLayout& set_layout(std::size_t set) const { return kernel_->set_layouts.at(set); }
   std::array<std::uint32_t, 3> workgroup_size() const { return local_size_; }
   const std::string& shader() const { return shader_; }
 
@@ -94,9 +111,7 @@ class ComputePipeline {
   std::uint32_t push_bytes_ = 0;
   std::array<std::uint32_t, 3> local_size_{1, 1, 1};
   std::array<std::uint32_t, 3> max_groups_{0, 0, 0};
-  std::vector<DescriptorSetLayout> set_layouts_;
-  DeviceHandle<VkPipelineLayout, vkDestroyPipelineLayout> layout_;
-  DeviceHandle<VkPipeline, vkDestroyPipeline> pipeline_;
+  std::shared_ptr<const CompiledKernel> kernel_;
 };
 
 // Compute pipelines on a device Fovea does not own (the application's, in the API layer and
