@@ -22,16 +22,20 @@ for m in "$b"/share/openxr/1/api_layers/explicit.d/*.json "$b"/share/openxr/1/ru
   [[ -f $(dirname "$m")/$lib ]] || fail "$m: library_path $lib does not resolve"
 done
 
-env -i PATH=/usr/bin:/bin HOME="$work" ${VK_ICD_FILENAMES:+VK_ICD_FILENAMES=$VK_ICD_FILENAMES} \
+# The driver's compiled shaders come from the caller's cache (the driver's own variable, not
+# the bundle's: compiling them again cold took 8 of the render's 9 s, and a machine that has
+# run its driver before has them); everything of fovea's own starts from an empty HOME.
+shaders=${MESA_SHADER_CACHE_DIR:-${XDG_CACHE_HOME:-${HOME:-$work}/.cache}}
+env -i PATH=/usr/bin:/bin HOME="$work" MESA_SHADER_CACHE_DIR="$shaders" ${VK_ICD_FILENAMES:+VK_ICD_FILENAMES=$VK_ICD_FILENAMES} \
   ${VK_DRIVER_FILES:+VK_DRIVER_FILES=$VK_DRIVER_FILES} \
   bash "$b/run.sh" bin/fovea render --display tiny --scene cornell --frames 1 --quiet --out "$work/render" \
   > "$work/render.log" 2>&1 || { cat "$work/render.log"; fail "the bundle's fovea render exited non-zero"; }
 [[ -s $work/render/report.json && -s $work/render/frame_0000_sbs.png ]] || fail "render wrote no report or frame"
 
 # The device measurements from the bundle, in their quick form (tiny display, small batches):
-# every step runs and the summary names the device. The render's caches (its traversal choice,
-# the driver's shaders) are shared, as a second call on the same machine would find them.
-env -i PATH=/usr/bin:/bin HOME="$work" XDG_CACHE_HOME="$work/.cache" QUICK=1 \
+# every step runs and the summary names the device. The render's cache (its traversal choice)
+# is shared, as a second call on the same machine would find it.
+env -i PATH=/usr/bin:/bin HOME="$work" XDG_CACHE_HOME="$work/.cache" MESA_SHADER_CACHE_DIR="$shaders" QUICK=1 \
   ${VK_ICD_FILENAMES:+VK_ICD_FILENAMES=$VK_ICD_FILENAMES} \
   ${VK_DRIVER_FILES:+VK_DRIVER_FILES=$VK_DRIVER_FILES} LP_NUM_THREADS="${LP_NUM_THREADS:-2}" \
   bash "$b/run.sh" bash "$b/device-measure.sh" "$work/measure" > "$work/measure.log" 2>&1 ||
