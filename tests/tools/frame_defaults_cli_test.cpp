@@ -65,4 +65,40 @@ TEST(FrameDefaults, RenderLatencyAndViewStartFromTheSameFrame) {
   fs::remove_all(dir);
 }
 
+// The option's lines in a --help text: "  --name" and the lines that continue it; empty when the
+// help does not list it.
+std::string help_lines(const std::string& help, const std::string& name) {
+  std::istringstream in(help);
+  std::string line, out;
+  bool inside = false;
+  while (std::getline(in, line)) {
+    if (line.rfind("  --", 0) == 0) inside = line.rfind("  --" + name + " ", 0) == 0 || line == "  --" + name;
+    else if (line.rfind("                        ", 0) != 0) inside = false;
+    if (inside) out += line + "\n";
+  }
+  return out;
+}
+
+// The frame options are documented once (tools/src/render_setup.cpp): each command that
+// takes them lists every one with the same text and FrameConfig's default.
+TEST(FrameDefaults, RenderLatencyAndViewDescribeTheFrameOptionsAlike) {
+  const auto render = run_fovea("render --help"), latency = run_fovea("latency --help"), view = run_fovea("view --help");
+  ASSERT_EQ(render.status, 0) << render.err;
+  ASSERT_EQ(latency.status, 0) << latency.err;
+  ASSERT_EQ(view.status, 0) << view.err;
+  const nlohmann::json defaults = fovea::pipeline::to_json(fovea::pipeline::FrameConfig{});
+  for (const std::string& name : fovea::pipeline::frame_option_names()) {
+    const std::string lines = help_lines(render.out, name);
+    ASSERT_FALSE(lines.empty()) << "fovea render --help does not list --" << name;
+    const std::string shown = defaults.at(name).is_string() ? defaults.at(name).get<std::string>() : defaults.at(name).dump();
+    EXPECT_NE(lines.find("[" + shown.substr(0, shown.find(".0")) + "]\n"), std::string::npos) << lines;
+    EXPECT_EQ(help_lines(view.out, name), lines) << "fovea view --help, --" << name;
+    if (name == "jitter") {  // fovea latency's --jitter is the tracker's
+      EXPECT_NE(help_lines(latency.out, name).find("tracker"), std::string::npos) << latency.out;
+    } else {
+      EXPECT_EQ(help_lines(latency.out, name), lines) << "fovea latency --help, --" << name;
+    }
+  }
+}
+
 }  // namespace frame_defaults

@@ -32,7 +32,7 @@ namespace fs = std::filesystem;
 
 constexpr const char* kDefaultGaze = "synthetic:1?task=search&rate=1000&noise=0&dropouts=0";
 
-constexpr const char* kHelp = R"(usage: fovea latency [options]
+constexpr const char* kHelpHead = R"(usage: fovea latency [options]
        fovea latency --records FILE.jsonl [--out DIR]
 
 Measures latency the way it reaches the eye, in virtual time (reproducible): a true eye
@@ -65,27 +65,11 @@ Prints the summary JSON on stdout; writes into --out:
   --display NAME|FILE   display preset or JSON: raster, FOV, refresh [small]
   --gaze SRC            the true eye: recording or synthetic:<seed>[?...] (docs/gaze.md)
                         [synthetic:1?task=search&rate=1000&noise=0&dropouts=0]
-  --budget B            grid samples as a fraction of display pixels: the foveation's
-                        strength (docs/visual-polar.md) [0.39]
-  --cap K               visual-polar: at most K samples per display pixel, the fovea's
-                        density (κ, docs/visual-polar.md), in (0, 16] [1]
-  --distribution D      as `fovea render` (the frame's options and defaults are the same):
-                        visual-polar | paper-visual-polar | cartesian | cartesian-uniform |
-                        linear-falloff | log-polar [visual-polar]
-  --denoiser D          bmfr | none [bmfr]
-  --bmfr-precision P    fp32 | fp16 [fp32]
-  --stereo-share M      off | gather | alternate [gather]
-  --bounces N|auto      BSDF-sampled bounces after the primary hit [1]
-  --landing-spp N       samples per cell in a new fovea's first 4 frames after a gaze jump
-                        of 5° or more (1..8; 1: one, as every other frame) [8]
-  --seed N              noise seed: another N, another noise realisation of the same frames
-                        (path tracing and BMFR keyed by frame + 1024·N; gaze and jitter
-                        unchanged) [0]
-  --trace T             auto | rayquery | compute [auto]; the grid's sub-cell jitter is on
-                        (--jitter here is the tracker's)
-  --tracker PRESET      eye-tracker model preset: fove0 | ideal [fove0]
+)";
+constexpr const char* kHelpTail = R"(  --tracker PRESET      eye-tracker model preset: fove0 | ideal [fove0]
   --tracker-delay T     delay from measurement to delivery [preset's]
-  --jitter T            extra delivery delay, uniform in [0, T] [preset's]
+  --jitter T            the tracker's extra delivery delay, uniform in [0, T] [preset's]
+                        (not the grid's: its sub-cell jitter is on)
   --rate HZ             tracker sample rate [preset's]
   --predict MODE        gaze compensation of the main run: none | linear | landing (the
                         delivered samples predicted to each frame's display time; docs/gaze.md)
@@ -224,7 +208,7 @@ devices::SourceOptions predicting(devices::SourceOptions o, devices::PredictMode
 int run(std::vector<std::string> argv) {
   for (const auto& a : argv)
     if (a == "--help" || a == "-h") {
-      std::cout << kHelp;
+      std::cout << kHelpHead << frame_options_help({"jitter"}) << kHelpTail;
       return 0;
     }
   const std::vector<std::string> sim_options{"scene", "display", "gaze", "tracker", "tracker-delay", "jitter", "rate",

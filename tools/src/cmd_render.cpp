@@ -41,7 +41,7 @@ namespace {
 
 namespace fs = std::filesystem;
 
-constexpr const char* kHelp = R"(usage: fovea render [options]
+constexpr const char* kHelpHead = R"(usage: fovea render [options]
 
 Renders a stereo sequence: per frame and eye the sample grid follows the gaze, the grid is
 path traced (1 sample per cell), reconstructed in grid space (temporal accumulation,
@@ -81,38 +81,14 @@ With no options: a short demo on the shipped scene and gaze.
 
   --scene S             cornell | furnace | glossy-spheres | stereo-occluders | default,
                         or a .gltf/.glb/.obj file [default]
-  --trace auto|rayquery|compute
-                        ray queries through the device's acceleration structure, or the
-                        compute BVH traversal; auto: the faster of the two on this device,
-                        measured once per device and driver and cached
-                        (report.json: trace, trace_choice) [auto]
   --display NAME|FILE   display preset (fove0, vive, modern, wide, small, tiny) or JSON [small]
   --gaze URI            recording, or synthetic:<seed>[?...] (docs/gaze.md)
                         [the shipped recording data/gaze/default.csv]
   --screen GEOMETRY     what 2-D gaze coordinates refer to: WxH@HFOVxVFOV or
                         WxH@SWxSHmm@Dmm (as the URI key screen=; docs/gaze.md)
   --frames N            frames to render [24]
-  --distribution D      visual-polar | paper-visual-polar | cartesian | cartesian-uniform |
-                        linear-falloff | log-polar [visual-polar]
-  --budget B            grid samples as a fraction of display pixels, met within 5% or
-                        refused with exit 2 naming what the distribution reaches
-                        (cartesian: 1 only) [0.39]
-  --cap K               visual-polar: at most K samples per display pixel, the fovea's
-                        density (κ, docs/visual-polar.md), in (0, 16] [1]
-  --jitter on|off       per-frame sub-cell jitter (Halton 2, 3) of every grid [on]
-  --denoiser D          bmfr | none (accumulation only) [bmfr]
-  --bmfr-precision P    fp32 | fp16: storage of BMFR's regression matrix [fp32]
-  --stereo-share M      off | gather | alternate [gather]
-  --bounces N|auto      BSDF-sampled bounces after the primary hit, no Russian roulette (1:
-                        the BMFR/P5 configuration); auto: the bounce limit and Russian
-                        roulette from the scene's albedo, i.e. full global illumination as
-                        `fovea reference` traces it [1]
-  --landing-spp N       samples per cell in a new fovea's first 4 frames after a gaze jump
-                        of 5° or more (1..8; 1: one, as every other frame) [8]
-  --seed N              noise seed: another N, another noise realisation of the same frames
-                        (path tracing and BMFR keyed by frame + 1024·N; gaze and jitter
-                        unchanged) [0]
-  --no-blur             skip the peripheral blur
+)";
+constexpr const char* kHelpTail = R"(  --no-blur             skip the peripheral blur
   --no-cull             trace the lens' hidden area too
   --reference SPP|DIR   SPP: converged reference of the last frame with the render's own light
                         transport (--bounces; at most SPP samples per pixel, see
@@ -422,7 +398,7 @@ class Recovery {
 int run(std::vector<std::string> argv) {
   for (const auto& a : argv)
     if (a == "--help" || a == "-h") {
-      std::cout << kHelp;
+      std::cout << kHelpHead << frame_options_help() << kHelpTail;
       return 0;
     }
   const Args args(argv,

@@ -32,7 +32,7 @@
 namespace fovea::tools::cmd_view {
 namespace {
 
-constexpr const char* kHelp = R"(usage: fovea view [options]
+constexpr const char* kHelpHead = R"(usage: fovea view [options]
 
 Opens the mirror window (X11; e.g. under Xvfb with DISPLAY set): both eyes' panels side
 by side as the headset shows them, through the lens distortion pass, with a gaze marker.
@@ -44,33 +44,14 @@ of view directions (lines every 5 degrees), a picture of the optics.
   --display NAME|FILE   display preset (fove0, vive, modern, wide, small, tiny) or JSON file [small]
   --scene S             cornell | furnace | glossy-spheres | stereo-occluders | default, or a
                         .gltf/.glb/.obj file: path trace it (otherwise the direction grid)
-  --trace auto|rayquery|compute
-                        ray queries through the device's acceleration structure, or the
-                        compute BVH traversal; auto: the faster of the two on this device,
-                        measured once per device and driver and cached [auto]
   --gaze G              mouse: the cursor over a panel is the gaze (looked at through that
                         eye's lens; kept when the cursor leaves the panels);
                         X,Y: fixed gaze in normalised view coordinates;
                         FILE or synthetic:SEED[?...]: a recording or synthetic gaze
                         (docs/gaze.md), sampled at frame / refresh rate [0.5,0.5]
   --gaze-dir x,y,z      fixed gaze as a view-space direction (OpenXR: -Z forward, +Y up)
-  --budget B            grid samples as a fraction of display pixels [0.39]
-  --cap K               visual-polar: at most K samples per display pixel, the fovea's
-                        density (κ, docs/visual-polar.md), in (0, 16] [1]
-  --jitter on|off       per-frame sub-cell jitter (Halton 2, 3) of every grid [on]
-  --distribution D      as `fovea render` (the frame's options and defaults are the same):
-                        visual-polar | paper-visual-polar | cartesian | cartesian-uniform |
-                        linear-falloff | log-polar [visual-polar]
-  --denoiser D          bmfr | none [bmfr]
-  --bmfr-precision P    fp32 | fp16 [fp32]
-  --stereo-share M      off | gather | alternate [gather]
-  --bounces N|auto      BSDF-sampled bounces after the primary hit [1]
-  --landing-spp N       samples per cell in a new fovea's first 4 frames after a gaze jump
-                        of 5° or more (1..8; 1: one, as every other frame) [8]
-  --seed N              noise seed: another N, another noise realisation of the same frames
-                        (path tracing and BMFR keyed by frame + 1024·N; gaze and jitter
-                        unchanged) [0]
-  --optics direct|lut   distortion pass: evaluate the optics per pixel, or read them from
+)";
+constexpr const char* kHelpTail = R"(  --optics direct|lut   distortion pass: evaluate the optics per pixel, or read them from
                         the 128x128 LUT cache [direct]
   --window WxH          window size [fits both panels in 1280x720]
   --frames N            close after N frames; 0 = when the window is closed [0]
@@ -128,7 +109,7 @@ void write_panels(const std::string& prefix, const compositor::PanelImage (&p)[2
 int run(std::vector<std::string> argv) {
   for (const auto& a : argv)
     if (a == "--help" || a == "-h") {
-      std::cout << kHelp;
+      std::cout << kHelpHead << frame_options_help() << kHelpTail;
       return 0;
     }
   const Args args(argv,
