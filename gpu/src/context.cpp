@@ -489,8 +489,21 @@ VkDeviceSize Context::memory_in_use(std::uint32_t memory_type) const {
   return heap_in_use_[memory_.memoryTypes[memory_type].heapIndex].load();
 }
 
+std::vector<Context::HeapUse> Context::heap_use() const {
+  std::vector<HeapUse> out;
+  for (std::uint32_t h = 0; h < memory_.memoryHeapCount; ++h)
+    out.push_back({h, (memory_.memoryHeaps[h].flags & VK_MEMORY_HEAP_DEVICE_LOCAL_BIT) != 0, memory_.memoryHeaps[h].size,
+                   heap_in_use_[h].load(), heap_peak_[h].load()});
+  return out;
+}
+
+void Context::reset_memory_peaks() {
+  for (std::uint32_t h = 0; h < VK_MAX_MEMORY_HEAPS; ++h) heap_peak_[h] = heap_in_use_[h].load();
+}
+
 MemoryCharge Context::charge_memory(const std::string& what, VkDeviceSize bytes, std::uint32_t memory_type) {
-  std::atomic<std::uint64_t>& account = heap_in_use_[memory_.memoryTypes[memory_type].heapIndex];
+  const std::uint32_t heap = memory_.memoryTypes[memory_type].heapIndex;
+  std::atomic<std::uint64_t>& account = heap_in_use_[heap];
   const std::uint64_t before = account.fetch_add(bytes);
   const VkDeviceSize limit = memory_limit(memory_type);
   if (before + bytes > limit) {
@@ -500,6 +513,9 @@ MemoryCharge Context::charge_memory(const std::string& what, VkDeviceSize bytes,
                            " already held, is more than this device can give (" + mib(limit) +
                            (host_available_ > 0 ? ": 3/4 of the host memory available to this CPU device" : ": its heap") +
                            "); a smaller display raster, budget or scene fits");
+  }
+  std::atomic<std::uint64_t>& peak = heap_peak_[heap];
+  for (std::uint64_t p = peak.load(); p < before + bytes && !peak.compare_exchange_weak(p, before + bytes);) {
   }
   return MemoryCharge(&account, bytes);
 }

@@ -185,6 +185,17 @@ TEST_F(Buffers, DeviceMemoryIsChargedAndTheLimitRefusedBeforeAllocating) {
     EXPECT_LT(ctx().memory_in_use(type), before + (2u << 20));
   }
   EXPECT_EQ(ctx().memory_in_use(type), before);
+  // Per heap: held now, and the most held at once (a refused charge is not counted in it).
+  const auto heap_of = [&] {
+    for (const auto& h : ctx().heap_use())
+      if (h.size == ctx().memory_type_heap_size(type)) return h;
+    ADD_FAILURE() << "no heap of memory type " << type;
+    return gpu::Context::HeapUse{};
+  };
+  EXPECT_EQ(heap_of().held, before);
+  EXPECT_GE(heap_of().peak, before + (1u << 20));
+  ctx().reset_memory_peaks();
+  EXPECT_EQ(heap_of().peak, before);
   const VkDeviceSize limit = ctx().memory_limit(type);
   EXPECT_LE(limit, ctx().memory_type_heap_size(type));
   try {
@@ -196,4 +207,5 @@ TEST_F(Buffers, DeviceMemoryIsChargedAndTheLimitRefusedBeforeAllocating) {
     EXPECT_NE(what.find("more than this device can give"), std::string::npos) << what;
   }
   EXPECT_EQ(ctx().memory_in_use(type), before);
+  EXPECT_EQ(heap_of().peak, before);
 }

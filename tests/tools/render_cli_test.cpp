@@ -51,6 +51,16 @@ TEST(RenderCli, ReportFramesAndExrOnTheTinyDisplay) {
   EXPECT_EQ(j["output"]["host_bytes_read_back"].get<std::int64_t>(), 3 * 2 * 64 * 72 * 16);
   EXPECT_GT(j["output"]["write_cpu_ms"].get<double>(), 0.0);
   EXPECT_GT(j["cpu_ms"]["total"].get<double>(), 0.0);
+  // The device memory the frames held, per heap (the reference of the recovery curve, made
+  // before them, apart).
+  ASSERT_FALSE(j["device_memory"]["heaps"].empty());
+  double held = 0;
+  for (const auto& h : j["device_memory"]["heaps"]) {
+    EXPECT_GE(h["peak_mib"].get<double>(), h["held_mib"].get<double>()) << h;
+    EXPECT_LE(h["peak_mib"].get<double>(), h["size_mib"].get<double>()) << h;
+    held += h["held_mib"].get<double>();
+  }
+  EXPECT_GT(held, 0.0);
   // The tiny preset's lens hides the view's corners: those cells are not traced.
   for (const char* eye : {"left", "right"}) EXPECT_GT(j["samples_hidden"][eye].get<double>(), 0) << eye;
   for (const char* eye : {"left", "right"}) {

@@ -56,6 +56,8 @@ the peripheral blur. Writes to --out:
                 and CPU ms per stage
   report.json   {"frames", "samples_traced_per_eye", "samples_hidden": {"left", "right"},
                  "device": {name, driver}, "trace": "rayquery" or "compute",
+                 "device_memory": {"heaps": per memory heap its size and what the frames'
+                 buffers and images held at the end (held) and at most (peak), MiB},
                  "gpu_ms": {grid, trace, reconstruct, resolve, total, accumulate, bmfr_fit, post,
                             mip, resample, blur},
                  "cpu_ms": {gaze, grid, trace, reconstruct, resolve, submit, wait, total}
@@ -506,6 +508,7 @@ int run(std::vector<std::string> argv) {
     write_reference((out_dir / "reference_left.exr").string(), *loaded[0]);
   }
   Recovery recovery(recovery_frames);
+  ctx.reset_memory_peaks();  // report.json's device_memory: the frames' own
   // Per-frame times, milliseconds: GPU and CPU per stage (medians reported).
   std::map<std::string, std::vector<double>> gpu_ms, cpu_ms;
   // Output work, apart from the frame: reading images back (only those written or in the
@@ -605,6 +608,13 @@ int run(std::vector<std::string> argv) {
                 << " frames; it was clamped to the view's border (frames.jsonl: used_gaze)\n";
   }
   frame_log.finish();
+  // The device memory of the frames (the scene, the frame pipeline, the read-back buffers):
+  // held after the last and at most while they ran, apart from any reference's.
+  nlohmann::json heaps = nlohmann::json::array();
+  const auto mib = [](VkDeviceSize b) { return std::round(double(b) / (1 << 20) * 10) / 10; };
+  for (const gpu::Context::HeapUse& h : ctx.heap_use())
+    heaps.push_back({{"heap", h.heap}, {"device_local", h.device_local}, {"size_mib", mib(h.size)},
+                     {"held_mib", mib(h.held)}, {"peak_mib", mib(h.peak)}});
   renderer::write_exr((out_dir / "last_left.exr").string(), last[0]);
   renderer::write_exr((out_dir / "last_right.exr").string(), last[1]);
 
@@ -641,6 +651,9 @@ int run(std::vector<std::string> argv) {
                  {"note", "medians over the frames that did each; the frame's own times are gpu_ms and cpu_ms"}};
   // Which Vulkan driver produced the timings (lavapipe 22.3 and 25 differ ~2x).
   j["device"] = {{"name", ctx.info().name}, {"driver", ctx.info().driver}};
+  j["device_memory"] = {{"heaps", heaps},
+                        {"note", "per memory heap: what this run's buffers and images held after the last frame (held) and "
+                                 "at most while the frames ran (peak), MiB; references apart"}};
   j["trace"] = renderer::tracing_name(gpu_scene.tracing());
   const renderer::TraceChoice& choice = setup.driver.trace_choice();
   j["trace_choice"] = {{"requested", args.str("trace", "auto")},

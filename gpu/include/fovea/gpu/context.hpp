@@ -175,6 +175,17 @@ class Context {
   // core::InputError naming what, the sizes and the limit when it would pass memory_limit.
   MemoryCharge charge_memory(const std::string& what, VkDeviceSize bytes, std::uint32_t memory_type);
   VkDeviceSize memory_in_use(std::uint32_t memory_type) const;
+  // Each memory heap of the device: its size, what this context's buffers and images hold in
+  // it now (charge_memory) and the most they held at once since the context was made or
+  // reset_memory_peaks.
+  struct HeapUse {
+    std::uint32_t heap = 0;
+    bool device_local = false;
+    VkDeviceSize size = 0, held = 0, peak = 0;
+  };
+  std::vector<HeapUse> heap_use() const;
+  // Starts the peaks over from what is held now (to measure one phase of a run).
+  void reset_memory_peaks();
 
   // Names an object for validation messages (no-op without VK_EXT_debug_utils).
   void set_name(VkObjectType type, std::uint64_t handle, const std::string& name) const;
@@ -212,6 +223,7 @@ class Context {
   VkPhysicalDeviceLimits limits_{};
   VkPhysicalDeviceMemoryProperties memory_{};
   std::array<std::atomic<std::uint64_t>, VK_MAX_MEMORY_HEAPS> heap_in_use_{};
+  std::array<std::atomic<std::uint64_t>, VK_MAX_MEMORY_HEAPS> heap_peak_{};
   std::uint64_t host_available_ = 0;  // bytes available to the process at creation (CPU devices)
   EnabledFeatures features_;
   PFN_vkSetDebugUtilsObjectNameEXT set_object_name_ = nullptr;
