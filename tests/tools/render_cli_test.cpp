@@ -61,6 +61,9 @@ TEST(RenderCli, ReportFramesAndExrOnTheTinyDisplay) {
     held += h["held_mib"].get<double>();
   }
   EXPECT_GT(held, 0.0);
+  EXPECT_LE(j["device_memory"]["device_local_held_mib"].get<double>(), held + 0.05);
+  EXPECT_GE(j["device_memory"]["device_local_peak_mib"].get<double>(),
+            j["device_memory"]["device_local_held_mib"].get<double>());
   // The tiny preset's lens hides the view's corners: those cells are not traced.
   for (const char* eye : {"left", "right"}) EXPECT_GT(j["samples_hidden"][eye].get<double>(), 0) << eye;
   for (const char* eye : {"left", "right"}) {

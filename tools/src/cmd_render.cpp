@@ -57,7 +57,8 @@ the peripheral blur. Writes to --out:
   report.json   {"frames", "samples_traced_per_eye", "samples_hidden": {"left", "right"},
                  "device": {name, driver}, "trace": "rayquery" or "compute",
                  "device_memory": {"heaps": per memory heap its size and what the frames'
-                 buffers and images held at the end (held) and at most (peak), MiB},
+                 buffers and images held at the end (held) and at most (peak), MiB;
+                 device_local_held_mib, device_local_peak_mib: over the device-local heaps},
                  "gpu_ms": {grid, trace, reconstruct, resolve, total, accumulate, bmfr_fit, post,
                             mip, resample, blur},
                  "cpu_ms": {gaze, grid, trace, reconstruct, resolve, submit, wait, total}
@@ -612,9 +613,12 @@ int run(std::vector<std::string> argv) {
   // held after the last and at most while they ran, apart from any reference's.
   nlohmann::json heaps = nlohmann::json::array();
   const auto mib = [](VkDeviceSize b) { return std::round(double(b) / (1 << 20) * 10) / 10; };
-  for (const gpu::Context::HeapUse& h : ctx.heap_use())
+  VkDeviceSize local_held = 0, local_peak = 0;  // device-local heaps (a GPU's own memory)
+  for (const gpu::Context::HeapUse& h : ctx.heap_use()) {
     heaps.push_back({{"heap", h.heap}, {"device_local", h.device_local}, {"size_mib", mib(h.size)},
                      {"held_mib", mib(h.held)}, {"peak_mib", mib(h.peak)}});
+    if (h.device_local) local_held += h.held, local_peak += h.peak;
+  }
   renderer::write_exr((out_dir / "last_left.exr").string(), last[0]);
   renderer::write_exr((out_dir / "last_right.exr").string(), last[1]);
 
@@ -652,8 +656,11 @@ int run(std::vector<std::string> argv) {
   // Which Vulkan driver produced the timings (lavapipe 22.3 and 25 differ ~2x).
   j["device"] = {{"name", ctx.info().name}, {"driver", ctx.info().driver}};
   j["device_memory"] = {{"heaps", heaps},
+                        {"device_local_held_mib", mib(local_held)},
+                        {"device_local_peak_mib", mib(local_peak)},
                         {"note", "per memory heap: what this run's buffers and images held after the last frame (held) and "
-                                 "at most while the frames ran (peak), MiB; references apart"}};
+                                 "at most while the frames ran (peak), MiB; references apart; device_local_*: the sums "
+                                 "over the device-local heaps"}};
   j["trace"] = renderer::tracing_name(gpu_scene.tracing());
   const renderer::TraceChoice& choice = setup.driver.trace_choice();
   j["trace_choice"] = {{"requested", args.str("trace", "auto")},
