@@ -217,7 +217,6 @@ ComputePipeline::ComputePipeline(Context& ctx, const ComputePipelineDesc& desc)
     : shader_(desc.shader),
       push_bytes_(desc.push_constant_bytes),
       kernel_(ctx.kernel(kernel_key(desc), [&] { return compile_kernel(ctx, desc); })) {
-  local_size_ = kernel_->local_size;
   for (int i = 0; i < 3; ++i) max_groups_[i] = ctx.limits().maxComputeWorkGroupCount[i];
 }
 
@@ -239,9 +238,10 @@ void ComputePipeline::push_bytes(VkCommandBuffer cmd, std::span<const std::byte>
 
 void ComputePipeline::dispatch(VkCommandBuffer cmd, std::uint32_t x, std::uint32_t y, std::uint32_t z) const {
   const std::uint32_t threads[3] = {x, y, z};
+  const std::array<std::uint32_t, 3> size = workgroup_size();
   std::uint32_t groups[3];
   for (int i = 0; i < 3; ++i) {
-    groups[i] = static_cast<std::uint32_t>((std::uint64_t(threads[i]) + local_size_[i] - 1) / local_size_[i]);
+    groups[i] = static_cast<std::uint32_t>((std::uint64_t(threads[i]) + size[i] - 1) / size[i]);
     if (groups[i] > max_groups_[i])
       throw core::InputError("gpu::ComputePipeline '" + shader_ + "': " + std::to_string(groups[i]) +
                              " workgroups in dimension " + std::to_string(i) + " exceed the device limit " +
@@ -258,7 +258,8 @@ void ComputePipeline::dispatch_indirect(VkCommandBuffer cmd, const Buffer& args,
 }
 
 void ComputePipeline::dispatch_linear(VkCommandBuffer cmd, std::uint32_t count) const {
-  const std::uint64_t groups = (std::uint64_t(count) + local_size_[0] - 1) / local_size_[0];
+  const std::uint64_t size = workgroup_size()[0];
+  const std::uint64_t groups = (std::uint64_t(count) + size - 1) / size;
   // Rows of at most max_x groups, as even as the rounding allows.
   const std::uint64_t rows = std::max<std::uint64_t>(1, (groups + max_groups_[0] - 1) / max_groups_[0]);
   const std::uint64_t per_row = (groups + rows - 1) / rows;

@@ -64,7 +64,9 @@ class ComputePipeline {
   VkPipeline handle() const { return kernel_ ? kernel_->pipeline.get() : VK_NULL_HANDLE; }
   VkPipelineLayout layout() const { return kernel_ ? kernel_->layout.get() : VK_NULL_HANDLE; }
   const DescriptorSetLayout& set_layout(std::size_t set) const { return kernel_->set_layouts.at(set); }
-  std::array<std::uint32_t, 3> workgroup_size() const { return local_size_; }
+  std::array<std::uint32_t, 3> workgroup_size() const {
+    return kernel_ ? kernel_->local_size : std::array<std::uint32_t, 3>{1, 1, 1};
+  }
   const std::string& shader() const { return shader_; }
 
   // Records: bind the pipeline and sets[i] as set i.
@@ -109,7 +111,6 @@ class ComputePipeline {
  private:
   std::string shader_;
   std::uint32_t push_bytes_ = 0;
-  std::array<std::uint32_t, 3> local_size_{1, 1, 1};
   std::array<std::uint32_t, 3> max_groups_{0, 0, 0};
   std::shared_ptr<const CompiledKernel> kernel_;
 };
