@@ -220,6 +220,11 @@ ComputePipeline::ComputePipeline(Context& ctx, const ComputePipelineDesc& desc)
   for (int i = 0; i < 3; ++i) max_groups_[i] = ctx.limits().maxComputeWorkGroupCount[i];
 }
 
+const DescriptorSetLayout& ComputePipeline::set_layout(std::size_t set) const {
+  if (!kernel_) throw std::out_of_range("gpu::ComputePipeline: an empty pipeline has no set " + std::to_string(set));
+  return kernel_->set_layouts.at(set);
+}
+
 void ComputePipeline::bind(VkCommandBuffer cmd, std::initializer_list<const DescriptorSet*> sets) const {
   vkCmdBindPipeline(cmd, VK_PIPELINE_BIND_POINT_COMPUTE, handle());
   if (sets.size() == 0) return;

@@ -1,5 +1,6 @@
 #include <cstdint>
 #include <memory>
+#include <stdexcept>
 #include <vector>
 
 #include <glm/vec4.hpp>
@@ -153,6 +154,7 @@ TEST_F(Compute, MisuseIsReportedBeforeVulkanSeesIt) {
   } catch (const fovea::core::InputError& e) {
     EXPECT_NE(std::string(e.what()).find("test_gpu_fill.comp.spv"), std::string::npos) << "lists known shaders";
   }
+  EXPECT_THROW(gpu::ComputePipeline{}.set_layout(0), std::out_of_range);  // an empty pipeline
   gpu::ComputePipeline pipe(ctx(), fill_desc({}));
   gpu::Buffer buf(ctx(), {.size = 4, .usage = gpu::BufferUsage::Storage | gpu::BufferUsage::Uniform});
   gpu::DescriptorSet set(ctx(), pipe.set_layout(0));

@@ -326,9 +326,10 @@ TEST(SweepReport, WithoutPythonWritesTheDataAndSaysHowToDrawTheFigures) {
   const std::string plan_path = dir + "/plan.jsonl";
   core::write_file_atomic(plan_path, plan_to_jsonl(plan));
   const std::string report = dir + "/report";
-  setenv("FOVEA_PYTHON", "/nonexistent/python3", 1);
-  const auto r = test::run_fovea("sweep report " + plan_path + " --out " + report);
-  unsetenv("FOVEA_PYTHON");
+  const auto r = [&] {
+    const test::PythonOverride no_python("/nonexistent/python3");
+    return test::run_fovea("sweep report " + plan_path + " --out " + report);
+  }();
   ASSERT_EQ(r.status, 0) << r.err;
   // The data is all there; no figure was drawn, and the summary lists only what was written.
   EXPECT_TRUE(fs::exists(report + "/results.json"));

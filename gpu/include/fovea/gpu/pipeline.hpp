@@ -63,7 +63,8 @@ class ComputePipeline {
 
   VkPipeline handle() const { return kernel_ ? kernel_->pipeline.get() : VK_NULL_HANDLE; }
   VkPipelineLayout layout() const { return kernel_ ? kernel_->layout.get() : VK_NULL_HANDLE; }
-  const DescriptorSetLayout& set_layout(std::size_t set) const { return kernel_->set_layouts.at(set); }
+  // Throws std::out_of_range for a set the layout does not have (any, for an empty pipeline).
+  const DescriptorSetLayout& set_layout(std::size_t set) const;
   std::array<std::uint32_t, 3> workgroup_size() const {
     return kernel_ ? kernel_->local_size : std::array<std::uint32_t, 3>{1, 1, 1};
   }
