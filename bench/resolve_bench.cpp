@@ -4,7 +4,8 @@
 // (1 bounce, so the grid holds a real image); then each iteration resolves that frame's
 // grids again and times the parts with timestamps (the benchmark's time is their sum).
 // Counters: copy_ms, mip_ms, resample_ms, blur_ms, and the process CPU time of each
-// (*_cpu_ms: lavapipe's work, which other load on the machine inflates less).
+// (*_cpu_ms: lavapipe's work, which other load on the machine inflates less). The /depth
+// variants also write the display depth, as the layer's depth compositing asks for.
 //   LP_NUM_THREADS=2 fovea_bench_resolve --benchmark_repetitions=5 --benchmark_report_aggregates_only=true
 #include <benchmark/benchmark.h>
 
@@ -37,12 +38,13 @@ glm::dvec3 gaze_at(double deg) {
   return glm::normalize(glm::dvec3(t, t, -1));
 }
 
-void resolve(benchmark::State& state, std::string display, fc::DistributionKind kind, double gaze_deg) {
+void resolve(benchmark::State& state, std::string display, fc::DistributionKind kind, double gaze_deg, bool depth) {
   const fc::DisplayPreset d = fc::load_display(display);
   fc::DistributionParams dp;
   dp.kind = kind;
   fovea::reconstruct::ReconSettings s;
   fp::FramePipeline p(context(), gpu_scene(), fc::stereo_views(d), dp, s);
+  if (depth) p.enable_depth_output();
   const glm::dvec3 g = gaze_at(gaze_deg);
   p.render(fc::eye_poses(scene().camera, d), {g, g}, 0);
   fp::testing::ResolveKernelTimes sum;
@@ -66,12 +68,14 @@ void register_all() {
     for (const auto& [name, kind] : {std::pair{"visual-polar", fc::DistributionKind::VisualPolar},
                                      std::pair{"cartesian", fc::DistributionKind::Cartesian}})
       for (const double gaze : {0.0, 25.0})
-        benchmark::RegisterBenchmark(
-            (std::string("Resolve/") + display + "/" + name + "/gaze" + std::to_string(int(gaze))).c_str(),
-            [=](benchmark::State& st) { resolve(st, display, kind, gaze); })
-            ->UseManualTime()
-            ->Unit(benchmark::kMillisecond)
-            ->Iterations(display == std::string("fove0") ? 3 : 10);
+        for (const bool depth : {false, true})
+          benchmark::RegisterBenchmark((std::string("Resolve/") + display + "/" + name + "/gaze" +
+                                        std::to_string(int(gaze)) + (depth ? "/depth" : ""))
+                                           .c_str(),
+                                       [=](benchmark::State& st) { resolve(st, display, kind, gaze, depth); })
+              ->UseManualTime()
+              ->Unit(benchmark::kMillisecond)
+              ->Iterations(display == std::string("fove0") ? 3 : 10);
 }
 
 }  // namespace

@@ -4,9 +4,10 @@
 // recon_map.h) and samples the grid — trilinear over the φ-only mip chain
 // (bilinear in ρ between the two columns, each with its own row count; φ wraps, ρ clamps).
 // The level comes from the pixel's footprint along φ in rows of its column (analytic). The
-// same grid coordinate gives the display-space depth: the nearest cell's sample's view-space
-// distance along -Z (no filtering: depths must not blend across silhouettes), 0 where that
-// cell saw the sky or holds no sample; for depth compositing, the image does not use it.
+// same grid coordinate gives the display-space depth, when asked for (push constant depth): the
+// nearest cell's sample's view-space distance along -Z (no filtering: depths must not blend
+// across silhouettes), 0 where that cell saw the sky or holds no sample; for depth
+// compositing, the image does not use it.
 #extension GL_GOOGLE_include_directive : require
 #extension GL_EXT_samplerless_texture_functions : require  // texelFetch on texture buffers
 
@@ -106,6 +107,7 @@ void main() {
   vec4 v = fetch_level(m, k0, k1, fx, l0);
   if (f > 0.0 && l0 + 1u < pc.levels) v = mix(v, fetch_level(m, k0, k1, fx, l0 + 1u), f);
   screen[i] = v.w > 1e-6 ? vec4(v.rgb / v.w, 1.0) : vec4(0.0, 0.0, 0.0, 1.0);
+  if (pc.depth == 0u) return;  // only depth compositing reads it (FramePipeline::enable_depth_output)
 
   uint r = min(uint(max(floor(near.v), 0.0)), uint(near.rows) - 1u);
   vec4 s = texelFetch(vpos, int(r * m.g.padded_columns + near.c));

@@ -317,8 +317,16 @@ core::Image FramePipeline::image(core::Eye e) const {
   return img;
 }
 
+void FramePipeline::enable_depth_output() { impl_->resolve->set_depth_output(true); }
+
+// The depth buffers hold what the resample last wrote: nothing unless it writes depth.
+static void require_depth(const reconstruct::Resolve& r, const char* what) {
+  if (!r.depth_output()) throw core::InputError(std::string(what) + ": the depth output is off (enable_depth_output)");
+}
+
 std::vector<float> FramePipeline::depth(core::Eye e) const {
   const int i = impl_->index(e, "depth");
+  require_depth(*impl_->resolve, "depth");
   const core::View& v = impl_->eyes[std::size_t(i)]->base_view;
   std::vector<float> d = impl_->resolve->depth(i).download<float>();
   d.resize(std::size_t(v.width()) * std::size_t(v.height()));
@@ -330,7 +338,9 @@ const gpu::Buffer& FramePipeline::screen_buffer(core::Eye e) const {
 }
 
 const gpu::Buffer& FramePipeline::depth_buffer(core::Eye e) const {
-  return impl_->resolve->depth(impl_->index(e, "depth_buffer"));
+  const int i = impl_->index(e, "depth_buffer");
+  require_depth(*impl_->resolve, "depth_buffer");
+  return impl_->resolve->depth(i);
 }
 
 std::vector<shaders::GridSample> FramePipeline::grid_samples(core::Eye eye) const {

@@ -210,7 +210,8 @@ void Resolve::record_resample(VkCommandBuffer cmd, int parity, bool grid_coords)
   for (const Eye& e : eyes_) {
     const std::uint32_t lod_columns = mip_reach(current_map(*e.maps), *e.tables, e.levels).lod_columns;
     resolve_.run(cmd, {&e.resolve_set[parity]},
-                 shaders::ReconResolvePush{e.width, e.height, e.levels, grid_coords ? 1u : 0u, lod_columns, 0, 0, 0}, e.width,
+                 shaders::ReconResolvePush{e.width, e.height, e.levels, grid_coords ? 1u : 0u, lod_columns,
+                                           depth_output_ ? 1u : 0u, 0, 0}, e.width,
                  e.height);
   }
   gpu::compute_to_compute(cmd);

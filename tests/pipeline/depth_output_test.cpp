@@ -1,6 +1,11 @@
 // FramePipeline::depth(): per display pixel the view-space distance along -Z of the grid
-// sample its direction falls in (the nearest sample), 0 for the sky.
+// sample its direction falls in (the nearest sample), 0 for the sky; written only when asked for.
+#include <algorithm>
 #include <cmath>
+#include <cstring>
+#include <string>
+
+#include "fovea/core/error.hpp"
 
 #include "fovea/renderer/scene_io.hpp"
 #include "gpu_fixture.hpp"
@@ -20,6 +25,7 @@ TEST_F(GpuTest, FramePipelineDepthIsTheNearestSamplesViewZ) {
   s.blur = false;
   pipeline::FramePipeline p(ctx(), gs, core::stereo_views(display), {}, s);
   const auto poses = core::eye_poses(scene.camera, display);
+  p.enable_depth_output();
   p.render(poses, {glm::dvec3(0.05, 0, -1), glm::dvec3(0.05, 0, -1)}, 3);
   for (core::Eye eye : {core::Eye::Left, core::Eye::Right}) {
     const std::vector<float> depth = p.depth(eye);
@@ -50,5 +56,40 @@ TEST_F(GpuTest, FramePipelineDepthIsTheNearestSamplesViewZ) {
                 sky);
     EXPECT_GE(match, int(0.97 * n));  // cell-boundary pixels may round to the neighbouring cell
     EXPECT_GT(surfaces, n / 2);
+  }
+}
+
+// Off by default: the frame writes no depth (only depth compositing reads it), asking for it
+// is refused by name, and writing it leaves the image as it was.
+TEST_F(GpuTest, FramePipelineDepthOnlyWhenAskedFor) {
+  const renderer::Scene scene = renderer::load_scene("stereo-occluders");
+  renderer::GpuScene gs(ctx(), scene);
+  const core::DisplayPreset display = fovea::test::display_of_size(40, 44);
+  const auto poses = core::eye_poses(scene.camera, display);
+  const std::array<glm::dvec3, 2> gaze{glm::dvec3(0.05, 0, -1), glm::dvec3(0.05, 0, -1)};
+  pipeline::FramePipeline plain(ctx(), gs, core::stereo_views(display), {}, reconstruct::ReconSettings{});
+  pipeline::FramePipeline with_depth(ctx(), gs, core::stereo_views(display), {}, reconstruct::ReconSettings{});
+  with_depth.enable_depth_output();
+  for (std::uint32_t f = 0; f < 3; ++f) {
+    plain.render(poses, gaze, f);
+    with_depth.render(poses, gaze, f);
+  }
+  for (core::Eye eye : {core::Eye::Left, core::Eye::Right}) {
+    EXPECT_THROW(
+        {
+          try {
+            (void)plain.depth(eye);
+          } catch (const core::InputError& e) {
+            EXPECT_NE(std::string(e.what()).find("depth output is off"), std::string::npos) << e.what();
+            throw;
+          }
+        },
+        core::InputError);
+    EXPECT_THROW((void)plain.depth_buffer(eye), core::InputError);
+    const std::vector<float> depth = with_depth.depth(eye);
+    EXPECT_TRUE(std::any_of(depth.begin(), depth.end(), [](float d) { return d > 0; }));
+    const core::Image a = plain.image(eye), b = with_depth.image(eye);
+    ASSERT_EQ(a.pixels.size(), b.pixels.size());
+    EXPECT_EQ(std::memcmp(a.pixels.data(), b.pixels.data(), a.pixels.size() * sizeof(a.pixels[0])), 0);
   }
 }

@@ -44,6 +44,7 @@ std::array<glm::dvec3, 2> gaze_of(std::uint32_t f) {
 }
 
 Snapshot render_sequence(pipeline::FramePipeline& p, const std::array<core::Pose, 2>& poses) {
+  p.enable_depth_output();
   for (std::uint32_t f = 0; f < kRunFrames; ++f) p.render(poses, gaze_of(f), 10 + f);
   Snapshot s;
   for (int e = 0; e < p.eyes(); ++e) {

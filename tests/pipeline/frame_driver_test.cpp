@@ -2,6 +2,7 @@
 // display's views with the head at the scene's camera and the lens hidden area culled, or the
 // views it is given with the hidden area it is given culled; the frame configuration reaches
 // the pipeline; each frame's step reads the gaze and records the frame's times.
+#include <algorithm>
 #include <cmath>
 #include <optional>
 #include <stdexcept>
@@ -83,7 +84,8 @@ TEST_F(GpuTest, FrameDriverLaysGivenViewsOutForTheMaskItIsGiven) {
   pipeline::EyeMasks masks;
   for (core::Eye e : {core::Eye::Left, core::Eye::Right}) masks[std::size_t(e)] = core::EyeOptics(display, e).view_mask();
   pipeline::FrameDriver given(ctx(), scene, views, {frame, true, false}, masks);
-  pipeline::FrameDriver late(ctx(), scene, views, {frame, true, false});
+  // `late` as the layer makes it for depth compositing: every pipeline it makes writes depth.
+  pipeline::FrameDriver late(ctx(), scene, views, {frame, true, false, /*depth_output=*/true});
   for (core::Eye e : {core::Eye::Left, core::Eye::Right}) late.pipeline().set_visibility(e, *masks[std::size_t(e)]);
   const auto head = views.poses();
   const std::array<glm::dvec3, 2> gaze{glm::dvec3(0, 0, -1), glm::dvec3(0, 0, -1)};
@@ -108,6 +110,9 @@ TEST_F(GpuTest, FrameDriverLaysGivenViewsOutForTheMaskItIsGiven) {
     EXPECT_EQ(late.pipeline().traced_cells(e), given.pipeline().traced_cells(e)) << core::eye_name(e);
     EXPECT_EQ(late.pipeline().hidden_cells(e), given.pipeline().hidden_cells(e)) << core::eye_name(e);
     EXPECT_EQ(core::visual_polar_state(late.pipeline().distribution(e))->row_scale, 1.0) << core::eye_name(e);
+    const std::vector<float> depth = late.pipeline().depth(e);
+    EXPECT_TRUE(std::any_of(depth.begin(), depth.end(), [](float d) { return d > 0; })) << core::eye_name(e);
+    EXPECT_THROW((void)given.pipeline().depth(e), core::InputError) << core::eye_name(e);
   }
 }
 

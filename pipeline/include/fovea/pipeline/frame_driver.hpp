@@ -35,6 +35,9 @@ struct FrameDriverOptions {
   // `--trace auto` may measure both traversals (seconds at start-up; cached per device and
   // driver). false: the cached choice, or the static one (the layer's first frame waits for none).
   bool measure_trace = true;
+  // Every pipeline the driver makes writes the display depth (FramePipeline::enable_depth_output):
+  // for depth compositing (the layer), which nothing else reads.
+  bool depth_output = false;
 };
 
 // Frame `index`'s time on a display's frame timeline: index / refresh rate, from 0.
@@ -106,6 +109,7 @@ class FrameDriver {
 
   gpu::Context& ctx_;
   FrameConfig frame_;
+  bool depth_output_ = false;
   double refresh_hz_ = 0;  // the display preset's (0: given views)
   std::unique_ptr<devices::FoveationGaze> gaze_;
   core::Pose camera_;

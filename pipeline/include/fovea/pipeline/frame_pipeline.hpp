@@ -35,7 +35,7 @@ struct FrameTimes {
   StageTime grid;         // CPU: the distributions' per-frame update (gaze → grid) and upload; GPU: generation
   StageTime trace;        // CPU: recording; GPU: path tracing
   StageTime reconstruct;  // CPU: grid mappings and recording; GPU: accumulation, sharing, BMFR, post, TAA
-  StageTime resolve;      // CPU: recording; GPU: mips, resolve, depth, blur
+  StageTime resolve;      // CPU: recording; GPU: mips, resolve, depth (enable_depth_output), blur
   // Parts of reconstruct: Phase I with the stereo gather, the BMFR regression, Phase III with TAA.
   double accumulate_gpu_ms = 0, bmfr_fit_gpu_ms = 0, post_gpu_ms = 0;
   double mip_gpu_ms = 0, resample_gpu_ms = 0, blur_gpu_ms = 0;  // parts of resolve: its three kernels
@@ -107,14 +107,20 @@ class FramePipeline {
   // before the second frame).
   double temporal_error(core::Eye e) const;
 
+  // Write each frame's display-space depth (depth(), depth_buffer()) from the next frame on.
+  // Off at first: only depth compositing reads it, and it costs every pixel of the resample a
+  // read, a transform and a store.
+  void enable_depth_output();
+
   core::Image image(core::Eye e) const;  // the displayed image of the last frame
   // The last frame's display-space linear depth, row-major like image(): per pixel the
   // view-space distance along -Z (scene units) of the nearest grid sample's surface; 0 where
   // that sample saw the sky or none exists. For depth compositing; the image ignores it.
+  // core::InputError without enable_depth_output(), as for an eye not rendered.
   std::vector<float> depth(core::Eye e) const;
   // The same two on the device, for work that keeps the frame there (the API layer's
   // hand-over): vec4 and float per pixel, row-major, the first width × height elements.
-  // Written by each render().
+  // Written by each render() (the depth: after enable_depth_output(), else core::InputError).
   const gpu::Buffer& screen_buffer(core::Eye e) const;
   const gpu::Buffer& depth_buffer(core::Eye e) const;
   std::vector<shaders::GridSample> grid_samples(core::Eye e) const;

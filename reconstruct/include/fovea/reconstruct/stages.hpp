@@ -143,8 +143,8 @@ class Resolve {
   // Copies a grid image into level 0 (transfer; the caller orders its writes before).
   void record_copy(VkCommandBuffer cmd, std::span<const gpu::Buffer* const> grid_images) const;
   // Optional blur of level 0 in grid space, mips from level 0, resolve, optional blur: into
-  // the screen buffers; the resample also writes the depth of the nearest sample per display
-  // pixel from the positions of `parity`. The kernels are also recorded one by one
+  // the screen buffers; with set_depth_output(true) the resample also writes the depth of the
+  // nearest sample per display pixel from the positions of `parity`. The kernels are also recorded one by one
   // (per-kernel timestamps). The peripheral blur runs in grid space on angular polar grids
   // (record_grid_blur, before the mips) and on the display for the others (record_blur).
   void record_resolve(VkCommandBuffer cmd, int parity, bool blur, const ReconSettings& settings) const;
@@ -152,6 +152,10 @@ class Resolve {
   void record_mips(VkCommandBuffer cmd) const;
   // grid_coords: each pixel's grid coordinate (u, t, LOD, 0) instead of its colour (tests).
   void record_resample(VkCommandBuffer cmd, int parity, bool grid_coords = false) const;
+  // Whether the resample writes the display depth (depth()); off at first: a texel read, a
+  // transform and a store per pixel that only depth compositing needs.
+  void set_depth_output(bool on) { depth_output_ = on; }
+  bool depth_output() const { return depth_output_; }
   void record_blur(VkCommandBuffer cmd, const ReconSettings& settings) const;
   // The temporal error of the screen images on the device (shaders/recon_temporal.comp):
   // keeps each eye's luminance for the next call and, with `accumulate` (a previous image
@@ -179,6 +183,7 @@ class Resolve {
   std::uint32_t max_levels() const;
   gpu::ComputePipeline mip_, resolve_, blur_, grid_blur_, temporal_;
   std::vector<Eye> eyes_;
+  bool depth_output_ = false;
 };
 
 }  // namespace fovea::reconstruct

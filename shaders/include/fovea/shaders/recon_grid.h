@@ -90,7 +90,8 @@ struct ReconMipPush {
 
 struct ReconResolvePush {
   FOVEA_UINT width, height, levels, grid_coords;  // grid_coords = 1: write (u, t, LOD, 0) per pixel, for tests
-  FOVEA_UINT lod_columns, pad0, pad1, pad2;       // pixels of columns >= lod_columns have LOD 0 (Resolve, mip_reach)
+  FOVEA_UINT lod_columns, depth, pad0, pad1;      // pixels of columns >= lod_columns have LOD 0 (Resolve, mip_reach);
+                                                  // depth = 1: also write the display depth
 };
 
 // Radius -> column lookup table of a polar mapping (reconstruct::radius_lut builds one per
