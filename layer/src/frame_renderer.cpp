@@ -162,12 +162,11 @@ class PathTracer {
                         : nullptr),
         // The frame of `fovea render` (pipeline/frame_driver.hpp) on the application's views. A
         // measurement would delay the first traced frame by seconds: the cached choice, or none.
-        driver_(std::make_unique<pipeline::FrameDriver>(*ctx_, scene, views,
-                                                        pipeline::FrameDriverOptions{.frame = config_.frame,
-                                                                                     .cull = false,
-                                                                                     .measure_trace = false,
-                                                                                     .depth_output = config_.composite != Composite::SceneOnly},
-                                                        first_visibility(masks, views))) {
+        driver_(std::make_unique<pipeline::FrameDriver>(
+            *ctx_, scene, views,
+            pipeline::FrameDriverOptions{.frame = config_.frame, .cull = false, .measure_trace = false,
+                                         .depth_output = config_.composite != Composite::SceneOnly},
+            first_visibility(masks, views))) {
     shared_.reset();  // its descriptor is the imported memory's now
     if (writer_) {
       FOVEA_LAYER_INFO("hand-over: shared memory (the layer's device encodes each traced frame into the application's "

@@ -6,7 +6,6 @@
 #include <string>
 
 #include "fovea/core/error.hpp"
-
 #include "fovea/renderer/scene_io.hpp"
 #include "gpu_fixture.hpp"
 #include "pipeline_helpers.hpp"

@@ -144,8 +144,8 @@ class Resolve {
   void record_copy(VkCommandBuffer cmd, std::span<const gpu::Buffer* const> grid_images) const;
   // Optional blur of level 0 in grid space, mips from level 0, resolve, optional blur: into
   // the screen buffers; with set_depth_output(true) the resample also writes the depth of the
-  // nearest sample per display pixel from the positions of `parity`. The kernels are also recorded one by one
-  // (per-kernel timestamps). The peripheral blur runs in grid space on angular polar grids
+  // nearest sample per display pixel from the positions of `parity`. The kernels are also
+  // recorded one by one (per-kernel timestamps). The peripheral blur runs in grid space on angular polar grids
   // (record_grid_blur, before the mips) and on the display for the others (record_blur).
   void record_resolve(VkCommandBuffer cmd, int parity, bool blur, const ReconSettings& settings) const;
   void record_grid_blur(VkCommandBuffer cmd, const ReconSettings& settings) const;
