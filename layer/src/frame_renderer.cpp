@@ -124,6 +124,7 @@ struct TraceRequest {
   bool gaze_from_action = false;
   ActionGaze action_gaze;
   MaskSource masks;
+  bool depth = false;  // the application chains depth to both views in a mode that composites by it
 };
 
 // A finished path-traced frame, encoded in the application's swapchain format: in `colour`
@@ -136,7 +137,8 @@ struct TracedFrame {
   std::int64_t done_ns = 0;
   std::array<glm::dquat, 2> orientation{};  // the views' orientations it was traced for (the application's space)
   std::array<Pixels8, 2> colour;
-  std::array<std::vector<float>, 2> depth;  // view distances (FramePipeline::depth); empty in scene-only mode
+  std::array<std::vector<float>, 2> depth;  // view distances (FramePipeline::depth); empty without has_depth
+  bool has_depth = false;                    // traced with its depth (in `depth` or the slot)
   std::unique_ptr<SlotLease> slot;           // the GPU path: colour and depth are there instead
   RenderTimes times;
 };
@@ -162,11 +164,9 @@ class PathTracer {
                         : nullptr),
         // The frame of `fovea render` (pipeline/frame_driver.hpp) on the application's views. A
         // measurement would delay the first traced frame by seconds: the cached choice, or none.
-        driver_(std::make_unique<pipeline::FrameDriver>(
-            *ctx_, scene, views,
-            pipeline::FrameDriverOptions{.frame = config_.frame, .cull = false, .measure_trace = false,
-                                         .depth_output = config_.composite != Composite::SceneOnly},
-            first_visibility(masks, views))) {
+        driver_(std::make_unique<pipeline::FrameDriver>(*ctx_, scene, views,
+                                                        pipeline::FrameDriverOptions{config_.frame, false, false},
+                                                        first_visibility(masks, views))) {
     shared_.reset();  // its descriptor is the imported memory's now
     if (writer_) {
       FOVEA_LAYER_INFO("hand-over: shared memory (the layer's device encodes each traced frame into the application's "
@@ -211,6 +211,13 @@ class PathTracer {
       poses[ei] = driver_->at_camera(p);
     }
     times.gaze_cpu = ms_since(t_gaze);
+    // The scene's depth from the first request whose application submits depth on: only depth
+    // compositing reads it, and it costs the resample a read, a transform and a store per pixel.
+    if (in.depth && !depth_) {
+      driver_->enable_depth_output();
+      depth_ = true;
+    }
+    f->has_depth = depth_;
     times.frame = driver_->step(std::uint32_t(in.id), fg, poses, times.gaze_cpu).times;
     // Counted by the grid pass (no read-back); the hidden ones while a mask is set.
     {
@@ -226,10 +233,9 @@ class PathTracer {
       if (slot < 0) return nullptr;
       f->slot = std::make_unique<SlotLease>(pool, slot);
       const pipeline::FramePipeline& p = driver_->pipeline();
-      const bool depth = config_.composite != Composite::SceneOnly;
       std::array<SlotWriter::Eye, 2> eyes;
       for (int e = 0; e < 2; ++e)
-        eyes[std::size_t(e)] = {&p.screen_buffer(core::Eye(e)), depth ? &p.depth_buffer(core::Eye(e)) : nullptr};
+        eyes[std::size_t(e)] = {&p.screen_buffer(core::Eye(e)), depth_ ? &p.depth_buffer(core::Eye(e)) : nullptr};
       writer_->write(eyes, slot);
       times.handover = "shared-memory";
       times.readback_cpu = ms_since(r0);
@@ -240,7 +246,7 @@ class PathTracer {
       times.host_bytes += std::int64_t(linear.pixels.size() * sizeof(linear.pixels[0]));
       f->colour[std::size_t(e)] = encode_scene(linear, pixel_format(format_));
       times.host_bytes += std::int64_t(f->colour[std::size_t(e)].data.size());  // written into the app's memory
-      if (config_.composite != Composite::SceneOnly) {
+      if (depth_) {
         f->depth[std::size_t(e)] = driver_->pipeline().depth(core::Eye(e));
         times.host_bytes += 2 * std::int64_t(f->depth[std::size_t(e)].size() * sizeof(float));  // read, written
       }
@@ -335,6 +341,7 @@ class PathTracer {
   std::optional<AppDevice::SharedSlots> shared_;  // the slots' memory until writer_ imports it
   std::unique_ptr<LayerGaze> gaze_;
   bool gaze_from_action_ = false;
+  bool depth_ = false;  // the pipeline writes depth (a request asked for it)
   std::optional<std::uint64_t> mask_generation_;  // of the mask fetched last (none yet)
   pipeline::EyeMasks masks_;                      // the runtime's hidden area the grids are laid out for
   std::unique_ptr<gpu::Context> ctx_;
@@ -404,6 +411,7 @@ class PathTraceRenderer final : public FrameRenderer {
     req.gaze_from_action = in.gaze_from_action;
     req.action_gaze = in.action_gaze;
     req.masks = {in.get_visibility_mask, in.visibility_mask_generation};
+    req.depth = config_.composite != Composite::SceneOnly && in.app_views[0].depth && in.app_views[1].depth;
     {
       // Asynchronous: never wait for the render thread. At its low priority it may hold the
       // mailbox while it waits for a core (priority inversion); a frame that finds the mailbox
@@ -498,7 +506,8 @@ class PathTraceRenderer final : public FrameRenderer {
     shown.done_ns = f.done_ns;
     shown.times = f.times;
     const bool scene_only = config_.composite == Composite::SceneOnly;
-    const bool by_depth = !scene_only && composite_by_depth(in);
+    // A frame traced before the application first chained depth has none: the configured mode.
+    const bool by_depth = !scene_only && composite_by_depth(in) && f.has_depth;
     const bool on_gpu = app_.gpu_composition();
     const std::int64_t readbacks = app_.host_readbacks();
     std::array<EyeComposition, 2> eyes;

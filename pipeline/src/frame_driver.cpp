@@ -39,7 +39,6 @@ FrameDriver::FrameDriver(gpu::Context& ctx, const renderer::Scene& scene, const 
                          const EyeMasks& visibility)
     : ctx_(ctx),
       frame_(options.frame),
-      depth_output_(options.depth_output),
       refresh_hz_(display ? display->refresh_hz : 0),
       camera_(scene.camera),
       trace_choice_(renderer::choose_tracing(ctx, frame_.tracing, renderer::default_trace_choice_cache(),
@@ -56,6 +55,11 @@ void FrameDriver::set_visibility(const EyeMasks& visibility) {
   pipeline_.emplace(ctx_, gpu_scene_, views_, distribution_, frame_.recon, path_, false, visibility);
   pipeline_->set_seed(frame_.seed);
   if (depth_output_) pipeline_->enable_depth_output();
+}
+
+void FrameDriver::enable_depth_output() {
+  depth_output_ = true;
+  if (pipeline_) pipeline_->enable_depth_output();
 }
 
 core::Pose FrameDriver::at_camera(const core::Pose& eye) const {

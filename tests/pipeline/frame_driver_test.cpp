@@ -84,8 +84,8 @@ TEST_F(GpuTest, FrameDriverLaysGivenViewsOutForTheMaskItIsGiven) {
   pipeline::EyeMasks masks;
   for (core::Eye e : {core::Eye::Left, core::Eye::Right}) masks[std::size_t(e)] = core::EyeOptics(display, e).view_mask();
   pipeline::FrameDriver given(ctx(), scene, views, {frame, true, false}, masks);
-  // `late` as the layer makes it for depth compositing: every pipeline it makes writes depth.
-  pipeline::FrameDriver late(ctx(), scene, views, {.frame = frame, .measure_trace = false, .depth_output = true});
+  pipeline::FrameDriver late(ctx(), scene, views, {frame, true, false});
+  late.enable_depth_output();  // as the layer's for depth compositing: every pipeline it makes writes depth
   for (core::Eye e : {core::Eye::Left, core::Eye::Right}) late.pipeline().set_visibility(e, *masks[std::size_t(e)]);
   const auto head = views.poses();
   const std::array<glm::dvec3, 2> gaze{glm::dvec3(0, 0, -1), glm::dvec3(0, 0, -1)};

@@ -35,9 +35,6 @@ struct FrameDriverOptions {
   // `--trace auto` may measure both traversals (seconds at start-up; cached per device and
   // driver). false: the cached choice, or the static one (the layer's first frame waits for none).
   bool measure_trace = true;
-  // Every pipeline the driver makes writes the display depth (FramePipeline::enable_depth_output):
-  // for depth compositing (the layer), which nothing else reads.
-  bool depth_output = false;
 };
 
 // Frame `index`'s time on a display's frame timeline: index / refresh rate, from 0.
@@ -81,6 +78,11 @@ class FrameDriver {
   // area that changes during a session (the layer, after the runtime's change event). Where
   // making it throws, the driver is left without one (pipeline() throws).
   void set_visibility(const EyeMasks& visibility);
+
+  // The display depth (FramePipeline::enable_depth_output) from the next frame on, in this
+  // pipeline and every one set_visibility makes: for depth compositing (the layer, once the
+  // application submits depth), which nothing else reads.
+  void enable_depth_output();
 
   // An eye pose given in the scene camera's frame (the application's reference space, its
   // origin at the camera) in world coordinates.
