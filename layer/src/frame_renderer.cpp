@@ -213,11 +213,8 @@ class PathTracer {
     times.gaze_cpu = ms_since(t_gaze);
     // The scene's depth from the first request whose application submits depth on: only depth
     // compositing reads it, and it costs the resample a read, a transform and a store per pixel.
-    if (in.depth && !depth_) {
-      driver_->enable_depth_output();
-      depth_ = true;
-    }
-    f->has_depth = depth_;
+    if (in.depth) driver_->enable_depth_output();
+    f->has_depth = driver_->depth_output();
     times.frame = driver_->step(std::uint32_t(in.id), fg, poses, times.gaze_cpu).times;
     // Counted by the grid pass (no read-back); the hidden ones while a mask is set.
     {
@@ -235,7 +232,7 @@ class PathTracer {
       const pipeline::FramePipeline& p = driver_->pipeline();
       std::array<SlotWriter::Eye, 2> eyes;
       for (int e = 0; e < 2; ++e)
-        eyes[std::size_t(e)] = {&p.screen_buffer(core::Eye(e)), depth_ ? &p.depth_buffer(core::Eye(e)) : nullptr};
+        eyes[std::size_t(e)] = {&p.screen_buffer(core::Eye(e)), f->has_depth ? &p.depth_buffer(core::Eye(e)) : nullptr};
       writer_->write(eyes, slot);
       times.handover = "shared-memory";
       times.readback_cpu = ms_since(r0);
@@ -246,7 +243,7 @@ class PathTracer {
       times.host_bytes += std::int64_t(linear.pixels.size() * sizeof(linear.pixels[0]));
       f->colour[std::size_t(e)] = encode_scene(linear, pixel_format(format_));
       times.host_bytes += std::int64_t(f->colour[std::size_t(e)].data.size());  // written into the app's memory
-      if (depth_) {
+      if (f->has_depth) {
         f->depth[std::size_t(e)] = driver_->pipeline().depth(core::Eye(e));
         times.host_bytes += 2 * std::int64_t(f->depth[std::size_t(e)].size() * sizeof(float));  // read, written
       }
@@ -341,7 +338,6 @@ class PathTracer {
   std::optional<AppDevice::SharedSlots> shared_;  // the slots' memory until writer_ imports it
   std::unique_ptr<LayerGaze> gaze_;
   bool gaze_from_action_ = false;
-  bool depth_ = false;  // the pipeline writes depth (a request asked for it)
   std::optional<std::uint64_t> mask_generation_;  // of the mask fetched last (none yet)
   pipeline::EyeMasks masks_;                      // the runtime's hidden area the grids are laid out for
   std::unique_ptr<gpu::Context> ctx_;

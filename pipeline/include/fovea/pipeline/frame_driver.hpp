@@ -83,6 +83,7 @@ class FrameDriver {
   // pipeline and every one set_visibility makes: for depth compositing (the layer, once the
   // application submits depth), which nothing else reads.
   void enable_depth_output();
+  bool depth_output() const { return depth_output_; }
 
   // An eye pose given in the scene camera's frame (the application's reference space, its
   // origin at the camera) in world coordinates.
