@@ -1,9 +1,11 @@
 // BMFR at 1280×720 per eye, the resolution of the BMFR paper's timings (PoCL reference:
 // ~480 ms per frame on 2 cores).
 // - fit: the fit (shaders/recon_bmfr_fit.comp) alone on a synthetic grid, one eye, inputs
-//   resident on the device; wall time of one submission holding the fit only. The scene is
+//   resident on the device; wall time of one submission holding the fit only; per schedule
+//   (workgroup/subgroup: 0/0 the device's own, reconstruct::bmfr_schedule). The scene is
 //   a room corner (three walls and a floor, positions in metres) with noisy radiance, so
-//   every block has valid rows, several normals and rank-deficient planar parts.
+//   every block has valid rows, several normals and rank-deficient planar parts. Counters:
+//   gpu_ms (timestamps around the dispatch), cpu_ms (the process's CPU time), the schedule.
 // - Chain/<scene>: the whole reconstruction before the resolve (Phase I accumulation, stereo
 //   gather, fit, Phase III, TAA) of a stereo Cartesian 1280×720 frame of a shipped scene after
 //   two frames of history, each pass in its own submission (pipeline/testing.hpp). The
@@ -26,6 +28,7 @@
 #include "fovea/core/display.hpp"
 #include "fovea/core/stereo_views.hpp"
 #include "fovea/gpu/context.hpp"
+#include "fovea/gpu/timer.hpp"
 #include "fovea/pipeline/frame_pipeline.hpp"
 #include "fovea/pipeline/testing.hpp"
 #include "fovea/reconstruct/bmfr.hpp"
@@ -85,11 +88,20 @@ Inputs room() {
   return in;
 }
 
-// Arguments: workgroup invocations, fp16 (0/1).
+// Arguments: workgroup invocations (0: the device's schedule, reconstruct::bmfr_schedule),
+// subgroup reductions (0/1), fp16 (0/1).
 void fit(benchmark::State& state) {
-  const fc::BmfrOptions options{.precision = state.range(1) ? fc::BmfrPrecision::Fp16 : fc::BmfrPrecision::Fp32,
-                                .workgroup = std::uint32_t(state.range(0))};
   fg::Context& ctx = context();
+  if (state.range(1) && !ctx.info().subgroup_arithmetic) {
+    state.SkipWithError("no subgroup arithmetic on this device");
+    return;
+  }
+  const fc::BmfrSchedule schedule =
+      state.range(0) ? fc::BmfrSchedule{std::uint32_t(state.range(0)),
+                                        state.range(1) ? fc::BmfrReduction::Subgroup : fc::BmfrReduction::Serial}
+                     : fc::bmfr_schedule(ctx.info());
+  const fc::BmfrOptions options{.precision = state.range(2) ? fc::BmfrPrecision::Fp16 : fc::BmfrPrecision::Fp32,
+                                .schedule = schedule};
   static const Inputs in = room();
   const std::size_t bytes = in.pos.size() * 16;
   auto make = [&](const char* name, VkFormat texels = VK_FORMAT_R32G32B32A32_SFLOAT) {  // the fit's texelFetch
@@ -114,18 +126,27 @@ void fit(benchmark::State& state) {
   edge.upload(std::vector<std::uint32_t>(in.pos.size(), 0u));  // the flags come from the chain's gather: none here
   const fg::DescriptorSet set = bmfr.bind(p, n, z, out, columns, materials, excess, edge);
   std::uint32_t frame = 0;
+  fg::GpuTimer timer(ctx, 1);
+  std::int64_t gpu_ns = 0;
   auto run = [&] {
     ctx.submit_and_wait([&](VkCommandBuffer cmd) {
+      timer.begin(cmd);
       bmfr.record(cmd, set, {kWidth, kPadded}, frame, fc::bmfr_block_offset(frame), 0.01f);
+      timer.stage(cmd, "fit");
     });
+    if (const auto stages = timer.read()) gpu_ns += stages->front().duration_ns();
   };
   run();  // lavapipe compiles the shader at its first dispatch
+  gpu_ns = 0;
   const double cpu0 = process_cpu_ms();
   for (auto _ : state) {
     run();
     ++frame;
   }
   state.counters["cpu_ms"] = (process_cpu_ms() - cpu0) / double(state.iterations());
+  state.counters["gpu_ms"] = fovea::core::ns_to_ms(gpu_ns) / double(state.iterations());
+  state.counters["workgroup"] = bmfr.schedule().workgroup;
+  state.counters["subgroup"] = bmfr.schedule().reduction == fc::BmfrReduction::Subgroup;
   state.counters["blocks"] = double((kWidth / 32 + 1) * (kPadded / 32 + 1));
   state.counters["load1"] = load1();
 }
@@ -174,8 +195,9 @@ void chain(benchmark::State& state, const char* scene_name) {
 }  // namespace
 
 BENCHMARK(fit)
-    ->ArgNames({"workgroup", "fp16"})
-    ->ArgsProduct({{8, 16, 32, 64, 256}, {0, 1}})
+    ->ArgNames({"workgroup", "subgroup", "fp16"})
+    ->Args({0, 0, 0})  // the device's own schedule
+    ->ArgsProduct({{8, 16, 32, 64, 256}, {0, 1}, {0, 1}})
     ->Unit(benchmark::kMillisecond)
     ->UseRealTime()
     ->MinTime(1.0);

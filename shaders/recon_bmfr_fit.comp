@@ -23,11 +23,18 @@
 // regularises it to cancellation in fp32. Pivots whose column lies within 10⁻⁵ (squared
 // sine) of the previous columns' span are dropped (zero coefficient).
 //
-// Workgroup: kGroup invocations (default 8: one 8-wide SIMD row on lavapipe) loop over
-// 1024/kGroup rows each; a row's grid cell and validity are kept in shared memory.
+// Workgroup: kGroup invocations loop over 1024/kGroup rows each; a row's grid cell and
+// validity are kept in shared memory. The schedule follows the device
+// (reconstruct::bmfr_schedule): on a CPU device 8 (one 8-wide SIMD row of lavapipe) with a
+// serial fold for the reductions; on a GPU 256, whose reductions (FOVEA_SUBGROUP_REDUCE, this
+// file's variant for devices with subgroup arithmetic) add within each subgroup first, so the
+// serial fold runs over the subgroups' partial sums, not over every invocation.
 #extension GL_GOOGLE_include_directive : require
 #extension GL_EXT_samplerless_texture_functions : require  // texelFetch on texture buffers
 #extension GL_EXT_control_flow_attributes : require
+#ifdef FOVEA_SUBGROUP_REDUCE
+#extension GL_KHR_shader_subgroup_arithmetic : require
+#endif
 
 layout(local_size_x_id = 0) in;
 layout(constant_id = 0) const uint kGroup = 8u;  // invocations per block (divides 1024)
@@ -83,17 +90,32 @@ uint gram_index(uint k, uint j) { return k * kCols - (k * (k - 1u)) / 2u + (j - 
 // Max (bit j of max_mask set) or sum (clear) of each of vals[0..n) over the workgroup, in
 // rounds of kChunk values: each invocation stores its values, then invocation v folds value
 // v over the group serially (on lavapipe several times faster than subgroup reductions,
-// which loop over the lanes of every subgroup for every value). Results in s_result.
+// which loop over the lanes of every subgroup for every value). With FOVEA_SUBGROUP_REDUCE
+// each subgroup reduces its values first and one of its invocations stores them: the fold
+// then runs over the subgroups (8 of 32 lanes on a 256-wide group), not the invocations.
+// Results in s_result.
 void reduce(inout float vals[kGram], const uint n, const uint max_mask) {
-  uint tid = gl_LocalInvocationIndex;
+#ifdef FOVEA_SUBGROUP_REDUCE
+  const uint slot = gl_SubgroupID, slots = gl_NumSubgroups;
+#else
+  const uint slot = gl_LocalInvocationIndex, slots = kGroup;
+#endif
   for (uint base = 0u; base < n; base += kChunk) {
     [[unroll]] for (uint j = 0u; j < n; ++j)
-      if (j >= base && j < base + kChunk) s_partial[j - base][tid] = vals[j];
+      if (j >= base && j < base + kChunk) {
+        bool is_max = j < 32u && ((max_mask >> j) & 1u) != 0u;
+#ifdef FOVEA_SUBGROUP_REDUCE
+        float v = is_max ? subgroupMax(vals[j]) : subgroupAdd(vals[j]);
+        if (subgroupElect()) s_partial[j - base][slot] = v;
+#else
+        s_partial[j - base][slot] = vals[j];
+#endif
+      }
     barrier();
-    for (uint v = tid; v < kChunk && base + v < n; v += kGroup) {
+    for (uint v = gl_LocalInvocationIndex; v < kChunk && base + v < n; v += kGroup) {
       bool is_max = base + v < 32u && ((max_mask >> (base + v)) & 1u) != 0u;
       float acc = s_partial[v][0];
-      for (uint g = 1u; g < kGroup; ++g) acc = is_max ? max(acc, s_partial[v][g]) : acc + s_partial[v][g];
+      for (uint g = 1u; g < slots; ++g) acc = is_max ? max(acc, s_partial[v][g]) : acc + s_partial[v][g];
       s_result[base + v] = acc;
     }
     barrier();

@@ -40,7 +40,7 @@ env -i PATH=/usr/bin:/bin HOME="$work" XDG_CACHE_HOME="$work/.cache" MESA_SHADER
   ${VK_DRIVER_FILES:+VK_DRIVER_FILES=$VK_DRIVER_FILES} LP_NUM_THREADS="${LP_NUM_THREADS:-2}" \
   bash "$b/run.sh" bash "$b/device-measure.sh" "$work/measure" > "$work/measure.log" 2>&1 ||
   { cat "$work/measure.log"; fail "device-measure.sh exited non-zero"; }
-for s in device sweep-plan sweep sweep-report frame traversal trace-cost-tiny; do
+for s in device sweep-plan sweep sweep-report frame traversal trace-cost-tiny bmfr-fit; do
   grep -q "^| $s | ok |" "$work/measure/summary.md" || { cat "$work/measure/summary.md"; fail "device-measure: step $s not ok"; }
 done
 grep -q "^Device: llvmpipe" "$work/measure/summary.md" || fail "device-measure: the summary names no device"

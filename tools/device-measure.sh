@@ -10,6 +10,8 @@
 #   frame       one stereo frame per stage, GPU and CPU, fove0 and modern (fovea_bench_frame)
 #   traversal   rays per second by ray type, both traversals (and Embree where it was built)
 #   trace-cost  trace time per traced sample and the SIMD vectors' use, fove0 and modern
+#   bmfr-fit    BMFR's fit at 1280×720 per schedule (workgroup, subgroup reductions), GPU ms:
+#               the device's own (reconstruct::bmfr_schedule) against the others
 #   tests       the GPU test programs with the validation layer on
 # A step that would not finish before the deadline is cut short (the sweep keeps the jobs it
 # finished, and resumes when run again with the same OUT) or skipped, and says so.
@@ -106,6 +108,10 @@ step traversal 90 "$bench/fovea_bench_traversal" --scenes "$scenes" --rays "$ray
 for d in "${displays[@]}"; do
   step "trace-cost-$d" 120 "$bench/fovea_bench_trace_cost" "$d" 1 "$LANES"
 done
+# QUICK: the device's own schedule only (lavapipe compiles each other variant in seconds).
+fits='fit/workgroup:(0|8|64|256)/subgroup:./fp16:0'
+((QUICK)) && fits='fit/workgroup:0/'
+step bmfr-fit 90 "$bench/fovea_bench_bmfr" --benchmark_filter="$fits" --benchmark_counters_tabular=true
 
 if ((!QUICK)); then
   for t in "${tests[@]}"; do

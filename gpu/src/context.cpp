@@ -309,6 +309,8 @@ void Context::describe_device() {
   info_.subgroup_size = p11.subgroupSize;
   info_.subgroup_ballot = (p11.subgroupSupportedStages & VK_SHADER_STAGE_COMPUTE_BIT) != 0 &&
                           (p11.subgroupSupportedOperations & VK_SUBGROUP_FEATURE_BALLOT_BIT) != 0;
+  info_.subgroup_arithmetic = (p11.subgroupSupportedStages & VK_SHADER_STAGE_COMPUTE_BIT) != 0 &&
+                              (p11.subgroupSupportedOperations & VK_SUBGROUP_FEATURE_ARITHMETIC_BIT) != 0;
   info_.max_shared_memory_bytes = limits_.maxComputeSharedMemorySize;
   info_.max_workgroup_invocations = limits_.maxComputeWorkGroupInvocations;
   for (int i = 0; i < 3; ++i) info_.max_workgroup_size[i] = limits_.maxComputeWorkGroupSize[i];

@@ -20,21 +20,31 @@ namespace fovea::reconstruct {
 
 namespace {
 
-std::uint32_t checked_workgroup(const BmfrOptions& o) {
-  const std::uint32_t w = o.workgroup ? o.workgroup : kBmfrDefaultWorkgroup;
-  if (w < 8 || w > 512 || 1024 % w != 0)
-    throw core::InputError("bmfr: workgroup must divide 1024 and be 8..512, got " + std::to_string(w));
-  return w;
+BmfrSchedule checked_schedule(const gpu::Context& ctx, const BmfrOptions& o) {
+  const BmfrSchedule s = o.schedule ? *o.schedule : bmfr_schedule(ctx.info());
+  if (s.workgroup < 8 || s.workgroup > 512 || 1024 % s.workgroup != 0)
+    throw core::InputError("bmfr: workgroup must divide 1024 and be 8..512, got " + std::to_string(s.workgroup));
+  if (s.reduction == BmfrReduction::Subgroup && !ctx.info().subgroup_arithmetic)
+    throw core::InputError("bmfr: subgroup reductions need subgroup arithmetic in compute shaders, which " +
+                           ctx.info().name + " does not have");
+  return s;
 }
 
 }  // namespace
 
+BmfrSchedule bmfr_schedule(const gpu::DeviceInfo& device) {
+  if (device.type == VK_PHYSICAL_DEVICE_TYPE_CPU) return {8, BmfrReduction::Serial};
+  return {256, device.subgroup_arithmetic ? BmfrReduction::Subgroup : BmfrReduction::Serial};
+}
+
 BmfrFit::BmfrFit(gpu::Context& ctx, const BmfrOptions& options)
     : ctx_(&ctx),
-      workgroup_(checked_workgroup(options)),
+      schedule_(checked_schedule(ctx, options)),
       pipeline_(kernel<BmfrBindings, shaders::ReconBmfrPush>(
-          ctx, "recon_bmfr_fit.comp.spv",
-          {gpu::SpecConstant::u32(0, workgroup_),
+          ctx,
+          schedule_.reduction == BmfrReduction::Subgroup ? "recon_bmfr_fit.subgroup.comp.spv"
+                                                         : "recon_bmfr_fit.comp.spv",
+          {gpu::SpecConstant::u32(0, schedule_.workgroup),
            gpu::SpecConstant::boolean(1, options.precision == BmfrPrecision::Fp16)})) {}
 
 gpu::DescriptorSet BmfrFit::bind(const gpu::Buffer& vpos, const gpu::Buffer& vnrm, const gpu::Buffer& z,
@@ -51,7 +61,7 @@ void BmfrFit::record(VkCommandBuffer cmd, const gpu::DescriptorSet& set, BmfrGri
   const std::uint32_t bx = g.padded_columns / 32 + 1, by = g.padded_rows / 32 + (g.columns ? 0 : 1);
   pipeline_.run(cmd, {&set},
                 shaders::ReconBmfrPush{g.padded_columns, g.padded_rows, bx, frame, offset.x, offset.y, noise, g.columns},
-                bx * by * workgroup_);
+                bx * by * schedule_.workgroup);
 }
 
 std::vector<glm::vec4> BmfrFit::fit(BmfrGrid g, const std::vector<glm::vec4>& vpos, const std::vector<glm::vec4>& vnrm,

@@ -6,6 +6,7 @@
 #include <map>
 #include <memory>
 #include <random>
+#include <tuple>
 
 #include "fovea/core/error.hpp"
 #include "fovea/core/metrics.hpp"
@@ -56,14 +57,15 @@ class Bmfr : public GpuTest {
  protected:
   // One pipeline per configuration (lavapipe compiles the unrolled shader in ~1 s).
   const reconstruct::BmfrFit& fitter(reconstruct::BmfrOptions o) {
-    auto& f = fits_[{int(o.precision), o.workgroup}];
+    const reconstruct::BmfrSchedule sc = o.schedule.value_or(reconstruct::BmfrSchedule{});
+    auto& f = fits_[{int(o.precision), sc.workgroup, int(sc.reduction)}];
     if (!f) f = std::make_unique<reconstruct::BmfrFit>(ctx(), o);
     return *f;
   }
   std::vector<glm::vec4> run(const Inputs& in, glm::ivec2 offset = {0, 0}, reconstruct::BmfrOptions o = {}) {
     return fitter(o).fit({kSide, kSide}, in.pos, in.nrm, in.z, 3, offset);
   }
-  std::map<std::pair<int, std::uint32_t>, std::unique_ptr<reconstruct::BmfrFit>> fits_;
+  std::map<std::tuple<int, std::uint32_t, int>, std::unique_ptr<reconstruct::BmfrFit>> fits_;
   static void expect_sane(const std::vector<glm::vec4>& out) {
     ASSERT_TRUE(fovea::test::all_finite(out));
     for (const auto& p : out) {
@@ -119,8 +121,8 @@ TEST_F(Bmfr, PositionsAtTenToTheFiveUnitsStayFinite) {
   }
 }
 
-// fp16 storage of the regression matrix against fp32, and the workgroup size (a pure
-// schedule choice) against the default, on a smooth ramp under heavy noise.
+// fp16 storage of the regression matrix against fp32, and the schedules (workgroup size and
+// reductions: a pure schedule choice) against lavapipe's, on a smooth ramp under heavy noise.
 TEST_F(Bmfr, Fp16StorageAndWorkgroupSizesMatchFp32) {
   Inputs in = flat_wall(1.0f, 8);
   std::vector<glm::vec4> truth(in.z.size());
@@ -141,15 +143,49 @@ TEST_F(Bmfr, Fp16StorageAndWorkgroupSizesMatchFp32) {
   std::printf("smooth ramp: input %.2f dB, fp32 fit %.2f dB, fp16 fit %.2f dB\n", p_in, p32, p16);
   EXPECT_GE(p32, p_in + 15.0);
   EXPECT_NEAR(p16, p32, 0.5);
-  for (std::uint32_t wg : {512u}) {
-    const auto other = run(in, {7, 19}, {.workgroup = wg});
-    for (std::size_t i = 0; i < other.size(); ++i) ASSERT_NEAR(other[i].x, fp32[i].x, 1e-3f) << wg << " " << i;
+  using reconstruct::BmfrReduction;
+  // A GPU's schedule (bmfr_schedule); lavapipe compiles each subgroup variant in ~7 s.
+  for (reconstruct::BmfrSchedule sc : {reconstruct::BmfrSchedule{512, BmfrReduction::Serial},
+                                       reconstruct::BmfrSchedule{256, BmfrReduction::Subgroup}}) {
+    if (sc.reduction == BmfrReduction::Subgroup && !ctx().info().subgroup_arithmetic) continue;  // not lavapipe
+    const auto other = run(in, {7, 19}, {.schedule = sc});
+    for (std::size_t i = 0; i < other.size(); ++i)
+      ASSERT_NEAR(other[i].x, fp32[i].x, 1e-3f) << sc.workgroup << " " << int(sc.reduction) << " " << i;
   }
 }
 
 TEST_F(Bmfr, WorkgroupMustDivideTheBlock) {
-  EXPECT_THROW(reconstruct::BmfrFit(ctx(), {.workgroup = 96}), core::InputError);
-  EXPECT_THROW(reconstruct::BmfrFit(ctx(), {.workgroup = 1024}), core::InputError);
+  EXPECT_THROW(reconstruct::BmfrFit(ctx(), {.schedule = reconstruct::BmfrSchedule{96}}), core::InputError);
+  EXPECT_THROW(reconstruct::BmfrFit(ctx(), {.schedule = reconstruct::BmfrSchedule{1024}}), core::InputError);
+}
+
+// The schedule follows the device: lavapipe's is the one measured fastest there, a GPU's
+// fills whole subgroups and reduces within them where it can.
+TEST(BmfrSchedule, FollowsTheDevice) {
+  using reconstruct::BmfrReduction;
+  fovea::gpu::DeviceInfo cpu;
+  cpu.type = VK_PHYSICAL_DEVICE_TYPE_CPU;
+  cpu.subgroup_arithmetic = true;
+  EXPECT_EQ(reconstruct::bmfr_schedule(cpu).workgroup, 8u);
+  EXPECT_EQ(reconstruct::bmfr_schedule(cpu).reduction, BmfrReduction::Serial);
+  for (VkPhysicalDeviceType type : {VK_PHYSICAL_DEVICE_TYPE_DISCRETE_GPU, VK_PHYSICAL_DEVICE_TYPE_INTEGRATED_GPU,
+                                    VK_PHYSICAL_DEVICE_TYPE_VIRTUAL_GPU, VK_PHYSICAL_DEVICE_TYPE_OTHER}) {
+    fovea::gpu::DeviceInfo gpu;
+    gpu.type = type;
+    gpu.subgroup_arithmetic = true;
+    EXPECT_EQ(reconstruct::bmfr_schedule(gpu).workgroup, 256u) << type;
+    EXPECT_EQ(reconstruct::bmfr_schedule(gpu).reduction, BmfrReduction::Subgroup) << type;
+    gpu.subgroup_arithmetic = false;
+    EXPECT_EQ(reconstruct::bmfr_schedule(gpu).reduction, BmfrReduction::Serial) << type;
+  }
+}
+
+TEST_F(Bmfr, ScheduleIsTheDevicesUnlessGiven) {
+  const reconstruct::BmfrFit fit(ctx());
+  EXPECT_EQ(fit.schedule().workgroup, reconstruct::bmfr_schedule(ctx().info()).workgroup);
+  EXPECT_EQ(fit.schedule().reduction, reconstruct::bmfr_schedule(ctx().info()).reduction);
+  const reconstruct::BmfrSchedule given{64, reconstruct::BmfrReduction::Subgroup};
+  EXPECT_EQ(reconstruct::BmfrFit(ctx(), {.schedule = given}).schedule().workgroup, 64u);
 }
 
 TEST_F(Bmfr, MaskedAndNearlyEmptyBlocksStayFinite) {

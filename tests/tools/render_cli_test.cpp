@@ -43,6 +43,11 @@ TEST(RenderCli, ReportFramesAndExrOnTheTinyDisplay) {
   // The Vulkan device and driver the timings come from.
   EXPECT_FALSE(j["device"]["name"].get<std::string>().empty());
   EXPECT_FALSE(j["device"]["driver"].get<std::string>().empty());
+  // lavapipe's BMFR schedule (reconstruct::bmfr_schedule: a CPU device).
+  if (j["device"]["name"].get<std::string>().starts_with("llvmpipe")) {
+    EXPECT_EQ(j["device"]["bmfr_fit"]["workgroup"], 8);
+    EXPECT_EQ(j["device"]["bmfr_fit"]["reduction"], "serial");
+  }
   for (const char* k : {"gaze", "grid", "trace", "reconstruct", "resolve", "submit", "wait", "total"})
     EXPECT_GE(j["cpu_ms"].value(k, -1.0), 0.0) << "cpu_ms." << k;
   // Output apart from the frame: every frame is written (--png-every 1), so each is read back.

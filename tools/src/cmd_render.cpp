@@ -33,6 +33,7 @@
 #include "render_setup.hpp"
 #include "fovea/gpu/context.hpp"
 #include "fovea/pipeline/frame_pipeline.hpp"
+#include "fovea/reconstruct/bmfr.hpp"
 #include "fovea/renderer/reference.hpp"
 #include "fovea/renderer/scene_io.hpp"
 
@@ -654,7 +655,12 @@ int run(std::vector<std::string> argv) {
                  {"temporal_error_gpu_ms", median(temporal_gpu_ms)},
                  {"note", "medians over the frames that did each; the frame's own times are gpu_ms and cpu_ms"}};
   // Which Vulkan driver produced the timings (lavapipe 22.3 and 25 differ ~2x).
-  j["device"] = {{"name", ctx.info().name}, {"driver", ctx.info().driver}};
+  // and how BMFR's fit is scheduled on it (reconstruct::bmfr_schedule, the pipeline's).
+  const reconstruct::BmfrSchedule bmfr = reconstruct::bmfr_schedule(ctx.info());
+  const bool subgroup = bmfr.reduction == reconstruct::BmfrReduction::Subgroup;
+  j["device"] = {{"name", ctx.info().name},
+                 {"driver", ctx.info().driver},
+                 {"bmfr_fit", {{"workgroup", bmfr.workgroup}, {"reduction", subgroup ? "subgroup" : "serial"}}}};
   j["device_memory"] = {{"heaps", heaps},
                         {"device_local_held_mib", mib(local_held)},
                         {"device_local_peak_mib", mib(local_peak)},

@@ -97,6 +97,7 @@ struct DeviceInfo {
   std::uint32_t api_version = 0;
   std::uint32_t subgroup_size = 0;
   bool subgroup_ballot = false;  // compute shaders have subgroup ballots (and elect, broadcast)
+  bool subgroup_arithmetic = false;  // compute shaders have subgroup arithmetic (subgroupAdd, subgroupMax)
   std::uint32_t max_shared_memory_bytes = 0;
   std::uint32_t max_workgroup_invocations = 0;
   std::uint32_t max_workgroup_size[3] = {0, 0, 0};

@@ -13,12 +13,14 @@
 // cell with a 3×3 neighbour that the history's validity test would not take for the same
 // surface), whose jittered history mixes both sides.
 #include <cstdint>
+#include <optional>
 #include <vector>
 
 #include <glm/vec2.hpp>
 #include <glm/vec4.hpp>
 
 #include "fovea/gpu/buffer.hpp"
+#include "fovea/gpu/context.hpp"
 #include "fovea/gpu/descriptors.hpp"
 #include "fovea/gpu/pipeline.hpp"
 
@@ -36,16 +38,36 @@ struct BmfrGrid {
 // maximum, so no value exceeds the fp16 range). Sums and the solve are fp32 in both.
 enum class BmfrPrecision { Fp32, Fp16 };
 
-inline constexpr std::uint32_t kBmfrDefaultWorkgroup = 8;
+// How a block's reductions combine the invocations' partial sums: each invocation's folded
+// serially, or each subgroup's first (subgroup arithmetic), then the subgroups' serially.
+enum class BmfrReduction { Serial, Subgroup };
+
+// The fit's workgroup per block (invocations, each streaming 1024 / workgroup of the block's
+// rows) and its reductions: a pure schedule choice, the same images up to fp32 summation order.
+struct BmfrSchedule {
+  std::uint32_t workgroup = 8;
+  BmfrReduction reduction = BmfrReduction::Serial;
+};
+
+// The schedule for a device. A CPU device (lavapipe runs a workgroup on one thread, its
+// invocations as SIMD lanes, and a barrier switches between groups of lanes): 8 invocations,
+// serial folds (docs/reconstruction.md, "Workgroup design": fastest there, where subgroup
+// arithmetic loops over the lanes). A GPU: 256 invocations, so a block fills whole
+// subgroups (8 of 32 lanes left 3/4 of each warp idle and gave a block's 1024 rows to 8
+// threads), with subgroup reductions where the device has subgroup arithmetic.
+BmfrSchedule bmfr_schedule(const gpu::DeviceInfo& device);
 
 struct BmfrOptions {
   BmfrPrecision precision = BmfrPrecision::Fp32;
-  std::uint32_t workgroup = 0;  // invocations per block: 8..512 dividing 1024; 0: default (8)
+  // The schedule; none: bmfr_schedule of the context's device. Its workgroup divides 1024
+  // and is 8..512; Subgroup needs subgroup arithmetic.
+  std::optional<BmfrSchedule> schedule;
 };
 
 class BmfrFit {
  public:
   explicit BmfrFit(gpu::Context& ctx, const BmfrOptions& options = {});
+  BmfrSchedule schedule() const { return schedule_; }
   // `columns`: the grid's column table (shaders::GridColumn, this frame's first);
   // `materials`: the scene's shaders::PtMaterial table (material codes beyond it count as diffuse);
   // `edge`: uint per cell, non-zero for a cell on a surface edge. vpos, vnrm and z are read
@@ -68,7 +90,7 @@ class BmfrFit {
 
  private:
   gpu::Context* ctx_;
-  std::uint32_t workgroup_;
+  BmfrSchedule schedule_;
   gpu::ComputePipeline pipeline_;
 };
 
