@@ -343,13 +343,11 @@ void main() {
   Sample first;
   // A new fovea's first frames (PathConfig::boost_spp): more samples near the gaze.
   const uint spp = pc.boost_spp > pc.spp && g.ecc_deg <= pc.boost_deg ? pc.boost_spp : max(pc.spp, 1u);
-  // With kPtTextureLod the primary ray's cone is the cell's angular size: its sample spacing
-  // on the z = -1 tangent plane times cos^1.5 of the angle off the axis (a tangent-plane step
-  // dt spans dt·cos² radially and dt·cos across; their geometric mean).
+  // The primary ray's cone (PathConfig::texture_cone) in cells of the cell's angular size:
+  // its sample spacing on the z = -1 tangent plane times cos^1.5 of the angle off the axis (a
+  // tangent-plane step dt spans dt·cos² radially and dt·cos across; their geometric mean).
   const float off_axis = dv.z < 0.0 ? -dv.z : 0.0;
-  const float spread = (pc.flags & kPtTextureLod) != 0u
-                           ? g.footprint * sqrt(pc.pixel_tx * pc.pixel_ty) * off_axis * sqrt(off_axis)
-                           : 0.0;
+  const float spread = pc.texture_cone * g.footprint * sqrt(pc.pixel_tx * pc.pixel_ty) * off_axis * sqrt(off_axis);
   for (uint i = 0u; i < spp; ++i) {
     PtRng rng = pt_rng(idx, pc.frame, pc.eye, pc.sample_offset + i);
     vec3 d = dv;

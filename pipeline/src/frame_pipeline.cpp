@@ -229,7 +229,10 @@ FrameTimes FramePipeline::render(const std::array<core::Pose, 2>& eye_pose, cons
       renderer::PathConfig cfg = m.path;
       if (!fresh[i]) cfg.max_bounces = 0;
       cfg.order = m.trace_order();
-      cfg.texture_lod = true;  // one sample per cell and frame: textures prefiltered at the cell's size
+      // One sample per cell and frame: textures prefiltered at the cell's size, or at half of
+      // it on a jittered grid, whose accumulated frames already box-filter them over the cell
+      // (the mip bias of −1 that jittered temporal accumulation takes; docs/reconstruction.md).
+      cfg.texture_cone = m.eyes.front()->dist->params().jitter ? 0.5 : 1.0;
       if (landing) {
         cfg.boost_spp = m.settings.landing_spp;
         cfg.boost_deg = landing_deg;

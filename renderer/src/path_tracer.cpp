@@ -128,8 +128,8 @@ void PathTracer::record(VkCommandBuffer cmd, TraceOutputs& out, const core::View
     p.boost_spp = boost ? std::min(c.boost_spp, shaders::kPtMaxSppPerDispatch) : 0u;
     p.boost_deg = float(c.boost_deg);
     p.flags = (c.jitter ? shaders::kPtJitter : 0u) | (done > 0 ? shaders::kPtAccumulate : 0u) |
-              (tiles ? shaders::kPtTileOrder : 0u) | (c.texture_lod ? shaders::kPtTextureLod : 0u) |
-              (listed ? shaders::kPtLiveList : 0u);
+              (tiles ? shaders::kPtTileOrder : 0u) | (listed ? shaders::kPtLiveList : 0u);
+    p.texture_cone = float(std::max(c.texture_cone, 0.0));
     if (scene_.tracing() == Tracing::RayQuery) pipeline_.bind(cmd, {&out.set_, &scene_.ray_query_set()});
     else pipeline_.bind(cmd, {&out.set_});
     pipeline_.push(cmd, p);

@@ -115,9 +115,11 @@ TEST_F(GrazingTexture, BricksKeptWithoutMoire) {
               cart_drift.ssim, cart_drift.hdr_flip);
   // Textures re-modulated from one sample per frame aliased (Cartesian 0.77, visual-polar
   // 0.66 with moiré fanning out from the gaze); the accumulated albedo is the box filter.
-  EXPECT_GT(cart_still.ssim, 0.95);
-  EXPECT_GT(cart_drift.ssim, 0.95);  // the raster does not move with the gaze
-  EXPECT_GT(vp_still.ssim, 0.75);
+  // A texture cone of the whole cell on top of the jittered frames' box filter blurred them
+  // (Cartesian 0.968, visual-polar 0.847; half a cell: 0.987 and 0.874).
+  EXPECT_GT(cart_still.ssim, 0.98);
+  EXPECT_GT(cart_drift.ssim, 0.98);  // the raster does not move with the gaze
+  EXPECT_GT(vp_still.ssim, 0.86);
   // A drift within the grid's hold (0.5°) leaves the polar grid where it is, so the cells keep
   // their history as under a still gaze (moving the grid every frame: 0.74 against 0.83).
   // The remaining gap to Cartesian is the resolve's resampling (docs/reconstruction.md,

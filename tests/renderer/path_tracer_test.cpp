@@ -7,6 +7,9 @@
 #include <cmath>
 #include <cstdio>
 #include <cstring>
+#include <numbers>
+#include <numeric>
+#include <random>
 #include <utility>
 
 #include <glm/geometric.hpp>
@@ -209,6 +212,58 @@ TEST_F(PathTracer, FloorUnderWhiteSkyReflectsItsAlbedo) {
       EXPECT_GE(l.mean, 0.97);
     }
   }
+}
+
+// The first hit's texture level of detail follows PathConfig::texture_cone: a wall of 8-texel
+// blocks, each black or white at random, seen at 16 texels per cell, reads the blocks
+// themselves (mip level 3, each cell black or white) with half a cell's cone (the frame
+// pipeline's on a jittered grid), and level 4 (each texel the mean of 2×2 blocks) with a
+// whole cell's; with no cone, the full-resolution texel.
+TEST_F(PathTracer, TextureConeSelectsTheMipLevel) {
+  constexpr int kTexels = 256, kBlock = 8, kCells = 16;
+  fr::Scene s;
+  s.environment = glm::vec3(1.0f);
+  fr::Texture t{"blocks", kTexels, kTexels, {}};
+  std::mt19937 rng(11);
+  std::vector<std::uint8_t> block(std::size_t(kTexels / kBlock) * (kTexels / kBlock));
+  for (auto& b : block) b = rng() % 2 ? 255 : 0;
+  for (int y = 0; y < kTexels; ++y)
+    for (int x = 0; x < kTexels; ++x) {
+      const std::uint8_t v = block[std::size_t(y / kBlock) * (kTexels / kBlock) + std::size_t(x / kBlock)];
+      t.rgba.insert(t.rgba.end(), {v, v, v, 255});
+    }
+  s.textures.push_back(t);
+  fr::Material m;
+  m.base_color = glm::vec3(1.0f);
+  m.base_color_texture = 0;
+  m.specular = 0.0f;
+  // A wall at z = −2 filling a ±20° view, its uv shifted a quarter of a level-3 texel so
+  // that the cells' centres meet texel centres rather than the blocks' edges.
+  const float h = 2.0f * float(std::tan(20.0 * std::numbers::pi / 180.0));
+  s.add_quad({-h, -h, -2}, {h, -h, -2}, {h, h, -2}, {-h, h, -2}, s.add_material(m));
+  for (std::size_t i = s.uvs.size() - 6; i < s.uvs.size(); ++i) s.uvs[i] += glm::vec2(1.0f / 64.0f);
+  fr::sanitize(s, "blocks");
+  fr::GpuScene g(ctx(), s);
+  const fc::View v(fc::Fov::from_degrees(-20, 20, 20, -20), kCells, kCells);
+  // The standard deviation of the first hits' albedo over the cells.
+  auto contrast = [&](double cone) {
+    fr::PathConfig c;
+    c.max_bounces = 0;
+    c.texture_cone = cone;
+    const auto r = trace_grid(ctx(), g, fr::cartesian_grid(v), v, fc::Eye::Left, c);
+    std::vector<double> a;
+    for (const auto& p : r.albedo) a.push_back(p.x);
+    const double mean = std::accumulate(a.begin(), a.end(), 0.0) / double(a.size());
+    double var = 0;
+    for (const double x : a) var += (x - mean) * (x - mean);
+    return std::sqrt(var / double(a.size()));
+  };
+  const double full = contrast(0.0), half = contrast(0.5), whole = contrast(1.0);
+  std::printf("albedo standard deviation over the cells: cone 0 %.3f, half a cell %.3f, a cell %.3f\n", full, half,
+              whole);
+  EXPECT_GT(full, 0.45);  // black or white: 0.5
+  EXPECT_GT(half, 0.45);
+  EXPECT_LT(whole, 0.35);  // the mean of four blocks: 0.25
 }
 
 // The tile order (pt_order.h) on grids of whole tiles: every cell exactly once, and every

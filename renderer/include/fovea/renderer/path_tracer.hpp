@@ -42,11 +42,11 @@ struct PathConfig {
   int max_bounces = 1;            // BSDF-sampled bounces after the primary hit; < 0: unlimited
   std::uint32_t rr_start = 1000;  // bounce from which Russian roulette applies (large: off)
   bool jitter = false;            // spread samples over the cell's footprint (anti-aliasing)
-  // The first hit reads its texture's mip level for the cell's angular size (a ray cone,
-  // pt_trace.comp): for one sample per cell and frame (the frame pipeline), where full
-  // resolution aliases into rings and per-frame noise. Off for references: their many
-  // jittered samples per pixel are the pixel's box filter of the full-resolution texture.
-  bool texture_lod = false;
+  // > 0: the first hit reads its texture's mip level for a ray cone this many cells wide
+  // (pt_trace.comp): for one sample per cell and frame (the frame pipeline), where full
+  // resolution aliases into rings and per-frame noise. 0 (references): full resolution,
+  // their many jittered samples per pixel being the pixel's box filter.
+  double texture_cone = 0;
   // Cells within boost_deg of the gaze trace boost_spp samples (at most kPtMaxSppPerDispatch)
   // instead of spp: the frame pipeline's first frames at a new fovea. Only with spp = 1 and
   // no accumulation over dispatches (the tracer's direct/indirect .a then says the count).

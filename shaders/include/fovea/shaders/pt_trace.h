@@ -29,7 +29,6 @@ FOVEA_CONST FOVEA_UINT kPtHardMaxBounces = 256;
 FOVEA_CONST FOVEA_UINT kPtJitter = 1;      // jitter directions over the cell's footprint
 FOVEA_CONST FOVEA_UINT kPtAccumulate = 2;  // running mean with `accumulated_samples` earlier samples
 FOVEA_CONST FOVEA_UINT kPtTileOrder = 4;   // invocations take cells in tile order (pt_order.h)
-FOVEA_CONST FOVEA_UINT kPtTextureLod = 8;  // first hits read the texture mip level of the cell's size
 FOVEA_CONST FOVEA_UINT kPtLiveList = 16;   // invocations take the grid pass's live cells (live_cells.h)
 
 // Scene features, specialization constants of pt_trace.comp (constant_id): a variant
@@ -59,10 +58,11 @@ struct PtFrameParams {
   FOVEA_UINT columns;               // the grid's padded column count (kPtTileOrder)
   FOVEA_UINT boost_spp;             // cells within boost_deg of the gaze trace this many samples (0: none)
   float boost_deg;
+  float texture_cone;  // > 0: first hits read the texture mip level of a cone this many cells wide
 };
 
 #ifdef __cplusplus
-static_assert(sizeof(PtFrameParams) == 120);
+static_assert(sizeof(PtFrameParams) == 124);
 }  // namespace fovea::shaders
 #endif
 #endif
