@@ -32,17 +32,10 @@ const std::array<glm::dvec3, 2> kGaze{glm::dvec3(0, 0, -1), glm::dvec3(0, 0, -1)
 renderer::Scene checker_room(bool direct) {
   renderer::Scene s;
   s.name = direct ? "checker-direct" : "checker-indirect";
-  renderer::Texture t{"checker", 16, 16, {}};
-  for (int y = 0; y < 16; ++y)
-    for (int x = 0; x < 16; ++x) {
-      const std::uint8_t v = (x + y) % 2 ? 237 : 108;  // sRGB of linear 0.85 and 0.15
-      t.rgba.insert(t.rgba.end(), {v, v, v, 255});
-    }
-  s.textures.push_back(t);
-  renderer::Material wall;
-  wall.base_color = glm::vec3(1.0f);
-  wall.base_color_texture = 0;
-  wall.specular = 0.0f;
+  s.textures.push_back(fovea::test::grey_texture("checker", 16, 16, [](int x, int y) {
+    return std::uint8_t((x + y) % 2 ? 237 : 108);  // sRGB of linear 0.85 and 0.15
+  }));
+  const renderer::Material wall = fovea::test::textured_material(0);
   renderer::Material white = wall;
   white.base_color = glm::vec3(0.8f);
   white.base_color_texture = -1;

@@ -223,24 +223,16 @@ TEST_F(PathTracer, TextureConeSelectsTheMipLevel) {
   constexpr int kTexels = 256, kBlock = 8, kCells = 16;
   fr::Scene s;
   s.environment = glm::vec3(1.0f);
-  fr::Texture t{"blocks", kTexels, kTexels, {}};
   std::mt19937 rng(11);
   std::vector<std::uint8_t> block(std::size_t(kTexels / kBlock) * (kTexels / kBlock));
   for (auto& b : block) b = rng() % 2 ? 255 : 0;
-  for (int y = 0; y < kTexels; ++y)
-    for (int x = 0; x < kTexels; ++x) {
-      const std::uint8_t v = block[std::size_t(y / kBlock) * (kTexels / kBlock) + std::size_t(x / kBlock)];
-      t.rgba.insert(t.rgba.end(), {v, v, v, 255});
-    }
-  s.textures.push_back(t);
-  fr::Material m;
-  m.base_color = glm::vec3(1.0f);
-  m.base_color_texture = 0;
-  m.specular = 0.0f;
+  s.textures.push_back(fovea::test::grey_texture("blocks", kTexels, kTexels, [&](int x, int y) {
+    return block[std::size_t(y / kBlock) * (kTexels / kBlock) + std::size_t(x / kBlock)];
+  }));
   // A wall at z = −2 filling a ±20° view, its uv shifted a quarter of a level-3 texel so
   // that the cells' centres meet texel centres rather than the blocks' edges.
   const float h = 2.0f * float(std::tan(20.0 * std::numbers::pi / 180.0));
-  s.add_quad({-h, -h, -2}, {h, -h, -2}, {h, h, -2}, {-h, h, -2}, s.add_material(m));
+  s.add_quad({-h, -h, -2}, {h, -h, -2}, {h, h, -2}, {-h, h, -2}, s.add_material(fovea::test::textured_material(0)));
   for (std::size_t i = s.uvs.size() - 6; i < s.uvs.size(); ++i) s.uvs[i] += glm::vec2(1.0f / 64.0f);
   fr::sanitize(s, "blocks");
   fr::GpuScene g(ctx(), s);

@@ -2,6 +2,9 @@
 // Test helpers: trace a grid with the path tracer and read the outputs back.
 #include <algorithm>
 #include <cmath>
+#include <cstdint>
+#include <string>
+#include <utility>
 #include <vector>
 
 #include <glm/vec4.hpp>
@@ -18,6 +21,26 @@ namespace fovea::test {
 // GPU tests (but the few that share these tests' fixtures) keep GpuScene's default, ray
 // queries where the device has them.
 inline constexpr renderer::Tracing kStatisticsTracing = renderer::Tracing::Compute;
+
+// A grey texture of w × h texels, texel (x, y) = value(x, y) (sRGB-encoded), and a material
+// that shows it: white base, no specular.
+template <class Value>
+renderer::Texture grey_texture(std::string name, int w, int h, Value value) {
+  renderer::Texture t{std::move(name), w, h, {}};
+  for (int y = 0; y < h; ++y)
+    for (int x = 0; x < w; ++x) {
+      const std::uint8_t v = value(x, y);
+      t.rgba.insert(t.rgba.end(), {v, v, v, 255});
+    }
+  return t;
+}
+inline renderer::Material textured_material(int texture) {
+  renderer::Material m;
+  m.base_color = glm::vec3(1.0f);
+  m.base_color_texture = texture;
+  m.specular = 0.0f;
+  return m;
+}
 
 struct Traced {
   std::vector<glm::vec4> radiance, direct, indirect, albedo, normal_depth, position_material;
