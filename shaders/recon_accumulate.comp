@@ -188,7 +188,8 @@ void main() {
   // the grid moved, every frame's bilinear resampling would blur it further (measured: a
   // fine texture under a drifting gaze lost most of its contrast), so the history fades out
   // as the nearest tap's weight falls from 0.99 to 0.9 (≈ 0.05 cells off) and the cell takes
-  // this frame's sample, which the tracer prefilters at the cell's size (PathConfig::texture_cone).
+  // this frame's sample, which the tracer prefilters (PathConfig::texture_cone: half the
+  // cell's size on a jittered grid, the cell's without jitter).
   float aligned = clamp((max(max(w.x, w.y), max(w.z, w.w)) - 0.9) / 0.09, 0.0, 1.0);
   acc_albedo[i] = vec4(mix(ha.rgb, texelFetch(albedo, int(i)).rgb, mix(1.0, ad, aligned)), 1.0);
   if (pc.indirect_fresh != 0u) {
