@@ -231,8 +231,8 @@ FrameTimes FramePipeline::render(const std::array<core::Pose, 2>& eye_pose, cons
       cfg.order = m.trace_order();
       // One sample per cell and frame: textures prefiltered at the cell's size, or at half of
       // it on a jittered grid, whose accumulated frames already box-filter them over the cell
-      // (the mip bias of −1 that jittered temporal accumulation takes; docs/reconstruction.md).
-      cfg.texture_cone = m.eyes.front()->dist->params().jitter ? 0.5 : 1.0;
+      // (a mip bias of −1, as temporal upscalers recommend; docs/reconstruction.md).
+      cfg.texture_cone = e.dist->params().jitter ? 0.5 : 1.0;
       if (landing) {
         cfg.boost_spp = m.settings.landing_spp;
         cfg.boost_deg = landing_deg;
