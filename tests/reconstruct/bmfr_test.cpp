@@ -57,7 +57,8 @@ class Bmfr : public GpuTest {
  protected:
   // One pipeline per configuration (lavapipe compiles the unrolled shader in ~1 s).
   const reconstruct::BmfrFit& fitter(reconstruct::BmfrOptions o) {
-    const reconstruct::BmfrSchedule sc = o.schedule.value_or(reconstruct::BmfrSchedule{});
+    // Keyed by the schedule the fit will run (none given: the device's).
+    const reconstruct::BmfrSchedule sc = o.schedule.value_or(reconstruct::bmfr_schedule(ctx().info()));
     auto& f = fits_[{int(o.precision), sc.workgroup, int(sc.reduction)}];
     if (!f) f = std::make_unique<reconstruct::BmfrFit>(ctx(), o);
     return *f;
