@@ -195,8 +195,10 @@ void main() {
     vec3 d = normalize(rg_world_to_view(m, here.xyz, abs(here.w - kReconSky) < 0.5));
     if (dot(d, vec3(m.g.gaze_x, m.g.gaze_y, m.g.gaze_z)) >= cos(radians(pc.landing_deg))) history = false;
   }
-  // Accumulation only, nothing to blend, or a history that is the coarse periphery's.
-  if (!denoise || !history || since == 1.0) {  // nothing to blend, or the history is the coarse periphery's
+  // Accumulation only, nothing to blend, a history that is the coarse periphery's, or a still
+  // view outside a restart window, whose blend below would take the current value alone
+  // (a = 1): its history is neither read nor clamped.
+  if (!denoise || !history || since == 1.0 || (pc.still >= 1.0 && !follow)) {
     final_color[i] = vec4(capped(c, cap), 1.0);
     return;
   }
@@ -212,7 +214,8 @@ void main() {
   float g = weighted ? exp(-dot(jitter, jitter) / (2.0 * kCentreSigma * kCentreSigma)) : 1.0;
   float a = follow ? g / ((weighted ? kMeanCentre : 1.0) * (since - 1.0) + g)
                    : max(1.0 / max(texelFetch(post, int(i)).w, 1.0), pc.taa_alpha) * g;
-  // A still view (pc.still 1) needs no TAA outside a restart window: Phase I's cumulative
+  // A still view (pc.still 1, returned above) needs no TAA outside a restart window, and a
+  // slow one leans toward it (pc.still between 0 and 1): Phase I's cumulative
   // mean of the jittered samples is each cell's box-filtered mean already, and TAA's blend
   // kept a bias that never averages out (measured, docs/reconstruction-history.md "TAA on a
   // still view and the fit's hand-over: tried and not taken": with the clamp; without it in
