@@ -121,12 +121,21 @@ void main() {
   if (pc.has_history != 0u && maps[kReconPrevious].valid != 0u) {
     ReconGrid prev = maps[kReconPrevious];
     vec2 uv;
-    if (rg_world_to_grid(prev, p, sky, true, uv)) {
+    // An unmoved grid (the previous frame's but for the jitter: a still view whose layout
+    // held) holds each cell's history in the cell itself, which reprojecting the jittered
+    // sample finds only up to rounding (the rest of the bilinear weight on its neighbours).
+    bool unmoved = pc.unmoved != 0u;
+    if (unmoved || rg_world_to_grid(prev, p, sky, true, uv)) {
       GridColumn col = rg_column(cur, i % cur.g.padded_columns);
-      uvec2 cols;
-      vec2 sizes;
-      rg_taps(prev, rg_unjitter(cur, col, prev, uv), idx, w, cols, sizes);
       float own = rg_column_cell_size(cur, col), valid = 0.0, kept = 0.0;
+      uvec2 cols;
+      vec2 sizes = vec2(own);
+      if (unmoved) {
+        idx = uvec4(i);
+        w = vec4(1.0, 0.0, 0.0, 0.0);
+      } else {
+        rg_taps(prev, rg_unjitter(cur, col, prev, uv), idx, w, cols, sizes);
+      }
       // A cell the view moved by less than kHeldCellShare of its size holds the same part of
       // the static scene as the frame before, and its history is the box mean of that area
       // whichever surfaces the jittered samples hit (a tap without a sample still counts for
@@ -136,9 +145,9 @@ void main() {
       vec2 coarse = vec2(rg_coarse_weight(sizes.x, own, pc.coarse_keep, pc.coarse_reject),
                          rg_coarse_weight(sizes.y, own, pc.coarse_keep, pc.coarse_reject));
       for (int k = 0; k < 4; ++k) {
-        bool usable = held ? !rg_no_sample(texelFetch(prev_pos, int(idx[k])).w)  // any surface, not none
-                           : seen_near(prev, idx[k], here, n, depth);
-        if (w[k] <= 0.0 || !usable) w[k] = 0.0;
+        bool usable = w[k] > 0.0 && (held ? !rg_no_sample(texelFetch(prev_pos, int(idx[k])).w)  // any surface, not none
+                                          : seen_near(prev, idx[k], here, n, depth));
+        if (!usable) w[k] = 0.0;
         valid += w[k];
         w[k] *= coarse[k >> 1];
         kept += w[k];

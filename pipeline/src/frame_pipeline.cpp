@@ -207,6 +207,7 @@ FrameTimes FramePipeline::render(const std::array<core::Pose, 2>& eye_pose, cons
   if (landing) --m.landing_left;
   t.grid.cpu_ms = lap_ms(t0);
   m.write_mappings();
+  const std::array<bool, 2> unmoved = m.unmoved();
   t.reconstruct.cpu_ms = lap_ms(t0);
   const bool stereo = m.eyes.size() == 2;
   const bool alternate = stereo && m.settings.share == reconstruct::StereoShare::Alternate;
@@ -243,7 +244,8 @@ FrameTimes FramePipeline::render(const std::array<core::Pose, 2>& eye_pose, cons
     gpu::compute_to_compute(cmd);
     m.timer.stage(cmd, "trace");
     t.trace.cpu_ms = lap_ms(r0);
-    m.accumulation->record(cmd, p, history, std::span(fresh, m.eyes.size()), settings);
+    m.accumulation->record(cmd, p, history, std::span(fresh, m.eyes.size()), std::span(unmoved.data(), m.eyes.size()),
+                           settings);
     m.gather->record(cmd, p, stereo && m.settings.share != reconstruct::StereoShare::Off, settings);
     m.timer.stage(cmd, "accumulate");
     if (m.bmfr)

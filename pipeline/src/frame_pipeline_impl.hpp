@@ -1,5 +1,6 @@
 #pragma once
 // FramePipeline's state, shared by frame_pipeline.cpp and the test access (testing.cpp).
+#include <array>
 #include <memory>
 #include <optional>
 #include <vector>
@@ -62,6 +63,12 @@ struct FramePipeline::Impl {
       const EyeState* o = other(*e);
       e->mapping->write(e->pose, o ? &o->pose : nullptr);
     }
+  }
+  // Per eye, from the mappings written last: the previous frame's grid but for the jitter.
+  std::array<bool, 2> unmoved() const {
+    std::array<bool, 2> u{};
+    for (std::size_t i = 0; i < eyes.size(); ++i) u[i] = eyes[i]->mapping->unmoved();
+    return u;
   }
   // The grid pass's live tiles, in tile order (docs/renderer.md, "Live cells"): no workgroup
   // for a tile without a sample, and vectors of neighbours in φ on polar grids (whose grid-order

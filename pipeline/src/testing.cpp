@@ -30,6 +30,7 @@ std::vector<glm::vec4> grid_buffer(const FramePipeline& pipeline, core::Eye eye,
     case GridBuffer::Albedo: b = &e.trace.albedo(); break;
     case GridBuffer::AccAlbedo: b = &m.accumulation->albedo(i, p); break;
     case GridBuffer::Position: b = &m.accumulation->position(i, p); break;
+    case GridBuffer::TapWeight: b = &m.accumulation->tap_weight(i); break;
   }
   std::vector<glm::vec4> v = b->download<glm::vec4>();
   v.resize(e.cells);
@@ -162,9 +163,11 @@ ReconKernelTimes time_reconstruct(FramePipeline& pipeline, std::uint32_t frame) 
   const bool stereo = m.eyes.size() == 2;
   const bool fresh[2] = {true, true};
   m.write_mappings();
+  const std::array<bool, 2> unmoved = m.unmoved();
   ReconKernelTimes t;
   t.accumulate = time([&](VkCommandBuffer cmd) {
-    m.accumulation->record(cmd, p, history, std::span(fresh, m.eyes.size()), m.settings);
+    m.accumulation->record(cmd, p, history, std::span(fresh, m.eyes.size()), std::span(unmoved.data(), m.eyes.size()),
+                           m.settings);
   });
   t.share = time([&](VkCommandBuffer cmd) {
     m.gather->record(cmd, p, stereo && m.settings.share != reconstruct::StereoShare::Off, m.settings);

@@ -38,13 +38,14 @@ Accumulation::Accumulation(gpu::Context& ctx, std::span<const EyeGrid> eyes, con
 }
 
 void Accumulation::record(VkCommandBuffer cmd, int parity, bool history, std::span<const bool> fresh,
-                          const ReconSettings& s) const {
+                          std::span<const bool> unmoved, const ReconSettings& s) const {
   for (std::size_t i = 0; i < eyes_.size(); ++i) {
     const Eye& e = eyes_[i];
     run_cells(cmd, kernel_, e.set[parity],
               shaders::ReconAccumulatePush{e.cells, history ? 1u : 0u, fresh[i] ? 1u : 0u, s.live_cells ? 1u : 0u,
                                            s.alpha_min, s.coarse_keep, s.coarse_reject, s.landing_deg,
-                                           s.landing_history, s.motion_deg / kHeldCellShare, 0, 0},
+                                           s.landing_history, s.motion_deg / kHeldCellShare,
+                                           unmoved[i] ? 1u : 0u, 0},
               e.cells, e.live);
   }
   gpu::compute_to_compute(cmd);

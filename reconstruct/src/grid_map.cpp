@@ -39,6 +39,23 @@ void append_table(std::vector<GridColumn>& out, std::vector<GridColumn> t, std::
   out.insert(out.end(), t.begin(), t.end());
 }
 
+// Whether mappings a and b lay their cells out alike from the same pose: equal but for the
+// jitter, the frame (which only picks a linear fall-off's killed cells, not where cells lie)
+// and where their tables are bound. Bytewise, so a NaN or a signed zero counts as a change.
+bool same_layout(ReconGrid a, ReconGrid b) {
+  for (ReconGrid* m : {&a, &b}) {
+    m->g.jitter_u = m->g.jitter_v = 0;
+    m->g.frame = 0;
+    m->table_offset = m->lut_offset = 0;
+    m->lut_scale = 0;
+  }
+  return std::memcmp(&a, &b, sizeof(ReconGrid)) == 0;
+}
+
+bool same_table(const std::vector<GridColumn>& a, const std::vector<GridColumn>& b) {
+  return a.size() == b.size() && (a.empty() || std::memcmp(a.data(), b.data(), a.size() * sizeof(GridColumn)) == 0);
+}
+
 // Mapping m's radius lookup table from its column table, at slot `slot` of `luts`; none
 // (lut_scale 0: the shaders search the whole table) for a Cartesian or absent mapping.
 void put_lut(ReconGrid& m, const std::vector<GridColumn>& table, std::uint32_t slot, std::uint32_t* luts) {
@@ -86,6 +103,7 @@ GridMapping::GridMapping(gpu::Context& ctx, const core::SampleDistribution& own,
 void GridMapping::write(const core::Pose& own_pose, const core::Pose* other_pose) {
   ReconGrid m[3] = {recon_grid(*own_, own_pose, 0), prev_, ReconGrid{}};
   m[1].table_offset = table_len_;
+  unmoved_ = prev_.valid && same_layout(m[0], prev_) && same_table(own_->column_table(), prev_table_);
   if (other_ && other_pose) m[2] = recon_grid(*other_, *other_pose, 2 * table_len_);
   auto* luts = reinterpret_cast<std::uint32_t*>(luts_.mapped().data());
   put_lut(m[0], own_->column_table(), 0, luts);

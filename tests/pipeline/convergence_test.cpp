@@ -88,7 +88,8 @@ TEST_F(GpuTest, StillViewConvergesForEveryDistribution) {
 // tested by surface such cells restarted whenever their sample changed sides (still, at budget
 // 0.02: 34-117 of 356-368 cells held fewer than 12 samples, some 1; full Cartesian 7), so
 // they never converged and showed single samples. Linear fall-off kills cells at random
-// every frame, by design.
+// every frame, by design. Still, the grid is unmoved and Phase I takes each cell's own
+// history without reprojecting it (GridMapping::unmoved); turning, it reprojects.
 TEST_F(GpuTest, StillViewKeepsTheHistoryOfEveryCell) {
   Cornell c(ctx());
   reconstruct::ReconSettings s;
@@ -110,8 +111,9 @@ TEST_F(GpuTest, StillViewKeepsTheHistoryOfEveryCell) {
         p.render(turned, kGaze, f);
       }
       const auto acc = pipeline::testing::grid_buffer(p, core::Eye::Left, pipeline::testing::GridBuffer::AccDirect);
+      const auto taps = pipeline::testing::grid_buffer(p, core::Eye::Left, pipeline::testing::GridBuffer::TapWeight);
       const auto samples = p.grid_samples(core::Eye::Left);
-      int counted = 0, short_history = 0;
+      int counted = 0, short_history = 0, resampled = 0;
       float fewest = float(frames);
       for (std::size_t i = 0; i < acc.size(); ++i) {
         if (samples[i].flags != 0) continue;
@@ -122,12 +124,17 @@ TEST_F(GpuTest, StillViewKeepsTheHistoryOfEveryCell) {
         if (turn_deg > 0 && samples[i].footprint < 1) continue;
         ++counted;
         if (acc[i].w != float(frames)) ++short_history;
+        // Still, the grid is unmoved: each cell takes its own history, whole (the first tap,
+        // weight exactly 1), not the reprojection's bilinear weights around it.
+        if (taps[i] != glm::vec4(1, 0, 0, 0)) ++resampled;
         fewest = std::min(fewest, acc[i].w);
       }
       std::printf("turning %.2f deg/frame, %-18s %d cells counted, %d with fewer than %u samples (fewest %.0f)\n",
                   turn_deg, core::distribution_name(kind), counted, short_history, frames, fewest);
       EXPECT_GT(counted, 0) << core::distribution_name(kind);
       EXPECT_EQ(short_history, 0) << core::distribution_name(kind) << ", turning " << turn_deg << " deg/frame";
+      if (turn_deg == 0) EXPECT_EQ(resampled, 0) << core::distribution_name(kind);
+      else EXPECT_GT(resampled, 0) << core::distribution_name(kind) << ": turning reprojects";
     }
   }
 }

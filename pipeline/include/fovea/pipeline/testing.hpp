@@ -21,6 +21,7 @@ enum class GridBuffer {
   Albedo,          // the path tracer's first-hit albedo, this frame
   AccAlbedo,       // Phase I's accumulated albedo (what TAA re-modulates with)
   Position,        // validation data: world position (sky: direction), .w material (-2: no sample)
+  TapWeight,       // Phase I's weights of its four history taps (renormalised; 0: none)
 };
 
 std::vector<glm::vec4> grid_buffer(const FramePipeline& p, core::Eye e, GridBuffer which);

@@ -38,6 +38,10 @@ class GridMapping {
   void write(const core::Pose& own_pose, const core::Pose* other_pose);
   // After a frame: this frame's mapping becomes the previous one.
   void advance(const core::Pose& own_pose);
+  // Whether the last write's mapping is the previous one's but for the cells' jitter (same
+  // layout, pose and column table): every cell's history is then its own cell's, and Phase I
+  // takes it without reprojecting (shaders/recon_accumulate.comp).
+  bool unmoved() const { return unmoved_; }
 
   const gpu::Buffer& maps() const { return maps_; }
   const gpu::Buffer& tables() const { return tables_; }
@@ -50,6 +54,7 @@ class GridMapping {
   std::uint32_t table_len_ = 1, other_table_len_ = 1;
   shaders::ReconGrid prev_{};
   std::vector<shaders::GridColumn> prev_table_;
+  bool unmoved_ = false;
   gpu::Buffer maps_, tables_, luts_;
 };
 

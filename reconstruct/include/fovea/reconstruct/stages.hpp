@@ -40,9 +40,10 @@ struct EyeGrid {
 class Accumulation {
  public:
   Accumulation(gpu::Context& ctx, std::span<const EyeGrid> eyes, const gpu::Buffer& materials);
-  // `fresh[e]`: eye e traced new indirect diffuse this frame.
+  // `fresh[e]`: eye e traced new indirect diffuse this frame; `unmoved[e]`: eye e's grid
+  // mapping is the previous frame's but for the jitter (GridMapping::unmoved).
   void record(VkCommandBuffer cmd, int parity, bool history, std::span<const bool> fresh,
-              const ReconSettings& settings) const;
+              std::span<const bool> unmoved, const ReconSettings& settings) const;
   void fill(VkCommandBuffer cmd, std::uint32_t word) const;
 
   const gpu::Buffer& direct(int eye, int parity) const { return eyes_[eye].direct[parity]; }

@@ -58,7 +58,8 @@ struct ReconAccumulatePush {
   float landing_deg;      // as ReconPostPush: > 0 on a landing frame, the new fovea's angle
   float landing_history;  // samples the new fovea's history counts for there at most (ReconSettings)
   float held_deg;         // the view's motion since the last frame over kHeldCellShare (degrees)
-  float pad1, pad2;
+  FOVEA_UINT unmoved;     // 1: the previous mapping is this one but for the jitter (GridMapping::unmoved)
+  float pad2;
 };
 
 struct ReconSharePush {
