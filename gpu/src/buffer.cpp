@@ -28,6 +28,17 @@ std::string hex(std::uint32_t v) {
 
 }  // namespace
 
+MemoryProperties memory_properties(Memory m) {
+  // Mapped memory is also asked to be coherent, so no flushes are needed.
+  constexpr VkMemoryPropertyFlags mapped = VK_MEMORY_PROPERTY_HOST_VISIBLE_BIT | VK_MEMORY_PROPERTY_HOST_COHERENT_BIT;
+  switch (m) {
+    case Memory::HostVisible: return {mapped, VK_MEMORY_PROPERTY_HOST_CACHED_BIT};
+    case Memory::Upload: return {mapped, VK_MEMORY_PROPERTY_DEVICE_LOCAL_BIT};
+    case Memory::DeviceLocal: break;
+  }
+  return {0, VK_MEMORY_PROPERTY_DEVICE_LOCAL_BIT};
+}
+
 VkDeviceSize texel_buffer_bytes(VkFormat format) {
   switch (format) {
     case VK_FORMAT_R32_UINT: case VK_FORMAT_R32_SFLOAT: return 4;
@@ -73,9 +84,7 @@ Buffer::Buffer(Context& ctx, const BufferDesc& desc) : ctx_(&ctx), size_(desc.si
 
   VkMemoryRequirements req;
   vkGetBufferMemoryRequirements(dev, buffer, &req);
-  const bool host = desc.memory == Memory::HostVisible && !desc.imported;
-  // Host-visible memory is also asked to be coherent so no flushes are needed; cached
-  // memory is preferred because readback is its main use.
+  const bool host = desc.memory != Memory::DeviceLocal && !desc.imported;
   std::uint32_t type = 0;
   if (desc.imported) {
     type = desc.imported->memory_type;
@@ -84,10 +93,8 @@ Buffer::Buffer(Context& ctx, const BufferDesc& desc) : ctx_(&ctx), size_(desc.si
                              std::to_string(desc.imported->allocation_size) + " bytes) cannot hold it (" +
                              std::to_string(req.size) + " bytes, memory types 0x" + hex(req.memoryTypeBits) + ")");
   } else {
-    type = host ? ctx.memory_type(req.memoryTypeBits,
-                                  VK_MEMORY_PROPERTY_HOST_VISIBLE_BIT | VK_MEMORY_PROPERTY_HOST_COHERENT_BIT,
-                                  VK_MEMORY_PROPERTY_HOST_CACHED_BIT)
-                : ctx.memory_type(req.memoryTypeBits, 0, VK_MEMORY_PROPERTY_DEVICE_LOCAL_BIT);
+    const MemoryProperties p = memory_properties(desc.memory);
+    type = ctx.memory_type(req.memoryTypeBits, p.required, p.preferred);
   }
   VkMemoryAllocateInfo ai{VK_STRUCTURE_TYPE_MEMORY_ALLOCATE_INFO};
   ai.allocationSize = desc.imported ? desc.imported->allocation_size : req.size;

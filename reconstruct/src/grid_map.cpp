@@ -92,12 +92,12 @@ GridMapping::GridMapping(gpu::Context& ctx, const core::SampleDistribution& own,
       other_(other),
       table_len_(table_len(own)),
       other_table_len_(other ? table_len(*other) : table_len(own)),
-      maps_(storage(ctx, 3 * sizeof(ReconGrid), "recon.maps", gpu::Memory::HostVisible)),
+      maps_(storage(ctx, 3 * sizeof(ReconGrid), "recon.maps", gpu::Memory::Upload)),
       tables_(gpu::Buffer(ctx, {.size = VkDeviceSize(2 * table_len_ + other_table_len_) * sizeof(GridColumn),
-                                .memory = gpu::Memory::HostVisible, .name = "recon.tables",
+                                .memory = gpu::Memory::Upload, .name = "recon.tables",
                                 .texel_format = VK_FORMAT_R32G32B32A32_SFLOAT})),
       luts_(gpu::Buffer(ctx, {.size = VkDeviceSize(3) * shaders::kReconRadiusLutEntries * sizeof(std::uint32_t),
-                              .memory = gpu::Memory::HostVisible, .name = "recon.radius_luts",
+                              .memory = gpu::Memory::Upload, .name = "recon.radius_luts",
                               .texel_format = VK_FORMAT_R32_UINT})) {}
 
 void GridMapping::write(const core::Pose& own_pose, const core::Pose* other_pose) {
@@ -110,8 +110,10 @@ void GridMapping::write(const core::Pose& own_pose, const core::Pose* other_pose
   put_lut(m[1], prev_table_, 1, luts);
   if (other_ && other_pose) put_lut(m[2], other_->column_table(), 2, luts);
   std::memcpy(maps_.mapped().data(), m, sizeof(m));
-  std::vector<GridColumn> t;
-  append_table(t, own_->column_table(), table_len_);
+  current_ = m[0];
+  current_table_.clear();
+  append_table(current_table_, own_->column_table(), table_len_);  // as the shaders see it
+  std::vector<GridColumn> t = current_table_;
   append_table(t, prev_table_, table_len_);
   if (other_ && other_pose) append_table(t, other_->column_table(), other_table_len_);
   std::memcpy(tables_.mapped().data(), t.data(), t.size() * sizeof(GridColumn));

@@ -2,7 +2,6 @@
 // with the display-space depth, recon_blur.comp).
 #include <algorithm>
 #include <cmath>
-#include <cstring>
 #include <numbers>
 
 #include "bindings.hpp"
@@ -29,22 +28,15 @@ float blur_skip_cos(const ReconSettings& s, double ppd) {
   return float(std::cos(lo * std::numbers::pi / 180));
 }
 
-// The current mapping of an eye, read from its host-visible mapping buffer (GridMapping
-// writes it before the frame is recorded).
-shaders::ReconGrid current_map(const gpu::Buffer& maps) {
-  shaders::ReconGrid m{};
-  std::memcpy(&m, maps.mapped().data() + shaders::kReconCurrent * sizeof(m), sizeof(m));
-  return m;
-}
-
 bool grid_space_blur(const shaders::ReconGrid& m) { return m.g.family == shaders::kFamilyAngularPolar; }
 
 // The first column of an angular polar mapping whose acuity kernel (recon_grid_blur.comp) is
 // at least min_sigma_px cells wide across or along it, or `columns` when none is: the blur
 // passes start there (σ in cells grows outwards; columns beyond it below the limit are copied).
-std::uint32_t first_blurred_column(const shaders::ReconGrid& m, const gpu::Buffer& tables, const ReconSettings& s) {
-  const auto* table = reinterpret_cast<const shaders::GridColumn*>(tables.mapped().data()) + m.table_offset;
-  for (std::uint32_t c = 0; c < m.g.columns; ++c) {
+std::uint32_t first_blurred_column(const GridMapping& mapping, const ReconSettings& s) {
+  const shaders::ReconGrid& m = mapping.current();
+  const std::span<const shaders::GridColumn> table = mapping.current_table();
+  for (std::uint32_t c = 0; c < m.g.columns && c < table.size(); ++c) {
     const shaders::GridColumn& col = table[c];
     const double e = 0.5 * (double(col.r0) + double(col.r1));
     const double arc = 1.0 - double(col.phi_gap) / (2 * std::numbers::pi);
@@ -67,14 +59,15 @@ struct MipReach {
   std::uint32_t lod_columns = 0;       // columns whose pixels can have a LOD > 0
 };
 
-MipReach mip_reach(const shaders::ReconGrid& m, const gpu::Buffer& tables, std::uint32_t levels) {
+MipReach mip_reach(const GridMapping& mapping, std::uint32_t levels) {
+  const shaders::ReconGrid& m = mapping.current();
   MipReach reach;
   reach.columns.assign(levels, 0);
   if (m.g.family == shaders::kFamilyCartesian) return reach;
-  const auto* table = reinterpret_cast<const shaders::GridColumn*>(tables.mapped().data()) + m.table_offset;
+  const std::span<const shaders::GridColumn> table = mapping.current_table();
   const double delta = std::max((m.g.tan_right - m.g.tan_left) / m.g.width, (m.g.tan_up - m.g.tan_down) / m.g.height);
   constexpr double kDeg = std::numbers::pi / 180;
-  for (std::uint32_t c = 0; c < m.g.columns; ++c) {
+  for (std::uint32_t c = 0; c < m.g.columns && c < table.size(); ++c) {
     const shaders::GridColumn& col = table[c];
     const double turn_rows = col.rows / (1.0 - double(col.phi_gap) / (2 * std::numbers::pi));
     const double f = m.g.family == shaders::kFamilyAngularPolar
@@ -108,8 +101,7 @@ Resolve::Resolve(gpu::Context& ctx, std::span<const EyeGrid> eyes, const Accumul
     e.height = g.height;
     e.padded_columns = g.padded_columns;
     e.polar = g.polar;
-    e.maps = g.maps;
-    e.tables = g.tables;
+    e.mapping = g.mapping;
     e.max_pixels_per_deg = g.max_pixels_per_deg;
     // φ-only mip chain (polar grids): level l has ceil(rows / 2^l) rows.
     std::uint32_t rows = g.padded_rows, offset = 0;
@@ -168,15 +160,15 @@ void Resolve::record_grid_blur(VkCommandBuffer cmd, const ReconSettings& s) cons
   std::vector<std::uint32_t> first(eyes_.size(), 0);
   bool any = false;
   for (std::size_t i = 0; i < eyes_.size(); ++i) {
-    const shaders::ReconGrid m = current_map(*eyes_[i].maps);
-    first[i] = grid_space_blur(m) ? first_blurred_column(m, *eyes_[i].tables, s) : m.g.columns;
+    const shaders::ReconGrid& m = eyes_[i].mapping->current();
+    first[i] = grid_space_blur(m) ? first_blurred_column(*eyes_[i].mapping, s) : m.g.columns;
     any = any || first[i] < m.g.columns;
   }
   if (!any) return;  // the acuity kernel is below min σ in every cell: nothing to blur
   for (int pass = 0; pass < 2; ++pass) {
     for (std::size_t i = 0; i < eyes_.size(); ++i) {
       const Eye& e = eyes_[i];
-      const std::uint32_t columns = current_map(*e.maps).g.columns;
+      const std::uint32_t columns = e.mapping->current().g.columns;
       if (first[i] >= columns) continue;
       const shaders::ReconGridBlurPush push{first[i], std::uint32_t(pass), 0, 0,
                                             float(blur_sigma_deg(0.0, s.blur_mar_fovea_deg)),
@@ -189,7 +181,7 @@ void Resolve::record_grid_blur(VkCommandBuffer cmd, const ReconSettings& s) cons
 
 void Resolve::record_mips(VkCommandBuffer cmd) const {
   std::vector<MipReach> reach;
-  for (const Eye& e : eyes_) reach.push_back(mip_reach(current_map(*e.maps), *e.tables, e.levels));
+  for (const Eye& e : eyes_) reach.push_back(mip_reach(*e.mapping, e.levels));
   for (std::uint32_t l = 0; l + 1 < max_levels(); ++l) {
     bool any = false;
     for (std::size_t i = 0; i < eyes_.size(); ++i) {
@@ -208,7 +200,7 @@ void Resolve::record_mips(VkCommandBuffer cmd) const {
 
 void Resolve::record_resample(VkCommandBuffer cmd, int parity, bool grid_coords) const {
   for (const Eye& e : eyes_) {
-    const std::uint32_t lod_columns = mip_reach(current_map(*e.maps), *e.tables, e.levels).lod_columns;
+    const std::uint32_t lod_columns = mip_reach(*e.mapping, e.levels).lod_columns;
     resolve_.run(cmd, {&e.resolve_set[parity]},
                  shaders::ReconResolvePush{e.width, e.height, e.levels, grid_coords ? 1u : 0u, lod_columns,
                                            depth_output_ ? 1u : 0u, 0, 0}, e.width,
@@ -220,7 +212,7 @@ void Resolve::record_resample(VkCommandBuffer cmd, int parity, bool grid_coords)
 void Resolve::record_blur(VkCommandBuffer cmd, const ReconSettings& s) const {
   for (int pass = 0; pass < 2; ++pass) {
     for (const Eye& e : eyes_) {
-      if (grid_space_blur(current_map(*e.maps))) continue;  // blurred in grid space (record_grid_blur)
+      if (grid_space_blur(e.mapping->current())) continue;  // blurred in grid space (record_grid_blur)
       const shaders::ReconBlurPush push{e.width, e.height, std::uint32_t(pass), 0,
                                         float(blur_sigma_deg(0.0, s.blur_mar_fovea_deg)), float(s.blur_min_sigma_px),
                                         float(s.blur_max_sigma_px), blur_skip_cos(s, e.max_pixels_per_deg)};

@@ -37,8 +37,20 @@ constexpr BufferUsage operator|(BufferUsage a, BufferUsage b) {
 
 enum class Memory {
   DeviceLocal,  // fastest for shaders; host access goes through staging copies
-  HostVisible,  // mapped and coherent; for readback, uniforms and per-frame uploads
+  HostVisible,  // mapped and coherent, host-cached where the device has such memory: readback
+  // Mapped and coherent, device-local where the device has such memory (a discrete GPU's
+  // BAR; any type of a CPU or integrated device): what the host writes for a frame and the
+  // frame's shaders then read in many invocations or update by atomics. In host memory each
+  // such read or atomic would cross the bus; reading it back is slow, so the host keeps its
+  // own copy of what it wrote.
+  Upload,
 };
+
+// The memory properties a kind requires and prefers (find_memory_type's arguments).
+struct MemoryProperties {
+  VkMemoryPropertyFlags required = 0, preferred = 0;
+};
+MemoryProperties memory_properties(Memory m);
 
 // Memory another VkDevice of the same physical device allocated (dedicated to one buffer)
 // and exported as an opaque file descriptor (VK_KHR_external_memory_fd): the allocation's

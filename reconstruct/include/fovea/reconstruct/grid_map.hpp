@@ -1,8 +1,9 @@
 #pragma once
 // The per-frame grid mappings the reconstruction kernels read (shaders/include/fovea/shaders/
 // recon_grid.h): per eye, ReconGrid[3] = this frame, the previous frame (reprojection), the
-// other eye (stereo gather), their column tables and radius lookup tables, in host-visible
-// buffers.
+// other eye (stereo gather), their column tables and radius lookup tables, in mapped buffers
+// (gpu::Memory::Upload: device memory where the device can map it). The host reads its own
+// copies of what it wrote, never the buffers.
 #include <cstdint>
 #include <span>
 #include <vector>
@@ -43,6 +44,10 @@ class GridMapping {
   // takes it without reprojecting (shaders/recon_accumulate.comp).
   bool unmoved() const { return unmoved_; }
 
+  // This frame's mapping and column table, as the last write uploaded them.
+  const shaders::ReconGrid& current() const { return current_; }
+  std::span<const shaders::GridColumn> current_table() const { return current_table_; }
+
   const gpu::Buffer& maps() const { return maps_; }
   const gpu::Buffer& tables() const { return tables_; }
   // R32_UINT texels: the radius lookup table of each polar mapping, at its lut_offset.
@@ -52,8 +57,8 @@ class GridMapping {
   const core::SampleDistribution* own_;
   const core::SampleDistribution* other_;
   std::uint32_t table_len_ = 1, other_table_len_ = 1;
-  shaders::ReconGrid prev_{};
-  std::vector<shaders::GridColumn> prev_table_;
+  shaders::ReconGrid prev_{}, current_{};
+  std::vector<shaders::GridColumn> prev_table_, current_table_;
   bool unmoved_ = false;
   gpu::Buffer maps_, tables_, luts_;
 };

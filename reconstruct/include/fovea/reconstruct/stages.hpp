@@ -16,6 +16,7 @@
 #include "fovea/gpu/descriptors.hpp"
 #include "fovea/gpu/pipeline.hpp"
 #include "fovea/reconstruct/bmfr.hpp"
+#include "fovea/reconstruct/grid_map.hpp"
 #include "fovea/reconstruct/settings.hpp"
 
 namespace fovea::reconstruct {
@@ -26,7 +27,8 @@ struct EyeGrid {
   bool polar = true;                   // φ-only mip chain (polar grids) or one level
   std::uint32_t width = 0, height = 0;  // the display raster the grid resolves to
   double max_pixels_per_deg = 0;        // the raster's densest pixels (bounds the blur's reach)
-  const gpu::Buffer* maps = nullptr;    // GridMapping::maps(), tables(), luts()
+  const GridMapping* mapping = nullptr;  // the host's copy of the mapping (GridMapping::current)
+  const gpu::Buffer* maps = nullptr;     // GridMapping::maps(), tables(), luts()
   const gpu::Buffer* tables = nullptr;
   const gpu::Buffer* luts = nullptr;
   // The path tracer's per-cell outputs (renderer::TraceOutputs) and the grid itself.
@@ -176,7 +178,7 @@ class Resolve {
     std::uint32_t cells = 0, width = 0, height = 0, padded_columns = 0, levels = 1;
     bool polar = true;
     double max_pixels_per_deg = 0;
-    const gpu::Buffer *maps = nullptr, *tables = nullptr;  // host-visible (GridMapping)
+    const GridMapping* mapping = nullptr;  // EyeGrid::mapping
     std::vector<std::uint32_t> level_rows, level_offset;
     gpu::Buffer mips, offsets, screen_a, screen_b, depth, grid_tmp, prev_luma, temporal_sums;
     gpu::DescriptorSet mip_set, resolve_set[2], blur_h, blur_v, grid_blur_rho, grid_blur_phi, temporal_set;
