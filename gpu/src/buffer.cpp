@@ -10,6 +10,7 @@
 #include "fovea/core/error.hpp"
 #include "fovea/gpu/context.hpp"
 #include "fovea/gpu/error.hpp"
+#include "fovea/gpu/memory_type.hpp"
 
 namespace fovea::gpu {
 namespace {
@@ -37,6 +38,19 @@ MemoryProperties memory_properties(Memory m) {
     case Memory::DeviceLocal: break;
   }
   return {0, VK_MEMORY_PROPERTY_DEVICE_LOCAL_BIT};
+}
+
+std::optional<std::uint32_t> upload_fallback_type(const VkPhysicalDeviceMemoryProperties& memory,
+                                                  std::uint32_t type_bits, std::uint32_t type) {
+  const auto in_device_heap = [&](std::uint32_t i) {
+    return (memory.memoryHeaps[memory.memoryTypes[i].heapIndex].flags & VK_MEMORY_HEAP_DEVICE_LOCAL_BIT) != 0;
+  };
+  if (type >= memory.memoryTypeCount || !in_device_heap(type)) return std::nullopt;
+  std::uint32_t host_types = 0;
+  for (std::uint32_t i = 0; i < memory.memoryTypeCount && i < 32; ++i)
+    if (!in_device_heap(i)) host_types |= 1u << i;
+  const MemoryProperties p = memory_properties(Memory::HostVisible);
+  return find_memory_type(memory, type_bits & host_types, p.required, p.preferred);
 }
 
 VkDeviceSize texel_buffer_bytes(VkFormat format) {
@@ -96,6 +110,13 @@ Buffer::Buffer(Context& ctx, const BufferDesc& desc) : ctx_(&ctx), size_(desc.si
     const MemoryProperties p = memory_properties(desc.memory);
     type = ctx.memory_type(req.memoryTypeBits, p.required, p.preferred);
   }
+  // An upload whose device-local memory is full goes to host memory: slower for its readers,
+  // where failing would stop the frame. Taken before allocating when this context filled the
+  // heap, and after a failed allocation when others did.
+  std::optional<std::uint32_t> fallback =
+      desc.memory == Memory::Upload && !desc.imported ? upload_fallback_type(ctx.memory_types(), req.memoryTypeBits, type)
+                                                      : std::nullopt;
+  if (fallback && ctx.memory_in_use(type) + req.size > ctx.memory_limit(type)) type = *std::exchange(fallback, std::nullopt);
   VkMemoryAllocateInfo ai{VK_STRUCTURE_TYPE_MEMORY_ALLOCATE_INFO};
   ai.allocationSize = desc.imported ? desc.imported->allocation_size : req.size;
   ai.memoryTypeIndex = type;
@@ -114,8 +135,14 @@ Buffer::Buffer(Context& ctx, const BufferDesc& desc) : ctx_(&ctx), size_(desc.si
   }
   charge_ = ctx.charge_memory(what, req.size, type);
   VkDeviceMemory memory = VK_NULL_HANDLE;
-  check_fits(vkAllocateMemory(dev, &ai, nullptr, &memory), "vkAllocateMemory", what, req.size,
-             ctx.memory_type_heap_size(type));
+  VkResult allocated = vkAllocateMemory(dev, &ai, nullptr, &memory);
+  if (allocated == VK_ERROR_OUT_OF_DEVICE_MEMORY && fallback) {
+    charge_ = {};
+    type = ai.memoryTypeIndex = *fallback;
+    charge_ = ctx.charge_memory(what, req.size, type);
+    allocated = vkAllocateMemory(dev, &ai, nullptr, &memory);
+  }
+  check_fits(allocated, "vkAllocateMemory", what, req.size, ctx.memory_type_heap_size(type));
   imported_fd.fd = -1;  // the memory owns it now
   memory_ = {dev, memory};
   check(vkBindBufferMemory(dev, buffer, memory, 0), "vkBindBufferMemory");

@@ -3,8 +3,8 @@
 // host-visible device memory (its BAR) and a CPU device. Per-frame uploads that every shader
 // invocation reads (gpu::Memory::Upload) go to device memory where the device can map it, so
 // a discrete GPU's shaders do not read them, nor run atomics on them, across the bus;
-// readback stays in cached host memory. (Buffers.RoundTripEveryMemoryKind uses each kind on
-// the test's device.)
+// readback stays in cached host memory, and an upload whose device memory is full falls back
+// to host memory. (Buffers.RoundTripEveryMemoryKind uses each kind on the test's device.)
 #include <cstdint>
 #include <initializer_list>
 #include <optional>
@@ -20,9 +20,17 @@ constexpr VkMemoryPropertyFlags kLocal = VK_MEMORY_PROPERTY_DEVICE_LOCAL_BIT;
 constexpr VkMemoryPropertyFlags kMapped = VK_MEMORY_PROPERTY_HOST_VISIBLE_BIT | VK_MEMORY_PROPERTY_HOST_COHERENT_BIT;
 constexpr VkMemoryPropertyFlags kCached = VK_MEMORY_PROPERTY_HOST_CACHED_BIT;
 
+// Memory types with these properties; a device-local type's heap is device memory, every
+// other type's host memory (heaps 0 and 1).
 VkPhysicalDeviceMemoryProperties types(std::initializer_list<VkMemoryPropertyFlags> flags) {
   VkPhysicalDeviceMemoryProperties p{};
-  for (VkMemoryPropertyFlags f : flags) p.memoryTypes[p.memoryTypeCount++].propertyFlags = f;
+  p.memoryHeapCount = 2;
+  p.memoryHeaps[0].flags = VK_MEMORY_HEAP_DEVICE_LOCAL_BIT;
+  for (VkMemoryPropertyFlags f : flags) {
+    VkMemoryType& t = p.memoryTypes[p.memoryTypeCount++];
+    t.propertyFlags = f;
+    t.heapIndex = (f & kLocal) != 0 ? 0 : 1;
+  }
   return p;
 }
 
@@ -56,4 +64,19 @@ TEST(MemoryKinds, PickTheirTypesOnDiscreteAndCpuDevices) {
   const auto unmapped = types({kLocal});
   EXPECT_FALSE(pick(unmapped, gpu::Memory::Upload).has_value());
   EXPECT_FALSE(pick(unmapped, gpu::Memory::HostVisible).has_value());
+}
+
+TEST(MemoryKinds, AnUploadFallsBackToHostMemoryWhenDeviceMemoryIsFull) {
+  const auto discrete = types({0, kLocal, kMapped, kMapped | kCached, kLocal | kMapped});
+  EXPECT_EQ(gpu::upload_fallback_type(discrete, ~0u, 4), 3u);        // the BAR's: cached host memory
+  EXPECT_EQ(gpu::upload_fallback_type(discrete, 0b10111u, 4), 2u);   // one the buffer can live in
+  EXPECT_FALSE(gpu::upload_fallback_type(discrete, ~0u, 3).has_value());  // in host memory already
+  EXPECT_FALSE(gpu::upload_fallback_type(discrete, ~0u, 9).has_value());  // no such type
+  // A CPU device's one heap: nowhere else to go.
+  VkPhysicalDeviceMemoryProperties cpu{};
+  cpu.memoryHeapCount = 1;
+  cpu.memoryHeaps[0].flags = VK_MEMORY_HEAP_DEVICE_LOCAL_BIT;
+  cpu.memoryTypeCount = 1;
+  cpu.memoryTypes[0].propertyFlags = kLocal | kMapped | kCached;
+  EXPECT_FALSE(gpu::upload_fallback_type(cpu, ~0u, 0).has_value());
 }

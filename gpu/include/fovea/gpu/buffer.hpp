@@ -51,6 +51,12 @@ struct MemoryProperties {
   VkMemoryPropertyFlags required = 0, preferred = 0;
 };
 MemoryProperties memory_properties(Memory m);
+// Where an Upload that took memory type `type` of a device-local heap goes when that heap is
+// full (a BAR without resizable BAR holds 256 MiB for every user of the GPU): a mapped type
+// of a heap in host memory, as HostVisible picks it; none when `type` is in host memory
+// already or the device has no such heap (a CPU device's one heap).
+std::optional<std::uint32_t> upload_fallback_type(const VkPhysicalDeviceMemoryProperties& memory,
+                                                  std::uint32_t type_bits, std::uint32_t type);
 
 // Memory another VkDevice of the same physical device allocated (dedicated to one buffer)
 // and exported as an opaque file descriptor (VK_KHR_external_memory_fd): the allocation's

@@ -164,6 +164,7 @@ class Context {
   std::uint32_t memory_type(std::uint32_t type_bits, VkMemoryPropertyFlags required,
                             VkMemoryPropertyFlags preferred = 0) const;
   VkMemoryPropertyFlags memory_type_flags(std::uint32_t index) const;
+  const VkPhysicalDeviceMemoryProperties& memory_types() const { return memory_; }
   // Size of the heap that memory type `index` allocates from, bytes.
   VkDeviceSize memory_type_heap_size(std::uint32_t index) const;
   // The most device memory this context's buffers and images may hold in that heap: the
