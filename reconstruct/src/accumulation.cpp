@@ -28,10 +28,10 @@ Accumulation::Accumulation(gpu::Context& ctx, std::span<const EyeGrid> eyes, con
     for (int p = 0; p < 2; ++p) {
       const int q = 1 - p;  // history read by a frame writing p
       e.set[p] = make_set(ctx, kernel_,
-                          AccumulateBindings{g.maps, g.tables, g.samples, g.direct, g.indirect, g.normal_depth,
+                          AccumulateBindings{g.maps(), g.tables(), g.samples, g.direct, g.indirect, g.normal_depth,
                                              g.position_material, &e.direct[q], &e.indirect[q], &e.pos[q], &e.nrm[q],
                                              &e.direct[p], &e.indirect[p], &e.pos[p], &e.nrm[p], &e.tap_idx, &e.tap_w,
-                                             &materials, &e.restart[q], &e.restart[p], g.luts, g.albedo, &e.albedo[q],
+                                             &materials, &e.restart[q], &e.restart[p], g.luts(), g.albedo, &e.albedo[q],
                                              &e.albedo[p], e.live});
     }
   }
@@ -74,9 +74,10 @@ StereoGather::StereoGather(gpu::Context& ctx, std::span<const EyeGrid> eyes, con
     const int me = int(i), other = eyes.size() == 2 ? 1 - me : me;  // one eye gathers from itself (unused)
     for (int p = 0; p < 2; ++p)
       e.set[p] = make_set(ctx, kernel_,
-                          ShareBindings{g.maps, g.tables, &acc.position(me, p), &acc.normal(me, p), &acc.direct(me, p),
-                                        &acc.indirect(me, p), &acc.position(other, p), &acc.normal(other, p),
-                                        &acc.indirect(other, p), &e.shared, &e.z, &e.edge, g.luts, e.live});
+                          ShareBindings{g.maps(), g.tables(), &acc.position(me, p), &acc.normal(me, p),
+                                        &acc.direct(me, p), &acc.indirect(me, p), &acc.position(other, p),
+                                        &acc.normal(other, p), &acc.indirect(other, p), &e.shared, &e.z, &e.edge,
+                                        g.luts(), e.live});
   }
 }
 

@@ -137,7 +137,7 @@ Bmfr::Bmfr(gpu::Context& ctx, std::span<const EyeGrid> eyes, const Accumulation&
     e.excess = cells(ctx, eyes[i].cells, "recon.excess");
     for (int p = 0; p < 2; ++p)
       e.set[p] = fit_.bind(acc.position(int(i), p), acc.normal(int(i), p), gather.shared(int(i)), e.fitted,
-                           *eyes[i].tables, materials, e.excess, gather.edge(int(i)));
+                           *eyes[i].tables(), materials, e.excess, gather.edge(int(i)));
   }
 }
 

@@ -32,7 +32,7 @@ PostTaa::PostTaa(gpu::Context& ctx, std::span<const EyeGrid> eyes, const Accumul
                                             &acc.direct(me, p), &e.post[q], &e.post[p], &acc.direct(me, q), excess,
                                             &e.sum, e.live, g.direct});
       e.taa_set[p] = make_set(ctx, taa_,
-                              TaaBindings{g.maps, g.tables, &acc.position(me, p), &acc.tap_index(me),
+                              TaaBindings{g.maps(), g.tables(), &acc.position(me, p), &acc.tap_index(me),
                                           &acc.tap_weight(me), &e.sum, &acc.albedo(me, p), &e.final_[q], &e.final_[p],
                                           &acc.normal(me, p), &acc.restart(me, p), e.live});
     }

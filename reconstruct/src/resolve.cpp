@@ -119,20 +119,20 @@ Resolve::Resolve(gpu::Context& ctx, std::span<const EyeGrid> eyes, const Accumul
     e.screen_a = cells(ctx, pixels, "recon.screen");
     e.screen_b = cells(ctx, pixels, "recon.screen_tmp");
     e.depth = storage(ctx, VkDeviceSize(pixels) * 4, "recon.depth");
-    e.mip_set = make_set(ctx, mip_, MipBindings{g.maps, g.tables, &e.mips});
+    e.mip_set = make_set(ctx, mip_, MipBindings{g.maps(), g.tables(), &e.mips});
     for (int p = 0; p < 2; ++p)
-      e.resolve_set[p] = make_set(ctx, resolve_, ResolveBindings{g.maps, g.tables, &e.mips, &e.offsets, &e.screen_a,
-                                                                 &acc.position(int(i), p), &e.depth, g.luts});
+      e.resolve_set[p] = make_set(ctx, resolve_, ResolveBindings{g.maps(), g.tables(), &e.mips, &e.offsets, &e.screen_a,
+                                                                 &acc.position(int(i), p), &e.depth, g.luts()});
     e.prev_luma = storage(ctx, VkDeviceSize(pixels) * 4, "recon.temporal_prev_luma");
     e.temporal_sums = storage(ctx, VkDeviceSize(temporal_runs(g.width, g.height)) * 4, "recon.temporal_sums");
     e.temporal_sums.upload(std::vector<float>(temporal_runs(g.width, g.height), 0.0f));
     e.temporal_set = make_set(ctx, temporal_, TemporalBindings{&e.screen_a, &e.prev_luma, &e.temporal_sums});
-    e.blur_h = make_set(ctx, blur_, BlurBindings{g.maps, g.tables, &e.screen_a, &e.screen_b});
-    e.blur_v = make_set(ctx, blur_, BlurBindings{g.maps, g.tables, &e.screen_b, &e.screen_a});
+    e.blur_h = make_set(ctx, blur_, BlurBindings{g.maps(), g.tables(), &e.screen_a, &e.screen_b});
+    e.blur_v = make_set(ctx, blur_, BlurBindings{g.maps(), g.tables(), &e.screen_b, &e.screen_a});
     if (g.polar) {  // grid-space blur: level 0 -> grid_tmp (across columns) -> level 0 (along φ)
       e.grid_tmp = cells(ctx, g.padded_rows * g.padded_columns, "recon.grid_blur_tmp");
-      e.grid_blur_rho = make_set(ctx, grid_blur_, BlurBindings{g.maps, g.tables, &e.mips, &e.grid_tmp});
-      e.grid_blur_phi = make_set(ctx, grid_blur_, BlurBindings{g.maps, g.tables, &e.grid_tmp, &e.mips});
+      e.grid_blur_rho = make_set(ctx, grid_blur_, BlurBindings{g.maps(), g.tables(), &e.mips, &e.grid_tmp});
+      e.grid_blur_phi = make_set(ctx, grid_blur_, BlurBindings{g.maps(), g.tables(), &e.grid_tmp, &e.mips});
     }
   }
 }

@@ -27,10 +27,12 @@ struct EyeGrid {
   bool polar = true;                   // φ-only mip chain (polar grids) or one level
   std::uint32_t width = 0, height = 0;  // the display raster the grid resolves to
   double max_pixels_per_deg = 0;        // the raster's densest pixels (bounds the blur's reach)
-  const GridMapping* mapping = nullptr;  // the host's copy of the mapping (GridMapping::current)
-  const gpu::Buffer* maps = nullptr;     // GridMapping::maps(), tables(), luts()
-  const gpu::Buffer* tables = nullptr;
-  const gpu::Buffer* luts = nullptr;
+  // The eye's grid mappings: the buffers the kernels bind, and the host's copy of the current
+  // one (GridMapping::current).
+  const GridMapping* mapping = nullptr;
+  const gpu::Buffer* maps() const { return &mapping->maps(); }
+  const gpu::Buffer* tables() const { return &mapping->tables(); }
+  const gpu::Buffer* luts() const { return &mapping->luts(); }
   // The path tracer's per-cell outputs (renderer::TraceOutputs) and the grid itself.
   const gpu::Buffer *samples = nullptr, *direct = nullptr, *indirect = nullptr, *normal_depth = nullptr,
                     *position_material = nullptr, *albedo = nullptr;
