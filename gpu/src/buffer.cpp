@@ -113,10 +113,11 @@ Buffer::Buffer(Context& ctx, const BufferDesc& desc) : ctx_(&ctx), size_(desc.si
   // An upload whose device-local memory is full goes to host memory: slower for its readers,
   // where failing would stop the frame. Taken before allocating when this context filled the
   // heap, and after a failed allocation when others did.
-  std::optional<std::uint32_t> fallback =
-      desc.memory == Memory::Upload && !desc.imported ? upload_fallback_type(ctx.memory_types(), req.memoryTypeBits, type)
-                                                      : std::nullopt;
-  if (fallback && ctx.memory_in_use(type) + req.size > ctx.memory_limit(type)) type = *std::exchange(fallback, std::nullopt);
+  std::optional<std::uint32_t> fallback;
+  if (desc.memory == Memory::Upload && !desc.imported)
+    fallback = upload_fallback_type(ctx.memory_types(), req.memoryTypeBits, type);
+  if (fallback && ctx.memory_in_use(type) + req.size > ctx.memory_limit(type))
+    type = *std::exchange(fallback, std::nullopt);
   VkMemoryAllocateInfo ai{VK_STRUCTURE_TYPE_MEMORY_ALLOCATE_INFO};
   ai.allocationSize = desc.imported ? desc.imported->allocation_size : req.size;
   ai.memoryTypeIndex = type;

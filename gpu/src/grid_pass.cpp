@@ -20,7 +20,8 @@ namespace {
 // the host, added to by one atomic per subgroup, read back once): device-local where the
 // device can map such memory.
 Buffer host_buffer(Context& ctx, VkDeviceSize bytes, BufferUsage usage, const char* name) {
-  return Buffer(ctx, {.size = std::max<VkDeviceSize>(bytes, 16), .usage = usage, .memory = Memory::Upload, .name = name});
+  return Buffer(ctx,
+                {.size = std::max<VkDeviceSize>(bytes, 16), .usage = usage, .memory = Memory::Upload, .name = name});
 }
 }  // namespace
 

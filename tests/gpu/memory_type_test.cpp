@@ -9,6 +9,8 @@
 #include <initializer_list>
 #include <optional>
 
+#include <gtest/gtest.h>
+
 #include "fovea/gpu/buffer.hpp"
 #include "fovea/gpu/memory_type.hpp"
 
