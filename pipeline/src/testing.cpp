@@ -163,7 +163,7 @@ ReconKernelTimes time_reconstruct(FramePipeline& pipeline, std::uint32_t frame) 
   const bool stereo = m.eyes.size() == 2;
   const bool fresh[2] = {true, true};
   m.write_mappings();
-  const std::array<bool, 2> unmoved = m.unmoved();
+  const std::array<bool, 2> unmoved{};  // as a moving view: reprojected (time_reconstruct)
   ReconKernelTimes t;
   t.accumulate = time([&](VkCommandBuffer cmd) {
     m.accumulation->record(cmd, p, history, std::span(fresh, m.eyes.size()), std::span(unmoved.data(), m.eyes.size()),

@@ -75,7 +75,9 @@ ResolveKernelTimes time_resolve(FramePipeline& p, bool blur);
 
 // Reconstructing the last frame again the same way, one submission per pass (Phase I
 // accumulation, stereo gather, BMFR fit — zero without BMFR —, Phase III, TAA), both eyes;
-// the history is the one the last frame read. For the BMFR chain benchmark.
+// the history is the one the last frame read. Always as for a moving view (the pipeline's
+// settings without this frame's motion, the grid reprojected), as a headset's frames run,
+// whatever the last frame's motion was. For the BMFR chain benchmark.
 struct ReconKernelTimes {
   KernelTime accumulate, share, fit, post, taa;
 };
