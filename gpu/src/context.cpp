@@ -143,6 +143,8 @@ Context::Context(const GivenDevice& given) : owns_device_(false) {
   physical_device_ = given.physical_device;
   device_ = given.device;
   queue_family_ = given.queue_family;
+  external_memory_fd_ = std::find(given.device_extensions.begin(), given.device_extensions.end(),
+                                  VK_KHR_EXTERNAL_MEMORY_FD_EXTENSION_NAME) != given.device_extensions.end();
   describe_device();
   vkGetDeviceQueue(device_, queue_family_, given.queue_index, &queue_);
   if (given.ray_query_features) note_ray_queries();

@@ -1,13 +1,14 @@
-// The layer's path-tracing renderer. Fovea's pipeline runs on its own thread and its own
-// compute context (gpu::Context creates its own VkInstance/VkDevice and queue, so the render
-// thread never touches the application's queue), and publishes each finished frame read back
-// and encoded in the application's format. xrEndFrame takes the newest finished frame,
-// reprojects it by rotation to the submitted view orientations and composites the
-// application's projection views over it (by depth when it chains usable depth) into the
-// layer's swapchains: by a compute pass on the application's device (the traced frame uploaded
-// once per traced frame, the application's images never leave the device), or, where that
-// device cannot or the configuration says so, on the host after reading the application's
-// images back.
+// The layer's path-tracing renderer. Fovea's pipeline runs on its own thread, on a compute
+// context of its own: on the application's VkDevice with a queue the layer added to it (in
+// lockstep, where the application waits for each frame, its session queue), else on a device
+// of the layer's own; the render thread never submits to the application's queue while the
+// application may. Each finished frame is encoded in the application's format into a slot of
+// the application's device memory (through the host only where that device cannot share it).
+// xrEndFrame takes the newest finished frame, reprojects it by rotation to the submitted view
+// orientations and composites the application's projection views over it (by depth when it
+// chains usable depth) into the layer's swapchains: by a compute pass on the application's
+// device (the application's images never leave the device), or, where that device cannot or
+// the configuration says so, on the host after reading the application's images back.
 #include "frame_renderer.hpp"
 
 #include <pthread.h>
@@ -37,6 +38,7 @@
 #include "composite.hpp"
 #include "fovea/core/clock.hpp"
 #include "fovea/core/display.hpp"
+#include "fovea/core/error.hpp"
 #include "fovea/core/eye_optics.hpp"
 #include "fovea/core/stereo_views.hpp"
 #include "fovea/gpu/context.hpp"
@@ -143,19 +145,19 @@ struct TracedFrame {
   RenderTimes times;
 };
 
-// The render thread's side: Fovea's pipeline on its own gpu::Context (its own VkDevice and
-// queue), created on the render thread so that the application's first frames do not wait
-// for the scene upload and shader setup either.
+// The render thread's side: Fovea's pipeline on its gpu::Context (make_context says where),
+// created on the render thread so that the application's first frames do not wait for the
+// scene upload and shader setup either.
 class PathTracer {
  public:
   // `slots`: the GPU composition's traced-frame slots, which finished frames are written into
   // (null: the host path, frames kept in host memory).
   // `masks`: the runtime's hidden area at the first frame, which the grids are laid out for.
   PathTracer(const LayerConfig& config, const renderer::Scene& scene, const core::StereoViews& views,
-             const core::DisplayPreset& display, VkFormat format, XrSession session, const AppDevice* slots,
-             const MaskSource& masks)
+             const core::DisplayPreset& display, VkFormat format, XrSession session, const VulkanBinding& vk,
+             const AppDevice* slots, const MaskSource& masks)
       : config_(config), format_(format), session_(session), slots_(slots),
-        gaze_(std::make_unique<LayerGaze>(config.gaze, display)), ctx_(make_context(slots, shared_)),
+        gaze_(std::make_unique<LayerGaze>(config.gaze, display)), ctx_(make_context(vk, slots)),
         // Imported before anything else can fail: the slots' descriptor is the writer's then.
         writer_(shared_ ? std::make_unique<SlotWriter>(
                               *ctx_, shared_->memory,
@@ -168,9 +170,12 @@ class PathTracer {
                                                         pipeline::FrameDriverOptions{config_.frame, false, false},
                                                         first_visibility(masks, views))) {
     shared_.reset();  // its descriptor is the imported memory's now
-    if (writer_) {
+    if (writer_ && on_app_device_) {
+      FOVEA_LAYER_INFO("hand-over: the application's device (the path tracer runs on it, on %s; each traced frame is "
+                       "encoded into the application's device memory, no host copy)", placement_.c_str());
+    } else if (writer_) {
       FOVEA_LAYER_INFO("hand-over: shared memory (the layer's device encodes each traced frame into the application's "
-                       "device memory, no host copy)");
+                       "device memory, no host copy; not on the application's device: %s)", placement_.c_str());
     } else if (slots) {
       FOVEA_LAYER_INFO("hand-over: through the host (read back, encoded, written into the application's device memory): %s",
                        slots->no_shared_slots().c_str());
@@ -234,7 +239,7 @@ class PathTracer {
       for (int e = 0; e < 2; ++e)
         eyes[std::size_t(e)] = {&p.screen_buffer(core::Eye(e)), f->has_depth ? &p.depth_buffer(core::Eye(e)) : nullptr};
       writer_->write(eyes, slot);
-      times.handover = "shared-memory";
+      times.handover = on_app_device_ ? "application-device" : "shared-memory";
       times.readback_cpu = ms_since(r0);
       return finish(std::move(f), in, t0);
     }
@@ -279,18 +284,47 @@ class PathTracer {
     return f;
   }
 
-  // The layer's device: on the application's physical device, importing its slots, where it
-  // exported them (the hand-over without the host); else the automatic choice.
-  static std::unique_ptr<gpu::Context> make_context(const AppDevice* slots, std::optional<AppDevice::SharedSlots>& shared) {
-    shared = slots ? slots->shared_slots() : std::nullopt;
-    if (!shared) return std::make_unique<gpu::Context>();
-    gpu::ContextOptions o;
-    o.device_uuid = shared->device_uuid;
-    o.external_memory_fd = true;
+  // The path tracer's device. Where the application's device exported the slots (the
+  // hand-over without the host): that device itself, on the queue the layer added to it, or,
+  // rendering in lockstep, on the session queue (every submission then happens while the
+  // application waits in xrEndFrame, where OpenXR lets a runtime use that queue); else a
+  // device of its own on the same physical device, importing them. Without an export, the
+  // automatic choice.
+  std::unique_ptr<gpu::Context> make_context(const VulkanBinding& vk, const AppDevice* slots) {
+    shared_ = slots ? slots->shared_slots() : std::nullopt;
+    if (!shared_) return std::make_unique<gpu::Context>();
     try {
+      gpu::GivenDevice given{vk.instance, vk.physical_device, vk.device};
+      given.instance_api_version = vk.instance_api_version;
+      given.device_extensions = vk.device_extensions;
+      if (vk.layer_queue) {
+        given.queue_family = vk.layer_queue->family;
+        given.queue_index = vk.layer_queue->index;
+        placement_ = "its own queue (family " + std::to_string(given.queue_family) + ", index " +
+                     std::to_string(given.queue_index) + ")";
+      } else if (config_.lockstep) {
+        given.queue_family = vk.queue_family;
+        given.queue_index = vk.queue_index;
+        placement_ = "the session queue, inside xrEndFrame (lockstep rendering; no queue of its own: " +
+                     vk.no_layer_queue + ")";
+      } else {
+        placement_ = "no queue of its own there (" + vk.no_layer_queue + ")";
+      }
+      if (vk.layer_queue || config_.lockstep) {
+        try {
+          auto ctx = std::make_unique<gpu::Context>(given);
+          on_app_device_ = true;
+          return ctx;
+        } catch (const core::InputError& e) {
+          placement_ = e.what();
+        }
+      }
+      gpu::ContextOptions o;
+      o.device_uuid = shared_->device_uuid;
+      o.external_memory_fd = true;
       return std::make_unique<gpu::Context>(o);
     } catch (...) {
-      close(shared->memory.fd);
+      close(shared_->memory.fd);
       throw;
     }
   }
@@ -336,6 +370,8 @@ class PathTracer {
   const XrSession session_;
   const AppDevice* slots_;
   std::optional<AppDevice::SharedSlots> shared_;  // the slots' memory until writer_ imports it
+  bool on_app_device_ = false;  // the path tracer runs on the application's VkDevice
+  std::string placement_;       // on which of its queues, or why not
   std::unique_ptr<LayerGaze> gaze_;
   bool gaze_from_action_ = false;
   std::optional<std::uint64_t> mask_generation_;  // of the mask fetched last (none yet)
@@ -366,7 +402,7 @@ class PathTraceRenderer final : public FrameRenderer {
  public:
   PathTraceRenderer(const LayerConfig& config, const VulkanBinding& vk, const Dispatch& next, XrSession session)
       : config_(config), next_(next), session_(session), scene_(renderer::load_scene(config.scene)),
-        vk_queue_family_(vk.queue_family), app_(vk) {
+        vk_(vk), app_(vk) {
     for (const auto& w : scene_.warnings) FOVEA_LAYER_WARN("scene %s: %s", config.scene.c_str(), w.c_str());
     // Tests slow the render thread down to show that the application never waits for it.
     if (const char* d = std::getenv("FOVEA_LAYER_TEST_RENDER_DELAY_MS")) test_delay_ = std::chrono::milliseconds(std::atoll(d));
@@ -462,7 +498,7 @@ class PathTraceRenderer final : public FrameRenderer {
                        render_priority_name(config_.render_priority).c_str(), failed.c_str());
     std::unique_ptr<PathTracer> tracer;
     try {
-      tracer = std::make_unique<PathTracer>(config_, scene_, views_in_, display_, format_, session_,
+      tracer = std::make_unique<PathTracer>(config_, scene_, views_in_, display_, format_, session_, vk_,
                                             app_.gpu_composition() ? &app_ : nullptr, first_masks_);
       for (;;) {
         TraceRequest req;
@@ -682,7 +718,7 @@ class PathTraceRenderer final : public FrameRenderer {
       try {
         app_.enable_gpu_composition(views_in_[core::Eye::Left].width(), views_in_[core::Eye::Left].height());
         FOVEA_LAYER_INFO("composition: on the GPU (a compute pass on the application's device, session queue family %u)",
-                         vk_queue_family_);
+                         vk_.queue_family);
       } catch (const std::exception& e) {
         FOVEA_LAYER_WARN("composition: on the host, the application's device cannot composite: %s", e.what());
       }
@@ -699,7 +735,7 @@ class PathTraceRenderer final : public FrameRenderer {
   MaskSource first_masks_;      // the runtime's hidden area as the first frame saw it
   core::DisplayPreset display_;
   VkFormat format_ = VK_FORMAT_UNDEFINED;
-  std::uint32_t vk_queue_family_ = 0;
+  const VulkanBinding vk_;  // the application's device, for the path tracer's placement
   std::chrono::milliseconds test_delay_{0};
 
   // The mailbox between the application's xrEndFrame and the render thread; held only to

@@ -1,8 +1,8 @@
 #pragma once
 // The path-tracing part of the layer. A FrameRenderer renders the configured scene foveated
-// for the views the application submitted (FramePipeline on Fovea's own compute context),
-// composites the application's pixels (composite.hpp), writes the result into layer-owned
-// swapchains and returns the frame that replaces the application's.
+// for the views the application submitted (FramePipeline on the application's device or the
+// layer's own), composites the application's pixels (composite.hpp), writes the result into
+// layer-owned swapchains and returns the frame that replaces the application's.
 #include <cstdint>
 #include <memory>
 #include <optional>
@@ -20,6 +20,7 @@
 #include "config.hpp"
 #include "fovea/pipeline/frame_pipeline.hpp"
 #include "gaze_input.hpp"
+#include "layer_queue.hpp"
 
 namespace fovea::layer {
 
@@ -36,6 +37,11 @@ struct VulkanBinding {
   // Otherwise why not, for the log.
   bool external_memory_fd = false;
   std::string no_external_memory = "the application created its Vulkan device itself (XR_KHR_vulkan_enable)";
+  // The path tracer's queue on `device` (the layer added it, vulkan_enable.cpp), else why none.
+  std::optional<QueueIndex> layer_queue;
+  std::string no_layer_queue = "the application created its Vulkan device itself (XR_KHR_vulkan_enable)";
+  std::uint32_t instance_api_version = 0;      // of `instance` (0: not known to the layer)
+  std::vector<std::string> device_extensions;  // enabled on `device`, as far as the layer knows
   bool valid() const { return device != VK_NULL_HANDLE; }
 };
 
@@ -97,7 +103,8 @@ struct RenderTimes {
   std::int64_t samples_traced = 0;  // grid cells traced, both eyes
   std::int64_t samples_hidden = 0;  // grid cells under the runtime's hidden area, both eyes: not traced
   // How the traced frame reached the application's device, and the bytes that crossed the
-  // host on the way: "shared-memory" (encoded by the layer's device into the GPU
+  // host on the way: "application-device" (traced on that device, encoded into the GPU
+  // composition's slot there: 0 bytes), "shared-memory" (encoded by the layer's device into the GPU
   // composition's slot, memory of the application's device it imported: 0 bytes),
   // "host-slot" (read back, encoded and written by the host into that slot) or "host" (read
   // back and encoded for the host composition, which uploads its result: those bytes are

@@ -138,6 +138,15 @@ struct InstanceState {
   bool timespec_hidden = false;
 };
 
+// What the layer added to a Vulkan device the runtime created for the application.
+struct VulkanDeviceRecord {
+  std::string no_external_memory;          // why VK_KHR_external_memory_fd is not enabled (empty: it is)
+  std::optional<QueueIndex> layer_queue;   // the path tracer's queue, added to the application's
+  std::string no_layer_queue;              // else why none
+  std::uint32_t instance_api_version = 0;  // of the instance the device was created on
+  std::vector<std::string> extensions;     // enabled on the device
+};
+
 struct Layer {
   std::mutex mutex;
   std::map<XrInstance, InstanceState> instances;
@@ -147,10 +156,10 @@ struct Layer {
   XrInstance last_instance = XR_NULL_HANDLE;  // dispatch for handles the layer does not know
   // The Vulkan objects the runtime created for the application through the layer
   // (XR_KHR_vulkan_enable2, vulkan_enable.cpp): the last instance and its API version, and
-  // per device why VK_KHR_external_memory_fd could not be enabled on it (empty: it was).
+  // per device what the layer added to it.
   VkInstance vulkan_instance = VK_NULL_HANDLE;
   std::uint32_t vulkan_instance_version = 0;
-  std::map<VkDevice, std::string> vulkan_devices;
+  std::map<VkDevice, VulkanDeviceRecord> vulkan_devices;
 };
 
 Layer& layer();

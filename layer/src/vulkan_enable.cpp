@@ -1,16 +1,19 @@
 // XR_KHR_vulkan_enable2's xrCreateVulkanInstanceKHR and xrCreateVulkanDeviceKHR: the runtime
 // creates the application's Vulkan objects, and the layer adds what the traced frames'
-// hand-over without the host needs (frame_renderer.hpp, slot_writer.hpp): Vulkan 1.1 on the
-// instance (external memory, dedicated allocations and device UUIDs are core there) and
-// VK_KHR_external_memory_fd on the device. Only when a scene is configured for the
-// application and its configuration keeps the shared hand-over; everything else is passed
-// down as the application gave it. An application written for Vulkan 1.0 runs unchanged on a
-// 1.1 instance; the added device extension changes nothing it does.
+// hand-over without the host needs (frame_renderer.hpp, slot_writer.hpp): Vulkan 1.2 on the
+// instance where the loader offers it (what the path tracer needs on the application's device;
+// at least 1.1: external memory, dedicated allocations and device UUIDs are core there),
+// VK_KHR_external_memory_fd on the device, and a queue for the path tracer where the device
+// has one to spare (layer_queue.hpp). Only when a scene is configured for the application and
+// its configuration keeps the shared hand-over; everything else is passed down as the
+// application gave it. An application written for Vulkan 1.0 runs unchanged on a newer
+// instance; the added device extension and queue change nothing it does.
 #include <cstring>
 #include <string>
 #include <vector>
 
 #include "layer.hpp"
+#include "layer_queue.hpp"
 #include "log.hpp"
 
 namespace fovea::layer {
@@ -83,7 +86,11 @@ XrResult intercept::xrCreateVulkanInstanceKHR(XrInstance instance, const XrVulka
       info->pfnGetInstanceProcAddr(VK_NULL_HANDLE, "vkEnumerateInstanceVersion"));
   std::uint32_t available = VK_API_VERSION_1_0;
   if (loader_version && loader_version(&available) != VK_SUCCESS) available = VK_API_VERSION_1_0;
-  if (version < VK_API_VERSION_1_1 && available >= VK_API_VERSION_1_1) version = VK_API_VERSION_1_1;
+  for (const std::uint32_t wanted : {VK_API_VERSION_1_2, VK_API_VERSION_1_1})
+    if (version < wanted && available >= wanted) {
+      version = wanted;
+      break;
+    }
   app.apiVersion = version;
   VkInstanceCreateInfo ci = *info->vulkanCreateInfo;
   ci.pApplicationInfo = &app;
@@ -127,13 +134,41 @@ XrResult intercept::xrCreateVulkanDeviceKHR(XrInstance instance, const XrVulkanD
   VkDeviceCreateInfo ci = given;
   ci.enabledExtensionCount = std::uint32_t(extensions.size());
   ci.ppEnabledExtensionNames = extensions.data();
+  // The path tracer's own queue on this device: it runs on the same memory as the
+  // application's composition, and hands frames over through that shared memory.
+  LayerQueueRequest queues;
+  if (!refusal.empty()) {
+    queues.no_queue = "no shared memory on the device (" + refusal + ")";
+  } else {
+    const auto family_properties = reinterpret_cast<PFN_vkGetPhysicalDeviceQueueFamilyProperties>(
+        info->pfnGetInstanceProcAddr(vk, "vkGetPhysicalDeviceQueueFamilyProperties"));
+    std::uint32_t n = 0;
+    if (family_properties) family_properties(info->vulkanPhysicalDevice, &n, nullptr);
+    std::vector<VkQueueFamilyProperties> families(n);
+    if (n > 0) family_properties(info->vulkanPhysicalDevice, &n, families.data());
+    families.resize(n);
+    queues = request_layer_queue(families, given.pQueueCreateInfos, given.queueCreateInfoCount);
+    ci.queueCreateInfoCount = std::uint32_t(queues.infos.size());
+    ci.pQueueCreateInfos = queues.infos.data();
+  }
   XrVulkanDeviceCreateInfoKHR changed = *info;
   changed.vulkanCreateInfo = &ci;
   const XrResult r = next(instance, &changed, vk_device, vk_result);
   if (XR_SUCCEEDED(r) && *vk_result == VK_SUCCESS) {
     if (!refusal.empty()) FOVEA_LAYER_INFO("traced frames will cross the host: %s", refusal.c_str());
+    if (queues.queue)
+      FOVEA_LAYER_INFO("a queue of the application's device for the path tracer: family %u, index %u",
+                       queues.queue->family, queues.queue->index);
+    else
+      FOVEA_LAYER_INFO("no queue of the application's device for the path tracer: %s", queues.no_queue.c_str());
+    VulkanDeviceRecord record;
+    record.no_external_memory = refusal;
+    record.layer_queue = queues.queue;
+    record.no_layer_queue = queues.no_queue;
+    record.instance_api_version = version;
+    record.extensions.assign(extensions.begin(), extensions.end());
     std::lock_guard lock(layer().mutex);
-    layer().vulkan_devices[*vk_device] = refusal;
+    layer().vulkan_devices[*vk_device] = std::move(record);
   }
   return r;
 }

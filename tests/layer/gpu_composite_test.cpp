@@ -14,6 +14,8 @@
 #include <string>
 #include <vector>
 
+#include <unistd.h>
+
 #include <gtest/gtest.h>
 
 #include "app_device.hpp"
@@ -450,11 +452,12 @@ TEST_F(GpuComposite, RecordsOncePerImagesAndWaitsOnlyForPassesOnTheImage) {
 
 // The hand-over without the host: the slots are memory of the application's device (a device
 // of its own here, with VK_KHR_external_memory_fd, standing in for one the runtime created
-// through the layer), exported and imported into the layer's device (another VkDevice of the
-// same physical device, chosen by UUID), where SlotWriter encodes linear frames, extreme values
-// included, as encode_scene does on the host and copies their depths; the application's
-// composition pass reads what was written. Both devices validated, no validation message.
-TEST_F(GpuComposite, SharedSlotsHandTheFrameOverWithoutTheHost) {
+// through the layer), exported and imported by the path tracer's device: another VkDevice of
+// the same physical device, chosen by UUID, or the application's device itself, adopted
+// (gpu::GivenDevice), as the layer runs where it has a queue there. SlotWriter encodes linear
+// frames, extreme values included, as encode_scene does on the host and copies their depths;
+// the application's composition pass reads what was written. Validated, no validation message.
+void hand_over_through_shared_slots(bool on_app_device) {
   constexpr int W = 24, H = 20;
   const std::size_t px = std::size_t(W) * H;
   gpu::ContextOptions app_options;
@@ -482,11 +485,23 @@ TEST_F(GpuComposite, SharedSlotsHandTheFrameOverWithoutTheHost) {
   std::optional<AppDevice::SharedSlots> shared = dev.shared_slots();
   ASSERT_TRUE(shared.has_value()) << dev.no_shared_slots();
   EXPECT_THROW(dev.slot_colour(0, 0), std::logic_error);  // nothing for the host to write
-  gpu::ContextOptions layer_options;
-  layer_options.validation = true;
-  layer_options.device_uuid = shared->device_uuid;
-  layer_options.external_memory_fd = true;
-  gpu::Context layer_ctx(layer_options);
+  close(shared->memory.fd);
+  std::unique_ptr<gpu::Context> path_tracer;
+  if (on_app_device) {
+    // One thread here: the test's submissions never overlap on the one queue.
+    gpu::GivenDevice given{app.instance(), app.physical_device(), app.device(), app.queue_family(), 0};
+    given.instance_api_version = VK_API_VERSION_1_2;
+    given.device_extensions = {VK_KHR_EXTERNAL_MEMORY_FD_EXTENSION_NAME};
+    path_tracer = std::make_unique<gpu::Context>(given);
+  } else {
+    gpu::ContextOptions layer_options;
+    layer_options.validation = true;
+    layer_options.device_uuid = shared->device_uuid;
+    layer_options.external_memory_fd = true;
+    path_tracer = std::make_unique<gpu::Context>(layer_options);
+  }
+  gpu::Context& layer_ctx = *path_tracer;
+  EXPECT_EQ(layer_ctx.device() == app.device(), on_app_device);
   const int slots = dev.traced_slots()->slots();
   // What the slots hold, read on the layer's device through a second import of the memory.
   std::optional<AppDevice::SharedSlots> probe_memory = dev.shared_slots();
@@ -553,6 +568,9 @@ TEST_F(GpuComposite, SharedSlotsHandTheFrameOverWithoutTheHost) {
   EXPECT_EQ(app.validation_errors(), 0);
   EXPECT_EQ(layer_ctx.validation_errors(), 0);
 }
+
+TEST_F(GpuComposite, SharedSlotsHandTheFrameOverWithoutTheHost) { hand_over_through_shared_slots(false); }
+TEST_F(GpuComposite, SlotsHandTheFrameOverOnTheApplicationsDevice) { hand_over_through_shared_slots(true); }
 
 }  // namespace
 }  // namespace fovea::layer

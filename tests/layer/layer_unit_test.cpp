@@ -8,6 +8,7 @@
 #include <fstream>
 #include <limits>
 #include <thread>
+#include <tuple>
 #include <vector>
 
 #include <gtest/gtest.h>
@@ -20,6 +21,7 @@
 #include "frame_log.hpp"
 #include "frame_queue.hpp"
 #include "gaze_input.hpp"
+#include "layer_queue.hpp"
 #include "next_chain.hpp"
 #include "traced_slots.hpp"
 
@@ -569,6 +571,79 @@ TEST(FrameConfigLayer, EnvironmentTakesTheSameOptions) {
     EXPECT_NE(std::string(e.what()).find("FOVEA_LAYER_DENOISER: unknown \"neural\""), std::string::npos) << e.what();
   }
   for (const char* v : {"FOVEA_LAYER_BUDGET", "FOVEA_LAYER_STEREO_SHARE", "FOVEA_LAYER_DENOISER"}) unsetenv(v);
+}
+
+// The path tracer's queue on the application's device, for the queue families of common
+// drivers (NVIDIA: 16 graphics, 2 transfer, 8 compute; RADV: 1 graphics, 4 compute; lavapipe:
+// 1 of everything) and the requests an application makes.
+VkQueueFamilyProperties family(VkQueueFlags flags, std::uint32_t count) {
+  VkQueueFamilyProperties f{};
+  f.queueFlags = flags;
+  f.queueCount = count;
+  return f;
+}
+VkDeviceQueueCreateInfo queues(std::uint32_t family, std::uint32_t count, const float* priorities,
+                               VkDeviceQueueCreateFlags flags = 0) {
+  VkDeviceQueueCreateInfo q{VK_STRUCTURE_TYPE_DEVICE_QUEUE_CREATE_INFO};
+  q.flags = flags;
+  q.queueFamilyIndex = family;
+  q.queueCount = count;
+  q.pQueuePriorities = priorities;
+  return q;
+}
+
+TEST(LayerQueue, AsynchronousComputeFamilyFirstThenASpareQueueElseWhyNot) {
+  constexpr VkQueueFlags G = VK_QUEUE_GRAPHICS_BIT | VK_QUEUE_COMPUTE_BIT | VK_QUEUE_TRANSFER_BIT;
+  constexpr VkQueueFlags C = VK_QUEUE_COMPUTE_BIT | VK_QUEUE_TRANSFER_BIT, T = VK_QUEUE_TRANSFER_BIT;
+  const std::vector<VkQueueFamilyProperties> nvidia{family(G, 16), family(T, 2), family(C, 8)};
+  const std::vector<VkQueueFamilyProperties> radv{family(G, 1), family(C, 4)};
+  const std::vector<VkQueueFamilyProperties> lavapipe{family(G, 1)};
+  const float app_priorities[] = {1.0f, 0.5f};
+
+  // The graphics queue the application renders with: the compute family beside it.
+  const VkDeviceQueueCreateInfo graphics = queues(0, 1, app_priorities);
+  for (const auto* families : {&nvidia, &radv}) {
+    const LayerQueueRequest r = request_layer_queue(*families, &graphics, 1);
+    ASSERT_TRUE(r.queue.has_value()) << r.no_queue;
+    EXPECT_EQ(*r.queue, (QueueIndex{std::uint32_t(families->size() - 1), 0}));
+    ASSERT_EQ(r.infos.size(), 2u);
+    EXPECT_EQ(r.infos[0].queueCount, 1u);  // the application's request unchanged
+    EXPECT_EQ(r.infos[0].pQueuePriorities, app_priorities);
+    EXPECT_EQ(r.infos[1].queueFamilyIndex, r.queue->family);
+    EXPECT_EQ(r.infos[1].queueCount, 1u);
+    EXPECT_EQ(r.infos[1].pQueuePriorities[0], 0.0f);
+  }
+  // Every compute-capable family in use: one more queue of the first with a queue to spare,
+  // the application's priorities kept.
+  const VkDeviceQueueCreateInfo both[] = {queues(0, 2, app_priorities), queues(2, 8, app_priorities)};
+  LayerQueueRequest r = request_layer_queue(nvidia, both, 2);
+  ASSERT_TRUE(r.queue.has_value()) << r.no_queue;
+  EXPECT_EQ(*r.queue, (QueueIndex{0, 2}));
+  ASSERT_EQ(r.infos.size(), 2u);
+  EXPECT_EQ(r.infos[0].queueCount, 3u);
+  EXPECT_EQ(r.infos[0].pQueuePriorities[0], 1.0f);
+  EXPECT_EQ(r.infos[0].pQueuePriorities[1], 0.5f);
+  EXPECT_EQ(r.infos[0].pQueuePriorities[2], 0.0f);
+  EXPECT_EQ(r.infos[1].queueCount, 8u);
+  // No queue to spare: the request unchanged, and why.
+  const VkDeviceQueueCreateInfo radv_all[] = {queues(0, 1, app_priorities), queues(1, 4, app_priorities)};
+  for (const auto& [families, request, count] :
+       {std::tuple{&lavapipe, &graphics, 1u}, std::tuple{&radv, radv_all, 2u}}) {
+    r = request_layer_queue(*families, request, count);
+    EXPECT_FALSE(r.queue.has_value());
+    ASSERT_EQ(r.infos.size(), count);
+    for (std::uint32_t i = 0; i < count; ++i) EXPECT_EQ(r.infos[i].queueCount, request[i].queueCount);
+    EXPECT_NE(r.no_queue.find("the application asks for every queue"), std::string::npos) << r.no_queue;
+    EXPECT_NE(r.no_queue.find("family 0: 1 of 1"), std::string::npos) << r.no_queue;
+  }
+  // A family with protected queues is the application's alone; none without compute at all.
+  const VkDeviceQueueCreateInfo protected_compute[] = {
+      queues(0, 1, app_priorities), queues(1, 1, app_priorities, VK_DEVICE_QUEUE_CREATE_PROTECTED_BIT)};
+  r = request_layer_queue(radv, protected_compute, 2);
+  EXPECT_FALSE(r.queue.has_value());
+  r = request_layer_queue({family(T, 2)}, nullptr, 0);
+  EXPECT_FALSE(r.queue.has_value());
+  EXPECT_NE(r.no_queue.find("no compute-capable queue family"), std::string::npos) << r.no_queue;
 }
 
 }  // namespace

@@ -58,7 +58,9 @@ struct GivenDevice {
   std::uint32_t queue_family = 0;
   std::uint32_t queue_index = 0;
   std::uint32_t instance_api_version = VK_API_VERSION_1_0;  // VkApplicationInfo::apiVersion of the instance
-  std::vector<std::string> device_extensions;                // enabled on `device`
+  // Enabled on `device`; with VK_KHR_external_memory_fd among them the Context imports memory
+  // (BufferDesc::imported), also memory this same device exported.
+  std::vector<std::string> device_extensions;
   // accelerationStructure, rayQuery and bufferDeviceAddress were enabled (with the three
   // extensions): the path tracer may use ray queries.
   bool ray_query_features = false;
@@ -135,7 +137,7 @@ class Context {
   explicit Context(const GivenDevice& given);
   ~Context();
   bool owns_device() const { return owns_device_; }
-  bool external_memory_fd() const { return external_memory_fd_; }  // ContextOptions::external_memory_fd
+  bool external_memory_fd() const { return external_memory_fd_; }  // ContextOptions::external_memory_fd, or given
   Context(const Context&) = delete;
   Context& operator=(const Context&) = delete;
 
