@@ -50,10 +50,11 @@ struct LayerConfig {
   // "compositor": "gpu" (true): a compute pass on the application's device, the host path
   // when that device cannot run it; "host" (false): always the host round trip.
   bool gpu_compositor = true;
-  // "handover": "shared" (true): the GPU composition's traced frames are written by the
-  // layer's device into memory it imports from the application's device, when the runtime
-  // created that device through the layer (XR_KHR_vulkan_enable2: the layer enables
-  // VK_KHR_external_memory_fd on it); "host" (false): read back and written by the host.
+  // "handover": "shared" (true): the GPU composition's traced frames are written by the path
+  // tracer, on the application's device or the layer's own, into memory it imports from the
+  // application's device, when the runtime created that device through the layer
+  // (XR_KHR_vulkan_enable2: the layer enables VK_KHR_external_memory_fd on it and adds the
+  // path tracer's queue where it can); "host" (false): read back and written by the host.
   bool shared_handover = true;
   // "render_priority": a nice value 0..19 (SCHED_OTHER; default 19) or "idle" (SCHED_IDLE) for the render
   // thread and the threads of the device it creates (Linux threads inherit both), so that on a
