@@ -38,7 +38,8 @@ namespace {
 constexpr const char* kVariables[] = {"XR_API_LAYER_PATH", "XR_ENABLE_API_LAYERS", "FOVEA_LAYER_OUT",
                                       "FOVEA_LAYER_LOG_FILE", "FOVEA_SCENE", "FOVEA_LAYER_SCENE",
                                       "XDG_CONFIG_HOME", "FOVEA_LAYER_RENDER", "FOVEA_LAYER_TEST_RENDER_DELAY_MS",
-                                      "FOVEA_LAYER_COMPOSITOR", "FOVEA_LAYER_RENDER_PRIORITY", "FOVEA_LAYER_HANDOVER"};
+                                      "FOVEA_LAYER_COMPOSITOR", "FOVEA_LAYER_RENDER_PRIORITY", "FOVEA_LAYER_HANDOVER",
+                                      "VK_ADD_LAYER_PATH", "VK_INSTANCE_LAYERS"};
 
 // A thread of this process as /proc/self/task/<tid>/stat shows it.
 struct ThreadInfo {
@@ -77,7 +78,9 @@ std::vector<nlohmann::json> records(const std::string& file) {
   return out;
 }
 
-// The parameter: how the traced frame reaches the application: "shared-memory" (the GPU
+// The parameter: how the traced frame reaches the application: "application-device" (the GPU
+// composition, the path tracer on the application's device with a queue of its own: lavapipe
+// gets a spare queue from tests/layer/spare_queue_layer.cpp), "shared-memory" (the GPU
 // composition, the slots written by the layer's device), "host-slot" (the GPU composition,
 // FOVEA_LAYER_HANDOVER=host) or "host" (FOVEA_LAYER_COMPOSITOR=host).
 class AsyncLayer : public XrTest, public ::testing::WithParamInterface<const char*> {
@@ -96,7 +99,12 @@ class AsyncLayer : public XrTest, public ::testing::WithParamInterface<const cha
     unsetenv("FOVEA_LAYER_RENDER_PRIORITY");  // the default: nice 19
     const std::string handover = GetParam();
     setenv("FOVEA_LAYER_COMPOSITOR", handover == "host" ? "host" : "gpu", 1);
-    setenv("FOVEA_LAYER_HANDOVER", handover == "shared-memory" ? "shared" : "host", 1);
+    const bool shared = handover == "shared-memory" || handover == "application-device";
+    setenv("FOVEA_LAYER_HANDOVER", shared ? "shared" : "host", 1);
+    if (handover == "application-device") {
+      setenv("VK_ADD_LAYER_PATH", FOVEA_TEST_SPARE_QUEUE_DIR, 1);
+      setenv("VK_INSTANCE_LAYERS", "VK_LAYER_FOVEA_test_spare_queue", 1);
+    }
     // Far slower than a frame interval: the application must not notice.
     setenv("FOVEA_LAYER_TEST_RENDER_DELAY_MS", "700", 1);
   }
@@ -235,9 +243,12 @@ TEST_P(AsyncLayer, PipelinedFramesOnTwoThreadsNeverWaitForTheRenderThread) {
       << log;
   EXPECT_EQ(log.find("internal failure"), std::string::npos) << log;
   if (gpu) {
-    EXPECT_NE(log.find(handover == "shared-memory" ? "hand-over: shared memory" : "hand-over: through the host"),
-              std::string::npos)
-        << log;
+    const char* expected = handover == "application-device"
+                               ? "hand-over: the application's device (the path tracer runs on it, on its own queue "
+                                 "(family 0, index 1)"
+                           : handover == "shared-memory" ? "hand-over: shared memory"
+                                                         : "hand-over: through the host";
+    EXPECT_NE(log.find(expected), std::string::npos) << log;
     if (handover == "host-slot") {  // and why: the configuration asked for it
       EXPECT_NE(log.find("configured (\"handover\": \"host\")"), std::string::npos) << log;
     }
@@ -282,7 +293,9 @@ TEST_P(AsyncLayer, PipelinedFramesOnTwoThreadsNeverWaitForTheRenderThread) {
   }
   EXPECT_GE(render, 1);
   EXPECT_EQ(log_writer, 1);
-  if (app_device > 0) {  // lavapipe: as many rasteriser threads per device, compute workers too
+  if (app_device > 0 && handover == "application-device") {
+    EXPECT_EQ(render_device, 0) << "the path tracer made no device of its own";
+  } else if (app_device > 0) {  // lavapipe: as many rasteriser threads per device, compute workers too
     EXPECT_EQ(render_device, app_device) << "one device's rasteriser threads each";
     EXPECT_GT(render, 1) << "the render device's compute workers";
   }
@@ -343,7 +356,7 @@ TEST_P(AsyncLayer, PipelinedFramesOnTwoThreadsNeverWaitForTheRenderThread) {
     // How the traced frame got there, and the bytes it moved through the host: none when the
     // layer's device wrote it into the application's device memory (docs/openxr.md).
     EXPECT_EQ(r["handover"], handover) << r.dump();
-    if (handover == "shared-memory") {
+    if (handover == "shared-memory" || handover == "application-device") {
       EXPECT_EQ(r["host_bytes"].get<std::int64_t>(), 0) << r.dump();
     } else {
       // Per eye the linear colour read back (RGBA32F) and written encoded (RGBA8), and no
@@ -366,7 +379,8 @@ TEST_P(AsyncLayer, PipelinedFramesOnTwoThreadsNeverWaitForTheRenderThread) {
   EXPECT_GT(replaced, 0);
 }
 
-INSTANTIATE_TEST_SUITE_P(Handover, AsyncLayer, ::testing::Values("shared-memory", "host-slot", "host"),
+INSTANTIATE_TEST_SUITE_P(Handover, AsyncLayer,
+                         ::testing::Values("application-device", "shared-memory", "host-slot", "host"),
                          [](const ::testing::TestParamInfo<const char*>& info) {
                            std::string name = info.param;
                            for (char& c : name) c = c == '-' ? '_' : c;
