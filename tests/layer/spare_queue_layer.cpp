@@ -5,6 +5,7 @@
 // (layer/src/layer_queue.hpp); with it that path runs here, on the same driver. Enabled by
 // VK_INSTANCE_LAYERS (above the validation layer an application enables, which sees only the
 // driver's queues, used under the lock).
+#include <algorithm>
 #include <cstring>
 #include <map>
 #include <memory>
@@ -64,7 +65,8 @@ Fn queue_fn(VkQueue q, const char* name, QueueRecord& out) {
 VKAPI_ATTR VkResult VKAPI_CALL CreateInstance(const VkInstanceCreateInfo* ci, const VkAllocationCallbacks* a,
                                               VkInstance* out) {
   auto* link = static_cast<const VkLayerInstanceCreateInfo*>(ci->pNext);
-  while (link && !(link->sType == VK_STRUCTURE_TYPE_LOADER_INSTANCE_CREATE_INFO && link->function == VK_LAYER_LINK_INFO))
+  while (link &&
+         !(link->sType == VK_STRUCTURE_TYPE_LOADER_INSTANCE_CREATE_INFO && link->function == VK_LAYER_LINK_INFO))
     link = static_cast<const VkLayerInstanceCreateInfo*>(link->pNext);
   if (!link) return VK_ERROR_INITIALIZATION_FAILED;
   const PFN_vkGetInstanceProcAddr next = link->u.pLayerInfo->pfnNextGetInstanceProcAddr;
@@ -93,22 +95,26 @@ Instance instance_of(const void* dispatchable) {
   return g_instances.at(key(dispatchable));
 }
 
+std::uint32_t& count_of(VkQueueFamilyProperties& f) { return f.queueCount; }
+std::uint32_t& count_of(VkQueueFamilyProperties2& f) { return f.queueFamilyProperties.queueCount; }
+
+// The driver's families, each with its spare queue.
+template <class Fn, class Props>
+void family_properties(const char* name, VkPhysicalDevice p, std::uint32_t* n, Props* props) {
+  const Instance in = instance_of(p);
+  reinterpret_cast<Fn>(in.next(in.handle, name))(p, n, props);
+  if (props)
+    for (std::uint32_t i = 0; i < *n; ++i) ++count_of(props[i]);
+}
 VKAPI_ATTR void VKAPI_CALL GetPhysicalDeviceQueueFamilyProperties(VkPhysicalDevice p, std::uint32_t* n,
                                                                   VkQueueFamilyProperties* props) {
-  const Instance in = instance_of(p);
-  reinterpret_cast<PFN_vkGetPhysicalDeviceQueueFamilyProperties>(
-      in.next(in.handle, "vkGetPhysicalDeviceQueueFamilyProperties"))(p, n, props);
-  if (props)
-    for (std::uint32_t i = 0; i < *n; ++i) ++props[i].queueCount;
+  family_properties<PFN_vkGetPhysicalDeviceQueueFamilyProperties>("vkGetPhysicalDeviceQueueFamilyProperties", p, n,
+                                                                   props);
 }
-
 VKAPI_ATTR void VKAPI_CALL GetPhysicalDeviceQueueFamilyProperties2(VkPhysicalDevice p, std::uint32_t* n,
                                                                    VkQueueFamilyProperties2* props) {
-  const Instance in = instance_of(p);
-  reinterpret_cast<PFN_vkGetPhysicalDeviceQueueFamilyProperties2>(
-      in.next(in.handle, "vkGetPhysicalDeviceQueueFamilyProperties2"))(p, n, props);
-  if (props)
-    for (std::uint32_t i = 0; i < *n; ++i) ++props[i].queueFamilyProperties.queueCount;
+  family_properties<PFN_vkGetPhysicalDeviceQueueFamilyProperties2>("vkGetPhysicalDeviceQueueFamilyProperties2", p, n,
+                                                                    props);
 }
 
 VKAPI_ATTR VkResult VKAPI_CALL CreateDevice(VkPhysicalDevice p, const VkDeviceCreateInfo* ci,
@@ -132,7 +138,7 @@ VKAPI_ATTR VkResult VKAPI_CALL CreateDevice(VkPhysicalDevice p, const VkDeviceCr
   auto dev = std::make_unique<Device>();
   for (VkDeviceQueueCreateInfo& q : queues)
     if (q.queueFamilyIndex < nf) {
-      if (q.queueCount > families[q.queueFamilyIndex].queueCount) q.queueCount = families[q.queueFamilyIndex].queueCount;
+      q.queueCount = std::min(q.queueCount, families[q.queueFamilyIndex].queueCount);
       dev->created[q.queueFamilyIndex] = q.queueCount;
     }
   VkDeviceCreateInfo changed = *ci;
@@ -261,24 +267,41 @@ VKAPI_ATTR VkResult VKAPI_CALL SetDebugUtilsObjectNameEXT(VkDevice d, const VkDe
   return fn(d, info);
 }
 
-PFN_vkVoidFunction device_command(const char* name) {
-  static const std::pair<const char*, PFN_vkVoidFunction> kCommands[] = {
-      {"vkGetDeviceQueue", reinterpret_cast<PFN_vkVoidFunction>(GetDeviceQueue)},
-      {"vkGetDeviceQueue2", reinterpret_cast<PFN_vkVoidFunction>(GetDeviceQueue2)},
-      {"vkDestroyDevice", reinterpret_cast<PFN_vkVoidFunction>(DestroyDevice)},
-      {"vkQueueSubmit", reinterpret_cast<PFN_vkVoidFunction>(QueueSubmit)},
-      {"vkQueueSubmit2", reinterpret_cast<PFN_vkVoidFunction>(QueueSubmit2)},
-      {"vkQueueSubmit2KHR", reinterpret_cast<PFN_vkVoidFunction>(QueueSubmit2)},
-      {"vkQueueWaitIdle", reinterpret_cast<PFN_vkVoidFunction>(QueueWaitIdle)},
-      {"vkQueueBindSparse", reinterpret_cast<PFN_vkVoidFunction>(QueueBindSparse)},
-      {"vkQueueBeginDebugUtilsLabelEXT", reinterpret_cast<PFN_vkVoidFunction>(QueueBeginDebugUtilsLabelEXT)},
-      {"vkQueueEndDebugUtilsLabelEXT", reinterpret_cast<PFN_vkVoidFunction>(QueueEndDebugUtilsLabelEXT)},
-      {"vkQueueInsertDebugUtilsLabelEXT", reinterpret_cast<PFN_vkVoidFunction>(QueueInsertDebugUtilsLabelEXT)},
-      {"vkSetDebugUtilsObjectNameEXT", reinterpret_cast<PFN_vkVoidFunction>(SetDebugUtilsObjectNameEXT)},
-  };
-  for (const auto& [n, fn] : kCommands)
+using Command = std::pair<const char*, PFN_vkVoidFunction>;
+template <class Fn>
+Command command(const char* name, Fn fn) {
+  return {name, reinterpret_cast<PFN_vkVoidFunction>(fn)};
+}
+template <std::size_t N>
+PFN_vkVoidFunction find(const Command (&commands)[N], const char* name) {
+  for (const auto& [n, fn] : commands)
     if (!std::strcmp(n, name)) return fn;
   return nullptr;
+}
+
+PFN_vkVoidFunction device_command(const char* name) {
+  static const Command kCommands[] = {
+      command("vkGetDeviceQueue", GetDeviceQueue),
+      command("vkGetDeviceQueue2", GetDeviceQueue2),
+      command("vkDestroyDevice", DestroyDevice),
+      command("vkQueueSubmit", QueueSubmit),
+      command("vkQueueSubmit2", QueueSubmit2),
+      command("vkQueueSubmit2KHR", QueueSubmit2),
+      command("vkQueueWaitIdle", QueueWaitIdle),
+      command("vkQueueBindSparse", QueueBindSparse),
+      command("vkQueueBeginDebugUtilsLabelEXT", QueueBeginDebugUtilsLabelEXT),
+      command("vkQueueEndDebugUtilsLabelEXT", QueueEndDebugUtilsLabelEXT),
+      command("vkQueueInsertDebugUtilsLabelEXT", QueueInsertDebugUtilsLabelEXT),
+      command("vkSetDebugUtilsObjectNameEXT", SetDebugUtilsObjectNameEXT),
+  };
+  return find(kCommands, name);
+}
+
+// This layer's command where the chain below offers `name` (`next`): a command the driver
+// lacks stays absent.
+PFN_vkVoidFunction over(PFN_vkVoidFunction next, const char* name) {
+  const PFN_vkVoidFunction mine = next ? device_command(name) : nullptr;
+  return mine ? mine : next;
 }
 
 VKAPI_ATTR PFN_vkVoidFunction VKAPI_CALL GetDeviceProcAddr(VkDevice d, const char* name) {
@@ -288,34 +311,24 @@ VKAPI_ATTR PFN_vkVoidFunction VKAPI_CALL GetDeviceProcAddr(VkDevice d, const cha
     const Device& dev = *g_devices.at(key(d));
     next = dev.next(dev.handle, name);
   }
-  // Only what the driver chain offers: a command it lacks stays absent.
-  if (!next) return nullptr;
-  const PFN_vkVoidFunction mine = device_command(name);
-  return mine ? mine : next;
+  return over(next, name);
 }
 
 VKAPI_ATTR PFN_vkVoidFunction VKAPI_CALL GetInstanceProcAddr(VkInstance instance, const char* name) {
-  static const std::pair<const char*, PFN_vkVoidFunction> kCommands[] = {
-      {"vkGetInstanceProcAddr", reinterpret_cast<PFN_vkVoidFunction>(GetInstanceProcAddr)},
-      {"vkGetDeviceProcAddr", reinterpret_cast<PFN_vkVoidFunction>(GetDeviceProcAddr)},
-      {"vkCreateInstance", reinterpret_cast<PFN_vkVoidFunction>(CreateInstance)},
-      {"vkDestroyInstance", reinterpret_cast<PFN_vkVoidFunction>(DestroyInstance)},
-      {"vkCreateDevice", reinterpret_cast<PFN_vkVoidFunction>(CreateDevice)},
-      {"vkGetPhysicalDeviceQueueFamilyProperties",
-       reinterpret_cast<PFN_vkVoidFunction>(GetPhysicalDeviceQueueFamilyProperties)},
-      {"vkGetPhysicalDeviceQueueFamilyProperties2",
-       reinterpret_cast<PFN_vkVoidFunction>(GetPhysicalDeviceQueueFamilyProperties2)},
-      {"vkGetPhysicalDeviceQueueFamilyProperties2KHR",
-       reinterpret_cast<PFN_vkVoidFunction>(GetPhysicalDeviceQueueFamilyProperties2)},
+  static const Command kCommands[] = {
+      command("vkGetInstanceProcAddr", GetInstanceProcAddr),
+      command("vkGetDeviceProcAddr", GetDeviceProcAddr),
+      command("vkCreateInstance", CreateInstance),
+      command("vkDestroyInstance", DestroyInstance),
+      command("vkCreateDevice", CreateDevice),
+      command("vkGetPhysicalDeviceQueueFamilyProperties", GetPhysicalDeviceQueueFamilyProperties),
+      command("vkGetPhysicalDeviceQueueFamilyProperties2", GetPhysicalDeviceQueueFamilyProperties2),
+      command("vkGetPhysicalDeviceQueueFamilyProperties2KHR", GetPhysicalDeviceQueueFamilyProperties2),
   };
-  for (const auto& [n, fn] : kCommands)
-    if (!std::strcmp(n, name)) return fn;
+  if (const PFN_vkVoidFunction mine = find(kCommands, name)) return mine;
   if (instance == VK_NULL_HANDLE) return nullptr;
   const Instance in = instance_of(instance);
-  const PFN_vkVoidFunction next = in.next(in.handle, name);
-  if (!next) return nullptr;
-  const PFN_vkVoidFunction mine = device_command(name);
-  return mine ? mine : next;
+  return over(in.next(in.handle, name), name);
 }
 
 }  // namespace
