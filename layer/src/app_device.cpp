@@ -93,8 +93,8 @@ AppDevice::AppDevice(const VulkanBinding& vk) : device_(vk.device), queue_family
   }
   get_device_proc_ = gdpa;
   physical_device_ = vk.physical_device;
-  no_shared_ = vk.no_external_memory;
-  if (vk.external_memory_fd) {
+  no_shared_ = vk.added.no_external_memory;
+  if (vk.external_memory_fd()) {
     // The instance is Vulkan 1.1 or later here (vulkan_enable.cpp raised it): the device's
     // UUID, for the layer's device to be made on the same physical device.
     const auto props2 = reinterpret_cast<PFN_vkGetPhysicalDeviceProperties2>(

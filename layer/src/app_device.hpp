@@ -74,7 +74,7 @@ class AppDevice {
   // `traced_width` x `traced_height` per eye in host-visible memory of this device; throws
   // std::runtime_error with the reason when the device cannot run it (the session queue's
   // family has no compute, no memory type).
-  // With VK_KHR_external_memory_fd on the device (VulkanBinding::external_memory_fd) the slots
+  // With VK_KHR_external_memory_fd on the device (VulkanBinding::external_memory_fd()) the slots
   // are exportable device memory instead (shared_slots(); slot_colour and slot_depth then
   // throw), unless the export fails: shared_slots() is empty then, and no_shared_slots() says why.
   void enable_gpu_composition(int traced_width, int traced_height, int slots = 3);
@@ -186,7 +186,7 @@ class AppDevice {
   Buffer download_, upload_;
   VkPhysicalDeviceMemoryProperties memory_{};
   VkDeviceSize storage_alignment_ = 256;  // minStorageBufferOffsetAlignment
-  // The shared path (VulkanBinding::external_memory_fd): the device's UUID and its export.
+  // The shared path (VulkanBinding::external_memory_fd()): the device's UUID and its export.
   bool external_memory_ = false;
   std::string no_shared_;
   std::array<std::uint8_t, VK_UUID_SIZE> device_uuid_{};

@@ -295,22 +295,22 @@ class PathTracer {
     if (!shared_) return std::make_unique<gpu::Context>();
     try {
       gpu::GivenDevice given{vk.instance, vk.physical_device, vk.device};
-      given.instance_api_version = vk.instance_api_version;
-      given.device_extensions = vk.device_extensions;
-      if (vk.layer_queue) {
-        given.queue_family = vk.layer_queue->family;
-        given.queue_index = vk.layer_queue->index;
+      given.instance_api_version = vk.added.instance_api_version;
+      given.device_extensions = vk.added.extensions;
+      if (vk.added.layer_queue) {
+        given.queue_family = vk.added.layer_queue->family;
+        given.queue_index = vk.added.layer_queue->index;
         placement_ = "its own queue (family " + std::to_string(given.queue_family) + ", index " +
                      std::to_string(given.queue_index) + ")";
       } else if (config_.lockstep) {
         given.queue_family = vk.queue_family;
         given.queue_index = vk.queue_index;
         placement_ = "the session queue, inside xrEndFrame (lockstep rendering; no queue of its own: " +
-                     vk.no_layer_queue + ")";
+                     vk.added.no_layer_queue + ")";
       } else {
-        placement_ = "no queue of its own there (" + vk.no_layer_queue + ")";
+        placement_ = "no queue of its own there (" + vk.added.no_layer_queue + ")";
       }
-      if (vk.layer_queue || config_.lockstep) {
+      if (vk.added.layer_queue || config_.lockstep) {
         try {
           auto ctx = std::make_unique<gpu::Context>(given);
           on_app_device_ = true;
@@ -772,8 +772,7 @@ std::unique_ptr<FrameRenderer> make_frame_renderer(const LayerConfig& config, co
   // layer does not add the extension, and the device's record would name another reason).
   VulkanBinding binding = vk;
   if (!config.shared_handover) {
-    binding.external_memory_fd = false;
-    binding.no_external_memory = "configured (\"handover\": \"host\")";
+    binding.added.no_external_memory = "configured (\"handover\": \"host\")";
   }
   return std::make_unique<PathTraceRenderer>(config, binding, next, session);
 }

@@ -26,22 +26,29 @@ namespace fovea::layer {
 
 struct Dispatch;
 
+// What the layer added to a Vulkan device the runtime created for the application
+// (vulkan_enable.cpp). A device the application created itself (XR_KHR_vulkan_enable) has
+// nothing added, as the defaults say.
+struct VulkanDeviceRecord {
+  static constexpr const char* kMadeByApplication =
+      "the application created its Vulkan device itself (XR_KHR_vulkan_enable)";
+  // Why VK_KHR_external_memory_fd is not enabled, for the log (empty: it is, and the traced
+  // frames reach the device without the host).
+  std::string no_external_memory = kMadeByApplication;
+  std::optional<QueueIndex> layer_queue;            // the path tracer's queue on the device
+  std::string no_layer_queue = kMadeByApplication;  // else why none
+  std::uint32_t instance_api_version = 0;           // of the device's instance (0: not known)
+  std::vector<std::string> extensions;              // enabled on the device, as far as the layer knows
+};
+
 // The application's Vulkan objects, from XrGraphicsBindingVulkan(2)KHR at xrCreateSession.
 struct VulkanBinding {
   VkInstance instance = VK_NULL_HANDLE;
   VkPhysicalDevice physical_device = VK_NULL_HANDLE;
   VkDevice device = VK_NULL_HANDLE;
   std::uint32_t queue_family = 0, queue_index = 0;
-  // VK_KHR_external_memory_fd is enabled on `device` (the layer added it when the runtime
-  // created the device, vulkan_enable.cpp): the traced frames reach it without the host.
-  // Otherwise why not, for the log.
-  bool external_memory_fd = false;
-  std::string no_external_memory = "the application created its Vulkan device itself (XR_KHR_vulkan_enable)";
-  // The path tracer's queue on `device` (the layer added it, vulkan_enable.cpp), else why none.
-  std::optional<QueueIndex> layer_queue;
-  std::string no_layer_queue = "the application created its Vulkan device itself (XR_KHR_vulkan_enable)";
-  std::uint32_t instance_api_version = 0;      // of `instance` (0: not known to the layer)
-  std::vector<std::string> device_extensions;  // enabled on `device`, as far as the layer knows
+  VulkanDeviceRecord added;
+  bool external_memory_fd() const { return added.no_external_memory.empty(); }
   bool valid() const { return device != VK_NULL_HANDLE; }
 };
 

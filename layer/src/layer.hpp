@@ -138,15 +138,6 @@ struct InstanceState {
   bool timespec_hidden = false;
 };
 
-// What the layer added to a Vulkan device the runtime created for the application.
-struct VulkanDeviceRecord {
-  std::string no_external_memory;          // why VK_KHR_external_memory_fd is not enabled (empty: it is)
-  std::optional<QueueIndex> layer_queue;   // the path tracer's queue, added to the application's
-  std::string no_layer_queue;              // else why none
-  std::uint32_t instance_api_version = 0;  // of the instance the device was created on
-  std::vector<std::string> extensions;     // enabled on the device
-};
-
 struct Layer {
   std::mutex mutex;
   std::map<XrInstance, InstanceState> instances;

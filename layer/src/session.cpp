@@ -41,16 +41,10 @@ XrResult intercept::xrCreateSession(XrInstance instance, const XrSessionCreateIn
         st.vulkan = {b->instance, b->physicalDevice, b->device, b->queueFamilyIndex, b->queueIndex};
         std::lock_guard lock(layer().mutex);
         if (auto d = layer().vulkan_devices.find(b->device); d != layer().vulkan_devices.end()) {
-          const VulkanDeviceRecord& rec = d->second;
-          st.vulkan.external_memory_fd = rec.no_external_memory.empty();
-          st.vulkan.no_external_memory = rec.no_external_memory;
-          st.vulkan.layer_queue = rec.layer_queue;
-          st.vulkan.no_layer_queue = rec.no_layer_queue;
-          st.vulkan.instance_api_version = rec.instance_api_version;
-          st.vulkan.device_extensions = rec.extensions;
-          if (rec.layer_queue && *rec.layer_queue == QueueIndex{b->queueFamilyIndex, b->queueIndex}) {
-            st.vulkan.layer_queue.reset();
-            st.vulkan.no_layer_queue = "the application uses the queue the layer added to its device";
+          VulkanDeviceRecord& added = st.vulkan.added = d->second;
+          if (added.layer_queue == QueueIndex{b->queueFamilyIndex, b->queueIndex}) {
+            added.layer_queue.reset();
+            added.no_layer_queue = "the application uses the queue the layer added to its device";
           }
         }
       }

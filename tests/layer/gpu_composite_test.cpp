@@ -479,7 +479,7 @@ void hand_over_through_shared_slots(bool on_app_device) {
     EXPECT_NE(host_written.no_shared_slots().find("XR_KHR_vulkan_enable"), std::string::npos);
     EXPECT_NO_THROW(host_written.slot_colour(0, 0));
   }
-  vk.external_memory_fd = true;
+  vk.added.no_external_memory.clear();  // the layer enabled the extension
   AppDevice dev(vk);
   ASSERT_NO_THROW(dev.enable_gpu_composition(W, H));
   std::optional<AppDevice::SharedSlots> shared = dev.shared_slots();
