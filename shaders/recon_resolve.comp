@@ -7,7 +7,9 @@
 // same grid coordinate gives the display-space depth, when asked for (push constant depth): the
 // nearest cell's sample's view-space distance along -Z (no filtering: depths must not blend
 // across silhouettes), 0 where that cell saw the sky or holds no sample; for depth
-// compositing, the image does not use it.
+// compositing, the image does not use it. Near the gaze, where the path tracer's first hits
+// at the display's pixels are given (pt_primary.h), textures are re-modulated at the display's
+// resolution (detail_gain).
 #extension GL_GOOGLE_include_directive : require
 #extension GL_EXT_samplerless_texture_functions : require  // texelFetch on texture buffers
 
@@ -16,6 +18,7 @@ layout(local_size_x = 8, local_size_y = 8) in;
 #include "fovea/shaders/recon_bindings.h"
 #include "fovea/shaders/grid.h"
 #include "fovea/shaders/recon_grid.h"
+#include "fovea/shaders/pt_trace.h"  // kPtMinDemodAlbedo
 
 layout(std430, binding = RECON_MAPS) readonly buffer Maps { ReconGrid maps[]; };
 layout(binding = RECON_TABLES) uniform textureBuffer tables;  // GridColumn: rg_table()
@@ -25,6 +28,8 @@ layout(std430, binding = RECON_RESOLVE_SCREEN) writeonly buffer Screen { vec4 sc
 layout(binding = RECON_RESOLVE_POS) uniform textureBuffer vpos;  // world position, .w material code
 layout(std430, binding = RECON_RESOLVE_DEPTH) writeonly buffer Depth { float depth[]; };
 layout(binding = RECON_RESOLVE_LUTS) uniform utextureBuffer radius_luts;
+layout(binding = RECON_RESOLVE_ALBEDO) uniform textureBuffer cell_albedo;
+layout(binding = RECON_RESOLVE_PRIMARY) uniform textureBuffer primary;
 
 #define RG_RADIUS_LUT
 #include "fovea/shaders/recon_map.h"
@@ -81,6 +86,39 @@ float phi_footprint(ReconGrid m, vec2 t, vec3 d, vec2 px, float turn_rows) {
   return turn_rows / (2.0 * kRgPi * max(r, 1e-6));
 }
 
+// The factor that re-modulates a pixel's colour with its own first hit's base colour instead
+// of its cells' albedo (the Phase I albedo TAA re-modulated them with, interpolated by the
+// same level-0 weights as the colour): the cells' box filter of the texture, which the tent
+// between cells blurs once more, gives way to the pixel's own texture, where the grid's cells
+// are about a pixel and polar cells are not the display's pixels (docs/reconstruction.md,
+// "Textures at the display's resolution"). Only where the pixel and every weighted cell saw
+// the same material (never across a silhouette, an emitter or the sky), fading out from
+// detail_cos_full to detail_cos_none, and at most kReconDetailMaxGain either way.
+vec3 detail_gain(ReconGrid m, ColumnTap k0, ColumnTap k1, float fx, uvec2 p, vec3 d) {
+  uvec2 q = p - uvec2(pc.detail_x0, pc.detail_y0);  // wraps above the window's corner
+  if (q.x >= pc.detail_width || q.y >= pc.detail_height) return vec3(1.0);
+  float fade = smoothstep(pc.detail_cos_none, pc.detail_cos_full, dot(d, rg_gaze(m)));
+  vec4 hit = texelFetch(primary, int(q.y * pc.detail_width + q.x));
+  if (fade <= 0.0 || hit.w < 0.0) return vec3(1.0);
+  vec4 a = vec4(0.0);
+  for (int side = 0; side < 2; ++side) {
+    ColumnTap k = side == 0 ? k0 : k1;
+    int r0, r1;
+    float fy;
+    rg_row_pair(k.rows, k.wraps, k.v, r0, r1, fy);
+    for (int t = 0; t < 2; ++t) {
+      float w = (side == 0 ? 1.0 - fx : fx) * (t == 0 ? 1.0 - fy : fy);
+      int j = int(uint(t == 0 ? r0 : r1) * m.g.padded_columns + k.c);
+      if (w <= 0.0 || texelFetch(mips, j).w <= 0.0) continue;  // no weight, or no sample (level 0)
+      if (texelFetch(vpos, j).w != hit.w) return vec3(1.0);
+      a += w * vec4(texelFetch(cell_albedo, j).rgb, 1.0);
+    }
+  }
+  if (!(a.w > 0.0)) return vec3(1.0);
+  vec3 gain = max(hit.rgb, vec3(kPtMinDemodAlbedo)) / max(a.rgb / a.w, vec3(kPtMinDemodAlbedo));
+  return mix(vec3(1.0), clamp(gain, vec3(1.0 / kReconDetailMaxGain), vec3(kReconDetailMaxGain)), fade);
+}
+
 void main() {
   uvec2 p = gl_GlobalInvocationID.xy;
   if (p.x >= pc.width || p.y >= pc.height) return;
@@ -106,7 +144,9 @@ void main() {
   float f = lod - float(l0);
   vec4 v = fetch_level(m, k0, k1, fx, l0);
   if (f > 0.0 && l0 + 1u < pc.levels) v = mix(v, fetch_level(m, k0, k1, fx, l0 + 1u), f);
-  screen[i] = v.w > 1e-6 ? vec4(v.rgb / v.w, 1.0) : vec4(0.0, 0.0, 0.0, 1.0);
+  vec3 colour = v.w > 1e-6 ? v.rgb / v.w : vec3(0.0);
+  if (pc.detail_width > 0u && l0 == 0u) colour *= detail_gain(m, k0, k1, fx, p, d);
+  screen[i] = vec4(colour, 1.0);
   if (pc.depth == 0u) return;  // only depth compositing reads it (FramePipeline::enable_depth_output)
 
   uint r = min(uint(max(floor(near.v), 0.0)), uint(near.rows) - 1u);

@@ -20,7 +20,8 @@ reconstruct::ReconSettings FrameConfig::default_recon() {
 const std::vector<std::string>& frame_option_names() {
   static const std::vector<std::string> names = {"budget",         "cap",          "distribution", "jitter",
                                                  "denoiser",       "bmfr-precision", "stereo-share", "trace",
-                                                 "bounces",        "seed",           "landing-spp"};
+                                                 "bounces",        "seed",           "landing-spp",
+                                                 "pixel-albedo"};
   return names;
 }
 
@@ -75,6 +76,10 @@ void apply_frame_option(FrameConfig& c, std::string_view name, std::string_view 
       else c.bounces = {false, int(whole_number(value, 0, Bounces::kMaxBounces, "auto or "))};
     } else if (name == "landing-spp") {
       c.recon.landing_spp = std::uint32_t(whole_number(value, 1, FrameConfig::kMaxLandingSpp));
+    } else if (name == "pixel-albedo") {
+      if (value != "on" && value != "off")
+        throw core::InputError("expected on or off, got \"" + std::string(value) + "\"");
+      c.recon.pixel_albedo = value == "on";
     } else if (name == "seed") {
       c.seed = std::uint32_t(whole_number(value, 0, FrameConfig::kMaxSeed));
     } else {
@@ -113,7 +118,8 @@ nlohmann::json to_json(const FrameConfig& c) {
           {"trace", renderer::tracing_name(c.tracing)},
           {"bounces", c.bounces.from_albedo ? nlohmann::json("auto") : nlohmann::json(c.bounces.count)},
           {"seed", c.seed},
-          {"landing-spp", c.recon.landing_spp}};
+          {"landing-spp", c.recon.landing_spp},
+          {"pixel-albedo", c.recon.pixel_albedo ? "on" : "off"}};
 }
 
 renderer::PathConfig path_config(const Bounces& bounces, const renderer::Scene& scene) {

@@ -1,6 +1,8 @@
 #include "fovea/pipeline/frame_pipeline.hpp"
 
 #include <algorithm>
+#include <cmath>
+#include <numbers>
 #include <string>
 
 #include "fovea/core/acuity.hpp"
@@ -60,6 +62,20 @@ std::unique_ptr<EyeState> make_eye(gpu::Context& ctx, renderer::PathTracer& trac
   return e;
 }
 
+// Whether the grid is the display's own raster (full Cartesian, linear fall-off): its cells
+// are the pixels, which the resolve reads at their centres.
+bool display_raster(const EyeState& e) {
+  return e.dist->gpu_params().family == shaders::kFamilyCartesian && e.dist->columns() == e.base_view.width() &&
+         e.dist->rows() == e.base_view.height();
+}
+
+// The angles from the gaze within which the resolve re-modulates with the pixels' own albedo
+// fully (the fovea) and beyond which not at all (the distribution's margin, at least 0.5°).
+double pixel_albedo_full_deg() { return core::acuity::kFoveaDeg; }
+double pixel_albedo_none_deg(const EyeState& e) {
+  return core::acuity::kFoveaDeg + std::max(e.dist->params().margin_deg, 0.5);
+}
+
 }  // namespace
 
 int FramePipeline::Impl::index(core::Eye e, const char* what) const {
@@ -97,8 +113,12 @@ FramePipeline::FramePipeline(gpu::Context& ctx, const renderer::GpuScene& scene,
   Impl& m = *impl_;
   for (int i = 0; i < (mono ? 1 : 2); ++i)
     m.eyes.push_back(make_eye(ctx, m.tracer, core::Eye(i), views[core::Eye(i)], distribution, visibility[size_t(i)]));
+  if (settings.pixel_albedo && scene.features().textures && !display_raster(*m.eyes[0]))
+    m.pixel_albedo = std::make_unique<renderer::DisplayAlbedo>(ctx, scene);
   std::vector<reconstruct::EyeGrid> grids;
   for (auto& e : m.eyes) {
+    if (m.pixel_albedo)
+      e->primary = m.pixel_albedo->bind(renderer::cone_window_capacity(e->base_view, pixel_albedo_none_deg(*e)));
     const EyeState* o = m.other(*e);
     e->mapping = std::make_unique<reconstruct::GridMapping>(ctx, *e->dist, o ? o->dist.get() : nullptr);
     const renderer::TraceOutputs& t = e->trace;
@@ -117,7 +137,8 @@ FramePipeline::FramePipeline(gpu::Context& ctx, const renderer::GpuScene& scene,
                      .normal_depth = &t.normal_depth(),
                      .position_material = &t.position_material(),
                      .albedo = &t.albedo(),
-                     .live = &e->grid_pass->live_tiles()});
+                     .live = &e->grid_pass->live_tiles(),
+                     .primary = m.pixel_albedo ? &e->primary.hits() : nullptr});
   }
   // The reconstruction's per-cell kernels over the live tiles, except for a Cartesian raster
   // on a CPU device: lavapipe's SIMD vectors then run down a tile's column, 8 raster rows
@@ -158,7 +179,7 @@ void FramePipeline::set_visibility(core::Eye eye, const core::ViewMask& mask) {
 std::vector<std::pair<std::string, double>> FrameTimes::gpu_record() const {
   std::vector<std::pair<std::string, double>> r;
   for (const auto& [name, st] : stages()) r.emplace_back(name, st.gpu_ms);
-  r.insert(r.end(), {{"accumulate", accumulate_gpu_ms}, {"bmfr_fit", bmfr_fit_gpu_ms}, {"post", post_gpu_ms},
+  r.insert(r.end(), {{"pixel_albedo", pixel_albedo_gpu_ms}, {"accumulate", accumulate_gpu_ms}, {"bmfr_fit", bmfr_fit_gpu_ms}, {"post", post_gpu_ms},
                      {"mip", mip_gpu_ms}, {"resample", resample_gpu_ms}, {"blur", blur_gpu_ms}, {"total", gpu_ms()}});
   return r;
 }
@@ -241,6 +262,20 @@ FrameTimes FramePipeline::render(const std::array<core::Pose, 2>& eye_pose, cons
     }
     gpu::compute_to_compute(cmd);
     m.timer.stage(cmd, "trace");
+    if (m.pixel_albedo) {
+      for (std::size_t i = 0; i < m.eyes.size(); ++i) {
+        EyeState& e = *m.eyes[i];
+        const core::View view(e.base_view.fov(), e.base_view.width(), e.base_view.height(), e.pose);
+        const double none_deg = pixel_albedo_none_deg(e);
+        const renderer::PixelWindow w = renderer::cone_window(view, e.gaze_used, none_deg, e.primary.capacity());
+        m.pixel_albedo->record(cmd, e.primary, view, w);
+        constexpr double kDeg = std::numbers::pi / 180;
+        m.resolve->set_detail(int(i), {w.x0, w.y0, w.width, w.height, float(std::cos(pixel_albedo_full_deg() * kDeg)),
+                                       float(std::cos(none_deg * kDeg))});
+      }
+      gpu::compute_to_compute(cmd);
+      m.timer.stage(cmd, "pixel_albedo");
+    }
     t.trace.cpu_ms = lap_ms(r0);
     m.accumulation->record(cmd, p, history, std::span(fresh, m.eyes.size()), std::span(unmoved.data(), m.eyes.size()),
                            settings);
@@ -285,6 +320,7 @@ FrameTimes FramePipeline::render(const std::array<core::Pose, 2>& eye_pose, cons
       if (s.name == "temporal") t.temporal_gpu_ms = ms;
       else if (s.name == "grid") t.grid.gpu_ms += ms;
       else if (s.name == "trace") t.trace.gpu_ms += ms;
+      else if (s.name == "pixel_albedo") t.trace.gpu_ms += (t.pixel_albedo_gpu_ms = ms);
       else if (s.name == "resolve" || s.name == "grid_blur" || s.name == "mip" || s.name == "resample" || s.name == "blur")
         t.resolve.gpu_ms += ms;
       else t.reconstruct.gpu_ms += ms;

@@ -11,6 +11,7 @@
 #include "fovea/pipeline/frame_pipeline.hpp"
 #include "fovea/reconstruct/grid_map.hpp"
 #include "fovea/reconstruct/stages.hpp"
+#include "fovea/renderer/display_albedo.hpp"
 
 namespace fovea::pipeline {
 
@@ -24,6 +25,7 @@ struct EyeState {
   std::unique_ptr<gpu::GridPass> grid_pass;
   gpu::Buffer grid;
   renderer::TraceOutputs trace;
+  renderer::PrimaryHits primary;  // the display pixels' first hits near the gaze (pixel albedo)
   std::uint32_t cells = 0;
   std::unique_ptr<reconstruct::GridMapping> mapping;
   std::vector<std::uint32_t> mask;  // ViewMask words; empty: every cell is visible
@@ -40,6 +42,7 @@ struct FramePipeline::Impl {
   std::unique_ptr<reconstruct::Bmfr> bmfr;  // null without the BMFR denoiser
   std::unique_ptr<reconstruct::PostTaa> post;
   std::unique_ptr<reconstruct::Resolve> resolve;
+  std::unique_ptr<renderer::DisplayAlbedo> pixel_albedo;  // null: no pixel albedo (ReconSettings::pixel_albedo)
   gpu::GpuTimer timer;
   std::uint32_t frames_done = 0;  // frames since the last reset
   std::uint32_t landing_left = 0;  // frames still tracing the new fovea's extra samples

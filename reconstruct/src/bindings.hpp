@@ -136,7 +136,7 @@ struct MipBindings {
 
 struct ResolveBindings {
   FOVEA_BINDING_COUNT(RECON_RESOLVE_COUNT)
-  Buf maps, tables, mips, offsets, screen, pos, depth, luts;
+  Buf maps, tables, mips, offsets, screen, pos, depth, luts, albedo, primary;
   Slots slots() const {
     return {{{RECON_MAPS, maps},
              {RECON_TABLES, tables},
@@ -145,7 +145,9 @@ struct ResolveBindings {
              {RECON_RESOLVE_SCREEN, screen},
              {RECON_RESOLVE_POS, pos},
              {RECON_RESOLVE_DEPTH, depth},
-             {RECON_RESOLVE_LUTS, luts}}};
+             {RECON_RESOLVE_LUTS, luts},
+             {RECON_RESOLVE_ALBEDO, albedo},
+             {RECON_RESOLVE_PRIMARY, primary}}};
   }
 };
 

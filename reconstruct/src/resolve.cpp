@@ -120,9 +120,13 @@ Resolve::Resolve(gpu::Context& ctx, std::span<const EyeGrid> eyes, const Accumul
     e.screen_b = cells(ctx, pixels, "recon.screen_tmp");
     e.depth = storage(ctx, VkDeviceSize(pixels) * 4, "recon.depth");
     e.mip_set = make_set(ctx, mip_, MipBindings{g.maps(), g.tables(), &e.mips});
+    e.has_primary = g.primary != nullptr;
+    if (!e.has_primary) e.no_primary = cells(ctx, 1, "recon.no_primary");  // bound, never read
     for (int p = 0; p < 2; ++p)
-      e.resolve_set[p] = make_set(ctx, resolve_, ResolveBindings{g.maps(), g.tables(), &e.mips, &e.offsets, &e.screen_a,
-                                                                 &acc.position(int(i), p), &e.depth, g.luts()});
+      e.resolve_set[p] = make_set(ctx, resolve_,
+                                  ResolveBindings{g.maps(), g.tables(), &e.mips, &e.offsets, &e.screen_a,
+                                                  &acc.position(int(i), p), &e.depth, g.luts(), &acc.albedo(int(i), p),
+                                                  e.has_primary ? g.primary : &e.no_primary});
     e.prev_luma = storage(ctx, VkDeviceSize(pixels) * 4, "recon.temporal_prev_luma");
     e.temporal_sums = storage(ctx, VkDeviceSize(temporal_runs(g.width, g.height)) * 4, "recon.temporal_sums");
     e.temporal_sums.upload(std::vector<float>(temporal_runs(g.width, g.height), 0.0f));
@@ -198,13 +202,24 @@ void Resolve::record_mips(VkCommandBuffer cmd) const {
   }
 }
 
+void Resolve::set_detail(int eye, const DetailWindow& window) {
+  Eye& e = eyes_.at(std::size_t(eye));
+  if (window.width > 0 && window.height > 0 &&
+      (window.x0 + window.width > e.width || window.y0 + window.height > e.height || !e.has_primary))
+    throw core::InputError("resolve: detail window outside the display or an eye without first hits");
+  e.detail = window;
+}
+
 void Resolve::record_resample(VkCommandBuffer cmd, int parity, bool grid_coords) const {
   for (const Eye& e : eyes_) {
     const std::uint32_t lod_columns = mip_reach(*e.mapping, e.levels).lod_columns;
+    const DetailWindow& d = e.detail;
+    const bool detail = !grid_coords && d.width > 0 && d.height > 0;
     resolve_.run(cmd, {&e.resolve_set[parity]},
                  shaders::ReconResolvePush{e.width, e.height, e.levels, grid_coords ? 1u : 0u, lod_columns,
-                                           depth_output_ ? 1u : 0u, 0, 0}, e.width,
-                 e.height);
+                                           depth_output_ ? 1u : 0u, 0, 0, d.x0, d.y0, detail ? d.width : 0u,
+                                           d.height, d.cos_full, d.cos_none, 0, 0},
+                 e.width, e.height);
   }
   gpu::compute_to_compute(cmd);
 }
@@ -237,7 +252,7 @@ double Resolve::temporal_abs_luma_sum(int eye) const {
 
 void Resolve::fill(VkCommandBuffer cmd, std::uint32_t word) const {
   for (const Eye& e : eyes_)
-    for (const gpu::Buffer* b : {&e.mips, &e.screen_a, &e.screen_b, &e.depth, &e.grid_tmp})
+    for (const gpu::Buffer* b : {&e.mips, &e.screen_a, &e.screen_b, &e.depth, &e.grid_tmp, &e.no_primary})
       if (b->size() > 0) gpu::fill_buffer(cmd, *b, word);
 }
 

@@ -3,8 +3,6 @@
 #include <cmath>
 #include <limits>
 
-#include <glm/gtc/quaternion.hpp>
-#include <glm/mat3x3.hpp>
 
 #include "fovea/core/error.hpp"
 #include "fovea/gpu/barriers.hpp"
@@ -89,15 +87,8 @@ TraceOutputs PathTracer::bind(const gpu::Buffer& grid, std::uint32_t cells) cons
 
 void PathTracer::record(VkCommandBuffer cmd, TraceOutputs& out, const core::View& view, core::Eye eye,
                         std::uint32_t frame, const PathConfig& c, std::uint32_t accumulated) const {
-  const glm::dmat3 r = glm::mat3_cast(view.pose().orientation);
-  const glm::dvec3 o = view.pose().position;
-  if (!std::isfinite(o.x) || !std::isfinite(o.y) || !std::isfinite(o.z) || !std::isfinite(r[0][0]))
-    throw core::InputError("path tracer: non-finite eye pose");
   shaders::PtFrameParams p{};
-  p.rot0_x = float(r[0].x); p.rot0_y = float(r[0].y); p.rot0_z = float(r[0].z);
-  p.rot1_x = float(r[1].x); p.rot1_y = float(r[1].y); p.rot1_z = float(r[1].z);
-  p.rot2_x = float(r[2].x); p.rot2_y = float(r[2].y); p.rot2_z = float(r[2].z);
-  p.origin_x = float(o.x); p.origin_y = float(o.y); p.origin_z = float(o.z);
+  set_eye_pose(p, view, "path tracer");
   const glm::vec3 env = scene_.environment();
   p.env_r = env.x; p.env_g = env.y; p.env_b = env.z;
   p.light_count = scene_.light_count();

@@ -151,7 +151,8 @@ TEST_F(GpuTest, FrameDriverStepReadsTheGazeAtTheFrameTimeAndRecordsItsTimes) {
       cpu.push_back(name);
       EXPECT_TRUE(std::isfinite(v) && v >= 0) << name;
     }
-    EXPECT_EQ(gpu, (std::vector<std::string>{"grid", "trace", "reconstruct", "resolve", "accumulate", "bmfr_fit", "post",
+    EXPECT_EQ(gpu, (std::vector<std::string>{"grid", "trace", "reconstruct", "resolve", "pixel_albedo", "accumulate",
+                                             "bmfr_fit", "post",
                                              "mip", "resample", "blur", "total"}));
     EXPECT_EQ(cpu, (std::vector<std::string>{"gaze", "grid", "trace", "reconstruct", "resolve", "submit", "wait", "total"}));
     EXPECT_DOUBLE_EQ(d.gpu_ms().back().second, d.times.gpu_ms());

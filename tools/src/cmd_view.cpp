@@ -114,7 +114,7 @@ int run(std::vector<std::string> argv) {
     }
   const Args args(argv,
                   {"display", "scene", "trace", "gaze", "gaze-dir", "budget", "cap", "jitter", "optics", "window", "frames",
-                   "distribution", "denoiser", "bmfr-precision", "stereo-share", "bounces", "seed", "landing-spp",
+                   "distribution", "denoiser", "bmfr-precision", "stereo-share", "bounces", "seed", "landing-spp", "pixel-albedo",
                    "screenshot", "panels"},
                   {});
   const core::DisplayPreset d = core::load_display(args.str("display", core::kDefaultDisplay));

@@ -51,6 +51,9 @@ constexpr OptionHelp kFrameOptionsHelp[] = {
     {"landing-spp",
      "  --landing-spp N       samples per cell in a new fovea's first 4 frames after a gaze jump\n"
      "                        of 5° or more (1..8; 1: one, as every other frame)"},
+    {"pixel-albedo",
+     "  --pixel-albedo on|off textures at the display's resolution in the fovea: each display\n"
+     "                        pixel's own first hit re-modulates it (scenes with textures)"},
     {"seed",
      "  --seed N              noise seed: another N, another noise realisation of the same frames\n"
      "                        (path tracing and BMFR keyed by frame + 1024·N; gaze and jitter\n"

@@ -33,7 +33,8 @@ struct StageTime {
 
 struct FrameTimes {
   StageTime grid;         // CPU: the distributions' per-frame update (gaze → grid) and upload; GPU: generation
-  StageTime trace;        // CPU: recording; GPU: path tracing
+  StageTime trace;        // CPU: recording; GPU: path tracing, and the display pixels' first hits near the gaze
+  double pixel_albedo_gpu_ms = 0;  // part of trace: those first hits (ReconSettings::pixel_albedo)
   StageTime reconstruct;  // CPU: grid mappings and recording; GPU: accumulation, sharing, BMFR, post, TAA
   StageTime resolve;      // CPU: recording; GPU: mips, resolve, depth (enable_depth_output), blur
   // Parts of reconstruct: Phase I with the stereo gather, the BMFR regression, Phase III with TAA.

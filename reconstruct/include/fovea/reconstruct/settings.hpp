@@ -74,6 +74,12 @@ struct ReconSettings {
   // a still gaze's by the 4th frame; 4 did not (1.09-1.24), and costs the landing's frames
   // less (fove0: +9 % against +20 % GPU time).
   std::uint32_t landing_spp = 8;
+  // Textures at the display's resolution near the gaze (the `pixel-albedo` frame option): the
+  // frame pipeline traces each display pixel's first hit within the fovea and the margin, and
+  // the resolve re-modulates those pixels with their own base colour instead of their cells'
+  // (recon_resolve.comp, detail_gain; docs/reconstruction.md, "Textures at the display's
+  // resolution"). Only for scenes with textures and grids that are not the display's raster.
+  bool pixel_albedo = true;
   // On that jump's frame, Phase I counts the new fovea's history (the periphery's, resampled
   // from another layout) for at most this many samples (huge: its full count), so that the
   // landing's own samples outweigh its blur within a few frames. 2 recovered best of 0, 2, 4

@@ -39,6 +39,17 @@ struct EyeGrid {
   // The grid pass's live-tile list (gpu::GridPass::live_tiles()): with
   // ReconSettings::live_cells the per-cell kernels run over its live and reset tiles alone.
   const gpu::Buffer* live = nullptr;
+  // The display pixels' first hits near the gaze (renderer::PrimaryHits, a window of the
+  // display each frame: Resolve::set_detail), or none.
+  const gpu::Buffer* primary = nullptr;
+};
+
+// A window of display pixels whose first hits EyeGrid::primary holds this frame, and the
+// angles from the gaze (cosines) within which the resolve re-modulates the pixels with them
+// fully, and beyond which not at all (recon_resolve.comp, detail_gain). Empty: none.
+struct DetailWindow {
+  std::uint32_t x0 = 0, y0 = 0, width = 0, height = 0;
+  float cos_full = 1, cos_none = 1;
 };
 
 class Accumulation {
@@ -160,6 +171,8 @@ class Resolve {
   // Whether the resample writes the display depth (depth()); off at first: a texel read, a
   // transform and a store per pixel that only depth compositing needs.
   void set_depth_output(bool on) { depth_output_ = on; }
+  // This frame's window of the eye's EyeGrid::primary (none at first, and for an eye without one).
+  void set_detail(int eye, const DetailWindow& window);
   bool depth_output() const { return depth_output_; }
   void record_blur(VkCommandBuffer cmd, const ReconSettings& settings) const;
   // The temporal error of the screen images on the device (shaders/recon_temporal.comp):
@@ -182,7 +195,9 @@ class Resolve {
     double max_pixels_per_deg = 0;
     const GridMapping* mapping = nullptr;  // EyeGrid::mapping
     std::vector<std::uint32_t> level_rows, level_offset;
-    gpu::Buffer mips, offsets, screen_a, screen_b, depth, grid_tmp, prev_luma, temporal_sums;
+    DetailWindow detail;
+    bool has_primary = false;
+    gpu::Buffer mips, offsets, screen_a, screen_b, depth, grid_tmp, prev_luma, temporal_sums, no_primary;
     gpu::DescriptorSet mip_set, resolve_set[2], blur_h, blur_v, grid_blur_rho, grid_blur_phi, temporal_set;
   };
   std::uint32_t max_levels() const;

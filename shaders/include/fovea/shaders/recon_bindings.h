@@ -106,7 +106,9 @@
 #define RECON_RESOLVE_POS 5
 #define RECON_RESOLVE_DEPTH 6
 #define RECON_RESOLVE_LUTS 7
-#define RECON_RESOLVE_COUNT 8
+#define RECON_RESOLVE_ALBEDO 8   // the cells' re-modulation albedo (Phase I's, as TAA's)
+#define RECON_RESOLVE_PRIMARY 9  // the display pixels' first hits near the gaze (pt_primary.h)
+#define RECON_RESOLVE_COUNT 10
 
 // recon_blur.comp
 #define RECON_BLUR_SRC 2

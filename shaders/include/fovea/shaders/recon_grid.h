@@ -89,10 +89,19 @@ struct ReconMipPush {
   FOVEA_UINT offset_in, offset_out, pad0, pad1;            // element offsets in the mip buffer
 };
 
+// Textures at the display's resolution near the gaze (recon_resolve.comp, detail_gain): at most
+// this factor between a pixel's own base colour and its cells' re-modulation albedo.
+FOVEA_CONST float kReconDetailMaxGain = 4.0f;
+
 struct ReconResolvePush {
   FOVEA_UINT width, height, levels, grid_coords;  // grid_coords = 1: write (u, t, LOD, 0) per pixel, for tests
   FOVEA_UINT lod_columns, depth, pad0, pad1;      // pixels of columns >= lod_columns have LOD 0 (Resolve, mip_reach);
                                                   // depth = 1: also write the display depth
+  // The window of display pixels whose first hits RECON_RESOLVE_PRIMARY holds (width 0:
+  // none), and the cosines of the angles from the gaze within which they re-modulate fully
+  // and beyond which not at all.
+  FOVEA_UINT detail_x0, detail_y0, detail_width, detail_height;
+  float detail_cos_full, detail_cos_none, pad2, pad3;
 };
 
 // Radius -> column lookup table of a polar mapping (reconstruct::radius_lut builds one per
@@ -131,7 +140,7 @@ static_assert(sizeof(ReconSharePush) == 32);
 static_assert(sizeof(ReconBmfrPush) == 32);
 static_assert(sizeof(ReconPostPush) == 32);
 static_assert(sizeof(ReconMipPush) == 32);
-static_assert(sizeof(ReconResolvePush) == 32);
+static_assert(sizeof(ReconResolvePush) == 64);
 static_assert(sizeof(ReconBlurPush) == 32);
 static_assert(sizeof(ReconTemporalPush) == 16);
 }  // namespace fovea::shaders
