@@ -87,13 +87,16 @@ float phi_footprint(ReconGrid m, vec2 t, vec3 d, vec2 px, float turn_rows) {
 }
 
 // The factor that re-modulates a pixel's colour with its own first hit's base colour instead
-// of its cells' albedo (the Phase I albedo TAA re-modulated them with, interpolated by the
-// same level-0 weights as the colour): the cells' box filter of the texture, which the tent
-// between cells blurs once more, gives way to the pixel's own texture, where the grid's cells
-// are about a pixel and polar cells are not the display's pixels (docs/reconstruction.md,
-// "Textures at the display's resolution"). Only where the pixel and every weighted cell saw
-// the same material (never across a silhouette, an emitter or the sky), fading out from
-// detail_cos_full to detail_cos_none, and at most kReconDetailMaxGain either way.
+// of its cells' albedo (the one their output holds: TAA's re-modulation albedo, blended with
+// the history's as the colour is, interpolated by the colour's level-0 weights): the cells'
+// box filter of the texture, which the tent between cells blurs once more, gives way to the
+// pixel's own texture, where the grid's cells are about a pixel and polar cells are not the
+// display's pixels (docs/reconstruction.md, "Textures at the display's resolution"). Only
+// where the pixel and every weighted cell saw a surface (never at an emitter or the sky, whose
+// light no albedo scales), fading out from detail_cos_full to detail_cos_none, and at most
+// kReconDetailMaxGain either way. Across a silhouette between surfaces the pixel's own albedo
+// scales the cells' light: requiring one material there switched the gain on and off with the
+// cells' jitter from frame to frame.
 vec3 detail_gain(ReconGrid m, ColumnTap k0, ColumnTap k1, float fx, uvec2 p, vec3 d) {
   uvec2 q = p - uvec2(pc.detail_x0, pc.detail_y0);  // wraps above the window's corner
   if (q.x >= pc.detail_width || q.y >= pc.detail_height) return vec3(1.0);
@@ -110,7 +113,7 @@ vec3 detail_gain(ReconGrid m, ColumnTap k0, ColumnTap k1, float fx, uvec2 p, vec
       float w = (side == 0 ? 1.0 - fx : fx) * (t == 0 ? 1.0 - fy : fy);
       int j = int(uint(t == 0 ? r0 : r1) * m.g.padded_columns + k.c);
       if (w <= 0.0 || texelFetch(mips, j).w <= 0.0) continue;  // no weight, or no sample (level 0)
-      if (texelFetch(vpos, j).w != hit.w) return vec3(1.0);
+      if (texelFetch(vpos, j).w < 0.0) return vec3(1.0);  // the sky or an emitter
       a += w * vec4(texelFetch(cell_albedo, j).rgb, 1.0);
     }
   }

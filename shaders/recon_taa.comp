@@ -67,6 +67,11 @@ layout(binding = RECON_TAA_PREV_FINAL) uniform textureBuffer prev_final;
 layout(std430, binding = RECON_TAA_FINAL) writeonly buffer Final { vec4 final_color[]; };
 layout(binding = RECON_TAA_NRM) uniform textureBuffer vnrm;
 layout(binding = RECON_TAA_RESTART) uniform textureBuffer restart;  // Phase I's window
+// The albedo the output holds: the re-modulation's, blended with the history's as the colour
+// is (linearly, with the same weights), so that the resolve can take it out again where the
+// display pixels' own albedo re-modulates the fovea (recon_resolve.comp, detail_gain).
+layout(binding = RECON_TAA_PREV_FINAL_ALBEDO) uniform textureBuffer prev_final_albedo;
+layout(std430, binding = RECON_TAA_FINAL_ALBEDO) writeonly buffer FinalAlbedo { vec4 final_albedo[]; };
 
 #include "fovea/shaders/recon_map.h"
 
@@ -100,8 +105,9 @@ vec3 remodulated(uint i) {
 // tap rejected as another surface or reweighted as coarser; the bilinear weights come from
 // the middle two of the four columns, each column's entry read once); false otherwise, or
 // when a tap holds no sample (the caller then keeps Phase I's taps).
-bool history_catmull_rom(ReconGrid prev, vec2 uv, vec4 kept, out vec3 h) {
+bool history_catmull_rom(ReconGrid prev, vec2 uv, vec4 kept, out vec3 h, out vec3 ha) {
   h = vec3(0.0);
+  ha = vec3(0.0);
   float uc = uv.x - 0.5, c0f = floor(uc), fx = uc - c0f;
   vec4 wx = rg_catmull_rom(fx);
   bool ok = true;
@@ -120,9 +126,11 @@ bool history_catmull_rom(ReconGrid prev, vec2 uv, vec4 kept, out vec3 h) {
     for (int b = 0; b < 4; ++b) {
       int r = int(r0f) - 1 + b;
       r = wraps ? rg_wrap(r, rows) : clamp(r, 0, rows - 1);
-      vec4 v = texelFetch(prev_final, int(uint(r) * prev.g.padded_columns + c));
+      int j = int(uint(r) * prev.g.padded_columns + c);
+      vec4 v = texelFetch(prev_final, j);
       if (v.w <= 0.0) return false;
       h += wx[a] * wy[b] * compress(v.rgb);
+      ha += wx[a] * wy[b] * texelFetch(prev_final_albedo, j).rgb;
     }
   }
   return ok;
@@ -130,12 +138,13 @@ bool history_catmull_rom(ReconGrid prev, vec2 uv, vec4 kept, out vec3 h) {
 
 // The history of a cell of column `col` whose sample is `here` (position, code) by
 // Catmull–Rom, where Phase I kept all its bilinear taps `kept` and every tap holds a sample.
-bool sharp_history(ReconGrid cur, uint col, vec4 here, vec4 kept, out vec3 h) {
+bool sharp_history(ReconGrid cur, uint col, vec4 here, vec4 kept, out vec3 h, out vec3 ha) {
   h = vec3(0.0);
+  ha = vec3(0.0);
   ReconGrid prev = maps[kReconPrevious];
   vec2 uv;
   if (!rg_world_to_grid(prev, here.xyz, abs(here.w - kReconSky) < 0.5, false, uv)) return false;
-  return history_catmull_rom(prev, rg_unjitter(cur, rg_column(cur, col), prev, uv), kept, h);
+  return history_catmull_rom(prev, rg_unjitter(cur, rg_column(cur, col), prev, uv), kept, h, ha);
 }
 
 vec3 capped(vec3 c, float cap) {
@@ -148,6 +157,7 @@ void main() {
   if (i == kNoLiveCell) return;
   if (rg_no_sample(texelFetch(vpos, int(i)).w)) {
     final_color[i] = vec4(0.0);
+    final_albedo[i] = vec4(0.0);
     return;
   }
   ReconGrid m = maps[kReconCurrent];
@@ -187,7 +197,8 @@ void main() {
   }
   // No cap for emitters, the sky and a cell without neighbours.
   float cap = here.w < 0.0 || brightest < 0.0 ? 3.0e38 : kFireflyRatio * brightest;
-  vec3 c = avg / avg_w * max(texelFetch(albedo, int(i)).rgb, vec3(kPtMinDemodAlbedo));
+  vec3 alb = max(texelFetch(albedo, int(i)).rgb, vec3(kPtMinDemodAlbedo));
+  vec3 c = avg / avg_w * alb;
   // The frame a gaze jump lands (ReconSettings::landing_deg): the new fovea's history is the
   // previous frame's periphery resampled, too coarse to blend in, yet mostly within the
   // coarse-cell test's limits; blended, it made BMFR's landed fovea worse than no denoiser's.
@@ -200,13 +211,18 @@ void main() {
   // (a = 1): its history is neither read nor clamped.
   if (!denoise || !history || since == 1.0 || (pc.still >= 1.0 && !follow)) {
     final_color[i] = vec4(capped(c, cap), 1.0);
+    final_albedo[i] = vec4(alb, 1.0);
     return;
   }
-  vec3 h;
-  if (!sharp_history(m, cell.col, here, w, h)) {
+  vec3 h, ha;
+  if (!sharp_history(m, cell.col, here, w, h, ha)) {
     uvec4 idx = texelFetch(tap_idx, int(i));
     h = vec3(0.0);
-    for (int k = 0; k < 4; ++k) h += w[k] * compress(texelFetch(prev_final, int(idx[k])).rgb);
+    ha = vec3(0.0);
+    for (int k = 0; k < 4; ++k) {
+      h += w[k] * compress(texelFetch(prev_final, int(idx[k])).rgb);
+      ha += w[k] * texelFetch(prev_final_albedo, int(idx[k])).rgb;
+    }
   }
   h = from_ycocg(clamp(to_ycocg(h), lo, hi));
   vec2 jitter = vec2(m.g.jitter_u, m.g.jitter_v);  // the sample's offset from the cell centre (cells)
@@ -223,4 +239,5 @@ void main() {
   // keeps its running mean: its history is young.
   if (!follow) a = mix(a, 1.0, pc.still);
   final_color[i] = vec4(capped(max(expand(mix(h, compress(c), a)), vec3(0.0)), cap), 1.0);
+  final_albedo[i] = vec4(max(mix(ha, alb, a), vec3(kPtMinDemodAlbedo)), 1.0);
 }

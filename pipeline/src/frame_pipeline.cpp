@@ -153,7 +153,7 @@ FramePipeline::FramePipeline(gpu::Context& ctx, const renderer::GpuScene& scene,
     m.bmfr = std::make_unique<reconstruct::Bmfr>(ctx, grids, *m.accumulation, *m.gather,
                                                   m.tracer.scene().materials(), settings.bmfr_precision);
   m.post = std::make_unique<reconstruct::PostTaa>(ctx, grids, *m.accumulation, *m.gather, m.bmfr.get());
-  m.resolve = std::make_unique<reconstruct::Resolve>(ctx, grids, *m.accumulation);
+  m.resolve = std::make_unique<reconstruct::Resolve>(ctx, grids, *m.accumulation, *m.post);
   m.fill(0);
 }
 

@@ -111,7 +111,8 @@ struct PostBindings {
 
 struct TaaBindings {
   FOVEA_BINDING_COUNT(RECON_TAA_COUNT)
-  Buf maps, tables, pos, tap_idx, tap_w, post, albedo, prev_final, final_color, nrm, restart, live;
+  Buf maps, tables, pos, tap_idx, tap_w, post, albedo, prev_final, final_color, nrm, restart, live, prev_final_albedo,
+      final_albedo;
   Slots slots() const {
     return {{{RECON_MAPS, maps},
              {RECON_TABLES, tables},
@@ -124,7 +125,9 @@ struct TaaBindings {
              {RECON_TAA_FINAL, final_color},
              {RECON_TAA_NRM, nrm},
              {RECON_TAA_RESTART, restart},
-             {RECON_TAA_LIVE, live}}};
+             {RECON_TAA_LIVE, live},
+             {RECON_TAA_PREV_FINAL_ALBEDO, prev_final_albedo},
+             {RECON_TAA_FINAL_ALBEDO, final_albedo}}};
   }
 };
 

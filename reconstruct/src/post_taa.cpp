@@ -21,6 +21,7 @@ PostTaa::PostTaa(gpu::Context& ctx, std::span<const EyeGrid> eyes, const Accumul
     for (int p = 0; p < 2; ++p) {
       e.post[p] = cells(ctx, g.cells, "recon.post");
       e.final_[p] = cells(ctx, g.cells, "recon.final");
+      e.final_albedo[p] = cells(ctx, g.cells, "recon.final_albedo");
     }
     e.sum = cells(ctx, g.cells, "recon.post_sum");
     const gpu::Buffer* source = bmfr ? &bmfr->fitted(me) : &gather.z(me);
@@ -34,7 +35,8 @@ PostTaa::PostTaa(gpu::Context& ctx, std::span<const EyeGrid> eyes, const Accumul
       e.taa_set[p] = make_set(ctx, taa_,
                               TaaBindings{g.maps(), g.tables(), &acc.position(me, p), &acc.tap_index(me),
                                           &acc.tap_weight(me), &e.sum, &acc.albedo(me, p), &e.final_[q], &e.final_[p],
-                                          &acc.normal(me, p), &acc.restart(me, p), e.live});
+                                          &acc.normal(me, p), &acc.restart(me, p), e.live, &e.final_albedo[q],
+                                          &e.final_albedo[p]});
     }
   }
 }
@@ -74,6 +76,7 @@ void PostTaa::fill(VkCommandBuffer cmd, std::uint32_t word) const {
     for (int p = 0; p < 2; ++p) {
       gpu::fill_buffer(cmd, e.post[p], word);
       gpu::fill_buffer(cmd, e.final_[p], word);
+      gpu::fill_buffer(cmd, e.final_albedo[p], word);
     }
     gpu::fill_buffer(cmd, e.sum, word);
   }

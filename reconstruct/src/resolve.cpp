@@ -86,7 +86,7 @@ std::uint32_t temporal_runs(std::uint32_t width, std::uint32_t height) {
 }
 }  // namespace
 
-Resolve::Resolve(gpu::Context& ctx, std::span<const EyeGrid> eyes, const Accumulation& acc)
+Resolve::Resolve(gpu::Context& ctx, std::span<const EyeGrid> eyes, const Accumulation& acc, const PostTaa& post)
     : mip_(kernel<MipBindings, shaders::ReconMipPush>(ctx, "recon_mip.comp.spv")),
       resolve_(kernel<ResolveBindings, shaders::ReconResolvePush>(ctx, "recon_resolve.comp.spv")),
       blur_(kernel<BlurBindings, shaders::ReconBlurPush>(ctx, "recon_blur.comp.spv")),
@@ -125,7 +125,7 @@ Resolve::Resolve(gpu::Context& ctx, std::span<const EyeGrid> eyes, const Accumul
     for (int p = 0; p < 2; ++p)
       e.resolve_set[p] = make_set(ctx, resolve_,
                                   ResolveBindings{g.maps(), g.tables(), &e.mips, &e.offsets, &e.screen_a,
-                                                  &acc.position(int(i), p), &e.depth, g.luts(), &acc.albedo(int(i), p),
+                                                  &acc.position(int(i), p), &e.depth, g.luts(), &post.final_albedo(int(i), p),
                                                   e.has_primary ? g.primary : &e.no_primary});
     e.prev_luma = storage(ctx, VkDeviceSize(pixels) * 4, "recon.temporal_prev_luma");
     e.temporal_sums = storage(ctx, VkDeviceSize(temporal_runs(g.width, g.height)) * 4, "recon.temporal_sums");

@@ -60,8 +60,8 @@ the peripheral blur. Writes to --out:
                  "device_memory": {"heaps": per memory heap its size and what the frames'
                  buffers and images held at the end (held) and at most (peak), MiB;
                  device_local_held_mib, device_local_peak_mib: over the device-local heaps},
-                 "gpu_ms": {grid, trace, reconstruct, resolve, total, accumulate, bmfr_fit, post,
-                            mip, resample, blur},
+                 "gpu_ms": {grid, trace, reconstruct, resolve, total, pixel_albedo (part of trace),
+                            accumulate, bmfr_fit, post, mip, resample, blur},
                  "cpu_ms": {gaze, grid, trace, reconstruct, resolve, submit, wait, total}
                  (medians per frame; submit: vkQueueSubmit, wait: the fence; total: the
                  frame alone, without output),

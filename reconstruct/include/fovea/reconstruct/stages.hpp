@@ -141,12 +141,14 @@ class PostTaa {
 
   // Remodulated output in grid space (.w = 1 where a sample exists).
   const gpu::Buffer& final_color(int eye, int parity) const { return eyes_[eye].final_[parity]; }
+  // The albedo the output holds: the re-modulation's, blended with the history's as the colour.
+  const gpu::Buffer& final_albedo(int eye, int parity) const { return eyes_[eye].final_albedo[parity]; }
 
  private:
   struct Eye {
     std::uint32_t cells = 0;
     const gpu::Buffer* live = nullptr;  // EyeGrid::live
-    gpu::Buffer post[2], sum, final_[2];  // post: accumulated fit (history); sum: + excess + direct
+    gpu::Buffer post[2], sum, final_[2], final_albedo[2];  // post: accumulated fit (history); sum: + excess + direct
     gpu::DescriptorSet post_set[2], taa_set[2];
   };
   gpu::ComputePipeline post_, taa_;
@@ -155,7 +157,8 @@ class PostTaa {
 
 class Resolve {
  public:
-  Resolve(gpu::Context& ctx, std::span<const EyeGrid> eyes, const Accumulation& acc);
+  // `post`: the albedo its output holds, which the display pixels' own replaces near the gaze.
+  Resolve(gpu::Context& ctx, std::span<const EyeGrid> eyes, const Accumulation& acc, const PostTaa& post);
   // Copies a grid image into level 0 (transfer; the caller orders its writes before).
   void record_copy(VkCommandBuffer cmd, std::span<const gpu::Buffer* const> grid_images) const;
   // Optional blur of level 0 in grid space, mips from level 0, resolve, optional blur: into

@@ -93,7 +93,9 @@
 #define RECON_TAA_NRM 9
 #define RECON_TAA_RESTART 10
 #define RECON_TAA_LIVE 11
-#define RECON_TAA_COUNT 12
+#define RECON_TAA_PREV_FINAL_ALBEDO 12  // the albedo in the previous frame's output (below)
+#define RECON_TAA_FINAL_ALBEDO 13       // the albedo in this frame's output, blended as the colour
+#define RECON_TAA_COUNT 14
 
 // recon_mip.comp
 #define RECON_MIP_MIPS 2
@@ -106,7 +108,7 @@
 #define RECON_RESOLVE_POS 5
 #define RECON_RESOLVE_DEPTH 6
 #define RECON_RESOLVE_LUTS 7
-#define RECON_RESOLVE_ALBEDO 8   // the cells' re-modulation albedo (Phase I's, as TAA's)
+#define RECON_RESOLVE_ALBEDO 8   // the albedo in the cells' output (TAA's RECON_TAA_FINAL_ALBEDO)
 #define RECON_RESOLVE_PRIMARY 9  // the display pixels' first hits near the gaze (pt_primary.h)
 #define RECON_RESOLVE_COUNT 10
 
