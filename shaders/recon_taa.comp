@@ -70,8 +70,10 @@ layout(binding = RECON_TAA_RESTART) uniform textureBuffer restart;  // Phase I's
 // The albedo the output holds: the re-modulation's, blended with the history's as the colour
 // is (linearly, with the same weights), so that the resolve can take it out again where the
 // display pixels' own albedo re-modulates the fovea (recon_resolve.comp, detail_gain).
+// Only where the resolve asks for it (kFinalAlbedo; otherwise its buffers are not the grid's size).
 layout(binding = RECON_TAA_PREV_FINAL_ALBEDO) uniform textureBuffer prev_final_albedo;
 layout(std430, binding = RECON_TAA_FINAL_ALBEDO) writeonly buffer FinalAlbedo { vec4 final_albedo[]; };
+layout(constant_id = 0) const bool kFinalAlbedo = false;
 
 #include "fovea/shaders/recon_map.h"
 
@@ -130,7 +132,7 @@ bool history_catmull_rom(ReconGrid prev, vec2 uv, vec4 kept, out vec3 h, out vec
       vec4 v = texelFetch(prev_final, j);
       if (v.w <= 0.0) return false;
       h += wx[a] * wy[b] * compress(v.rgb);
-      ha += wx[a] * wy[b] * texelFetch(prev_final_albedo, j).rgb;
+      if (kFinalAlbedo) ha += wx[a] * wy[b] * texelFetch(prev_final_albedo, j).rgb;
     }
   }
   return ok;
@@ -157,7 +159,7 @@ void main() {
   if (i == kNoLiveCell) return;
   if (rg_no_sample(texelFetch(vpos, int(i)).w)) {
     final_color[i] = vec4(0.0);
-    final_albedo[i] = vec4(0.0);
+    if (kFinalAlbedo) final_albedo[i] = vec4(0.0);
     return;
   }
   ReconGrid m = maps[kReconCurrent];
@@ -211,7 +213,7 @@ void main() {
   // (a = 1): its history is neither read nor clamped.
   if (!denoise || !history || since == 1.0 || (pc.still >= 1.0 && !follow)) {
     final_color[i] = vec4(capped(c, cap), 1.0);
-    final_albedo[i] = vec4(alb, 1.0);
+    if (kFinalAlbedo) final_albedo[i] = vec4(alb, 1.0);
     return;
   }
   vec3 h, ha;
@@ -221,7 +223,7 @@ void main() {
     ha = vec3(0.0);
     for (int k = 0; k < 4; ++k) {
       h += w[k] * compress(texelFetch(prev_final, int(idx[k])).rgb);
-      ha += w[k] * texelFetch(prev_final_albedo, int(idx[k])).rgb;
+      if (kFinalAlbedo) ha += w[k] * texelFetch(prev_final_albedo, int(idx[k])).rgb;
     }
   }
   h = from_ycocg(clamp(to_ycocg(h), lo, hi));
@@ -239,5 +241,5 @@ void main() {
   // keeps its running mean: its history is young.
   if (!follow) a = mix(a, 1.0, pc.still);
   final_color[i] = vec4(capped(max(expand(mix(h, compress(c), a)), vec3(0.0)), cap), 1.0);
-  final_albedo[i] = vec4(max(mix(ha, alb, a), vec3(kPtMinDemodAlbedo)), 1.0);
+  if (kFinalAlbedo) final_albedo[i] = vec4(max(mix(ha, alb, a), vec3(kPtMinDemodAlbedo)), 1.0);
 }

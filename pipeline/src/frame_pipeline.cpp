@@ -152,7 +152,8 @@ FramePipeline::FramePipeline(gpu::Context& ctx, const renderer::GpuScene& scene,
   if (settings.denoiser == reconstruct::Denoiser::Bmfr)
     m.bmfr = std::make_unique<reconstruct::Bmfr>(ctx, grids, *m.accumulation, *m.gather,
                                                   m.tracer.scene().materials(), settings.bmfr_precision);
-  m.post = std::make_unique<reconstruct::PostTaa>(ctx, grids, *m.accumulation, *m.gather, m.bmfr.get());
+  m.post = std::make_unique<reconstruct::PostTaa>(ctx, grids, *m.accumulation, *m.gather, m.bmfr.get(),
+                                                  m.pixel_albedo != nullptr);
   m.resolve = std::make_unique<reconstruct::Resolve>(ctx, grids, *m.accumulation, *m.post);
   m.fill(0);
 }

@@ -8,9 +8,10 @@
 namespace fovea::reconstruct {
 
 PostTaa::PostTaa(gpu::Context& ctx, std::span<const EyeGrid> eyes, const Accumulation& acc,
-                 const StereoGather& gather, const Bmfr* bmfr)
+                 const StereoGather& gather, const Bmfr* bmfr, bool final_albedo)
     : post_(kernel<PostBindings, shaders::ReconPostPush>(ctx, "recon_post.comp.spv")),
-      taa_(kernel<TaaBindings, shaders::ReconPostPush>(ctx, "recon_taa.comp.spv")),
+      taa_(kernel<TaaBindings, shaders::ReconPostPush>(ctx, "recon_taa.comp.spv",
+                                                       {gpu::SpecConstant::boolean(0, final_albedo)})),
       eyes_(eyes.size()) {
   for (std::size_t i = 0; i < eyes.size(); ++i) {
     const EyeGrid& g = eyes[i];
@@ -21,7 +22,7 @@ PostTaa::PostTaa(gpu::Context& ctx, std::span<const EyeGrid> eyes, const Accumul
     for (int p = 0; p < 2; ++p) {
       e.post[p] = cells(ctx, g.cells, "recon.post");
       e.final_[p] = cells(ctx, g.cells, "recon.final");
-      e.final_albedo[p] = cells(ctx, g.cells, "recon.final_albedo");
+      e.final_albedo[p] = cells(ctx, final_albedo ? g.cells : 1, "recon.final_albedo");
     }
     e.sum = cells(ctx, g.cells, "recon.post_sum");
     const gpu::Buffer* source = bmfr ? &bmfr->fitted(me) : &gather.z(me);

@@ -131,8 +131,10 @@ class Bmfr {
 class PostTaa {
  public:
   // `bmfr`: the fitted input, or nullptr when BMFR is off (Phase III then filters z).
+  // `final_albedo`: also write the albedo the output holds (final_albedo(); the resolve's
+  // pixel albedo needs it), two more buffers of the grid's size per eye.
   PostTaa(gpu::Context& ctx, std::span<const EyeGrid> eyes, const Accumulation& acc, const StereoGather& gather,
-          const Bmfr* bmfr);
+          const Bmfr* bmfr, bool final_albedo = false);
   void record(VkCommandBuffer cmd, int parity, bool history, const ReconSettings& settings) const;
   // The two halves of record (Phase III, then TAA), each followed by its barrier; for timing.
   void record_post(VkCommandBuffer cmd, int parity, bool history, const ReconSettings& settings) const;
@@ -141,7 +143,8 @@ class PostTaa {
 
   // Remodulated output in grid space (.w = 1 where a sample exists).
   const gpu::Buffer& final_color(int eye, int parity) const { return eyes_[eye].final_[parity]; }
-  // The albedo the output holds: the re-modulation's, blended with the history's as the colour.
+  // The albedo the output holds: the re-modulation's, blended with the history's as the colour
+  // (one cell without final_albedo at construction).
   const gpu::Buffer& final_albedo(int eye, int parity) const { return eyes_[eye].final_albedo[parity]; }
 
  private:
