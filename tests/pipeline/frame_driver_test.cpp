@@ -226,6 +226,27 @@ TEST(FrameOptions, LandingSamplesAreAWholeNumberFromOneToEight) {
   EXPECT_EQ(c.recon.landing_spp, 1u);  // a refused value changes nothing
 }
 
+// --pixel-albedo turns the display pixels' own albedo in the fovea on or off, by the same name
+// everywhere; anything but on or off is refused naming where it came from.
+TEST(FrameOptions, PixelAlbedoIsOnOrOff) {
+  pipeline::FrameConfig c;
+  EXPECT_TRUE(c.recon.pixel_albedo);
+  EXPECT_EQ(pipeline::to_json(c)["pixel-albedo"], "on");
+  pipeline::apply_frame_option(c, "pixel-albedo", "off", "--pixel-albedo");
+  EXPECT_FALSE(c.recon.pixel_albedo);
+  EXPECT_EQ(pipeline::to_json(c)["pixel-albedo"], "off");
+  for (const char* bad : {"", "true", "1", "ON"}) {
+    try {
+      pipeline::apply_frame_option(c, "pixel-albedo", bad, "layer.json: default.pixel-albedo");
+      ADD_FAILURE() << bad;
+    } catch (const fovea::core::InputError& e) {
+      EXPECT_NE(std::string(e.what()).find("layer.json: default.pixel-albedo: expected on or off"), std::string::npos)
+          << e.what();
+    }
+  }
+  EXPECT_FALSE(c.recon.pixel_albedo);  // a refused value changes nothing
+}
+
 // --cap sets Visual-Polar's samples per display pixel at most (κ) by the same name everywhere;
 // the grid then puts that many in the fovea. A cap outside (0, 16] or not a number is refused
 // naming where it came from.
