@@ -24,8 +24,8 @@
 //   fovea; kReconRestartFrames, never at a still gaze) the current input is first averaged
 //   with the grid neighbours that pass the history's validity test (same surface): 5×5 in
 //   the first kRestartFollow frames, 3×3 after. The first frame is shown without TAA's
-//   history (it holds the coarse periphery); in the next kRestartFollow − 1 frames TAA is a
-//   running mean weighted by the jitter's centre weight g, α = g / (ḡ·(k − 1) + g) at the
+//   history (it holds the coarse periphery); in the rest of the window TAA is a running
+//   mean weighted by the jitter's centre weight g, α = g / (ḡ·(k − 1) + g) at the
 //   window's frame k (ḡ: g's mean over the cell), so the window's frames count about evenly
 //   and the albedo, re-modulated from each frame's jittered sample, converges to the cell
 //   centre's as with a fixed gaze. (With jitter off, g = 1, the newest frame weighs more;
@@ -85,7 +85,7 @@ const float kCentreSigma = 0.25;
 // ḡ: the mean of exp(−|j|²/(2σ²)) over a uniform jitter j in the cell, (σ√(2π) erf(1/(2√2 σ)))².
 const float kMeanCentre = 0.358;
 const float kFireflyRatio = 4.0;   // a surface cell's luminance over its brightest neighbour's, at most
-const float kRestartFollow = 4.0;  // restart frames with the 5×5 average and TAA's running mean
+const float kRestartFollow = 4.0;  // restart frames with the 5×5 average
 const int kRestartReach = 2;       // the 5×5 average's reach (cells)
 
 vec3 to_ycocg(vec3 c) {
@@ -175,8 +175,8 @@ void main() {
   vec3 avg = texelFetch(post, int(i)).rgb;
   float avg_w = 1.0;
   RgCell cell = rg_cell(m, i);
-  bool follow = since > 0.0 && since <= kRestartFollow;  // the window's first frames
-  int reach = follow ? kRestartReach : 1;
+  bool follow = since > 0.0;  // the window: TAA's running mean
+  int reach = follow && since <= kRestartFollow ? kRestartReach : 1;
   for (int dc = -reach; dc <= reach; ++dc) {
     RgColumnNear near;
     if (!rg_column_next_to(m, cell, dc, near)) continue;

@@ -143,12 +143,6 @@ TEST_F(GpuTest, FoveaIsSharpWithinThreeFramesAfterA40DegreeSaccade) {
   for (const auto denoiser : {reconstruct::Denoiser::None, reconstruct::Denoiser::Bmfr}) {
     reconstruct::ReconSettings s;
     s.denoiser = denoiser;
-    // The reconstruction's recovery alone: the display pixels' own albedo (on by default)
-    // sharpens the steady fovea's textures more than the landed one's noise, so the landed
-    // fovea's PSNR trails the control by up to 1.4 dB at frames 5–6 with it, its HDR-FLIP
-    // within 3 % (docs/reconstruction.md, "Textures at the display's resolution");
-    // ShippedScenes/LandingRecovery checks the default settings' recovery.
-    s.pixel_albedo = false;
     pipeline::FramePipeline control(ctx(), gs, core::stereo_views(display), {}, s, {}, true);
     for (int f = 0; f < settle + after; ++f) control.render(poses, {target, target}, std::uint32_t(f));
     const double sharp = fovea_sharpness(control.image(core::Eye::Left), control.view(core::Eye::Left), target);
@@ -198,12 +192,6 @@ TEST_F(GpuTest, SaccadeRecoveryCurveOnTheDefaultScene) {
   for (const auto denoiser : {reconstruct::Denoiser::None, reconstruct::Denoiser::Bmfr}) {
     reconstruct::ReconSettings s;
     s.denoiser = denoiser;
-    // The reconstruction's recovery alone: the display pixels' own albedo (on by default)
-    // sharpens the steady fovea's textures more than the landed one's noise, so the landed
-    // fovea's PSNR trails the control by up to 1.4 dB at frames 5–6 with it, its HDR-FLIP
-    // within 3 % (docs/reconstruction.md, "Textures at the display's resolution");
-    // ShippedScenes/LandingRecovery checks the default settings' recovery.
-    s.pixel_albedo = false;
     pipeline::FramePipeline control(ctx(), gs, core::stereo_views(c.display), {}, s, c.path, true);
     std::vector<double> sharp(c.after);
     std::vector<core::Scores> control_scores(c.after);
@@ -355,12 +343,6 @@ TEST_P(LandingBmfrAgainstNone, BmfrIsNoWorseOnAnyFrameAfterTheLanding) {
   for (const auto denoiser : {reconstruct::Denoiser::None, reconstruct::Denoiser::Bmfr}) {
     reconstruct::ReconSettings s = pipeline::FrameConfig::default_recon();
     s.denoiser = denoiser;
-    // The reconstruction's recovery alone: the display pixels' own albedo (on by default)
-    // sharpens the steady fovea's textures more than the landed one's noise, so the landed
-    // fovea's PSNR trails the control by up to 1.4 dB at frames 5–6 with it, its HDR-FLIP
-    // within 3 % (docs/reconstruction.md, "Textures at the display's resolution");
-    // ShippedScenes/LandingRecovery checks the default settings' recovery.
-    s.pixel_albedo = false;
     pipeline::FramePipeline jump(ctx(), gs, core::stereo_views(display), {}, s);
     for (int f = 0; f < kSettle + int(reconstruct::kLandingFrames); ++f) {
       const glm::dvec3 gaze = f < kSettle ? before : target;
