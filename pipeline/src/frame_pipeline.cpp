@@ -180,8 +180,9 @@ void FramePipeline::set_visibility(core::Eye eye, const core::ViewMask& mask) {
 std::vector<std::pair<std::string, double>> FrameTimes::gpu_record() const {
   std::vector<std::pair<std::string, double>> r;
   for (const auto& [name, st] : stages()) r.emplace_back(name, st.gpu_ms);
-  r.insert(r.end(), {{"pixel_albedo", pixel_albedo_gpu_ms}, {"accumulate", accumulate_gpu_ms}, {"bmfr_fit", bmfr_fit_gpu_ms}, {"post", post_gpu_ms},
-                     {"mip", mip_gpu_ms}, {"resample", resample_gpu_ms}, {"blur", blur_gpu_ms}, {"total", gpu_ms()}});
+  r.insert(r.end(), {{"pixel_albedo", pixel_albedo_gpu_ms}, {"accumulate", accumulate_gpu_ms},
+                     {"bmfr_fit", bmfr_fit_gpu_ms}, {"post", post_gpu_ms}, {"mip", mip_gpu_ms},
+                     {"resample", resample_gpu_ms}, {"blur", blur_gpu_ms}, {"total", gpu_ms()}});
   return r;
 }
 

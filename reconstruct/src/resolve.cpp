@@ -125,7 +125,8 @@ Resolve::Resolve(gpu::Context& ctx, std::span<const EyeGrid> eyes, const Accumul
     for (int p = 0; p < 2; ++p)
       e.resolve_set[p] = make_set(ctx, resolve_,
                                   ResolveBindings{g.maps(), g.tables(), &e.mips, &e.offsets, &e.screen_a,
-                                                  &acc.position(int(i), p), &e.depth, g.luts(), &post.final_albedo(int(i), p),
+                                                  &acc.position(int(i), p), &e.depth, g.luts(),
+                                                  &post.final_albedo(int(i), p),
                                                   e.has_primary ? g.primary : &e.no_primary});
     e.prev_luma = storage(ctx, VkDeviceSize(pixels) * 4, "recon.temporal_prev_luma");
     e.temporal_sums = storage(ctx, VkDeviceSize(temporal_runs(g.width, g.height)) * 4, "recon.temporal_sums");

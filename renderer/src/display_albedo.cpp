@@ -39,7 +39,8 @@ PixelWindow cone_window(const core::View& view, glm::dvec3 axis, double radius_d
     px = {(d.x / -d.z - view.tan_left()) * sx, (view.tan_up() - d.y / -d.z) * sy};
     return true;
   };
-  const glm::dvec3 u = glm::normalize(std::abs(a.x) < 0.9 ? glm::cross(a, glm::dvec3(1, 0, 0)) : glm::cross(a, glm::dvec3(0, 1, 0)));
+  const glm::dvec3 u =
+      glm::normalize(glm::cross(a, std::abs(a.x) < 0.9 ? glm::dvec3(1, 0, 0) : glm::dvec3(0, 1, 0)));
   const glm::dvec3 v = glm::cross(a, u);
   const double r = std::min(radius_deg, 89.0) * kDeg;
   constexpr double kInf = std::numeric_limits<double>::infinity();
@@ -95,7 +96,8 @@ DisplayAlbedo::DisplayAlbedo(gpu::Context& ctx, const GpuScene& scene)
     : ctx_(ctx),
       scene_(scene),
       pipeline_(ctx, tracer_pipeline(scene, "pt_primary", bindings(), sizeof(shaders::PtPrimaryParams),
-                                     {gpu::SpecConstant::boolean(shaders::kPtSpecTextures, scene.features().textures)})) {}
+                                     {gpu::SpecConstant::boolean(shaders::kPtSpecTextures,
+                                                                 scene.features().textures)})) {}
 
 PrimaryHits DisplayAlbedo::bind(std::uint32_t capacity) const {
   if (capacity == 0) throw core::InputError("display albedo: a window of no pixels");
@@ -114,8 +116,8 @@ PrimaryHits DisplayAlbedo::bind(std::uint32_t capacity) const {
 void DisplayAlbedo::record(VkCommandBuffer cmd, PrimaryHits& out, const core::View& view, const PixelWindow& window,
                            std::uint32_t grid, double texture_cone) const {
   if (window.empty()) return;
-  if (window.x0 + window.width > std::uint32_t(view.width()) || window.y0 + window.height > std::uint32_t(view.height()) ||
-      window.pixels() > out.capacity_)
+  if (window.x0 + window.width > std::uint32_t(view.width()) ||
+      window.y0 + window.height > std::uint32_t(view.height()) || window.pixels() > out.capacity_)
     throw core::InputError("display albedo: window " + std::to_string(window.width) + "x" +
                            std::to_string(window.height) + " at (" + std::to_string(window.x0) + ", " +
                            std::to_string(window.y0) + ") outside the raster or beyond the buffer's " +

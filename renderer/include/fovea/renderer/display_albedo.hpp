@@ -62,8 +62,8 @@ class DisplayAlbedo {
   bool needed() const { return scene_.features().textures; }
   PrimaryHits bind(std::uint32_t capacity) const;
   // Records the first hits of `window`'s pixels of `view`'s raster (its pose: the eye's)
-  // into `out` (window.pixels() ≤ its capacity): `grid` × `grid` rays per pixel, each with a
-  // texture cone of `texture_cone` times its stratum. The caller orders later reads with a barrier.
+  // into `out` (window.pixels() ≤ its capacity): `grid` × `grid` rays per pixel (1 to 4), each
+  // with a texture cone of `texture_cone` times its stratum. The caller orders later reads with a barrier.
   void record(VkCommandBuffer cmd, PrimaryHits& out, const core::View& view, const PixelWindow& window,
               std::uint32_t grid = kPixelAlbedoGrid, double texture_cone = 1.0) const;
 
