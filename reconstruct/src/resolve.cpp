@@ -121,6 +121,8 @@ Resolve::Resolve(gpu::Context& ctx, std::span<const EyeGrid> eyes, const Accumul
     e.depth = storage(ctx, VkDeviceSize(pixels) * 4, "recon.depth");
     e.mip_set = make_set(ctx, mip_, MipBindings{g.maps(), g.tables(), &e.mips});
     e.has_primary = g.primary != nullptr;
+    if (e.has_primary && post.final_albedo(int(i), 0).size() < VkDeviceSize(g.cells) * 16)
+      throw core::InputError("resolve: the display pixels' first hits need TAA's output albedo (PostTaa final_albedo)");
     if (!e.has_primary) e.no_primary = cells(ctx, 1, "recon.no_primary");  // bound, never read
     for (int p = 0; p < 2; ++p)
       e.resolve_set[p] = make_set(ctx, resolve_,

@@ -4,6 +4,7 @@
 #include <cmath>
 #include <limits>
 #include <numbers>
+#include <optional>
 #include <string>
 
 #include <glm/geometric.hpp>
@@ -32,13 +33,6 @@ PixelWindow cone_window(const core::View& view, glm::dvec3 axis, double radius_d
   if (!std::isfinite(len) || !(len > 0) || !(radius_deg > 0) || max_pixels == 0) return {};
   const glm::dvec3 a = axis / len;
   const double w = view.width(), h = view.height();
-  const double sx = w / (view.tan_right() - view.tan_left()), sy = h / (view.tan_up() - view.tan_down());
-  // Raster position of a direction in front of the eye (z < 0), else none.
-  const auto to_px = [&](glm::dvec3 d, glm::dvec2& px) {
-    if (!(d.z < -1e-9)) return false;
-    px = {(d.x / -d.z - view.tan_left()) * sx, (view.tan_up() - d.y / -d.z) * sy};
-    return true;
-  };
   const glm::dvec3 u =
       glm::normalize(glm::cross(a, std::abs(a.x) < 0.9 ? glm::dvec3(1, 0, 0) : glm::dvec3(0, 1, 0)));
   const glm::dvec3 v = glm::cross(a, u);
@@ -49,13 +43,13 @@ PixelWindow cone_window(const core::View& view, glm::dvec3 axis, double radius_d
   for (int k = 0; k < kConeSteps; ++k) {
     const double phi = 2 * std::numbers::pi * k / kConeSteps;
     const glm::dvec3 d = std::cos(r) * a + std::sin(r) * (std::cos(phi) * u + std::sin(phi) * v);
-    glm::dvec2 px;
-    if (!to_px(d, px)) { behind = true; continue; }
-    x0 = std::min(x0, px.x); x1 = std::max(x1, px.x);
-    y0 = std::min(y0, px.y); y1 = std::max(y1, px.y);
+    const std::optional<glm::dvec2> px = view.dir_to_pixel(d);  // none behind the eye's plane
+    if (!px) { behind = true; continue; }
+    x0 = std::min(x0, px->x), x1 = std::max(x1, px->x), y0 = std::min(y0, px->y), y1 = std::max(y1, px->y);
   }
-  glm::dvec2 centre(0.0);
-  const bool front = to_px(a, centre);
+  const std::optional<glm::dvec2> axis_px = view.dir_to_pixel(a);
+  const bool front = axis_px.has_value();
+  const glm::dvec2 centre = axis_px.value_or(glm::dvec2(0.0));
   if (behind) {  // the cone reaches the eye's plane: its trace runs off to infinity beyond the axis
     if (!front) return {};
     x0 = std::min(x0, centre.x), x1 = std::max(x1, centre.x), y0 = std::min(y0, centre.y), y1 = std::max(y1, centre.y);

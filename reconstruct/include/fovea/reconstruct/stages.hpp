@@ -151,7 +151,8 @@ class PostTaa {
   struct Eye {
     std::uint32_t cells = 0;
     const gpu::Buffer* live = nullptr;  // EyeGrid::live
-    gpu::Buffer post[2], sum, final_[2], final_albedo[2];  // post: accumulated fit (history); sum: + excess + direct
+    // post: accumulated fit (history); sum: + excess + direct
+    gpu::Buffer post[2], sum, final_[2], final_albedo[2];
     gpu::DescriptorSet post_set[2], taa_set[2];
   };
   gpu::ComputePipeline post_, taa_;
