@@ -1,6 +1,7 @@
 #version 460
-// Display pixels' first hits: one ray through each pixel centre of a window of the display
-// raster, its first hit's base colour (textured at the pixel's footprint) and material.
+// Display pixels' first hits: for each pixel of a window of the display raster, rays at the
+// centres of its grid × grid strata, their first hits' mean base colour (each textured over its
+// stratum) and the material of the ray nearest the pixel's centre.
 // Conventions: fovea/shaders/pt_primary.h.
 #extension GL_GOOGLE_include_directive : require
 #extension GL_EXT_samplerless_texture_functions : require  // texelFetch on texture buffers

@@ -69,9 +69,8 @@ bool display_raster(const EyeState& e) {
          e.dist->rows() == e.base_view.height();
 }
 
-// The angles from the gaze within which the resolve re-modulates with the pixels' own albedo
-// fully (the fovea) and beyond which not at all (the distribution's margin, at least 0.5°).
-double pixel_albedo_full_deg() { return core::acuity::kFoveaDeg; }
+// The angle from the gaze beyond which the resolve no longer re-modulates with the pixels' own
+// albedo: the fovea (within which it does fully) and the distribution's margin, at least 0.5°.
 double pixel_albedo_none_deg(const EyeState& e) {
   return core::acuity::kFoveaDeg + std::max(e.dist->params().margin_deg, 0.5);
 }
@@ -272,7 +271,7 @@ FrameTimes FramePipeline::render(const std::array<core::Pose, 2>& eye_pose, cons
         const renderer::PixelWindow w = renderer::cone_window(view, e.gaze_used, none_deg, e.primary.capacity());
         m.pixel_albedo->record(cmd, e.primary, view, w);
         constexpr double kDeg = std::numbers::pi / 180;
-        m.resolve->set_detail(int(i), {w.x0, w.y0, w.width, w.height, float(std::cos(pixel_albedo_full_deg() * kDeg)),
+        m.resolve->set_detail(int(i), {w.x0, w.y0, w.width, w.height, float(std::cos(core::acuity::kFoveaDeg * kDeg)),
                                        float(std::cos(none_deg * kDeg))});
       }
       gpu::compute_to_compute(cmd);

@@ -1,7 +1,7 @@
 #pragma once
 // Display pixels' first hits (pt_primary.comp): for a window of an eye's display raster
-// around the gaze, the ray through each pixel centre and its first hit's base colour
-// (textured, prefiltered over the pixel) and material. The reconstruction re-modulates the
+// around the gaze, rays through the strata of each pixel and their first hits' mean base
+// colour (textured, together the pixel's box filter) and material. The reconstruction re-modulates the
 // fovea with them, so that textures there keep the display's resolution where the grid's
 // cells, which are not the display's pixels, would blur them once more in the resolve
 // (docs/reconstruction.md, "Textures at the display's resolution").

@@ -1,5 +1,5 @@
-// Display pixels' first hits (pt_primary.comp): for a window of an eye's display raster, the
-// ray through each pixel centre, and its first hit's base colour and material. The
+// Display pixels' first hits (pt_primary.comp): for a window of an eye's display raster, rays
+// through the strata of each pixel, and their first hits' base colour and material. The
 // reconstruction re-modulates the fovea with them (recon_resolve.comp: textures at the
 // display's resolution where the grid's cells are about a pixel). Shared C++/GLSL.
 //
