@@ -6,7 +6,10 @@
 // row height 360°·sin e·arc / rows (φ pass, along the column). Cells and σ both follow the
 // eccentricity, so the kernel is a few cells wide at most, where on the display it reaches
 // many pixels; cells whose σ is below min_sigma_cells are copied (the grid cannot carry a
-// sub-cell blur; the resample's bilinear reconstruction is already a cell wide).
+// sub-cell blur; the resample's bilinear reconstruction is already a cell wide), unless the
+// cell spans several display pixels in the pass's direction: then σ is at least
+// lattice_sigma_cells, faded in from kReconLatticeFromPx to kReconLatticeFullPx pixels, so
+// that the reconstruction reaches beyond the cell and its lattice (rings, spokes) does not show.
 // The ρ pass reads each neighbouring column at the cell's φ (rows differ per column),
 // linearly between its two rows there; φ wraps on full rings, clamps at a packed column's
 // ends and at the grid's first/last column (weights renormalised).
@@ -40,6 +43,19 @@ vec4 column_at(ReconGrid m, uint cc, float t) {
   return (1.0 - f) * texelFetch(src, int(uint(r0) * pcols + cc)) + f * texelFetch(src, int(uint(r1) * pcols + cc));
 }
 
+// Display pixels per degree at the centre of a cell at eccentricity e_deg and grid coordinate
+// t (φ / 2π from the basis b1): the mean of a pixel's angular width and height there. A cell
+// whose centre is not in front of the eye counts as having no pixels.
+float cell_pixels_per_deg(ReconGrid m, float e_deg, float t) {
+  float e = e_deg * (kRgPi / 180.0), phi = 2.0 * kRgPi * t;
+  vec3 d = cos(e) * rg_gaze(m) + sin(e) * (cos(phi) * vec3(m.g.b1_x, m.g.b1_y, m.g.b1_z) +
+                                          sin(phi) * vec3(m.g.b2_x, m.g.b2_y, m.g.b2_z));
+  if (!(d.z < -1e-6)) return 0.0;
+  vec2 tan_xy = d.xy / -d.z;
+  float pixel_rad = 0.5 * (rg_pixel_angle(m, tan_xy, false) + rg_pixel_angle(m, tan_xy, true));
+  return (kRgPi / 180.0) / max(pixel_rad, 1e-12);
+}
+
 void main() {
   ReconGrid m = maps[kReconCurrent];
   uint c = pc.first_column + gl_GlobalInvocationID.x, r = gl_GlobalInvocationID.y;
@@ -47,20 +63,31 @@ void main() {
   uint i = r * m.g.padded_columns + c;
   GridColumn col = rg_table(m.table_offset + c);
   if (r >= col.rows) return;  // beyond the column's rows: no kernel reads these cells
+  vec4 own = texelFetch(src, int(i));
+  if (!(own.w > 0.0)) {  // no sample (the lens' hidden area, off the view): it stays without one
+    dst[i] = own;
+    return;
+  }
   bool phi_pass = pc.phi_pass != 0u;
   float e = 0.5 * (col.r0 + col.r1);
   float arc = 1.0 - col.phi_gap / (2.0 * kRgPi);
   float cell_deg = phi_pass ? 360.0 * sin(e * (kRgPi / 180.0)) * arc / float(col.rows) : col.r1 - col.r0;
   float sigma = min(rg_blur_sigma_deg(e, pc.sigma_fovea_deg) / max(cell_deg, 1e-6), pc.max_sigma_cells);
-  if (sigma < pc.min_sigma_cells) {
-    dst[i] = texelFetch(src, int(i));
+  float t = rg_row_to_t_of(col, float(r) + 0.5);
+  float lattice = pc.lattice_sigma_cells > 0.0 && e >= pc.lattice_min_deg
+                      ? smoothstep(kReconLatticeFromPx, kReconLatticeFullPx, cell_deg * cell_pixels_per_deg(m, e, t))
+                      : 0.0;
+  bool acuity = sigma >= pc.min_sigma_cells;
+  if (!acuity && !(lattice > 0.0)) {
+    dst[i] = own;
     return;
   }
+  if (lattice > 0.0) sigma = max(sigma, pc.lattice_sigma_cells);
   int radius = int(ceil(3.0 * sigma));
   // Weights exp(a k²), a = -1/(2σ²), by the recurrence of recon_blur.comp.
   float a = -0.5 / (sigma * sigma);
   float w = 1.0, q = exp(a), q2 = q * q;
-  vec4 acc = texelFetch(src, int(i));
+  vec4 acc = own;
   float wsum = 1.0;
   if (phi_pass) {
     int rows = int(col.rows);
@@ -78,7 +105,6 @@ void main() {
       }
     }
   } else {
-    float t = rg_row_to_t_of(col, float(r) + 0.5);
     for (int k = 1; k <= radius; ++k) {
       w *= q;
       q *= q2;
@@ -90,5 +116,6 @@ void main() {
       }
     }
   }
-  dst[i] = acc / wsum;
+  // Where only the lattice asks for it, the blur fades in with the cell's size in pixels.
+  dst[i] = acuity ? acc / wsum : mix(own, acc / wsum, lattice);
 }

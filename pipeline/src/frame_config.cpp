@@ -21,7 +21,7 @@ const std::vector<std::string>& frame_option_names() {
   static const std::vector<std::string> names = {"budget",         "cap",          "distribution", "jitter",
                                                  "denoiser",       "bmfr-precision", "stereo-share", "trace",
                                                  "bounces",        "seed",           "landing-spp",
-                                                 "pixel-albedo"};
+                                                 "pixel-albedo",   "lattice-blur"};
   return names;
 }
 
@@ -37,6 +37,12 @@ long whole_number(std::string_view value, long lo, long hi, const char* or_what 
     throw core::InputError(std::string("expected ") + or_what + "a whole number in " + std::to_string(lo) + ".." +
                            std::to_string(hi) + ", got \"" + v + "\"");
   return n;
+}
+
+// "on" or "off"; otherwise InputError "expected on or off, got "value"".
+bool on_off(std::string_view value) {
+  if (value != "on" && value != "off") throw core::InputError("expected on or off, got \"" + std::string(value) + "\"");
+  return value == "on";
 }
 
 // A finite number written in full; otherwise InputError "expected a finite number, got "value"".
@@ -77,9 +83,9 @@ void apply_frame_option(FrameConfig& c, std::string_view name, std::string_view 
     } else if (name == "landing-spp") {
       c.recon.landing_spp = std::uint32_t(whole_number(value, 1, FrameConfig::kMaxLandingSpp));
     } else if (name == "pixel-albedo") {
-      if (value != "on" && value != "off")
-        throw core::InputError("expected on or off, got \"" + std::string(value) + "\"");
-      c.recon.pixel_albedo = value == "on";
+      c.recon.pixel_albedo = on_off(value);
+    } else if (name == "lattice-blur") {
+      c.recon.blur_lattice_sigma_cells = on_off(value) ? reconstruct::kLatticeBlurSigmaCells : 0.0;
     } else if (name == "seed") {
       c.seed = std::uint32_t(whole_number(value, 0, FrameConfig::kMaxSeed));
     } else {
@@ -119,7 +125,8 @@ nlohmann::json to_json(const FrameConfig& c) {
           {"bounces", c.bounces.from_albedo ? nlohmann::json("auto") : nlohmann::json(c.bounces.count)},
           {"seed", c.seed},
           {"landing-spp", c.recon.landing_spp},
-          {"pixel-albedo", c.recon.pixel_albedo ? "on" : "off"}};
+          {"pixel-albedo", c.recon.pixel_albedo ? "on" : "off"},
+          {"lattice-blur", c.recon.blur_lattice_sigma_cells > 0 ? "on" : "off"}};
 }
 
 renderer::PathConfig path_config(const Bounces& bounces, const renderer::Scene& scene) {

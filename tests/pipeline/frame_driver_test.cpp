@@ -226,25 +226,41 @@ TEST(FrameOptions, LandingSamplesAreAWholeNumberFromOneToEight) {
   EXPECT_EQ(c.recon.landing_spp, 1u);  // a refused value changes nothing
 }
 
-// --pixel-albedo turns the display pixels' own albedo in the fovea on or off, by the same name
-// everywhere; anything but on or off is refused naming where it came from.
-TEST(FrameOptions, PixelAlbedoIsOnOrOff) {
-  pipeline::FrameConfig c;
-  EXPECT_TRUE(c.recon.pixel_albedo);
-  EXPECT_EQ(pipeline::to_json(c)["pixel-albedo"], "on");
-  pipeline::apply_frame_option(c, "pixel-albedo", "off", "--pixel-albedo");
-  EXPECT_FALSE(c.recon.pixel_albedo);
-  EXPECT_EQ(pipeline::to_json(c)["pixel-albedo"], "off");
-  for (const char* bad : {"", "true", "1", "ON"}) {
-    try {
-      pipeline::apply_frame_option(c, "pixel-albedo", bad, "layer.json: default.pixel-albedo");
-      ADD_FAILURE() << bad;
-    } catch (const fovea::core::InputError& e) {
-      EXPECT_NE(std::string(e.what()).find("layer.json: default.pixel-albedo: expected on or off"), std::string::npos)
-          << e.what();
+// --pixel-albedo (the display pixels' own albedo in the fovea; default on) and --lattice-blur
+// (half a cell's blur of cells several pixels wide; default off) are on or off by the same
+// name everywhere; anything else is refused naming where it came from and changes nothing.
+TEST(FrameOptions, OnOffOptionsTakeOnlyOnOrOff) {
+  struct Case {
+    const char* name;
+    bool on_by_default;
+    bool (*is_on)(const pipeline::FrameConfig&);
+  };
+  const Case cases[] = {
+      {"pixel-albedo", true, [](const pipeline::FrameConfig& c) { return c.recon.pixel_albedo; }},
+      {"lattice-blur", false,
+       [](const pipeline::FrameConfig& c) {
+         return c.recon.blur_lattice_sigma_cells == fovea::reconstruct::kLatticeBlurSigmaCells;
+       }},
+  };
+  for (const Case& k : cases) {
+    pipeline::FrameConfig c;
+    EXPECT_EQ(k.is_on(c), k.on_by_default) << k.name;
+    EXPECT_EQ(pipeline::to_json(c)[k.name], k.on_by_default ? "on" : "off") << k.name;
+    const char* flipped = k.on_by_default ? "off" : "on";
+    pipeline::apply_frame_option(c, k.name, flipped, std::string("--") + k.name);
+    EXPECT_EQ(k.is_on(c), !k.on_by_default) << k.name;
+    EXPECT_EQ(pipeline::to_json(c)[k.name], flipped) << k.name;
+    const std::string where = std::string("layer.json: default.") + k.name;
+    for (const char* bad : {"", "true", "1", "ON"}) {
+      try {
+        pipeline::apply_frame_option(c, k.name, bad, where);
+        ADD_FAILURE() << k.name << " " << bad;
+      } catch (const fovea::core::InputError& e) {
+        EXPECT_NE(std::string(e.what()).find(where + ": expected on or off"), std::string::npos) << e.what();
+      }
     }
+    EXPECT_EQ(k.is_on(c), !k.on_by_default) << k.name;  // a refused value changes nothing
   }
-  EXPECT_FALSE(c.recon.pixel_albedo);  // a refused value changes nothing
 }
 
 // --cap sets Visual-Polar's samples per display pixel at most (κ) by the same name everywhere;

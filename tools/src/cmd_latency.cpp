@@ -216,7 +216,8 @@ int run(std::vector<std::string> argv) {
                                              "inject-latency", "quality-frames", "reference-spp", "budget", "cap",
                                              "quality-at", "quality-radius", "reference-error", "reference-cache",
                                              "distribution", "denoiser", "bmfr-precision", "stereo-share", "trace",
-                                             "bounces", "seed", "landing-spp", "pixel-albedo"};
+                                             "bounces", "seed", "landing-spp", "pixel-albedo",
+                                             "lattice-blur"};
   std::vector<std::string> valued = sim_options;
   valued.insert(valued.end(), {"records", "out"});
   const Args args(argv, valued, {"quiet", "no-main-render"});

@@ -92,7 +92,7 @@ With no options: a short demo on the shipped scene and gaze.
                         WxH@SWxSHmm@Dmm (as the URI key screen=; docs/gaze.md)
   --frames N            frames to render [24]
 )";
-constexpr const char* kHelpTail = R"(  --no-blur             skip the peripheral blur
+constexpr const char* kHelpTail = R"(  --no-blur             skip the peripheral blur (and the lattice's, --lattice-blur)
   --no-cull             trace the lens' hidden area too
   --reference SPP|DIR   SPP: converged reference of the last frame with the render's own light
                         transport (--bounces; at most SPP samples per pixel, see
@@ -408,7 +408,8 @@ int run(std::vector<std::string> argv) {
   const Args args(argv,
                   {"scene", "display", "gaze", "frames", "distribution", "budget", "cap", "jitter", "denoiser", "bmfr-precision",
                    "stereo-share", "bounces", "reference", "reference-error", "reference-cache", "reference-window", "recovery-frames", "png-every",
-                   "out", "screen", "trace", "seed", "landing-spp", "pixel-albedo"},
+                   "out", "screen", "trace", "seed", "landing-spp", "pixel-albedo",
+                   "lattice-blur"},
                   {"no-blur", "no-cull", "no-marker", "quiet", "full-gi-score"});
   const long frames = args.integer("frames", 24);
   if (frames < 1 || frames > 100000) throw core::InputError("--frames must be in 1..100000");

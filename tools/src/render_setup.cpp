@@ -54,6 +54,10 @@ constexpr OptionHelp kFrameOptionsHelp[] = {
     {"pixel-albedo",
      "  --pixel-albedo on|off textures at the display's resolution in the fovea: each display\n"
      "                        pixel's own first hit re-modulates it (scenes with textures)"},
+    {"lattice-blur",
+     "  --lattice-blur on|off visual-polar: blur cells of several display pixels by half a cell,\n"
+     "                        so that their lattice (arcs about the gaze) does not show: steadier\n"
+     "                        and less detailed (docs/reconstruction.md, \"The lattice's rings\")"},
     {"seed",
      "  --seed N              noise seed: another N, another noise realisation of the same frames\n"
      "                        (path tracing and BMFR keyed by frame + 1024·N; gaze and jitter\n"

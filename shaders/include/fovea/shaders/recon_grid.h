@@ -127,10 +127,18 @@ struct ReconTemporalPush {
 // Grid-space peripheral blur of an angular polar grid (recon_grid_blur.comp): one pass over
 // columns [first_column, columns) of the current mapping, across columns (along ρ) or, with
 // phi_pass, along the rows of each column; σ in cells from the acuity model and the cells'
-// angular size, cells below min_sigma_cells copied.
+// angular size, cells below min_sigma_cells copied. Where a cell spans more display pixels
+// than kReconLatticeFromPx in the pass's direction, σ is at least lattice_sigma_cells, fully
+// from kReconLatticeFullPx: the reconstruction then reaches beyond the cell, so the lattice's
+// rings do not show (docs/reconstruction.md, "The lattice's rings"); not within
+// lattice_min_deg of the gaze, where the display pixels' own albedo re-modulates the cells
+// (the resolve's detail window divides by the cells' albedo, which is not blurred).
+FOVEA_CONST float kReconLatticeFromPx = 2.0f;
+FOVEA_CONST float kReconLatticeFullPx = 4.0f;
 struct ReconGridBlurPush {
-  FOVEA_UINT first_column, phi_pass, pad0, pad1;
-  float sigma_fovea_deg, min_sigma_cells, max_sigma_cells, pad2;
+  FOVEA_UINT first_column, phi_pass;
+  float lattice_sigma_cells, lattice_min_deg;
+  float sigma_fovea_deg, min_sigma_cells, max_sigma_cells, pad1;
 };
 #ifdef __cplusplus
 static_assert(sizeof(ReconGrid) == 192);
