@@ -73,10 +73,11 @@ void main() {
   float arc = 1.0 - col.phi_gap / (2.0 * kRgPi);
   float cell_deg = phi_pass ? 360.0 * sin(e * (kRgPi / 180.0)) * arc / float(col.rows) : col.r1 - col.r0;
   float sigma = min(rg_blur_sigma_deg(e, pc.sigma_fovea_deg) / max(cell_deg, 1e-6), pc.max_sigma_cells);
-  float t = rg_row_to_t_of(col, float(r) + 0.5);
-  float lattice = pc.lattice_sigma_cells > 0.0 && e >= pc.lattice_min_deg
-                      ? smoothstep(kReconLatticeFromPx, kReconLatticeFullPx, cell_deg * cell_pixels_per_deg(m, e, t))
-                      : 0.0;
+  float lattice = 0.0;  // the lattice's blur (off unless asked for): its weight, by the cell's pixels
+  if (pc.lattice_sigma_cells > 0.0 && e >= pc.lattice_min_deg) {
+    float px = cell_deg * cell_pixels_per_deg(m, e, rg_row_to_t_of(col, float(r) + 0.5));
+    lattice = smoothstep(kReconLatticeFromPx, kReconLatticeFullPx, px);
+  }
   bool acuity = sigma >= pc.min_sigma_cells;
   if (!acuity && !(lattice > 0.0)) {
     dst[i] = own;
@@ -105,6 +106,7 @@ void main() {
       }
     }
   } else {
+    float t = rg_row_to_t_of(col, float(r) + 0.5);
     for (int k = 1; k <= radius; ++k) {
       w *= q;
       q *= q2;

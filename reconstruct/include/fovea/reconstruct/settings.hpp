@@ -28,8 +28,8 @@ const char* stereo_share_name(StereoShare s);
 // σ(e) = √(ln 2 / 2) / π · MAR(e) ≈ 0.187 MAR(e), 0.042° at 30°. Gratings the eye resolves
 // (f ≤ 1/(2 MAR)) keep at least 84% of their contrast.
 constexpr double kMarFoveaDeg = 1.0 / 60.0;
-// The lattice's blur when on (ReconSettings::blur_lattice_sigma_cells): the least σ that hides
-// the arcs, about the cubic B-spline's reach with the resample's tent (docs/reconstruction.md).
+// The lattice's blur when on (ReconSettings::blur_lattice_sigma_cells): with the resample's tent
+// it reaches about as far as the cubic B-spline that removed the arcs (docs/reconstruction.md).
 constexpr double kLatticeBlurSigmaCells = 0.5;
 double blur_sigma_deg(double e_deg, double mar_fovea_deg = kMarFoveaDeg);
 
