@@ -6,10 +6,7 @@
 // row height 360°·sin e·arc / rows (φ pass, along the column). Cells and σ both follow the
 // eccentricity, so the kernel is a few cells wide at most, where on the display it reaches
 // many pixels; cells whose σ is below min_sigma_cells are copied (the grid cannot carry a
-// sub-cell blur; the resample's bilinear reconstruction is already a cell wide), unless the
-// cell spans several display pixels in the pass's direction: then σ is at least
-// lattice_sigma_cells, faded in from kReconLatticeFromPx to kReconLatticeFullPx pixels, so
-// that the reconstruction reaches beyond the cell and its lattice (rings, spokes) does not show.
+// sub-cell blur; the resample's reconstruction is already a cell wide).
 // The ρ pass reads each neighbouring column at the cell's φ (rows differ per column),
 // linearly between its two rows there; φ wraps on full rings, clamps at a packed column's
 // ends and at the grid's first/last column (weights renormalised).
@@ -43,19 +40,6 @@ vec4 column_at(ReconGrid m, uint cc, float t) {
   return (1.0 - f) * texelFetch(src, int(uint(r0) * pcols + cc)) + f * texelFetch(src, int(uint(r1) * pcols + cc));
 }
 
-// Display pixels per degree at the centre of a cell at eccentricity e_deg and grid coordinate
-// t (φ / 2π from the basis b1): the mean of a pixel's angular width and height there. A cell
-// whose centre is not in front of the eye counts as having no pixels.
-float cell_pixels_per_deg(ReconGrid m, float e_deg, float t) {
-  float e = e_deg * (kRgPi / 180.0), phi = 2.0 * kRgPi * t;
-  vec3 d = cos(e) * rg_gaze(m) + sin(e) * (cos(phi) * vec3(m.g.b1_x, m.g.b1_y, m.g.b1_z) +
-                                          sin(phi) * vec3(m.g.b2_x, m.g.b2_y, m.g.b2_z));
-  if (!(d.z < -1e-6)) return 0.0;
-  vec2 tan_xy = d.xy / -d.z;
-  float pixel_rad = 0.5 * (rg_pixel_angle(m, tan_xy, false) + rg_pixel_angle(m, tan_xy, true));
-  return (kRgPi / 180.0) / max(pixel_rad, 1e-12);
-}
-
 void main() {
   ReconGrid m = maps[kReconCurrent];
   uint c = pc.first_column + gl_GlobalInvocationID.x, r = gl_GlobalInvocationID.y;
@@ -73,17 +57,10 @@ void main() {
   float arc = 1.0 - col.phi_gap / (2.0 * kRgPi);
   float cell_deg = phi_pass ? 360.0 * sin(e * (kRgPi / 180.0)) * arc / float(col.rows) : col.r1 - col.r0;
   float sigma = min(rg_blur_sigma_deg(e, pc.sigma_fovea_deg) / max(cell_deg, 1e-6), pc.max_sigma_cells);
-  float lattice = 0.0;  // the lattice's blur (off unless asked for): its weight, by the cell's pixels
-  if (pc.lattice_sigma_cells > 0.0 && e >= pc.lattice_min_deg) {
-    float px = cell_deg * cell_pixels_per_deg(m, e, rg_row_to_t_of(col, float(r) + 0.5));
-    lattice = smoothstep(kReconLatticeFromPx, kReconLatticeFullPx, px);
-  }
-  bool acuity = sigma >= pc.min_sigma_cells;
-  if (!acuity && !(lattice > 0.0)) {
+  if (sigma < pc.min_sigma_cells) {
     dst[i] = own;
     return;
   }
-  if (lattice > 0.0) sigma = max(sigma, pc.lattice_sigma_cells);
   int radius = int(ceil(3.0 * sigma));
   // Weights exp(a k²), a = -1/(2σ²), by the recurrence of recon_blur.comp.
   float a = -0.5 / (sigma * sigma);
@@ -118,6 +95,5 @@ void main() {
       }
     }
   }
-  // Where only the lattice asks for it, the blur fades in with the cell's size in pixels.
-  dst[i] = acuity ? acc / wsum : mix(own, acc / wsum, lattice);
+  dst[i] = acc / wsum;
 }

@@ -9,7 +9,8 @@
 // across silhouettes), 0 where that cell saw the sky or holds no sample; for depth
 // compositing, the image does not use it. Near the gaze, where the path tracer's first hits
 // at the display's pixels are given (pt_primary.h), textures are re-modulated at the display's
-// resolution (detail_gain).
+// resolution (detail_gain). With the lattice's reconstruction on, cells several pixels wide
+// are reconstructed with the cubic B-spline instead of the tent (lattice_weights).
 #extension GL_GOOGLE_include_directive : require
 #extension GL_EXT_samplerless_texture_functions : require  // texelFetch on texture buffers
 
@@ -44,6 +45,7 @@ struct ColumnTap {
   bool wraps;       // full ring: rows wrap (r0 in [-1, rows), r1 in [0, rows]); else clamp
   float v;          // row coordinate of the pixel's φ at level 0 (cell centres at +0.5)
   float turn_rows;  // rows over a full turn at the column's spacing (the LOD's unit)
+  float width;      // r1 - r0: degrees (angular polar) or pixels (screen polar)
 };
 
 ColumnTap column_tap(ReconGrid m, int ci, float t) {
@@ -54,6 +56,7 @@ ColumnTap column_tap(ReconGrid m, int ci, float t) {
   k.wraps = rg_column_wraps(m, col);
   k.v = rg_row_coord_of(col, t);
   k.turn_rows = float(col.rows) / (1.0 - col.phi_gap / (2.0 * kRgPi));
+  k.width = col.r1 - col.r0;
   return k;
 }
 
@@ -73,15 +76,48 @@ vec4 fetch_level(ReconGrid m, ColumnTap k0, ColumnTap k1, float fx, uint level) 
   return (1.0 - fx) * fetch_column(k0, level, base, m.g.padded_columns) + fx * fetch_column(k1, level, base, m.g.padded_columns);
 }
 
-// Footprint of the pixel along φ in rows of its column (turn_rows; the LOD's argument): a
-// pixel of angular size δ (the larger of its two sides) at eccentricity e spans
-// δ / (2π sin e) of the circle (angular polar); at radius r one pixel spans 1 / (2π r)
-// (screen polar).
-float phi_footprint(ReconGrid m, vec2 t, vec3 d, vec2 px, float turn_rows) {
-  if (m.g.family == kFamilyAngularPolar) {
-    float delta = max(rg_pixel_angle(m, t, false), rg_pixel_angle(m, t, true));
-    return delta * turn_rows / (2.0 * kRgPi * max(length(cross(d, rg_gaze(m))), 1e-6));
+// Weights of the four samples around x in [0, 1) between the middle two: the tent's (0, 1-x,
+// x, 0) blended with the uniform cubic B-spline's by `smooth` (0..1). The B-spline is C2
+// across the samples, so the reconstruction has no kinks at the cell centres, whose Mach
+// bands show the lattice (rings about the gaze, spokes) where a cell spans several pixels.
+vec4 lattice_weights(float x, float smooth_) {
+  float y = 1.0 - x, x2 = x * x, x3 = x2 * x;
+  vec4 b = vec4(y * y * y, 3.0 * x3 - 6.0 * x2 + 4.0, -3.0 * x3 + 3.0 * x2 + 3.0 * x + 1.0, x3) / 6.0;
+  return mix(vec4(0.0, y, x, 0.0), b, smooth_);
+}
+
+// Column k at level 0 (at the buffer's start) over four rows around its row coordinate
+// (lattice_weights along φ).
+vec4 fetch_column_smooth(ColumnTap k, uint pcols, float smooth_) {
+  if (!(smooth_ > 0.0)) return fetch_column(k, 0u, 0u, pcols);
+  int r0, r1;
+  float fy;
+  rg_row_pair(k.rows, k.wraps, k.v, r0, r1, fy);
+  vec4 w = lattice_weights(fy, smooth_);
+  int rm = r0 - 1, rp = r1 + 1;
+  if (k.wraps) {
+    rm += rm < 0 ? k.rows : 0;
+    rp -= rp >= k.rows ? k.rows : 0;
+  } else {
+    rm = clamp(rm, 0, k.rows - 1);
+    rp = clamp(rp, 0, k.rows - 1);
   }
+  return w.x * texelFetch(mips, int(uint(rm) * pcols + k.c)) + w.y * texelFetch(mips, int(uint(r0) * pcols + k.c)) +
+         w.z * texelFetch(mips, int(uint(r1) * pcols + k.c)) + w.w * texelFetch(mips, int(uint(rp) * pcols + k.c));
+}
+
+// The pixel's angular size δ on angular polar grids (the larger of its two sides, radians),
+// else 1 (screen polar grids measure radii in pixels).
+float pixel_delta(ReconGrid m, vec2 t) {
+  return m.g.family == kFamilyAngularPolar ? max(rg_pixel_angle(m, t, false), rg_pixel_angle(m, t, true)) : 1.0;
+}
+
+// Footprint of the pixel along φ in rows of its column (turn_rows; the LOD's argument): a
+// pixel of angular size δ (pixel_delta) at eccentricity e spans δ / (2π sin e) of the circle
+// (angular polar); at radius r one pixel spans 1 / (2π r) (screen polar).
+float phi_footprint(ReconGrid m, float delta, vec3 d, vec2 px, float turn_rows) {
+  if (m.g.family == kFamilyAngularPolar)
+    return delta * turn_rows / (2.0 * kRgPi * max(length(cross(d, rg_gaze(m))), 1e-6));
   float r = length(px - vec2(m.g.gaze_px_x, m.g.gaze_px_y));
   return turn_rows / (2.0 * kRgPi * max(r, 1e-6));
 }
@@ -137,7 +173,10 @@ void main() {
   ColumnTap k0 = column_tap(m, int(c0f), uv.y), k1 = column_tap(m, int(c0f) + 1, uv.y);
   ColumnTap near = fx >= 0.5 ? k1 : k0;  // the column of floor(u), clamped
   float lod = 0.0;
-  if (pc.levels > 1u && polar && near.c < pc.lod_columns) lod = clamp(log2(max(phi_footprint(m, t, d, px, near.turn_rows), 1.0)), 0.0, float(pc.levels - 1u));
+  if (pc.levels > 1u && polar && near.c < pc.lod_columns) {
+    float footprint = phi_footprint(m, pixel_delta(m, t), d, px, near.turn_rows);
+    lod = clamp(log2(max(footprint, 1.0)), 0.0, float(pc.levels - 1u));
+  }
   uint i = p.y * pc.width + p.x;
   if (pc.grid_coords != 0u) {
     screen[i] = vec4(uv, lod, 0.0);
@@ -145,8 +184,31 @@ void main() {
   }
   uint l0 = uint(floor(lod));
   float f = lod - float(l0);
-  vec4 v = fetch_level(m, k0, k1, fx, l0);
-  if (f > 0.0 && l0 + 1u < pc.levels) v = mix(v, fetch_level(m, k0, k1, fx, l0 + 1u), f);
+  // The lattice's reconstruction (--lattice-blur on, recon_grid.h): where a cell spans more
+  // than kReconLatticeFromPx display pixels in a direction (fully from kReconLatticeFullPx),
+  // the cubic B-spline across four cells in that direction instead of the tent; not within
+  // the display pixels' albedo window, whose gain divides by the tent-weighted cells' albedo.
+  // A cell's pixels: its width over the pixel's size δ, and one over its rows per pixel.
+  float lat_rho = 0.0, lat_phi = 0.0;
+  if (pc.lattice != 0u && polar && lod == 0.0 &&
+      !(pc.detail_width > 0u && dot(d, rg_gaze(m)) > pc.detail_cos_none)) {
+    float delta = pixel_delta(m, t);
+    float unit = m.g.family == kFamilyAngularPolar ? delta * (180.0 / kRgPi) : 1.0;  // degrees or pixels
+    lat_rho = smoothstep(kReconLatticeFromPx, kReconLatticeFullPx, near.width / unit);
+    lat_phi = smoothstep(kReconLatticeFromPx, kReconLatticeFullPx,
+                         1.0 / max(phi_footprint(m, delta, d, px, near.turn_rows), 1e-6));
+  }
+  vec4 v;
+  if (lat_rho > 0.0 || lat_phi > 0.0) {
+    vec4 w = lattice_weights(fx, lat_rho);
+    uint pcols = m.g.padded_columns;
+    v = w.y * fetch_column_smooth(k0, pcols, lat_phi) + w.z * fetch_column_smooth(k1, pcols, lat_phi);
+    if (w.x > 0.0) v += w.x * fetch_column_smooth(column_tap(m, int(c0f) - 1, uv.y), pcols, lat_phi);
+    if (w.w > 0.0) v += w.w * fetch_column_smooth(column_tap(m, int(c0f) + 2, uv.y), pcols, lat_phi);
+  } else {
+    v = fetch_level(m, k0, k1, fx, l0);
+    if (f > 0.0 && l0 + 1u < pc.levels) v = mix(v, fetch_level(m, k0, k1, fx, l0 + 1u), f);
+  }
   vec3 colour = v.w > 1e-6 ? v.rgb / v.w : vec3(0.0);
   if (pc.detail_width > 0u && l0 == 0u) colour *= detail_gain(m, k0, k1, fx, p, d);
   screen[i] = vec4(colour, 1.0);

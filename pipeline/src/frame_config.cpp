@@ -85,7 +85,7 @@ void apply_frame_option(FrameConfig& c, std::string_view name, std::string_view 
     } else if (name == "pixel-albedo") {
       c.recon.pixel_albedo = on_off(value);
     } else if (name == "lattice-blur") {
-      c.recon.blur_lattice_sigma_cells = on_off(value) ? reconstruct::kLatticeBlurSigmaCells : 0.0;
+      c.recon.lattice_blur = on_off(value);
     } else if (name == "seed") {
       c.seed = std::uint32_t(whole_number(value, 0, FrameConfig::kMaxSeed));
     } else {
@@ -126,7 +126,7 @@ nlohmann::json to_json(const FrameConfig& c) {
           {"seed", c.seed},
           {"landing-spp", c.recon.landing_spp},
           {"pixel-albedo", c.recon.pixel_albedo ? "on" : "off"},
-          {"lattice-blur", c.recon.blur_lattice_sigma_cells > 0 ? "on" : "off"}};
+          {"lattice-blur", c.recon.lattice_blur ? "on" : "off"}};
 }
 
 renderer::PathConfig path_config(const Bounces& bounces, const renderer::Scene& scene) {

@@ -297,7 +297,7 @@ FrameTimes FramePipeline::render(const std::array<core::Pose, 2>& eye_pose, cons
     m.timer.stage(cmd, "grid_blur");
     m.resolve->record_mips(cmd);
     m.timer.stage(cmd, "mip");
-    m.resolve->record_resample(cmd, p);
+    m.resolve->record_resample(cmd, p, m.settings);
     m.timer.stage(cmd, "resample");
     if (m.settings.blur) m.resolve->record_blur(cmd, m.settings);
     m.timer.stage(cmd, "blur");

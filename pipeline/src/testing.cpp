@@ -91,7 +91,7 @@ std::vector<glm::vec4> resolve_grid_coords(FramePipeline& pipeline, core::Eye ey
   auto& m = Access::impl(pipeline);
   const int i = m.index(eye, "resolve_grid_coords");
   m.write_mappings();
-  m.ctx.submit_and_wait([&](VkCommandBuffer cmd) { m.resolve->record_resample(cmd, m.parity, true); });
+  m.ctx.submit_and_wait([&](VkCommandBuffer cmd) { m.resolve->record_resample(cmd, m.parity, m.settings, true); });
   std::vector<glm::vec4> v = m.resolve->screen(i).download<glm::vec4>();
   const core::View& view = m.eyes[std::size_t(i)]->base_view;
   v.resize(std::size_t(view.width()) * view.height());
@@ -148,7 +148,7 @@ ResolveKernelTimes time_resolve(FramePipeline& pipeline, bool blur) {
   KernelTime grid_blur;
   if (blur) grid_blur = time([&](VkCommandBuffer cmd) { m.resolve->record_grid_blur(cmd, m.settings); });
   t.mip = time([&](VkCommandBuffer cmd) { m.resolve->record_mips(cmd); });
-  t.resample = time([&](VkCommandBuffer cmd) { m.resolve->record_resample(cmd, m.parity); });
+  t.resample = time([&](VkCommandBuffer cmd) { m.resolve->record_resample(cmd, m.parity, m.settings); });
   if (blur) t.blur = time([&](VkCommandBuffer cmd) { m.resolve->record_blur(cmd, m.settings); });
   t.blur.gpu_ms += grid_blur.gpu_ms, t.blur.cpu_ms += grid_blur.cpu_ms;
   return t;

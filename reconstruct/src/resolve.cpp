@@ -31,12 +31,9 @@ float blur_skip_cos(const ReconSettings& s, double ppd) {
 bool grid_space_blur(const shaders::ReconGrid& m) { return m.g.family == shaders::kFamilyAngularPolar; }
 
 // The first column of an angular polar mapping whose acuity kernel (recon_grid_blur.comp) is
-// at least min_sigma_px cells wide across or along it, or whose cells can span
-// kReconLatticeFromPx display pixels (at the raster's most pixels per degree), or `columns`
-// when none is: the blur passes start there (σ in cells and the cells' size grow outwards;
-// columns beyond it that need neither are copied).
-std::uint32_t first_blurred_column(const GridMapping& mapping, const ReconSettings& s, double max_pixels_per_deg,
-                                   double lattice_min_deg) {
+// at least min_sigma_px cells wide across or along it, or `columns` when none is: the blur
+// passes start there (σ in cells grows outwards; columns beyond it below the limit are copied).
+std::uint32_t first_blurred_column(const GridMapping& mapping, const ReconSettings& s) {
   const shaders::ReconGrid& m = mapping.current();
   const std::span<const shaders::GridColumn> table = mapping.current_table();
   for (std::uint32_t c = 0; c < m.g.columns && c < table.size(); ++c) {
@@ -46,9 +43,6 @@ std::uint32_t first_blurred_column(const GridMapping& mapping, const ReconSettin
     const double row_deg = 360.0 * std::sin(e * std::numbers::pi / 180) * arc / std::max(col.rows, 1u);
     const double sigma = blur_sigma_deg(e, s.blur_mar_fovea_deg);
     if (sigma >= s.blur_min_sigma_px * std::min(double(col.r1 - col.r0), row_deg)) return c;
-    if (s.blur_lattice_sigma_cells > 0 && e >= lattice_min_deg &&
-        std::max(double(col.r1 - col.r0), row_deg) * max_pixels_per_deg > shaders::kReconLatticeFromPx)
-      return c;
   }
   return m.g.columns;
 }
@@ -165,25 +159,17 @@ void Resolve::record_copy(VkCommandBuffer cmd, std::span<const gpu::Buffer* cons
 void Resolve::record_resolve(VkCommandBuffer cmd, int parity, bool blur, const ReconSettings& s) const {
   if (blur) record_grid_blur(cmd, s);
   record_mips(cmd);
-  record_resample(cmd, parity);
+  record_resample(cmd, parity, s);
   if (blur) record_blur(cmd, s);
 }
 
 void Resolve::record_grid_blur(VkCommandBuffer cmd, const ReconSettings& s) const {
-  // Within the detail window's reach the resolve divides by the cells' albedo, which is not
-  // blurred: the lattice's blur starts beyond it (recon_grid.h, ReconGridBlurPush).
-  const auto lattice_min_deg = [](const Eye& e) {
-    const DetailWindow& d = e.detail;
-    if (d.width == 0 || d.height == 0) return 0.0;
-    return std::acos(std::clamp(double(d.cos_none), -1.0, 1.0)) * 180 / std::numbers::pi;
-  };
   std::vector<std::uint32_t> first(eyes_.size(), 0);
   bool any = false;
   for (std::size_t i = 0; i < eyes_.size(); ++i) {
     const shaders::ReconGrid& m = eyes_[i].mapping->current();
     const Eye& e = eyes_[i];
-    first[i] = grid_space_blur(m) ? first_blurred_column(*e.mapping, s, e.max_pixels_per_deg, lattice_min_deg(e))
-                                  : m.g.columns;
+    first[i] = grid_space_blur(m) ? first_blurred_column(*e.mapping, s) : m.g.columns;
     any = any || first[i] < m.g.columns;
   }
   if (!any) return;  // the acuity kernel is below min σ in every cell: nothing to blur
@@ -192,8 +178,7 @@ void Resolve::record_grid_blur(VkCommandBuffer cmd, const ReconSettings& s) cons
       const Eye& e = eyes_[i];
       const std::uint32_t columns = e.mapping->current().g.columns;
       if (first[i] >= columns) continue;
-      const shaders::ReconGridBlurPush push{first[i], std::uint32_t(pass), float(s.blur_lattice_sigma_cells),
-                                            float(lattice_min_deg(e)),
+      const shaders::ReconGridBlurPush push{first[i], std::uint32_t(pass), 0, 0,
                                             float(blur_sigma_deg(0.0, s.blur_mar_fovea_deg)),
                                             float(s.blur_min_sigma_px), float(s.blur_max_sigma_px), 0};
       grid_blur_.run(cmd, {pass == 0 ? &e.grid_blur_rho : &e.grid_blur_phi}, push, columns - first[i], e.level_rows[0]);
@@ -229,7 +214,7 @@ void Resolve::set_detail(int eye, const DetailWindow& window) {
   e.detail = window;
 }
 
-void Resolve::record_resample(VkCommandBuffer cmd, int parity, bool grid_coords) const {
+void Resolve::record_resample(VkCommandBuffer cmd, int parity, const ReconSettings& s, bool grid_coords) const {
   for (const Eye& e : eyes_) {
     const std::uint32_t lod_columns = mip_reach(*e.mapping, e.levels).lod_columns;
     const DetailWindow& d = e.detail;
@@ -237,7 +222,8 @@ void Resolve::record_resample(VkCommandBuffer cmd, int parity, bool grid_coords)
     resolve_.run(cmd, {&e.resolve_set[parity]},
                  shaders::ReconResolvePush{e.width, e.height, e.levels, grid_coords ? 1u : 0u, lod_columns,
                                            depth_output_ ? 1u : 0u, 0, 0, d.x0, d.y0, detail ? d.width : 0u,
-                                           d.height, d.cos_full, d.cos_none, 0, 0},
+                                           d.height, d.cos_full, d.cos_none,
+                                           s.lattice_blur && !grid_coords ? 1u : 0u, 0},
                  e.width, e.height);
   }
   gpu::compute_to_compute(cmd);

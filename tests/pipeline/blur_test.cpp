@@ -40,14 +40,11 @@ core::DistributionParams cartesian() {
 
 // One frame of the Cornell box, gaze at the view centre, on a width×height raster with the
 // blur's MAR₀ = mar_deg: the mapping the blur kernels read.
-// The lattice's blur (off by default) only where a test asks for it.
 struct BlurRig {
-  BlurRig(fovea::gpu::Context& ctx, int width, int height, double mar_deg, const core::DistributionParams& dp,
-          double lattice_sigma_cells = 0)
+  BlurRig(fovea::gpu::Context& ctx, int width, int height, double mar_deg, const core::DistributionParams& dp)
       : scene(renderer::load_scene("cornell")), gs(ctx, scene), display(fovea::test::display_of_size(width, height)) {
     settings.denoiser = reconstruct::Denoiser::None;
     settings.blur_mar_fovea_deg = mar_deg;
-    settings.blur_lattice_sigma_cells = lattice_sigma_cells;
     p = std::make_unique<pipeline::FramePipeline>(ctx, gs, core::stereo_views(display), dp, settings,
                                                   renderer::PathConfig{}, true);
     p->render(core::eye_poses(scene.camera, display), {glm::dvec3(0, 0, -1), glm::dvec3(0, 0, -1)}, 0);
@@ -167,71 +164,4 @@ TEST_F(GpuTest, GridBlurLeavesCellsWhoseKernelIsBelowHalfACellUntouched) {
   // With MAR₀ = 16′ the outer columns are blurred (the same pass is live).
   BlurRig wide(ctx(), 320, 360, 16.0 / 60.0, {});
   EXPECT_NE(pipeline::testing::blur_grid(*wide.p, core::Eye::Left, grid), grid);
-}
-
-TEST_F(GpuTest, GridBlurHidesTheLatticeOfCellsSeveralPixelsWide) {
-  // At the model's scale the acuity kernel is below half a cell everywhere on `small`, so
-  // only the lattice's least blur (0.5 cells where a cell spans 4 pixels or more, none below
-  // 2) acts: a single bright cell spreads by σ ≈ 0.46 cells (the discrete kernel e^(−2k²),
-  // renormalised) across and along the rings where cells are large (budget 0.01), and stays
-  // where its cells and its neighbours' are under 2 pixels (the fovea at budget 0.39).
-  for (const double budget : {0.39, 0.01}) {
-    core::DistributionParams dp;
-    dp.budget = budget;
-    BlurRig rig(ctx(), 320, 360, reconstruct::kMarFoveaDeg, dp, reconstruct::kLatticeBlurSigmaCells);
-    const core::SampleDistribution& d = rig.p->distribution(core::Eye::Left);
-    const auto& table = d.column_table();
-    const core::View v = core::stereo_views(rig.display)[core::Eye::Left];
-    // Pixels per degree at pixel px along `step`: the raster's centre has its sparsest pixels.
-    const auto ppd = [&](glm::dvec2 px, glm::dvec2 step) {
-      return 1 / core::angle_deg(v.pixel_to_dir(px), v.pixel_to_dir(px + step));
-    };
-    const glm::dvec2 mid(v.width() / 2.0, v.height() / 2.0);
-    const double centre_ppd = std::min(ppd(mid, {1, 0}), ppd(mid, {0, 1}));
-    // Within 5° of the centre the pixels are at most 1 % denser than at the centre itself.
-    const double near_ppd = 1.01 * std::max(ppd(mid, {1, 0}), ppd(mid, {0, 1}));
-    const auto cell_px = [&](int c, double ppd) {  // the cell's larger and smaller extent in pixels
-      const auto& col = table[std::size_t(c)];
-      const double e = 0.5 * (double(col.r0) + double(col.r1));
-      const double arc = 1 - col.phi_gap / (2 * std::numbers::pi);
-      const double row = 360 * std::sin(e * std::numbers::pi / 180) * arc / col.rows;
-      const double w = double(col.r1 - col.r0);
-      return std::pair{std::max(w, row) * ppd, std::min(w, row) * ppd};
-    };
-    int c = -1;
-    for (int k = 1; c < 0 && k + 1 < d.columns(); ++k) {
-      const bool full = table[std::size_t(k - 1)].phi_gap == 0 && table[std::size_t(k + 1)].phi_gap == 0;
-      if (budget > 0.1 ? table[std::size_t(k + 1)].r1 < 5 && cell_px(k + 1, near_ppd).first < 1.9
-                       : full && cell_px(k - 1, centre_ppd).second > 4.5)  // cells grow outwards
-        c = k;
-    }
-    ASSERT_GE(c, 0) << budget;
-    const int pcols = d.padded_columns(), rows0 = int(table[std::size_t(c)].rows), r0 = rows0 / 3;
-    std::vector<glm::vec4> grid(std::size_t(pcols) * d.padded_rows(), glm::vec4(0, 0, 0, 1));  // every cell sampled
-    grid[std::size_t(r0) * pcols + c] = glm::vec4(1, 0, 0, 1);
-    // A cell without a sample (under the lens, off the view) amid sampled ones stays without one.
-    const std::size_t unsampled = std::size_t((r0 + rows0 / 2) % rows0) * pcols + c;
-    grid[unsampled] = glm::vec4(0);
-    const std::vector<glm::vec4> out = pipeline::testing::blur_grid(*rig.p, core::Eye::Left, grid);
-    EXPECT_EQ(out[unsampled], glm::vec4(0));
-    if (budget > 0.1) {
-      EXPECT_EQ(out, grid) << "column " << c;
-      continue;
-    }
-    double sum = 0, m_rho = 0, m_phi = 0;
-    for (int cc = 0; cc < d.columns(); ++cc)
-      for (int r = 0; r < int(table[std::size_t(cc)].rows); ++r) {
-        const double w = out[std::size_t(r) * pcols + cc].x;
-        if (w == 0) continue;
-        // The offset along the ring, in rows of the impulse's column (full rings: t = row / rows).
-        const double rows = table[std::size_t(cc)].rows;
-        const double dr = std::remainder((r + 0.5) / rows - (r0 + 0.5) / rows0, 1.0) * rows0;
-        sum += w, m_rho += w * (cc - c) * (cc - c), m_phi += w * dr * dr;
-      }
-    std::printf("column %d: %.1f x %.1f px; sigma across %.3f, along %.3f cells\n", c, cell_px(c, centre_ppd).first,
-                cell_px(c, centre_ppd).second, std::sqrt(m_rho / sum), std::sqrt(m_phi / sum));
-    EXPECT_NEAR(sum, 1.0, 0.05);
-    EXPECT_NEAR(std::sqrt(m_rho / sum), 0.46, 0.06);
-    EXPECT_NEAR(std::sqrt(m_phi / sum), 0.46, 0.12);  // along: the neighbouring columns' rows are read at φ
-  }
 }

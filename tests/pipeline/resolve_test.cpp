@@ -1,10 +1,14 @@
 // Resolve to the display: constant grids resolve to constants (φ wrap, ρ clamp, coverage),
-// and a smooth analytic image survives the round trip display -> grid -> display within
-// 0.5 dB of the budget-limited ideal.
+// a smooth analytic image survives the round trip display -> grid -> display within 0.5 dB
+// of the budget-limited ideal, and wide cells take the lattice's reconstruction when asked.
+#include <algorithm>
 #include <cmath>
+#include <numbers>
+#include <vector>
 
 #include "fovea/core/metrics.hpp"
 #include "fovea/renderer/scene_io.hpp"
+#include "fovea/shaders/recon_grid.h"
 #include "gpu_fixture.hpp"
 #include "pipeline_helpers.hpp"
 
@@ -87,4 +91,92 @@ TEST_F(Resolve, RoundTripWithinHalfDecibelOfTheBudgetLimitedIdeal) {
   const double got = core::psnr(img, truth), best = core::psnr(ideal, truth);
   std::printf("round trip %.2f dB, ideal %.2f dB\n", got, best);
   EXPECT_GE(got, best - 0.5);
+}
+
+// The lattice's reconstruction (ReconSettings::lattice_blur, the `lattice-blur` option): where
+// a polar cell spans kReconLatticeFullPx display pixels or more across and along the rings,
+// the resample weighs the cells around a pixel with the cubic B-spline B(x)·B(y) (x across
+// the rings in columns, y along them in rows of the cell's own column) instead of the tent
+// T(x)·T(y), whose kinks at the cell centres draw the lattice; where the cells are under
+// kReconLatticeFromPx pixels it leaves the image as it was. A single bright cell amid dark
+// ones shows the kernel directly: each pixel's value is its weight.
+TEST_F(Resolve, LatticeBlurReconstructsWideCellsWithTheCubicBSpline) {
+  const core::DisplayPreset display = core::load_display("small");
+  const auto bspline = [](double x) {
+    x = std::abs(x);
+    return x < 1 ? (4 - 6 * x * x + 3 * x * x * x) / 6 : x < 2 ? (2 - x) * (2 - x) * (2 - x) / 6 : 0.0;
+  };
+  const auto tent = [](double x) { return std::max(0.0, 1 - std::abs(x)); };
+  for (const double budget : {0.01, 0.39}) {
+    core::DistributionParams dp;
+    dp.budget = budget;
+    std::vector<core::Image> images;
+    for (const bool lattice : {false, true}) {
+      reconstruct::ReconSettings s;
+      s.blur = false;
+      s.lattice_blur = lattice;
+      pipeline::FramePipeline p(ctx(), *gs_, core::stereo_views(display), dp, s, {}, true);
+      const core::SampleDistribution& d = p.distribution(core::Eye::Left);
+      const auto& table = d.column_table();
+      const core::View v = p.view(core::Eye::Left);
+      // Pixels per degree: fewest at the raster's centre, at most 1 % more within 5° of it.
+      const glm::dvec2 mid(v.width() / 2.0, v.height() / 2.0);
+      const auto ppd = [&](glm::dvec2 step) {
+        return 1 / core::angle_deg(v.pixel_to_dir(mid), v.pixel_to_dir(mid + step));
+      };
+      const double fewest = std::min(ppd({1, 0}), ppd({0, 1})), most = 1.01 * std::max(ppd({1, 0}), ppd({0, 1}));
+      // A column's cells in pixels, the smaller and the larger extent (rows at its inner edge).
+      const auto extent = [&](int c, double px_per_deg) {
+        const auto& col = table[std::size_t(c)];
+        const double row = 360 * std::sin(double(col.r0) * std::numbers::pi / 180) / col.rows;
+        const double w = double(col.r1 - col.r0);
+        return std::pair{std::min(w, row) * px_per_deg, std::max(w, row) * px_per_deg};
+      };
+      // The impulse's column: its neighbours within two columns full rings with cells of more than
+      // kReconLatticeFullPx pixels (budget 0.01), or within 5° of the gaze with cells under
+      // kReconLatticeFromPx (0.39: the fovea's cells, about a pixel at the cap).
+      const double from = fovea::shaders::kReconLatticeFromPx, full = fovea::shaders::kReconLatticeFullPx;
+      int c = -1;
+      for (int k = 2; c < 0 && k + 2 < d.columns(); ++k) {
+        bool ok = true;
+        for (int j = k - 2; j <= k + 2; ++j)
+          ok = ok && (budget < 0.1 ? table[std::size_t(j)].phi_gap == 0 && extent(j, fewest).first > full + 0.1
+                                   : table[std::size_t(j)].r1 < 5 && extent(j, most).second < from - 0.05);
+        if (ok) c = k;
+      }
+      ASSERT_GE(c, 0) << budget;
+      const int pcols = d.padded_columns(), rows = int(table[std::size_t(c)].rows), r0 = rows / 3;
+      std::vector<glm::vec4> grid(std::size_t(pcols) * d.padded_rows(), glm::vec4(0));
+      for (int cc = 0; cc < d.columns(); ++cc)
+        for (int r = 0; r < int(table[std::size_t(cc)].rows); ++r) grid[std::size_t(r) * pcols + cc] = {0, 0, 0, 1};
+      grid[std::size_t(r0) * pcols + c] = {1, 0, 0, 1};
+      images.push_back(pipeline::testing::resolve_grid(p, core::Eye::Left, grid, false));
+      if (budget > 0.1) continue;
+      // Every pixel against the kernel at its grid coordinate (u across columns, cell centres
+      // at +0.5; t·rows along the full ring, wrapping).
+      const std::vector<glm::vec4> uv = pipeline::testing::resolve_grid_coords(p, core::Eye::Left);
+      double worst = 0, peak = 0, reach = 0;
+      for (int y = 0; y < v.height(); ++y)
+        for (int x = 0; x < v.width(); ++x) {
+          const glm::vec4 g = uv[std::size_t(y) * v.width() + x];
+          const double du = g.x - (c + 0.5), dv = std::remainder(double(g.y) * rows - (r0 + 0.5), double(rows));
+          const double want = lattice ? bspline(du) * bspline(dv) : tent(du) * tent(dv);
+          const double got = images.back().at(x, y).x;
+          if (want > 0) {
+            ASSERT_EQ(g.z, 0.0f) << "level 0 at pixel " << x << ", " << y;
+          }
+          worst = std::max(worst, std::abs(got - want));
+          peak = std::max(peak, got);
+          if (got > 1e-4) reach = std::max(reach, std::abs(du));
+        }
+      std::printf("budget %.2f, column %d (%.1f-%.1f px), lattice blur %s: peak %.3f, reach %.2f columns, worst %.1e\n",
+                  budget, c, extent(c, fewest).first, extent(c, fewest).second, lattice ? "on" : "off", peak, reach,
+                  worst);
+      EXPECT_LT(worst, 2e-3) << (lattice ? "B-spline" : "tent");
+      EXPECT_NEAR(reach, lattice ? 2.0 : 1.0, 0.25);
+    }
+    if (budget > 0.1) {  // cells under a pixel: the tent, as without the option
+      EXPECT_EQ(images[0].pixels, images[1].pixels);
+    }
+  }
 }

@@ -92,7 +92,7 @@ With no options: a short demo on the shipped scene and gaze.
                         WxH@SWxSHmm@Dmm (as the URI key screen=; docs/gaze.md)
   --frames N            frames to render [24]
 )";
-constexpr const char* kHelpTail = R"(  --no-blur             skip the peripheral blur (and the lattice's, --lattice-blur)
+constexpr const char* kHelpTail = R"(  --no-blur             skip the peripheral blur
   --no-cull             trace the lens' hidden area too
   --reference SPP|DIR   SPP: converged reference of the last frame with the render's own light
                         transport (--bounces; at most SPP samples per pixel, see

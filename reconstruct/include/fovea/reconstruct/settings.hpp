@@ -28,9 +28,6 @@ const char* stereo_share_name(StereoShare s);
 // σ(e) = √(ln 2 / 2) / π · MAR(e) ≈ 0.187 MAR(e), 0.042° at 30°. Gratings the eye resolves
 // (f ≤ 1/(2 MAR)) keep at least 84% of their contrast.
 constexpr double kMarFoveaDeg = 1.0 / 60.0;
-// The lattice's blur when on (ReconSettings::blur_lattice_sigma_cells): with the resample's tent
-// it reaches about as far as the cubic B-spline that removed the arcs (docs/reconstruction.md).
-constexpr double kLatticeBlurSigmaCells = 0.5;
 double blur_sigma_deg(double e_deg, double mar_fovea_deg = kMarFoveaDeg);
 
 struct ReconSettings;
@@ -111,12 +108,11 @@ struct ReconSettings {
   double blur_mar_fovea_deg = kMarFoveaDeg;  // MAR₀ of blur_sigma_deg
   double blur_min_sigma_px = 0.5;            // narrower kernels leave the pixel as it is (sub-pixel: ±1 px weighs ≤ 11%)
   double blur_max_sigma_px = 16;
-  // Angular polar grids: the least blur, in cells, where a cell spans several display pixels
-  // (recon_grid_blur.comp, kReconLatticeFromPx; the `lattice-blur` frame option sets
-  // kLatticeBlurSigmaCells): the bilinear reconstruction of such cells draws their lattice,
-  // arcs and spokes around the gaze, which the blur hides and steadies at the price of detail
-  // (measured: docs/reconstruction.md, "The lattice's rings"). 0: off, the default.
-  double blur_lattice_sigma_cells = 0;
+  // Polar grids: where a cell spans several display pixels the resample reconstructs with the
+  // cubic B-spline over four cells instead of the tent over two (recon_grid.h,
+  // kReconLatticeFromPx; the `lattice-blur` frame option): the tent's kinks draw the lattice,
+  // rings and spokes around the gaze (measured: docs/reconstruction.md, "The lattice's rings").
+  bool lattice_blur = false;
 };
 
 }  // namespace fovea::reconstruct

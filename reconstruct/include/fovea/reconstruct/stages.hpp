@@ -173,8 +173,9 @@ class Resolve {
   void record_resolve(VkCommandBuffer cmd, int parity, bool blur, const ReconSettings& settings) const;
   void record_grid_blur(VkCommandBuffer cmd, const ReconSettings& settings) const;
   void record_mips(VkCommandBuffer cmd) const;
-  // grid_coords: each pixel's grid coordinate (u, t, LOD, 0) instead of its colour (tests).
-  void record_resample(VkCommandBuffer cmd, int parity, bool grid_coords = false) const;
+  // grid_coords: each pixel's grid coordinate (u, t, LOD, 0) instead of its colour (tests);
+  // settings.lattice_blur: the lattice's reconstruction of wide polar cells.
+  void record_resample(VkCommandBuffer cmd, int parity, const ReconSettings& settings, bool grid_coords = false) const;
   // Whether the resample writes the display depth (depth()); off at first: a texel read, a
   // transform and a store per pixel that only depth compositing needs.
   void set_depth_output(bool on) { depth_output_ = on; }

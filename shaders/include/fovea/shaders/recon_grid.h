@@ -101,8 +101,17 @@ struct ReconResolvePush {
   // none), and the cosines of the angles from the gaze within which they re-modulate fully
   // and beyond which not at all.
   FOVEA_UINT detail_x0, detail_y0, detail_width, detail_height;
-  float detail_cos_full, detail_cos_none, pad2, pad3;
+  float detail_cos_full, detail_cos_none;
+  FOVEA_UINT lattice, pad2;  // lattice = 1: the lattice's reconstruction (below)
 };
+
+// The lattice's reconstruction (ReconSettings::lattice_blur, recon_resolve.comp): where a polar
+// cell spans more display pixels than kReconLatticeFromPx in a direction (across the rings or
+// along them), the resample blends its tent between two cells into the cubic B-spline over
+// four, fully from kReconLatticeFullPx. The tent's kinks at the cell centres draw the lattice
+// there, rings about the gaze and spokes (docs/reconstruction.md, "The lattice's rings").
+FOVEA_CONST float kReconLatticeFromPx = 1.5f;
+FOVEA_CONST float kReconLatticeFullPx = 2.5f;
 
 // Radius -> column lookup table of a polar mapping (reconstruct::radius_lut builds one per
 // mapping and frame; recon_map.h, rg_column_range, reads it): kReconRadiusLutSize uniform
@@ -127,18 +136,10 @@ struct ReconTemporalPush {
 // Grid-space peripheral blur of an angular polar grid (recon_grid_blur.comp): one pass over
 // columns [first_column, columns) of the current mapping, across columns (along ρ) or, with
 // phi_pass, along the rows of each column; σ in cells from the acuity model and the cells'
-// angular size, cells below min_sigma_cells copied. Where a cell spans more display pixels
-// than kReconLatticeFromPx in the pass's direction, σ is at least lattice_sigma_cells, fully
-// from kReconLatticeFullPx: the reconstruction then reaches beyond the cell, so the lattice's
-// rings do not show (docs/reconstruction.md, "The lattice's rings"); not within
-// lattice_min_deg of the gaze, where the display pixels' own albedo re-modulates the cells
-// (the resolve's detail window divides by the cells' albedo, which is not blurred).
-FOVEA_CONST float kReconLatticeFromPx = 2.0f;
-FOVEA_CONST float kReconLatticeFullPx = 4.0f;
+// angular size, cells below min_sigma_cells copied.
 struct ReconGridBlurPush {
-  FOVEA_UINT first_column, phi_pass;
-  float lattice_sigma_cells, lattice_min_deg;
-  float sigma_fovea_deg, min_sigma_cells, max_sigma_cells, pad1;
+  FOVEA_UINT first_column, phi_pass, pad0, pad1;
+  float sigma_fovea_deg, min_sigma_cells, max_sigma_cells, pad2;
 };
 #ifdef __cplusplus
 static_assert(sizeof(ReconGrid) == 192);
