@@ -87,9 +87,13 @@ vec4 lattice_weights(float x, float smooth_) {
 }
 
 // Column k at level 0 (at the buffer's start) over four rows around its row coordinate
-// (lattice_weights along φ).
-vec4 fetch_column_smooth(ColumnTap k, uint pcols, float smooth_) {
-  if (!(smooth_ > 0.0)) return fetch_column(k, 0u, 0u, pcols);
+// (lattice_weights along φ); `tent_w`: the coverage (.w) the tent's two rows give.
+vec4 fetch_column_smooth(ColumnTap k, uint pcols, float smooth_, out float tent_w) {
+  if (!(smooth_ > 0.0)) {
+    vec4 v = fetch_column(k, 0u, 0u, pcols);
+    tent_w = v.w;
+    return v;
+  }
   int r0, r1;
   float fy;
   rg_row_pair(k.rows, k.wraps, k.v, r0, r1, fy);
@@ -102,8 +106,10 @@ vec4 fetch_column_smooth(ColumnTap k, uint pcols, float smooth_) {
     rm = clamp(rm, 0, k.rows - 1);
     rp = clamp(rp, 0, k.rows - 1);
   }
-  return w.x * texelFetch(mips, int(uint(rm) * pcols + k.c)) + w.y * texelFetch(mips, int(uint(r0) * pcols + k.c)) +
-         w.z * texelFetch(mips, int(uint(r1) * pcols + k.c)) + w.w * texelFetch(mips, int(uint(rp) * pcols + k.c));
+  vec4 a = texelFetch(mips, int(uint(r0) * pcols + k.c)), b = texelFetch(mips, int(uint(r1) * pcols + k.c));
+  tent_w = (1.0 - fy) * a.w + fy * b.w;
+  return w.x * texelFetch(mips, int(uint(rm) * pcols + k.c)) + w.y * a + w.z * b +
+         w.w * texelFetch(mips, int(uint(rp) * pcols + k.c));
 }
 
 // The pixel's angular size δ on angular polar grids (the larger of its two sides, radians),
@@ -202,9 +208,13 @@ void main() {
   if (lat_rho > 0.0 || lat_phi > 0.0) {
     vec4 w = lattice_weights(fx, lat_rho);
     uint pcols = m.g.padded_columns;
-    v = w.y * fetch_column_smooth(k0, pcols, lat_phi) + w.z * fetch_column_smooth(k1, pcols, lat_phi);
-    if (w.x > 0.0) v += w.x * fetch_column_smooth(column_tap(m, int(c0f) - 1, uv.y), pcols, lat_phi);
-    if (w.w > 0.0) v += w.w * fetch_column_smooth(column_tap(m, int(c0f) + 2, uv.y), pcols, lat_phi);
+    float t0, t1, unused;
+    v = w.y * fetch_column_smooth(k0, pcols, lat_phi, t0) + w.z * fetch_column_smooth(k1, pcols, lat_phi, t1);
+    if (w.x > 0.0) v += w.x * fetch_column_smooth(column_tap(m, int(c0f) - 1, uv.y), pcols, lat_phi, unused);
+    if (w.w > 0.0) v += w.w * fetch_column_smooth(column_tap(m, int(c0f) + 2, uv.y), pcols, lat_phi, unused);
+    // Coverage as the tent's: a pixel whose two nearest cells in each direction hold no sample
+    // (the lens' hidden area, off the view) stays without one, however far the spline reaches.
+    if (!((1.0 - fx) * t0 + fx * t1 > 1e-6)) v = vec4(0.0);
   } else {
     v = fetch_level(m, k0, k1, fx, l0);
     if (f > 0.0 && l0 + 1u < pc.levels) v = mix(v, fetch_level(m, k0, k1, fx, l0 + 1u), f);

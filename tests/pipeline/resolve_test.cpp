@@ -110,7 +110,7 @@ TEST_F(Resolve, LatticeBlurReconstructsWideCellsWithTheCubicBSpline) {
   for (const double budget : {0.01, 0.39}) {
     core::DistributionParams dp;
     dp.budget = budget;
-    std::vector<core::Image> images;
+    std::vector<core::Image> images, holes;
     for (const bool lattice : {false, true}) {
       reconstruct::ReconSettings s;
       s.blur = false;
@@ -174,9 +174,22 @@ TEST_F(Resolve, LatticeBlurReconstructsWideCellsWithTheCubicBSpline) {
                   worst);
       EXPECT_LT(worst, 2e-3) << (lattice ? "B-spline" : "tent");
       EXPECT_NEAR(reach, lattice ? 2.0 : 1.0, 0.25);
+      // Two columns without a sample (as under the lens) amid lit ones: the pixels between
+      // their centres stay without one, however far the spline reaches.
+      for (int cc = 0; cc < d.columns(); ++cc)
+        for (int r = 0; r < int(table[std::size_t(cc)].rows); ++r)
+          grid[std::size_t(r) * pcols + cc] = cc == c + 1 || cc == c + 2 ? glm::vec4(0) : glm::vec4(1, 1, 1, 1);
+      holes.push_back(pipeline::testing::resolve_grid(p, core::Eye::Left, grid, false));
     }
     if (budget > 0.1) {  // cells under a pixel: the tent, as without the option
       EXPECT_EQ(images[0].pixels, images[1].pixels);
+    } else {
+      long unlit = 0;
+      for (std::size_t i = 0; i < holes[0].pixels.size(); ++i) {
+        unlit += holes[0].pixels[i].x == 0;
+        ASSERT_EQ(holes[0].pixels[i].x == 0, holes[1].pixels[i].x == 0) << "pixel " << i;
+      }
+      EXPECT_GT(unlit, 100);
     }
   }
 }
