@@ -55,10 +55,10 @@ constexpr OptionHelp kFrameOptionsHelp[] = {
      "  --pixel-albedo on|off textures at the display's resolution in the fovea: each display\n"
      "                        pixel's own first hit re-modulates it (scenes with textures)"},
     {"lattice-blur",
-     "  --lattice-blur on|off polar grids: where a cell spans more than a display pixel, the cubic\n"
-     "                        B-spline over four cells instead of the tent over two, so that their\n"
-     "                        lattice (rings about the gaze, spokes) does not show: smoother and a\n"
-     "                        little less detailed (docs/reconstruction.md, \"The lattice's rings\")"},
+     "  --lattice-blur on|off polar grids: where a cell spans more than 1.5 display pixels, the\n"
+     "                        cubic B-spline over four cells instead of the tent over two, so that\n"
+     "                        their lattice (rings about the gaze, spokes) does not show: smoother\n"
+     "                        and less detailed (docs/reconstruction.md, \"The lattice's rings\")"},
     {"seed",
      "  --seed N              noise seed: another N, another noise realisation of the same frames\n"
      "                        (path tracing and BMFR keyed by frame + 1024·N; gaze and jitter\n"
