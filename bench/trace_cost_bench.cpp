@@ -128,14 +128,16 @@ int run(int argc, char** argv) {
   const fr::GpuScene gs(ctx, scene);
   const auto poses = fc::eye_poses(scene.camera, display);
   const glm::dvec3 gaze(0, 0, -1);
-  // Visual-Polar at its default budget and two lower ones; a uniform raster with as many
-  // samples as the default Visual-Polar grid (the same count, spread evenly and coherently);
-  // full resolution.
+  // Visual-Polar at its default budget and three lower ones; a uniform raster with as many
+  // samples as Visual-Polar at the default and at the lowest (the same count, spread evenly
+  // and coherently: sparsity without the polar layout); full resolution.
   const fc::DistributionParams defaults;
   const Config configs[] = {{fc::DistributionKind::VisualPolar, 0},
                             {fc::DistributionKind::VisualPolar, 0.25},
                             {fc::DistributionKind::VisualPolar, 0.2},
+                            {fc::DistributionKind::VisualPolar, 0.1},
                             {fc::DistributionKind::CartesianUniform, defaults.budget},
+                            {fc::DistributionKind::CartesianUniform, 0.1},
                             {fc::DistributionKind::Cartesian, 1}};
   fovea::reconstruct::ReconSettings settings;
   settings.share = fovea::reconstruct::StereoShare::Gather;
