@@ -4,6 +4,8 @@
 // mask frees on the visible field (its rows or its layout change).
 #include <cmath>
 #include <cstring>
+#include <string>
+#include <utility>
 
 #include "fovea/core/error.hpp"
 #include "fovea/core/eye_optics.hpp"
@@ -112,7 +114,8 @@ TEST_F(GpuTest, FramePipelineNeverTracesHiddenCells) {
 
 // A hidden area that covers the whole view (a runtime's bogus mesh, a display whose lens
 // shows nothing) given when the pipeline is made: nothing is traced, and the frames are
-// black, finite and pass validation, for the grid laid out by the budget and for the raster.
+// black, finite and pass validation, for the grid laid out by the budget (also with the
+// lattice's reconstruction, whose spline reaches two cells) and for the raster.
 TEST_F(GpuTest, FramePipelineWithEveryPixelHidden) {
   const renderer::Scene scene = renderer::load_scene("cornell");
   renderer::GpuScene gs(ctx(), scene);
@@ -124,11 +127,15 @@ TEST_F(GpuTest, FramePipelineWithEveryPixelHidden) {
   for (core::Eye e : {core::Eye::Left, core::Eye::Right})
     masks[std::size_t(e)] = core::ViewMask::from_hidden_triangles(views[e], vertices, indices, "everything");
   ASSERT_EQ(masks[0]->hidden_fraction(), 1.0);
-  for (core::DistributionKind kind : {core::DistributionKind::VisualPolar, core::DistributionKind::Cartesian}) {
-    SCOPED_TRACE(core::distribution_name(kind));
+  for (const auto& [kind, lattice] : {std::pair{core::DistributionKind::VisualPolar, false},
+                                      std::pair{core::DistributionKind::VisualPolar, true},
+                                      std::pair{core::DistributionKind::Cartesian, false}}) {
+    SCOPED_TRACE(std::string(core::distribution_name(kind)) + (lattice ? ", lattice blur" : ""));
     core::DistributionParams dp;
     dp.kind = kind;
-    pipeline::FramePipeline p(ctx(), gs, views, dp, reconstruct::ReconSettings{}, {}, false, masks);
+    reconstruct::ReconSettings s;
+    s.lattice_blur = lattice;
+    pipeline::FramePipeline p(ctx(), gs, views, dp, s, {}, false, masks);
     const auto poses = core::eye_poses(scene.camera, display);
     for (std::uint32_t f = 0; f < 2; ++f) p.render(poses, {glm::dvec3(0, 0, -1), glm::dvec3(0, 0, -1)}, f);
     for (core::Eye e : {core::Eye::Left, core::Eye::Right}) {
