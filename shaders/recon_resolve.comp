@@ -98,14 +98,7 @@ vec4 fetch_column_smooth(ColumnTap k, uint pcols, float smooth_, out float tent_
   float fy;
   rg_row_pair(k.rows, k.wraps, k.v, r0, r1, fy);
   vec4 w = lattice_weights(fy, smooth_);
-  int rm = r0 - 1, rp = r1 + 1;
-  if (k.wraps) {
-    rm += rm < 0 ? k.rows : 0;
-    rp -= rp >= k.rows ? k.rows : 0;
-  } else {
-    rm = clamp(rm, 0, k.rows - 1);
-    rp = clamp(rp, 0, k.rows - 1);
-  }
+  int rm = rg_row_index(r0 - 1, k.rows, k.wraps), rp = rg_row_index(r1 + 1, k.rows, k.wraps);
   vec4 a = texelFetch(mips, int(uint(r0) * pcols + k.c)), b = texelFetch(mips, int(uint(r1) * pcols + k.c));
   tent_w = (1.0 - fy) * a.w + fy * b.w;
   return w.x * texelFetch(mips, int(uint(rm) * pcols + k.c)) + w.y * a + w.z * b +

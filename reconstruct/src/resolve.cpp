@@ -168,8 +168,7 @@ void Resolve::record_grid_blur(VkCommandBuffer cmd, const ReconSettings& s) cons
   bool any = false;
   for (std::size_t i = 0; i < eyes_.size(); ++i) {
     const shaders::ReconGrid& m = eyes_[i].mapping->current();
-    const Eye& e = eyes_[i];
-    first[i] = grid_space_blur(m) ? first_blurred_column(*e.mapping, s) : m.g.columns;
+    first[i] = grid_space_blur(m) ? first_blurred_column(*eyes_[i].mapping, s) : m.g.columns;
     any = any || first[i] < m.g.columns;
   }
   if (!any) return;  // the acuity kernel is below min σ in every cell: nothing to blur

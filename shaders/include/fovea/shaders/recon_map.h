@@ -118,6 +118,13 @@ int rg_wrap(int r, int rows) {
   return r < 0 ? r + rows : (r >= rows ? r - rows : r);
 }
 
+// Row r of a column of `rows` rows, r within one turn of the column (-rows <= r < 2 rows):
+// wrapped on a full ring, clamped to the column's ends otherwise.
+int rg_row_index(int r, int rows, bool wraps) {
+  if (!wraps) return clamp(r, 0, rows - 1);
+  return r < 0 ? r + rows : (r >= rows ? r - rows : r);
+}
+
 // The two rows of a column of `rows` rows around row coordinate v (cell centres at +0.5)
 // and the weight f of r1: a full ring wraps (v in [0, rows]: one conditional add/subtract,
 // no integer division), a packed column or the raster clamps.
@@ -125,15 +132,8 @@ void rg_row_pair(int rows, bool wraps, float v, out int r0, out int r1, out floa
   float vr = v - 0.5;
   float r0f = floor(vr);
   f = vr - r0f;
-  r0 = int(r0f);
-  r1 = r0 + 1;
-  if (wraps) {
-    r0 += r0 < 0 ? rows : 0;
-    r1 -= r1 >= rows ? rows : 0;
-  } else {
-    r0 = clamp(r0, 0, rows - 1);
-    r1 = clamp(r1, 0, rows - 1);
-  }
+  r0 = rg_row_index(int(r0f), rows, wraps);
+  r1 = rg_row_index(int(r0f) + 1, rows, wraps);
 }
 
 // The last column i in [range.x, range.y) with r0(i) <= r (range.x when none; the columns'
