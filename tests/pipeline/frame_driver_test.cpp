@@ -227,7 +227,7 @@ TEST(FrameOptions, LandingSamplesAreAWholeNumberFromOneToEight) {
 }
 
 // --pixel-albedo (the display pixels' own albedo in the fovea; default on) and --lattice-blur
-// (the B-spline over cells several pixels wide; default off) are on or off by the same
+// (the B-spline over cells several pixels wide; default on) are on or off by the same
 // name everywhere; anything else is refused naming where it came from and changes nothing.
 TEST(FrameOptions, OnOffOptionsTakeOnlyOnOrOff) {
   struct Case {
@@ -237,7 +237,7 @@ TEST(FrameOptions, OnOffOptionsTakeOnlyOnOrOff) {
   };
   const Case cases[] = {
       {"pixel-albedo", true, [](const pipeline::FrameConfig& c) { return c.recon.pixel_albedo; }},
-      {"lattice-blur", false, [](const pipeline::FrameConfig& c) { return c.recon.lattice_blur; }},
+      {"lattice-blur", true, [](const pipeline::FrameConfig& c) { return c.recon.lattice_blur; }},
   };
   for (const Case& k : cases) {
     pipeline::FrameConfig c;

@@ -58,7 +58,7 @@ constexpr OptionHelp kFrameOptionsHelp[] = {
      "  --lattice-blur on|off polar grids: where a cell spans more than 1.5 display pixels, the\n"
      "                        cubic B-spline over four cells instead of the tent over two, so that\n"
      "                        their lattice (rings about the gaze, spokes) does not show: smoother\n"
-     "                        and less detailed (docs/reconstruction.md, \"The lattice's rings\")"},
+     "                        and less detailed (docs/reconstruction.md, \"The lattice's rings\") [on]"},
     {"seed",
      "  --seed N              noise seed: another N, another noise realisation of the same frames\n"
      "                        (path tracing and BMFR keyed by frame + 1024·N; gaze and jitter\n"

@@ -111,8 +111,9 @@ struct ReconSettings {
   // Polar grids: where a cell spans several display pixels the resample reconstructs with the
   // cubic B-spline over four cells instead of the tent over two (recon_grid.h,
   // kReconLatticeFromPx; the `lattice-blur` frame option): the tent's kinks draw the lattice,
-  // rings and spokes around the gaze (measured: docs/reconstruction.md, "The lattice's rings").
-  bool lattice_blur = false;
+  // rings and spokes around the gaze that swim with it (measured: docs/reconstruction.md,
+  // "The lattice's rings"). On by default: the periphery sees flicker and motion first.
+  bool lattice_blur = true;
 };
 
 }  // namespace fovea::reconstruct
