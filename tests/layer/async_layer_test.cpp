@@ -50,8 +50,15 @@ struct ThreadInfo {
 std::map<int, ThreadInfo> threads() {
   std::map<int, ThreadInfo> out;
   for (const auto& entry : std::filesystem::directory_iterator("/proc/self/task")) {
-    std::ifstream in(entry.path() / "stat");
-    std::string stat((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+    std::string stat;
+    try {
+      std::ifstream in(entry.path() / "stat");
+      stat.assign(std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>());
+    } catch (const std::ios_base::failure&) {
+      // A thread that ends between the open and the read fails the read with ESRCH, which
+      // libstdc++'s filebuf throws whatever the stream's exception mask.
+      continue;
+    }
     const auto open = stat.find('('), close = stat.rfind(')');
     if (open == std::string::npos || close == std::string::npos) continue;  // the thread ended meanwhile
     ThreadInfo t;
