@@ -10,7 +10,8 @@
 // compositing, the image does not use it. Near the gaze, where the path tracer's first hits
 // at the display's pixels are given (pt_primary.h), textures are re-modulated at the display's
 // resolution (detail_gain). With the lattice's reconstruction on, cells several pixels wide
-// are reconstructed with the cubic B-spline instead of the tent (lattice_weights).
+// are reconstructed with the cubic B-spline instead of the tent (lattice_weights); the
+// Cartesian raster with its Gaussian filter on, each pixel over its 3×3 cells (raster_gaussian).
 #extension GL_GOOGLE_include_directive : require
 #extension GL_EXT_samplerless_texture_functions : require  // texelFetch on texture buffers
 
@@ -103,6 +104,30 @@ vec4 fetch_column_smooth(ColumnTap k, uint pcols, float smooth_, out float tent_
   tent_w = (1.0 - fy) * a.w + fy * b.w;
   return w.x * texelFetch(mips, int(uint(rm) * pcols + k.c)) + w.y * a + w.z * b +
          w.w * texelFetch(mips, int(uint(rp) * pcols + k.c));
+}
+
+// The Cartesian raster's Gaussian reconstruction (pc.raster_side > 0): the cells around cell
+// (c, r) weighed per axis by side, 1 − 2·side, side; cells beyond the raster drop out and the
+// weights renormalise. Summed as the tent's taps are (coverage in .w), so a cell without a
+// sample (the lens' hidden area) adds nothing, and a pixel whose own cell has none stays
+// without one.
+vec4 raster_gaussian(ReconGrid m, int c, int r) {
+  if (!(texelFetch(mips, int(uint(r) * m.g.padded_columns + uint(c))).w > 1e-6)) return vec4(0.0);
+  vec4 acc = vec4(0.0);
+  float wsum = 0.0;
+  for (int dr = -1; dr <= 1; ++dr) {
+    int rr = r + dr;
+    if (rr < 0 || rr >= int(m.g.rows)) continue;
+    float wr = dr == 0 ? 1.0 - 2.0 * pc.raster_side : pc.raster_side;
+    for (int dc = -1; dc <= 1; ++dc) {
+      int cc = c + dc;
+      if (cc < 0 || cc >= int(m.g.columns)) continue;
+      float w = wr * (dc == 0 ? 1.0 - 2.0 * pc.raster_side : pc.raster_side);
+      acc += w * texelFetch(mips, int(uint(rr) * m.g.padded_columns + uint(cc)));
+      wsum += w;
+    }
+  }
+  return acc / wsum;
 }
 
 // The pixel's angular size δ on angular polar grids (the larger of its two sides, radians),
@@ -198,7 +223,9 @@ void main() {
                          1.0 / max(phi_footprint(m, delta, d, px, near.turn_rows), 1e-6));
   }
   vec4 v;
-  if (lat_rho > 0.0 || lat_phi > 0.0) {
+  if (!polar && pc.raster_side > 0.0) {
+    v = raster_gaussian(m, int(near.c), int(floor(near.v)));
+  } else if (lat_rho > 0.0 || lat_phi > 0.0) {
     vec4 w = lattice_weights(fx, lat_rho);
     uint pcols = m.g.padded_columns;
     float t0, t1, unused;

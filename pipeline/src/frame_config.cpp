@@ -21,7 +21,7 @@ const std::vector<std::string>& frame_option_names() {
   static const std::vector<std::string> names = {"budget",         "cap",          "distribution", "jitter",
                                                  "denoiser",       "bmfr-precision", "stereo-share", "trace",
                                                  "bounces",        "seed",           "landing-spp",
-                                                 "pixel-albedo",   "lattice-blur"};
+                                                 "pixel-albedo",   "lattice-blur",   "raster-filter"};
   return names;
 }
 
@@ -86,6 +86,10 @@ void apply_frame_option(FrameConfig& c, std::string_view name, std::string_view 
       c.recon.pixel_albedo = on_off(value);
     } else if (name == "lattice-blur") {
       c.recon.lattice_blur = on_off(value);
+    } else if (name == "raster-filter") {
+      if (value != "box" && value != "gaussian")
+        throw core::InputError("expected box or gaussian, got \"" + std::string(value) + "\"");
+      c.recon.raster_gaussian = value == "gaussian";
     } else if (name == "seed") {
       c.seed = std::uint32_t(whole_number(value, 0, FrameConfig::kMaxSeed));
     } else {
@@ -110,6 +114,9 @@ void finish(FrameConfig& c, bool budget_given) {
   if (c.distribution.kind != core::DistributionKind::VisualPolar && c.distribution.cap != core::DistributionParams{}.cap)
     throw core::InputError(std::string("cap: only visual-polar caps its samples per pixel, not ") +
                            core::distribution_name(c.distribution.kind));
+  if (c.recon.raster_gaussian && c.distribution.kind != core::DistributionKind::Cartesian)
+    throw core::InputError(std::string("raster-filter: only cartesian's cells are the display's pixels; ") +
+                           core::distribution_name(c.distribution.kind) + " reconstructs its cells with the tent");
   c.distribution.validate();
 }
 
@@ -126,7 +133,8 @@ nlohmann::json to_json(const FrameConfig& c) {
           {"seed", c.seed},
           {"landing-spp", c.recon.landing_spp},
           {"pixel-albedo", c.recon.pixel_albedo ? "on" : "off"},
-          {"lattice-blur", c.recon.lattice_blur ? "on" : "off"}};
+          {"lattice-blur", c.recon.lattice_blur ? "on" : "off"},
+          {"raster-filter", c.recon.raster_gaussian ? "gaussian" : "box"}};
 }
 
 renderer::PathConfig path_config(const Bounces& bounces, const renderer::Scene& scene) {

@@ -222,7 +222,8 @@ void Resolve::record_resample(VkCommandBuffer cmd, int parity, const ReconSettin
                  shaders::ReconResolvePush{e.width, e.height, e.levels, grid_coords ? 1u : 0u, lod_columns,
                                            depth_output_ ? 1u : 0u, 0, 0, d.x0, d.y0, detail ? d.width : 0u,
                                            d.height, d.cos_full, d.cos_none,
-                                           s.lattice_blur && !grid_coords ? 1u : 0u, 0},
+                                           s.lattice_blur && !grid_coords ? 1u : 0u,
+                                           s.raster_gaussian ? float(raster_filter_side_weight()) : 0.0f},
                  e.width, e.height);
   }
   gpu::compute_to_compute(cmd);

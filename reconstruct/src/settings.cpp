@@ -29,6 +29,13 @@ double blur_sigma_deg(double e_deg, double mar_fovea_deg) {
   return std::sqrt(std::numbers::ln2 / 2) / std::numbers::pi * mar_fovea_deg / core::acuity::m(e_deg);
 }
 
+double raster_filter_side_weight() {
+  constexpr double sigma = 0.5, radius = 1.5;
+  const auto gauss = [&](double d) { return std::exp(-d * d / (2 * sigma * sigma)); };
+  const auto g = [&](double d) { return gauss(d) - gauss(radius); };
+  return g(1) / (g(0) + 2 * g(1));
+}
+
 double view_motion_deg(glm::dvec3 gaze_before, glm::dvec3 gaze_now, const core::Pose& before, const core::Pose& now) {
   // The relative rotation's angle: 2·acos|w| of q_now · q_before⁻¹ (|w| folds q and −q).
   const double w = std::min(1.0, std::abs((now.orientation * glm::inverse(before.orientation)).w));

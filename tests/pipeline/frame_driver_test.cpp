@@ -260,6 +260,36 @@ TEST(FrameOptions, OnOffOptionsTakeOnlyOnOrOff) {
   }
 }
 
+// --raster-filter is box (the default) or gaussian by the same name everywhere; anything else
+// is refused naming where it came from, and gaussian only for cartesian, whose cells are the
+// display's pixels.
+TEST(FrameOptions, RasterFilterIsBoxOrGaussianForCartesianOnly) {
+  pipeline::FrameConfig c;
+  EXPECT_FALSE(c.recon.raster_gaussian);
+  EXPECT_EQ(pipeline::to_json(c)["raster-filter"], "box");
+  for (const char* bad : {"", "on", "Gaussian", "tent"}) {
+    try {
+      pipeline::apply_frame_option(c, "raster-filter", bad, "layer.json: default.raster-filter");
+      ADD_FAILURE() << bad;
+    } catch (const fovea::core::InputError& e) {
+      EXPECT_NE(std::string(e.what()).find("layer.json: default.raster-filter: expected box or gaussian"),
+                std::string::npos)
+          << e.what();
+    }
+  }
+  pipeline::apply_frame_option(c, "raster-filter", "gaussian", "--raster-filter");
+  EXPECT_EQ(pipeline::to_json(c)["raster-filter"], "gaussian");
+  try {
+    pipeline::finish(c, false);  // the default distribution, visual-polar
+    ADD_FAILURE() << "gaussian accepted for visual-polar";
+  } catch (const fovea::core::InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("raster-filter: only cartesian"), std::string::npos) << e.what();
+  }
+  pipeline::apply_frame_option(c, "distribution", "cartesian", "--distribution");
+  pipeline::finish(c, false);
+  EXPECT_TRUE(c.recon.raster_gaussian);
+}
+
 // --cap sets Visual-Polar's samples per display pixel at most (κ) by the same name everywhere;
 // the grid then puts that many in the fovea. A cap outside (0, 16] or not a number is refused
 // naming where it came from.

@@ -1,6 +1,7 @@
 // Resolve to the display: constant grids resolve to constants (φ wrap, ρ clamp, coverage),
 // a smooth analytic image survives the round trip display -> grid -> display within 0.5 dB
-// of the budget-limited ideal, and wide cells take the lattice's reconstruction when asked.
+// of the budget-limited ideal, wide cells take the lattice's reconstruction when asked, and
+// the Cartesian raster its Gaussian filter.
 #include <algorithm>
 #include <cmath>
 #include <numbers>
@@ -198,5 +199,52 @@ TEST_F(Resolve, LatticeBlurReconstructsWideCellsWithTheCubicBSpline) {
       }
       EXPECT_GT(unlit, 100);
     }
+  }
+}
+
+// The Cartesian raster's reconstruction filter (ReconSettings::raster_gaussian, the
+// `raster-filter` option): box, each display pixel shows its own cell; gaussian, the cells
+// around it weighed per axis by s, 1 − 2s, s (s = raster_filter_side_weight, pbrt-v4's
+// Gaussian of σ = 0.5 px cut at 1.5 px), renormalised at the raster's border. Single bright
+// cells amid dark ones, inside and at a corner, show the kernel; a pixel whose own cell holds
+// no sample stays without one.
+TEST_F(Resolve, RasterFilterWeighsTheNeighbouringCellsWithPbrtsGaussian) {
+  const double side = reconstruct::raster_filter_side_weight();
+  EXPECT_NEAR(side, 0.1004, 5e-4);
+  const core::DisplayPreset display = fovea::test::display_of_size(24, 20);
+  core::DistributionParams dp;
+  dp.kind = core::DistributionKind::Cartesian;
+  dp.budget = 1;
+  for (const bool gaussian : {false, true}) {
+    reconstruct::ReconSettings s;
+    s.blur = false;
+    s.raster_gaussian = gaussian;
+    pipeline::FramePipeline p(ctx(), *gs_, core::stereo_views(display), dp, s, {}, true);
+    const core::SampleDistribution& d = p.distribution(core::Eye::Left);
+    ASSERT_EQ(d.columns(), 24);
+    ASSERT_EQ(d.rows(), 20);
+    const int pcols = d.padded_columns();
+    std::vector<glm::vec4> grid(std::size_t(pcols) * d.padded_rows(), glm::vec4(0));
+    for (int r = 0; r < 20; ++r)
+      for (int c = 0; c < 24; ++c) grid[std::size_t(r) * pcols + c] = {0, 0, 0, 1};
+    grid[std::size_t(7) * pcols + 9] = {1, 0, 0, 1};  // inside
+    grid[0] = {1, 0, 0, 1};                           // the corner
+    grid[std::size_t(15) * pcols + 15] = glm::vec4(0);  // no sample
+    grid[std::size_t(15) * pcols + 16] = {1, 1, 1, 1};  // next to it
+    const core::Image img = pipeline::testing::resolve_grid(p, core::Eye::Left, grid, false);
+    const auto w = [&](int k) {
+      if (!gaussian) return k == 0 ? 1.0 : 0.0;
+      return k == 0 ? 1 - 2 * side : std::abs(k) == 1 ? side : 0.0;
+    };
+    for (int y = 2; y < 13; ++y)
+      for (int x = 4; x < 15; ++x)
+        ASSERT_NEAR(img.at(x, y).x, w(x - 9) * w(y - 7), 1e-5)
+            << "pixel " << x << ", " << y << (gaussian ? " gaussian" : " box");
+    const double corner = gaussian ? (1 - 2 * side) * (1 - 2 * side) / ((1 - side) * (1 - side)) : 1.0;
+    EXPECT_NEAR(img.at(0, 0).x, corner, 1e-5);
+    EXPECT_NEAR(img.at(1, 1).x, gaussian ? side * side : 0.0, 1e-5);  // all its cells on the raster
+    EXPECT_EQ(img.at(15, 15), glm::vec4(0, 0, 0, 1)) << "no sample: no colour";
+    // Beside it: the weights of the cells with a sample renormalise.
+    EXPECT_NEAR(img.at(16, 15).y, gaussian ? (1 - 2 * side) * (1 - 2 * side) / (1 - side * (1 - 2 * side)) : 1.0, 1e-5);
   }
 }

@@ -217,7 +217,7 @@ int run(std::vector<std::string> argv) {
                                              "quality-at", "quality-radius", "reference-error", "reference-cache",
                                              "distribution", "denoiser", "bmfr-precision", "stereo-share", "trace",
                                              "bounces", "seed", "landing-spp", "pixel-albedo",
-                                             "lattice-blur"};
+                                             "lattice-blur", "raster-filter"};
   std::vector<std::string> valued = sim_options;
   valued.insert(valued.end(), {"records", "out"});
   const Args args(argv, valued, {"quiet", "no-main-render"});

@@ -409,7 +409,7 @@ int run(std::vector<std::string> argv) {
                   {"scene", "display", "gaze", "frames", "distribution", "budget", "cap", "jitter", "denoiser", "bmfr-precision",
                    "stereo-share", "bounces", "reference", "reference-error", "reference-cache", "reference-window", "recovery-frames", "png-every",
                    "out", "screen", "trace", "seed", "landing-spp", "pixel-albedo",
-                   "lattice-blur"},
+                   "lattice-blur", "raster-filter"},
                   {"no-blur", "no-cull", "no-marker", "quiet", "full-gi-score"});
   const long frames = args.integer("frames", 24);
   if (frames < 1 || frames > 100000) throw core::InputError("--frames must be in 1..100000");

@@ -115,7 +115,7 @@ int run(std::vector<std::string> argv) {
   const Args args(argv,
                   {"display", "scene", "trace", "gaze", "gaze-dir", "budget", "cap", "jitter", "optics", "window", "frames",
                    "distribution", "denoiser", "bmfr-precision", "stereo-share", "bounces", "seed", "landing-spp",
-                   "pixel-albedo", "lattice-blur", "screenshot", "panels"},
+                   "pixel-albedo", "lattice-blur", "raster-filter", "screenshot", "panels"},
                   {});
   const core::DisplayPreset d = core::load_display(args.str("display", core::kDefaultDisplay));
   const long frames = args.integer("frames", 0);

@@ -59,6 +59,11 @@ constexpr OptionHelp kFrameOptionsHelp[] = {
      "                        cubic B-spline over four cells instead of the tent over two, so that\n"
      "                        their lattice (rings about the gaze, spokes) does not show: smoother\n"
      "                        and less detailed (docs/reconstruction.md, \"The lattice's rings\") [on]"},
+    {"raster-filter",
+     "  --raster-filter box|gaussian\n"
+     "                        cartesian: each display pixel its own cell (box), or a Gaussian\n"
+     "                        over its 3x3 cells (sigma 0.5 px, radius 1.5: pbrt-v4's default),\n"
+     "                        which averages about as much noise as the tent over polar cells"},
     {"seed",
      "  --seed N              noise seed: another N, another noise realisation of the same frames\n"
      "                        (path tracing and BMFR keyed by frame + 1024·N; gaze and jitter\n"

@@ -50,7 +50,7 @@ struct FrameConfig {
 
 // The option names, shared by the command line (--NAME VALUE) and the layer's configuration
 // ("NAME": VALUE): budget, cap, distribution, jitter, denoiser, bmfr-precision, stereo-share,
-// trace, bounces, seed, landing-spp, pixel-albedo, lattice-blur.
+// trace, bounces, seed, landing-spp, pixel-albedo, lattice-blur, raster-filter.
 const std::vector<std::string>& frame_option_names();
 
 // Sets option `name` from its text `value`; core::InputError naming `where` (e.g. "--budget",

@@ -114,6 +114,19 @@ struct ReconSettings {
   // rings and spokes around the gaze that swim with it (measured: docs/reconstruction.md,
   // "The lattice's rings"). On by default: the periphery sees flicker and motion first.
   bool lattice_blur = true;
+  // The full-resolution Cartesian raster (cells = the display's pixels): reconstruct each
+  // pixel with a Gaussian over its 3×3 cells (σ = 0.5 px, radius 1.5: pbrt-v4's default film
+  // filter, raster_filter_side_weight) instead of its own cell alone (the `raster-filter`
+  // frame option, gaussian | box). The tent over polar cells, which are not the pixels, averages
+  // about as much noise; box-filtered, the raster is the weaker baseline (docs/measurements.md,
+  // "Why Visual-Polar's fovea beats the display's raster"). Off by default: the shipped sweep's
+  // baseline.
+  bool raster_gaussian = false;
 };
+
+// raster_gaussian's weight of each side neighbour along an axis, the centre's 1 − 2× it (before
+// renormalising at the raster's border): pbrt-v4's Gaussian filter, exp(−d²/2σ²) − exp(−r²/2σ²)
+// for |d| < r, σ = 0.5 px and r = 1.5 px, at d = 0 and ±1 (≈ 0.1004).
+double raster_filter_side_weight();
 
 }  // namespace fovea::reconstruct

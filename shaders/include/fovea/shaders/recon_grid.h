@@ -102,7 +102,10 @@ struct ReconResolvePush {
   // and beyond which not at all.
   FOVEA_UINT detail_x0, detail_y0, detail_width, detail_height;
   float detail_cos_full, detail_cos_none;
-  FOVEA_UINT lattice, pad2;  // lattice = 1: the lattice's reconstruction (below)
+  FOVEA_UINT lattice;  // lattice = 1: the lattice's reconstruction (below)
+  // The Cartesian raster's Gaussian (ReconSettings::raster_gaussian): each side neighbour's
+  // weight per axis; 0: each pixel its own cell (box).
+  float raster_side;
 };
 
 // The lattice's reconstruction (ReconSettings::lattice_blur, recon_resolve.comp): where a polar
