@@ -245,6 +245,7 @@ TEST_F(Resolve, RasterFilterWeighsTheNeighbouringCellsWithPbrtsGaussian) {
     EXPECT_NEAR(img.at(1, 1).x, gaussian ? side * side : 0.0, 1e-5);  // all its cells on the raster
     EXPECT_EQ(img.at(15, 15), glm::vec4(0, 0, 0, 1)) << "no sample: no colour";
     // Beside it: the weights of the cells with a sample renormalise.
-    EXPECT_NEAR(img.at(16, 15).y, gaussian ? (1 - 2 * side) * (1 - 2 * side) / (1 - side * (1 - 2 * side)) : 1.0, 1e-5);
+    const double beside = (1 - 2 * side) * (1 - 2 * side) / (1 - side * (1 - 2 * side));
+    EXPECT_NEAR(img.at(16, 15).y, gaussian ? beside : 1.0, 1e-5);
   }
 }
