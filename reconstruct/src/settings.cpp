@@ -30,10 +30,13 @@ double blur_sigma_deg(double e_deg, double mar_fovea_deg) {
 }
 
 double raster_filter_side_weight() {
-  constexpr double sigma = 0.5, radius = 1.5;
-  const auto gauss = [&](double d) { return std::exp(-d * d / (2 * sigma * sigma)); };
-  const auto g = [&](double d) { return gauss(d) - gauss(radius); };
-  return g(1) / (g(0) + 2 * g(1));
+  static const double side = [] {  // a constant: computed once, not on every frame's resample
+    constexpr double sigma = 0.5, radius = 1.5;
+    const auto gauss = [](double d) { return std::exp(-d * d / (2 * sigma * sigma)); };
+    const auto g = [&](double d) { return gauss(d) - gauss(radius); };
+    return g(1) / (g(0) + 2 * g(1));
+  }();
+  return side;
 }
 
 double view_motion_deg(glm::dvec3 gaze_before, glm::dvec3 gaze_now, const core::Pose& before, const core::Pose& now) {
