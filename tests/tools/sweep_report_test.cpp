@@ -164,12 +164,13 @@ TEST(SweepReport, SectionsByTwoSettingsAndSpeedUpAtEqualQuality) {
   const test::PythonOverride no_python("/nonexistent/python3");
   const std::string dir = test::temp_dir("sweep-report-speedup");
   const std::vector<RenderOption> opts = {{"scene", true}, {"display", true}, {"distribution", true},
-                                          {"budget", true}, {"out", true},     {"quiet", false}};
+                                          {"budget", true}, {"out", true},     {"quiet", false},
+                                          {"raster-filter", true}};
   const json file = core::parse_json(R"([
     {"scenes": "default", "displays": ["p1", "p2"], "distribution": "vp", "budget": [0.1, 0.2, 0.4],
      "report": {"quality": ["fovea_flip", "fovea_psnr"], "section": ["scene", "display"],
                 "speedup": {"of": "vp", "over": "full", "tolerance": 0.05}}},
-    {"scenes": "default", "displays": ["p1", "p2"], "distribution": "full"}])");
+    {"scenes": "default", "displays": ["p1", "p2"], "distribution": "full", "raster-filter": "gaussian"}])");
   const Plan plan = expand_sweep(file, "synthetic.json", opts);
   ASSERT_EQ(plan.jobs.size(), 8u);
   // full: 100 ms, FLIP 0.200, 1000 samples. vp on p1: FLIP 0.30, 0.209 (within 5%), 0.19 at
@@ -199,6 +200,12 @@ TEST(SweepReport, SectionsByTwoSettingsAndSpeedUpAtEqualQuality) {
         "| display p1 | 1000 | 100 / 110 | 0.2000 | 0.2 | 200 | 20.0 / 22.0 | 0.2090 | **5.00×** | 5.00× | 5.00 | 1.00 | 50.0 / 60.0 (1.20) | fovea_psnr 30.00 → 31.00 |",
         "| display p2 | 1000 | 100 / 110 | 0.2000 | none as good (best: 0.3500 at budget 0.1) | – | – | – | – | – | – | – | – | – |"})
     EXPECT_NE(page.find(text), std::string::npos) << text << "\n" << page;
+  // An option only one group ran with is named, in the speed-up's text and in each section; the
+  // options every job shares are the command's.
+  EXPECT_NE(page.find(" The full jobs run with `--raster-filter gaussian`. *Speed-up*"), std::string::npos) << page;
+  const std::size_t p2 = page.find("## display p2\n");
+  EXPECT_NE(page.find("\nThe full jobs also run with `--raster-filter gaussian`.\n", p2), std::string::npos) << page;
+  EXPECT_EQ(page.find("The vp jobs"), std::string::npos) << page;
   // The scene does not vary: it names no section; the fronts and plots are per display.
   const json j = core::parse_json(test::read_text(dir + "/report/results.json"));
   EXPECT_TRUE(j["pareto"]["fovea_flip"].contains("p1/vp")) << j["pareto"].dump();
@@ -251,6 +258,66 @@ TEST(SweepReport, SectionsByTwoSettingsAndSpeedUpAtEqualQuality) {
   const auto r5 = test::run_fovea("sweep report " + plan_path + " --out " + dir + "/report");
   EXPECT_EQ(r5.status, 2);
   EXPECT_NE(r5.err.find("report.speedup: at"), std::string::npos) << r5.err;
+  fs::remove_all(dir);
+}
+
+// A list of speed-ups is a table each; a list of qualities asks for each to be as good: at
+// equal fovea_flip alone the pick on p1 is budget 0.2, but its fovea_psnr is 10% worse than the
+// full job's, so at equal fovea_flip and fovea_psnr it is budget 0.4. On p2 no budget's is.
+TEST(SweepReport, SpeedUpAtEqualQualityInEveryListedMetric) {
+  const test::PythonOverride no_python("/nonexistent/python3");
+  const std::string dir = test::temp_dir("sweep-report-speedups");
+  const std::vector<RenderOption> opts = {{"display", true}, {"distribution", true}, {"budget", true},
+                                          {"out", true},     {"quiet", false}};
+  const json file = core::parse_json(R"([
+    {"displays": ["p1", "p2"], "distribution": "vp", "budget": [0.1, 0.2, 0.4],
+     "report": {"quality": ["fovea_flip", "fovea_psnr"], "section": "display",
+                "speedup": [{"of": "vp", "over": "full", "tolerance": 0.05},
+                            {"of": "vp", "over": "full", "quality": ["fovea_flip", "fovea_psnr"], "tolerance": 0.05}]}},
+    {"displays": ["p1", "p2"], "distribution": "full"}])");
+  const Plan plan = expand_sweep(file, "synthetic.json", opts);
+  for (const Job& j : plan.jobs) {
+    const bool full = j.settings["distribution"] == "full";
+    const double budget = full ? 1.0 : j.settings["budget"].get<double>();
+    const double flip = full ? 0.2 : budget < 0.15 ? 0.3 : budget < 0.3 ? 0.209 : 0.19;
+    const double psnr = full ? 30 : budget < 0.3 || j.settings["display"] == "p2" ? 27 : 31;  // p2: never as good
+    json rep = render_report(100 * budget, psnr, flip, 40);
+    rep["samples_traced_per_eye"] = 1000 * budget;
+    fs::create_directories(dir + "/" + j.out);
+    core::write_file_atomic(dir + "/" + j.out + "/report.json", rep.dump());
+  }
+  const std::string plan_path = dir + "/plan.jsonl";
+  core::write_file_atomic(plan_path, plan_to_jsonl(plan));
+  const auto r =
+      test::run_fovea("sweep report " + plan_path + " --out " + dir + "/report --markdown " + dir + "/page.md");
+  ASSERT_EQ(r.status, 0) << r.err;
+  const std::string page = test::read_text(dir + "/page.md");
+  const std::size_t one = page.find("## vp against full at equal fovea_flip\n"),
+                    both = page.find("## vp against full at equal fovea_flip and fovea_psnr\n");
+  ASSERT_NE(one, std::string::npos) << page;
+  ASSERT_NE(both, std::string::npos) << page;
+  ASSERT_LT(one, both) << "the tables keep the sweep file's order";
+  const std::string first = page.substr(one, both - one), second = page.substr(both);
+  EXPECT_NE(first.find("| 0.2 | 200 | 20.0 / – | 0.2090 | **5.00×** |"), std::string::npos) << first;
+  EXPECT_NE(second.find("whose fovea_flip and fovea_psnr are each at least as good as its, within 5% "
+                        "(\"as good\": at most 1 + 0.05 times the full job's where lower is better, at least "
+                        "1 − 0.05 times where higher is). The columns are those of the first table."),
+            std::string::npos)
+      << second;
+  EXPECT_NE(second.find("| 0.4 | 400 | 40.0 / – | 0.1900 | **2.50×** |"), std::string::npos) << second;
+  EXPECT_NE(second.find("fovea_psnr 30.00 → 31.00 |"), std::string::npos) << second;
+  EXPECT_NE(page.find("| display p2 | 1000 | 100 / – | 0.2000 | none as good in each (best fovea_flip: 0.1900 at "
+                      "budget 0.4) |"),
+            std::string::npos)
+      << page;
+
+  // An empty list of qualities names the key.
+  json bad = file;
+  bad[0]["report"]["speedup"][1]["quality"] = json::array();
+  core::write_file_atomic(plan_path, plan_to_jsonl(expand_sweep(bad, "synthetic.json", opts)));
+  const auto r2 = test::run_fovea("sweep report " + plan_path + " --out " + dir + "/report");
+  EXPECT_EQ(r2.status, 2);
+  EXPECT_NE(r2.err.find("report.speedup: quality"), std::string::npos) << r2.err;
   fs::remove_all(dir);
 }
 

@@ -100,11 +100,15 @@ struct Row {
 };
 
 std::string setting_text(const json& v) { return v.is_string() ? v.get<std::string>() : v.dump(); }
+std::string group_text(const Row& r, const std::string& group) {
+  return r.settings.contains(group) ? setting_text(r.settings[group]) : "";
+}
 
 // report.speedup: one group's whole-frame speed-up over another's per section, at equal quality
 // or, with `at`, at the listed budgets (a sweep that measures time only, without references).
 struct SpeedUp {
-  std::string of, over, quality;  // quality: empty = the first quality metric
+  std::string of, over;
+  std::vector<std::string> quality;  // as good in each; empty = the first quality metric
   double tolerance = 0;           // relative: "as good" allows this much worse
   std::vector<double> at;         // the `of` jobs' budgets compared; empty: at equal quality
 };
@@ -115,7 +119,7 @@ struct Config {
   std::string repeat;  // the setting whose values are repeated runs of one job (e.g. "seed")
   std::vector<std::string> section = {"scene"};  // as configured
   std::vector<std::string> section_keys;          // of those, the ones whose value differs between render jobs
-  std::optional<SpeedUp> speedup;
+  std::vector<SpeedUp> speedups;  // one table each
   std::set<std::string> lower, higher;
   bool lower_better(const std::string& m) const {
     if (lower.count(m)) return true;
@@ -200,17 +204,25 @@ Config read_config(const json& r, const std::vector<Row>& rows) {
     if (values.size() > 1) c.section_keys.push_back(k);
   }
   if (c.section_keys.empty()) c.section_keys.push_back(c.section[0]);
-  if (r.contains("speedup")) {
-    const json& x = r["speedup"];
+  const json speedups = !r.contains("speedup") ? json::array() : r["speedup"].is_array() ? r["speedup"]
+                                                                                          : json::array({r["speedup"]});
+  for (const json& x : speedups) {
     const auto bad = [](const std::string& what) { return core::InputError("report.speedup: " + what); };
     if (!x.is_object())
-      throw bad("expected an object {\"of\": GROUP, \"over\": GROUP, \"quality\": METRIC, \"tolerance\": N} "
-                "or {\"of\": GROUP, \"over\": GROUP, \"at\": [BUDGET, ...]}");
+      throw bad("expected an object {\"of\": GROUP, \"over\": GROUP, \"quality\": METRIC or [METRIC, ...], "
+                "\"tolerance\": N} or {\"of\": GROUP, \"over\": GROUP, \"at\": [BUDGET, ...]}, or a list of them");
     SpeedUp s;
     for (const auto& [k, v] : x.items()) {
-      if (k == "of" || k == "over" || k == "quality") {
+      if (k == "of" || k == "over") {
         if (!v.is_string() || v.get<std::string>().empty()) throw bad(k + ": expected a non-empty name");
-        (k == "of" ? s.of : k == "over" ? s.over : s.quality) = v.get<std::string>();
+        (k == "of" ? s.of : s.over) = v.get<std::string>();
+      } else if (k == "quality") {
+        for (const json& m : v.is_array() ? v : json::array({v})) {
+          if (!m.is_string() || m.get<std::string>().empty())
+            throw bad("quality: expected a metric or a list of metrics");
+          s.quality.push_back(m.get<std::string>());
+        }
+        if (s.quality.empty()) throw bad("quality: expected a metric or a list of metrics");
       } else if (k == "tolerance") {
         if (!v.is_number() || !(v.get<double>() >= 0 && v.get<double>() < 1))
           throw bad("tolerance: expected a number in [0, 1)");
@@ -226,7 +238,7 @@ Config read_config(const json& r, const std::vector<Row>& rows) {
       }
     }
     if (s.of.empty() || s.over.empty()) throw bad("\"of\" and \"over\" are required");
-    c.speedup = s;
+    c.speedups.push_back(s);
   }
   c.bands = strings("bands");
   if (auto l = strings("latency"); !l.empty()) c.latency = l[0];
@@ -468,10 +480,36 @@ std::string job_argv_text(const Plan& plan, const std::string& id) {
   return "";
 }
 
+// The options every job of one group ran with and no job of another group did (the Cartesian
+// raster's filter, say), as `--key value` text; "" if none. A row names only its group and
+// budget, so without these the page would not say how the group's jobs ran.
+std::string group_options(const std::vector<const Row*>& done, const Config& cfg, const std::string& g) {
+  std::map<std::string, json> shared;
+  bool first = true;
+  for (const Row* r : done) {
+    if (group_text(*r, cfg.group) != g) continue;
+    std::map<std::string, json> mine;
+    for (auto it = r->settings.begin(); it != r->settings.end(); ++it)
+      if (it.key() != cfg.group && it.key() != cfg.budget && it.key() != cfg.repeat) mine[it.key()] = *it;
+    if (first) shared = mine, first = false;
+    std::erase_if(shared, [&](const auto& kv) { return !mine.count(kv.first) || mine.at(kv.first) != kv.second; });
+  }
+  for (const Row* r : done)
+    if (group_text(*r, cfg.group) != g)
+      std::erase_if(shared, [&](const auto& kv) {
+        return r->settings.contains(kv.first) && r->settings[kv.first] == kv.second;
+      });
+  std::string out;
+  for (const auto& [k, v] : shared)
+    out += (out.empty() ? "`--" : ", `--") + k + (v.is_boolean() ? "" : " " + setting_text(v)) + "`";
+  return out;
+}
+
 void markdown_section(std::ostringstream& md, const MarkdownInput& in, const std::vector<const Row*>& done,
                       const std::string& h, const std::vector<std::string>& images);
 void markdown_latency(std::ostringstream& md, const MarkdownInput& in, const std::vector<std::string>& images);
-void markdown_speedup(std::ostringstream& md, const MarkdownInput& in, const std::vector<const Row*>& done);
+void markdown_speedup(std::ostringstream& md, const MarkdownInput& in, const std::vector<const Row*>& done,
+                      const SpeedUp& su, bool first);
 
 // The page: settings, every job, equal samples, equal time, per band, the plots, and what
 // the Pareto front means for a 90 Hz frame.
@@ -529,7 +567,7 @@ std::string markdown_page(const MarkdownInput& in) {
     }
     md << (in.images.count(kLatencySection) ? "; then [latency against quality](#latency-against-quality)" : "") << ".\n\n";
   }
-  if (cfg.speedup) markdown_speedup(md, in, done);
+  for (const SpeedUp& su : cfg.speedups) markdown_speedup(md, in, done, su, &su == &cfg.speedups.front());
   for (const auto& section : in.sections) {
     std::vector<const Row*> rows;
     for (const Row* r : done)
@@ -557,6 +595,13 @@ void markdown_section(std::ostringstream& md, const MarkdownInput& in, const std
     md << "Each job is the command below with its row's settings (`shared/<id>`: the shared reference, "
           "`jobs/<id>`: its output, both in the sweep's results directory):\n\n    "
        << job_argv_text(in.plan, done.front()->id) << "\n\n";
+  std::vector<std::string> groups;
+  for (const Row* r : done)
+    if (std::find(groups.begin(), groups.end(), setting(*r, cfg.group)) == groups.end())
+      groups.push_back(setting(*r, cfg.group));
+  for (const std::string& g : groups)
+    if (const std::string options = group_options(done, cfg, g); !options.empty())
+      md << "The " << g << " jobs also run with " << options << ".\n\n";
 
   // Every job, grouped by budget (equal samples), Pareto membership of the first quality.
   std::vector<const Row*> sorted = done;
@@ -578,10 +623,6 @@ void markdown_section(std::ostringstream& md, const MarkdownInput& in, const std
     const auto f = in.on_front.find(q0);
     md << " | " << (f != in.on_front.end() && f->second.count(r->id) && f->second.at(r->id) ? "yes" : "") << " |\n";
   }
-
-  std::vector<std::string> groups;
-  for (const Row* r : done)
-    if (std::find(groups.begin(), groups.end(), setting(*r, cfg.group)) == groups.end()) groups.push_back(setting(*r, cfg.group));
 
   // Which to pick: the best first quality, and the fastest job within 5% of it; then the
   // first group against each other group at equal budget.
@@ -734,19 +775,34 @@ void markdown_section(std::ostringstream& md, const MarkdownInput& in, const std
   }
 }
 
-// report.speedup: per section, the `over` job against the cheapest `of` job whose quality is
-// at least as good (within the tolerance), or against the `of` job at each budget of `at`:
+// report.speedup: per section, the `over` job against the cheapest `of` job whose qualities are
+// each at least as good (within the tolerance), or against the `of` job at each budget of `at`:
 // whole-frame times on the GPU and the CPU, traced samples, and how much of the samples'
 // ratio the time's ratio keeps.
-void markdown_speedup(std::ostringstream& md, const MarkdownInput& in, const std::vector<const Row*>& done) {
+void markdown_speedup(std::ostringstream& md, const MarkdownInput& in, const std::vector<const Row*>& done,
+                      const SpeedUp& su, bool first) {
   const Config& cfg = in.cfg;
-  const SpeedUp& su = *cfg.speedup;
-  const std::string q = !su.quality.empty() ? su.quality : cfg.quality.empty() ? "" : cfg.quality[0];
+  std::vector<std::string> qs = su.quality;
+  if (qs.empty() && !cfg.quality.empty()) qs.push_back(cfg.quality[0]);
+  const std::string q = qs.empty() ? "" : qs[0];  // the one in the table's columns
   const bool at_budgets = !su.at.empty();
   if (q.empty() && !at_budgets) return;
   const bool lower = !q.empty() && cfg.lower_better(q);
+  std::string qs_text;  // "a", "a and b", "a, b and c"
+  for (std::size_t i = 0; i < qs.size(); ++i) qs_text += (i == 0 ? "" : i + 1 == qs.size() ? " and " : ", ") + qs[i];
+  // As good in each quality: at most (lower-is-better) or at least 1 ± tolerance times the `over` job's.
+  const auto as_good = [&](const Row& r, const Row& over) {
+    for (const auto& m : qs) {
+      const double v = r.metrics.at(m), ref = over.metrics.at(m), slack = su.tolerance * std::abs(ref);
+      if (cfg.lower_better(m) ? v > ref + slack : v < ref - slack) return false;
+    }
+    return true;
+  };
+  const auto has_qualities = [&](const Row& r) {
+    return std::all_of(qs.begin(), qs.end(), [&](const std::string& m) { return r.metrics.count(m) > 0; });
+  };
   const std::string cpu = "cpu_ms.total", samples = "samples_traced_per_eye", trace = "gpu_ms.trace";
-  const auto group = [&](const Row& r) { return r.settings.contains(cfg.group) ? setting_text(r.settings[cfg.group]) : ""; };
+  const auto group = [&](const Row& r) { return group_text(r, cfg.group); };
   const auto ratio = [](const Row& a, const Row& b, const std::string& m) {
     return a.metrics.count(m) && b.metrics.count(m) && b.metrics.at(m) > 0 ? fixed(a.metrics.at(m) / b.metrics.at(m), 2)
                                                                            : std::string("–");
@@ -758,22 +814,33 @@ void markdown_speedup(std::ostringstream& md, const MarkdownInput& in, const std
     md << "## " << su.of << " against " << su.over << " at " << cfg.budget << " " << list << "\n\n"
        << "Per section: the " << su.over << " job, and the " << su.of << " job at each " << cfg.budget << " listed.";
   } else {
-    md << "## " << su.of << " against " << su.over << " at equal " << q << "\n\n"
+    md << "## " << su.of << " against " << su.over << " at equal " << qs_text << "\n\n"
        << "Per section: the " << su.over << " job, and the cheapest " << su.of << " job (by `" << cfg.time
-       << "`) whose " << q << " is at least as good as its, within " << fixed(100 * su.tolerance, 0)
-       << "% (\"as good\": " << (lower ? "at most" : "at least") << " " << (lower ? "1 + " : "1 − ")
-       << fixed(su.tolerance, 2) << " times the " << su.over << " job's).";
+       << "`) whose " << qs_text << (qs.size() > 1 ? " are each" : " is") << " at least as good as its, within "
+       << fixed(100 * su.tolerance, 0) << "% (\"as good\": ";
+    const std::string t = fixed(su.tolerance, 2);
+    if (qs.size() == 1)
+      md << (lower ? "at most 1 + " : "at least 1 − ") << t << " times the " << su.over << " job's).";
+    else
+      md << "at most 1 + " << t << " times the " << su.over << " job's where lower is better, at least 1 − " << t
+         << " times where higher is).";
   }
-  md << " *Speed-up*: the " << su.over << " job's whole-frame time over the " << su.of << " job's (GPU: `" << cfg.time
-     << "`, CPU: `" << cpu << "`, both per stereo frame, every stage); *samples ratio*: traced samples per eye, "
-     << su.over << " over " << su.of << "; the last column is how much of the samples' ratio the GPU speed-up keeps "
-     << "(1 = cost follows the samples); *trace per 1000 samples*: `" << trace << "` per 1000 traced samples per eye, "
-     << su.over << " / " << su.of << " and the second over the first (1 = a sample costs the same to trace); *other "
-     << "quality*: the other quality metrics, " << su.over << " → " << su.of << ".\n\n"
-     << "| section | " << su.over << " samples/eye | " << su.over << " GPU / CPU ms | " << su.over << " " << quality_name
-     << " | " << su.of << " " << cfg.budget << " | " << su.of << " samples/eye | " << su.of << " GPU / CPU ms | " << su.of
-     << " " << quality_name << " | GPU speed-up | CPU speed-up | samples ratio | speed-up / samples ratio | "
-     << "trace per 1000 samples | other quality |\n"
+  for (const std::string& g : {su.over, su.of})
+    if (const std::string options = group_options(done, cfg, g); !options.empty())
+      md << " The " << g << " jobs run with " << options << ".";
+  if (!first)
+    md << " The columns are those of the first table.";
+  else
+    md << " *Speed-up*: the " << su.over << " job's whole-frame time over the " << su.of << " job's (GPU: `"
+       << cfg.time << "`, CPU: `" << cpu << "`, both per stereo frame, every stage); *samples ratio*: traced samples "
+       << "per eye, " << su.over << " over " << su.of << "; the last column is how much of the samples' ratio the GPU "
+       << "speed-up keeps (1 = cost follows the samples); *trace per 1000 samples*: `" << trace << "` per 1000 traced "
+       << "samples per eye, " << su.over << " / " << su.of << " and the second over the first (1 = a sample costs the "
+       << "same to trace); *other quality*: the other quality metrics, " << su.over << " → " << su.of << ".";
+  md << "\n\n| section | " << su.over << " samples/eye | " << su.over << " GPU / CPU ms | " << su.over << " "
+     << quality_name << " | " << su.of << " " << cfg.budget << " | " << su.of << " samples/eye | " << su.of
+     << " GPU / CPU ms | " << su.of << " " << quality_name << " | GPU speed-up | CPU speed-up | samples ratio | "
+     << "speed-up / samples ratio | trace per 1000 samples | other quality |\n"
      << "|---|---|---|---|---|---|---|---|---|---|---|---|---|---|\n";
   const auto budget_of = [&](const Row& r) {
     return r.settings.contains(cfg.budget) && r.settings[cfg.budget].is_number() ? r.settings[cfg.budget].get<double>()
@@ -784,7 +851,7 @@ void markdown_speedup(std::ostringstream& md, const MarkdownInput& in, const std
     std::vector<const Row*> of;
     for (const Row* r : done) {
       if (job_command(r->settings) != "render" || section_of(*r, cfg) != section.id || !r->metrics.count(cfg.time) ||
-          (!at_budgets && !r->metrics.count(q)))
+          (!at_budgets && !has_qualities(*r)))
         continue;
       if (group(*r) == su.over && (!over || r->metrics.at(cfg.time) < over->metrics.at(cfg.time))) over = r;
       if (group(*r) == su.of) of.push_back(r);
@@ -835,13 +902,9 @@ void markdown_speedup(std::ostringstream& md, const MarkdownInput& in, const std
       }
       continue;
     }
-    const double ref = over->metrics.at(q), slack = su.tolerance * std::abs(ref);
     const Row* pick = nullptr;
-    for (const Row* r : of) {
-      const double v = r->metrics.at(q);
-      if ((lower ? v <= ref + slack : v >= ref - slack) && (!pick || r->metrics.at(cfg.time) < pick->metrics.at(cfg.time)))
-        pick = r;
-    }
+    for (const Row* r : of)
+      if (as_good(*r, *over) && (!pick || r->metrics.at(cfg.time) < pick->metrics.at(cfg.time))) pick = r;
     if (pick) {
       row(pick);
       continue;
@@ -850,7 +913,8 @@ void markdown_speedup(std::ostringstream& md, const MarkdownInput& in, const std
     for (const Row* r : of)
       if (lower ? r->metrics.at(q) < best->metrics.at(q) : r->metrics.at(q) > best->metrics.at(q)) best = r;
     head();
-    md << "none as good (best: " << md_value(*best, q) << " at " << cfg.budget << " "
+    md << "none as good" << (qs.size() > 1 ? " in each (best " + q + ": " : " (best: ") << md_value(*best, q) << " at "
+       << cfg.budget << " "
        << (best->settings.contains(cfg.budget) ? setting_text(best->settings[cfg.budget]) : "–")
        << ") | – | – | – | – | – | – | – | – | – |\n";
   }
