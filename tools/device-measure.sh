@@ -91,7 +91,8 @@ if ((QUICK)); then
     ' "distribution": "visual-polar", "budget": [0.2, 0.39],' \
     ' "report": {"time": "gpu_ms.total", "section": ["display"],' \
     '            "speedup": {"of": "visual-polar", "over": "cartesian", "at": [0.2, 0.39]}}},' \
-    ' {"scenes": "default", "displays": "tiny", "frames": 2, "png-every": 0, "distribution": "cartesian"}]' \
+    ' {"scenes": "default", "displays": "tiny", "frames": 2, "png-every": 0, "distribution": "cartesian",' \
+    ' "raster-filter": "gaussian"}]' \
     > "$sweep_file"
 fi
 step sweep-plan 30 "$fovea" sweep plan "$sweep_file" --out "$OUT/sweep/plan.jsonl"
