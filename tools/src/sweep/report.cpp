@@ -109,8 +109,8 @@ std::string group_text(const Row& r, const std::string& group) {
 struct SpeedUp {
   std::string of, over;
   std::vector<std::string> quality;  // as good in each; empty = the first quality metric
-  double tolerance = 0;           // relative: "as good" allows this much worse
-  std::vector<double> at;         // the `of` jobs' budgets compared; empty: at equal quality
+  double tolerance = 0;              // relative: "as good" allows this much worse
+  std::vector<double> at;            // the `of` jobs' budgets compared; empty: at equal quality
 };
 
 struct Config {
