@@ -35,6 +35,17 @@ pipeline::FrameConfig compute_frame(std::optional<double> budget = std::nullopt)
   pipeline::finish(frame, budget.has_value());
   return frame;
 }
+// A frame option's value refused: an InputError that names where it came from and what the
+// option takes.
+void expect_refused(pipeline::FrameConfig& c, const std::string& name, const std::string& value,
+                    const std::string& where, const std::string& expected) {
+  try {
+    pipeline::apply_frame_option(c, name, value, where);
+    ADD_FAILURE() << name << " " << value;
+  } catch (const fovea::core::InputError& e) {
+    EXPECT_NE(std::string(e.what()).find(where + ": " + expected), std::string::npos) << e.what();
+  }
+}
 }  // namespace
 
 TEST_F(GpuTest, FrameDriverSetsUpEveryEntryPointAlike) {
@@ -213,16 +224,8 @@ TEST(FrameOptions, LandingSamplesAreAWholeNumberFromOneToEight) {
   pipeline::apply_frame_option(c, "landing-spp", "1", "--landing-spp");
   EXPECT_EQ(c.recon.landing_spp, 1u);
   EXPECT_EQ(pipeline::to_json(c)["landing-spp"], 1);
-  for (const char* bad : {"0", "9", "-1", "4.5", "", "four", "99999999999999999999"}) {
-    try {
-      pipeline::apply_frame_option(c, "landing-spp", bad, "layer.json: default.landing-spp");
-      ADD_FAILURE() << bad;
-    } catch (const fovea::core::InputError& e) {
-      EXPECT_NE(std::string(e.what()).find("layer.json: default.landing-spp: expected a whole number in 1..8"),
-                std::string::npos)
-          << e.what();
-    }
-  }
+  for (const char* bad : {"0", "9", "-1", "4.5", "", "four", "99999999999999999999"})
+    expect_refused(c, "landing-spp", bad, "layer.json: default.landing-spp", "expected a whole number in 1..8");
   EXPECT_EQ(c.recon.landing_spp, 1u);  // a refused value changes nothing
 }
 
@@ -248,14 +251,7 @@ TEST(FrameOptions, OnOffOptionsTakeOnlyOnOrOff) {
     EXPECT_EQ(k.is_on(c), !k.on_by_default) << k.name;
     EXPECT_EQ(pipeline::to_json(c)[k.name], flipped) << k.name;
     const std::string where = std::string("layer.json: default.") + k.name;
-    for (const char* bad : {"", "true", "1", "ON"}) {
-      try {
-        pipeline::apply_frame_option(c, k.name, bad, where);
-        ADD_FAILURE() << k.name << " " << bad;
-      } catch (const fovea::core::InputError& e) {
-        EXPECT_NE(std::string(e.what()).find(where + ": expected on or off"), std::string::npos) << e.what();
-      }
-    }
+    for (const char* bad : {"", "true", "1", "ON"}) expect_refused(c, k.name, bad, where, "expected on or off");
     EXPECT_EQ(k.is_on(c), !k.on_by_default) << k.name;  // a refused value changes nothing
   }
 }
@@ -267,16 +263,8 @@ TEST(FrameOptions, RasterFilterIsBoxOrGaussianForCartesianOnly) {
   pipeline::FrameConfig c;
   EXPECT_FALSE(c.recon.raster_gaussian);
   EXPECT_EQ(pipeline::to_json(c)["raster-filter"], "box");
-  for (const char* bad : {"", "on", "Gaussian", "tent"}) {
-    try {
-      pipeline::apply_frame_option(c, "raster-filter", bad, "layer.json: default.raster-filter");
-      ADD_FAILURE() << bad;
-    } catch (const fovea::core::InputError& e) {
-      EXPECT_NE(std::string(e.what()).find("layer.json: default.raster-filter: expected box or gaussian"),
-                std::string::npos)
-          << e.what();
-    }
-  }
+  for (const char* bad : {"", "on", "Gaussian", "tent"})
+    expect_refused(c, "raster-filter", bad, "layer.json: default.raster-filter", "expected box or gaussian");
   pipeline::apply_frame_option(c, "raster-filter", "gaussian", "--raster-filter");
   EXPECT_EQ(pipeline::to_json(c)["raster-filter"], "gaussian");
   try {
