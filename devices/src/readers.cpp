@@ -76,6 +76,10 @@ Format detect_format(const std::string& path) {
   gzclose(g);
   head.resize(n > 0 ? static_cast<std::size_t>(n) : 0);
   if (head.rfind("\xEF\xBB\xBF", 0) == 0) head.erase(0, 3);
+  // From the first line that is not blank, as the readers skip blank lines: exports passed
+  // through other tools or edited by hand can start with an empty line.
+  for (std::size_t end; (end = head.find('\n')) != std::string::npos && head.find_first_not_of(" \t\r") >= end;)
+    head.erase(0, end + 1);
   const std::string first = head.substr(0, head.find('\n'));
   // A raw HID capture (docs/hid.md), plain or gzip: its first line is the magic.
   if (first.rfind("fovea-hid-capture", 0) == 0) return Format::HidCapture;
@@ -97,7 +101,7 @@ Format detect_format(const std::string& path) {
   if (head.rfind("**", 0) == 0 || head.find("\nMSG") != std::string::npos ||
       head.find("\nSAMPLES") != std::string::npos || head.find("\nSTART") != std::string::npos)
     return Format::EyelinkAsc;
-  throw core::InputError(path + ": cannot detect the gaze format from its first line; pass the format (" +
+  throw core::InputError(path + ": cannot detect the gaze format from its first line that is not blank; pass the format (" +
                          kFormatList + ")");
 }
 

@@ -173,6 +173,21 @@ TEST(Replay, FormatOverrideAndDetectionFailure) {
   o.format = "tobii";
   EXPECT_THROW(open_reader(write_text("x.txt", "a,b\n"), o), fovea::core::InputError);
   EXPECT_THROW(open_reader(write_text("y.txt", "a,b\n1,2\n"), SourceOptions{}), fovea::core::InputError);
+  EXPECT_THROW(open_reader(write_text("blank.txt", "\n \r\n\t\n"), SourceOptions{}), fovea::core::InputError);
+}
+
+// Detection reads the first line that is not blank (a public Pupil Core export starts with an
+// empty line; the readers skip blank lines as well).
+TEST(Replay, DetectionSkipsLeadingBlankLines) {
+  const std::string pupil = "\n\r\n  \ngaze_timestamp,world_index,confidence,norm_pos_x,norm_pos_y\n"
+                            "5.0,0,1.0,0.5,0.5\n5.004,0,1.0,0.25,0.5\n";
+  auto r = open_reader(write_text("pupil.csv", pupil), symmetric_screen(1280, 720, 90, 60));
+  EXPECT_EQ(r->format(), Format::PupilCore);
+  const auto v = read_all(*r);
+  ASSERT_EQ(v.size(), 2u);
+  EXPECT_NEAR(az(v[1].combined.dir), -26.565, 1e-3);  // x = 0.25: tan⁻¹(½·tan 45°) left
+  EXPECT_EQ(detect_format(write_text("eyelink.asc", "\n** CONVERTED FROM x.edf\n")), Format::EyelinkAsc);
+  EXPECT_EQ(detect_format(write_text("fovea.csv", "\xEF\xBB\xBF\r\nt_ns,eye,dir_x\n")), Format::Fovea);
 }
 
 TEST(Replay, OverlongLineIsDroppedAndBufferStaysBounded) {
