@@ -94,7 +94,8 @@ Format detect_format(const std::string& path) {
                            "(an object with \"type\" and \"timestamp\")");
   }
   if (first.find("t_ns") != std::string::npos && first.find("dir_x") != std::string::npos) return Format::Fovea;
-  if (first.find("gaze_timestamp") != std::string::npos && first.find("norm_pos_x") != std::string::npos)
+  if (first.find("norm_pos_x") != std::string::npos &&
+      (first.find("gaze_timestamp") != std::string::npos || first.rfind("timestamp,", 0) == 0))
     return Format::PupilCore;
   if (first.find("timestamp [ns]") != std::string::npos && first.find("gaze x [px]") != std::string::npos)
     return Format::Neon;
@@ -365,11 +366,12 @@ class PupilCoreReader final : public ReaderBase {
     if (!header_) {
       std::vector<std::string> h(fields_.begin(), fields_.end());
       t_ = column(h, "gaze_timestamp");
+      if (t_ < 0) t_ = column(h, "timestamp");  // older Pupil Player exports: timestamp, index
       c_ = column(h, "confidence");
       x_ = column(h, "norm_pos_x");
       y_ = column(h, "norm_pos_y");
       if (t_ < 0 || c_ < 0 || x_ < 0 || y_ < 0)
-        fail(l, "header needs gaze_timestamp, confidence, norm_pos_x, norm_pos_y");
+        fail(l, "header needs gaze_timestamp (or timestamp), confidence, norm_pos_x, norm_pos_y");
       for (int e = 0; e < 2; ++e)
         for (int k = 0; k < 3; ++k)
           n_[e][k] = column(h, "gaze_normal" + std::to_string(e) + "_" + "xyz"[k]);

@@ -60,6 +60,34 @@ TEST(PupilCore, NormalisedBottomLeftAndGazeNormals) {
   EXPECT_EQ(r->stats().dropped.at("non_finite"), 1u);
 }
 
+// Older Pupil Player exports name the first columns timestamp and index (gaze_timestamp and
+// world_index later); both are detected and read alike.
+TEST(PupilCore, OlderExportsNameTheTimeColumnTimestamp) {
+  const std::string text =
+      "timestamp,index,confidence,norm_pos_x,norm_pos_y,base_data,gaze_point_3d_x\n"
+      "146663.960698,0,0.9,0.5,0.5,146663.960698-0,-6.9\n"
+      "146663.964698,0,0.9,0.0,1.0,146663.964698-0,-6.9\n";
+  const std::string path = write_text("old_gaze_positions.csv", text);
+  EXPECT_EQ(detect_format(path), Format::PupilCore);
+  auto r = open_reader(path, symmetric_screen(1280, 720, 90, 60));
+  const auto v = read_all(*r);
+  ASSERT_EQ(v.size(), 2u);
+  EXPECT_EQ(v[1].t_ns, 4'000'000);
+  EXPECT_EQ(v[0].device_time_ns, 146663960698000);
+  EXPECT_NEAR(az(v[1].combined.dir), -45, 1e-9);
+  EXPECT_NEAR(el(v[1].combined.dir), 30, 1e-9);
+  // Neither name: refused with the header named.
+  auto bad = open_reader(write_text("no_time.csv", "t,confidence,norm_pos_x,norm_pos_y\n1,1,0.5,0.5\n"),
+                         [] { SourceOptions o; o.format = "pupil-core"; return o; }());
+  GazeSample s;
+  try {
+    bad->next(s);
+    ADD_FAILURE() << "a header without a time column was read";
+  } catch (const fovea::core::InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("gaze_timestamp (or timestamp)"), std::string::npos) << e.what();
+  }
+}
+
 TEST(Neon, ScenePixelsWornAndAngles) {
   const std::string text =
       "section id,recording id,timestamp [ns],gaze x [px],gaze y [px],worn,fixation id,blink id,azimuth [deg],elevation [deg]\r\n"
