@@ -622,12 +622,15 @@ class EyelinkReader final : public ReaderBase {
     disp_w_ = view_.width();
     disp_h_ = view_.height();
     samples_ = 0;
+    rate_hz_ = 0;
+    have_prev_ = false;
   }
   bool parse(const Line& l, GazeSample& out) override {
     detail::split_blank(l.text, fields_);
     if (fields_.empty()) return false;
-    const std::string_view k = fields_[0];
-    if (!(k[0] >= '0' && k[0] <= '9')) {
+    // A sample starts with its time stamp in the first column; indented numbers are not
+    // samples (the calibration's coefficient and residual tables in the preamble).
+    if (!(l.text[0] >= '0' && l.text[0] <= '9')) {
       control(l);
       return false;
     }
@@ -644,6 +647,14 @@ class EyelinkReader final : public ReaderBase {
     }
     out = GazeSample{};
     out.device_time_ns = std::llround(tms * 1e6);
+    // Above 1 kHz edf2asc writes whole milliseconds unless asked for fractions (-ftime): the
+    // second sample of a millisecond repeats its time stamp and was measured one sample
+    // period (RATE of the SAMPLES line) after the first.
+    if (rate_hz_ > 1000 && have_prev_ && tms == prev_ms_ && tms == std::floor(tms))
+      out.device_time_ns = prev_ns_ + std::llround(1e9 / rate_hz_);
+    have_prev_ = true;
+    prev_ms_ = tms;
+    prev_ns_ = out.device_time_ns;
     const int eyes = binocular_ ? 2 : 1;
     for (int i = 0; i < eyes; ++i) {
       const int eye = binocular_ ? i : (mono_right_ ? 1 : 0);  // 0 = left, 1 = right
@@ -691,6 +702,14 @@ class EyelinkReader final : public ReaderBase {
         fail(l, "only GAZE samples are supported (this file has HREF or PUPIL samples)");
       binocular_ = has("LEFT") && has("RIGHT");
       mono_right_ = !binocular_ && has("RIGHT");
+      if (k == "SAMPLES") {
+        const auto r = std::find(fields_.begin(), fields_.end(), "RATE");
+        double hz = 0;
+        rate_hz_ = r != fields_.end() && r + 1 != fields_.end() && detail::parse_double(*(r + 1), hz) == Num::Ok &&
+                           hz > 0 && hz <= 1e5
+                       ? hz
+                       : 0;
+      }
     } else if (k == "SBLINK" || k == "EBLINK") {
       const bool on = k == "SBLINK";
       if (fields_.size() > 1) blink_[fields_[1] == "R" ? 1 : 0] = on;
@@ -726,6 +745,10 @@ class EyelinkReader final : public ReaderBase {
   Coords coords_ = Coords::None;
   double disp_w_ = view_.width(), disp_h_ = view_.height();
   std::uint64_t samples_ = 0;
+  double rate_hz_ = 0;  // the SAMPLES line's RATE, 0 when not given
+  bool have_prev_ = false;
+  double prev_ms_ = 0;  // the last sample's time stamp as written, and its time
+  core::TimeNs prev_ns_ = 0;
 };
 
 }  // namespace

@@ -146,6 +146,10 @@ TEST(EyelinkAsc, MonocularBinocularMissingAndBlinks) {
   const std::string mono =
       "** CONVERTED FROM test.edf\n"
       "MSG\t1000 DISPLAY_COORDS 0 0 1919 1079\n"
+      // A calibration's tables as EyeLink writes them (indented numbers): not samples.
+      ">>>>>>> CALIBRATION (HV13,P-CR) FOR RIGHT: <<<<<<<<<\n"
+      "   5107.4  224.55  525.97 -1.4154  21.426 \n"
+      "\t-3904  6893 -1664  8322\n"
       "START\t1000 \tRIGHT\tSAMPLES\tEVENTS\n"
       "SAMPLES\tGAZE\tRIGHT\tRATE\t500.00\tTRACKING\tCR\tFILTER\t2\n"
       "1000\t  960.0\t  540.0\t  800.0\t...\n"
@@ -191,6 +195,29 @@ TEST(EyelinkAsc, MonocularBinocularMissingAndBlinks) {
   auto href = open_reader(write_text("href.asc", "** x\nSAMPLES\tHREF\tLEFT\tRATE\t500\n1 2 3 4\n"), SourceOptions{});
   GazeSample s;
   EXPECT_THROW(href->next(s), fovea::core::InputError);
+}
+
+// 2 kHz recordings converted without fractional times repeat each millisecond's time stamp:
+// the second sample is half a millisecond later (the SAMPLES line's RATE), not a duplicate.
+// Written fractions are kept as written; at 1 kHz a repeated time stays a duplicate.
+TEST(EyelinkAsc, TwoKilohertzWholeMillisecondsGetTheSamplePeriod) {
+  const auto times = [](const std::string& rate, const std::string& samples) {
+    const std::string text = "** CONVERTED FROM t.edf\nSTART\t100 \tRIGHT\tSAMPLES\tEVENTS\n"
+                             "SAMPLES\tGAZE\tRIGHT\tRATE\t" + rate + "\tTRACKING\tCR\tFILTER\t2\n" + samples;
+    auto r = open_reader(write_text("rate.asc", text), symmetric_screen(1920, 1080, 60, 40));
+    std::vector<fovea::core::TimeNs> t;
+    for (const GazeSample& s : read_all(*r)) t.push_back(s.device_time_ns);
+    return std::make_pair(t, r->stats().dropped);
+  };
+  const std::string line = "\t  960.0\t  540.0\t  800.0\t...\n";
+  const auto [whole, whole_dropped] = times("2000.00", "100" + line + "100" + line + "101" + line + "101" + line);
+  EXPECT_EQ(whole, (std::vector<fovea::core::TimeNs>{100'000'000, 100'500'000, 101'000'000, 101'500'000}));
+  EXPECT_TRUE(whole_dropped.empty());
+  const auto [fractional, unused] = times("2000.00", "100" + line + "100.5" + line + "101" + line);
+  EXPECT_EQ(fractional, (std::vector<fovea::core::TimeNs>{100'000'000, 100'500'000, 101'000'000}));
+  const auto [khz, khz_dropped] = times("1000.00", "100" + line + "100" + line + "101" + line);
+  EXPECT_EQ(khz, (std::vector<fovea::core::TimeNs>{100'000'000, 101'000'000}));
+  EXPECT_EQ(khz_dropped.at("duplicate_time"), 1u);
 }
 
 TEST(Replay, FormatOverrideAndDetectionFailure) {
