@@ -102,8 +102,8 @@ Format detect_format(const std::string& path) {
   if (head.rfind("**", 0) == 0 || head.find("\nMSG") != std::string::npos ||
       head.find("\nSAMPLES") != std::string::npos || head.find("\nSTART") != std::string::npos)
     return Format::EyelinkAsc;
-  throw core::InputError(path + ": cannot detect the gaze format from its first line that is not blank; pass the format (" +
-                         kFormatList + ")");
+  throw core::InputError(path + ": cannot detect the gaze format from its first line that is not blank; " +
+                         "pass the format (" + kFormatList + ")");
 }
 
 namespace {

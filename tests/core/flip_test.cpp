@@ -5,6 +5,7 @@
 
 #include <cmath>
 #include <cstdint>
+#include <string>
 
 #include <gtest/gtest.h>
 
@@ -201,8 +202,10 @@ TEST(Flip, MatchesTheAuthorsImplementation) {
     EXPECT_EQ(hdr.exposures, 6);
     for (int k = 0; k < 7; ++k) {
       const std::size_t i = std::size_t(kPixels[k][1]) * 64 + std::size_t(kPixels[k][0]);
-      EXPECT_NEAR(ldr[i], e.ldr[k], 5e-5f) << "ppd " << e.ppd << ", pixel " << kPixels[k][0] << "," << kPixels[k][1];
-      EXPECT_NEAR(hdr.error[i], e.hdr[k], 5e-5f) << "ppd " << e.ppd << ", pixel " << kPixels[k][0] << "," << kPixels[k][1];
+      const std::string where = "ppd " + std::to_string(e.ppd) + ", pixel " + std::to_string(kPixels[k][0]) + "," +
+                                std::to_string(kPixels[k][1]);
+      EXPECT_NEAR(ldr[i], e.ldr[k], 5e-5f) << where;
+      EXPECT_NEAR(hdr.error[i], e.hdr[k], 5e-5f) << where;
     }
   }
 }
