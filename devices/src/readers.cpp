@@ -607,10 +607,51 @@ class TobiiG3Reader final : public ReaderBase {
 };
 
 // ---- EyeLink ASC (edf2asc) -----------------------------------------------------------
+// An EyeLink file's own screen geometry: its raster (DISPLAY_COORDS, else GAZE_COORDS) and
+// the angular resolution the tracker measured (RES x y on an END line: screen pixels per
+// degree, averaged over the recording block), as a pinhole centred on the raster with the eye
+// at RES·180/π pixels (1° spans RES pixels at the centre). Read from the start of the file up
+// to the first END line with RES (at most kEyelinkScanBytes); nullopt without either.
+constexpr std::uint64_t kEyelinkScanBytes = 64ull << 20;
+
+std::optional<core::View> eyelink_screen(const std::string& path) {
+  detail::LineReader lines(path);
+  detail::Line l;
+  std::vector<std::string_view> f;
+  double w = 0, h = 0;
+  bool display = false;
+  std::uint64_t bytes = 0;
+  while (lines.next(l) && (bytes += l.text.size() + 1) <= kEyelinkScanBytes) {
+    detail::split_blank(l.text, f);
+    if (f.empty() || !(f[0] == "MSG" || f[0] == "END" || f[0] == "DISPLAY_COORDS" || f[0] == "GAZE_COORDS")) continue;
+    const auto at = [&](std::string_view word) { return std::find(f.begin(), f.end(), word); };
+    for (const std::string_view key : {"DISPLAY_COORDS", "GAZE_COORDS"}) {
+      const auto k = at(key);
+      double c[4];
+      if (k == f.end() || f.end() - k < 5 || (display && key == "GAZE_COORDS")) continue;
+      bool ok = true;
+      for (int i = 0; i < 4; ++i) ok = ok && detail::parse_double(k[1 + i], c[i]) == Num::Ok;
+      if (ok && c[2] > c[0] && c[3] > c[1] && c[2] - c[0] < 1e5 && c[3] - c[1] < 1e5) {
+        w = std::round(c[2] - c[0] + 1), h = std::round(c[3] - c[1] + 1);
+        display = display || key == "DISPLAY_COORDS";
+      }
+    }
+    const auto r = at("RES");
+    double rx = 0, ry = 0;
+    if (f[0] == "END" && r != f.end() && f.end() - r >= 3 && detail::parse_double(r[1], rx) == Num::Ok &&
+        detail::parse_double(r[2], ry) == Num::Ok && rx > 0 && ry > 0 && rx < 1e4 && ry < 1e4) {
+      if (!(w > 0)) return std::nullopt;
+      const double hx = std::atan(w / 2 / (rx / kDeg)) / kDeg, hy = std::atan(h / 2 / (ry / kDeg)) / kDeg;
+      return core::View(core::Fov::from_degrees(-hx, hx, hy, -hy), int(w), int(h));
+    }
+  }
+  return std::nullopt;
+}
+
 class EyelinkReader final : public ReaderBase {
  public:
   EyelinkReader(const std::string& path, const SourceOptions& opt)
-      : ReaderBase(path, opt, Format::EyelinkAsc, opt.screen_view()), view_(opt.screen_view()) {}
+      : EyelinkReader(path, opt, opt.screen ? std::nullopt : eyelink_screen(path)) {}
   bool reports_blinks() const override { return true; }
 
  protected:
@@ -683,6 +724,14 @@ class EyelinkReader final : public ReaderBase {
     return true;
   }
   bool flush(GazeSample&) override {
+    if (own_screen_ && samples_ > 0) {
+      char geometry[96];
+      std::snprintf(geometry, sizeof geometry, "%dx%d px, %.1f x %.1f degrees", view_.width(), view_.height(),
+                    (view_.fov().angle_right - view_.fov().angle_left) / kDeg,
+                    (view_.fov().angle_up - view_.fov().angle_down) / kDeg);
+      note(lines_.path() + ": gaze angles from the file's own screen, " + geometry +
+           " (its DISPLAY_COORDS and the tracker's RES); --screen replaces it");
+    }
     if (coords_ == Coords::None && samples_ > 0)
       note(lines_.path() + ": no DISPLAY_COORDS or GAZE_COORDS message; gaze pixels were taken as the screen raster (" +
            std::to_string(view_.width()) + "x" + std::to_string(view_.height()) + ")");
@@ -740,7 +789,13 @@ class EyelinkReader final : public ReaderBase {
       drop("bad_value");
     }
   }
+  EyelinkReader(const std::string& path, const SourceOptions& opt, const std::optional<core::View>& own)
+      : ReaderBase(path, opt, Format::EyelinkAsc, own.value_or(opt.screen_view())),
+        view_(own.value_or(opt.screen_view())),
+        own_screen_(own.has_value()) {}
+
   core::View view_;
+  bool own_screen_;  // view_ is the file's own screen (eyelink_screen)
   bool binocular_ = false, mono_right_ = false, blink_[2] = {};
   Coords coords_ = Coords::None;
   double disp_w_ = view_.width(), disp_h_ = view_.height();

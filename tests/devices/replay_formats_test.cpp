@@ -220,6 +220,42 @@ TEST(EyelinkAsc, TwoKilohertzWholeMillisecondsGetTheSamplePeriod) {
   EXPECT_EQ(khz_dropped.at("duplicate_time"), 1u);
 }
 
+// Without --screen an EyeLink file gives its own screen: DISPLAY_COORDS and the angular
+// resolution on its END line (RES: pixels per degree), a pinhole with the eye RES·180/π
+// pixels from the raster's centre. A point RES·180/π·tan 10° right of the centre is 10° out.
+TEST(EyelinkAsc, WithoutAScreenTheFileGivesItsOwn) {
+  const double d = 35.9 * 180 / M_PI;  // the eye's distance in pixels
+  char right10[64];
+  std::snprintf(right10, sizeof right10, "%.3f", 512 + d * std::tan(10 * M_PI / 180));
+  const std::string body = std::string("MSG\t900 DISPLAY_COORDS 0 0 1023 767\n") +
+                           "START\t1000 \tRIGHT\tSAMPLES\tEVENTS\n"
+                           "SAMPLES\tGAZE\tRIGHT\tRATE\t500.00\tTRACKING\tCR\tFILTER\t2\n"
+                           "1000\t  512.0\t  384.0\t  800.0\t...\n"
+                           "1002\t  " + right10 + "\t  384.0\t  800.0\t...\n";
+  const std::string with_res = write_text("res.asc", "** x\n" + body + "END\t1004 \tSAMPLES\tEVENTS\tRES\t 35.90\t 35.90\n");
+  auto r = open_reader(with_res, SourceOptions{});
+  auto v = read_all(*r);
+  ASSERT_EQ(v.size(), 2u);
+  EXPECT_NEAR(az(v[0].combined.dir), 0, 1e-9);
+  EXPECT_NEAR(el(v[0].combined.dir), 0, 1e-9);
+  EXPECT_NEAR(az(v[1].combined.dir), 10, 1e-3);
+  ASSERT_EQ(r->stats().notes.size(), 1u);
+  EXPECT_NE(r->stats().notes[0].find("1024x768 px, 28.0 x 21.1 degrees"), std::string::npos) << r->stats().notes[0];
+  // A given screen wins (60° over 1920 pixels: the centre sample is no longer straight ahead).
+  auto given = open_reader(with_res, symmetric_screen(1920, 1080, 60, 40));
+  v = read_all(*given);
+  ASSERT_EQ(v.size(), 2u);
+  EXPECT_NEAR(az(v[1].combined.dir), std::atan((512 + d * std::tan(10 * M_PI / 180)) / 1024 * 1920 / 960 *
+                                                   std::tan(30 * M_PI / 180) - std::tan(30 * M_PI / 180)) * 180 / M_PI,
+              1e-3);
+  EXPECT_TRUE(given->stats().notes.empty());
+  // No RES: the display's view, as for every 2D format.
+  auto none = open_reader(write_text("nores.asc", "** x\n" + body), SourceOptions{});
+  v = read_all(*none);
+  ASSERT_EQ(v.size(), 2u);
+  EXPECT_TRUE(none->stats().notes.empty());
+}
+
 TEST(Replay, FormatOverrideAndDetectionFailure) {
   SourceOptions o;
   o.format = "neon";
