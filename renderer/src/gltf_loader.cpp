@@ -258,10 +258,23 @@ glm::dmat4 local_transform(const tinygltf::Node& n) {
   return t;
 }
 
+// A triangle strip's or fan's vertex list as a triangle list, keeping each triangle's winding
+// (glTF 2.0 §3.7.2.1: strip p_i = {v_i, v_{i+1+i%2}, v_{i+2-i%2}}, fan p_i = {v_{i+1}, v_{i+2}, v_0}).
+std::vector<double> triangle_list(int mode, const std::vector<double>& v) {
+  if (mode != TINYGLTF_MODE_TRIANGLE_STRIP && mode != TINYGLTF_MODE_TRIANGLE_FAN) return v;
+  std::vector<double> t;
+  for (std::size_t i = 0; i + 2 < v.size(); ++i) {
+    if (mode == TINYGLTF_MODE_TRIANGLE_STRIP) t.insert(t.end(), {v[i], v[i + 1 + i % 2], v[i + 2 - i % 2]});
+    else t.insert(t.end(), {v[i + 1], v[i + 2], v[0]});
+  }
+  return t;
+}
+
 void add_primitive(Ctx& c, const tinygltf::Primitive& p, const glm::dmat4& world, const std::string& mesh_name) {
   const std::string where = "mesh \"" + mesh_name + "\"";
-  if (p.mode != TINYGLTF_MODE_TRIANGLES && p.mode != -1) {
-    c.warn(where + ": non-triangle primitive skipped");
+  const bool list = p.mode == TINYGLTF_MODE_TRIANGLES || p.mode == -1;
+  if (!list && p.mode != TINYGLTF_MODE_TRIANGLE_STRIP && p.mode != TINYGLTF_MODE_TRIANGLE_FAN) {
+    c.warn(where + ": point or line primitive skipped");
     return;
   }
   std::string why;
@@ -290,6 +303,8 @@ void add_primitive(Ctx& c, const tinygltf::Primitive& p, const glm::dmat4& world
     idx.resize(nv);
     for (std::size_t i = 0; i < nv; ++i) idx[i] = double(i);
   }
+  if (list && idx.size() % 3) c.warn(where + ": index count not a multiple of 3, remainder ignored");
+  idx = triangle_list(p.mode, idx);
   std::uint32_t mat = c.default_material;
   if (p.material >= 0 && std::size_t(p.material) < c.material_map.size()) mat = c.material_map[std::size_t(p.material)];
   else if (p.material >= 0) c.warn(where + ": invalid material index, default material used");
@@ -323,7 +338,6 @@ void add_primitive(Ctx& c, const tinygltf::Primitive& p, const glm::dmat4& world
     c.s.add_triangle(P[0], P[1], P[2], mat, N[0], N[1], N[2], T[0], T[1], T[2]);
   }
   if (bad) c.warn(where + ": " + std::to_string(bad) + " triangles with out-of-range indices dropped");
-  if (idx.size() % 3) c.warn(where + ": index count not a multiple of 3, remainder ignored");
 }
 
 void visit(Ctx& c, int node, const glm::dmat4& parent, std::vector<int>& path) {

@@ -142,6 +142,40 @@ TEST(Scene, GltfDoubleSidedIsReadAndDefaultsToFalse) {
   std::filesystem::remove_all(dir);
 }
 
+// Triangle strips and fans (glTF 2.0 §3.7.2.1) become triangle lists with each triangle's
+// winding kept: the glTF Asset Generator's Mesh_PrimitiveMode models (Debian's
+// assimp-testmodels) draw the same square as a list (06; 13 and 14 indexed), a strip (04; 11
+// indexed) and a fan (05; 12 indexed); point and line primitives (00-03, 07-10) have none.
+TEST(Scene, GltfStripsAndFansAreTheListsTriangles) {
+  const std::filesystem::path dir = "/usr/share/assimp/models/glTF2/glTF-Asset-Generator/Mesh_PrimitiveMode";
+  ASSERT_TRUE(std::filesystem::is_directory(dir)) << "install Debian's assimp-testmodels (./x deps)";
+  const auto load = [&](const char* n) { return fr::load_scene((dir / ("Mesh_PrimitiveMode_" + std::string(n) + ".gltf")).string()); };
+  // Area and facing: twice the area vector of each triangle, summed.
+  const auto area = [](const fr::Scene& s) {
+    glm::dvec3 a(0);
+    for (std::size_t t = 0; t < s.triangle_count(); ++t) {
+      const glm::dvec3 p0 = s.positions[3 * t], p1 = s.positions[3 * t + 1], p2 = s.positions[3 * t + 2];
+      a += glm::cross(p1 - p0, p2 - p0);
+    }
+    return a;
+  };
+  const fr::Scene list = load("06");
+  ASSERT_EQ(list.triangle_count(), 2u);
+  const glm::dvec3 expected = area(list);
+  ASSERT_GT(glm::length(expected), 0.0);
+  for (const char* n : {"04", "05", "11", "12", "13", "14"}) {
+    const fr::Scene s = load(n);
+    ASSERT_EQ(s.triangle_count(), 2u) << n;
+    EXPECT_NEAR(glm::length(area(s) - expected), 0.0, 1e-6) << n;
+    for (std::size_t t = 0; t < 2; ++t) {  // each triangle faces as the list's do
+      const glm::dvec3 p0 = s.positions[3 * t], p1 = s.positions[3 * t + 1], p2 = s.positions[3 * t + 2];
+      EXPECT_GT(glm::dot(glm::cross(p1 - p0, p2 - p0), expected), 0.0) << n << ", triangle " << t;
+    }
+  }
+  for (const char* n : {"00", "01", "02", "03", "07", "08", "09", "10"})
+    EXPECT_THROW(load(n), fovea::core::InputError) << n;
+}
+
 TEST(Scene, UnknownNameIsAnInputError) {
   EXPECT_THROW(fr::load_scene("no-such-scene"), fovea::core::InputError);
   EXPECT_THROW(fr::load_scene("/nonexistent/x.gltf"), fovea::core::InputError);
