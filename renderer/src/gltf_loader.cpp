@@ -4,6 +4,7 @@
 // through a size budget, and everything it hands back is treated as untrusted: every
 // index, offset, stride and count is checked here before use.
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <cstring>
 #include <filesystem>
@@ -21,6 +22,7 @@
 
 #include "fovea/core/error.hpp"
 #include "fovea/core/input_limits.hpp"
+#include "fovea/core/json.hpp"
 #include "fovea/renderer/scene_io.hpp"
 #include "texture_decode.hpp"
 
@@ -475,6 +477,34 @@ std::string_view glb_json(std::string_view bytes) {
   return bytes.substr(20, std::min<std::size_t>(len, bytes.size() - 20));
 }
 
+// The glTF extensions this loader reads; an asset that requires another is refused (glTF 2.0
+// §3.12). KHR_mesh_quantization allows integer attributes, which read_component reads.
+constexpr std::array<std::string_view, 2> kReadExtensions = {"KHR_materials_emissive_strength",
+                                                             "KHR_mesh_quantization"};
+
+void check_required(const std::vector<std::string>& required, const std::string& origin) {
+  std::string missing;
+  for (const std::string& e : required)
+    if (std::find(kReadExtensions.begin(), kReadExtensions.end(), e) == kReadExtensions.end())
+      missing += (missing.empty() ? "" : ", ") + e;
+  if (!missing.empty())
+    throw core::InputError(origin + ": requires the glTF extension(s) " + missing + ", which fovea does not read");
+}
+
+// The asset's extensionsRequired from its JSON text, when the parser could not load it (a
+// compressed mesh's accessors have no data without their extension); empty when unreadable.
+std::vector<std::string> required_in_text(std::string_view json) {
+  std::vector<std::string> r;
+  try {
+    const nlohmann::json j = core::parse_json(json);
+    if (j.is_object() && j.contains("extensionsRequired") && j["extensionsRequired"].is_array())
+      for (const auto& e : j["extensionsRequired"])
+        if (e.is_string()) r.push_back(e.get<std::string>());
+  } catch (const nlohmann::json::exception&) {
+  }
+  return r;
+}
+
 Scene load(std::string_view bytes, bool binary, const std::string& origin, const std::string& base_dir,
            const SceneLimits& limits) {
   if (bytes.size() > limits.max_file_bytes || bytes.size() > std::numeric_limits<unsigned>::max())
@@ -495,7 +525,11 @@ Scene load(std::string_view bytes, bool binary, const std::string& origin, const
   } catch (const std::exception& e) {  // e.g. JSON type errors thrown from inside the parser
     err = e.what();
   }
-  if (!ok) throw core::InputError(origin + ": not a valid glTF 2.0 file: " + first_line(err.empty() ? warn : err));
+  if (!ok) {
+    check_required(required_in_text(binary ? glb_json(bytes) : bytes), origin);
+    throw core::InputError(origin + ": not a valid glTF 2.0 file: " + first_line(err.empty() ? warn : err));
+  }
+  check_required(m.extensionsRequired, origin);
   Scene s = from_model(m, images, origin, limits);
   collect_warnings(s, origin, warn);
   return s;
