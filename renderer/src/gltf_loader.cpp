@@ -6,6 +6,7 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <cstdio>
 #include <cstring>
 #include <filesystem>
 #include <limits>
@@ -491,6 +492,24 @@ void check_required(const std::vector<std::string>& required, const std::string&
     throw core::InputError(origin + ": requires the glTF extension(s) " + missing + ", which fovea does not read");
 }
 
+// The asset's version (glTF 2.0 §3.2's note): with a minVersion, both its major and minor
+// version must be readable, here 2.0; otherwise the major version must be 2 (2.x assets are
+// backward compatible with 2.0 readers).
+void check_version(const tinygltf::Asset& a, const std::string& origin) {
+  const auto parse = [](const std::string& v, int& major, int& minor) {
+    char tail = 0;
+    return std::sscanf(v.c_str(), "%d.%d%c", &major, &minor, &tail) == 2 && major >= 0 && minor >= 0;
+  };
+  int major = 0, minor = 0;
+  if (!a.minVersion.empty()) {
+    if (!parse(a.minVersion, major, minor) || major != 2 || minor > 0)
+      throw core::InputError(origin + ": needs a reader of glTF " + a.minVersion +
+                             " (asset.minVersion); fovea reads glTF 2.0");
+  } else if (!parse(a.version, major, minor) || major != 2) {
+    throw core::InputError(origin + ": glTF version \"" + a.version + "\" (asset.version); fovea reads glTF 2.x");
+  }
+}
+
 // The asset's extensionsRequired from its JSON text, when the parser could not load it (a
 // compressed mesh's accessors have no data without their extension); empty when unreadable.
 std::vector<std::string> required_in_text(std::string_view json) {
@@ -529,6 +548,7 @@ Scene load(std::string_view bytes, bool binary, const std::string& origin, const
     check_required(required_in_text(binary ? glb_json(bytes) : bytes), origin);
     throw core::InputError(origin + ": not a valid glTF 2.0 file: " + first_line(err.empty() ? warn : err));
   }
+  check_version(m.asset, origin);
   check_required(m.extensionsRequired, origin);
   Scene s = from_model(m, images, origin, limits);
   collect_warnings(s, origin, warn);

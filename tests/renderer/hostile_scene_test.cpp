@@ -3,6 +3,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <cstdint>
 #include <cstring>
 #include <filesystem>
 #include <fstream>
@@ -202,6 +203,57 @@ std::string refusal(const std::string& path, const fr::SceneLimits& limits = {})
     return e.what();
   }
   return "accepted";
+}
+
+namespace {
+
+// A one-triangle glTF in `dir`: 16-bit integer positions (0,0,0), (100,0,0), (0,100,0) under a
+// node scaled by 0.01, with the given asset object and required extensions (JSON array items).
+std::string integer_triangle(const fs::path& dir, const std::string& asset, const std::string& required) {
+  const std::int16_t pos[10] = {0, 0, 0, 100, 0, 0, 0, 100, 0, 0};  // three SHORT VEC3, padded to 4 bytes
+  std::ofstream(dir / "q.bin", std::ios::binary).write(reinterpret_cast<const char*>(pos), sizeof(pos));
+  std::ofstream(dir / "q.gltf") << R"({"asset": )" + asset + R"(, "scene": 0, "scenes": [{"nodes": [0]}],
+    "extensionsUsed": [)" + required + R"(], "extensionsRequired": [)" + required + R"(],
+    "nodes": [{"mesh": 0, "scale": [0.01, 0.01, 0.01]}],
+    "meshes": [{"primitives": [{"attributes": {"POSITION": 0}}]}],
+    "buffers": [{"uri": "q.bin", "byteLength": 20}],
+    "bufferViews": [{"buffer": 0, "byteLength": 20}],
+    "accessors": [{"bufferView": 0, "componentType": 5122, "count": 3, "type": "VEC3",
+                   "min": [0, 0, 0], "max": [100, 100, 0]}]})";
+  return (dir / "q.gltf").string();
+}
+
+}  // namespace
+
+// extensionsRequired (glTF 2.0 §3.12): an asset that requires an extension this loader does
+// not read is refused, naming it, also when the parser cannot load the file without it (a
+// Draco-compressed mesh); KHR_mesh_quantization is read: 16-bit integer positions.
+TEST_F(Hostile, GltfRequiredExtensionsAreReadOrRefusedByName) {
+  const fr::Scene s = fr::load_scene(integer_triangle(dir, R"({"version": "2.0"})", R"("KHR_mesh_quantization")"));
+  ASSERT_EQ(s.triangle_count(), 1u);
+  EXPECT_NEAR(glm::length(s.positions[1] - glm::vec3(1, 0, 0)), 0.0f, 1e-6f);
+  EXPECT_NEAR(glm::length(s.positions[2] - glm::vec3(0, 1, 0)), 0.0f, 1e-6f);
+  EXPECT_NE(refusal(integer_triangle(dir, R"({"version": "2.0"})", R"("KHR_mesh_quantization", "EXT_not_read_here")"))
+                .find("requires the glTF extension(s) EXT_not_read_here"),
+            std::string::npos);
+  const std::string draco = "/usr/share/assimp/models/glTF2/draco/2CylinderEngine.gltf";
+  if (fs::exists(draco)) {
+    EXPECT_NE(refusal(draco).find("KHR_draco_mesh_compression"), std::string::npos);
+  }
+}
+
+// The asset's version (glTF 2.0 §3.2): a 2.x asset loads (minor versions are backward
+// compatible), one that needs a 2.1 reader (minVersion) or has another major version does not.
+TEST_F(Hostile, GltfVersionsAreCheckedAsTheSpecificationSays) {
+  const auto with = [&](const std::string& asset) {
+    return refusal(integer_triangle(dir, asset, R"("KHR_mesh_quantization")"));
+  };
+  EXPECT_EQ(with(R"({"version": "2.1"})"), "accepted");
+  EXPECT_EQ(with(R"({"version": "2.1", "minVersion": "2.0"})"), "accepted");
+  EXPECT_NE(with(R"({"version": "2.1", "minVersion": "2.1"})").find("needs a reader of glTF 2.1"), std::string::npos);
+  EXPECT_NE(with(R"({"version": "3.0"})").find("glTF version \"3.0\""), std::string::npos);
+  EXPECT_NE(with(R"({"version": "1.0"})").find("glTF version \"1.0\""), std::string::npos);
+  EXPECT_NE(with(R"({"version": "two"})").find("glTF version \"two\""), std::string::npos);
 }
 
 // A binary PPM (stb_image decodes PNM): the smallest image to put in a data URI.
