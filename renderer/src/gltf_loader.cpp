@@ -91,50 +91,78 @@ double read_component(const unsigned char* p, int ct, bool normalized) {
   }
 }
 
-// Reads accessor `index` as `comps` doubles per element. Returns false (with `why`) for
-// anything out of range: indices, offsets, strides, counts, types, sparse storage.
+// Reads `count` elements of `nc` components of type `ct` from buffer view `view` at
+// `offset`: false (with `why`, naming `what`) for anything outside the view or its buffer.
+bool read_view(const Model& m, int view, std::size_t offset, std::size_t count, int nc, int ct, bool normalized,
+               const std::string& what, std::vector<double>& out, std::string& why) {
+  if (view < 0 || std::size_t(view) >= m.bufferViews.size()) {
+    why = what + " references a missing bufferView";
+    return false;
+  }
+  const auto& bv = m.bufferViews[std::size_t(view)];
+  if (bv.buffer < 0 || std::size_t(bv.buffer) >= m.buffers.size()) {
+    why = "bufferView " + std::to_string(view) + " references a missing buffer";
+    return false;
+  }
+  const auto& buf = m.buffers[std::size_t(bv.buffer)].data;
+  const std::size_t cs = std::size_t(component_size(ct)), elem = std::size_t(nc) * cs;
+  const std::size_t stride = bv.byteStride ? bv.byteStride : elem;
+  // All arithmetic checked against the buffer size without overflow.
+  const std::size_t view_off = bv.byteOffset, view_len = bv.byteLength;
+  if (stride < elem || stride > 252 || view_off > buf.size() || view_len > buf.size() - view_off ||
+      offset > view_len || count > (std::size_t(1) << 31) ||
+      (count > 0 && ((count - 1) > (view_len - offset) / stride || (count - 1) * stride + elem > view_len - offset))) {
+    why = what + " lies outside its buffer";
+    return false;
+  }
+  out.resize(count * std::size_t(nc));
+  const unsigned char* base = buf.data() + view_off + offset;
+  for (std::size_t i = 0; i < count; ++i)
+    for (int c = 0; c < nc; ++c)
+      out[i * nc + c] = read_component(base + i * stride + std::size_t(c) * cs, ct, normalized);
+  return true;
+}
+
+// Reads accessor `index` as `comps` doubles per element, with its sparse substitutions
+// (glTF 2.0 §3.6.2.3: the dense values, or zeros without a bufferView, then `sparse.count`
+// values at their indices). Returns false (with `why`) for anything out of range: indices,
+// offsets, strides, counts, types.
 bool read_accessor(const Model& m, int index, int comps, std::vector<double>& out, std::string& why) {
   if (index < 0 || std::size_t(index) >= m.accessors.size()) {
     why = "accessor index " + std::to_string(index) + " out of range";
     return false;
   }
   const auto& a = m.accessors[std::size_t(index)];
-  if (a.sparse.isSparse) { why = "sparse accessors are not supported"; return false; }
-  const int nc = component_count(a.type), cs = component_size(a.componentType);
-  if (nc != comps || cs == 0) { why = "accessor " + std::to_string(index) + " has an unexpected type"; return false; }
-  if (a.bufferView < 0 || std::size_t(a.bufferView) >= m.bufferViews.size()) {
-    why = "accessor " + std::to_string(index) + " references a missing bufferView";
-    return false;
-  }
-  const auto& bv = m.bufferViews[std::size_t(a.bufferView)];
-  if (bv.buffer < 0 || std::size_t(bv.buffer) >= m.buffers.size()) {
-    why = "bufferView " + std::to_string(a.bufferView) + " references a missing buffer";
-    return false;
-  }
-  const auto& buf = m.buffers[std::size_t(bv.buffer)].data;
-  const std::size_t elem = std::size_t(nc) * std::size_t(cs);
-  const std::size_t stride = bv.byteStride ? bv.byteStride : elem;
+  const std::string what = "accessor " + std::to_string(index);
+  const int nc = component_count(a.type);
+  if (nc != comps || component_size(a.componentType) == 0) { why = what + " has an unexpected type"; return false; }
   const std::size_t count = a.count;
-  // All arithmetic checked against the buffer size without overflow.
-  const std::size_t view_off = bv.byteOffset, view_len = bv.byteLength, acc_off = a.byteOffset;
-  if (stride < elem || stride > 252 || view_off > buf.size() || view_len > buf.size() - view_off ||
-      acc_off > view_len || count > (std::size_t(1) << 31)) {
-    why = "accessor " + std::to_string(index) + " lies outside its buffer";
+  if (!a.sparse.isSparse || a.bufferView >= 0) {
+    if (!read_view(m, a.bufferView, a.byteOffset, count, nc, a.componentType, a.normalized, what, out, why))
+      return false;
+  } else {
+    if (count > (std::size_t(1) << 31)) { why = what + " lies outside its buffer"; return false; }
+    out.assign(count * std::size_t(nc), 0.0);
+  }
+  if (!a.sparse.isSparse) return true;
+  const auto& sp = a.sparse;
+  const int it = sp.indices.componentType;
+  if (sp.count < 1 || std::size_t(sp.count) > count ||
+      !(it == TINYGLTF_COMPONENT_TYPE_UNSIGNED_BYTE || it == TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT ||
+        it == TINYGLTF_COMPONENT_TYPE_UNSIGNED_INT)) {
+    why = what + " has a sparse count or index type out of range";
     return false;
   }
-  if (count > 0 && (count - 1) > (view_len - acc_off) / stride) {
-    why = "accessor " + std::to_string(index) + " lies outside its buffer";
+  std::vector<double> at, values;
+  if (!read_view(m, sp.indices.bufferView, std::size_t(std::max(sp.indices.byteOffset, 0)), std::size_t(sp.count), 1,
+                 it, false, what + "'s sparse indices", at, why) ||
+      !read_view(m, sp.values.bufferView, std::size_t(std::max(sp.values.byteOffset, 0)), std::size_t(sp.count), nc,
+                 a.componentType, a.normalized, what + "'s sparse values", values, why))
     return false;
+  for (std::size_t k = 0; k < at.size(); ++k) {
+    if (!(at[k] < double(count))) { why = what + " has a sparse index out of range"; return false; }
+    for (int c = 0; c < nc; ++c) out[std::size_t(at[k]) * nc + c] = values[k * nc + c];
   }
-  if (count > 0 && (count - 1) * stride + elem > view_len - acc_off) {
-    why = "accessor " + std::to_string(index) + " lies outside its buffer";
-    return false;
-  }
-  out.resize(count * std::size_t(nc));
-  const unsigned char* base = buf.data() + view_off + acc_off;
-  for (std::size_t i = 0; i < count; ++i)
-    for (int c = 0; c < nc; ++c)
-      out[i * nc + c] = read_component(base + i * stride + std::size_t(c) * cs, a.componentType, a.normalized);
   return true;
 }
 

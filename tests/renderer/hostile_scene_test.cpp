@@ -274,6 +274,40 @@ json textured(const json& image) {
   return j;
 }
 
+// Sparse accessors (glTF 2.0 §3.6.2.3): values substituted at their indices, over the dense
+// values or over zeros without a bufferView; an index past the accessor's count drops the
+// primitive with a warning.
+TEST_F(Hostile, SparseAccessorsSubstituteTheirValues) {
+  const auto with_sparse = [](json j, const std::vector<std::uint8_t>& at, const std::vector<float>& values) {
+    std::vector<std::uint8_t> bytes(4 + values.size() * 4, 0);  // the indices, padded to 4 bytes; the values
+    std::memcpy(bytes.data(), at.data(), at.size());
+    std::memcpy(bytes.data() + 4, values.data(), values.size() * 4);
+    j["buffers"].push_back({{"byteLength", bytes.size()}, {"uri", "data:application/octet-stream;base64," + base64(bytes)}});
+    j["bufferViews"].push_back({{"buffer", 1}, {"byteOffset", 0}, {"byteLength", at.size()}});
+    j["bufferViews"].push_back({{"buffer", 1}, {"byteOffset", 4}, {"byteLength", values.size() * 4}});
+    j["accessors"][0]["sparse"] = {{"count", at.size()},
+                                   {"indices", {{"bufferView", 2}, {"componentType", 5121}}},
+                                   {"values", {{"bufferView", 3}}}};
+    return j;
+  };
+  const std::vector<std::uint32_t> idx = {0, 1, 2, 1, 3, 2};
+  const fr::Scene dense = fr::load_scene(write("dense.gltf", make_gltf(kTwoTris, idx)));
+  ASSERT_EQ(dense.triangle_count(), 2u);
+  // Over the dense values: vertex 3 moves from (1, 1, 0) to (2, 2, 0).
+  const fr::Scene moved = fr::load_scene(write("moved.gltf", with_sparse(make_gltf(kTwoTris, idx), {3}, {2, 2, 0})));
+  ASSERT_EQ(moved.triangle_count(), 2u);
+  EXPECT_EQ(moved.positions[4], glm::vec3(2, 2, 0));
+  EXPECT_EQ(moved.positions[0], dense.positions[0]);
+  // Over zeros: the same square as the dense accessor.
+  json zeros = with_sparse(make_gltf(kTwoTris, idx), {1, 2, 3}, {1, 0, 0, 0, 1, 0, 1, 1, 0});
+  zeros["accessors"][0].erase("bufferView");
+  const fr::Scene from_zeros = fr::load_scene(write("zeros.gltf", zeros));
+  EXPECT_EQ(from_zeros.positions, dense.positions);
+  // An index past the count: the primitive is dropped, and with it the only one.
+  EXPECT_NE(refusal(write("past.gltf", with_sparse(make_gltf(kTwoTris, idx), {7}, {2, 2, 0}))).find("no renderable"),
+            std::string::npos);
+}
+
 TEST_F(Hostile, ImageBufferViewPastItsBufferIsNotDecoded) {
   json j = textured({{"bufferView", 2}, {"mimeType", "image/png"}});
   j["bufferViews"].push_back({{"buffer", 0}, {"byteOffset", 40}, {"byteLength", 1000000}});
