@@ -614,6 +614,18 @@ class TobiiG3Reader final : public ReaderBase {
 // to the first END line with RES (at most kEyelinkScanBytes); nullopt without either.
 constexpr std::uint64_t kEyelinkScanBytes = 64ull << 20;
 
+// The size in pixels of a DISPLAY_COORDS / GAZE_COORDS rectangle (left top right bottom,
+// inclusive) in f[first..first + 3]; false unless four numbers of a rectangle.
+bool eyelink_rect(const std::vector<std::string_view>& f, std::size_t first, double& w, double& h) {
+  double c[4];
+  if (f.size() < first + 4) return false;
+  for (int i = 0; i < 4; ++i)
+    if (detail::parse_double(f[first + std::size_t(i)], c[i]) != Num::Ok) return false;
+  if (!(c[2] > c[0] && c[3] > c[1] && c[2] - c[0] < 1e6 && c[3] - c[1] < 1e6)) return false;
+  w = c[2] - c[0] + 1, h = c[3] - c[1] + 1;
+  return true;
+}
+
 std::optional<core::View> eyelink_screen(const std::string& path) {
   detail::LineReader lines(path);
   detail::Line l;
@@ -625,22 +637,19 @@ std::optional<core::View> eyelink_screen(const std::string& path) {
     detail::split_blank(l.text, f);
     if (f.empty() || !(f[0] == "MSG" || f[0] == "END" || f[0] == "DISPLAY_COORDS" || f[0] == "GAZE_COORDS")) continue;
     const auto at = [&](std::string_view word) { return std::find(f.begin(), f.end(), word); };
-    for (const std::string_view key : {"DISPLAY_COORDS", "GAZE_COORDS"}) {
+    for (const std::string_view key : {"DISPLAY_COORDS", "GAZE_COORDS"}) {  // GAZE_COORDS when no DISPLAY_COORDS
       const auto k = at(key);
-      double c[4];
-      if (k == f.end() || f.end() - k < 5 || (display && key == "GAZE_COORDS")) continue;
-      bool ok = true;
-      for (int i = 0; i < 4; ++i) ok = ok && detail::parse_double(k[1 + i], c[i]) == Num::Ok;
-      if (ok && c[2] > c[0] && c[3] > c[1] && c[2] - c[0] < 1e5 && c[3] - c[1] < 1e5) {
-        w = std::round(c[2] - c[0] + 1), h = std::round(c[3] - c[1] + 1);
-        display = display || key == "DISPLAY_COORDS";
-      }
+      if (k == f.end() || (display && key == "GAZE_COORDS") ||
+          !eyelink_rect(f, std::size_t(k - f.begin()) + 1, w, h))
+        continue;
+      display = display || key == "DISPLAY_COORDS";
     }
     const auto r = at("RES");
     double rx = 0, ry = 0;
     if (f[0] == "END" && r != f.end() && f.end() - r >= 3 && detail::parse_double(r[1], rx) == Num::Ok &&
         detail::parse_double(r[2], ry) == Num::Ok && rx > 0 && ry > 0 && rx < 1e4 && ry < 1e4) {
       if (!(w > 0)) return std::nullopt;
+      w = std::round(w), h = std::round(h);
       const double hx = std::atan(w / 2 / (rx / kDeg)) / kDeg, hy = std::atan(h / 2 / (ry / kDeg)) / kDeg;
       return core::View(core::Fov::from_degrees(-hx, hx, hy, -hy), int(w), int(h));
     }
@@ -778,16 +787,8 @@ class EyelinkReader final : public ReaderBase {
   // only when the file has no DISPLAY_COORDS.
   void coords(Coords kind, std::size_t first) {
     if (kind < coords_ || fields_.size() < first + 4) return;
-    double x0 = 0, y0 = 0, x1 = 0, y1 = 0;
-    if (detail::parse_double(fields_[first], x0) == Num::Ok && detail::parse_double(fields_[first + 1], y0) == Num::Ok &&
-        detail::parse_double(fields_[first + 2], x1) == Num::Ok && detail::parse_double(fields_[first + 3], y1) == Num::Ok &&
-        x1 > x0 && y1 > y0 && x1 - x0 < 1e6 && y1 - y0 < 1e6) {
-      disp_w_ = x1 - x0 + 1;
-      disp_h_ = y1 - y0 + 1;
-      coords_ = kind;
-    } else {
-      drop("bad_value");
-    }
+    if (eyelink_rect(fields_, first, disp_w_, disp_h_)) coords_ = kind;
+    else drop("bad_value");
   }
   EyelinkReader(const std::string& path, const SourceOptions& opt, const std::optional<core::View>& own)
       : ReaderBase(path, opt, Format::EyelinkAsc, own.value_or(opt.screen_view())),
