@@ -232,7 +232,8 @@ TEST(EyelinkAsc, WithoutAScreenTheFileGivesItsOwn) {
                            "SAMPLES\tGAZE\tRIGHT\tRATE\t500.00\tTRACKING\tCR\tFILTER\t2\n"
                            "1000\t  512.0\t  384.0\t  800.0\t...\n"
                            "1002\t  " + right10 + "\t  384.0\t  800.0\t...\n";
-  const std::string with_res = write_text("res.asc", "** x\n" + body + "END\t1004 \tSAMPLES\tEVENTS\tRES\t 35.90\t 35.90\n");
+  const std::string with_res =
+      write_text("res.asc", "** x\n" + body + "END\t1004 \tSAMPLES\tEVENTS\tRES\t 35.90\t 35.90\n");
   auto r = open_reader(with_res, SourceOptions{});
   auto v = read_all(*r);
   ASSERT_EQ(v.size(), 2u);
@@ -241,13 +242,12 @@ TEST(EyelinkAsc, WithoutAScreenTheFileGivesItsOwn) {
   EXPECT_NEAR(az(v[1].combined.dir), 10, 1e-3);
   ASSERT_EQ(r->stats().notes.size(), 1u);
   EXPECT_NE(r->stats().notes[0].find("1024x768 px, 28.0 x 21.1 degrees"), std::string::npos) << r->stats().notes[0];
-  // A given screen wins (60° over 1920 pixels: the centre sample is no longer straight ahead).
+  // A given screen wins: the same pixel through its 60° (the place across the raster, -1..1).
   auto given = open_reader(with_res, symmetric_screen(1920, 1080, 60, 40));
   v = read_all(*given);
   ASSERT_EQ(v.size(), 2u);
-  EXPECT_NEAR(az(v[1].combined.dir), std::atan((512 + d * std::tan(10 * M_PI / 180)) / 1024 * 1920 / 960 *
-                                                   std::tan(30 * M_PI / 180) - std::tan(30 * M_PI / 180)) * 180 / M_PI,
-              1e-3);
+  const double across = (512 + d * std::tan(10 * M_PI / 180)) / 512 - 1;
+  EXPECT_NEAR(az(v[1].combined.dir), std::atan(across * std::tan(30 * M_PI / 180)) * 180 / M_PI, 1e-3);
   EXPECT_TRUE(given->stats().notes.empty());
   // No RES: the display's view, as for every 2D format.
   auto none = open_reader(write_text("nores.asc", "** x\n" + body), SourceOptions{});

@@ -282,7 +282,8 @@ TEST_F(Hostile, SparseAccessorsSubstituteTheirValues) {
     std::vector<std::uint8_t> bytes(4 + values.size() * 4, 0);  // the indices, padded to 4 bytes; the values
     std::memcpy(bytes.data(), at.data(), at.size());
     std::memcpy(bytes.data() + 4, values.data(), values.size() * 4);
-    j["buffers"].push_back({{"byteLength", bytes.size()}, {"uri", "data:application/octet-stream;base64," + base64(bytes)}});
+    j["buffers"].push_back(
+        {{"byteLength", bytes.size()}, {"uri", "data:application/octet-stream;base64," + base64(bytes)}});
     j["bufferViews"].push_back({{"buffer", 1}, {"byteOffset", 0}, {"byteLength", at.size()}});
     j["bufferViews"].push_back({{"buffer", 1}, {"byteOffset", 4}, {"byteLength", values.size() * 4}});
     j["accessors"][0]["sparse"] = {{"count", at.size()},

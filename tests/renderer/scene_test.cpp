@@ -149,7 +149,9 @@ TEST(Scene, GltfDoubleSidedIsReadAndDefaultsToFalse) {
 TEST(Scene, GltfStripsAndFansAreTheListsTriangles) {
   const std::filesystem::path dir = "/usr/share/assimp/models/glTF2/glTF-Asset-Generator/Mesh_PrimitiveMode";
   ASSERT_TRUE(std::filesystem::is_directory(dir)) << "install Debian's assimp-testmodels (./x deps)";
-  const auto load = [&](const char* n) { return fr::load_scene((dir / ("Mesh_PrimitiveMode_" + std::string(n) + ".gltf")).string()); };
+  const auto load = [&](const char* n) {
+    return fr::load_scene((dir / ("Mesh_PrimitiveMode_" + std::string(n) + ".gltf")).string());
+  };
   // Area and facing: twice the area vector of each triangle, summed.
   const auto area = [](const fr::Scene& s) {
     glm::dvec3 a(0);
