@@ -12,6 +12,7 @@
 #include <limits>
 #include <set>
 #include <span>
+#include <utility>
 
 #include <glm/geometric.hpp>
 #include <glm/gtc/matrix_transform.hpp>
@@ -291,7 +292,7 @@ glm::dmat4 local_transform(const tinygltf::Node& n) {
 
 // A triangle strip's or fan's vertex list as a triangle list, keeping each triangle's winding
 // (glTF 2.0 §3.7.2.1: strip p_i = {v_i, v_{i+1+i%2}, v_{i+2-i%2}}, fan p_i = {v_{i+1}, v_{i+2}, v_0}).
-std::vector<double> triangle_list(int mode, const std::vector<double>& v) {
+std::vector<double> triangle_list(int mode, std::vector<double> v) {
   if (mode != TINYGLTF_MODE_TRIANGLE_STRIP && mode != TINYGLTF_MODE_TRIANGLE_FAN) return v;
   std::vector<double> t;
   for (std::size_t i = 0; i + 2 < v.size(); ++i) {
@@ -335,7 +336,7 @@ void add_primitive(Ctx& c, const tinygltf::Primitive& p, const glm::dmat4& world
     for (std::size_t i = 0; i < nv; ++i) idx[i] = double(i);
   }
   if (list && idx.size() % 3) c.warn(where + ": index count not a multiple of 3, remainder ignored");
-  idx = triangle_list(p.mode, idx);
+  idx = triangle_list(p.mode, std::move(idx));
   std::uint32_t mat = c.default_material;
   if (p.material >= 0 && std::size_t(p.material) < c.material_map.size()) mat = c.material_map[std::size_t(p.material)];
   else if (p.material >= 0) c.warn(where + ": invalid material index, default material used");
